@@ -1,0 +1,226 @@
+//! CIC decimator: 4 integrators at the clock rate, 4 combs at f_clk / R.
+//!
+//! ```text
+//!  x[32] ─► ∫ ─► ∫ ─► ∫ ─► ∫ ──► ↓R ──► Δ ─► Δ ─► Δ ─► Δ ──► round(· 2^8 / 2^shift) ──► y[40]
+//!           80-bit registers, wrap-around   (one comb per clock after the strobe)   valid
+//! ```
+//!
+//! Hogenauer's CIC with N = 4 stages and differential delay M = 1. Gain
+//! R^N, so the registers need B_in + N log2(R_max) = 32 + 4 * 12 = 80 bits
+//! for decimation R up to R_max = 4096; the integrators wrap around (two's
+//! complement), which the combs undo exactly as long as the true output
+//! fits 80 bits, which the width guarantees. All stages keep the full 80
+//! bits (no pruning), so the only rounding is at the output.
+//!
+//! Output scaling: y = round(comb / 2^shift), rounded half up, low 40 bits.
+//! With shift = ceil(N log2 R) - 8 the output is the input's average times
+//! 2^8 times the residual gain G = R^N / 2^ceil(N log2 R), which lies in
+//! (1/2, 1] and is exactly 1 when R is a power of two. The 8 extra bits
+//! keep the resolution gained by averaging; the IIR filter after the CIC
+//! folds 1/G into its numerator (`crate::filter_design`), so z has unity
+//! gain. |x| < 2^31 gives |y| < 2^39: 40 bits, no overflow.
+//!
+//! Run-time settings: `decimation` R in 1..=4096 (a 13-bit word; the down
+//! counter reloads R - 1 at each output, so a new R acts from the next
+//! output on), `shift` in 0..=40. Timing: the integrators take x during
+//! cycle n at the next edge; when the counter reaches 0 the fourth
+//! integrator is sampled, the four combs follow on the next four clocks and
+//! `y` and a one-clock `valid` pulse appear 6 clocks after the sampling
+//! cycle. Power-up: all registers 0, the first output after R clocks.
+
+use crate::primitives::convert::signed_bit_cast_exact;
+use rust_hdl::prelude::*;
+
+/// Number of integrator and comb stages.
+pub const STAGES: u32 = 4;
+/// Width of the input word.
+pub const INPUT_BITS: usize = 32;
+/// Largest decimation: 2^12.
+pub const MAX_DECIMATION: u32 = 4096;
+/// Hogenauer register width: 32 + 4 * 12.
+pub const REGISTER_BITS: usize = 80;
+/// Width of the output word.
+pub const OUTPUT_BITS: usize = 40;
+/// Fractional bits kept at the output (y = average * 2^8 * G).
+pub const OUTPUT_FRACTION_BITS: u32 = 8;
+
+/// Four-stage CIC decimator with run-time rate and output shift.
+#[derive(LogicBlock)]
+pub struct CicDecimator {
+    /// The clock.
+    pub clock: Signal<In, Clock>,
+    /// Input sample, one per clock.
+    pub x: Signal<In, Signed<32>>,
+    /// Decimation R, 1..=4096.
+    pub decimation: Signal<In, Bits<13>>,
+    /// Output shift: y = round(comb / 2^shift); use ceil(4 log2 R) - 8.
+    pub shift: Signal<In, Bits<6>>,
+    /// Decimated output, updated when `valid` is high.
+    pub y: Signal<Out, Signed<40>>,
+    /// One-clock pulse marking a new `y`.
+    pub valid: Signal<Out, Bit>,
+    x_wide: Signal<Local, Signed<80>>,
+    integrator1: DFF<Signed<80>>,
+    integrator2: DFF<Signed<80>>,
+    integrator3: DFF<Signed<80>>,
+    integrator4: DFF<Signed<80>>,
+    count: DFF<Bits<13>>,
+    sample: DFF<Signed<80>>,
+    sample_valid: DFF<Bit>,
+    comb1: DFF<Signed<80>>,
+    comb2: DFF<Signed<80>>,
+    comb3: DFF<Signed<80>>,
+    comb4: DFF<Signed<80>>,
+    comb_delay1: DFF<Signed<80>>,
+    comb_delay2: DFF<Signed<80>>,
+    comb_delay3: DFF<Signed<80>>,
+    comb_delay4: DFF<Signed<80>>,
+    comb_valid1: DFF<Bit>,
+    comb_valid2: DFF<Bit>,
+    comb_valid3: DFF<Bit>,
+    comb_valid4: DFF<Bit>,
+    rounding: Signal<Local, Bits<80>>,
+    biased: Signal<Local, Signed<80>>,
+    biased_bits: Signal<Local, Bits<80>>,
+    sign_mask: Signal<Local, Bits<80>>,
+    shifted: Signal<Local, Bits<80>>,
+    y_out: DFF<Signed<40>>,
+    valid_out: DFF<Bit>,
+    one: Constant<Bits<80>>,
+    all_ones: Constant<Bits<80>>,
+}
+
+impl CicDecimator {
+    /// A CIC decimator with all registers at zero.
+    pub fn new() -> Self {
+        Self {
+            clock: Default::default(),
+            x: Default::default(),
+            decimation: Default::default(),
+            shift: Default::default(),
+            y: Default::default(),
+            valid: Default::default(),
+            x_wide: Default::default(),
+            integrator1: Default::default(),
+            integrator2: Default::default(),
+            integrator3: Default::default(),
+            integrator4: Default::default(),
+            count: Default::default(),
+            sample: Default::default(),
+            sample_valid: Default::default(),
+            comb1: Default::default(),
+            comb2: Default::default(),
+            comb3: Default::default(),
+            comb4: Default::default(),
+            comb_delay1: Default::default(),
+            comb_delay2: Default::default(),
+            comb_delay3: Default::default(),
+            comb_delay4: Default::default(),
+            comb_valid1: Default::default(),
+            comb_valid2: Default::default(),
+            comb_valid3: Default::default(),
+            comb_valid4: Default::default(),
+            rounding: Default::default(),
+            biased: Default::default(),
+            biased_bits: Default::default(),
+            sign_mask: Default::default(),
+            shifted: Default::default(),
+            y_out: Default::default(),
+            valid_out: Default::default(),
+            one: Constant::new(1.into()),
+            all_ones: Constant::new(Bits::<80>::mask()),
+        }
+    }
+}
+
+impl Default for CicDecimator {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Logic for CicDecimator {
+    #[hdl_gen]
+    fn update(&mut self) {
+        dff_setup!(
+            self,
+            clock,
+            integrator1,
+            integrator2,
+            integrator3,
+            integrator4,
+            count,
+            sample,
+            sample_valid,
+            comb1,
+            comb2,
+            comb3,
+            comb4,
+            comb_delay1,
+            comb_delay2,
+            comb_delay3,
+            comb_delay4,
+            comb_valid1,
+            comb_valid2,
+            comb_valid3,
+            comb_valid4,
+            y_out,
+            valid_out
+        );
+        // Integrators, wrap-around.
+        self.x_wide.next = signed_bit_cast_exact::<80, 32>(self.x.val());
+        self.integrator1.d.next = self.integrator1.q.val() + self.x_wide.val();
+        self.integrator2.d.next = self.integrator2.q.val() + self.integrator1.q.val();
+        self.integrator3.d.next = self.integrator3.q.val() + self.integrator2.q.val();
+        self.integrator4.d.next = self.integrator4.q.val() + self.integrator3.q.val();
+        // Rate counter and decimation.
+        self.sample_valid.d.next = false;
+        if self.count.q.val() == 0 {
+            self.count.d.next = self.decimation.val() - 1;
+            self.sample.d.next = self.integrator4.q.val();
+            self.sample_valid.d.next = true;
+        } else {
+            self.count.d.next = self.count.q.val() - 1;
+        }
+        // Combs, one per clock after the strobe.
+        self.comb_valid1.d.next = self.sample_valid.q.val();
+        self.comb_valid2.d.next = self.comb_valid1.q.val();
+        self.comb_valid3.d.next = self.comb_valid2.q.val();
+        self.comb_valid4.d.next = self.comb_valid3.q.val();
+        if self.sample_valid.q.val() {
+            self.comb1.d.next = self.sample.q.val() - self.comb_delay1.q.val();
+            self.comb_delay1.d.next = self.sample.q.val();
+        }
+        if self.comb_valid1.q.val() {
+            self.comb2.d.next = self.comb1.q.val() - self.comb_delay2.q.val();
+            self.comb_delay2.d.next = self.comb1.q.val();
+        }
+        if self.comb_valid2.q.val() {
+            self.comb3.d.next = self.comb2.q.val() - self.comb_delay3.q.val();
+            self.comb_delay3.d.next = self.comb2.q.val();
+        }
+        if self.comb_valid3.q.val() {
+            self.comb4.d.next = self.comb3.q.val() - self.comb_delay4.q.val();
+            self.comb_delay4.d.next = self.comb3.q.val();
+        }
+        // Output: arithmetic shift right with round-half-up, as
+        // ((b ^ s) >> shift) ^ s with s the sign mask of b.
+        self.rounding.next = (self.one.val() << self.shift.val()) >> 1;
+        self.biased.next = self.comb4.q.val() + signed_cast(self.rounding.val());
+        self.biased_bits.next = unsigned_cast(self.biased.val());
+        self.sign_mask.next = 0.into();
+        if self.biased_bits.val().get_bit(79) {
+            self.sign_mask.next = self.all_ones.val();
+        }
+        self.shifted.next = ((self.biased_bits.val() ^ self.sign_mask.val()) >> self.shift.val())
+            ^ self.sign_mask.val();
+        self.valid_out.d.next = self.comb_valid4.q.val();
+        if self.comb_valid4.q.val() {
+            self.y_out.d.next = signed_cast(self.shifted.val().get_bits::<40>(0));
+        }
+        self.y.next = self.y_out.q.val();
+        self.valid.next = self.valid_out.q.val();
+    }
+}
+
+crate::impl_clocked!(CicDecimator);

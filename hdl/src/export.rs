@@ -1,0 +1,195 @@
+//! Verilog export of `GyroInterface` and its port description.
+//!
+//! rust-hdl names the top module `top` and every sub-module after its
+//! instance path (`top$carrier_nco$drive`). The export renames them to
+//! `gyro_interface` and `gyro_interface__carrier_nco__drive`, which every
+//! FPGA tool accepts, and puts a header on the file. Nothing else is
+//! touched: the body is rust-hdl's output. `verilog-out/` holds the result;
+//! a test fails when the committed files differ from what this code writes.
+
+use crate::gyro_interface::GyroInterface;
+use regex::Regex;
+use rust_hdl::prelude::{Block, generate_verilog};
+
+/// Name of the top module in the exported Verilog.
+pub const TOP_MODULE: &str = "gyro_interface";
+/// File name of the exported Verilog inside `verilog-out/`.
+pub const VERILOG_FILE: &str = "gyro_interface.v";
+/// File name of the port description inside `verilog-out/`.
+pub const PORTS_FILE: &str = "PORTS.md";
+
+/// Direction of a top-level port.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PortDirection {
+    /// Input port.
+    Input,
+    /// Output port.
+    Output,
+}
+
+/// One port of the top module, as documented in `PORTS.md`.
+#[derive(Clone, Copy, Debug)]
+pub struct Port {
+    /// Port name.
+    pub name: &'static str,
+    /// Direction.
+    pub direction: PortDirection,
+    /// Width in bits.
+    pub bits: usize,
+    /// Two's complement (`signed`) or unsigned.
+    pub signed: bool,
+    /// Number format and range.
+    pub format: &'static str,
+    /// What the port does.
+    pub description: &'static str,
+}
+
+const fn port(
+    name: &'static str,
+    direction: PortDirection,
+    bits: usize,
+    signed: bool,
+    format: &'static str,
+    description: &'static str,
+) -> Port {
+    Port { name, direction, bits, signed, format, description }
+}
+
+use PortDirection::{Input, Output};
+
+/// The ports of `gyro_interface`, in declaration order. A test checks this
+/// table against the generated Verilog.
+pub const PORTS: &[Port] = &[
+    port("clock", Input, 1, false, "clock", "Every register uses its rising edge; one clock domain."),
+    port("adc1", Input, 16, true, "two's complement", "ADC word of gyroscope output 1 (mode 1 pick-off)."),
+    port("adc2", Input, 16, true, "two's complement", "ADC word of gyroscope output 2 (mode 2 pick-off)."),
+    port("dac1", Output, 16, true, "two's complement, |dac1| <= 32767", "Drive 1 = F1 A1 cos(wt), to DAC 1 (mode 1)."),
+    port("dac2", Output, 16, true, "two's complement, |dac2| <= 32767", "Drive 2 = F2 A2 sin(wt), to DAC 2 (mode 2)."),
+    port("z1", Output, 40, true, "two's complement, 8 fractional bits", "Filtered demodulator output 1, in mixer LSBs (adc x reference) times the filter's DC gain."),
+    port("z2", Output, 40, true, "two's complement, 8 fractional bits", "Filtered demodulator output 2, as z1."),
+    port("z_valid", Output, 1, false, "pulse", "High for one clock when z1 and z2 change (rate f_clk / R)."),
+    port("select", Input, 1, false, "0 / 1", "SELECT of paper Fig. 1: 0 readout (A = 1, each output mixed with its own drive), 1 calibration (A = cos/sin, outputs mixed with the other drive)."),
+    port("carrier_step", Input, 32, false, "unsigned", "Carrier phase step: f_carrier = carrier_step * f_clk / 2^32."),
+    port("ref_phase", Input, 32, false, "unsigned, 2^32 = 360 deg", "Phase advance of the demodulation references over the drives; carrier_step / 2 cancels the DAC's half-sample hold delay."),
+    port("ref_delay", Input, 6, false, "0..63", "References are delayed by ref_delay + 1 clocks; set to DAC latency + ADC latency (clocks)."),
+    port("mod_step", Input, 48, false, "unsigned", "Calibration rate: f_cal = mod_step * f_clk / 2^48 (virtual rate 360 f_cal deg/s)."),
+    port("amp1", Input, 16, true, "Q1.15", "Drive amplitude F1; 32767 is full scale. Any value is safe."),
+    port("amp2", Input, 16, true, "Q1.15", "Drive amplitude F2; 32767 is full scale. Any value is safe."),
+    port("cic_decimation", Input, 13, false, "16..4096", "CIC decimation R; z is updated every R clocks."),
+    port("cic_shift", Input, 6, false, "0..40", "CIC output shift, ceil(4 log2 R) - 8."),
+    port("iir_k0", Input, 32, true, "Q2.30", "Biquad numerator gain g (Butterworth b0 times the CIC gain correction)."),
+    port("iir_k1", Input, 32, true, "Q2.30", "Biquad feedback -a1 - 2."),
+    port("iir_k2", Input, 32, true, "Q2.30", "Biquad feedback 1 - a2."),
+    port("iir_alpha", Input, 32, true, "Q2.30", "RC section: 1 - exp(-2 pi f_rc R / f_clk)."),
+];
+
+/// The exported Verilog of `GyroInterface`: rust-hdl's output with the
+/// modules renamed and a header.
+pub fn verilog() -> String {
+    let mut uut = GyroInterface::new();
+    uut.connect_all();
+    let raw = generate_verilog(&uut);
+    let body = rename_modules(&raw);
+    format!(
+        "// {TOP_MODULE}: reconfigurable phase-readout and self-calibration datapath\n\
+         // for MEMS gyroscopes (Shirazi et al., TRANSDUCERS 2013, Fig. 1).\n\
+         //\n\
+         // Generated by `gyrocal export` from the rust-hdl design in hdl/ (gyrocal-hdl\n\
+         // {version}); do not edit. Ports: PORTS.md beside this file. One clock domain,\n\
+         // power-up values from `initial` blocks, no reset.\n\
+         {body}",
+        version = env!("CARGO_PKG_VERSION"),
+        body = body.trim_end_matches('\n').to_owned() + "\n"
+    )
+}
+
+/// Rename `top` to `gyro_interface` and `top$a$b` to `gyro_interface__a__b`
+/// in module declarations, instantiations and `endmodule` comments.
+fn rename_modules(verilog: &str) -> String {
+    let declaration = Regex::new(r"^module (top(?:\$[A-Za-z0-9_]+)*)\(").unwrap();
+    let instance = Regex::new(r"^(\s*)(top(?:\$[A-Za-z0-9_]+)*) ([A-Za-z0-9_]+)\($").unwrap();
+    let end = Regex::new(r"^endmodule // (top(?:\$[A-Za-z0-9_]+)*)$").unwrap();
+    let rename = |path: &str| path.replacen("top", TOP_MODULE, 1).replace('$', "__");
+    let mut out = String::with_capacity(verilog.len());
+    for line in verilog.lines() {
+        let line = line.trim_end();
+        let renamed = if let Some(c) = declaration.captures(line) {
+            line.replacen(&c[1], &rename(&c[1]), 1)
+        } else if let Some(c) = instance.captures(line) {
+            format!("{}{} {}(", &c[1], rename(&c[2]), &c[3])
+        } else if let Some(c) = end.captures(line) {
+            format!("endmodule // {}", rename(&c[1]))
+        } else {
+            line.to_owned()
+        };
+        out.push_str(&renamed);
+        out.push('\n');
+    }
+    out
+}
+
+/// `PORTS.md`: the port table with formats, for the FPGA engineer.
+pub fn ports_markdown() -> String {
+    let mut md = String::from(
+        "# gyro_interface ports\n\n\
+         Generated by `gyrocal export` from `hdl/src/export.rs`; a test checks this table\n\
+         against the exported Verilog. Every input is sampled at the rising edge of\n\
+         `clock`; drive the settings from a register bank in the same clock domain.\n\
+         `gyrocal_hdl::settings` computes them from frequencies in Hz.\n\n\
+         | port | dir | bits | format | description |\n\
+         |---|---|---|---|---|\n",
+    );
+    for p in PORTS {
+        let dir = match p.direction {
+            Input => "in",
+            Output => "out",
+        };
+        let signed = if p.signed { " signed" } else { "" };
+        md.push_str(&format!(
+            "| `{}` | {dir} | {}{signed} | {} | {} |\n",
+            p.name, p.bits, p.format, p.description
+        ));
+    }
+    md.push_str(
+        "\nLatencies: carrier phase to DAC word 6 clocks; ADC word to mixer product 2;\n\
+         mixer product to CIC output at most R + 6; CIC output to z 12.\n\
+         Reference alignment for converter latencies L_dac, L_adc (clocks):\n\
+         `ref_delay = L_dac + L_adc`, `ref_phase = carrier_step / 2`.\n",
+    );
+    md
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn port_table_matches_the_verilog_declarations() {
+        let v = verilog();
+        let header = Regex::new(&format!(r"(?m)^module {TOP_MODULE}\(([^)]*)\);")).unwrap();
+        let names: Vec<&str> = header.captures(&v).unwrap().get(1).unwrap().as_str().split(',').collect();
+        let table: Vec<&str> = PORTS.iter().map(|p| p.name).collect();
+        assert_eq!(names, table, "port order or names differ");
+        let decl = Regex::new(r"^\s*(input wire|output reg)\s+(signed)?\s*(?:\[(\d+):0\])?\s*([a-z0-9_]+);$").unwrap();
+        let top = v.split("endmodule // gyro_interface\n").next().unwrap();
+        let mut seen = 0;
+        for line in top.lines() {
+            if let Some(c) = decl.captures(line) {
+                let p = PORTS.iter().find(|p| p.name == &c[4]).unwrap();
+                let dir = if &c[1] == "input wire" { Input } else { Output };
+                let bits = c.get(3).map_or(1, |m| m.as_str().parse::<usize>().unwrap() + 1);
+                assert_eq!((dir, bits, c.get(2).is_some()), (p.direction, p.bits, p.signed), "{}", p.name);
+                seen += 1;
+            }
+        }
+        assert_eq!(seen, PORTS.len());
+    }
+
+    #[test]
+    fn every_module_is_renamed() {
+        let v = verilog();
+        assert!(!v.contains("module top"), "a module kept rust-hdl's name");
+        assert!(!Regex::new(r"(?m)^\s*top\$").unwrap().is_match(&v), "an instance kept rust-hdl's name");
+        assert!(v.contains(&format!("module {TOP_MODULE}(")));
+    }
+}

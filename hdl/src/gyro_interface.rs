@@ -1,0 +1,227 @@
+//! `GyroInterface`: the top of the datapath, paper Fig. 1 in one clock domain.
+//!
+//! ```text
+//!                       ┌────────────┐ drive_cos/sin ┌──────────┐ dac1, dac2
+//!  carrier_step ───────►│ CarrierNco ├──────────────►│          ├─────────────► to the DACs
+//!  ref_phase ──────────►│            ├──────────────►│ AmMixer  │ ref1, ref2
+//!                       └────────────┘ ref_cos/sin   │          ├──────┐
+//!  mod_step ──►┌───────────────┐ am1, am2            │          │      │
+//!  select ────►│ ModulationNco ├────────────────────►│          │      ▼
+//!              └───────────────┘       amp1, amp2 ──►└──────────┘ ┌────────────────────┐
+//!                                                   ref_delay ──►│ ReferenceAlignment │
+//!                                                                └─────────┬──────────┘
+//!  adc1, adc2 (from the ADCs) ──────────────────────►┌──────────┐ aligned1,2│
+//!  select ──────────────────────────────────────────►│ DemodMux │◄──────────┘
+//!                                                    └──┬────┬──┘
+//!                                                    w1 │    │ w2
+//!  cic_decimation, cic_shift ──────────────────►  CicDecimator x2
+//!  iir_k0, iir_k1, iir_k2, iir_alpha ──────────►  IirLowpass   x2 ──► z1, z2, z_valid
+//! ```
+//!
+//! Follow a sample in file order: `carrier_nco` (with `sincos`,
+//! `sine_table`), `modulation_nco`, `am_mixer` (with `q15_multiplier`), the
+//! DACs and the gyroscope (in the simulator), `reference_alignment`,
+//! `demod_mux`, `cic_decimator`, `iir_lowpass`.
+//!
+//! Every input is sampled at the rising edge of `clock`; the run-time
+//! settings are meant to be driven from a register bank in the same clock
+//! domain. Every register has a power-up value (Verilog `initial`); there is
+//! no reset. `crate::settings::Settings` computes all the settings from
+//! frequencies in Hz; the port list with formats is in
+//! `verilog-out/PORTS.md`.
+//!
+//! Latencies (clocks): carrier phase to DAC word 6, ADC word to mixer output
+//! 2, mixer output to CIC output R + 6 at most, CIC output to z 12.
+
+use crate::am_mixer::AmMixer;
+use crate::carrier_nco::CarrierNco;
+use crate::cic_decimator::CicDecimator;
+use crate::demod_mux::DemodMux;
+use crate::iir_lowpass::IirLowpass;
+use crate::modulation_nco::ModulationNco;
+use crate::reference_alignment::ReferenceAlignment;
+use rust_hdl::prelude::*;
+
+/// The reconfigurable phase-readout and self-calibration datapath.
+#[derive(LogicBlock)]
+pub struct GyroInterface {
+    /// The clock; every register of the design uses its rising edge.
+    pub clock: Signal<In, Clock>,
+    /// ADC word of gyroscope output 1 (16-bit two's complement).
+    pub adc1: Signal<In, Signed<16>>,
+    /// ADC word of gyroscope output 2 (16-bit two's complement).
+    pub adc2: Signal<In, Signed<16>>,
+    /// DAC word of drive 1, F1 A1 cos(wt): 16-bit two's complement, |dac1| <= 32767.
+    pub dac1: Signal<Out, Signed<16>>,
+    /// DAC word of drive 2, F2 A2 sin(wt): 16-bit two's complement, |dac2| <= 32767.
+    pub dac2: Signal<Out, Signed<16>>,
+    /// Filtered demodulator output 1: 40-bit two's complement, 8 fractional bits.
+    pub z1: Signal<Out, Signed<40>>,
+    /// Filtered demodulator output 2: 40-bit two's complement, 8 fractional bits.
+    pub z2: Signal<Out, Signed<40>>,
+    /// One-clock pulse when z1 and z2 are updated (once per CIC output).
+    pub z_valid: Signal<Out, Bit>,
+    /// SELECT: 0 readout (A = 1, own references), 1 calibration (A = cos/sin, crossed references).
+    pub select: Signal<In, Bit>,
+    /// Carrier phase step: f_carrier = carrier_step * f_clk / 2^32.
+    pub carrier_step: Signal<In, Bits<32>>,
+    /// Phase advance of the demodulation references over the drives, 2^32 = 360 degrees.
+    pub ref_phase: Signal<In, Bits<32>>,
+    /// Reference delay: references are delayed by ref_delay + 1 clocks (0..63).
+    pub ref_delay: Signal<In, Bits<6>>,
+    /// Modulation (calibration rate) phase step: f_cal = mod_step * f_clk / 2^48.
+    pub mod_step: Signal<In, Bits<48>>,
+    /// Drive amplitude F1, Q1.15 (32767 = full scale).
+    pub amp1: Signal<In, Signed<16>>,
+    /// Drive amplitude F2, Q1.15 (32767 = full scale).
+    pub amp2: Signal<In, Signed<16>>,
+    /// CIC decimation R, 16..=4096 (z rate f_clk / R).
+    pub cic_decimation: Signal<In, Bits<13>>,
+    /// CIC output shift, ceil(4 log2 R) - 8.
+    pub cic_shift: Signal<In, Bits<6>>,
+    /// Biquad numerator gain g, Q2.30.
+    pub iir_k0: Signal<In, Signed<32>>,
+    /// Biquad feedback -a1 - 2, Q2.30.
+    pub iir_k1: Signal<In, Signed<32>>,
+    /// Biquad feedback 1 - a2, Q2.30.
+    pub iir_k2: Signal<In, Signed<32>>,
+    /// RC section coefficient 1 - exp(-2 pi f_rc / f_z), Q2.30.
+    pub iir_alpha: Signal<In, Signed<32>>,
+    carrier_nco: CarrierNco,
+    modulation_nco: ModulationNco,
+    am_mixer: AmMixer,
+    reference_alignment: ReferenceAlignment,
+    demod_mux: DemodMux,
+    cic1: CicDecimator,
+    cic2: CicDecimator,
+    iir1: IirLowpass,
+    iir2: IirLowpass,
+}
+
+impl GyroInterface {
+    /// The datapath at its power-up state.
+    pub fn new() -> Self {
+        Self {
+            clock: Default::default(),
+            adc1: Default::default(),
+            adc2: Default::default(),
+            dac1: Default::default(),
+            dac2: Default::default(),
+            z1: Default::default(),
+            z2: Default::default(),
+            z_valid: Default::default(),
+            select: Default::default(),
+            carrier_step: Default::default(),
+            ref_phase: Default::default(),
+            ref_delay: Default::default(),
+            mod_step: Default::default(),
+            amp1: Default::default(),
+            amp2: Default::default(),
+            cic_decimation: Default::default(),
+            cic_shift: Default::default(),
+            iir_k0: Default::default(),
+            iir_k1: Default::default(),
+            iir_k2: Default::default(),
+            iir_alpha: Default::default(),
+            carrier_nco: CarrierNco::new(),
+            modulation_nco: ModulationNco::new(),
+            am_mixer: AmMixer::new(),
+            reference_alignment: ReferenceAlignment::new(),
+            demod_mux: DemodMux::new(),
+            cic1: CicDecimator::new(),
+            cic2: CicDecimator::new(),
+            iir1: IirLowpass::new(),
+            iir2: IirLowpass::new(),
+        }
+    }
+}
+
+impl Default for GyroInterface {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Logic for GyroInterface {
+    #[hdl_gen]
+    fn update(&mut self) {
+        self.carrier_nco.clock.next = self.clock.val();
+        self.modulation_nco.clock.next = self.clock.val();
+        self.am_mixer.clock.next = self.clock.val();
+        self.reference_alignment.clock.next = self.clock.val();
+        self.demod_mux.clock.next = self.clock.val();
+        self.cic1.clock.next = self.clock.val();
+        self.cic2.clock.next = self.clock.val();
+        self.iir1.clock.next = self.clock.val();
+        self.iir2.clock.next = self.clock.val();
+        // Excitation.
+        self.carrier_nco.step.next = self.carrier_step.val();
+        self.carrier_nco.ref_offset.next = self.ref_phase.val();
+        self.modulation_nco.step.next = self.mod_step.val();
+        self.modulation_nco.select.next = self.select.val();
+        self.am_mixer.amp1.next = self.amp1.val();
+        self.am_mixer.amp2.next = self.amp2.val();
+        self.am_mixer.am1.next = self.modulation_nco.am1.val();
+        self.am_mixer.am2.next = self.modulation_nco.am2.val();
+        self.am_mixer.drive_cos.next = self.carrier_nco.drive_cos.val();
+        self.am_mixer.drive_sin.next = self.carrier_nco.drive_sin.val();
+        self.am_mixer.ref_cos.next = self.carrier_nco.ref_cos.val();
+        self.am_mixer.ref_sin.next = self.carrier_nco.ref_sin.val();
+        self.dac1.next = self.am_mixer.dac1.val();
+        self.dac2.next = self.am_mixer.dac2.val();
+        // Demodulation.
+        self.reference_alignment.ref1.next = self.am_mixer.ref1.val();
+        self.reference_alignment.ref2.next = self.am_mixer.ref2.val();
+        self.reference_alignment.delay.next = self.ref_delay.val();
+        self.demod_mux.adc1.next = self.adc1.val();
+        self.demod_mux.adc2.next = self.adc2.val();
+        self.demod_mux.aligned1.next = self.reference_alignment.aligned1.val();
+        self.demod_mux.aligned2.next = self.reference_alignment.aligned2.val();
+        self.demod_mux.select.next = self.select.val();
+        // Decimation and filtering.
+        self.cic1.x.next = self.demod_mux.w1.val();
+        self.cic2.x.next = self.demod_mux.w2.val();
+        self.cic1.decimation.next = self.cic_decimation.val();
+        self.cic2.decimation.next = self.cic_decimation.val();
+        self.cic1.shift.next = self.cic_shift.val();
+        self.cic2.shift.next = self.cic_shift.val();
+        self.iir1.x.next = self.cic1.y.val();
+        self.iir2.x.next = self.cic2.y.val();
+        self.iir1.x_valid.next = self.cic1.valid.val();
+        self.iir2.x_valid.next = self.cic2.valid.val();
+        self.iir1.k0.next = self.iir_k0.val();
+        self.iir2.k0.next = self.iir_k0.val();
+        self.iir1.k1.next = self.iir_k1.val();
+        self.iir2.k1.next = self.iir_k1.val();
+        self.iir1.k2.next = self.iir_k2.val();
+        self.iir2.k2.next = self.iir_k2.val();
+        self.iir1.alpha.next = self.iir_alpha.val();
+        self.iir2.alpha.next = self.iir_alpha.val();
+        self.z1.next = self.iir1.z.val();
+        self.z2.next = self.iir2.z.val();
+        self.z_valid.next = self.iir1.z_valid.val();
+    }
+}
+
+crate::impl_clocked!(GyroInterface);
+
+impl GyroInterface {
+    /// Internal signals during the current cycle (for waveforms and tests).
+    pub fn probes(&self) -> crate::model::gyro_interface::Probes {
+        use crate::primitives::convert::signed_to_i128 as v;
+        let a = &self.am_mixer;
+        crate::model::gyro_interface::Probes {
+            reference: (v(a.ref1.val()) as i16, v(a.ref2.val()) as i16),
+            w: (
+                v(self.demod_mux.w1.val()) as i32,
+                v(self.demod_mux.w2.val()) as i32,
+            ),
+            cic: (v(self.cic1.y.val()) as i64, v(self.cic2.y.val()) as i64),
+            cic_valid: self.cic1.valid.val(),
+            am: (
+                v(self.modulation_nco.am1.val()) as i16,
+                v(self.modulation_nco.am2.val()) as i16,
+            ),
+        }
+    }
+}

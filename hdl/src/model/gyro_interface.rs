@@ -1,0 +1,126 @@
+//! Bit-true, cycle-true model of `crate::gyro_interface::GyroInterface`:
+//! the blocks' models wired as in the hardware. This is the `model` engine.
+
+use super::am_mixer::AmMixer;
+use super::carrier_nco::CarrierNco;
+use super::cic_decimator::CicDecimator;
+use super::demod_mux::DemodMux;
+use super::iir_lowpass::{Coefficients, IirLowpass};
+use super::modulation_nco::ModulationNco;
+use super::reference_alignment::ReferenceAlignment;
+
+/// The run-time settings of `GyroInterface`, one field per input port.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Registers {
+    /// SELECT: false readout, true calibration.
+    pub select: bool,
+    /// Carrier phase step (32 bits).
+    pub carrier_step: u32,
+    /// Reference phase advance (32 bits).
+    pub ref_phase: u32,
+    /// Reference delay (6 bits).
+    pub ref_delay: u8,
+    /// Modulation phase step (48 bits).
+    pub mod_step: u64,
+    /// Drive amplitudes F1, F2 (Q1.15).
+    pub amp: (i16, i16),
+    /// CIC decimation R (13 bits).
+    pub cic_decimation: u16,
+    /// CIC output shift (6 bits).
+    pub cic_shift: u8,
+    /// IIR coefficients (Q2.30).
+    pub iir: Coefficients,
+}
+
+/// The output ports of `GyroInterface` during one cycle.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Outputs {
+    /// DAC words.
+    pub dac: (i16, i16),
+    /// Filtered outputs z1, z2 (40 bits, 8 fractional bits).
+    pub z: (i64, i64),
+    /// New z this cycle.
+    pub z_valid: bool,
+}
+
+/// Internal signals worth watching (waveform dumps).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Probes {
+    /// Reference copies of the drives, before alignment.
+    pub reference: (i16, i16),
+    /// Mixer outputs w1, w2.
+    pub w: (i32, i32),
+    /// CIC outputs.
+    pub cic: (i64, i64),
+    /// CIC output strobe.
+    pub cic_valid: bool,
+    /// Modulation factors A1, A2.
+    pub am: (i16, i16),
+}
+
+/// Cycle-true model of the whole datapath.
+#[derive(Clone, Debug, Default)]
+pub struct GyroInterface {
+    carrier_nco: CarrierNco,
+    modulation_nco: ModulationNco,
+    am_mixer: AmMixer,
+    reference_alignment: ReferenceAlignment,
+    demod_mux: DemodMux,
+    cic: [CicDecimator; 2],
+    iir: [IirLowpass; 2],
+}
+
+impl GyroInterface {
+    /// The datapath at its power-up state.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// The output ports during the current cycle.
+    #[inline(always)]
+    pub fn outputs(&self) -> Outputs {
+        let drives = self.am_mixer.output();
+        let (z1, z_valid) = self.iir[0].output();
+        let (z2, _) = self.iir[1].output();
+        Outputs { dac: (drives.dac1, drives.dac2), z: (z1, z2), z_valid }
+    }
+
+    /// Internal signals during the current cycle.
+    pub fn probes(&self) -> Probes {
+        let drives = self.am_mixer.output();
+        let (cic1, cic_valid) = self.cic[0].output();
+        Probes {
+            reference: (drives.ref1, drives.ref2),
+            w: self.demod_mux.output(),
+            cic: (cic1, self.cic[1].output().0),
+            cic_valid,
+            am: self.modulation_nco.output(),
+        }
+    }
+
+    /// One clock: `adc` and `regs` are the inputs during the current cycle;
+    /// returns the outputs after the rising edge.
+    #[inline(always)]
+    pub fn step(&mut self, adc: (i16, i16), regs: &Registers) -> Outputs {
+        // Read every block's current outputs before any register moves.
+        let carriers = self.carrier_nco.output();
+        let am = self.modulation_nco.output();
+        let drives = self.am_mixer.output();
+        let aligned = self.reference_alignment.output(regs.ref_delay);
+        let w = self.demod_mux.output();
+        let cic = [self.cic[0].output(), self.cic[1].output()];
+
+        self.carrier_nco.step(regs.carrier_step, regs.ref_phase);
+        self.modulation_nco.step(regs.mod_step, regs.select);
+        self.am_mixer.step(regs.amp, am, carriers);
+        self.reference_alignment.step(drives.ref1, drives.ref2);
+        self.demod_mux.step(adc, aligned, regs.select);
+        let r = regs.cic_decimation as u32;
+        let shift = regs.cic_shift as u32;
+        self.cic[0].step(w.0, r, shift);
+        self.cic[1].step(w.1, r, shift);
+        self.iir[0].step(cic[0].0, cic[0].1, &regs.iir);
+        self.iir[1].step(cic[1].0, cic[1].1, &regs.iir);
+        self.outputs()
+    }
+}

@@ -1,0 +1,30 @@
+//! Bit-true model of `crate::q15_multiplier::Q15Multiplier`.
+
+/// `round(a * b / 2^15)`, rounded half up, wrapped to 16 bits.
+#[inline(always)]
+pub fn q15_product(a: i16, b: i16) -> i16 {
+    ((a as i32 * b as i32 + (1 << 14)) >> 15) as i16
+}
+
+/// Cycle-true model: the product register and the rounding register.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Q15Multiplier {
+    product: i32,
+    y: i16,
+}
+
+impl Q15Multiplier {
+    /// `y` during the current cycle.
+    #[inline(always)]
+    pub fn output(&self) -> i16 {
+        self.y
+    }
+
+    /// One clock; returns `y` after the edge.
+    #[inline(always)]
+    pub fn step(&mut self, a: i16, b: i16) -> i16 {
+        self.y = ((self.product.wrapping_add(1 << 14)) >> 15) as i16;
+        self.product = a as i32 * b as i32;
+        self.y
+    }
+}

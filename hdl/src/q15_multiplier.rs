@@ -1,0 +1,76 @@
+//! Fractional (Q1.15) multiplier with rounding: y = round(a * b / 2^15).
+//!
+//! ```text
+//!  a[16] ──┐
+//!          ×──► [p: 32 bit] ──► (p + 2^14)[30:15] ──► [y: 16 bit]
+//!  b[16] ──┘
+//! ```
+//!
+//! Both factors are 16-bit two's complement read as fractions of 2^15
+//! (32767 is just below 1.0). The product is rounded half up: add 2^14,
+//! then drop 15 bits (floor). The result fits 16 bits for every pair except
+//! a = b = -32768 (which would be +1.0): with |b| <= 32767, which holds for
+//! every use in this design (b is always a sine, cosine or modulation factor,
+//! peak 32767), |a b + 2^14| / 2^15 <= 32767.5 and y lies in [-32767, 32767].
+//!
+//! Latency: 2 clocks (multiplier register, rounding register).
+
+use crate::primitives::RegisteredMultiplier;
+use rust_hdl::prelude::*;
+
+/// Clock cycles from the factors to `y`.
+pub const LATENCY: usize = 2;
+
+/// `y = round(a * b / 2^15)`, registered twice.
+#[derive(LogicBlock)]
+pub struct Q15Multiplier {
+    /// The clock.
+    pub clock: Signal<In, Clock>,
+    /// First factor, Q1.15.
+    pub a: Signal<In, Signed<16>>,
+    /// Second factor, Q1.15; keep it above -32768 (see the header).
+    pub b: Signal<In, Signed<16>>,
+    /// Rounded product, Q1.15, two clocks after the factors.
+    pub y: Signal<Out, Signed<16>>,
+    product: RegisteredMultiplier<16, 16, 32>,
+    rounded: Signal<Local, Signed<32>>,
+    y_out: DFF<Signed<16>>,
+    half_lsb: Constant<Signed<32>>,
+}
+
+impl Q15Multiplier {
+    /// A Q1.15 multiplier with round-half-up.
+    pub fn new() -> Self {
+        Self {
+            clock: Default::default(),
+            a: Default::default(),
+            b: Default::default(),
+            y: Default::default(),
+            product: RegisteredMultiplier::new(),
+            rounded: Default::default(),
+            y_out: Default::default(),
+            half_lsb: Constant::new((1i64 << 14).into()),
+        }
+    }
+}
+
+impl Default for Q15Multiplier {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Logic for Q15Multiplier {
+    #[hdl_gen]
+    fn update(&mut self) {
+        dff_setup!(self, clock, y_out);
+        self.product.clock.next = self.clock.val();
+        self.product.a.next = self.a.val();
+        self.product.b.next = self.b.val();
+        self.rounded.next = self.product.p.val() + self.half_lsb.val();
+        self.y_out.d.next = self.rounded.val().get_bits::<16>(15);
+        self.y.next = self.y_out.q.val();
+    }
+}
+
+crate::impl_clocked!(Q15Multiplier);

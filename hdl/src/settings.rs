@@ -1,0 +1,191 @@
+//! Run-time settings of `GyroInterface` from a frequency plan in Hz.
+//!
+//! Phase steps are rounded to the nearest integer, and everything
+//! downstream uses the realized frequencies (`Realized`), never the asked
+//! ones: the carrier is step * f_clk / 2^32, the calibration rate
+//! step * f_clk / 2^48 (0.18 uHz resolution at 50 MHz).
+//!
+//! # Reference alignment
+//!
+//! Let the DAC output the word of cycle k over [(k + L_dac) T, (k + L_dac +
+//! 1) T) (latency L_dac clocks, zero-order hold) and the ADC present during
+//! cycle m the sample taken at the edge (m - L_adc) T. The hold's
+//! fundamental is the word sequence delayed by L_dac + 1/2 clocks (and
+//! scaled by sinc(f T)), so the sample reaching the mixer at cycle n
+//! (`demod_mux`: adc(n - 2)) responds to drive word n - 2 - L_adc - L_dac -
+//! 1/2. The reference used at cycle n is ref(n - 3 - ref_delay)
+//! (`demod_mux` 2 clocks + `reference_alignment` ref_delay + 1), advanced in
+//! phase by ref_phase / step words. Equating the two:
+//!
+//! ```text
+//!   ref_delay = L_dac + L_adc,   ref_phase = carrier_step / 2
+//! ```
+//!
+//! The modulation envelope is delayed with the carrier, so only half a
+//! clock of it remains (Om T / 2, about 1e-6 rad: negligible).
+
+use crate::filter_design::{self, FilterDesign};
+use crate::model::gyro_interface::Registers;
+use crate::reference_alignment::DELAY_BITS;
+
+/// What the user asks for.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrequencyPlan {
+    /// FPGA clock in Hz.
+    pub clock_hz: f64,
+    /// Carrier (excitation) frequency in Hz.
+    pub carrier_hz: f64,
+    /// Calibration rate f_cal in Hz (used when `calibration` is true).
+    pub cal_hz: f64,
+    /// SELECT: false readout, true calibration.
+    pub calibration: bool,
+    /// Drive amplitudes F1, F2 as fractions of full scale, in [-1, 1).
+    pub amplitude: (f64, f64),
+    /// CIC decimation R.
+    pub decimation: u32,
+    /// Butterworth cut-off in Hz.
+    pub butterworth_hz: f64,
+    /// RC cut-off in Hz.
+    pub rc_hz: f64,
+    /// DAC latency in clocks.
+    pub dac_latency: u32,
+    /// ADC latency in clocks.
+    pub adc_latency: u32,
+}
+
+/// The frequencies and gains the registers actually produce.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Realized {
+    /// Carrier frequency in Hz.
+    pub carrier_hz: f64,
+    /// Calibration rate in Hz (0 in readout).
+    pub cal_hz: f64,
+    /// The output filter.
+    pub filter: FilterDesign,
+}
+
+/// Full scale of a 16-bit signed word.
+const FULL_SCALE: f64 = 32768.0;
+
+/// Registers and realized values for a plan; a one-line error names the
+/// setting that is out of range and what is allowed.
+pub fn registers(plan: &FrequencyPlan) -> Result<(Registers, Realized), String> {
+    let clock = plan.clock_hz;
+    if !(clock.is_finite() && clock > 0.0) {
+        return Err(format!("clock_hz = {clock}: must be a positive number of Hz"));
+    }
+    let nyquist = clock / 2.0;
+    if !(plan.carrier_hz.is_finite() && plan.carrier_hz > 0.0 && plan.carrier_hz < nyquist) {
+        return Err(format!(
+            "carrier_hz = {}: must be above 0 and below clock_hz / 2 = {nyquist}",
+            plan.carrier_hz
+        ));
+    }
+    let carrier_step = (plan.carrier_hz / clock * 2f64.powi(32)).round() as u32;
+    let mod_step = if plan.calibration {
+        let max = clock / 1000.0;
+        if !(plan.cal_hz.is_finite() && plan.cal_hz >= 0.0 && plan.cal_hz <= max) {
+            return Err(format!(
+                "cal_hz = {}: allowed 0 to clock_hz / 1000 = {max}",
+                plan.cal_hz
+            ));
+        }
+        (plan.cal_hz / clock * 2f64.powi(48)).round() as u64
+    } else {
+        0
+    };
+    let mut amp = [0i16; 2];
+    for (k, a) in [plan.amplitude.0, plan.amplitude.1].into_iter().enumerate() {
+        if !(a.is_finite() && (-1.0..1.0).contains(&a)) {
+            return Err(format!("amplitude of drive {} = {a}: allowed -1 <= a < 1", k + 1));
+        }
+        amp[k] = (a * FULL_SCALE).round().min(32767.0) as i16;
+    }
+    let delay = plan.dac_latency + plan.adc_latency;
+    if delay >= 1 << DELAY_BITS {
+        return Err(format!(
+            "dac_latency + adc_latency = {delay} clocks: at most {}",
+            (1 << DELAY_BITS) - 1
+        ));
+    }
+    let filter = filter_design::design(clock, plan.decimation, plan.butterworth_hz, plan.rc_hz)?;
+    let regs = Registers {
+        select: plan.calibration,
+        carrier_step,
+        ref_phase: carrier_step.div_ceil(2),
+        ref_delay: delay as u8,
+        mod_step,
+        amp: (amp[0], amp[1]),
+        cic_decimation: filter.decimation as u16,
+        cic_shift: filter.cic_shift as u8,
+        iir: filter.coefficients,
+    };
+    let realized = Realized {
+        carrier_hz: carrier_step as f64 * clock / 2f64.powi(32),
+        cal_hz: mod_step as f64 * clock / 2f64.powi(48),
+        filter,
+    };
+    Ok((regs, realized))
+}
+
+/// If the carrier is within 1e-9 of a ratio p/q of the clock with q <= 1000,
+/// return q: the DAC and ADC then see only about q distinct phases, and
+/// their quantization errors no longer average out (a 16-bit loop with a
+/// 1 MHz carrier on a 10 MHz clock is off by about 1-3%).
+pub fn commensurate_period(carrier_hz: f64, clock_hz: f64) -> Option<u64> {
+    let r = carrier_hz / clock_hz;
+    (1..=1000u64).find(|&q| {
+        let x = r * q as f64;
+        (x - x.round()).abs() < 1e-9 * q as f64
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn plan() -> FrequencyPlan {
+        FrequencyPlan {
+            clock_hz: 50e6,
+            carrier_hz: 9.64e6,
+            cal_hz: 10.0,
+            calibration: true,
+            amplitude: (0.9, 0.9),
+            decimation: 1000,
+            butterworth_hz: 500.0,
+            rc_hz: 2000.0,
+            dac_latency: 1,
+            adc_latency: 2,
+        }
+    }
+
+    #[test]
+    fn realized_frequencies_are_within_half_a_step() {
+        let (regs, real) = registers(&plan()).unwrap();
+        assert!((real.carrier_hz - 9.64e6).abs() <= 50e6 / 2f64.powi(33));
+        assert!((real.cal_hz - 10.0).abs() <= 50e6 / 2f64.powi(49));
+        assert_eq!(regs.ref_delay, 3);
+        assert_eq!(regs.ref_phase, regs.carrier_step.div_ceil(2));
+    }
+
+    #[test]
+    fn bad_plans_name_the_setting() {
+        let mut p = plan();
+        p.carrier_hz = 25e6;
+        assert!(registers(&p).unwrap_err().starts_with("carrier_hz = 25000000"));
+        let mut p = plan();
+        p.amplitude.1 = 1.0;
+        assert!(registers(&p).unwrap_err().starts_with("amplitude of drive 2"));
+        let mut p = plan();
+        p.dac_latency = 60;
+        p.adc_latency = 4;
+        assert!(registers(&p).unwrap_err().starts_with("dac_latency + adc_latency = 64"));
+    }
+
+    #[test]
+    fn commensurate_plans_are_flagged() {
+        assert_eq!(commensurate_period(1e6, 10e6), Some(10));
+        assert_eq!(commensurate_period(1.0123e6, 10e6), None);
+        assert_eq!(commensurate_period(9.64e6, 50e6), None); // 241/1250
+    }
+}

@@ -1,0 +1,1 @@
+//! gyrocal-sim: gyroscope model, theory, co-simulation engines and experiments.
