@@ -52,7 +52,14 @@ const fn port(
     format: &'static str,
     description: &'static str,
 ) -> Port {
-    Port { name, direction, bits, signed, format, description }
+    Port {
+        name,
+        direction,
+        bits,
+        signed,
+        format,
+        description,
+    }
 }
 
 use PortDirection::{Input, Output};
@@ -60,27 +67,174 @@ use PortDirection::{Input, Output};
 /// The ports of `gyro_interface`, in declaration order. A test checks this
 /// table against the generated Verilog.
 pub const PORTS: &[Port] = &[
-    port("clock", Input, 1, false, "clock", "Every register uses its rising edge; one clock domain."),
-    port("adc1", Input, 16, true, "two's complement", "ADC word of gyroscope output 1 (mode 1 pick-off)."),
-    port("adc2", Input, 16, true, "two's complement", "ADC word of gyroscope output 2 (mode 2 pick-off)."),
-    port("dac1", Output, 16, true, "two's complement, |dac1| <= 32767", "Drive 1 = F1 A1 cos(wt), to DAC 1 (mode 1)."),
-    port("dac2", Output, 16, true, "two's complement, |dac2| <= 32767", "Drive 2 = F2 A2 sin(wt), to DAC 2 (mode 2)."),
-    port("z1", Output, 40, true, "two's complement, 8 fractional bits", "Filtered demodulator output 1, in mixer LSBs (adc x reference) times the filter's DC gain."),
-    port("z2", Output, 40, true, "two's complement, 8 fractional bits", "Filtered demodulator output 2, as z1."),
-    port("z_valid", Output, 1, false, "pulse", "High for one clock when z1 and z2 change (rate f_clk / R)."),
-    port("select", Input, 1, false, "0 / 1", "SELECT of paper Fig. 1: 0 readout (A = 1, each output mixed with its own drive), 1 calibration (A = cos/sin, outputs mixed with the other drive)."),
-    port("carrier_step", Input, 32, false, "unsigned", "Carrier phase step: f_carrier = carrier_step * f_clk / 2^32."),
-    port("ref_phase", Input, 32, false, "unsigned, 2^32 = 360 deg", "Phase advance of the demodulation references over the drives; carrier_step / 2 cancels the DAC's half-sample hold delay."),
-    port("ref_delay", Input, 6, false, "0..63", "References are delayed by ref_delay + 1 clocks; set to DAC latency + ADC latency (clocks)."),
-    port("mod_step", Input, 48, false, "unsigned", "Calibration rate: f_cal = mod_step * f_clk / 2^48 (virtual rate 360 f_cal deg/s)."),
-    port("amp1", Input, 16, true, "Q1.15", "Drive amplitude F1; 32767 is full scale. Any value is safe."),
-    port("amp2", Input, 16, true, "Q1.15", "Drive amplitude F2; 32767 is full scale. Any value is safe."),
-    port("cic_decimation", Input, 13, false, "16..4096", "CIC decimation R; z is updated every R clocks."),
-    port("cic_shift", Input, 6, false, "0..40", "CIC output shift, ceil(4 log2 R) - 8."),
-    port("iir_k0", Input, 32, true, "Q2.30", "Biquad numerator gain g (Butterworth b0 times the CIC gain correction)."),
-    port("iir_k1", Input, 32, true, "Q2.30", "Biquad feedback -a1 - 2."),
-    port("iir_k2", Input, 32, true, "Q2.30", "Biquad feedback 1 - a2."),
-    port("iir_alpha", Input, 32, true, "Q2.30", "RC section: 1 - exp(-2 pi f_rc R / f_clk)."),
+    port(
+        "clock",
+        Input,
+        1,
+        false,
+        "clock",
+        "Every register uses its rising edge; one clock domain.",
+    ),
+    port(
+        "adc1",
+        Input,
+        16,
+        true,
+        "two's complement",
+        "ADC word of gyroscope output 1 (mode 1 pick-off).",
+    ),
+    port(
+        "adc2",
+        Input,
+        16,
+        true,
+        "two's complement",
+        "ADC word of gyroscope output 2 (mode 2 pick-off).",
+    ),
+    port(
+        "dac1",
+        Output,
+        16,
+        true,
+        "two's complement, |dac1| <= 32767",
+        "Drive 1 = F1 A1 cos(wt), to DAC 1 (mode 1).",
+    ),
+    port(
+        "dac2",
+        Output,
+        16,
+        true,
+        "two's complement, |dac2| <= 32767",
+        "Drive 2 = F2 A2 sin(wt), to DAC 2 (mode 2).",
+    ),
+    port(
+        "z1",
+        Output,
+        40,
+        true,
+        "two's complement, 8 fractional bits",
+        "Filtered demodulator output 1, in mixer LSBs (adc x reference) times the filter's DC gain.",
+    ),
+    port(
+        "z2",
+        Output,
+        40,
+        true,
+        "two's complement, 8 fractional bits",
+        "Filtered demodulator output 2, as z1.",
+    ),
+    port(
+        "z_valid",
+        Output,
+        1,
+        false,
+        "pulse",
+        "High for one clock when z1 and z2 change (rate f_clk / R).",
+    ),
+    port(
+        "select",
+        Input,
+        1,
+        false,
+        "0 / 1",
+        "SELECT of paper Fig. 1: 0 readout (A = 1, each output mixed with its own drive), 1 calibration (A = cos/sin, outputs mixed with the other drive).",
+    ),
+    port(
+        "carrier_step",
+        Input,
+        32,
+        false,
+        "unsigned",
+        "Carrier phase step: f_carrier = carrier_step * f_clk / 2^32.",
+    ),
+    port(
+        "ref_phase",
+        Input,
+        32,
+        false,
+        "unsigned, 2^32 = 360 deg",
+        "Phase advance of the demodulation references over the drives; carrier_step / 2 cancels the DAC's half-sample hold delay.",
+    ),
+    port(
+        "ref_delay",
+        Input,
+        6,
+        false,
+        "0..63",
+        "References are delayed by ref_delay + 1 clocks; set to DAC latency + ADC latency (clocks).",
+    ),
+    port(
+        "mod_step",
+        Input,
+        48,
+        false,
+        "unsigned",
+        "Calibration rate: f_cal = mod_step * f_clk / 2^48 (virtual rate 360 f_cal deg/s).",
+    ),
+    port(
+        "amp1",
+        Input,
+        16,
+        true,
+        "Q1.15",
+        "Drive amplitude F1; 32767 is full scale. Any value is safe.",
+    ),
+    port(
+        "amp2",
+        Input,
+        16,
+        true,
+        "Q1.15",
+        "Drive amplitude F2; 32767 is full scale. Any value is safe.",
+    ),
+    port(
+        "cic_decimation",
+        Input,
+        13,
+        false,
+        "16..4096",
+        "CIC decimation R; z is updated every R clocks.",
+    ),
+    port(
+        "cic_shift",
+        Input,
+        6,
+        false,
+        "0..40",
+        "CIC output shift, ceil(4 log2 R) - 8.",
+    ),
+    port(
+        "iir_k0",
+        Input,
+        32,
+        true,
+        "Q2.30",
+        "Biquad numerator gain g (Butterworth b0 times the CIC gain correction).",
+    ),
+    port(
+        "iir_k1",
+        Input,
+        32,
+        true,
+        "Q2.30",
+        "Biquad feedback -a1 - 2.",
+    ),
+    port(
+        "iir_k2",
+        Input,
+        32,
+        true,
+        "Q2.30",
+        "Biquad feedback 1 - a2.",
+    ),
+    port(
+        "iir_alpha",
+        Input,
+        32,
+        true,
+        "Q2.30",
+        "RC section: 1 - exp(-2 pi f_rc R / f_clk).",
+    ),
 ];
 
 /// The exported Verilog of `GyroInterface`: rust-hdl's output with the
@@ -159,6 +313,19 @@ pub fn ports_markdown() -> String {
     md
 }
 
+/// The files of `verilog-out/` that `gyrocal export` writes, as (name, text).
+pub fn files() -> Vec<(&'static str, String)> {
+    vec![(VERILOG_FILE, verilog()), (PORTS_FILE, ports_markdown())]
+}
+
+/// Write `text` to `path` through a temporary file in the same folder and a
+/// rename, so a reader never sees a half-written file.
+pub fn write_atomically(path: &std::path::Path, text: &str) -> std::io::Result<()> {
+    let tmp = path.with_extension("tmp-write");
+    std::fs::write(&tmp, text)?;
+    std::fs::rename(&tmp, path)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -167,18 +334,35 @@ mod tests {
     fn port_table_matches_the_verilog_declarations() {
         let v = verilog();
         let header = Regex::new(&format!(r"(?m)^module {TOP_MODULE}\(([^)]*)\);")).unwrap();
-        let names: Vec<&str> = header.captures(&v).unwrap().get(1).unwrap().as_str().split(',').collect();
+        let names: Vec<&str> = header
+            .captures(&v)
+            .unwrap()
+            .get(1)
+            .unwrap()
+            .as_str()
+            .split(',')
+            .collect();
         let table: Vec<&str> = PORTS.iter().map(|p| p.name).collect();
         assert_eq!(names, table, "port order or names differ");
-        let decl = Regex::new(r"^\s*(input wire|output reg)\s+(signed)?\s*(?:\[(\d+):0\])?\s*([a-z0-9_]+);$").unwrap();
+        let decl = Regex::new(
+            r"^\s*(input wire|output reg)\s+(signed)?\s*(?:\[(\d+):0\])?\s*([a-z0-9_]+);$",
+        )
+        .unwrap();
         let top = v.split("endmodule // gyro_interface\n").next().unwrap();
         let mut seen = 0;
         for line in top.lines() {
             if let Some(c) = decl.captures(line) {
                 let p = PORTS.iter().find(|p| p.name == &c[4]).unwrap();
                 let dir = if &c[1] == "input wire" { Input } else { Output };
-                let bits = c.get(3).map_or(1, |m| m.as_str().parse::<usize>().unwrap() + 1);
-                assert_eq!((dir, bits, c.get(2).is_some()), (p.direction, p.bits, p.signed), "{}", p.name);
+                let bits = c
+                    .get(3)
+                    .map_or(1, |m| m.as_str().parse::<usize>().unwrap() + 1);
+                assert_eq!(
+                    (dir, bits, c.get(2).is_some()),
+                    (p.direction, p.bits, p.signed),
+                    "{}",
+                    p.name
+                );
                 seen += 1;
             }
         }
@@ -189,7 +373,10 @@ mod tests {
     fn every_module_is_renamed() {
         let v = verilog();
         assert!(!v.contains("module top"), "a module kept rust-hdl's name");
-        assert!(!Regex::new(r"(?m)^\s*top\$").unwrap().is_match(&v), "an instance kept rust-hdl's name");
+        assert!(
+            !Regex::new(r"(?m)^\s*top\$").unwrap().is_match(&v),
+            "an instance kept rust-hdl's name"
+        );
         assert!(v.contains(&format!("module {TOP_MODULE}(")));
     }
 }

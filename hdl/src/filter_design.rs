@@ -70,7 +70,9 @@ pub fn cic_bit_growth(decimation: u32) -> u32 {
 fn quantize(x: f64, what: &str) -> Result<i32, String> {
     let q = (x * f64::from(1u32 << COEFFICIENT_FRACTION_BITS)).round();
     if !(i32::MIN as f64..=i32::MAX as f64).contains(&q) {
-        return Err(format!("filter coefficient {what} = {x} does not fit Q2.30"));
+        return Err(format!(
+            "filter coefficient {what} = {x} does not fit Q2.30"
+        ));
     }
     Ok(q as i32)
 }
@@ -112,7 +114,10 @@ pub fn design(
         alpha: quantize(alpha, "alpha")?,
     };
     let scale = f64::from(1u32 << COEFFICIENT_FRACTION_BITS);
-    let (q1, q2) = (coefficients.k1 as f64 / scale, coefficients.k2 as f64 / scale);
+    let (q1, q2) = (
+        coefficients.k1 as f64 / scale,
+        coefficients.k2 as f64 / scale,
+    );
     // Quantized feedback a1 = -2 - k1, a2 = 1 - k2: the stability triangle.
     let (a1, a2) = (-2.0 - q1, 1.0 - q2);
     if !(a2.abs() < 1.0 && a1.abs() < 1.0 + a2) || coefficients.alpha <= 0 {
@@ -156,24 +161,51 @@ mod tests {
         // k0 carries 1 / G_cic, so the realized gain differs from 1 only by
         // the rounding of k0, k1, k2 (each +-2^-31 absolute): relative error
         // below 2^-31 (1 / k0 + 2 / |k1 + k2|) * 2^30.
-        for (r, fb, frc) in [(1000, 500.0, 2000.0), (16, 1e5, 2e5), (4096, 13.0, 30.0), (333, 2e3, 1e3)] {
+        for (r, fb, frc) in [
+            (1000, 500.0, 2000.0),
+            (16, 1e5, 2e5),
+            (4096, 13.0, 30.0),
+            (333, 2e3, 1e3),
+        ] {
             let f = design(50e6, r, fb, frc).unwrap();
             let k = f.coefficients;
             let bound = 0.5 * (1.0 / k.k0 as f64 + 2.0 / -(k.k1 as f64 + k.k2 as f64));
-            assert!((f.dc_gain - 1.0).abs() <= bound, "R {r}: gain {}", f.dc_gain);
+            assert!(
+                (f.dc_gain - 1.0).abs() <= bound,
+                "R {r}: gain {}",
+                f.dc_gain
+            );
         }
     }
 
     #[test]
     fn dead_band_is_below_a_quarter_output_lsb_over_the_allowed_range() {
-        let f = design(50e6, 4096, 50e6 / 4096.0 * MIN_CUTOFF_RATIO * 1.0001, 1000.0).unwrap();
+        let f = design(
+            50e6,
+            4096,
+            50e6 / 4096.0 * MIN_CUTOFF_RATIO * 1.0001,
+            1000.0,
+        )
+        .unwrap();
         assert!(f.dead_band_lsb < 0.25, "{}", f.dead_band_lsb);
     }
 
     #[test]
     fn out_of_range_settings_name_the_setting() {
-        assert!(design(50e6, 8, 100.0, 100.0).unwrap_err().starts_with("cic decimation = 8"));
-        assert!(design(50e6, 1000, 20e3, 100.0).unwrap_err().starts_with("butterworth_hz = 20000"));
-        assert!(design(50e6, 1000, 500.0, f64::NAN).unwrap_err().starts_with("rc_hz = NaN"));
+        assert!(
+            design(50e6, 8, 100.0, 100.0)
+                .unwrap_err()
+                .starts_with("cic decimation = 8")
+        );
+        assert!(
+            design(50e6, 1000, 20e3, 100.0)
+                .unwrap_err()
+                .starts_with("butterworth_hz = 20000")
+        );
+        assert!(
+            design(50e6, 1000, 500.0, f64::NAN)
+                .unwrap_err()
+                .starts_with("rc_hz = NaN")
+        );
     }
 }

@@ -206,13 +206,11 @@ impl Logic for IirLowpass {
         self.u_rounded.next = self.u.q.val() + self.half_output_lsb.val();
         // Schedule.
         self.z_valid_out.d.next = false;
-        if self.step.q.val() == 0 {
-            if self.x_valid.val() {
-                self.x0.d.next = self.x.val();
-                self.x1.d.next = self.x0.q.val();
-                self.x2.d.next = self.x1.q.val();
-                self.step.d.next = 1.into();
-            }
+        if (self.step.q.val() == 0) && self.x_valid.val() {
+            self.x0.d.next = self.x.val();
+            self.x1.d.next = self.x0.q.val();
+            self.x2.d.next = self.x1.q.val();
+            self.step.d.next = 1.into();
         }
         if self.step.q.val() == 1 {
             self.v.d.next = signed_cast(self.v_shifted.val());
@@ -270,3 +268,202 @@ impl Logic for IirLowpass {
 }
 
 crate::impl_clocked!(IirLowpass);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::drive::{prepare, tick};
+    use crate::filter_design::{self, FilterDesign};
+    use crate::model::iir_lowpass::{Coefficients, IirLowpass as Model};
+    use crate::primitives::convert::{i128_to_signed, signed_to_i128};
+    use crate::test_util::Rng;
+
+    /// Largest CIC output magnitude for valid settings: the mixer output is
+    /// below 2^30 and the CIC gain at most 1, times 2^8.
+    const FULL_SCALE: i64 = 1 << 38;
+
+    fn designs() -> Vec<FilterDesign> {
+        [
+            (1000, 500.0, 2000.0),
+            (16, 6e5, 3e5),
+            (4096, 12.3, 100.0),
+            (333, 30e3, 1e3),
+        ]
+        .into_iter()
+        .map(|(r, b, c)| filter_design::design(50e6, r, b, c).unwrap())
+        .collect()
+    }
+
+    /// Feed one sample per schedule; return z after each.
+    fn run(model: &mut Model, k: &Coefficients, x: &[i64]) -> Vec<i64> {
+        x.iter()
+            .map(|&v| {
+                model.step(v, true, k);
+                loop {
+                    let (z, valid) = model.step(0, false, k);
+                    if valid {
+                        break z;
+                    }
+                }
+            })
+            .collect()
+    }
+
+    /// The same recursion in f64 with the quantized coefficients: the
+    /// fixed-point model may differ from it only by its roundings.
+    fn run_float(k: &Coefficients, x: &[i64]) -> Vec<f64> {
+        let s = 2f64.powi(30);
+        let (k0, k1, k2, a) = (
+            k.k0 as f64 / s,
+            k.k1 as f64 / s,
+            k.k2 as f64 / s,
+            k.alpha as f64 / s,
+        );
+        let (mut x1, mut x2, mut y1, mut y2, mut u) = (0.0, 0.0, 0.0, 0.0, 0.0);
+        x.iter()
+            .map(|&x0| {
+                let x0 = x0 as f64;
+                let y = 2.0 * y1 - y2 + k0 * (x0 + 2.0 * x1 + x2) + k1 * y1 + k2 * y2;
+                (x2, x1, y2, y1) = (x1, x0, y1, y);
+                u += a * (y - u);
+                u
+            })
+            .collect()
+    }
+
+    #[test]
+    fn rtl_matches_model_with_random_inputs_and_dropped_strobes() {
+        let mut uut = IirLowpass::new();
+        prepare(&mut uut);
+        let mut model = Model::default();
+        let mut rng = Rng::new(23);
+        let designs = designs();
+        let mut k = designs[0].coefficients;
+        let mut x = 0i64;
+        let mut outputs = 0;
+        for n in 0..6000 {
+            if n % 1500 == 0 {
+                k = designs[n / 1500].coefficients;
+            }
+            // Strobes every 1..20 clocks: some land while a schedule runs.
+            let valid = rng.range(0, 12) == 0;
+            if valid {
+                x = rng.range(-FULL_SCALE, FULL_SCALE);
+            }
+            let s = |v: i32| i128_to_signed::<32>(v as i128);
+            uut.x.next = i128_to_signed(x as i128);
+            uut.x_valid.next = valid;
+            uut.k0.next = s(k.k0);
+            uut.k1.next = s(k.k1);
+            uut.k2.next = s(k.k2);
+            uut.alpha.next = s(k.alpha);
+            tick(&mut uut);
+            let hw = (signed_to_i128(uut.z.val()) as i64, uut.z_valid.val());
+            assert_eq!(hw, model.step(x, valid, &k), "cycle {n}");
+            outputs += hw.1 as u32;
+        }
+        assert!(outputs > 200, "only {outputs} outputs");
+    }
+
+    #[test]
+    fn step_and_impulse_track_the_float_recursion() {
+        // Each section rounds once per sample (half a state LSB, 2^-16
+        // output LSB); the recursion amplifies a constant rounding error by
+        // at most its dead band (< 0.25 output LSB, `filter_design`), and
+        // the output rounding adds 0.5. So |z - float| < 1 output LSB.
+        for f in designs() {
+            let k = f.coefficients;
+            let n = 4000;
+            let step: Vec<i64> = vec![FULL_SCALE / 3; n];
+            let mut impulse = vec![0i64; n];
+            impulse[0] = FULL_SCALE;
+            for x in [step, impulse] {
+                let z = run(&mut Model::default(), &k, &x);
+                let reference = run_float(&k, &x);
+                for (i, (&zi, &ri)) in z.iter().zip(&reference).enumerate() {
+                    assert!(
+                        (zi as f64 - ri).abs() < 1.0,
+                        "R {} sample {i}: {zi} vs {ri}",
+                        f.decimation
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn dc_gain_of_the_chain_is_the_designed_one() {
+        // CIC output c G (G = CIC gain) comes out as c G * 4 k0 / -(k1 + k2)
+        // = c * dc_gain, to within the dead band and output rounding.
+        for f in designs() {
+            let c = 123_456_789_i64;
+            let x = vec![(c as f64 * f.cic_gain).round() as i64; 6000];
+            let z = run(&mut Model::default(), &f.coefficients, &x);
+            let want = x[0] as f64 / f.cic_gain * f.dc_gain;
+            assert!(
+                (*z.last().unwrap() as f64 - want).abs() < 1.0,
+                "R {}",
+                f.decimation
+            );
+        }
+    }
+
+    #[test]
+    fn worst_case_full_scale_input_does_not_overflow() {
+        // The input that maximizes the output at sample N is the sign
+        // pattern of the impulse response read backwards; its peak is
+        // FULL_SCALE times the l1 norm of h (about 1.1 for these filters).
+        // Any wrap-around would show as a huge error against the float run.
+        for f in designs() {
+            let k = f.coefficients;
+            let n = 3000;
+            let mut impulse = vec![0i64; n];
+            impulse[0] = 1 << 30;
+            let h = run_float(&k, &impulse);
+            for sign in [1i64, -1] {
+                let x: Vec<i64> = (0..n)
+                    .map(|i| sign * FULL_SCALE * h[n - 1 - i].signum() as i64)
+                    .collect();
+                let z = run(&mut Model::default(), &k, &x);
+                let reference = run_float(&k, &x);
+                let peak = reference.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                assert!(
+                    peak > FULL_SCALE as f64,
+                    "worst case did not exceed full scale"
+                );
+                for (i, (&zi, &ri)) in z.iter().zip(&reference).enumerate() {
+                    assert!(
+                        (zi as f64 - ri).abs() < 1.0,
+                        "R {} sample {i}",
+                        f.decimation
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn zero_input_after_full_scale_returns_exactly_to_zero() {
+        // No limit cycle and no dead band visible at the output: after
+        // random full-scale samples, zeros bring z to exactly 0 and keep it
+        // there. The decay to below half an LSB from 2^38 takes about
+        // ln(2^39) / (1 - r) samples; 20000 covers the slowest design.
+        let mut rng = Rng::new(29);
+        for f in designs() {
+            let k = f.coefficients;
+            let mut x: Vec<i64> = (0..200)
+                .map(|_| rng.range(-FULL_SCALE, FULL_SCALE))
+                .collect();
+            x.extend(std::iter::repeat_n(0, 20000));
+            let z = run(&mut Model::default(), &k, &x);
+            assert!(z[..200].iter().any(|&v| v != 0));
+            let tail = &z[z.len() - 5000..];
+            assert!(
+                tail.iter().all(|&v| v == 0),
+                "R {}: {:?}",
+                f.decimation,
+                &tail[..5]
+            );
+        }
+    }
+}

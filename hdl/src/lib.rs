@@ -1,20 +1,22 @@
 //! gyrocal-hdl: the synthesizable datapath of the gyrocal interface.
 
-pub mod drive;
-pub mod primitives;
-pub mod sincos;
-pub mod sine_table;
-pub mod model;
 pub mod am_mixer;
 pub mod carrier_nco;
 pub mod cic_decimator;
 pub mod demod_mux;
-pub mod iir_lowpass;
-pub mod modulation_nco;
-pub mod q15_multiplier;
-pub mod reference_alignment;
-pub mod gyro_interface;
-pub mod rtl;
+pub mod drive;
 pub mod export;
 pub mod filter_design;
+pub mod gyro_interface;
+pub mod iir_lowpass;
+pub mod model;
+pub mod modulation_nco;
+pub mod primitives;
+pub mod q15_multiplier;
+pub mod reference_alignment;
+pub mod rtl;
 pub mod settings;
+pub mod sincos;
+pub mod sine_table;
+#[cfg(test)]
+pub(crate) mod test_util;

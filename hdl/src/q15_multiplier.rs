@@ -74,3 +74,45 @@ impl Logic for Q15Multiplier {
 }
 
 crate::impl_clocked!(Q15Multiplier);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::drive::{prepare, tick};
+    use crate::model::q15_multiplier::{Q15Multiplier as Model, q15_product};
+    use crate::primitives::convert::{i128_to_signed, signed_to_i128};
+    use crate::test_util::Rng;
+
+    #[test]
+    fn extreme_factors_never_overflow() {
+        // Exact reference: floor((a b + 2^14) / 2^15) in i64. For every b
+        // above -32768 the result must equal it and lie in [-32767, 32767].
+        let extremes = [i16::MIN, -32767, -16384, -1, 0, 1, 16384, 32766, i16::MAX];
+        for a in extremes {
+            for b in extremes.iter().copied().filter(|&b| b != i16::MIN) {
+                let exact = (a as i64 * b as i64 + (1 << 14)).div_euclid(1 << 15);
+                assert!((-32767..=32767).contains(&exact));
+                assert_eq!(q15_product(a, b) as i64, exact, "{a} x {b}");
+            }
+        }
+    }
+
+    #[test]
+    fn rtl_matches_model_on_extremes_and_random_words() {
+        let mut uut = Q15Multiplier::new();
+        prepare(&mut uut);
+        let mut model = Model::default();
+        let mut rng = Rng::new(7);
+        for n in 0..3000 {
+            let (a, b) = (rng.word16(), rng.word16().max(-32767));
+            uut.a.next = i128_to_signed(a as i128);
+            uut.b.next = i128_to_signed(b as i128);
+            tick(&mut uut);
+            assert_eq!(
+                signed_to_i128(uut.y.val()) as i16,
+                model.step(a, b),
+                "cycle {n}"
+            );
+        }
+    }
+}

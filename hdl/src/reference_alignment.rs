@@ -78,3 +78,50 @@ impl Logic for ReferenceAlignment {
 }
 
 crate::impl_clocked!(ReferenceAlignment);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::drive::{prepare, tick};
+    use crate::model::reference_alignment::ReferenceAlignment as Model;
+    use crate::primitives::convert::{i128_to_signed, signed_to_i128, u128_to_bits};
+    use crate::test_util::Rng;
+
+    #[test]
+    fn rtl_matches_model_with_changing_delay() {
+        let mut uut = ReferenceAlignment::new();
+        prepare(&mut uut);
+        let mut model = Model::default();
+        let mut rng = Rng::new(13);
+        let mut delay = 0u8;
+        for n in 0..3000 {
+            if n % 37 == 0 {
+                delay = rng.range(0, 63) as u8;
+            }
+            let (r1, r2) = (rng.word16(), rng.word16());
+            uut.ref1.next = i128_to_signed(r1 as i128);
+            uut.ref2.next = i128_to_signed(r2 as i128);
+            uut.delay.next = u128_to_bits(delay as u128);
+            // The tap read is combinational: compare before and after the edge.
+            let v = |x: Signed<16>| signed_to_i128(x) as i16;
+            tick(&mut uut);
+            model.step(r1, r2);
+            assert_eq!(
+                (v(uut.aligned1.val()), v(uut.aligned2.val())),
+                model.output(delay),
+                "cycle {n}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_delay_of_d_delays_by_d_plus_one_clocks() {
+        let mut model = Model::default();
+        for k in 0..100i16 {
+            model.step(k, -k);
+            if k >= 10 {
+                assert_eq!(model.output(9), (k - 9, 9 - k));
+            }
+        }
+    }
+}

@@ -7,15 +7,16 @@
 //!
 //! # Reference alignment
 //!
-//! Let the DAC output the word of cycle k over [(k + L_dac) T, (k + L_dac +
-//! 1) T) (latency L_dac clocks, zero-order hold) and the ADC present during
-//! cycle m the sample taken at the edge (m - L_adc) T. The hold's
+//! Let the DAC output the word of cycle k over the clock period that starts
+//! L_dac clocks later (zero-order hold), and let the ADC present during
+//! cycle m the sample taken at the edge of cycle m - L_adc. The hold's
 //! fundamental is the word sequence delayed by L_dac + 1/2 clocks (and
 //! scaled by sinc(f T)), so the sample reaching the mixer at cycle n
-//! (`demod_mux`: adc(n - 2)) responds to drive word n - 2 - L_adc - L_dac -
-//! 1/2. The reference used at cycle n is ref(n - 3 - ref_delay)
-//! (`demod_mux` 2 clocks + `reference_alignment` ref_delay + 1), advanced in
-//! phase by ref_phase / step words. Equating the two:
+//! (`demod_mux` uses adc(n - 2)) responds to drive word number
+//! n - 2 - L_adc - L_dac - 1/2. The reference used at cycle n is
+//! ref(n - 3 - ref_delay) (`demod_mux` 2 clocks, `reference_alignment`
+//! ref_delay + 1), advanced in phase by ref_phase / carrier_step words.
+//! Equating the two:
 //!
 //! ```text
 //!   ref_delay = L_dac + L_adc,   ref_phase = carrier_step / 2
@@ -72,7 +73,9 @@ const FULL_SCALE: f64 = 32768.0;
 pub fn registers(plan: &FrequencyPlan) -> Result<(Registers, Realized), String> {
     let clock = plan.clock_hz;
     if !(clock.is_finite() && clock > 0.0) {
-        return Err(format!("clock_hz = {clock}: must be a positive number of Hz"));
+        return Err(format!(
+            "clock_hz = {clock}: must be a positive number of Hz"
+        ));
     }
     let nyquist = clock / 2.0;
     if !(plan.carrier_hz.is_finite() && plan.carrier_hz > 0.0 && plan.carrier_hz < nyquist) {
@@ -97,7 +100,10 @@ pub fn registers(plan: &FrequencyPlan) -> Result<(Registers, Realized), String> 
     let mut amp = [0i16; 2];
     for (k, a) in [plan.amplitude.0, plan.amplitude.1].into_iter().enumerate() {
         if !(a.is_finite() && (-1.0..1.0).contains(&a)) {
-            return Err(format!("amplitude of drive {} = {a}: allowed -1 <= a < 1", k + 1));
+            return Err(format!(
+                "amplitude of drive {} = {a}: allowed -1 <= a < 1",
+                k + 1
+            ));
         }
         amp[k] = (a * FULL_SCALE).round().min(32767.0) as i16;
     }
@@ -172,14 +178,26 @@ mod tests {
     fn bad_plans_name_the_setting() {
         let mut p = plan();
         p.carrier_hz = 25e6;
-        assert!(registers(&p).unwrap_err().starts_with("carrier_hz = 25000000"));
+        assert!(
+            registers(&p)
+                .unwrap_err()
+                .starts_with("carrier_hz = 25000000")
+        );
         let mut p = plan();
         p.amplitude.1 = 1.0;
-        assert!(registers(&p).unwrap_err().starts_with("amplitude of drive 2"));
+        assert!(
+            registers(&p)
+                .unwrap_err()
+                .starts_with("amplitude of drive 2")
+        );
         let mut p = plan();
         p.dac_latency = 60;
         p.adc_latency = 4;
-        assert!(registers(&p).unwrap_err().starts_with("dac_latency + adc_latency = 64"));
+        assert!(
+            registers(&p)
+                .unwrap_err()
+                .starts_with("dac_latency + adc_latency = 64")
+        );
     }
 
     #[test]

@@ -15,7 +15,7 @@
 //! Taylor correction in `sincos` uses it to interpolate between entries, which
 //! takes the spur level from about -72 dBc (plain 256-entry table) to below
 //! -100 dBc. Both columns are positive and below 2^15 (value <= 32767,
-//! slope <= 25736), so they are stored as 16-bit signed words.
+//! slope <= 25735), so they are stored as 16-bit signed words.
 
 /// Address bits of the quarter-wave table (256 entries).
 pub const ADDRESS_BITS: usize = 8;
@@ -47,7 +47,10 @@ pub fn slope(i: usize) -> i32 {
 
 /// Both columns, built once: `(value, slope)`.
 pub fn table() -> (Vec<i32>, Vec<i32>) {
-    ((0..ENTRIES).map(value).collect(), (0..ENTRIES).map(slope).collect())
+    (
+        (0..ENTRIES).map(value).collect(),
+        (0..ENTRIES).map(slope).collect(),
+    )
 }
 
 #[cfg(test)]
@@ -60,7 +63,7 @@ mod tests {
         assert!(v.iter().all(|&x| (0..=PEAK).contains(&x)));
         assert!(s.iter().all(|&x| (0..=PEAK).contains(&x)));
         assert_eq!(*v.last().unwrap(), PEAK);
-        assert_eq!(s[0], 25736);
+        assert_eq!(s[0], 25735);
     }
 
     #[test]

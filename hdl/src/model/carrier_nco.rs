@@ -29,7 +29,12 @@ impl CarrierNco {
     pub fn output(&self) -> Carriers {
         let (drive_sin, drive_cos) = self.drive.output();
         let (ref_sin, ref_cos) = self.reference.output();
-        Carriers { drive_cos, drive_sin, ref_cos, ref_sin }
+        Carriers {
+            drive_cos,
+            drive_sin,
+            ref_cos,
+            ref_sin,
+        }
     }
 
     /// One clock with the given step and reference offset; outputs after the edge.

@@ -23,7 +23,11 @@ impl DemodMux {
             self.adc.1 as i32 * self.reference.1 as i32,
         );
         self.adc = adc;
-        self.reference = if select { (aligned.1, aligned.0) } else { aligned };
+        self.reference = if select {
+            (aligned.1, aligned.0)
+        } else {
+            aligned
+        };
         self.w
     }
 }

@@ -82,7 +82,11 @@ impl GyroInterface {
         let drives = self.am_mixer.output();
         let (z1, z_valid) = self.iir[0].output();
         let (z2, _) = self.iir[1].output();
-        Outputs { dac: (drives.dac1, drives.dac2), z: (z1, z2), z_valid }
+        Outputs {
+            dac: (drives.dac1, drives.dac2),
+            z: (z1, z2),
+            z_valid,
+        }
     }
 
     /// Internal signals during the current cycle.

@@ -24,7 +24,11 @@ impl ModulationNco {
     #[inline(always)]
     pub fn step(&mut self, step: u64, select: bool) -> (i16, i16) {
         let (sin, cos) = self.sincos.output();
-        self.am = if select { (cos, sin) } else { (PEAK as i16, PEAK as i16) };
+        self.am = if select {
+            (cos, sin)
+        } else {
+            (PEAK as i16, PEAK as i16)
+        };
         self.sincos.step((self.phase >> 16) as u32);
         self.phase = (self.phase + step) & PHASE_MASK;
         self.am

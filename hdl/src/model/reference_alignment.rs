@@ -12,7 +12,10 @@ pub struct ReferenceAlignment {
 
 impl Default for ReferenceAlignment {
     fn default() -> Self {
-        Self { taps: [(0, 0); TAPS], newest: 0 }
+        Self {
+            taps: [(0, 0); TAPS],
+            newest: 0,
+        }
     }
 }
 

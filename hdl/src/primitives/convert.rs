@@ -46,6 +46,18 @@ pub fn bits_to_u64<const N: usize>(x: Bits<N>) -> u64 {
     x.to_u64()
 }
 
+/// Sign extension (or truncation) of a `Signed<N>` to `Signed<M>`.
+///
+/// In `#[hdl_gen]` code any function whose name starts with
+/// `signed_bit_cast` becomes Verilog `$signed(x)`, which sign-extends when
+/// assigned straight to a wider signed signal. rust-hdl's own
+/// `signed_bit_cast` recurses forever on the most negative value (Rust side
+/// only); this one is exact for every input. Assign its result directly to
+/// a `Signal<Local, Signed<M>>`, never inside a larger expression.
+pub fn signed_bit_cast_exact<const M: usize, const N: usize>(x: Signed<N>) -> Signed<M> {
+    i128_to_signed::<M>(signed_to_i128(x))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -61,16 +73,4 @@ mod tests {
         assert_eq!(signed_to_i128(i128_to_signed::<16>(1 << 15)), -(1 << 15));
         assert_eq!(bits_to_u64(u128_to_bits::<48>(u128::MAX)), (1 << 48) - 1);
     }
-}
-
-/// Sign extension (or truncation) of a `Signed<N>` to `Signed<M>`.
-///
-/// In `#[hdl_gen]` code any function whose name starts with
-/// `signed_bit_cast` becomes Verilog `$signed(x)`, which sign-extends when
-/// assigned straight to a wider signed signal. rust-hdl's own
-/// `signed_bit_cast` recurses forever on the most negative value (Rust side
-/// only); this one is exact for every input. Assign its result directly to
-/// a `Signal<Local, Signed<M>>`, never inside a larger expression.
-pub fn signed_bit_cast_exact<const M: usize, const N: usize>(x: Signed<N>) -> Signed<M> {
-    i128_to_signed::<M>(signed_to_i128(x))
 }

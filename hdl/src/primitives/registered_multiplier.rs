@@ -39,7 +39,10 @@ impl<const A: usize, const B: usize, const P: usize> RegisteredMultiplier<A, B, 
     /// A multiplier; panics at construction if `P != A + B` or `P > 128`.
     pub fn new() -> Self {
         assert_eq!(P, A + B, "RegisteredMultiplier needs P = A + B");
-        assert!(P <= 128, "RegisteredMultiplier products are at most 128 bits");
+        assert!(
+            P <= 128,
+            "RegisteredMultiplier products are at most 128 bits"
+        );
         Self {
             clock: Default::default(),
             a: Default::default(),

@@ -34,7 +34,10 @@ pub struct TappedDelayLine<const W: usize, const A: usize> {
 impl<const W: usize, const A: usize> TappedDelayLine<W, A> {
     /// A delay line of `2^A` taps, all zero; `A` must be between 1 and 10.
     pub fn new() -> Self {
-        assert!((1..=10).contains(&A), "TappedDelayLine depth must be 2..1024 taps");
+        assert!(
+            (1..=10).contains(&A),
+            "TappedDelayLine depth must be 2..1024 taps"
+        );
         Self {
             clock: Default::default(),
             d: Default::default(),
