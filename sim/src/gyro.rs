@@ -1,0 +1,283 @@
+//! Two-mode gyroscope model, discretized exactly and stepped once per FPGA clock.
+//!
+//! # Equations
+//!
+//! Paper eqs (1)/(3) of Shirazi et al. (TRANSDUCERS 2013), generalized to
+//! mismatched modes (one frequency and one Q per mode):
+//!
+//! ```text
+//! x1'' + B1 x1' - 2 lam Omz x2' + w1^2 x1 = f1(t)
+//! x2'' + B2 x2' + 2 lam Omz x1' + w2^2 x2 = f2(t)        Bk = wk / Qk,  wk = 2 pi fk
+//! ```
+//!
+//! # Units
+//!
+//! Positions `x1`, `x2` in m, velocities in m/s, forces per unit mass `f1`, `f2`
+//! in N/kg = m/s^2, rate `Omz` in rad/s, frequencies in Hz, the clock in Hz.
+//!
+//! # Discretization
+//!
+//! The forces are held constant over each clock period `T = 1/clock_hz`
+//! (zero-order hold, like a DAC) and the rate is piecewise constant, so the
+//! model is discretized exactly, with no Euler or Runge-Kutta error:
+//!
+//! ```text
+//! exp( [[A, B], [0, 0]] * T ) = [[Phi, Gamma], [0, I]]
+//! s[n+1] = Phi s[n] + Gamma [f1[n], f2[n]]^T          s[n] = s(nT)
+//! ```
+//!
+//! `exp` is nalgebra's scaling-and-squaring Pade matrix exponential, evaluated
+//! once per rate change (the `Omz = 0` matrices are cached). For conditioning,
+//! the state is kept as `[x1, v1/wr, x2, v2/wr]` with `wr = (w1 + w2)/2`, and the
+//! input column of the augmented matrix is scaled by `wr^2`, so every entry of
+//! the matrix handed to `exp` is of order `w T` (at most about pi) or smaller,
+//! instead of mixing 1, 6e7 and 1e-16. A step is then a plain 4x4 plus 4x2
+//! multiply on `[f64; 4]` arrays: no allocation, no nalgebra.
+
+use nalgebra::SMatrix;
+
+/// Physical parameters of the two-mode gyroscope.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GyroParams {
+    /// Resonance frequency of mode 1 (Hz).
+    pub f1_hz: f64,
+    /// Resonance frequency of mode 2 (Hz).
+    pub f2_hz: f64,
+    /// Quality factor of mode 1 (B1 = w1/q1).
+    pub q1: f64,
+    /// Quality factor of mode 2 (B2 = w2/q2).
+    pub q2: f64,
+    /// Angular gain lambda (Coriolis coupling is 2 lambda Omz).
+    pub angular_gain: f64,
+}
+
+/// Transition and input matrices of one clock period, as plain arrays.
+#[derive(Clone, Debug, PartialEq)]
+struct Discrete {
+    phi: [[f64; 4]; 4],
+    gamma: [[f64; 2]; 4],
+}
+
+/// The gyroscope, stepped once per clock with zero-order-held forces.
+///
+/// Internal state is scaled (`[x1, v1/wr, x2, v2/wr]`); [`GyroModel::state`]
+/// and [`GyroModel::set_state`] use physical units `[x1, v1, x2, v2]`.
+#[derive(Clone, Debug)]
+pub struct GyroModel {
+    params: GyroParams,
+    clock_hz: f64,
+    /// Reference angular frequency used to scale velocities (rad/s).
+    wr: f64,
+    omz: f64,
+    /// `Omz != 0` (and lambda != 0): the full 4x4 step is needed.
+    coupled: bool,
+    rest: Discrete,
+    cur: Discrete,
+    s: [f64; 4],
+}
+
+fn check(name: &str, value: f64, ok: bool, allowed: &str) -> Result<(), String> {
+    if value.is_finite() && ok {
+        Ok(())
+    } else {
+        Err(format!("{name} = {value}: must be {allowed}"))
+    }
+}
+
+impl GyroModel {
+    /// Builds the model for a clock of `clock_hz`, at rest (zero state, `Omz = 0`).
+    ///
+    /// Errors (one line, naming the field) unless `clock_hz` is finite and > 0,
+    /// both mode frequencies are finite and in (0, clock_hz/2), both Q are finite
+    /// and > 0, and the angular gain is finite.
+    pub fn new(params: &GyroParams, clock_hz: f64) -> Result<GyroModel, String> {
+        check("clock_hz", clock_hz, clock_hz > 0.0, "finite and > 0 Hz")?;
+        let nyq = clock_hz / 2.0;
+        let allowed_f = format!("finite and in (0, clock_hz/2 = {nyq} Hz)");
+        check(
+            "f1_hz",
+            params.f1_hz,
+            params.f1_hz > 0.0 && params.f1_hz < nyq,
+            &allowed_f,
+        )?;
+        check(
+            "f2_hz",
+            params.f2_hz,
+            params.f2_hz > 0.0 && params.f2_hz < nyq,
+            &allowed_f,
+        )?;
+        check("q1", params.q1, params.q1 > 0.0, "finite and > 0")?;
+        check("q2", params.q2, params.q2 > 0.0, "finite and > 0")?;
+        check("angular_gain", params.angular_gain, true, "finite")?;
+        let w1 = std::f64::consts::TAU * params.f1_hz;
+        let w2 = std::f64::consts::TAU * params.f2_hz;
+        let wr = 0.5 * (w1 + w2);
+        let mut model = GyroModel {
+            params: params.clone(),
+            clock_hz,
+            wr,
+            omz: 0.0,
+            coupled: false,
+            rest: Discrete {
+                phi: [[0.0; 4]; 4],
+                gamma: [[0.0; 2]; 4],
+            },
+            cur: Discrete {
+                phi: [[0.0; 4]; 4],
+                gamma: [[0.0; 2]; 4],
+            },
+            s: [0.0; 4],
+        };
+        let mut rest = model.discretize(0.0);
+        // Decoupled modes: the off-diagonal blocks are zero in exact arithmetic
+        // (and in nalgebra's Pade evaluation); make that explicit, since step()
+        // skips them at Omz = 0.
+        for (i, j) in [(0, 2), (0, 3), (1, 2), (1, 3)] {
+            rest.phi[i][j] = 0.0;
+            rest.phi[j][i] = 0.0;
+        }
+        for i in 0..2 {
+            rest.gamma[i][1] = 0.0;
+            rest.gamma[i + 2][0] = 0.0;
+        }
+        model.rest = rest;
+        model.cur = model.rest.clone();
+        Ok(model)
+    }
+
+    /// Exact ZOH discretization at rate `omz` (rad/s).
+    fn discretize(&self, omz: f64) -> Discrete {
+        let p = &self.params;
+        let w1 = std::f64::consts::TAU * p.f1_hz;
+        let w2 = std::f64::consts::TAU * p.f2_hz;
+        let (b1, b2) = (w1 / p.q1, w2 / p.q2);
+        let g = 2.0 * p.angular_gain * omz;
+        let wr = self.wr;
+        let t = 1.0 / self.clock_hz;
+        // Scaled state s = [x1, u1, x2, u2], u = v/wr; scaled input g_k = f_k/wr^2:
+        //   x1' = wr u1,  u1' = -(w1^2/wr) x1 - B1 u1 + 2 lam Omz u2 + wr g1
+        //   x2' = wr u2,  u2' = -(w2^2/wr) x2 - B2 u2 - 2 lam Omz u1 + wr g2
+        #[rustfmt::skip]
+        let m = SMatrix::<f64, 6, 6>::from_row_slice(&[
+            0.0,           wr,  0.0,           0.0, 0.0, 0.0,
+            -w1 * w1 / wr, -b1, 0.0,           g,   wr,  0.0,
+            0.0,           0.0, 0.0,           wr,  0.0, 0.0,
+            0.0,           -g,  -w2 * w2 / wr, -b2, 0.0, wr,
+            0.0,           0.0, 0.0,           0.0, 0.0, 0.0,
+            0.0,           0.0, 0.0,           0.0, 0.0, 0.0,
+        ]) * t;
+        let e = m.exp();
+        let inv_wr2 = 1.0 / (wr * wr);
+        let mut d = Discrete {
+            phi: [[0.0; 4]; 4],
+            gamma: [[0.0; 2]; 4],
+        };
+        for i in 0..4 {
+            for j in 0..4 {
+                d.phi[i][j] = e[(i, j)];
+            }
+            for j in 0..2 {
+                // Gamma acts on the physical force f = wr^2 g.
+                d.gamma[i][j] = e[(i, 4 + j)] * inv_wr2;
+            }
+        }
+        d
+    }
+
+    /// Sets the (piecewise constant) rotation rate `Omz` (rad/s) that applies from
+    /// the next step on; recomputes the transition matrices (cached for 0).
+    ///
+    /// # Panics
+    /// If `omz_rad_s` is not finite.
+    pub fn set_rate(&mut self, omz_rad_s: f64) {
+        assert!(
+            omz_rad_s.is_finite(),
+            "set_rate: omz_rad_s = {omz_rad_s}: must be finite"
+        );
+        if omz_rad_s == self.omz {
+            return;
+        }
+        self.omz = omz_rad_s;
+        self.coupled = omz_rad_s != 0.0 && self.params.angular_gain != 0.0;
+        self.cur = if omz_rad_s == 0.0 {
+            self.rest.clone()
+        } else {
+            self.discretize(omz_rad_s)
+        };
+    }
+
+    /// Advances one clock period with the forces per unit mass `f1`, `f2` (N/kg)
+    /// held constant over it (zero-order hold).
+    ///
+    /// At `Omz = 0` the modes are decoupled and only the two 2x2 diagonal blocks
+    /// are used (the others are exactly zero): about 1.3x faster, same result.
+    #[inline]
+    pub fn step(&mut self, f1: f64, f2: f64) {
+        let p = &self.cur.phi;
+        let g = &self.cur.gamma;
+        let s = self.s;
+        // The input term does not depend on the state: adding it first keeps
+        // it off the critical (state-to-state) latency path.
+        self.s = if self.coupled {
+            let row = |i: usize| {
+                ((g[i][0] * f1 + g[i][1] * f2) + p[i][0] * s[0] + p[i][1] * s[1])
+                    + (p[i][2] * s[2] + p[i][3] * s[3])
+            };
+            [row(0), row(1), row(2), row(3)]
+        } else {
+            [
+                (g[0][0] * f1 + p[0][0] * s[0]) + p[0][1] * s[1],
+                (g[1][0] * f1 + p[1][0] * s[0]) + p[1][1] * s[1],
+                (g[2][1] * f2 + p[2][2] * s[2]) + p[2][3] * s[3],
+                (g[3][1] * f2 + p[3][2] * s[2]) + p[3][3] * s[3],
+            ]
+        };
+    }
+
+    /// Position of mode 1 at the current clock edge (m).
+    #[inline]
+    pub fn x1(&self) -> f64 {
+        self.s[0]
+    }
+
+    /// Position of mode 2 at the current clock edge (m).
+    #[inline]
+    pub fn x2(&self) -> f64 {
+        self.s[2]
+    }
+
+    /// State `[x1, v1, x2, v2]` at the current clock edge (m, m/s, m, m/s).
+    pub fn state(&self) -> [f64; 4] {
+        [
+            self.s[0],
+            self.s[1] * self.wr,
+            self.s[2],
+            self.s[3] * self.wr,
+        ]
+    }
+
+    /// Sets the state `[x1, v1, x2, v2]` (m, m/s, m, m/s).
+    pub fn set_state(&mut self, state: [f64; 4]) {
+        self.s = [state[0], state[1] / self.wr, state[2], state[3] / self.wr];
+    }
+
+    /// Zeroes the state (the rate is kept).
+    pub fn reset(&mut self) {
+        self.s = [0.0; 4];
+    }
+
+    /// Current rotation rate `Omz` (rad/s).
+    pub fn rate(&self) -> f64 {
+        self.omz
+    }
+
+    /// The parameters the model was built with.
+    pub fn params(&self) -> &GyroParams {
+        &self.params
+    }
+
+    /// The clock frequency (Hz) (one step = one period).
+    pub fn clock_hz(&self) -> f64 {
+        self.clock_hz
+    }
+}

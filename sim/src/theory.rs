@@ -1,0 +1,251 @@
+//! Exact steady state of the linear gyroscope model, and the paper's equations.
+//!
+//! # Model and conventions
+//!
+//! Paper eqs (1)/(3) generalized to mismatched modes (see [`crate::gyro`]):
+//!
+//! ```text
+//! x1'' + B1 x1' - 2 lam Omz x2' + w1^2 x1 = f1,   x2'' + B2 x2' + 2 lam Omz x1' + w2^2 x2 = f2
+//! Bk = wk/Qk, wk = 2 pi fk, wb = 2 pi carrier_hz.
+//! Readout:     f1 = F1 cos(wb t),             f2 = F2 sin(wb t)
+//!              z1 = DC[x1 F1 cos(wb t)],      z2 = DC[x2 F2 sin(wb t)]
+//! Calibration: f1 = F1 cos(wb t) cos(Om t),   f2 = F2 sin(wb t) sin(Om t),  Omz = 0
+//!              z1 = DC[x1 F2 sin(wb t) sin(Om t)],  z2 = DC[x2 F1 cos(wb t) cos(Om t)]
+//! ```
+//!
+//! A calibration frequency `f_cal` (Hz) is the virtual rate `Om = 2 pi f_cal`
+//! rad/s = `360 f_cal` deg/s. Readout outputs are negative for a positive rate,
+//! calibration outputs positive (matched modes: ratio = -2 lam).
+//!
+//! # Exact steady state (continuous time, no sampling/hold/quantization)
+//!
+//! With `Dk(w) = wk^2 - w^2 + j w Bk` and `c = 2 lam Omz wb`, the readout phasors
+//! solve `[[D1, -j c], [j c, D2]] X = [F1, -j F2]`, so with `det = D1 D2 - c^2`:
+//!
+//! ```text
+//! z1 = F1/2 Re[(F1 D2 + c F2)/det] = F1/2 { F1 Re(1/D1) + Re[c (F2 D1 + c F1)/(D1 det)] }
+//! z2 = F2/2 Re[(F2 D1 + c F1)/det] = F2/2 { F2 Re(1/D2) + Re[c (F1 D2 + c F2)/(D2 det)] }
+//! ```
+//!
+//! The second form (offset + rate term) is what is evaluated: it avoids the
+//! cancellation between a large offset and a tiny rate signal. In calibration
+//! the modes are decoupled and each sees tones at `wb -+ Om`; only equal
+//! frequencies give DC, and `Hk(a) - Hk(b) = (b - a)(j Bk - a - b)/(Dk(a) Dk(b))`:
+//!
+//! ```text
+//! zk = F1 F2/8 Re[Hk(wb-Om) - Hk(wb+Om)] = F1 F2 Om/4 Re[(j Bk - 2 wb)/(Dk(wb-Om) Dk(wb+Om))]
+//! ```
+//!
+//! Small-signal scale factors (exact derivatives at 0, per rad/s):
+//!
+//! ```text
+//! SF_read,1 = SF_read,2 = lam wb F1 F2 Re[1/(D1 D2)]         (both outputs identical)
+//! SF_cal,k  = F1 F2/4 Re[(j Bk - 2 wb)/Dk^2]
+//! ```
+//!
+//! All `Dk` are evaluated as `(wk - wb)(wk + wb) + j wb Bk` with `wk - wb`
+//! formed from `fk - fb` (exact in f64 for close frequencies), and everything is
+//! normalized by `wb^2` so no intermediate can overflow.
+//!
+//! # Units
+//!
+//! Frequencies in Hz, rates in rad/s unless a name says `_dps` (deg/s), forces
+//! per unit mass `F1`, `F2` in N/kg, positions in m, `z` in m^2/s^2 (m x N/kg),
+//! scale factors in (m^2/s^2) per rad/s.
+//!
+//! The functions do not validate their inputs (a NaN or a zero frequency
+//! propagates to the result); [`crate::gyro::GyroModel::new`] does.
+
+use nalgebra::Complex;
+use std::f64::consts::TAU;
+
+use crate::gyro::GyroParams;
+
+type C64 = Complex<f64>;
+
+/// A gyroscope plus its excitation: everything the steady state depends on.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Device {
+    /// Resonance frequency of mode 1 (Hz).
+    pub f1_hz: f64,
+    /// Resonance frequency of mode 2 (Hz).
+    pub f2_hz: f64,
+    /// Quality factor of mode 1.
+    pub q1: f64,
+    /// Quality factor of mode 2.
+    pub q2: f64,
+    /// Angular gain lambda.
+    pub angular_gain: f64,
+    /// Excitation (carrier) frequency `fb`, `wb = 2 pi fb` (Hz).
+    pub carrier_hz: f64,
+    /// Drive amplitude F1 on mode 1 (force per unit mass) (N/kg).
+    pub f1_force: f64,
+    /// Drive amplitude F2 on mode 2 (force per unit mass) (N/kg).
+    pub f2_force: f64,
+}
+
+impl Device {
+    /// The mechanical parameters, for [`crate::gyro::GyroModel::new`].
+    pub fn gyro_params(&self) -> GyroParams {
+        GyroParams {
+            f1_hz: self.f1_hz,
+            f2_hz: self.f2_hz,
+            q1: self.q1,
+            q2: self.q2,
+            angular_gain: self.angular_gain,
+        }
+    }
+}
+
+/// Per-mode quantities normalized by wb: `dk(w) = Dk(w)/wb^2`, `bk = Bk/wb`.
+struct Norm {
+    wb: f64,
+    /// (wk - wb), (wk + wb) (rad/s)
+    delta: [f64; 2],
+    sigma: [f64; 2],
+    /// Bk / wb
+    b: [f64; 2],
+}
+
+impl Norm {
+    fn new(dev: &Device) -> Norm {
+        let fb = dev.carrier_hz;
+        let wb = TAU * fb;
+        let f = [dev.f1_hz, dev.f2_hz];
+        let q = [dev.q1, dev.q2];
+        Norm {
+            wb,
+            delta: [TAU * (f[0] - fb), TAU * (f[1] - fb)],
+            sigma: [TAU * (f[0] + fb), TAU * (f[1] + fb)],
+            b: [f[0] / fb / q[0], f[1] / fb / q[1]],
+        }
+    }
+
+    /// `Dk(wb + dw) / wb^2` for mode k.
+    fn d(&self, k: usize, dw: f64) -> C64 {
+        let wb2 = self.wb * self.wb;
+        let re = (self.delta[k] - dw) * (self.sigma[k] + dw) / wb2;
+        let im = (self.wb + dw) * self.b[k] / self.wb;
+        C64::new(re, im)
+    }
+}
+
+/// Exact steady-state readout outputs `[z1, z2]` (m^2/s^2) at rate `omz_rad_s`,
+/// offsets included (coupled 2x2 phasor solve at `wb`, no narrow-band approximation).
+pub fn readout_z(dev: &Device, omz_rad_s: f64) -> [f64; 2] {
+    let n = Norm::new(dev);
+    let (f1, f2) = (dev.f1_force, dev.f2_force);
+    let d1 = n.d(0, 0.0);
+    let d2 = n.d(1, 0.0);
+    // c / wb^2
+    let c = 2.0 * dev.angular_gain * omz_rad_s / n.wb;
+    let det = d1 * d2 - c * c;
+    let scale = 1.0 / (2.0 * n.wb * n.wb);
+    let z1 = f1 * (f1 * d1.inv().re + (c * (f2 * d1 + c * f1) / (d1 * det)).re);
+    let z2 = f2 * (f2 * d2.inv().re + (c * (f1 * d2 + c * f2) / (d2 * det)).re);
+    [z1 * scale, z2 * scale]
+}
+
+/// Exact steady-state calibration outputs `[z1, z2]` (m^2/s^2) at calibration
+/// (modulation) frequency `f_cal_hz`, i.e. virtual rate `Om = 2 pi f_cal_hz`.
+pub fn calibration_z(dev: &Device, f_cal_hz: f64) -> [f64; 2] {
+    let n = Norm::new(dev);
+    let om = TAU * f_cal_hz;
+    let k = dev.f1_force * dev.f2_force * om / (4.0 * n.wb.powi(3));
+    let z = |m: usize| {
+        let num = C64::new(-2.0, n.b[m]);
+        k * (num / (n.d(m, -om) * n.d(m, om))).re
+    };
+    [z(0), z(1)]
+}
+
+/// Exact small-signal readout scale factors `dz/dOmz` at `Omz = 0`
+/// ((m^2/s^2)/(rad/s)); the two outputs are identical in exact arithmetic.
+pub fn sf_read_per_rad_s(dev: &Device) -> [f64; 2] {
+    let n = Norm::new(dev);
+    let sf = dev.angular_gain * dev.f1_force * dev.f2_force / n.wb.powi(3)
+        * (n.d(0, 0.0) * n.d(1, 0.0)).inv().re;
+    [sf, sf]
+}
+
+/// Exact small-signal calibration scale factors `dz/dOm` at `Om -> 0`
+/// ((m^2/s^2)/(rad/s) of virtual rate).
+pub fn sf_cal_per_rad_s(dev: &Device) -> [f64; 2] {
+    let n = Norm::new(dev);
+    let k = dev.f1_force * dev.f2_force / (4.0 * n.wb.powi(3));
+    let sf = |m: usize| {
+        let d = n.d(m, 0.0);
+        k * (C64::new(-2.0, n.b[m]) / (d * d)).re
+    };
+    [sf(0), sf(1)]
+}
+
+/// Small-signal ratio `SF_read / SF_cal` per output (what calibration predicts).
+pub fn sf_ratio(dev: &Device) -> [f64; 2] {
+    let r = sf_read_per_rad_s(dev);
+    let c = sf_cal_per_rad_s(dev);
+    [r[0] / c[0], r[1] / c[1]]
+}
+
+/// `f(x) = x/(x^2 + 1)` of eqs (2) and (4).
+fn paper_f(x: f64) -> f64 {
+    x / (x * x + 1.0)
+}
+
+/// Paper eq (2), matched modes, as printed: `z1 = z2 = -(Q F1 F2 / (2 w0^2)) f(2 lam Omz Q / w0)`,
+/// with `w0 = wb` (carrier) and `Q = q1`. Exact for matched modes excited at
+/// resonance (`f1 = f2 = carrier`, `q1 = q2`); ignores `f1_hz`, `f2_hz`, `q2`.
+pub fn eq2_readout_z(dev: &Device, omz_rad_s: f64) -> f64 {
+    let w0 = TAU * dev.carrier_hz;
+    let q = dev.q1;
+    -q * dev.f1_force * dev.f2_force / (2.0 * w0 * w0)
+        * paper_f(dev.angular_gain * 2.0 * omz_rad_s * q / w0)
+}
+
+/// Paper eq (4), matched modes, as printed: `z1 = z2 = (1/2)(Q F1 F2 / (2 w0^2)) f(2 Om Q / w0)`,
+/// `Om = 2 pi f_cal_hz`, with `w0 = wb` and `Q = q1`. Narrow-band: for matched
+/// modes at resonance it differs from the exact value by O((Om/w0)^2).
+pub fn eq4_calibration_z(dev: &Device, f_cal_hz: f64) -> f64 {
+    let w0 = TAU * dev.carrier_hz;
+    let q = dev.q1;
+    let om = TAU * f_cal_hz;
+    0.5 * q * dev.f1_force * dev.f2_force / (2.0 * w0 * w0) * paper_f(2.0 * om * q / w0)
+}
+
+/// Paper eq (5), per rad/s, with `w0 = wb`, `dwk = wk - wb`:
+///
+/// ```text
+/// SF_read = (lam F1 F2 / w0) (4 dw1 dw2 - b1 b2) / ([(2 dw1)^2 + b1^2][(2 dw2)^2 + b2^2]),  bk = w0/Qk
+/// ```
+///
+/// identical to the printed formula when `q1 = q2` (the paper assumes one Q);
+/// with unequal Q this is its narrow-band generalization. Signed like the exact
+/// readout (negative near resonance): it is the narrow-band limit of
+/// [`sf_read_per_rad_s`], not a magnitude.
+pub fn eq5_sf_read_per_rad_s(dev: &Device) -> f64 {
+    let w0 = TAU * dev.carrier_hz;
+    let dw1 = TAU * (dev.f1_hz - dev.carrier_hz);
+    let dw2 = TAU * (dev.f2_hz - dev.carrier_hz);
+    let (b1, b2) = (w0 / dev.q1, w0 / dev.q2);
+    dev.angular_gain * dev.f1_force * dev.f2_force / w0 * (4.0 * dw1 * dw2 - b1 * b2)
+        / ((4.0 * dw1 * dw1 + b1 * b1) * (4.0 * dw2 * dw2 + b2 * b2))
+}
+
+/// Paper eq (6), per rad/s of virtual rate, `[SF_cal1, SF_cal2]` with `w0 = wb`,
+/// `dwk = wk - wb`, `bk = w0/Qk` (the paper: "substituting dw2 for dw1"):
+///
+/// ```text
+/// SF_cal,k = (F1 F2 / (2 w0)) (bk^2 - (2 dwk)^2) / [(2 dwk)^2 + bk^2]^2
+/// ```
+///
+/// Signed like the exact calibration output; exact at a resonant output.
+pub fn eq6_sf_cal_per_rad_s(dev: &Device) -> [f64; 2] {
+    let w0 = TAU * dev.carrier_hz;
+    let one = |f_hz: f64, q: f64| {
+        let dw = TAU * (f_hz - dev.carrier_hz);
+        let b = w0 / q;
+        let den = 4.0 * dw * dw + b * b;
+        dev.f1_force * dev.f2_force / (2.0 * w0) * (b * b - 4.0 * dw * dw) / (den * den)
+    };
+    [one(dev.f1_hz, dev.q1), one(dev.f2_hz, dev.q2)]
+}
