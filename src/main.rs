@@ -1,1 +1,58 @@
-fn main() {}
+//! `gyrocal`: the command line of the gyrocal interface.
+//!
+//! Every error is one line on stderr naming what is wrong and what is
+//! allowed; bad input exits with status 2, a failed run with status 1.
+
+mod commands;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// Reconfigurable phase readout and self-calibration of MEMS gyroscopes:
+/// gateware export and co-simulation.
+#[derive(Parser)]
+#[command(name = "gyrocal", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Write the exported Verilog and its port description to verilog-out/.
+    Export(commands::export::Args),
+}
+
+/// A failure, with the exit status it deserves.
+#[derive(Debug)]
+pub enum Failure {
+    /// Bad input (a file, a key, a value): exit status 2.
+    Input(String),
+    /// The run itself failed: exit status 1.
+    Run(String),
+}
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            let code = if e.use_stderr() { 2 } else { 0 };
+            let _ = e.print();
+            return ExitCode::from(code);
+        }
+    };
+    let result = match cli.command {
+        Command::Export(args) => commands::export::run(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(Failure::Input(msg)) => {
+            eprintln!("error: {msg}");
+            ExitCode::from(2)
+        }
+        Err(Failure::Run(msg)) => {
+            eprintln!("error: {msg}");
+            ExitCode::from(1)
+        }
+    }
+}

@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Runs every test of gyrocal on a fresh Debian machine.
+#
+# Installs the Verilog tools the tests need (iverilog, verilator, yosys) with
+# apt-get when they are missing (root, non-interactive), then runs the whole
+# test suite in release mode (the co-simulation tests need optimized code),
+# with the Verilator engine enabled, and the format and lint checks.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+missing=()
+command -v iverilog >/dev/null 2>&1 || missing+=(iverilog)
+command -v verilator >/dev/null 2>&1 || missing+=(verilator)
+command -v yosys >/dev/null 2>&1 || missing+=(yosys)
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "installing Debian packages: ${missing[*]}"
+  SUDO=""
+  [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  $SUDO apt-get update -q
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q "${missing[@]}"
+fi
+
+cargo fmt --all -- --check
+cargo clippy --release --workspace --all-targets --all-features -- -D warnings
+cargo test --release --workspace --all-features
