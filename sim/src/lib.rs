@@ -1,5 +1,18 @@
 //! gyrocal-sim: gyroscope model, theory, co-simulation engines and experiments.
+//!
+//! Read in order: `gyro` (the two-mode resonator, discretized exactly),
+//! `theory` (exact steady state and the paper's equations), `frontend`
+//! (DACs and ADCs), `engine` (the three simulators of the datapath),
+//! `cosim` (the closed loop), `experiment` (readout sweep and calibration
+//! staircase), `fit` (scale factors).
 
+pub mod average;
+pub mod cosim;
+pub mod engine;
+pub mod experiment;
 pub mod fit;
+pub mod frontend;
 pub mod gyro;
 pub mod theory;
+#[cfg(feature = "verilator")]
+pub mod verilator;

@@ -249,3 +249,32 @@ pub fn eq6_sf_cal_per_rad_s(dev: &Device) -> [f64; 2] {
     };
     [one(dev.f1_hz, dev.q1), one(dev.f2_hz, dev.q2)]
 }
+
+/// Peak displacements `[|x1|, |x2|]` (m) of the readout steady state at rate
+/// `omz_rad_s`: the moduli of the two phasors (used to set ADC gains).
+pub fn readout_peak_displacement(dev: &Device, omz_rad_s: f64) -> [f64; 2] {
+    let n = Norm::new(dev);
+    let d1 = n.d(0, 0.0);
+    let d2 = n.d(1, 0.0);
+    let c = 2.0 * dev.angular_gain * omz_rad_s / n.wb;
+    let det = d1 * d2 - c * c;
+    // [[D1, -j c], [j c, D2]] X = [F1, -j F2] (all over wb^2).
+    let j = C64::new(0.0, 1.0);
+    let (f1, f2) = (C64::new(dev.f1_force, 0.0), -j * dev.f2_force);
+    let x1 = (d2 * f1 + j * c * f2) / det;
+    let x2 = (d1 * f2 - j * c * f1) / det;
+    let wb2 = n.wb * n.wb;
+    [x1.norm() / wb2, x2.norm() / wb2]
+}
+
+/// Upper bound on the calibration displacements `[|x1|, |x2|]` (m) at
+/// `f_cal_hz`: each mode sees tones at wb -+ Om of amplitude Fk/2, so its
+/// peak is at most the sum of the two responses.
+pub fn calibration_peak_displacement(dev: &Device, f_cal_hz: f64) -> [f64; 2] {
+    let n = Norm::new(dev);
+    let om = TAU * f_cal_hz;
+    let wb2 = n.wb * n.wb;
+    let peak =
+        |k: usize, f: f64| 0.5 * f * (1.0 / n.d(k, -om).norm() + 1.0 / n.d(k, om).norm()) / wb2;
+    [peak(0, dev.f1_force), peak(1, dev.f2_force)]
+}

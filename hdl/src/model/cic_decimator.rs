@@ -1,7 +1,10 @@
 //! Bit-true model of `crate::cic_decimator::CicDecimator`.
 //!
-//! Registers mirror the hardware one for one; 80-bit wrap-around is done by
-//! keeping i128 values sign-extended from bit 79 after every operation.
+//! Registers mirror the hardware one for one. The hardware's 80-bit
+//! wrap-around is modelled by wrapping i128 arithmetic: reduction modulo
+//! 2^80 commutes with addition and subtraction, so the low 80 bits of every
+//! model register equal the hardware register, and the output stage wraps
+//! to 80 bits before it shifts, where the upper bits would start to matter.
 
 use crate::cic_decimator::{OUTPUT_BITS, REGISTER_BITS};
 
@@ -22,9 +25,15 @@ pub fn scale_output(x: i128, shift: u32) -> i64 {
 }
 
 /// Cycle-true model of one CIC channel.
+///
+/// The integrators are brought up to date lazily: inputs wait in `pending`
+/// and are integrated in one tight loop when the counter samples the fourth
+/// integrator, the only place their values are read. The result is the
+/// same register values the hardware has at that cycle.
 #[derive(Clone, Debug, Default)]
 pub struct CicDecimator {
     integrator: [i128; 4],
+    pending: Vec<i32>,
     count: u32,
     sample: i128,
     sample_valid: bool,
@@ -48,34 +57,50 @@ impl CicDecimator {
         // Output stage (reads comb 4 before it updates).
         self.valid = self.comb_valid[3];
         if self.comb_valid[3] {
-            self.y = scale_output(self.comb[3], shift);
+            self.y = scale_output(wrap(self.comb[3]), shift);
         }
-        // Combs, last stage first so each reads the previous cycle's values.
-        for k in (1..4).rev() {
-            if self.comb_valid[k - 1] {
-                self.comb[k] = wrap(self.comb[k - 1] - self.comb_delay[k]);
-                self.comb_delay[k] = self.comb[k - 1];
+        // Combs, last stage first so each reads the previous cycle's values
+        // (nothing moves between outputs: skip them then).
+        if self.sample_valid || self.comb_valid != [false; 4] {
+            for k in (1..4).rev() {
+                if self.comb_valid[k - 1] {
+                    self.comb[k] = self.comb[k - 1].wrapping_sub(self.comb_delay[k]);
+                    self.comb_delay[k] = self.comb[k - 1];
+                }
+                self.comb_valid[k] = self.comb_valid[k - 1];
             }
-            self.comb_valid[k] = self.comb_valid[k - 1];
+            if self.sample_valid {
+                self.comb[0] = self.sample.wrapping_sub(self.comb_delay[0]);
+                self.comb_delay[0] = self.sample;
+            }
+            self.comb_valid[0] = self.sample_valid;
         }
-        if self.sample_valid {
-            self.comb[0] = wrap(self.sample - self.comb_delay[0]);
-            self.comb_delay[0] = self.sample;
-        }
-        self.comb_valid[0] = self.sample_valid;
         // Counter and decimation.
         self.sample_valid = self.count == 0;
         if self.count == 0 {
+            self.integrate_pending();
             self.sample = self.integrator[3];
             self.count = decimation.wrapping_sub(1) & 0x1fff;
         } else {
             self.count -= 1;
         }
-        // Integrators, last stage first.
-        for k in (1..4).rev() {
-            self.integrator[k] = wrap(self.integrator[k] + self.integrator[k - 1]);
-        }
-        self.integrator[0] = wrap(self.integrator[0] + x as i128);
+        // Integrators: x enters at this edge (see `integrate_pending`).
+        self.pending.push(x);
         (self.y, self.valid)
+    }
+
+    /// Play the integrators' edges for the inputs still pending.
+    #[inline(never)]
+    fn integrate_pending(&mut self) {
+        let [mut i1, mut i2, mut i3, mut i4] = self.integrator;
+        for &x in &self.pending {
+            // Every stage takes its predecessor's value before the edge.
+            i4 = i4.wrapping_add(i3);
+            i3 = i3.wrapping_add(i2);
+            i2 = i2.wrapping_add(i1);
+            i1 = i1.wrapping_add(x as i128);
+        }
+        self.integrator = [i1, i2, i3, i4];
+        self.pending.clear();
     }
 }

@@ -57,8 +57,19 @@ impl IirLowpass {
     /// One clock; returns `(z, z_valid)` after the edge.
     #[inline(always)]
     pub fn step(&mut self, x: i64, x_valid: bool, k: &Coefficients) -> (i64, bool) {
+        if self.step == 0 && !x_valid {
+            // Idle: only the pulse ends. (The multiplier register keeps
+            // multiplying the idle operands, but it is read only in steps
+            // 4, 5, 6 and 10, after it has been reloaded.)
+            self.z_valid = false;
+            return (self.z, false);
+        }
         let product = self.product;
-        self.product = self.operand * self.coefficient as i128;
+        // The product register during the next cycle: read in steps 4, 5, 6
+        // and 10, so it is loaded in steps 3, 4, 5 and 9.
+        if matches!(self.step, 3 | 4 | 5 | 9) {
+            self.product = self.operand * self.coefficient as i128;
+        }
         self.z_valid = false;
         match self.step {
             0 => {

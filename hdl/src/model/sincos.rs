@@ -10,9 +10,12 @@ use crate::sincos::LATENCY;
 use crate::sine_table;
 use std::sync::OnceLock;
 
-/// The table columns interleaved as `[value, slope]`, built once.
-fn table() -> &'static [[i32; 2]; sine_table::ENTRIES] {
-    static TABLE: OnceLock<[[i32; 2]; sine_table::ENTRIES]> = OnceLock::new();
+/// The table columns interleaved as `[value, slope]`.
+pub type Table = [[i32; 2]; sine_table::ENTRIES];
+
+/// The table, built once per process.
+pub fn table() -> &'static Table {
+    static TABLE: OnceLock<Table> = OnceLock::new();
     TABLE.get_or_init(|| std::array::from_fn(|i| [sine_table::value(i), sine_table::slope(i)]))
 }
 
@@ -20,7 +23,11 @@ fn table() -> &'static [[i32; 2]; sine_table::ENTRIES] {
 /// phase bits 29:7, before the quadrant mirror.
 #[inline(always)]
 pub fn first_quadrant(phase: u32) -> (i32, i32) {
-    let table = table();
+    first_quadrant_with(table(), phase)
+}
+
+#[inline(always)]
+fn first_quadrant_with(table: &Table, phase: u32) -> (i32, i32) {
     let i = ((phase >> 22) & 0xff) as usize;
     let [sin_sample, sin_slope] = table[i];
     let [cos_sample, cos_slope] = table[0xff - i];
@@ -35,22 +42,38 @@ pub fn first_quadrant(phase: u32) -> (i32, i32) {
 /// `(sin, cos)` of a 32-bit phase, as the hardware computes it.
 #[inline(always)]
 pub fn evaluate(phase: u32) -> (i16, i16) {
-    let (s, c) = first_quadrant(phase);
-    let (s, c) = match phase >> 30 {
-        0 => (s, c),
-        1 => (c, -s),
-        2 => (-s, -c),
-        _ => (-c, s),
-    };
-    (s as i16, c as i16)
+    evaluate_with(table(), phase)
+}
+
+#[inline(always)]
+fn evaluate_with(table: &Table, phase: u32) -> (i16, i16) {
+    let (s, c) = first_quadrant_with(table, phase);
+    // Quadrant mirror without branches: odd quadrants swap sine and
+    // cosine; the sine is negated in quadrants 2 and 3, the cosine in 1 and 2.
+    let q = phase >> 30;
+    let (a, b) = if q & 1 == 0 { (s, c) } else { (c, s) };
+    let sin = if q >= 2 { -a } else { a };
+    let cos = if q == 1 || q == 2 { -b } else { b };
+    (sin as i16, cos as i16)
 }
 
 /// Cycle-true model of the pipeline.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct SinCos {
     /// Values in flight; `pipe[head]` is the current output.
     pipe: [(i16, i16); LATENCY],
     head: usize,
+    table: &'static Table,
+}
+
+impl Default for SinCos {
+    fn default() -> Self {
+        Self {
+            pipe: Default::default(),
+            head: 0,
+            table: table(),
+        }
+    }
 }
 
 impl SinCos {
@@ -65,7 +88,7 @@ impl SinCos {
     pub fn step(&mut self, phase: u32) -> (i16, i16) {
         // The slot of the current output is reused for the newest value,
         // which comes out LATENCY edges later.
-        self.pipe[self.head] = evaluate(phase);
+        self.pipe[self.head] = evaluate_with(self.table, phase);
         self.head = (self.head + 1) % LATENCY;
         self.pipe[self.head]
     }

@@ -1,0 +1,98 @@
+//! The three simulators of one datapath, behind one interface.
+//!
+//! - `model`: the bit-true, cycle-true plain-Rust model
+//!   (`gyrocal_hdl::model`), the default: fast, no system dependency.
+//! - `rtl`: rust-hdl's own simulation of the design, driven directly. Slow
+//!   (thousands of clocks per second) but it is the design itself.
+//! - `verilator`: the exported Verilog compiled by Verilator and stepped
+//!   through a small C ABI wrapper (cargo feature `verilator`).
+//!
+//! All three give identical outputs on every cycle (tests prove it), so an
+//! experiment's results do not depend on the engine, only its speed does.
+
+use gyrocal_hdl::model::gyro_interface::{GyroInterface, Outputs, Probes, Registers};
+use gyrocal_hdl::rtl::RtlGyroInterface;
+
+/// One clock at a time: inputs during a cycle in, outputs after the edge out.
+pub trait Engine {
+    /// A fresh instance at its power-up state.
+    fn power_up() -> Result<Self, String>
+    where
+        Self: Sized;
+    /// One rising edge with these inputs; returns the ports after it.
+    fn step(&mut self, adc: (i16, i16), regs: &Registers) -> Outputs;
+    /// Internal signals during the current cycle (for waveforms).
+    fn probes(&self) -> Probes;
+}
+
+/// Which simulator runs the datapath.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum EngineKind {
+    /// Bit-true plain-Rust model (default).
+    #[default]
+    Model,
+    /// rust-hdl's simulation of the design.
+    Rtl,
+    /// The exported Verilog through Verilator.
+    Verilator,
+}
+
+impl EngineKind {
+    /// All engines, in speed order.
+    pub const ALL: [EngineKind; 3] = [EngineKind::Model, EngineKind::Verilator, EngineKind::Rtl];
+
+    /// The name used on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            EngineKind::Model => "model",
+            EngineKind::Rtl => "rtl",
+            EngineKind::Verilator => "verilator",
+        }
+    }
+
+    /// Parse a command-line name.
+    pub fn parse(name: &str) -> Result<Self, String> {
+        match name {
+            "model" => Ok(EngineKind::Model),
+            "rtl" => Ok(EngineKind::Rtl),
+            "verilator" => Ok(EngineKind::Verilator),
+            _ => Err(format!("engine = {name:?}: allowed model, verilator, rtl")),
+        }
+    }
+}
+
+/// The bit-true model engine.
+#[derive(Clone, Debug, Default)]
+pub struct ModelEngine(GyroInterface);
+
+impl Engine for ModelEngine {
+    fn power_up() -> Result<Self, String> {
+        Ok(Self::default())
+    }
+
+    #[inline(always)]
+    fn step(&mut self, adc: (i16, i16), regs: &Registers) -> Outputs {
+        self.0.step(adc, regs)
+    }
+
+    fn probes(&self) -> Probes {
+        self.0.probes()
+    }
+}
+
+/// rust-hdl's simulation of `GyroInterface`.
+pub struct RtlEngine(RtlGyroInterface);
+
+impl Engine for RtlEngine {
+    fn power_up() -> Result<Self, String> {
+        Ok(Self(RtlGyroInterface::new()))
+    }
+
+    fn step(&mut self, adc: (i16, i16), regs: &Registers) -> Outputs {
+        self.0.step(adc, regs)
+    }
+
+    fn probes(&self) -> Probes {
+        self.0.design().probes()
+    }
+}

@@ -1,0 +1,251 @@
+//! The analog front end between the FPGA and the gyroscope: DACs, force
+//! transducers, pick-offs and ADCs.
+//!
+//! ```text
+//!  dac word ──► [L_dac clocks] ──► hold one clock ──► x force_per_lsb ──► gyro force (N/kg)
+//!  gyro x(nT) ──► x adc_per_meter (+ noise) ──► round, saturate ──► [L_adc clocks] ──► adc word
+//! ```
+//!
+//! The DAC holds each word for one clock (zero-order hold, modelled exactly
+//! by the gyro's discretization) after a pipeline latency of L_dac clocks.
+//! The ADC samples the displacement at the clock edge, scales it by the
+//! pick-off, TIA and converter gain (LSB per metre), adds optional Gaussian
+//! noise (seeded), rounds half away from zero to `adc_bits` bits
+//! (left-justified in the 16-bit word, like a narrower converter on a
+//! 16-bit bus), saturates at full
+//! scale, and presents the word L_adc clocks later. A DAC with fewer bits
+//! drops the LSBs of the word (truncation, as a narrower DAC wired to the
+//! top bits does).
+
+/// Front-end parameters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrontEnd {
+    /// DAC pipeline latency in clocks.
+    pub dac_latency: u32,
+    /// ADC pipeline latency in clocks.
+    pub adc_latency: u32,
+    /// DAC resolution in bits (1..=16), MSB-aligned in the 16-bit word.
+    pub dac_bits: u32,
+    /// ADC resolution in bits (1..=16), MSB-aligned in the 16-bit word.
+    pub adc_bits: u32,
+    /// Force per unit mass per DAC LSB, per channel (N/kg per LSB).
+    pub force_per_lsb: [f64; 2],
+    /// ADC LSBs per metre of displacement, per channel.
+    pub adc_per_meter: [f64; 2],
+    /// RMS noise added at the ADC input, in ADC LSBs (0: none).
+    pub noise_lsb: f64,
+    /// Seed of the noise generator.
+    pub seed: u64,
+}
+
+/// Longest converter latency the ring buffers hold.
+pub const MAX_LATENCY: u32 = 31;
+
+/// The converters' state during a run.
+#[derive(Clone, Debug)]
+pub struct Converters {
+    config: FrontEnd,
+    dac_ring: [(i16, i16); MAX_LATENCY as usize + 1],
+    adc_ring: [(i16, i16); MAX_LATENCY as usize + 1],
+    head: usize,
+    dac_mask: i16,
+    adc_step: f64,
+    adc_step_inv: f64,
+    noise: Option<Gaussian>,
+}
+
+impl Converters {
+    /// Converters at rest (all words zero).
+    pub fn new(config: &FrontEnd) -> Result<Self, String> {
+        for (name, v) in [
+            ("dac_latency", config.dac_latency),
+            ("adc_latency", config.adc_latency),
+        ] {
+            if v > MAX_LATENCY {
+                return Err(format!("{name} = {v}: allowed 0..={MAX_LATENCY} clocks"));
+            }
+        }
+        for (name, v) in [("dac_bits", config.dac_bits), ("adc_bits", config.adc_bits)] {
+            if !(1..=16).contains(&v) {
+                return Err(format!("{name} = {v}: allowed 1..=16"));
+            }
+        }
+        for (name, v) in [
+            ("force gain of channel 1", config.force_per_lsb[0]),
+            ("force gain of channel 2", config.force_per_lsb[1]),
+            ("ADC gain of channel 1", config.adc_per_meter[0]),
+            ("ADC gain of channel 2", config.adc_per_meter[1]),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(format!("{name} = {v}: must be a positive number"));
+            }
+        }
+        if !(config.noise_lsb.is_finite() && config.noise_lsb >= 0.0) {
+            return Err(format!("noise_lsb = {}: must be >= 0", config.noise_lsb));
+        }
+        Ok(Self {
+            config: config.clone(),
+            dac_ring: [(0, 0); MAX_LATENCY as usize + 1],
+            adc_ring: [(0, 0); MAX_LATENCY as usize + 1],
+            head: 0,
+            dac_mask: !((1i32 << (16 - config.dac_bits)) - 1) as i16,
+            adc_step: f64::from(1u32 << (16 - config.adc_bits)),
+            adc_step_inv: 1.0 / f64::from(1u32 << (16 - config.adc_bits)),
+            noise: (config.noise_lsb > 0.0).then(|| Gaussian::new(config.seed)),
+        })
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &FrontEnd {
+        &self.config
+    }
+
+    /// One ADC conversion of the displacement `x` (m) on `channel` (0, 1).
+    #[inline(always)]
+    fn convert(&mut self, channel: usize, x: f64) -> i16 {
+        let mut v = x * self.config.adc_per_meter[channel];
+        if let Some(g) = &mut self.noise {
+            v += self.config.noise_lsb * g.sample();
+        }
+        // Round half away from zero by truncating v +- 1/2 (one instruction
+        // each way, where f64::round is a library call), then saturate.
+        let steps = v * self.adc_step_inv;
+        let code = (steps + 0.5f64.copysign(steps)) as i64 as f64 * self.adc_step;
+        code.clamp(-32768.0, 32767.0 - (self.adc_step - 1.0)) as i16
+    }
+
+    /// One clock. `dac` is the DAC word pair during this cycle, `x` the
+    /// displacements sampled at this cycle's edge. Returns the ADC words
+    /// presented to the FPGA during this cycle and the forces (N/kg) the
+    /// DACs apply over this clock period.
+    #[inline(always)]
+    pub fn step(&mut self, dac: (i16, i16), x: (f64, f64)) -> ((i16, i16), (f64, f64)) {
+        let sample = (self.convert(0, x.0), self.convert(1, x.1));
+        let n = self.dac_ring.len();
+        self.head = (self.head + 1) % n;
+        self.dac_ring[self.head] = (dac.0 & self.dac_mask, dac.1 & self.dac_mask);
+        self.adc_ring[self.head] = sample;
+        let held = self.dac_ring[(self.head + n - self.config.dac_latency as usize) % n];
+        let adc = self.adc_ring[(self.head + n - self.config.adc_latency as usize) % n];
+        let force = (
+            held.0 as f64 * self.config.force_per_lsb[0],
+            held.1 as f64 * self.config.force_per_lsb[1],
+        );
+        (adc, force)
+    }
+}
+
+/// Standard normal samples (Box-Muller on SplitMix64), seeded.
+#[derive(Clone, Debug)]
+struct Gaussian {
+    state: u64,
+    spare: Option<f64>,
+}
+
+impl Gaussian {
+    fn new(seed: u64) -> Self {
+        Self {
+            state: seed,
+            spare: None,
+        }
+    }
+
+    fn uniform(&mut self) -> f64 {
+        self.state = self.state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^= z >> 31;
+        ((z >> 11) as f64 + 0.5) / (1u64 << 53) as f64
+    }
+
+    fn sample(&mut self) -> f64 {
+        if let Some(s) = self.spare.take() {
+            return s;
+        }
+        let (u1, u2) = (self.uniform(), self.uniform());
+        let r = (-2.0 * u1.ln()).sqrt();
+        let t = std::f64::consts::TAU * u2;
+        self.spare = Some(r * t.sin());
+        r * t.cos()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn front_end() -> FrontEnd {
+        FrontEnd {
+            dac_latency: 2,
+            adc_latency: 3,
+            dac_bits: 16,
+            adc_bits: 16,
+            force_per_lsb: [1.0, 2.0],
+            adc_per_meter: [1.0, 1.0],
+            noise_lsb: 0.0,
+            seed: 1,
+        }
+    }
+
+    #[test]
+    fn latencies_delay_by_whole_clocks() {
+        let mut c = Converters::new(&front_end()).unwrap();
+        let mut log = vec![];
+        for n in 0..10i16 {
+            log.push(c.step((n, n), (f64::from(n) * 10.0, 0.0)));
+        }
+        // Word of cycle k is applied during cycle k + 2; the sample of edge m
+        // is presented during cycle m + 3.
+        assert_eq!(log[5].1, (3.0, 6.0));
+        assert_eq!((log[5].0).0, 20);
+    }
+
+    #[test]
+    fn adc_rounds_saturates_and_narrows() {
+        let mut fe = front_end();
+        fe.adc_latency = 0;
+        let mut c = Converters::new(&fe).unwrap();
+        assert_eq!(c.step((0, 0), (1e9, -1e9)).0, (32767, -32768));
+        assert_eq!(c.step((0, 0), (2.5, -2.5)).0, (3, -3));
+        fe.adc_bits = 12;
+        let mut c = Converters::new(&fe).unwrap();
+        assert_eq!(c.step((0, 0), (25.0, 1e9)).0, (32, 32752));
+    }
+
+    #[test]
+    fn noise_is_seeded_and_has_the_asked_rms() {
+        let mut fe = front_end();
+        fe.adc_latency = 0;
+        fe.noise_lsb = 100.0;
+        let run = |fe: &FrontEnd| {
+            let mut c = Converters::new(fe).unwrap();
+            (0..20000)
+                .map(|_| c.step((0, 0), (0.0, 0.0)).0.0 as f64)
+                .collect::<Vec<_>>()
+        };
+        let a = run(&fe);
+        assert_eq!(a, run(&fe));
+        let rms = (a.iter().map(|v| v * v).sum::<f64>() / a.len() as f64).sqrt();
+        // 20000 samples: the RMS estimate has relative spread 1/sqrt(2N) = 0.5%.
+        assert!((rms - 100.0).abs() < 3.0, "rms {rms}");
+    }
+
+    #[test]
+    fn bad_settings_name_the_setting() {
+        let mut fe = front_end();
+        fe.adc_latency = 40;
+        assert!(
+            Converters::new(&fe)
+                .unwrap_err()
+                .starts_with("adc_latency = 40")
+        );
+        let mut fe = front_end();
+        fe.dac_bits = 0;
+        assert!(
+            Converters::new(&fe)
+                .unwrap_err()
+                .starts_with("dac_bits = 0")
+        );
+    }
+}
