@@ -632,3 +632,24 @@ fn run_verilator(
 ) -> Result<PointResult, String> {
     Err("engine = \"verilator\": this build has no Verilator engine (rebuild with --features verilator)".into())
 }
+
+/// Plan and run an experiment on `engine`, timing it; `progress` receives
+/// clock counts as they are simulated.
+pub fn run(
+    exp: &Experiment,
+    engine: EngineKind,
+    progress: &(dyn Fn(u64) + Sync),
+) -> Result<crate::report::Report, String> {
+    let plan = plan(exp)?;
+    let start = std::time::Instant::now();
+    let points = run_points(exp, &plan, engine, progress)?;
+    let wall_s = start.elapsed().as_secs_f64();
+    let cycles = plan.total_cycles();
+    let timing = crate::report::Timing {
+        engine: engine.name().into(),
+        cycles,
+        wall_s,
+        cycles_per_s: cycles as f64 / wall_s,
+    };
+    Ok(crate::report::Report::new(exp, &plan, points, timing))
+}

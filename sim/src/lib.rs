@@ -13,6 +13,7 @@ pub mod experiment;
 pub mod fit;
 pub mod frontend;
 pub mod gyro;
+pub mod report;
 pub mod theory;
 #[cfg(feature = "verilator")]
 pub mod verilator;

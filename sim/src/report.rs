@@ -1,0 +1,221 @@
+//! The outcome of an experiment: simulated scale factors beside the exact
+//! theory at the same points, the paper's closed forms, and the readout
+//! scale factor predicted from calibration, in one serializable value.
+
+use crate::experiment::{Experiment, Mode, Plan, PointResult, ScaleFactors, fit_scale_factors};
+use crate::fit::linear_fit;
+use crate::theory;
+use serde::Serialize;
+
+/// Degrees per radian factor for scale factors: (per rad/s) -> (per deg/s).
+const PER_DPS: f64 = std::f64::consts::PI / 180.0;
+
+/// The device as simulated.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct DeviceSummary {
+    /// Mode 1 frequency (Hz).
+    pub f1_hz: f64,
+    /// Mode 2 frequency (Hz).
+    pub f2_hz: f64,
+    /// Mode 1 quality factor.
+    pub q1: f64,
+    /// Mode 2 quality factor.
+    pub q2: f64,
+    /// Angular gain lambda.
+    pub angular_gain: f64,
+    /// Realized carrier (Hz).
+    pub carrier_hz: f64,
+    /// FPGA clock (Hz).
+    pub clock_hz: f64,
+    /// Drive forces F1, F2 seen by the theory (N/kg, DAC word amplitude
+    /// times force gain; the hold scales the applied force by `hold_gain`).
+    pub force_n_per_kg: [f64; 2],
+    /// Fundamental gain of the DAC hold at the carrier, sin(x)/x.
+    pub hold_gain: f64,
+    /// ADC gains (LSB per metre).
+    pub adc_per_meter: [f64; 2],
+    /// CIC decimation and z rate (Hz).
+    pub decimation: u32,
+    /// z sample rate (Hz).
+    pub z_rate_hz: f64,
+    /// Realized DC gain of CIC and IIR.
+    pub filter_dc_gain: f64,
+    /// Slowest resonator time constant 2 Q / w (s).
+    pub tau_s: f64,
+}
+
+/// Closed forms at the simulated device.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SmallSignal {
+    /// Exact small-signal readout scale factor, per deg/s.
+    pub sf_read_per_dps: [f64; 2],
+    /// Exact small-signal calibration scale factor, per deg/s of virtual rate.
+    pub sf_cal_per_dps: [f64; 2],
+    /// Their ratio.
+    pub ratio: [f64; 2],
+    /// Paper eq. (5), per deg/s (same for both outputs).
+    pub eq5_sf_read_per_dps: f64,
+    /// Paper eq. (6), per deg/s, [SF_cal1, SF_cal2].
+    pub eq6_sf_cal_per_dps: [f64; 2],
+    /// eq. (5) / eq. (6): the paper's predicted ratio.
+    pub eq56_ratio: [f64; 2],
+}
+
+/// Exact theory under the same names as the simulated values.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Theory {
+    /// Fitted readout scale factor at the same points, same fit.
+    pub sf_read_per_dps: [f64; 2],
+    /// Fitted calibration scale factor at the same points, same fit.
+    pub sf_cal_per_dps: [f64; 2],
+    /// Ratio of the two.
+    pub ratio: [f64; 2],
+    /// Small-signal values and the paper's closed forms.
+    pub small_signal: SmallSignal,
+}
+
+/// Timing of the run.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Timing {
+    /// Engine that ran the datapath.
+    pub engine: String,
+    /// Clocks simulated, all points.
+    pub cycles: u64,
+    /// Wall time (s).
+    pub wall_s: f64,
+    /// Clocks per second of wall time (all cores).
+    pub cycles_per_s: f64,
+}
+
+/// Everything `gyrocal run --json` prints and `results.json` holds.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Report {
+    /// Simulated readout scale factor [output 1, output 2], (m^2/s^2) per deg/s.
+    pub sf_read_per_dps: [f64; 2],
+    /// Simulated calibration scale factor, per deg/s of virtual rate 360 f_cal.
+    pub sf_cal_per_dps: [f64; 2],
+    /// Simulated ratio sf_read / sf_cal.
+    pub ratio: [f64; 2],
+    /// Intercepts of the simulated readout and calibration fits.
+    pub intercept_read: [f64; 2],
+    /// Intercepts of the simulated calibration fits.
+    pub intercept_cal: [f64; 2],
+    /// The exact theory at the same points, and closed forms.
+    pub theory: Theory,
+    /// Relative error of the simulated ratio against the exact fitted one.
+    pub ratio_error: [f64; 2],
+    /// Readout scale factor predicted from the simulated calibration and the
+    /// exact theory's ratio (what self-calibration delivers).
+    pub predicted_sf_read_per_dps: [f64; 2],
+    /// Same, predicted with the paper's eqs. (5)/(6) ratio, as in the paper.
+    pub predicted_sf_read_eq56_per_dps: [f64; 2],
+    /// Relative error of the eq. (5)/(6) prediction against the simulated
+    /// readout scale factor (the paper's "3%").
+    pub prediction_error_eq56: [f64; 2],
+    /// Relative error of the exact-theory prediction.
+    pub prediction_error: [f64; 2],
+    /// Output (0 or 1) whose mode is farther from the carrier, if any.
+    pub detuned_output: Option<usize>,
+    /// The device and converters as simulated.
+    pub device: DeviceSummary,
+    /// Every point.
+    pub points: Vec<PointResult>,
+    /// Engine and speed.
+    pub timing: Timing,
+    /// Things worth knowing about the setup.
+    pub warnings: Vec<String>,
+}
+
+fn intercepts(
+    points: &[PointResult],
+    mode: Mode,
+    z: impl Fn(&PointResult) -> [f64; 2],
+) -> [f64; 2] {
+    std::array::from_fn(|k| {
+        let (x, y): (Vec<f64>, Vec<f64>) = points
+            .iter()
+            .filter(|p| p.mode == mode)
+            .map(|p| (p.rate_dps, z(p)[k]))
+            .unzip();
+        linear_fit(&x, &y).1
+    })
+}
+
+impl Report {
+    /// Assemble the report of a finished run.
+    pub fn new(exp: &Experiment, plan: &Plan, points: Vec<PointResult>, timing: Timing) -> Self {
+        let sim: ScaleFactors = fit_scale_factors(&points, |p| p.z);
+        let exact: ScaleFactors = fit_scale_factors(&points, |p| p.z_theory);
+        let mut dev = plan.theory_device(exp);
+        dev.f1_force *= plan.hold_gain.sqrt();
+        dev.f2_force *= plan.hold_gain.sqrt();
+        let sf_read = theory::sf_read_per_rad_s(&dev).map(|v| v * PER_DPS);
+        let sf_cal = theory::sf_cal_per_rad_s(&dev).map(|v| v * PER_DPS);
+        let eq5 = theory::eq5_sf_read_per_rad_s(&dev) * PER_DPS;
+        let eq6 = theory::eq6_sf_cal_per_rad_s(&dev).map(|v| v * PER_DPS);
+        let eq56_ratio = [eq5 / eq6[0], eq5 / eq6[1]];
+        let predicted: [f64; 2] = std::array::from_fn(|k| sim.sf_cal_per_dps[k] * exact.ratio[k]);
+        let predicted_eq56: [f64; 2] =
+            std::array::from_fn(|k| sim.sf_cal_per_dps[k] * eq56_ratio[k]);
+        let rel = |a: f64, b: f64| a / b - 1.0;
+        let d1 = (exp.gyro.f1_hz - plan.carrier_hz).abs();
+        let d2 = (exp.gyro.f2_hz - plan.carrier_hz).abs();
+        let detuned_output = if d1 == d2 {
+            None
+        } else if d2 > d1 {
+            Some(1)
+        } else {
+            Some(0)
+        };
+        Report {
+            intercept_read: intercepts(&points, Mode::Readout, |p| p.z),
+            intercept_cal: intercepts(&points, Mode::Calibration, |p| p.z),
+            ratio_error: std::array::from_fn(|k| rel(sim.ratio[k], exact.ratio[k])),
+            predicted_sf_read_per_dps: predicted,
+            predicted_sf_read_eq56_per_dps: predicted_eq56,
+            prediction_error: std::array::from_fn(|k| rel(predicted[k], sim.sf_read_per_dps[k])),
+            prediction_error_eq56: std::array::from_fn(|k| {
+                rel(predicted_eq56[k], sim.sf_read_per_dps[k])
+            }),
+            sf_read_per_dps: sim.sf_read_per_dps,
+            sf_cal_per_dps: sim.sf_cal_per_dps,
+            ratio: sim.ratio,
+            theory: Theory {
+                sf_read_per_dps: exact.sf_read_per_dps,
+                sf_cal_per_dps: exact.sf_cal_per_dps,
+                ratio: exact.ratio,
+                small_signal: SmallSignal {
+                    sf_read_per_dps: sf_read,
+                    sf_cal_per_dps: sf_cal,
+                    ratio: [sf_read[0] / sf_cal[0], sf_read[1] / sf_cal[1]],
+                    eq5_sf_read_per_dps: eq5,
+                    eq6_sf_cal_per_dps: eq6,
+                    eq56_ratio,
+                },
+            },
+            detuned_output,
+            device: DeviceSummary {
+                f1_hz: exp.gyro.f1_hz,
+                f2_hz: exp.gyro.f2_hz,
+                q1: exp.gyro.q1,
+                q2: exp.gyro.q2,
+                angular_gain: exp.gyro.angular_gain,
+                carrier_hz: plan.carrier_hz,
+                clock_hz: exp.clock_hz,
+                force_n_per_kg: [
+                    plan.theory_device(exp).f1_force,
+                    plan.theory_device(exp).f2_force,
+                ],
+                hold_gain: plan.hold_gain,
+                adc_per_meter: plan.front_end.adc_per_meter,
+                decimation: plan.filter.decimation,
+                z_rate_hz: plan.filter.output_rate_hz,
+                filter_dc_gain: plan.filter.dc_gain,
+                tau_s: plan.tau_s,
+            },
+            points,
+            timing,
+            warnings: plan.warnings.clone(),
+        }
+    }
+}
