@@ -21,6 +21,11 @@ struct Cli {
 enum Command {
     /// Write the exported Verilog and its port description to verilog-out/.
     Export(commands::export::Args),
+    /// Co-simulate a device described in a TOML file: readout sweep and
+    /// calibration staircase, scale factors against the exact theory.
+    Run(commands::run::Args),
+    /// Reproduce the paper's measurement on its device at full scale.
+    Reproduce(commands::reproduce::Args),
 }
 
 /// A failure, with the exit status it deserves.
@@ -43,6 +48,8 @@ fn main() -> ExitCode {
     };
     let result = match cli.command {
         Command::Export(args) => commands::export::run(&args),
+        Command::Run(args) => commands::run::run(&args),
+        Command::Reproduce(args) => commands::reproduce::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -26,6 +26,7 @@ pub struct CoSim<E: Engine> {
     gyro: GyroModel,
     regs: Registers,
     outputs: Outputs,
+    adc: (i16, i16),
     cycle: u64,
 }
 
@@ -38,6 +39,7 @@ impl<E: Engine> CoSim<E> {
             gyro,
             regs,
             outputs: Outputs::default(),
+            adc: (0, 0),
             cycle: 0,
         }
     }
@@ -48,10 +50,16 @@ impl<E: Engine> CoSim<E> {
         let (adc, force) = self
             .converters
             .step(self.outputs.dac, (self.gyro.x1(), self.gyro.x2()));
+        self.adc = adc;
         self.outputs = self.engine.step(adc, &self.regs);
         self.gyro.step(force.0, force.1);
         self.cycle += 1;
         self.outputs
+    }
+
+    /// The ADC words the last clock's edge captured.
+    pub fn last_adc(&self) -> (i16, i16) {
+        self.adc
     }
 
     /// Clocks played so far.

@@ -56,7 +56,7 @@ impl EngineKind {
             "model" => Ok(EngineKind::Model),
             "rtl" => Ok(EngineKind::Rtl),
             "verilator" => Ok(EngineKind::Verilator),
-            _ => Err(format!("engine = {name:?}: allowed model, verilator, rtl")),
+            _ => Err(format!("engine {name:?}: allowed model, verilator, rtl")),
         }
     }
 }

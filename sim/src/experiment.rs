@@ -481,11 +481,30 @@ pub struct PointResult {
     pub trace: Vec<TraceSample>,
 }
 
+/// What an observer sees of one clock.
+#[derive(Clone, Copy, Debug)]
+pub struct ClockView<'a> {
+    /// Number of the rising edge just played (1 for the first).
+    pub cycle: u64,
+    /// ADC words that edge captured (inputs during the cycle before it).
+    pub adc: (i16, i16),
+    /// Ports after the edge.
+    pub outputs: &'a Outputs,
+    /// Internal signals after the edge.
+    pub probes: &'a Probes,
+    /// Displacements x1, x2 at the edge (m).
+    pub x: (f64, f64),
+    /// SELECT.
+    pub select: bool,
+}
+
 /// Watches every clock of a run (waveform dumps).
 pub trait Observer {
-    /// Called after each clock with the ports, internal signals, the ADC
-    /// words of that cycle and the displacements.
-    fn clock(&mut self, cycle: u64, outputs: &Outputs, probes: &Probes, x: (f64, f64));
+    /// Called after each clock.
+    fn clock(&mut self, view: &ClockView);
+    /// Clocks after which the observer needs no more calls (the run goes on
+    /// at full speed).
+    fn last_cycle(&self) -> u64;
 }
 
 /// Simulate one point with engine `E`; `progress` receives clock counts.
@@ -509,9 +528,18 @@ pub fn run_point<E: Engine>(
     const CHUNK: u64 = 1 << 20;
     for n in 1..=point.total_cycles {
         let o = sim.step();
-        if let Some(obs) = observer.as_deref_mut() {
+        if let Some(obs) = observer.as_deref_mut()
+            && n <= obs.last_cycle()
+        {
             let g = sim.gyro();
-            obs.clock(n, &o, &sim.engine().probes(), (g.x1(), g.x2()));
+            obs.clock(&ClockView {
+                cycle: n,
+                adc: sim.last_adc(),
+                outputs: &o,
+                probes: &sim.engine().probes(),
+                x: (g.x1(), g.x2()),
+                select: point.regs.select,
+            });
         }
         if o.z_valid {
             if n >= first_kept {
@@ -652,4 +680,52 @@ pub fn run(
         cycles_per_s: cycles as f64 / wall_s,
     };
     Ok(crate::report::Report::new(exp, &plan, points, timing))
+}
+
+/// Simulate the first clocks of one point with an observer, up to the
+/// observer's last clock (waveform dumps); the point's result is not
+/// computed.
+pub fn observe_point<E: Engine>(
+    exp: &Experiment,
+    plan: &Plan,
+    point: &PointPlan,
+    observer: &mut dyn Observer,
+) -> Result<(), String> {
+    let gyro = GyroModel::new(&exp.gyro, exp.clock_hz)?;
+    let converters = Converters::new(&plan.front_end)?;
+    let mut sim = CoSim::new(E::power_up()?, converters, gyro, point.regs);
+    sim.set_rate(point.omz_rad_s);
+    for n in 1..=observer.last_cycle() {
+        let o = sim.step();
+        let g = sim.gyro();
+        observer.clock(&ClockView {
+            cycle: n,
+            adc: sim.last_adc(),
+            outputs: &o,
+            probes: &sim.engine().probes(),
+            x: (g.x1(), g.x2()),
+            select: point.regs.select,
+        });
+    }
+    Ok(())
+}
+
+/// `observe_point` on the engine of `kind`.
+pub fn observe_point_on(
+    kind: EngineKind,
+    exp: &Experiment,
+    plan: &Plan,
+    point: &PointPlan,
+    observer: &mut dyn Observer,
+) -> Result<(), String> {
+    match kind {
+        EngineKind::Model => observe_point::<ModelEngine>(exp, plan, point, observer),
+        EngineKind::Rtl => observe_point::<RtlEngine>(exp, plan, point, observer),
+        #[cfg(feature = "verilator")]
+        EngineKind::Verilator => observe_point::<crate::verilator::VerilatorEngine>(exp, plan, point, observer),
+        #[cfg(not(feature = "verilator"))]
+        EngineKind::Verilator => Err(
+            "engine = \"verilator\": this build has no Verilator engine (rebuild with --features verilator)".into(),
+        ),
+    }
 }

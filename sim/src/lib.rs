@@ -7,6 +7,7 @@
 //! staircase), `fit` (scale factors).
 
 pub mod average;
+pub mod config;
 pub mod cosim;
 pub mod engine;
 pub mod experiment;
@@ -17,3 +18,4 @@ pub mod report;
 pub mod theory;
 #[cfg(feature = "verilator")]
 pub mod verilator;
+pub mod waveform;
