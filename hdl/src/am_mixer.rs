@@ -129,6 +129,13 @@ impl Logic for AmMixer {
 
 crate::impl_clocked!(AmMixer);
 
+impl AmMixer {
+    #[doc(hidden)]
+    pub fn mutate_drive_rounding(&mut self) {
+        self.drive1.mutate_rounding();
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -90,6 +90,13 @@ impl Logic for CarrierNco {
 
 crate::impl_clocked!(CarrierNco);
 
+impl CarrierNco {
+    #[doc(hidden)]
+    pub fn mutate_sine_rounding(&mut self) {
+        self.drive.mutate_rounding();
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -205,7 +205,39 @@ impl Logic for GyroInterface {
 
 crate::impl_clocked!(GyroInterface);
 
+/// One-constant changes to the hardware, for the negative control of the
+/// model-vs-rtl comparisons (they must fail when the hardware changes).
+#[doc(hidden)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mutation {
+    /// The drive 1 rounding adds 2^13 instead of 2^14.
+    DriveRounding,
+    /// The sine correction rounding adds 1.5 half-LSBs.
+    SineRounding,
+    /// The readout amplitude is 32766 instead of 32767.
+    ModulationFullScale,
+}
+
+impl Mutation {
+    /// Every mutation.
+    pub const ALL: [Mutation; 3] = [
+        Mutation::DriveRounding,
+        Mutation::SineRounding,
+        Mutation::ModulationFullScale,
+    ];
+}
+
 impl GyroInterface {
+    /// Apply a mutation (before the design is connected).
+    #[doc(hidden)]
+    pub fn mutate(&mut self, mutation: Mutation) {
+        match mutation {
+            Mutation::DriveRounding => self.am_mixer.mutate_drive_rounding(),
+            Mutation::SineRounding => self.carrier_nco.mutate_sine_rounding(),
+            Mutation::ModulationFullScale => self.modulation_nco.mutate_full_scale(),
+        }
+    }
+
     /// Internal signals during the current cycle (for waveforms and tests).
     pub fn probes(&self) -> crate::model::gyro_interface::Probes {
         use crate::primitives::convert::signed_to_i128 as v;

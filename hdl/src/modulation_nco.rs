@@ -87,6 +87,13 @@ impl Logic for ModulationNco {
 
 crate::impl_clocked!(ModulationNco);
 
+impl ModulationNco {
+    #[doc(hidden)]
+    pub fn mutate_full_scale(&mut self) {
+        self.full_scale = Constant::new(((crate::sine_table::PEAK - 1) as i64).into());
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

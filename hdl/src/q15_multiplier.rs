@@ -75,6 +75,13 @@ impl Logic for Q15Multiplier {
 
 crate::impl_clocked!(Q15Multiplier);
 
+impl Q15Multiplier {
+    #[doc(hidden)]
+    pub fn mutate_rounding(&mut self) {
+        self.half_lsb = Constant::new((1i64 << 13).into());
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -184,6 +184,13 @@ impl Logic for SinCos {
 
 crate::impl_clocked!(SinCos);
 
+impl SinCos {
+    #[doc(hidden)]
+    pub fn mutate_rounding(&mut self) {
+        self.rounding = Constant::new(((1i64 << 21) + (1 << 20)).into());
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -5,7 +5,8 @@
 //! `dac2`, `z1`, `z2`, `z_valid`, `select`), the main internal ones
 //! (`ref1`, `ref2`: reference words; `am1`, `am2`: modulation factors;
 //! `w1`, `w2`: mixer products; `cic1`, `cic2`, `cic_valid`: CIC outputs)
-//! and the gyroscope's displacements `x1`, `x2` (real, metres). Groups:
+//! and the gyroscope's displacements `x1_pm`, `x2_pm` (real, picometres).
+//! Groups:
 //! `ports`, `internals`, `analog`, `all`. Time: rising edge n at n clock
 //! periods (1 ps resolution); inputs change at the falling edge before the
 //! rising edge that captures them. Values are written only when they
@@ -58,9 +59,9 @@ pub enum Probe {
     Cic2,
     /// CIC strobe.
     CicValid,
-    /// Displacement of mode 1 (m).
+    /// Displacement of mode 1 (pm).
     X1,
-    /// Displacement of mode 2 (m).
+    /// Displacement of mode 2 (pm).
     X2,
 }
 
@@ -92,8 +93,8 @@ impl Probe {
             Cic1 => "cic1",
             Cic2 => "cic2",
             CicValid => "cic_valid",
-            X1 => "x1",
-            X2 => "x2",
+            X1 => "x1_pm",
+            X2 => "x2_pm",
         }
     }
 
@@ -274,7 +275,7 @@ impl<W: Write> VcdRecorder<W> {
             match p {
                 Adc1 | Adc2 | Select => {}
                 X1 | X2 => {
-                    let x = if p == X1 { v.x.0 } else { v.x.1 };
+                    let x = 1e12 * if p == X1 { v.x.0 } else { v.x.1 };
                     if self.last_real[k] != Some(x) {
                         self.writer.change_real(id, x)?;
                         self.last_real[k] = Some(x);

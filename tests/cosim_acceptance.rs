@@ -1,0 +1,173 @@
+//! Co-simulation against the exact theory: the calibration scale factor
+//! predicts the readout scale factor.
+//!
+//! Tolerance 0.1% on every ratio, from the issue; what eats into it was
+//! measured while planning (design.md) and is reported by each test: the
+//! 16-bit ADC's deterministic quantization error (the rate signal is a
+//! fraction of an LSB on a detuned output), about 0.01-0.04% with 50 ms
+//! windows; each point settled to 1e-4 of the signal it measures; the
+//! whole-period window average, below 1e-6 (`average.rs`).
+
+use gyrocal_sim::engine::EngineKind;
+use gyrocal_sim::experiment::{self, Experiment};
+use gyrocal_sim::gyro::GyroParams;
+use gyrocal_sim::report::Report;
+
+/// A scaled copy of the paper's device: the same split in bandwidths
+/// (1.43 B) and the same rates and calibration frequencies relative to the
+/// bandwidth, at 1 MHz on a 10 MHz clock (non-round carrier, as design.md
+/// requires of test devices).
+fn scaled_paper(carrier_offset_hz: f64) -> Experiment {
+    let mut e = Experiment::paper();
+    let f1 = 1.0123e6;
+    let q = 5000.0;
+    let bandwidth = f1 / q;
+    e.gyro = GyroParams {
+        f1_hz: f1,
+        f2_hz: f1 + 1.426 * bandwidth,
+        q1: q,
+        q2: q,
+        angular_gain: 0.6,
+    };
+    e.carrier_hz = f1 + carrier_offset_hz;
+    e.clock_hz = 10e6;
+    e.decimation = 250;
+    e.readout_rates_dps = vec![1.0, 5.0, 10.0, 15.0, 20.0];
+    let scale = bandwidth / (9.64e6 / 55e3);
+    e.cal_freqs_hz = (10..=15).map(|f| f as f64 * scale).collect();
+    // Averaging windows of 0.1 s instead of the default 0.05 s: on the
+    // resonant output the readout signal is a small in-phase part of a
+    // full-scale quadrature signal, and the 16-bit ADC's deterministic
+    // quantization residue averaged over 0.05 s left +0.094% in its
+    // readout scale factor when excited at mode 2 (measured: 0.031% at
+    // 0.1 s, 0.029% at 0.2 s, so 0.1 s is past the knee).
+    e.min_window_s = 0.1;
+    e
+}
+
+fn run(e: &Experiment) -> Report {
+    experiment::run(e, EngineKind::Model, &|_| {}).unwrap()
+}
+
+fn assert_ratios_match_theory(r: &Report, what: &str) {
+    for k in 0..2 {
+        eprintln!(
+            "{what}, output {}: ratio {:.6} exact {:.6} error {:+.4}%",
+            k + 1,
+            r.ratio[k],
+            r.theory.ratio[k],
+            100.0 * r.ratio_error[k]
+        );
+    }
+    for k in 0..2 {
+        assert!(
+            r.ratio_error[k].abs() < 1e-3,
+            "{what}, output {}: {:+.4}%",
+            k + 1,
+            100.0 * r.ratio_error[k]
+        );
+    }
+}
+
+#[test]
+fn matched_modes_give_minus_two_lambda() {
+    // Q 1000 (bandwidth 1 kHz) and f_cal 2..6 Hz keep 2 Om / B below 0.012
+    // and the rates' 2 lam Omz Q / w0 below 0.002, so the exact fitted ratio
+    // sits within 2e-4 of -2 lambda (checked first: the test would
+    // otherwise measure the curvature of f(x) = x / (1 + x^2), not the
+    // co-simulation).
+    let mut e = Experiment::paper();
+    e.gyro = GyroParams {
+        f1_hz: 1.0123e6,
+        f2_hz: 1.0123e6,
+        q1: 1000.0,
+        q2: 1000.0,
+        angular_gain: 0.8,
+    };
+    e.carrier_hz = 1.0123e6;
+    e.clock_hz = 10e6;
+    e.decimation = 250;
+    e.readout_rates_dps = vec![100.0, 200.0, 300.0, 400.0];
+    e.cal_freqs_hz = vec![2.0, 4.0, 6.0];
+    let r = run(&e);
+    let target = -2.0 * 0.8;
+    for k in 0..2 {
+        assert!(
+            (r.theory.ratio[k] / target - 1.0).abs() < 2e-4,
+            "theory {}",
+            r.theory.ratio[k]
+        );
+        let error = r.ratio[k] / target - 1.0;
+        eprintln!(
+            "matched, output {}: ratio {:.6} vs -2 lambda: {:+.4}%",
+            k + 1,
+            r.ratio[k],
+            100.0 * error
+        );
+        assert!(
+            error.abs() < 1e-3,
+            "output {}: {:+.4}%",
+            k + 1,
+            100.0 * error
+        );
+    }
+}
+
+#[test]
+fn mismatched_modes_excited_at_mode_1() {
+    let r = run(&scaled_paper(0.0));
+    assert_eq!(r.detuned_output, Some(1));
+    assert_ratios_match_theory(&r, "excited at mode 1");
+}
+
+#[test]
+fn mismatched_modes_excited_at_mode_2() {
+    let e = scaled_paper(0.0);
+    let split = e.gyro.f2_hz - e.gyro.f1_hz;
+    let r = run(&scaled_paper(split));
+    assert_eq!(r.detuned_output, Some(0));
+    assert_ratios_match_theory(&r, "excited at mode 2");
+}
+
+#[test]
+fn mismatched_modes_excited_midway() {
+    let e = scaled_paper(0.0);
+    let split = e.gyro.f2_hz - e.gyro.f1_hz;
+    let r = run(&scaled_paper(split / 2.0));
+    assert_ratios_match_theory(&r, "excited midway");
+}
+
+#[test]
+fn unequal_q_and_negative_split() {
+    // The fifth reference case's shape: mode 2 below mode 1, Q 30,000 and
+    // 25,000, lambda 0.5, scaled to 1 MHz.
+    let mut e = scaled_paper(0.0);
+    e.gyro = GyroParams {
+        f1_hz: 1.0123e6,
+        f2_hz: 1.0123e6 - 27.0,
+        q1: 10_000.0,
+        q2: 8_300.0,
+        angular_gain: 0.5,
+    };
+    e.carrier_hz = e.gyro.f1_hz;
+    e.cal_freqs_hz = vec![1.0, 1.7, 2.4];
+    assert_ratios_match_theory(&run(&e), "split -27 Hz, unequal Q");
+}
+
+#[test]
+fn the_papers_device_at_full_scale() {
+    // `gyrocal reproduce`'s experiment: 9.64 MHz, Q 55,000, 250 Hz split,
+    // 50 MHz clock, 1..20 deg/s, 10..15 Hz: about 1.2e8 clocks.
+    let r = run(&Experiment::paper());
+    assert_eq!(r.detuned_output, Some(1));
+    // The exact fitted ratio at the paper's points is about 1.534 and the
+    // small-signal one 1.536 (design.md; 1.5338 and 1.5363 in the
+    // reference cases for the nominal carrier).
+    assert!(
+        (r.theory.ratio[1] - 1.534).abs() < 1e-3,
+        "{}",
+        r.theory.ratio[1]
+    );
+    assert!((r.theory.small_signal.ratio[1] - 1.5365).abs() < 1e-3);
+    assert_ratios_match_theory(&r, "paper's device");
+}
