@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs every test of gyrocal on a fresh Debian machine.
 #
-# Installs the Verilog tools the tests need (iverilog, verilator, yosys) with
+# Installs the tools the tests need (iverilog, verilator, yosys, make, g++) with
 # apt-get when they are missing (root, non-interactive), then runs the whole
 # test suite in release mode (the co-simulation tests need optimized code),
 # with the Verilator engine enabled, and the format and lint checks.
@@ -12,6 +12,9 @@ missing=()
 command -v iverilog >/dev/null 2>&1 || missing+=(iverilog)
 command -v verilator >/dev/null 2>&1 || missing+=(verilator)
 command -v yosys >/dev/null 2>&1 || missing+=(yosys)
+# Verilator's C++ build (the replay testbench and the verilator engine).
+command -v make >/dev/null 2>&1 || missing+=(make)
+command -v g++ >/dev/null 2>&1 || missing+=(g++)
 if [ ${#missing[@]} -gt 0 ]; then
   echo "installing Debian packages: ${missing[*]}"
   SUDO=""

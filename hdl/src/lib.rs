@@ -20,3 +20,4 @@ pub mod sincos;
 pub mod sine_table;
 #[cfg(test)]
 pub(crate) mod test_util;
+pub mod verify;

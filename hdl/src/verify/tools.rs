@@ -1,0 +1,169 @@
+//! Finding the external tools on `PATH`.
+//!
+//! Each function returns the tool's path, or a [`MissingTool`] error whose
+//! message names the Debian package that provides it, e.g.
+//!
+//! ```text
+//! iverilog not found on PATH: install the Debian package `iverilog` (apt-get install iverilog)
+//! ```
+//!
+//! Tests call these and fail with that message: a verification that cannot
+//! run must never pass or be skipped.
+
+use std::path::{Path, PathBuf};
+
+/// A program that is not on `PATH`, and the Debian package that provides it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct MissingTool {
+    /// The program that was looked for.
+    pub program: &'static str,
+    /// The Debian package that installs it.
+    pub package: &'static str,
+    /// What the program is needed for, if not obvious from its name.
+    pub needed_for: Option<&'static str>,
+}
+
+impl std::fmt::Display for MissingTool {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} not found on PATH{}: install the Debian package `{}` (apt-get install {})",
+            self.program,
+            self.needed_for
+                .map(|w| format!(" (needed for {w})"))
+                .unwrap_or_default(),
+            self.package,
+            self.package
+        )
+    }
+}
+
+impl std::error::Error for MissingTool {}
+
+/// The first executable file called `name` in the folders of `PATH`.
+pub fn find_program(name: &str) -> Option<PathBuf> {
+    let path = std::env::var_os("PATH")?;
+    std::env::split_paths(&path)
+        .map(|dir| dir.join(name))
+        .find(|p| is_executable(p))
+}
+
+#[cfg(unix)]
+fn is_executable(p: &Path) -> bool {
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::metadata(p).is_ok_and(|m| m.is_file() && m.permissions().mode() & 0o111 != 0)
+}
+
+#[cfg(not(unix))]
+fn is_executable(p: &Path) -> bool {
+    p.is_file()
+}
+
+fn require(
+    program: &'static str,
+    package: &'static str,
+    needed_for: Option<&'static str>,
+) -> Result<PathBuf, MissingTool> {
+    find_program(program).ok_or(MissingTool {
+        program,
+        package,
+        needed_for,
+    })
+}
+
+/// Icarus Verilog: the compiler and the runtime.
+#[derive(Clone, Debug)]
+pub struct Icarus {
+    /// `iverilog`, the compiler.
+    pub iverilog: PathBuf,
+    /// `vvp`, the simulation runtime.
+    pub vvp: PathBuf,
+}
+
+/// `iverilog` and `vvp` (Debian package `iverilog`).
+pub fn iverilog() -> Result<Icarus, MissingTool> {
+    Ok(Icarus {
+        iverilog: require("iverilog", "iverilog", None)?,
+        vvp: require("vvp", "iverilog", None)?,
+    })
+}
+
+/// `verilator` (Debian package `verilator`). Enough for `--lint-only`; a
+/// simulation binary also needs [`verilator_build`].
+pub fn verilator() -> Result<PathBuf, MissingTool> {
+    require("verilator", "verilator", None)
+}
+
+/// What `verilator --binary` needs: Verilator, `make` and a C++ compiler.
+#[derive(Clone, Debug)]
+pub struct VerilatorBuild {
+    /// `verilator`.
+    pub verilator: PathBuf,
+    /// `make`, which Verilator runs to build the model.
+    pub make: PathBuf,
+    /// The C++ compiler: `$CXX` if set, else `g++`.
+    pub cxx: PathBuf,
+}
+
+/// `verilator`, `make` and `g++` (or `$CXX`), each with its Debian package.
+pub fn verilator_build() -> Result<VerilatorBuild, MissingTool> {
+    let verilator = verilator()?;
+    let make = require("make", "make", Some("verilator --binary"))?;
+    let cxx = match std::env::var("CXX") {
+        Ok(cxx) if !cxx.is_empty() => {
+            let p = PathBuf::from(&cxx);
+            if p.is_absolute() && is_executable(&p) {
+                p
+            } else {
+                find_program(&cxx).ok_or(MissingTool {
+                    program: "the C++ compiler named by $CXX",
+                    package: "g++",
+                    needed_for: Some("verilator --binary"),
+                })?
+            }
+        }
+        _ => require("g++", "g++", Some("verilator --binary"))?,
+    };
+    Ok(VerilatorBuild {
+        verilator,
+        make,
+        cxx,
+    })
+}
+
+/// `yosys` (Debian package `yosys`).
+pub fn yosys() -> Result<PathBuf, MissingTool> {
+    require("yosys", "yosys", None)
+}
+
+/// The first line a tool prints for `arg` (e.g. `-V`, `--version`).
+pub fn version_line(program: &Path, arg: &str) -> Result<String, super::VerifyError> {
+    let mut cmd = std::process::Command::new(program);
+    cmd.arg(arg);
+    let (out, _) = super::run_ok(&mut cmd)?;
+    let text = super::combined_output(&out);
+    Ok(text.lines().next().unwrap_or("").trim().to_owned())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn message_names_the_debian_package() {
+        let m = MissingTool {
+            program: "iverilog",
+            package: "iverilog",
+            needed_for: None,
+        };
+        assert_eq!(
+            m.to_string(),
+            "iverilog not found on PATH: install the Debian package `iverilog` (apt-get install iverilog)"
+        );
+        let e = require("gyrocal-no-such-program", "gyrocal-pkg", Some("a test")).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "gyrocal-no-such-program not found on PATH (needed for a test): install the Debian package `gyrocal-pkg` (apt-get install gyrocal-pkg)"
+        );
+    }
+}
