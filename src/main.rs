@@ -4,6 +4,7 @@
 //! allowed; bad input exits with status 2, a failed run with status 1.
 
 mod commands;
+mod plots;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -26,6 +27,10 @@ enum Command {
     Run(commands::run::Args),
     /// Reproduce the paper's measurement on its device at full scale.
     Reproduce(commands::reproduce::Args),
+    /// Measure the engines' speed side by side, and the reproduce run.
+    Bench(commands::bench::Args),
+    /// Synthesize the export with Yosys and write verilog-out/RESOURCES.md.
+    Synth(commands::synth::Args),
 }
 
 /// A failure, with the exit status it deserves.
@@ -50,6 +55,8 @@ fn main() -> ExitCode {
         Command::Export(args) => commands::export::run(&args),
         Command::Run(args) => commands::run::run(&args),
         Command::Reproduce(args) => commands::reproduce::run(&args),
+        Command::Bench(args) => commands::bench::run(&args),
+        Command::Synth(args) => commands::synth::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -229,11 +229,9 @@ fn vcd_dump_reads_back_with_the_expected_signals_and_timing() {
                     .fold(0i64, |a, b| 2 * a + (*b == Value::V1) as i64);
                 max_dac = max_dac.max(if raw >= 1 << 15 { (1 << 16) - raw } else { raw });
             }
-            V::ChangeVector(i, v) if i == z_valid => {
-                if v.into_iter().next() == Some(Value::V1) {
-                    strobes.push(time - last_strobe);
-                    last_strobe = time;
-                }
+            V::ChangeVector(i, v) if i == z_valid && v.into_iter().next() == Some(Value::V1) => {
+                strobes.push(time - last_strobe);
+                last_strobe = time;
             }
             V::ChangeVector(i, v) if i == select => assert_eq!(
                 v.into_iter().next(),

@@ -6,8 +6,7 @@
 //! Requires `yosys` on PATH (Debian package `yosys`); without it the tests
 //! fail with that message. The two syntheses run once per test process, in
 //! parallel, and take about a minute on a 2-core machine. To rewrite
-//! RESOURCES.md after a design change:
-//! `GYROCAL_UPDATE_RESOURCES=1 cargo test --release --test verilog_synthesis`.
+//! RESOURCES.md after a design change: `cargo run --release -- synth`.
 
 use gyrocal_hdl::verify::synthesis::{self, SynthesisReport, Target};
 use gyrocal_hdl::verify::{self, ScratchDir, tools};
@@ -78,14 +77,9 @@ fn resources_md_matches_yosys() {
     require_yosys();
     let md = synthesis::resources_markdown(reports());
     let path = verify::committed_resources();
-    if std::env::var("GYROCAL_UPDATE_RESOURCES").is_ok_and(|v| v == "1") {
-        gyrocal_hdl::export::write_atomically(&path, &md)
-            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        eprintln!("wrote {}", path.display());
-    }
     let committed = std::fs::read_to_string(&path).unwrap_or_else(|e| {
         panic!(
-            "{}: {e}; create it with GYROCAL_UPDATE_RESOURCES=1 cargo test --release --test verilog_synthesis",
+            "{}: {e}; create it with `cargo run --release -- synth`",
             path.display()
         )
     });
@@ -100,7 +94,7 @@ fn resources_md_matches_yosys() {
             .collect();
         panic!(
             "{} differs from what Yosys reports now ({} vs {} lines); after checking the change, rewrite it with \
-             GYROCAL_UPDATE_RESOURCES=1 cargo test --release --test verilog_synthesis\n{}",
+             `cargo run --release -- synth`\n{}",
             path.display(),
             committed.lines().count(),
             md.lines().count(),

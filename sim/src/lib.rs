@@ -7,6 +7,7 @@
 //! staircase), `fit` (scale factors).
 
 pub mod average;
+pub mod bench;
 pub mod config;
 pub mod cosim;
 pub mod engine;

@@ -209,8 +209,8 @@ pub fn points_csv(report: &Report) -> String {
     csv
 }
 
-/// Write `results.json` and `points.csv` into `dir` (created if missing),
-/// each through a temporary file and a rename.
+/// Write `results.json`, `points.csv` and the figures into `dir` (created
+/// if missing), each through a temporary file and a rename.
 pub fn write_results(report: &Report, dir: &Path) -> Result<Vec<PathBuf>, Failure> {
     std::fs::create_dir_all(dir).map_err(|e| {
         Failure::Input(format!(
@@ -226,6 +226,7 @@ pub fn write_results(report: &Report, dir: &Path) -> Result<Vec<PathBuf>, Failur
             .map_err(|e| Failure::Run(format!("cannot write {}: {e}", path.display())))?;
         written.push(path);
     }
+    written.extend(crate::plots::write_figures(report, dir).map_err(Failure::Run)?);
     Ok(written)
 }
 

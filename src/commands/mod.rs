@@ -1,6 +1,8 @@
 //! One module per subcommand.
 
+pub mod bench;
 pub mod experiment;
 pub mod export;
 pub mod reproduce;
 pub mod run;
+pub mod synth;

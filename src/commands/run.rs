@@ -13,7 +13,7 @@ pub struct Args {
     /// Print one JSON object (the full report) to stdout instead of the summary.
     #[arg(long)]
     pub json: bool,
-    /// Also write results.json and points.csv into this folder.
+    /// Also write results.json, points.csv and the figures into this folder.
     #[arg(long)]
     pub out: Option<PathBuf>,
     #[command(flatten)]

@@ -1,0 +1,239 @@
+//! Side-by-side speed of the engines, in one process, on the same stimulus.
+//!
+//! For each engine: clocks per second stepping the datapath alone (ADC
+//! words from a precomputed table) and inside the closed loop with the
+//! gyroscope model (`CoSim`), each repeated and reported as the median with
+//! its spread. Stimulus: the paper's device, calibration at 12 Hz (every
+//! block busy). Optionally, the whole `reproduce` experiment, timed wall to
+//! wall on all cores, with the process's peak resident memory.
+
+use crate::cosim::CoSim;
+use crate::engine::{Engine, EngineKind, ModelEngine, RtlEngine};
+use crate::experiment::{self, Experiment, Plan};
+use crate::frontend::Converters;
+use crate::gyro::GyroModel;
+use serde::Serialize;
+use std::hint::black_box;
+use std::time::Instant;
+
+/// One engine in one setting.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Measurement {
+    /// Engine name.
+    pub engine: String,
+    /// True when the gyroscope model and converters were in the loop.
+    pub with_gyro: bool,
+    /// Clocks per repetition.
+    pub clocks: u64,
+    /// Clocks per second of each repetition.
+    pub samples: Vec<f64>,
+    /// Median of `samples`.
+    pub median_clocks_per_s: f64,
+}
+
+/// The whole reproduce experiment.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ReproduceTiming {
+    /// Wall time (s), all cores.
+    pub wall_s: f64,
+    /// Clocks simulated.
+    pub clocks: u64,
+    /// Worker threads.
+    pub threads: usize,
+    /// Peak resident memory of the process after the run (MB), from
+    /// /proc/self/status (VmHWM).
+    pub peak_memory_mb: Option<f64>,
+}
+
+/// Everything `gyrocal bench` measures.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct BenchReport {
+    /// Per engine and setting.
+    pub measurements: Vec<Measurement>,
+    /// Median model speed over median Verilator speed, gyroscope in the loop.
+    pub model_over_verilator_with_gyro: Option<f64>,
+    /// The reproduce run, when asked.
+    pub reproduce: Option<ReproduceTiming>,
+}
+
+fn median(v: &[f64]) -> f64 {
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    let n = s.len();
+    if n % 2 == 1 {
+        s[n / 2]
+    } else {
+        0.5 * (s[n / 2 - 1] + s[n / 2])
+    }
+}
+
+fn stimulus_plan() -> (Experiment, Plan) {
+    let mut exp = Experiment::paper();
+    exp.cal_freqs_hz = vec![12.0, 13.0];
+    let plan = experiment::plan(&exp).expect("the paper's plan is valid");
+    (exp, plan)
+}
+
+fn measure<E: Engine>(
+    name: &str,
+    clocks: u64,
+    repetitions: usize,
+) -> Result<[Measurement; 2], String> {
+    let (exp, plan) = stimulus_plan();
+    let point = plan
+        .points
+        .iter()
+        .find(|p| p.mode == experiment::Mode::Calibration)
+        .expect("a calibration point");
+    // ADC words for the datapath-alone runs: what the loop itself produces.
+    let adc: Vec<(i16, i16)> = {
+        let mut sim = CoSim::new(
+            ModelEngine::power_up()?,
+            Converters::new(&plan.front_end)?,
+            GyroModel::new(&exp.gyro, exp.clock_hz)?,
+            point.regs,
+        );
+        (0..clocks.min(1 << 22))
+            .map(|_| {
+                sim.step();
+                sim.last_adc()
+            })
+            .collect()
+    };
+    let mut alone = vec![];
+    let mut looped = vec![];
+    for _ in 0..repetitions {
+        let mut engine = E::power_up()?;
+        let start = Instant::now();
+        let mut check = 0i64;
+        for n in 0..clocks {
+            let o = engine.step(adc[(n % adc.len() as u64) as usize], black_box(&point.regs));
+            check = check.wrapping_add(o.z.0 ^ o.dac.0 as i64);
+        }
+        black_box(check);
+        alone.push(clocks as f64 / start.elapsed().as_secs_f64());
+        let mut sim = CoSim::new(
+            E::power_up()?,
+            Converters::new(&plan.front_end)?,
+            GyroModel::new(&exp.gyro, exp.clock_hz)?,
+            point.regs,
+        );
+        let start = Instant::now();
+        for _ in 0..clocks {
+            black_box(sim.step());
+        }
+        looped.push(clocks as f64 / start.elapsed().as_secs_f64());
+    }
+    let make = |with_gyro: bool, samples: Vec<f64>| Measurement {
+        engine: name.into(),
+        with_gyro,
+        clocks,
+        median_clocks_per_s: median(&samples),
+        samples,
+    };
+    Ok([make(false, alone), make(true, looped)])
+}
+
+/// Clocks per repetition for an engine: a fraction of a second each.
+pub fn default_clocks(kind: EngineKind) -> u64 {
+    match kind {
+        EngineKind::Model => 20_000_000,
+        EngineKind::Verilator => 1_000_000,
+        EngineKind::Rtl => 10_000,
+    }
+}
+
+/// Peak resident memory of this process (MB), Linux only.
+pub fn peak_memory_mb() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb / 1024.0)
+}
+
+/// Measure the given engines; `reproduce` also times the full experiment.
+pub fn run(
+    engines: &[EngineKind],
+    repetitions: usize,
+    scale: f64,
+    reproduce: bool,
+    progress: &dyn Fn(&str),
+) -> Result<BenchReport, String> {
+    let mut measurements = vec![];
+    for &kind in engines {
+        let clocks = ((default_clocks(kind) as f64 * scale) as u64).max(1000);
+        progress(&format!(
+            "{}: {repetitions} x {clocks} clocks, alone and with the gyroscope",
+            kind.name()
+        ));
+        let m = match kind {
+            EngineKind::Model => measure::<ModelEngine>("model", clocks, repetitions)?,
+            EngineKind::Rtl => measure::<RtlEngine>("rtl", clocks, repetitions)?,
+            #[cfg(feature = "verilator")]
+            EngineKind::Verilator => {
+                measure::<crate::verilator::VerilatorEngine>("verilator", clocks, repetitions)?
+            }
+            #[cfg(not(feature = "verilator"))]
+            EngineKind::Verilator => {
+                return Err("engine \"verilator\": this build has no Verilator engine (rebuild with --features verilator)".into());
+            }
+        };
+        measurements.extend(m);
+    }
+    let speed = |name: &str| {
+        measurements
+            .iter()
+            .find(|m| m.engine == name && m.with_gyro)
+            .map(|m| m.median_clocks_per_s)
+    };
+    let model_over_verilator_with_gyro = speed("model").zip(speed("verilator")).map(|(a, b)| a / b);
+    let reproduce = if reproduce {
+        progress("reproduce: the paper's full experiment on the model engine, all cores");
+        let exp = Experiment::paper();
+        let start = Instant::now();
+        let report = experiment::run(&exp, EngineKind::Model, &|_| {})?;
+        Some(ReproduceTiming {
+            wall_s: start.elapsed().as_secs_f64(),
+            clocks: report.timing.cycles,
+            threads: rayon::current_num_threads(),
+            peak_memory_mb: peak_memory_mb(),
+        })
+    } else {
+        None
+    };
+    Ok(BenchReport {
+        measurements,
+        model_over_verilator_with_gyro,
+        reproduce,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn median_of_odd_and_even_counts() {
+        assert_eq!(median(&[3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(&[4.0, 1.0, 2.0, 3.0]), 2.5);
+    }
+
+    #[test]
+    fn a_tiny_bench_reports_every_setting() {
+        let r = run(
+            &[EngineKind::Model, EngineKind::Rtl],
+            3,
+            1e-4,
+            false,
+            &|_| {},
+        )
+        .unwrap();
+        assert_eq!(r.measurements.len(), 4);
+        assert!(
+            r.measurements
+                .iter()
+                .all(|m| m.samples.len() == 3 && m.median_clocks_per_s > 0.0)
+        );
+        assert!(r.model_over_verilator_with_gyro.is_none());
+    }
+}

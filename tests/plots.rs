@@ -1,0 +1,344 @@
+//! The figures of a run (`src/plots.rs`): every file is written, each PNG
+//! decodes at its size and shows the data (both outputs' colours) and text,
+//! each SVG is well-formed and carries its axis labels, files are replaced
+//! whole, and a target that cannot be written, or a report that cannot be
+//! drawn, is an error naming it, never a panic.
+//!
+//! `cargo test --release --test plots -- --ignored paper_figures
+//! --nocapture` draws the paper's run into target/figures-paper (or
+//! $GYROCAL_FIGURES_DIR) and prints the time write_figures takes.
+
+#[path = "../src/plots.rs"]
+mod plots;
+
+use gyrocal_sim::engine::EngineKind;
+use gyrocal_sim::experiment::{Experiment, Mode, run};
+use gyrocal_sim::gyro::GyroParams;
+use gyrocal_sim::report::Report;
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+/// A scaled device (1 MHz, Q 5000, mode 2 detuned 60 Hz from the carrier):
+/// about a second in release, run once for all tests.
+fn small_report() -> &'static Report {
+    static REPORT: OnceLock<Report> = OnceLock::new();
+    REPORT.get_or_init(|| {
+        let mut e = Experiment::paper();
+        e.gyro = GyroParams {
+            f1_hz: 1.0123e6,
+            f2_hz: 1.0123e6 + 60.0,
+            q1: 5000.0,
+            q2: 5000.0,
+            angular_gain: 0.6,
+        };
+        e.carrier_hz = 1.0123e6;
+        e.clock_hz = 10e6;
+        e.decimation = 250;
+        e.readout_rates_dps = vec![100.0, 200.0, 300.0, 400.0];
+        e.cal_freqs_hz = vec![2.0, 4.0, 6.0];
+        run(&e, EngineKind::Model, &|_| {}).expect("small run")
+    })
+}
+
+/// Each figure: name, PNG size, texts its SVG must hold.
+const FIGURES: [(&str, (u32, u32), &[&str]); 4] = [
+    (
+        "fig4_readout",
+        (1400, 640),
+        &["rotation rate Ω (°/s)", "m²/s²", "SF = ", "exact theory"],
+    ),
+    (
+        "fig5a_staircase",
+        (1600, 1000),
+        &[
+            "time, runs end to end (s)",
+            "m²/s²",
+            "independent run",
+            "averaging window",
+            "window mean",
+        ],
+    ),
+    (
+        "fig5b_calibration",
+        (1400, 640),
+        &["virtual rate 360·f_cal (°/s)", "m²/s²", "SF = ", "Hz"],
+    ),
+    (
+        "fig_residuals",
+        (1400, 640),
+        &[
+            "rotation rate Ω (°/s)",
+            "virtual rate 360·f_cal (°/s)",
+            "ppm",
+        ],
+    ),
+];
+
+/// The colours of output 1 and output 2 in every figure.
+const OUTPUT_RGB: [[u8; 3]; 2] = [[31, 119, 180], [214, 39, 40]];
+
+fn decode_png(path: &Path) -> (u32, u32, Vec<[u8; 3]>) {
+    let file = std::fs::File::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let decoder = png::Decoder::new(std::io::BufReader::new(file));
+    let mut reader = decoder
+        .read_info()
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut buf = vec![0; reader.output_buffer_size().expect("buffer size")];
+    let info = reader
+        .next_frame(&mut buf)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    assert_eq!(info.color_type, png::ColorType::Rgb, "{}", path.display());
+    assert_eq!(info.bit_depth, png::BitDepth::Eight, "{}", path.display());
+    let pixels = buf[..info.buffer_size()]
+        .chunks_exact(3)
+        .map(|c| [c[0], c[1], c[2]])
+        .collect();
+    (info.width, info.height, pixels)
+}
+
+/// Tags balance (`<a>` ... `</a>`, `<a/>`), the root is one `<svg>`.
+fn check_xml(path: &Path, text: &str) {
+    let mut stack: Vec<&str> = vec![];
+    let mut roots = 0;
+    let mut rest = text;
+    while let Some(open) = rest.find('<') {
+        let close = rest[open..]
+            .find('>')
+            .unwrap_or_else(|| panic!("{}: unterminated tag", path.display()))
+            + open;
+        let tag = &rest[open + 1..close];
+        if let Some(name) = tag.strip_prefix('/') {
+            let top = stack.pop();
+            assert_eq!(top, Some(name.trim()), "{}: </{name}>", path.display());
+        } else if !tag.starts_with('?') && !tag.starts_with('!') {
+            let name = tag
+                .split(|c: char| c.is_whitespace() || c == '/')
+                .next()
+                .unwrap_or("");
+            assert!(!name.is_empty(), "{}: empty tag", path.display());
+            if stack.is_empty() {
+                roots += 1;
+                assert_eq!(name, "svg", "{}: root element", path.display());
+            }
+            if !tag.ends_with('/') {
+                stack.push(name);
+            }
+        }
+        rest = &rest[close + 1..];
+    }
+    assert!(stack.is_empty(), "{}: unclosed {stack:?}", path.display());
+    assert_eq!(roots, 1, "{}: root elements", path.display());
+}
+
+/// Characters of the embedded font subset (assets/fonts/README.md).
+fn in_font(c: char) -> bool {
+    let ranges = [
+        (0x20, 0x7e),
+        (0xa0, 0xff),
+        (0x391, 0x3a9),
+        (0x3b1, 0x3c9),
+        (0x2010, 0x2015),
+        (0x2022, 0x2022),
+        (0x2026, 0x2026),
+        (0x2070, 0x207f),
+        (0x2080, 0x2089),
+        (0x2190, 0x2193),
+        (0x2206, 0x2206),
+        (0x2212, 0x2212),
+        (0x221a, 0x221a),
+        (0x221e, 0x221e),
+        (0x2248, 0x2248),
+        (0x2264, 0x2265),
+    ];
+    ranges.iter().any(|&(a, b)| (a..=b).contains(&u32::from(c)))
+}
+
+/// The text content of every `<text>` element.
+fn svg_texts(svg: &str) -> Vec<&str> {
+    svg.split("<text")
+        .skip(1)
+        .filter_map(|t| {
+            let body = &t[t.find('>')? + 1..];
+            Some(body[..body.find("</text>")?].trim())
+        })
+        .collect()
+}
+
+/// Files in `dir` other than the figures (temporary files left behind).
+fn strays(dir: &Path, written: &[PathBuf]) -> Vec<PathBuf> {
+    std::fs::read_dir(dir)
+        .expect("read dir")
+        .map(|e| e.expect("entry").path())
+        .filter(|p| !written.contains(p) && p.is_file())
+        .collect()
+}
+
+#[test]
+fn writes_every_figure_as_png_and_svg() {
+    let report = small_report();
+    let dir = tempfile::tempdir().expect("temp dir");
+    let written = plots::write_figures(report, dir.path()).expect("figures");
+    let expected: Vec<PathBuf> = FIGURES
+        .iter()
+        .flat_map(|(name, _, _)| ["png", "svg"].map(|ext| dir.path().join(format!("{name}.{ext}"))))
+        .collect();
+    assert_eq!(written, expected);
+    assert_eq!(strays(dir.path(), &written), Vec::<PathBuf>::new());
+
+    for (name, (w, h), labels) in FIGURES {
+        let png_path = dir.path().join(format!("{name}.png"));
+        let (pw, ph, pixels) = decode_png(&png_path);
+        assert_eq!((pw, ph), (w, h), "{name}.png size");
+        let distinct: HashSet<[u8; 3]> = pixels.iter().copied().collect();
+        assert!(
+            distinct.len() > 50,
+            "{name}.png has {} colours: blank?",
+            distinct.len()
+        );
+        for rgb in OUTPUT_RGB {
+            let n = pixels.iter().filter(|p| **p == rgb).count();
+            assert!(n > 200, "{name}.png: {n} pixels of {rgb:?}, data not drawn");
+        }
+        let dark = pixels.iter().filter(|p| p.iter().all(|&c| c < 80)).count();
+        assert!(dark > 2000, "{name}.png: {dark} dark pixels, no text?");
+
+        let svg_path = dir.path().join(format!("{name}.svg"));
+        let svg = std::fs::read_to_string(&svg_path).expect("svg");
+        assert!(
+            svg.starts_with(&format!("<svg width=\"{w}\" height=\"{h}\"")),
+            "{name}.svg: {}",
+            &svg[..svg.len().min(80)]
+        );
+        check_xml(&svg_path, &svg);
+        for label in labels {
+            assert!(svg.contains(label), "{name}.svg lacks {label:?}");
+        }
+        let texts = svg_texts(&svg);
+        assert!(texts.len() > 20, "{name}.svg: {} texts", texts.len());
+        for text in texts {
+            let missing: String = text.chars().filter(|&c| !in_font(c)).collect();
+            assert!(
+                missing.is_empty(),
+                "{name}: {missing:?} in {text:?} is not in the embedded font (assets/fonts/README.md)"
+            );
+        }
+    }
+
+    // Again into the same folder: replaced whole, nothing left behind.
+    let again = plots::write_figures(report, dir.path()).expect("figures again");
+    assert_eq!(again, written);
+    assert_eq!(strays(dir.path(), &written), Vec::<PathBuf>::new());
+}
+
+#[test]
+fn creates_a_missing_folder() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let target = dir.path().join("a").join("b");
+    let written = plots::write_figures(small_report(), &target).expect("figures");
+    assert!(
+        written
+            .iter()
+            .all(|p| p.starts_with(&target) && p.is_file())
+    );
+}
+
+#[test]
+fn unwritable_folder_is_an_error_naming_it() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let file = dir.path().join("not-a-folder");
+    std::fs::write(&file, "x").expect("write");
+    let target = file.join("figures");
+    let e = plots::write_figures(small_report(), &target).expect_err("a file in the way");
+    assert!(
+        e.contains(&target.display().to_string()),
+        "error does not name {}: {e}",
+        target.display()
+    );
+    assert!(!e.contains('\n'), "not one line: {e}");
+}
+
+#[test]
+fn occupied_file_name_is_an_error_naming_it() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let occupied = dir.path().join("fig5a_staircase.png");
+    std::fs::create_dir(&occupied).expect("mkdir");
+    let e = plots::write_figures(small_report(), dir.path()).expect_err("a folder in the way");
+    assert!(
+        e.contains(&occupied.display().to_string()),
+        "error does not name {}: {e}",
+        occupied.display()
+    );
+    assert!(!e.contains('\n'), "not one line: {e}");
+    // The figures before it were written whole; no temporary file remains.
+    let written: Vec<PathBuf> = ["fig4_readout.png", "fig4_readout.svg"]
+        .iter()
+        .map(|n| dir.path().join(n))
+        .collect();
+    assert!(written.iter().all(|p| p.is_file()));
+    assert_eq!(strays(dir.path(), &written), Vec::<PathBuf>::new());
+}
+
+#[test]
+fn reports_that_cannot_be_drawn_are_errors() {
+    let dir = tempfile::tempdir().expect("temp dir");
+
+    let mut no_trace = small_report().clone();
+    for p in &mut no_trace.points {
+        p.trace.clear();
+    }
+    let e = plots::write_figures(&no_trace, dir.path()).expect_err("no traces");
+    assert!(e.contains("trace"), "{e}");
+
+    let mut nan = small_report().clone();
+    nan.points[1].z[1] = f64::NAN;
+    let e = plots::write_figures(&nan, dir.path()).expect_err("NaN");
+    assert!(e.contains("non-finite"), "{e}");
+
+    let first_readout = small_report()
+        .points
+        .iter()
+        .position(|p| p.mode == Mode::Readout)
+        .expect("readout");
+    let keep = small_report().points[first_readout].rate_dps;
+    let mut one_point = small_report().clone();
+    one_point
+        .points
+        .retain(|p| p.mode != Mode::Readout || p.rate_dps == keep);
+    let e = plots::write_figures(&one_point, dir.path()).expect_err("one readout point");
+    assert!(e.contains("readout"), "{e}");
+    assert_eq!(std::fs::read_dir(dir.path()).expect("dir").count(), 0);
+}
+
+#[test]
+fn flat_outputs_still_draw() {
+    // All window means equal (slope 0): the figures must still come out.
+    let mut flat = small_report().clone();
+    for p in &mut flat.points {
+        p.z = [1e-12, -2e-12];
+        p.z_theory = [1e-12, -2e-12];
+    }
+    flat.sf_read_per_dps = [0.0; 2];
+    flat.sf_cal_per_dps = [0.0; 2];
+    flat.theory.sf_read_per_dps = [0.0; 2];
+    flat.theory.sf_cal_per_dps = [0.0; 2];
+    flat.intercept_read = [1e-12, -2e-12];
+    flat.intercept_cal = [1e-12, -2e-12];
+    let dir = tempfile::tempdir().expect("temp dir");
+    plots::write_figures(&flat, dir.path()).expect("flat figures");
+}
+
+#[test]
+#[ignore = "the paper's run takes several seconds in release"]
+fn paper_figures() {
+    let report = run(&Experiment::paper(), EngineKind::Model, &|_| {}).expect("paper run");
+    let dir = std::env::var("GYROCAL_FIGURES_DIR")
+        .unwrap_or_else(|_| concat!(env!("CARGO_MANIFEST_DIR"), "/target/figures-paper").into());
+    let start = std::time::Instant::now();
+    let files = plots::write_figures(&report, Path::new(&dir)).expect("figures");
+    println!(
+        "write_figures: {:.3} s for {} files in {dir}",
+        start.elapsed().as_secs_f64(),
+        files.len()
+    );
+}
