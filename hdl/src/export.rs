@@ -96,7 +96,7 @@ pub const PORTS: &[Port] = &[
         Output,
         16,
         true,
-        "two's complement, |dac1| <= 32767",
+        "two's complement, -32767..32767",
         "Drive 1 = F1 A1 cos(wt), to DAC 1 (mode 1).",
     ),
     port(
@@ -104,7 +104,7 @@ pub const PORTS: &[Port] = &[
         Output,
         16,
         true,
-        "two's complement, |dac2| <= 32767",
+        "two's complement, -32767..32767",
         "Drive 2 = F2 A2 sin(wt), to DAC 2 (mode 2).",
     ),
     port(
