@@ -143,45 +143,47 @@ mod tests {
     use crate::model::am_mixer::{AmMixer as Model, Drives};
     use crate::model::carrier_nco::Carriers;
     use crate::primitives::convert::{i128_to_signed, signed_to_i128};
-    use crate::test_util::Rng;
+    use crate::test_util::{sample16, word16};
+    use proptest::prelude::*;
 
-    fn sample(rng: &mut Rng) -> i16 {
-        rng.word16().max(-32767)
+    fn carriers() -> impl Strategy<Value = Carriers> {
+        (sample16(), sample16(), sample16(), sample16()).prop_map(|(a, b, c, d)| Carriers {
+            drive_cos: a,
+            drive_sin: b,
+            ref_cos: c,
+            ref_sin: d,
+        })
     }
 
-    #[test]
-    fn rtl_matches_model_including_full_scale_words() {
-        let mut uut = AmMixer::new();
-        prepare(&mut uut);
-        let mut model = Model::default();
-        let mut rng = Rng::new(11);
-        for n in 0..3000 {
-            let amp = (rng.word16(), rng.word16());
-            let am = (sample(&mut rng), sample(&mut rng));
-            let c = Carriers {
-                drive_cos: sample(&mut rng),
-                drive_sin: sample(&mut rng),
-                ref_cos: sample(&mut rng),
-                ref_sin: sample(&mut rng),
-            };
-            let s = |x: i16| i128_to_signed(x as i128);
-            uut.amp1.next = s(amp.0);
-            uut.amp2.next = s(amp.1);
-            uut.am1.next = s(am.0);
-            uut.am2.next = s(am.1);
-            uut.drive_cos.next = s(c.drive_cos);
-            uut.drive_sin.next = s(c.drive_sin);
-            uut.ref_cos.next = s(c.ref_cos);
-            uut.ref_sin.next = s(c.ref_sin);
-            tick(&mut uut);
-            let v = |x: Signed<16>| signed_to_i128(x) as i16;
-            let hw = Drives {
-                dac1: v(uut.dac1.val()),
-                dac2: v(uut.dac2.val()),
-                ref1: v(uut.ref1.val()),
-                ref2: v(uut.ref2.val()),
-            };
-            assert_eq!(hw, model.step(amp, am, c), "cycle {n}");
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(8))]
+        #[test]
+        fn rtl_matches_model_including_full_scale_words(
+            cycles in prop::collection::vec(((word16(), word16()), (sample16(), sample16()), carriers()), 400),
+        ) {
+            let mut uut = AmMixer::new();
+            prepare(&mut uut);
+            let mut model = Model::default();
+            for (n, &(amp, am, c)) in cycles.iter().enumerate() {
+                let s = |x: i16| i128_to_signed(x as i128);
+                uut.amp1.next = s(amp.0);
+                uut.amp2.next = s(amp.1);
+                uut.am1.next = s(am.0);
+                uut.am2.next = s(am.1);
+                uut.drive_cos.next = s(c.drive_cos);
+                uut.drive_sin.next = s(c.drive_sin);
+                uut.ref_cos.next = s(c.ref_cos);
+                uut.ref_sin.next = s(c.ref_sin);
+                tick(&mut uut);
+                let v = |x: Signed<16>| signed_to_i128(x) as i16;
+                let hw = Drives {
+                    dac1: v(uut.dac1.val()),
+                    dac2: v(uut.dac2.val()),
+                    ref1: v(uut.ref1.val()),
+                    ref2: v(uut.ref2.val()),
+                };
+                prop_assert_eq!(hw, model.step(amp, am, c), "cycle {}", n);
+            }
         }
     }
 

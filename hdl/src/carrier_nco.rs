@@ -103,32 +103,32 @@ mod tests {
     use crate::drive::{prepare, tick};
     use crate::model::carrier_nco::{CarrierNco as Model, Carriers};
     use crate::primitives::convert::{signed_to_i128, u128_to_bits};
-    use crate::test_util::Rng;
+    use crate::test_util::segments;
+    use proptest::prelude::*;
     use rustfft::{FftPlanner, num_complex::Complex};
 
-    #[test]
-    fn rtl_matches_model_with_changing_step_and_offset() {
-        let mut uut = CarrierNco::new();
-        prepare(&mut uut);
-        let mut model = Model::default();
-        let mut rng = Rng::new(3);
-        let (mut step, mut offset) = (0u32, 0u32);
-        for n in 0..4000 {
-            if n % 500 == 0 {
-                step = rng.next_u64() as u32;
-                offset = rng.next_u64() as u32;
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(8))]
+        #[test]
+        fn rtl_matches_model_with_changing_step_and_offset(
+            settings in segments((any::<u32>(), any::<u32>()), 2..6, 50..200),
+        ) {
+            let mut uut = CarrierNco::new();
+            prepare(&mut uut);
+            let mut model = Model::default();
+            for (n, &(step, offset)) in settings.iter().enumerate() {
+                uut.step.next = u128_to_bits(step as u128);
+                uut.ref_offset.next = u128_to_bits(offset as u128);
+                tick(&mut uut);
+                let v = |x: Signed<16>| signed_to_i128(x) as i16;
+                let hw = Carriers {
+                    drive_cos: v(uut.drive_cos.val()),
+                    drive_sin: v(uut.drive_sin.val()),
+                    ref_cos: v(uut.ref_cos.val()),
+                    ref_sin: v(uut.ref_sin.val()),
+                };
+                prop_assert_eq!(hw, model.step(step, offset), "cycle {}", n);
             }
-            uut.step.next = u128_to_bits(step as u128);
-            uut.ref_offset.next = u128_to_bits(offset as u128);
-            tick(&mut uut);
-            let v = |x: Signed<16>| signed_to_i128(x) as i16;
-            let hw = Carriers {
-                drive_cos: v(uut.drive_cos.val()),
-                drive_sin: v(uut.drive_sin.val()),
-                ref_cos: v(uut.ref_cos.val()),
-                ref_sin: v(uut.ref_sin.val()),
-            };
-            assert_eq!(hw, model.step(step, offset), "cycle {n}");
         }
     }
 

@@ -232,7 +232,8 @@ mod tests {
     use crate::filter_design::cic_bit_growth;
     use crate::model::cic_decimator::CicDecimator as Model;
     use crate::primitives::convert::{i128_to_signed, signed_to_i128, u128_to_bits};
-    use crate::test_util::Rng;
+    use crate::test_util::segments;
+    use proptest::prelude::*;
 
     /// Run the model over `x`, returning the outputs in order.
     fn outputs(x: &[i32], r: u32, shift: u32) -> Vec<i64> {
@@ -242,33 +243,34 @@ mod tests {
             .collect()
     }
 
-    #[test]
-    fn rtl_matches_model_with_rate_changes_and_extreme_inputs() {
-        let mut uut = CicDecimator::new();
-        prepare(&mut uut);
-        let mut model = Model::default();
-        let mut rng = Rng::new(19);
-        let (mut r, mut shift) = (1u32, 0u32);
-        let mut strobes = 0;
-        for n in 0..5000 {
-            if n % 700 == 0 {
-                r = [1, 2, 3, 5, 16, 17, 31][rng.range(0, 6) as usize];
-                shift = rng.range(0, cic_bit_growth(r) as i64) as u32;
+    /// (R, shift) with the shift anywhere in 0..=ceil(4 log2 R).
+    fn rate_and_shift() -> impl Strategy<Value = (u32, u32)> {
+        prop::sample::select(vec![1u32, 2, 3, 5, 16, 17, 31])
+            .prop_flat_map(|r| (Just(r), 0..=cic_bit_growth(r)))
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(6))]
+        #[test]
+        fn rtl_matches_model_with_rate_changes_and_extreme_inputs(
+            settings in segments(rate_and_shift(), 4..6, 250..300),
+            inputs in prop::collection::vec(prop_oneof![1 => Just(i32::MIN), 1 => Just(i32::MAX), 6 => any::<i32>()], 1800),
+        ) {
+            let mut uut = CicDecimator::new();
+            prepare(&mut uut);
+            let mut model = Model::default();
+            let mut strobes = 0;
+            for (n, (&(r, shift), &x)) in settings.iter().zip(&inputs).enumerate() {
+                uut.x.next = i128_to_signed(x as i128);
+                uut.decimation.next = u128_to_bits(r as u128);
+                uut.shift.next = u128_to_bits(shift as u128);
+                tick(&mut uut);
+                let hw = (signed_to_i128(uut.y.val()) as i64, uut.valid.val());
+                prop_assert_eq!(hw, model.step(x, r, shift), "cycle {}", n);
+                strobes += hw.1 as u32;
             }
-            let x = match rng.range(0, 7) {
-                0 => i32::MIN,
-                1 => i32::MAX,
-                _ => rng.next_u64() as i32,
-            };
-            uut.x.next = i128_to_signed(x as i128);
-            uut.decimation.next = u128_to_bits(r as u128);
-            uut.shift.next = u128_to_bits(shift as u128);
-            tick(&mut uut);
-            let hw = (signed_to_i128(uut.y.val()) as i64, uut.valid.val());
-            assert_eq!(hw, model.step(x, r, shift), "cycle {n}");
-            strobes += hw.1 as u32;
+            prop_assert!(strobes > 10, "only {} outputs", strobes);
         }
-        assert!(strobes > 300, "only {strobes} outputs");
     }
 
     #[test]

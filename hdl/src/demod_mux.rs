@@ -110,28 +110,31 @@ mod tests {
     use crate::drive::{prepare, tick};
     use crate::model::demod_mux::DemodMux as Model;
     use crate::primitives::convert::{i128_to_signed, signed_to_i128};
-    use crate::test_util::Rng;
+    use crate::test_util::{segments, word16};
+    use proptest::prelude::*;
 
-    #[test]
-    fn rtl_matches_model_in_both_modes_with_extreme_words() {
-        let mut uut = DemodMux::new();
-        prepare(&mut uut);
-        let mut model = Model::default();
-        let mut rng = Rng::new(17);
-        for n in 0..3000 {
-            let select = (n / 100) % 2 == 1;
-            let adc = (rng.word16(), rng.word16());
-            let aligned = (rng.word16(), rng.word16());
-            let s = |x: i16| i128_to_signed(x as i128);
-            uut.adc1.next = s(adc.0);
-            uut.adc2.next = s(adc.1);
-            uut.aligned1.next = s(aligned.0);
-            uut.aligned2.next = s(aligned.1);
-            uut.select.next = select;
-            tick(&mut uut);
-            let v = |x: Signed<32>| signed_to_i128(x) as i32;
-            let hw = (v(uut.w1.val()), v(uut.w2.val()));
-            assert_eq!(hw, model.step(adc, aligned, select), "cycle {n}");
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(8))]
+        #[test]
+        fn rtl_matches_model_in_both_modes_with_extreme_words(
+            selects in segments(any::<bool>(), 8..12, 50..80),
+            words in prop::collection::vec(((word16(), word16()), (word16(), word16())), 640),
+        ) {
+            let mut uut = DemodMux::new();
+            prepare(&mut uut);
+            let mut model = Model::default();
+            for (n, (&select, &(adc, aligned))) in selects.iter().zip(&words).enumerate() {
+                let s = |x: i16| i128_to_signed(x as i128);
+                uut.adc1.next = s(adc.0);
+                uut.adc2.next = s(adc.1);
+                uut.aligned1.next = s(aligned.0);
+                uut.aligned2.next = s(aligned.1);
+                uut.select.next = select;
+                tick(&mut uut);
+                let v = |x: Signed<32>| signed_to_i128(x) as i32;
+                let hw = (v(uut.w1.val()), v(uut.w2.val()));
+                prop_assert_eq!(hw, model.step(adc, aligned, select), "cycle {}", n);
+            }
         }
     }
 

@@ -13,7 +13,8 @@
 //! k2 = 1 - a2 = 2 sqrt2 W / d (both computed without cancellation), where
 //! G_cic = R^4 / 2^ceil(4 log2 R) is the CIC's residual gain, so the chain
 //! has unity gain at DC. The RC section is the impulse-invariant one-pole
-//! alpha = 1 - exp(-2 pi f_rc / f_z). Every coefficient is rounded to Q2.30;
+//! alpha = 1 - exp(-2 pi f_rc / f_z). Every coefficient is rounded to Q2.30
+//! (the `fixed` crate's `I2F30`: nearest, ties to even, range checked);
 //! the realized DC gain, 4 k0 / -(k1 + k2) G_cic, is computed from the
 //! quantized values and reported, so results never depend on the ideal one.
 //!

@@ -276,7 +276,8 @@ mod tests {
     use crate::filter_design::{self, FilterDesign};
     use crate::model::iir_lowpass::{Coefficients, IirLowpass as Model};
     use crate::primitives::convert::{i128_to_signed, signed_to_i128};
-    use crate::test_util::Rng;
+    use crate::test_util::{Rng, segments};
+    use proptest::prelude::*;
 
     /// Largest CIC output magnitude for valid settings: the mixer output is
     /// below 2^30 and the CIC gain at most 1, times 2^8.
@@ -331,38 +332,36 @@ mod tests {
             .collect()
     }
 
-    #[test]
-    fn rtl_matches_model_with_random_inputs_and_dropped_strobes() {
-        let mut uut = IirLowpass::new();
-        prepare(&mut uut);
-        let mut model = Model::default();
-        let mut rng = Rng::new(23);
-        let designs = designs();
-        let mut k = designs[0].coefficients;
-        let mut x = 0i64;
-        let mut outputs = 0;
-        for n in 0..6000 {
-            if n % 1500 == 0 {
-                k = designs[n / 1500].coefficients;
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(6))]
+        #[test]
+        fn rtl_matches_model_with_random_inputs_and_dropped_strobes(
+            design in segments(0usize..4, 3..5, 500..700),
+            // Strobes one clock in 12 on average: some land while a
+            // schedule runs and must be dropped by both.
+            inputs in prop::collection::vec((prop::bool::weighted(1.0 / 12.0), -FULL_SCALE..=FULL_SCALE), 1500),
+        ) {
+            let designs = designs();
+            let mut uut = IirLowpass::new();
+            prepare(&mut uut);
+            let mut model = Model::default();
+            let mut outputs = 0;
+            for (n, (&d, &(valid, x))) in design.iter().zip(&inputs).enumerate() {
+                let k = designs[d].coefficients;
+                let s = |v: i32| i128_to_signed::<32>(v as i128);
+                uut.x.next = i128_to_signed(x as i128);
+                uut.x_valid.next = valid;
+                uut.k0.next = s(k.k0);
+                uut.k1.next = s(k.k1);
+                uut.k2.next = s(k.k2);
+                uut.alpha.next = s(k.alpha);
+                tick(&mut uut);
+                let hw = (signed_to_i128(uut.z.val()) as i64, uut.z_valid.val());
+                prop_assert_eq!(hw, model.step(x, valid, &k), "cycle {}", n);
+                outputs += hw.1 as u32;
             }
-            // Strobes every 1..20 clocks: some land while a schedule runs.
-            let valid = rng.range(0, 12) == 0;
-            if valid {
-                x = rng.range(-FULL_SCALE, FULL_SCALE);
-            }
-            let s = |v: i32| i128_to_signed::<32>(v as i128);
-            uut.x.next = i128_to_signed(x as i128);
-            uut.x_valid.next = valid;
-            uut.k0.next = s(k.k0);
-            uut.k1.next = s(k.k1);
-            uut.k2.next = s(k.k2);
-            uut.alpha.next = s(k.alpha);
-            tick(&mut uut);
-            let hw = (signed_to_i128(uut.z.val()) as i64, uut.z_valid.val());
-            assert_eq!(hw, model.step(x, valid, &k), "cycle {n}");
-            outputs += hw.1 as u32;
+            prop_assert!(outputs > 40, "only {} outputs", outputs);
         }
-        assert!(outputs > 200, "only {outputs} outputs");
     }
 
     #[test]

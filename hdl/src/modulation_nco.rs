@@ -101,28 +101,27 @@ mod tests {
     use crate::model::modulation_nco::ModulationNco as Model;
     use crate::primitives::convert::{signed_to_i128, u128_to_bits};
     use crate::sine_table::PEAK;
-    use crate::test_util::Rng;
+    use crate::test_util::segments;
+    use proptest::prelude::*;
 
-    #[test]
-    fn rtl_matches_model_across_select_changes() {
-        let mut uut = ModulationNco::new();
-        prepare(&mut uut);
-        let mut model = Model::default();
-        let mut rng = Rng::new(5);
-        let mut step = 0u64;
-        let mut select = false;
-        for n in 0..4000 {
-            if n % 300 == 0 {
-                // Large steps so the sine moves within the test.
-                step = rng.next_u64() >> 16;
-                select = !select;
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(8))]
+        #[test]
+        fn rtl_matches_model_across_select_changes(
+            // Large steps (up to 2^48 / 2^4) so the sine moves within the test.
+            settings in segments((0u64..(1 << 44), any::<bool>()), 2..8, 30..150),
+        ) {
+            let mut uut = ModulationNco::new();
+            prepare(&mut uut);
+            let mut model = Model::default();
+            for (n, &(step, select)) in settings.iter().enumerate() {
+                uut.step.next = u128_to_bits(step as u128);
+                uut.select.next = select;
+                tick(&mut uut);
+                let v = |x: Signed<16>| signed_to_i128(x) as i16;
+                let hw = (v(uut.am1.val()), v(uut.am2.val()));
+                prop_assert_eq!(hw, model.step(step, select), "cycle {}", n);
             }
-            uut.step.next = u128_to_bits(step as u128);
-            uut.select.next = select;
-            tick(&mut uut);
-            let v = |x: Signed<16>| signed_to_i128(x) as i16;
-            let hw = (v(uut.am1.val()), v(uut.am2.val()));
-            assert_eq!(hw, model.step(step, select), "cycle {n}");
         }
     }
 

@@ -88,7 +88,8 @@ mod tests {
     use crate::drive::{prepare, tick};
     use crate::model::q15_multiplier::{Q15Multiplier as Model, q15_product};
     use crate::primitives::convert::{i128_to_signed, signed_to_i128};
-    use crate::test_util::Rng;
+    use crate::test_util::{sample16, word16};
+    use proptest::prelude::*;
 
     #[test]
     fn extreme_factors_never_overflow() {
@@ -104,22 +105,21 @@ mod tests {
         }
     }
 
-    #[test]
-    fn rtl_matches_model_on_extremes_and_random_words() {
-        let mut uut = Q15Multiplier::new();
-        prepare(&mut uut);
-        let mut model = Model::default();
-        let mut rng = Rng::new(7);
-        for n in 0..3000 {
-            let (a, b) = (rng.word16(), rng.word16().max(-32767));
-            uut.a.next = i128_to_signed(a as i128);
-            uut.b.next = i128_to_signed(b as i128);
-            tick(&mut uut);
-            assert_eq!(
-                signed_to_i128(uut.y.val()) as i16,
-                model.step(a, b),
-                "cycle {n}"
-            );
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(8))]
+        #[test]
+        fn rtl_matches_model_on_extremes_and_random_words(
+            words in prop::collection::vec((word16(), sample16()), 400),
+        ) {
+            let mut uut = Q15Multiplier::new();
+            prepare(&mut uut);
+            let mut model = Model::default();
+            for (n, &(a, b)) in words.iter().enumerate() {
+                uut.a.next = i128_to_signed(a as i128);
+                uut.b.next = i128_to_signed(b as i128);
+                tick(&mut uut);
+                prop_assert_eq!(signed_to_i128(uut.y.val()) as i16, model.step(a, b), "cycle {}", n);
+            }
         }
     }
 }

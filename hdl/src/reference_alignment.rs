@@ -85,32 +85,29 @@ mod tests {
     use crate::drive::{prepare, tick};
     use crate::model::reference_alignment::ReferenceAlignment as Model;
     use crate::primitives::convert::{i128_to_signed, signed_to_i128, u128_to_bits};
-    use crate::test_util::Rng;
+    use crate::test_util::{segments, word16};
+    use proptest::prelude::*;
 
-    #[test]
-    fn rtl_matches_model_with_changing_delay() {
-        let mut uut = ReferenceAlignment::new();
-        prepare(&mut uut);
-        let mut model = Model::default();
-        let mut rng = Rng::new(13);
-        let mut delay = 0u8;
-        for n in 0..3000 {
-            if n % 37 == 0 {
-                delay = rng.range(0, 63) as u8;
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(8))]
+        #[test]
+        fn rtl_matches_model_with_changing_delay(
+            delays in segments(0u8..64, 10..20, 30..60),
+            refs in prop::collection::vec((word16(), word16()), 600),
+        ) {
+            let mut uut = ReferenceAlignment::new();
+            prepare(&mut uut);
+            let mut model = Model::default();
+            for (n, (&delay, &(r1, r2))) in delays.iter().zip(&refs).enumerate() {
+                uut.ref1.next = i128_to_signed(r1 as i128);
+                uut.ref2.next = i128_to_signed(r2 as i128);
+                uut.delay.next = u128_to_bits(delay as u128);
+                tick(&mut uut);
+                model.step(r1, r2);
+                // The tap read is combinational in the delay of this cycle.
+                let v = |x: Signed<16>| signed_to_i128(x) as i16;
+                prop_assert_eq!((v(uut.aligned1.val()), v(uut.aligned2.val())), model.output(delay), "cycle {}", n);
             }
-            let (r1, r2) = (rng.word16(), rng.word16());
-            uut.ref1.next = i128_to_signed(r1 as i128);
-            uut.ref2.next = i128_to_signed(r2 as i128);
-            uut.delay.next = u128_to_bits(delay as u128);
-            // The tap read is combinational: compare before and after the edge.
-            let v = |x: Signed<16>| signed_to_i128(x) as i16;
-            tick(&mut uut);
-            model.step(r1, r2);
-            assert_eq!(
-                (v(uut.aligned1.val()), v(uut.aligned2.val())),
-                model.output(delay),
-                "cycle {n}"
-            );
         }
     }
 

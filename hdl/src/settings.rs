@@ -65,9 +65,6 @@ pub struct Realized {
     pub filter: FilterDesign,
 }
 
-/// Full scale of a 16-bit signed word.
-const FULL_SCALE: f64 = 32768.0;
-
 /// Registers and realized values for a plan; a one-line error names the
 /// setting that is out of range and what is allowed.
 pub fn registers(plan: &FrequencyPlan) -> Result<(Registers, Realized), String> {
@@ -105,7 +102,8 @@ pub fn registers(plan: &FrequencyPlan) -> Result<(Registers, Realized), String> 
                 k + 1
             ));
         }
-        amp[k] = (a * FULL_SCALE).round().min(32767.0) as i16;
+        // Q1.15, nearest: just below 1.0 saturates to 32767.
+        amp[k] = fixed::types::I1F15::saturating_from_num(a).to_bits();
     }
     let delay = plan.dac_latency + plan.adc_latency;
     if delay >= 1 << DELAY_BITS {

@@ -37,3 +37,37 @@ impl Rng {
         }
     }
 }
+
+use proptest::prelude::*;
+
+/// A 16-bit word, a quarter of the time one of the extremes (-32768,
+/// -32767, 32767, 0).
+pub fn word16() -> impl Strategy<Value = i16> {
+    prop_oneof![
+        1 => Just(i16::MIN),
+        1 => Just(-32767i16),
+        1 => Just(i16::MAX),
+        1 => Just(0i16),
+        12 => any::<i16>(),
+    ]
+}
+
+/// A 16-bit word within +-32767 (sine, cosine and modulation outputs),
+/// biased toward the extremes.
+pub fn sample16() -> impl Strategy<Value = i16> {
+    word16().prop_map(|w| w.max(-32767))
+}
+
+/// Segments of a stimulus: `(value, length)` pairs expanded into one value
+/// per clock, so settings stay put for a while and then change.
+pub fn segments<T: Clone + std::fmt::Debug>(
+    value: impl Strategy<Value = T>,
+    segments: std::ops::Range<usize>,
+    length: std::ops::Range<usize>,
+) -> impl Strategy<Value = Vec<T>> {
+    prop::collection::vec((value, length), segments).prop_map(|s| {
+        s.into_iter()
+            .flat_map(|(v, n)| std::iter::repeat_n(v, n))
+            .collect()
+    })
+}
