@@ -16,8 +16,7 @@ mod with_verilator {
     use gyrocal_sim::cosim::CoSim;
     use gyrocal_sim::engine::{Engine, EngineKind, ModelEngine};
     use gyrocal_sim::experiment::{self, Experiment, Plan};
-    use gyrocal_sim::frontend::Converters;
-    use gyrocal_sim::gyro::{GyroModel, GyroParams};
+    use gyrocal_sim::gyro::GyroParams;
     use gyrocal_sim::verilator::VerilatorEngine;
 
     /// A fast scaled device: 1.0123 MHz modes 300 Hz apart, 10 MHz clock.
@@ -39,15 +38,7 @@ mod with_verilator {
     }
 
     fn cosim<E: Engine>(exp: &Experiment, plan: &Plan, point: usize) -> CoSim<E> {
-        let p = &plan.points[point];
-        let mut sim = CoSim::new(
-            E::power_up().unwrap(),
-            Converters::new(&plan.front_end).unwrap(),
-            GyroModel::new(&exp.gyro, exp.clock_hz).unwrap(),
-            p.regs,
-        );
-        sim.set_rate(p.omz_rad_s);
-        sim
+        experiment::point_loop::<E>(exp, plan, &plan.points[point]).unwrap()
     }
 
     #[test]

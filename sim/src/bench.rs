@@ -7,11 +7,8 @@
 //! block busy). Optionally, the whole `reproduce` experiment, timed wall to
 //! wall on all cores, with the process's peak resident memory.
 
-use crate::cosim::CoSim;
 use crate::engine::{Engine, EngineKind, ModelEngine, RtlEngine};
 use crate::experiment::{self, Experiment, Plan};
-use crate::frontend::Converters;
-use crate::gyro::GyroModel;
 use serde::Serialize;
 use std::hint::black_box;
 use std::time::Instant;
@@ -87,12 +84,7 @@ fn measure<E: Engine>(
         .expect("a calibration point");
     // ADC words for the datapath-alone runs: what the loop itself produces.
     let adc: Vec<(i16, i16)> = {
-        let mut sim = CoSim::new(
-            ModelEngine::power_up()?,
-            Converters::new(&plan.front_end)?,
-            GyroModel::new(&exp.gyro, exp.clock_hz)?,
-            point.regs,
-        );
+        let mut sim = experiment::point_loop::<ModelEngine>(&exp, &plan, point)?;
         (0..clocks.min(1 << 22))
             .map(|_| {
                 sim.step();
@@ -112,12 +104,7 @@ fn measure<E: Engine>(
         }
         black_box(check);
         alone.push(clocks as f64 / start.elapsed().as_secs_f64());
-        let mut sim = CoSim::new(
-            E::power_up()?,
-            Converters::new(&plan.front_end)?,
-            GyroModel::new(&exp.gyro, exp.clock_hz)?,
-            point.regs,
-        );
+        let mut sim = experiment::point_loop::<E>(&exp, &plan, point)?;
         let start = Instant::now();
         for _ in 0..clocks {
             black_box(sim.step());

@@ -502,9 +502,22 @@ pub struct ClockView<'a> {
 pub trait Observer {
     /// Called after each clock.
     fn clock(&mut self, view: &ClockView);
-    /// Clocks after which the observer needs no more calls (the run goes on
-    /// at full speed).
+    /// The last clock the observer needs (the simulation stops there).
     fn last_cycle(&self) -> u64;
+}
+
+/// The closed loop of one point at power-up: engine `E`, the plan's
+/// converters, the gyroscope at rest, rotating at the point's rate.
+pub fn point_loop<E: Engine>(
+    exp: &Experiment,
+    plan: &Plan,
+    point: &PointPlan,
+) -> Result<CoSim<E>, String> {
+    let gyro = GyroModel::new(&exp.gyro, exp.clock_hz)?;
+    let converters = Converters::new(&plan.front_end)?;
+    let mut sim = CoSim::new(E::power_up()?, converters, gyro, point.regs);
+    sim.set_rate(point.omz_rad_s);
+    Ok(sim)
 }
 
 /// Simulate one point with engine `E`; `progress` receives clock counts.
@@ -513,12 +526,8 @@ pub fn run_point<E: Engine>(
     plan: &Plan,
     point: &PointPlan,
     progress: &(dyn Fn(u64) + Sync),
-    mut observer: Option<&mut dyn Observer>,
 ) -> Result<PointResult, String> {
-    let gyro = GyroModel::new(&exp.gyro, exp.clock_hz)?;
-    let converters = Converters::new(&plan.front_end)?;
-    let mut sim = CoSim::new(E::power_up()?, converters, gyro, point.regs);
-    sim.set_rate(point.omz_rad_s);
+    let mut sim = point_loop::<E>(exp, plan, point)?;
     let r = exp.decimation as u64;
     let first_kept = point.settle_cycles.saturating_sub(2 * r);
     let (mut t, mut z1, mut z2) = (vec![], vec![], vec![]);
@@ -528,19 +537,6 @@ pub fn run_point<E: Engine>(
     const CHUNK: u64 = 1 << 20;
     for n in 1..=point.total_cycles {
         let o = sim.step();
-        if let Some(obs) = observer.as_deref_mut()
-            && n <= obs.last_cycle()
-        {
-            let g = sim.gyro();
-            obs.clock(&ClockView {
-                cycle: n,
-                adc: sim.last_adc(),
-                outputs: &o,
-                probes: &sim.engine().probes(),
-                x: (g.x1(), g.x2()),
-                select: point.regs.select,
-            });
-        }
         if o.z_valid {
             if n >= first_kept {
                 t.push(n as f64);
@@ -634,8 +630,8 @@ pub fn run_points(
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<Vec<PointResult>, String> {
     let run = |p: &PointPlan| match engine {
-        EngineKind::Model => run_point::<ModelEngine>(exp, plan, p, progress, None),
-        EngineKind::Rtl => run_point::<RtlEngine>(exp, plan, p, progress, None),
+        EngineKind::Model => run_point::<ModelEngine>(exp, plan, p, progress),
+        EngineKind::Rtl => run_point::<RtlEngine>(exp, plan, p, progress),
         EngineKind::Verilator => run_verilator(exp, plan, p, progress),
     };
     plan.points.par_iter().map(run).collect()
@@ -648,7 +644,7 @@ fn run_verilator(
     point: &PointPlan,
     progress: &(dyn Fn(u64) + Sync),
 ) -> Result<PointResult, String> {
-    run_point::<crate::verilator::VerilatorEngine>(exp, plan, point, progress, None)
+    run_point::<crate::verilator::VerilatorEngine>(exp, plan, point, progress)
 }
 
 #[cfg(not(feature = "verilator"))]
@@ -691,10 +687,7 @@ pub fn observe_point<E: Engine>(
     point: &PointPlan,
     observer: &mut dyn Observer,
 ) -> Result<(), String> {
-    let gyro = GyroModel::new(&exp.gyro, exp.clock_hz)?;
-    let converters = Converters::new(&plan.front_end)?;
-    let mut sim = CoSim::new(E::power_up()?, converters, gyro, point.regs);
-    sim.set_rate(point.omz_rad_s);
+    let mut sim = point_loop::<E>(exp, plan, point)?;
     for n in 1..=observer.last_cycle() {
         let o = sim.step();
         let g = sim.gyro();
