@@ -106,7 +106,14 @@ fn bad_configurations_fail_with_one_line_naming_the_key() {
 fn bad_options_fail_with_one_line() {
     let dir = tempfile::tempdir().unwrap();
     let missing = dir.path().join("missing.toml");
+    let file = dir.path().join("a_file");
+    std::fs::write(&file, "").unwrap();
+    let under_file = file.join("out").display().to_string();
     let cases: Vec<(Vec<String>, &str)> = vec![
+        (
+            vec!["reproduce".into(), "--out".into(), under_file.clone()],
+            "cannot create the folder",
+        ),
         (
             vec![
                 "run".into(),

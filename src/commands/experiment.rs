@@ -48,6 +48,12 @@ impl RunOptions {
     pub fn check(&self, exp: &Experiment) -> Result<Checked, Failure> {
         let engine =
             EngineKind::parse(&self.engine).map_err(|e| Failure::Input(format!("--{e}")))?;
+        if engine == EngineKind::Verilator && !cfg!(feature = "verilator") {
+            return Err(Failure::Input(
+                "--engine verilator: this build has no Verilator engine (build with --features verilator)"
+                    .into(),
+            ));
+        }
         let vcd = match &self.vcd {
             None => None,
             Some(path) => {

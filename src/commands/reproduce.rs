@@ -108,6 +108,13 @@ pub fn paper_table(report: &Report) -> String {
 pub fn run(args: &Args) -> Result<(), Failure> {
     let exp = Experiment::paper();
     let checked = args.options.check(&exp)?;
+    // Fail on an unusable output folder before the simulation, not after.
+    std::fs::create_dir_all(&args.out).map_err(|e| {
+        Failure::Input(format!(
+            "--out {}: cannot create the folder: {e}",
+            args.out.display()
+        ))
+    })?;
     let report = execute(&exp, &args.options, &checked)?;
     let text = format!("{}\n{}", paper_table(&report), summary(&report));
     print!("{text}");
