@@ -171,3 +171,35 @@ fn the_papers_device_at_full_scale() {
     assert!((r.theory.small_signal.ratio[1] - 1.5365).abs() < 1e-3);
     assert_ratios_match_theory(&r, "paper's device");
 }
+
+#[test]
+fn alignment_follows_the_converter_latencies() {
+    // The references are lined up from the model's own latencies
+    // (ref_delay = L_dac + L_adc, ref_phase = carrier_step / 2); the ratio,
+    // which a 1-degree phase error moves by several percent on the detuned
+    // output, must stay on the theory for any latencies.
+    for (dac, adc) in [(0, 0), (1, 7), (12, 20)] {
+        let mut e = scaled_paper(0.0);
+        e.dac_latency = dac;
+        e.adc_latency = adc;
+        assert_ratios_match_theory(&run(&e), &format!("L_dac {dac}, L_adc {adc}"));
+    }
+}
+
+#[test]
+fn a_reference_one_clock_late_is_visible() {
+    // Negative control for the alignment: the same experiment with every
+    // reference delayed one clock too long (36 degrees at this carrier)
+    // must miss the theory by far more than the 0.1% tolerance.
+    let e = scaled_paper(0.0);
+    let mut plan = experiment::plan(&e).unwrap();
+    for p in &mut plan.points {
+        p.regs.ref_delay += 1;
+    }
+    let points = experiment::run_points(&e, &plan, EngineKind::Model, &|_| {}).unwrap();
+    let sim = experiment::fit_scale_factors(&points, |p| p.z);
+    let exact = experiment::fit_scale_factors(&points, |p| p.z_theory);
+    let error = sim.ratio[1] / exact.ratio[1] - 1.0;
+    eprintln!("one clock late: detuned ratio error {:+.2}%", 100.0 * error);
+    assert!(error.abs() > 0.05, "{error}");
+}
