@@ -31,6 +31,7 @@
 use gyrocal_sim::experiment::{Mode, PointResult};
 use gyrocal_sim::report::Report;
 use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 use std::path::{Path, PathBuf};
@@ -986,6 +987,69 @@ fn draw_staircase<DB: DrawingBackend>(
     Ok(())
 }
 
+/// Axes of a staircase panel: time on x (runs end to end), z scaled by
+/// 10^exp on y, the averaging windows shaded (labelled in the legend when
+/// `label_windows`) and dashed separators between runs.
+#[allow(clippy::too_many_arguments)]
+fn staircase_axes<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    caption: String,
+    k: usize,
+    exp: i32,
+    (y0, y1): (f64, f64),
+    (end, y_labels): (f64, usize),
+    steps: &[Step],
+    label_windows: bool,
+) -> Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>, String> {
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, text_style(17))
+        .margin(12)
+        .margin_right(24)
+        .x_label_area_size(46)
+        .y_label_area_size(80)
+        .build_cartesian_2d(0.0..end, y0..y1)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .max_light_lines(0)
+        .bold_line_style(LIGHT)
+        .x_desc("time, runs end to end (s)")
+        .y_desc(format!("z{}  ({})", sub(k + 1), scaled_unit(exp, "m²/s²")))
+        .axis_desc_style(text_style(15))
+        .label_style(text_style(13))
+        .x_labels(10)
+        .y_labels(y_labels)
+        .x_label_formatter(&tick_formatter(end))
+        .y_label_formatter(&tick_formatter(y1 - y0))
+        .draw()
+        .map_err(err)?;
+    let windows = chart
+        .draw_series(steps.iter().map(|s| {
+            let a = s.start + s.point.settle_s;
+            Rectangle::new(
+                [(a, y0), (a + s.point.window_s, y1)],
+                LIGHT.mix(0.7).filled(),
+            )
+        }))
+        .map_err(err)?;
+    if label_windows {
+        windows
+            .label("averaging window")
+            .legend(|(x, y)| Rectangle::new([(x, y - 6), (x + 24, y + 6)], LIGHT.filled()));
+    }
+    for s in steps.iter().skip(1) {
+        chart
+            .draw_series(DashedLineSeries::new(
+                [(s.start, y0), (s.start, y1)],
+                4,
+                4,
+                GREY.stroke_width(1),
+            ))
+            .map_err(err)?;
+    }
+    Ok(chart)
+}
+
 /// Top panel: z as simulated, windows shaded.
 fn staircase_raw<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
@@ -1003,52 +1067,16 @@ fn staircase_raw<DB: DrawingBackend>(
     let exp = eng_exponent(lo.abs().max(hi.abs()));
     let scale = 10f64.powi(-exp);
     let (y0, y1) = (lo * scale, hi * scale);
-    let mut chart = ChartBuilder::on(area)
-        .caption(
-            format!("{}: z{} as simulated", data.output_name(k), sub(k + 1)),
-            text_style(17),
-        )
-        .margin(12)
-        .margin_right(24)
-        .x_label_area_size(46)
-        .y_label_area_size(80)
-        .build_cartesian_2d(0.0..end, y0..y1)
-        .map_err(err)?;
-    chart
-        .configure_mesh()
-        .max_light_lines(0)
-        .bold_line_style(LIGHT)
-        .x_desc("time, runs end to end (s)")
-        .y_desc(format!("z{}  ({})", sub(k + 1), scaled_unit(exp, "m²/s²")))
-        .axis_desc_style(text_style(15))
-        .label_style(text_style(13))
-        .x_labels(10)
-        .y_labels(6)
-        .x_label_formatter(&tick_formatter(end))
-        .y_label_formatter(&tick_formatter(y1 - y0))
-        .draw()
-        .map_err(err)?;
-    chart
-        .draw_series(steps.iter().map(|s| {
-            let a = s.start + s.point.settle_s;
-            Rectangle::new(
-                [(a, y0), (a + s.point.window_s, y1)],
-                LIGHT.mix(0.7).filled(),
-            )
-        }))
-        .map_err(err)?
-        .label("averaging window")
-        .legend(|(x, y)| Rectangle::new([(x, y - 6), (x + 24, y + 6)], LIGHT.filled()));
-    for s in steps.iter().skip(1) {
-        chart
-            .draw_series(DashedLineSeries::new(
-                [(s.start, y0), (s.start, y1)],
-                4,
-                4,
-                GREY.stroke_width(1),
-            ))
-            .map_err(err)?;
-    }
+    let mut chart = staircase_axes(
+        area,
+        format!("{}: z{} as simulated", data.output_name(k), sub(k + 1)),
+        k,
+        exp,
+        (y0, y1),
+        (end, 6),
+        steps,
+        true,
+    )?;
     for (i, s) in steps.iter().enumerate() {
         let series = chart
             .draw_series(LineSeries::new(
@@ -1101,53 +1129,19 @@ fn staircase_smooth<DB: DrawingBackend>(
     let exp = eng_exponent(lo.abs().max(hi.abs()));
     let scale = 10f64.powi(-exp);
     let (y0, y1) = (lo * scale, hi * scale);
-    let mut chart = ChartBuilder::on(area)
-        .caption(
-            format!(
-                "z{} averaged over one ripple period 1/(2 f_cal): the staircase",
-                sub(k + 1)
-            ),
-            text_style(17),
-        )
-        .margin(12)
-        .margin_right(24)
-        .x_label_area_size(46)
-        .y_label_area_size(80)
-        .build_cartesian_2d(0.0..end, y0..y1)
-        .map_err(err)?;
-    chart
-        .configure_mesh()
-        .max_light_lines(0)
-        .bold_line_style(LIGHT)
-        .x_desc("time, runs end to end (s)")
-        .y_desc(format!("z{}  ({})", sub(k + 1), scaled_unit(exp, "m²/s²")))
-        .axis_desc_style(text_style(15))
-        .label_style(text_style(13))
-        .x_labels(10)
-        .y_labels(8)
-        .x_label_formatter(&tick_formatter(end))
-        .y_label_formatter(&tick_formatter(y1 - y0))
-        .draw()
-        .map_err(err)?;
-    chart
-        .draw_series(steps.iter().map(|s| {
-            let a = s.start + s.point.settle_s;
-            Rectangle::new(
-                [(a, y0), (a + s.point.window_s, y1)],
-                LIGHT.mix(0.7).filled(),
-            )
-        }))
-        .map_err(err)?;
-    for s in steps.iter().skip(1) {
-        chart
-            .draw_series(DashedLineSeries::new(
-                [(s.start, y0), (s.start, y1)],
-                4,
-                4,
-                GREY.stroke_width(1),
-            ))
-            .map_err(err)?;
-    }
+    let mut chart = staircase_axes(
+        area,
+        format!(
+            "z{} averaged over one ripple period 1/(2 f_cal): the staircase",
+            sub(k + 1)
+        ),
+        k,
+        exp,
+        (y0, y1),
+        (end, 8),
+        steps,
+        false,
+    )?;
     let mut first = true;
     for s in steps {
         let scaled: Vec<(f64, f64)> = s.smooth[k].iter().map(|&(t, v)| (t, v * scale)).collect();
