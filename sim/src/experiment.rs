@@ -213,89 +213,12 @@ impl Plan {
     }
 }
 
-fn check_list(
-    name: &str,
-    values: &[f64],
-    allowed: &str,
-    ok: impl Fn(f64) -> bool,
-) -> Result<(), String> {
-    if let Some(v) = values.iter().find(|v| !(v.is_finite() && ok(**v))) {
-        return Err(format!("{name} contains {v}: {allowed}"));
-    }
-    Ok(())
-}
-
 /// Plan an experiment: registers, ADC gains, settling and windows.
 pub fn plan(exp: &Experiment) -> Result<Plan, String> {
-    GyroModel::new(&exp.gyro, exp.clock_hz)?;
+    // Every key's range, with the names of the configuration file.
+    crate::config::validate(exp)?;
     let rates = &exp.readout_rates_dps;
     let cals = &exp.cal_freqs_hz;
-    if rates.len() < 2 {
-        return Err(format!(
-            "readout_rates_dps has {} values: at least 2 distinct rates are needed for a slope",
-            rates.len()
-        ));
-    }
-    if cals.len() < 2 {
-        return Err(format!(
-            "cal_freqs_hz has {} values: at least 2 distinct frequencies are needed for a slope",
-            cals.len()
-        ));
-    }
-    check_list(
-        "readout_rates_dps",
-        rates,
-        "rates must be finite, |rate| <= 1e5 deg/s",
-        |v| v.abs() <= 1e5,
-    )?;
-    check_list(
-        "cal_freqs_hz",
-        cals,
-        "frequencies must be finite and > 0",
-        |v| v > 0.0,
-    )?;
-    let distinct = |v: &[f64]| v.iter().any(|x| *x != v[0]);
-    if !distinct(rates) || !distinct(cals) {
-        return Err(
-            "readout_rates_dps and cal_freqs_hz each need at least 2 distinct values".into(),
-        );
-    }
-    for (name, v, ok, allowed) in [
-        (
-            "tolerance",
-            exp.tolerance,
-            exp.tolerance > 0.0 && exp.tolerance < 0.1,
-            "between 0 and 0.1",
-        ),
-        (
-            "min_window_s",
-            exp.min_window_s,
-            exp.min_window_s > 0.0 && exp.min_window_s <= 100.0,
-            "between 0 and 100 s",
-        ),
-        (
-            "adc_headroom",
-            exp.adc_headroom,
-            exp.adc_headroom > 0.0 && exp.adc_headroom <= 1.0,
-            "between 0 and 1",
-        ),
-        (
-            "force_full_scale_n_per_kg[0]",
-            exp.force_full_scale[0],
-            exp.force_full_scale[0] > 0.0,
-            "a positive number",
-        ),
-        (
-            "force_full_scale_n_per_kg[1]",
-            exp.force_full_scale[1],
-            exp.force_full_scale[1] > 0.0,
-            "a positive number",
-        ),
-    ] {
-        if !(v.is_finite() && ok) {
-            return Err(format!("{name} = {v}: must be {allowed}"));
-        }
-    }
     let base = FrequencyPlan {
         clock_hz: exp.clock_hz,
         carrier_hz: exp.carrier_hz,
@@ -602,16 +525,9 @@ pub fn fit_scale_factors(
     points: &[PointResult],
     z: impl Fn(&PointResult) -> [f64; 2],
 ) -> ScaleFactors {
-    let fit = |mode: Mode, k: usize| {
-        let (x, y): (Vec<f64>, Vec<f64>) = points
-            .iter()
-            .filter(|p| p.mode == mode)
-            .map(|p| (p.rate_dps, z(p)[k]))
-            .unzip();
-        linear_fit(&x, &y).0
-    };
-    let sf_read_per_dps = [fit(Mode::Readout, 0), fit(Mode::Readout, 1)];
-    let sf_cal_per_dps = [fit(Mode::Calibration, 0), fit(Mode::Calibration, 1)];
+    let slopes = |mode| fit_lines(points, mode, &z).map(|(slope, _)| slope);
+    let sf_read_per_dps = slopes(Mode::Readout);
+    let sf_cal_per_dps = slopes(Mode::Calibration);
     ScaleFactors {
         sf_read_per_dps,
         sf_cal_per_dps,
@@ -620,6 +536,23 @@ pub fn fit_scale_factors(
             sf_read_per_dps[1] / sf_cal_per_dps[1],
         ],
     }
+}
+
+/// Least-squares `(slope, intercept)` of each output against the rate, over
+/// the points of one mode.
+pub fn fit_lines(
+    points: &[PointResult],
+    mode: Mode,
+    z: impl Fn(&PointResult) -> [f64; 2],
+) -> [(f64, f64); 2] {
+    std::array::from_fn(|k| {
+        let (x, y): (Vec<f64>, Vec<f64>) = points
+            .iter()
+            .filter(|p| p.mode == mode)
+            .map(|p| (p.rate_dps, z(p)[k]))
+            .unzip();
+        linear_fit(&x, &y)
+    })
 }
 
 /// Run every point of a plan on `engine`, in parallel.

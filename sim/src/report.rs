@@ -2,8 +2,9 @@
 //! theory at the same points, the paper's closed forms, and the readout
 //! scale factor predicted from calibration, in one serializable value.
 
-use crate::experiment::{Experiment, Mode, Plan, PointResult, ScaleFactors, fit_scale_factors};
-use crate::fit::linear_fit;
+use crate::experiment::{
+    Experiment, Mode, Plan, PointResult, ScaleFactors, fit_lines, fit_scale_factors,
+};
 use crate::theory;
 use serde::Serialize;
 
@@ -126,19 +127,8 @@ pub struct Report {
     pub warnings: Vec<String>,
 }
 
-fn intercepts(
-    points: &[PointResult],
-    mode: Mode,
-    z: impl Fn(&PointResult) -> [f64; 2],
-) -> [f64; 2] {
-    std::array::from_fn(|k| {
-        let (x, y): (Vec<f64>, Vec<f64>) = points
-            .iter()
-            .filter(|p| p.mode == mode)
-            .map(|p| (p.rate_dps, z(p)[k]))
-            .unzip();
-        linear_fit(&x, &y).1
-    })
+fn intercepts(points: &[PointResult], mode: Mode) -> [f64; 2] {
+    fit_lines(points, mode, |p| p.z).map(|(_, intercept)| intercept)
 }
 
 impl Report {
@@ -168,8 +158,8 @@ impl Report {
             Some(0)
         };
         Report {
-            intercept_read: intercepts(&points, Mode::Readout, |p| p.z),
-            intercept_cal: intercepts(&points, Mode::Calibration, |p| p.z),
+            intercept_read: intercepts(&points, Mode::Readout),
+            intercept_cal: intercepts(&points, Mode::Calibration),
             ratio_error: std::array::from_fn(|k| rel(sim.ratio[k], exact.ratio[k])),
             predicted_sf_read_per_dps: predicted,
             predicted_sf_read_eq56_per_dps: predicted_eq56,
