@@ -19,11 +19,13 @@ fn any_registers() -> impl Strategy<Value = Registers> {
         any::<bool>(),
         any::<u32>(),
         any::<u32>(),
-        0u8..64,
-        0u64..(1 << 48),
+        // Narrow ports get any word of the Rust type too: every engine must
+        // keep only the port's low bits (`Registers::at_ports`).
+        prop_oneof![0u8..64, any::<u8>()],
+        prop_oneof![0u64..(1 << 48), any::<u64>()],
         any::<(i16, i16)>(),
-        prop_oneof![1u16..40, 16u16..=4096, 0u16..8192],
-        0u8..64,
+        prop_oneof![1u16..40, 16u16..=4096, 0u16..8192, any::<u16>()],
+        prop_oneof![0u8..64, any::<u8>()],
         any::<(i32, i32, i32, i32)>(),
     )
         .prop_map(
@@ -103,5 +105,50 @@ proptest! {
         let adc = stimulus(seed);
         let mismatch = first_mismatch(&mut RtlGyroInterface::new(), &adc, &regs);
         prop_assert!(mismatch.is_none(), "{:?}", mismatch);
+    }
+}
+
+/// Named case: register words wider than their ports (`cic_shift = 64`
+/// holds 0 at the 6-bit port, `ref_delay = 200` holds 8, `cic_decimation =
+/// 8192 + 20` holds 20, `mod_step` with bits above 48). Before the model
+/// masked its words, `cic_shift = 64` alone made it differ from clock 50.
+#[test]
+fn words_wider_than_their_ports_are_cut_as_the_ports_cut_them() {
+    let plan = FrequencyPlan {
+        clock_hz: 10e6,
+        carrier_hz: 1.0123e6,
+        cal_hz: 12.5,
+        calibration: true,
+        amplitude: (0.9, 0.9),
+        decimation: 20,
+        butterworth_hz: 10e6 / 20.0 / 20.0,
+        rc_hz: 10e6 / 20.0 / 10.0,
+        dac_latency: 2,
+        adc_latency: 3,
+    };
+    let base = registers(&plan).unwrap().0;
+    let wide = [
+        Registers {
+            cic_shift: 64,
+            ..base
+        },
+        Registers {
+            ref_delay: 200,
+            ..base
+        },
+        Registers {
+            cic_decimation: 8192 + 20,
+            ..base
+        },
+        Registers {
+            mod_step: base.mod_step | (0xffff << 48),
+            ..base
+        },
+    ];
+    let adc = stimulus(7);
+    for regs in wide {
+        let regs = vec![regs; 3000];
+        let mismatch = first_mismatch(&mut RtlGyroInterface::new(), &adc[..3000], &regs);
+        assert!(mismatch.is_none(), "{regs:?}: {mismatch:?}", regs = regs[0]);
     }
 }

@@ -32,6 +32,32 @@ pub struct Registers {
     pub iir: Coefficients,
 }
 
+impl Registers {
+    /// Width of the `ref_delay` port (bits).
+    pub const REF_DELAY_BITS: u32 = crate::reference_alignment::DELAY_BITS as u32;
+    /// Width of the `mod_step` port (bits).
+    pub const MOD_STEP_BITS: u32 = 48;
+    /// Width of the `cic_decimation` port (bits).
+    pub const CIC_DECIMATION_BITS: u32 = 13;
+    /// Width of the `cic_shift` port (bits).
+    pub const CIC_SHIFT_BITS: u32 = 6;
+
+    /// The words as the ports hold them: a register word wider than its port
+    /// keeps only its low bits, as in the hardware (and in the rtl and
+    /// Verilator engines). Every engine sees registers through this.
+    #[inline(always)]
+    pub fn at_ports(&self) -> Self {
+        let low = |v: u64, bits: u32| v & ((1u64 << bits) - 1);
+        Self {
+            ref_delay: low(self.ref_delay.into(), Self::REF_DELAY_BITS) as u8,
+            mod_step: low(self.mod_step, Self::MOD_STEP_BITS),
+            cic_decimation: low(self.cic_decimation.into(), Self::CIC_DECIMATION_BITS) as u16,
+            cic_shift: low(self.cic_shift.into(), Self::CIC_SHIFT_BITS) as u8,
+            ..*self
+        }
+    }
+}
+
 /// The output ports of `GyroInterface` during one cycle.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Outputs {
@@ -106,6 +132,7 @@ impl GyroInterface {
     /// returns the outputs after the rising edge.
     #[inline(always)]
     pub fn step(&mut self, adc: (i16, i16), regs: &Registers) -> Outputs {
+        let regs = &regs.at_ports();
         // Read every block's current outputs before any register moves.
         let carriers = self.carrier_nco.output();
         let am = self.modulation_nco.output();
