@@ -159,6 +159,68 @@ pub fn calibration_z(dev: &Device, f_cal_hz: f64) -> [f64; 2] {
     [z(0), z(1)]
 }
 
+/// Exact steady-state calibration outputs `[z1, z2]` (m^2/s^2) when the
+/// reference envelopes lead the drive envelopes by `envelope_lead_rad`
+/// (references cos(Om t + lead) cos(wb t) and sin(Om t + lead) sin(wb t)
+/// against drives cos(Om t) cos(wb t) and sin(Om t) sin(wb t)).
+///
+/// Sideband by sideband: drive 1 is F1/2 at wb + Om and at wb - Om, drive 2
+/// is -F2/2 and +F2/2; at rest the modes are uncoupled, x_k = Re sum
+/// H_k(w) c_k(w) e^(iwt) with H_k = 1 / (w_k^2 - w^2 + i w w_k / Q_k), and
+/// the mean of a product of two tones at the same frequency is
+/// Re(a conj(b)) / 2. Output 1 mixes x1 with reference 2, output 2 x2
+/// with reference 1. With no lead this is [`calibration_z`]. A lead L adds
+/// -L F1 F2 (Im H_k(wb - Om) + Im H_k(wb + Om)) / 8 to output k: the
+/// resonant part of the response, which dwarfs the calibration signal
+/// (proportional to Om), so a lead of Om T / 2 (the half clock the
+/// datapath's envelope alignment leaves) moves a low-Q device's
+/// calibration scale factor by parts in 1e4 (`hdl/src/settings.rs`).
+pub fn calibration_z_with_envelope_lead(
+    dev: &Device,
+    f_cal_hz: f64,
+    envelope_lead_rad: f64,
+) -> [f64; 2] {
+    calibration_z_of_datapath(dev, f_cal_hz, envelope_lead_rad, [1.0, 1.0])
+}
+
+/// [`calibration_z_with_envelope_lead`] with the drive's sidebands at
+/// wb - Om and wb + Om scaled by `sideband_gain` (the DAC hold's sinc at
+/// each sideband over its value at the carrier, which `dev`'s forces
+/// already carry): the references are digital words and carry no hold.
+pub fn calibration_z_of_datapath(
+    dev: &Device,
+    f_cal_hz: f64,
+    envelope_lead_rad: f64,
+    sideband_gain: [f64; 2],
+) -> [f64; 2] {
+    let n = Norm::new(dev);
+    let om = TAU * f_cal_hz;
+    let wb2 = n.wb * n.wb;
+    let lead = C64::new(envelope_lead_rad.cos(), envelope_lead_rad.sin());
+    let (f1, f2) = (dev.f1_force, dev.f2_force);
+    // Sidebands [wb - Om, wb + Om]: drive and reference coefficients.
+    let [g0, g1] = sideband_gain;
+    let drive = [
+        [f1 / 2.0 * g0, f1 / 2.0 * g1],
+        [f2 / 2.0 * g0, -f2 / 2.0 * g1],
+    ]
+    .map(|c| c.map(|x| C64::new(x, 0.0)));
+    let reference = [
+        [f1 / 2.0 * lead.conj(), f1 / 2.0 * lead],
+        [f2 / 2.0 * lead.conj(), -f2 / 2.0 * lead],
+    ];
+    let dw = [-om, om];
+    let z = |k: usize| {
+        (0..2)
+            .map(|s| {
+                let h = 1.0 / (n.d(k, dw[s]) * wb2);
+                0.5 * (h * drive[k][s] * reference[1 - k][s].conj()).re
+            })
+            .sum::<f64>()
+    };
+    [z(0), z(1)]
+}
+
 /// Exact small-signal readout scale factors `dz/dOmz` at `Omz = 0`
 /// ((m^2/s^2)/(rad/s)); the two outputs are identical in exact arithmetic.
 pub fn sf_read_per_rad_s(dev: &Device) -> [f64; 2] {
@@ -277,4 +339,67 @@ pub fn calibration_peak_displacement(dev: &Device, f_cal_hz: f64) -> [f64; 2] {
     let peak =
         |k: usize, f: f64| 0.5 * f * (1.0 / n.d(k, -om).norm() + 1.0 / n.d(k, om).norm()) / wb2;
     [peak(0, dev.f1_force), peak(1, dev.f2_force)]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn device(f2_offset: f64, q: [f64; 2], carrier_offset: f64) -> Device {
+        Device {
+            f1_hz: 100.3e3,
+            f2_hz: 100.3e3 + f2_offset,
+            q1: q[0],
+            q2: q[1],
+            angular_gain: 0.7,
+            carrier_hz: 100.3e3 + carrier_offset,
+            f1_force: 0.8,
+            f2_force: 0.6,
+        }
+    }
+
+    #[test]
+    fn no_envelope_lead_is_the_closed_form() {
+        for (dev, f) in [
+            (device(1e3, [200.0, 200.0], 0.0), 300.0),
+            (device(-37.0, [5e4, 3e4], 12.0), 2.5),
+            (device(0.0, [1e3, 1e3], 0.0), 40.0),
+        ] {
+            let a = calibration_z(&dev, f);
+            let b = calibration_z_with_envelope_lead(&dev, f, 0.0);
+            for k in 0..2 {
+                assert!((a[k] / b[k] - 1.0).abs() < 1e-9, "{a:?} {b:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_small_lead_adds_the_resonant_part() {
+        // First order in the lead L, from the sums in the function's doc:
+        // dz_k = -L F1 F2 / 8 (Im H_k(wb - Om) + Im H_k(wb + Om)).
+        let dev = device(1e3, [200.0, 200.0], 0.0);
+        let f = 300.0;
+        let lead = 1e-6;
+        let z0 = calibration_z_with_envelope_lead(&dev, f, 0.0);
+        let z1 = calibration_z_with_envelope_lead(&dev, f, lead);
+        let n = Norm::new(&dev);
+        let om = TAU * f;
+        let im = |k: usize| -> f64 {
+            [-om, om]
+                .iter()
+                .map(|&dw| (1.0 / (n.d(k, dw) * n.wb * n.wb)).im)
+                .sum()
+        };
+        let f12 = dev.f1_force * dev.f2_force;
+        let expected = [-lead * f12 / 8.0 * im(0), -lead * f12 / 8.0 * im(1)];
+        for k in 0..2 {
+            let got = z1[k] - z0[k];
+            assert!(
+                (got / expected[k] - 1.0).abs() < 1e-4,
+                "output {}: {got} vs {}",
+                k + 1,
+                expected[k]
+            );
+        }
+    }
 }
