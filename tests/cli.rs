@@ -36,6 +36,19 @@ fn run_json_holds_the_scale_factors_and_the_theory() {
             assert!(pair.iter().all(|x| x.as_f64().unwrap().is_finite()));
         }
     }
+    for key in [
+        "sf_read_uncertainty",
+        "sf_cal_uncertainty",
+        "ratio_uncertainty",
+    ] {
+        let pair = v[key].as_array().unwrap_or_else(|| panic!("{key} missing"));
+        assert_eq!(pair.len(), 2);
+        assert!(pair.iter().all(|x| {
+            let x = x.as_f64().unwrap();
+            x.is_finite() && x > 0.0
+        }));
+    }
+    assert!(v["warnings"].is_array());
     // Paper's sign convention: readout negative for positive rates,
     // calibration positive at the resonant output.
     assert!(v["sf_read_per_dps"][0].as_f64().unwrap() < 0.0);
@@ -82,7 +95,7 @@ fn bad_configurations_fail_with_one_line_naming_the_key() {
         (base.replace("q1 = 5000", "q1 = nan"), "[gyro] q1 = NaN"),
         (base.replace("q2 = 5000", "q2 = -2"), "[gyro] q2 = -2"),
         (
-            base.replace("clock_hz = 10e6", "clock_hz = 10e6\ncarrier_hz = 5e6"),
+            base.replace("carrier_hz = 1.0123e6", "carrier_hz = 5e6"),
             "[drive] carrier_hz = 5000000",
         ),
         (
@@ -168,6 +181,16 @@ fn bad_options_fail_with_one_line() {
             ],
             "--vcd-point 7",
         ),
+        (
+            vec![
+                "run".into(),
+                "--config".into(),
+                SMALL.into(),
+                "--vcd".into(),
+                file.join("w.vcd").display().to_string(),
+            ],
+            "is not a folder",
+        ),
     ];
     for (args, needle) in cases {
         let args: Vec<&str> = args.iter().map(String::as_str).collect();
@@ -184,13 +207,17 @@ fn bad_options_fail_with_one_line() {
 #[test]
 fn vcd_dump_reads_back_with_the_expected_signals_and_timing() {
     use vcd::{Command as V, Value};
+    // The README's command: `--out out/ --vcd out/wave.vcd` with no out/ yet.
     let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("wave.vcd");
+    let out = dir.path().join("out");
+    let path = out.join("wave.vcd");
     let o = gyrocal(&[
         "run",
         "--config",
         SMALL,
         "--quiet",
+        "--out",
+        out.to_str().unwrap(),
         "--vcd",
         path.to_str().unwrap(),
         "--vcd-point",
@@ -201,6 +228,7 @@ fn vcd_dump_reads_back_with_the_expected_signals_and_timing() {
         "ports,w1,cic1,x1_pm",
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
+    assert!(out.join("results.json").exists());
     let mut parser = vcd::Parser::new(std::io::BufReader::new(std::fs::File::open(&path).unwrap()));
     let header = parser.parse_header().unwrap();
     let id = |name: &str| {

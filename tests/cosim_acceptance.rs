@@ -29,24 +29,24 @@ fn scaled_paper(carrier_offset_hz: f64) -> Experiment {
         q2: q,
         angular_gain: 0.6,
     };
-    e.carrier_hz = f1 + carrier_offset_hz;
-    e.clock_hz = 10e6;
-    e.decimation = 250;
-    e.readout_rates_dps = vec![1.0, 5.0, 10.0, 15.0, 20.0];
+    e.drive.carrier_hz = f1 + carrier_offset_hz;
+    e.drive.clock_hz = 10e6;
+    e.filter.decimation = Some(250);
+    e.points.readout_rates_dps = vec![1.0, 5.0, 10.0, 15.0, 20.0];
     let scale = bandwidth / (9.64e6 / 55e3);
-    e.cal_freqs_hz = (10..=15).map(|f| f as f64 * scale).collect();
+    e.points.cal_freqs_hz = (10..=15).map(|f| f as f64 * scale).collect();
     // Averaging windows of 0.1 s instead of the default 0.05 s: on the
     // resonant output the readout signal is a small in-phase part of a
     // full-scale quadrature signal, and the 16-bit ADC's deterministic
     // quantization residue averaged over 0.05 s left +0.094% in its
     // readout scale factor when excited at mode 2 (measured: 0.031% at
     // 0.1 s, 0.029% at 0.2 s, so 0.1 s is past the knee).
-    e.min_window_s = 0.1;
+    e.points.min_window_s = Some(0.1);
     e
 }
 
 fn run(e: &Experiment) -> Report {
-    experiment::run(e, EngineKind::Model, &|_| {}).unwrap()
+    gyrocal_sim::report::run(e, EngineKind::Model, &|_| {}).unwrap()
 }
 
 fn assert_ratios_match_theory(r: &Report, what: &str) {
@@ -84,11 +84,11 @@ fn matched_modes_give_minus_two_lambda() {
         q2: 1000.0,
         angular_gain: 0.8,
     };
-    e.carrier_hz = 1.0123e6;
-    e.clock_hz = 10e6;
-    e.decimation = 250;
-    e.readout_rates_dps = vec![100.0, 200.0, 300.0, 400.0];
-    e.cal_freqs_hz = vec![2.0, 4.0, 6.0];
+    e.drive.carrier_hz = 1.0123e6;
+    e.drive.clock_hz = 10e6;
+    e.filter.decimation = Some(250);
+    e.points.readout_rates_dps = vec![100.0, 200.0, 300.0, 400.0];
+    e.points.cal_freqs_hz = vec![2.0, 4.0, 6.0];
     let r = run(&e);
     let target = -2.0 * 0.8;
     for k in 0..2 {
@@ -149,8 +149,8 @@ fn unequal_q_and_negative_split() {
         q2: 8_300.0,
         angular_gain: 0.5,
     };
-    e.carrier_hz = e.gyro.f1_hz;
-    e.cal_freqs_hz = vec![1.0, 1.7, 2.4];
+    e.drive.carrier_hz = e.gyro.f1_hz;
+    e.points.cal_freqs_hz = vec![1.0, 1.7, 2.4];
     assert_ratios_match_theory(&run(&e), "split -27 Hz, unequal Q");
 }
 
@@ -180,8 +180,8 @@ fn alignment_follows_the_converter_latencies() {
     // output, must stay on the theory for any latencies.
     for (dac, adc) in [(0, 0), (1, 7), (12, 20)] {
         let mut e = scaled_paper(0.0);
-        e.dac_latency = dac;
-        e.adc_latency = adc;
+        e.frontend.dac_latency = dac;
+        e.frontend.adc_latency = adc;
         assert_ratios_match_theory(&run(&e), &format!("L_dac {dac}, L_adc {adc}"));
     }
 }
@@ -196,9 +196,11 @@ fn a_reference_one_clock_late_is_visible() {
     for p in &mut plan.points {
         p.regs.ref_delay += 1;
     }
-    let points = experiment::run_points(&e, &plan, EngineKind::Model, &|_| {}).unwrap();
-    let sim = experiment::fit_scale_factors(&points, |p| p.z);
-    let exact = experiment::fit_scale_factors(&points, |p| p.z_theory);
+    let points = experiment::run_points(&e, &plan, EngineKind::Model, &|_| {})
+        .unwrap()
+        .points;
+    let sim = experiment::measured_scale_factors(&points);
+    let exact = experiment::exact_scale_factors(&points);
     let error = sim.ratio[1] / exact.ratio[1] - 1.0;
     eprintln!("one clock late: detuned ratio error {:+.2}%", 100.0 * error);
     assert!(error.abs() > 0.05, "{error}");

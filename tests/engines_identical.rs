@@ -29,11 +29,11 @@ mod with_verilator {
             q2: 2500.0,
             angular_gain: 0.6,
         };
-        e.carrier_hz = 1.0123e6;
-        e.clock_hz = 10e6;
-        e.decimation = 250;
-        e.readout_rates_dps = vec![20.0, 40.0];
-        e.cal_freqs_hz = vec![3.0, 5.0];
+        e.drive.carrier_hz = 1.0123e6;
+        e.drive.clock_hz = 10e6;
+        e.filter.decimation = Some(250);
+        e.points.readout_rates_dps = vec![20.0, 40.0];
+        e.points.cal_freqs_hz = vec![3.0, 5.0];
         e
     }
 
@@ -71,18 +71,22 @@ mod with_verilator {
     #[test]
     fn one_experiment_gives_identical_results_on_all_three_engines() {
         // A tiny device (Q 150, short windows) so that rust-hdl's simulation
-        // runs it in seconds: four points of about 12,000 clocks.
+        // runs it in seconds: four points of 10,000-30,000 clocks (a
+        // calibration window is 8 periods of its 2 f_cal ripple). One round
+        // of windows: a budget too small for a second one, so that the
+        // engines' different speeds cannot change the plan.
         let mut exp = small_device();
         exp.gyro.q1 = 150.0;
         exp.gyro.q2 = 150.0;
-        exp.decimation = 16;
-        exp.butterworth_hz = 30e3;
-        exp.rc_hz = 60e3;
-        exp.cal_freqs_hz = vec![500.0, 1000.0];
-        exp.min_window_s = 5e-4;
+        exp.filter.decimation = Some(16);
+        exp.filter.butterworth_hz = Some(30e3);
+        exp.filter.rc_hz = Some(60e3);
+        exp.points.cal_freqs_hz = vec![2000.0, 4000.0];
+        exp.points.min_window_s = Some(5e-4);
+        exp.points.budget_s = 1e-6;
         let reports: Vec<_> = [EngineKind::Model, EngineKind::Verilator, EngineKind::Rtl]
             .into_iter()
-            .map(|engine| experiment::run(&exp, engine, &|_| {}).unwrap())
+            .map(|engine| gyrocal_sim::report::run(&exp, engine, &|_| {}).unwrap())
             .collect();
         assert!(
             reports[0].timing.cycles < 80_000,
@@ -93,6 +97,7 @@ mod with_verilator {
             assert_eq!(r.points.len(), reports[0].points.len());
             for (p, q) in r.points.iter().zip(&reports[0].points) {
                 assert_eq!(p.z_lsb, q.z_lsb, "{}", r.timing.engine);
+                assert_eq!(p.batch_z, q.batch_z, "{}", r.timing.engine);
                 assert_eq!(p.trace, q.trace, "{}", r.timing.engine);
             }
             assert_eq!(

@@ -12,9 +12,10 @@
 mod plots;
 
 use gyrocal_sim::engine::EngineKind;
-use gyrocal_sim::experiment::{Experiment, Mode, run};
+use gyrocal_sim::experiment::{Experiment, Mode};
 use gyrocal_sim::gyro::GyroParams;
 use gyrocal_sim::report::Report;
+use gyrocal_sim::report::run;
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -32,11 +33,11 @@ fn small_report() -> &'static Report {
             q2: 5000.0,
             angular_gain: 0.6,
         };
-        e.carrier_hz = 1.0123e6;
-        e.clock_hz = 10e6;
-        e.decimation = 250;
-        e.readout_rates_dps = vec![100.0, 200.0, 300.0, 400.0];
-        e.cal_freqs_hz = vec![2.0, 4.0, 6.0];
+        e.drive.carrier_hz = 1.0123e6;
+        e.drive.clock_hz = 10e6;
+        e.filter.decimation = Some(250);
+        e.points.readout_rates_dps = vec![100.0, 200.0, 300.0, 400.0];
+        e.points.cal_freqs_hz = vec![2.0, 4.0, 6.0];
         run(&e, EngineKind::Model, &|_| {}).expect("small run")
     })
 }

@@ -29,6 +29,11 @@ use crate::filter_design::{self, FilterDesign};
 use crate::model::gyro_interface::Registers;
 use crate::reference_alignment::DELAY_BITS;
 
+/// Highest calibration rate as a fraction of the clock.
+pub const MAX_CAL_RATIO: f64 = 1e-3;
+/// Longest reference delay, L_dac + L_adc (clocks): the delay line's depth.
+pub const MAX_REF_DELAY: u32 = (1 << DELAY_BITS) - 1;
+
 /// What the user asks for.
 #[derive(Clone, Debug, PartialEq)]
 pub struct FrequencyPlan {
@@ -83,10 +88,10 @@ pub fn registers(plan: &FrequencyPlan) -> Result<(Registers, Realized), String> 
     }
     let carrier_step = (plan.carrier_hz / clock * 2f64.powi(32)).round() as u32;
     let mod_step = if plan.calibration {
-        let max = clock / 1000.0;
+        let max = clock * MAX_CAL_RATIO;
         if !(plan.cal_hz.is_finite() && plan.cal_hz >= 0.0 && plan.cal_hz <= max) {
             return Err(format!(
-                "cal_hz = {}: allowed 0 to clock_hz / 1000 = {max}",
+                "cal_hz = {}: allowed 0 to clock_hz x {MAX_CAL_RATIO} = {max}",
                 plan.cal_hz
             ));
         }
@@ -106,10 +111,9 @@ pub fn registers(plan: &FrequencyPlan) -> Result<(Registers, Realized), String> 
         amp[k] = fixed::types::I1F15::saturating_from_num(a).to_bits();
     }
     let delay = plan.dac_latency + plan.adc_latency;
-    if delay >= 1 << DELAY_BITS {
+    if delay > MAX_REF_DELAY {
         return Err(format!(
-            "dac_latency + adc_latency = {delay} clocks: at most {}",
-            (1 << DELAY_BITS) - 1
+            "dac_latency + adc_latency = {delay} clocks: at most {MAX_REF_DELAY}"
         ));
     }
     let filter = filter_design::design(clock, plan.decimation, plan.butterworth_hz, plan.rc_hz)?;

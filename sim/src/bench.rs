@@ -66,7 +66,7 @@ fn median(v: &[f64]) -> f64 {
 
 fn stimulus_plan() -> (Experiment, Plan) {
     let mut exp = Experiment::paper();
-    exp.cal_freqs_hz = vec![12.0, 13.0];
+    exp.points.cal_freqs_hz = vec![12.0, 13.0];
     let plan = experiment::plan(&exp).expect("the paper's plan is valid");
     (exp, plan)
 }
@@ -178,7 +178,7 @@ pub fn run(
         progress("reproduce: the paper's full experiment on the model engine, all cores");
         let exp = Experiment::paper();
         let start = Instant::now();
-        let report = experiment::run(&exp, EngineKind::Model, &|_| {})?;
+        let report = crate::report::run(&exp, EngineKind::Model, &|_| {})?;
         Some(ReproduceTiming {
             wall_s: start.elapsed().as_secs_f64(),
             clocks: report.timing.cycles,

@@ -1,90 +1,267 @@
-//! The TOML description of a user's device and experiment.
-//!
-//! Every key has a default: the paper's device (`Experiment::paper()`),
-//! except that the carrier follows `[gyro] f1_hz` when it is not given
-//! (excitation at mode 1). Unknown keys, values of the wrong type, and
-//! values out of range are rejected with one line naming the section, the
-//! key and what is allowed.
+//! The experiment a user describes: device, drive, converters, filter and
+//! points, as one type that is its own TOML schema.
 //!
 //! ```toml
-//! [gyro]        # f1_hz, f2_hz, q1, q2, angular_gain
-//! [drive]       # carrier_hz, clock_hz, amplitude1, amplitude2,
-//!               # force_full_scale1_n_per_kg, force_full_scale2_n_per_kg
-//! [frontend]    # dac_latency, adc_latency, dac_bits, adc_bits, adc_headroom,
-//!               # adc_per_meter1, adc_per_meter2, noise_lsb, seed
-//! [filter]      # decimation, butterworth_hz, rc_hz
-//! [experiment]  # readout_rates_dps, cal_freqs_hz, tolerance, min_window_s
+//! [gyro]        # required: f1_hz, f2_hz, q1, q2, angular_gain
+//! [drive]       # required: carrier_hz, clock_hz
+//!               # amplitude1, amplitude2 (0.9), force_full_scale1_n_per_kg,
+//!               # force_full_scale2_n_per_kg (1.0)
+//! [frontend]    # dac_latency (2), adc_latency (3), dac_bits, adc_bits (16),
+//!               # adc_headroom (0.9), adc_per_meter1, adc_per_meter2 (from
+//!               # adc_headroom), noise_lsb (1), seed (1)
+//! [filter]      # decimation, butterworth_hz, rc_hz: derived when unset
+//! [experiment]  # required: readout_rates_dps, cal_freqs_hz
+//!               # tolerance (1e-4), min_window_s (derived), budget_s (60)
+//! ```
+//!
+//! A file with the required keys alone describes a complete experiment:
+//! the keys in parentheses have fixed defaults, and the filter and the first
+//! averaging window are derived from the device ([`Experiment::derived`]).
+//! Unknown keys, values of the wrong type, and values out of range are
+//! refused with one line naming the section, the key and what is allowed;
+//! an error never names a key the user did not write. Every limit comes from
+//! the constant beside the hardware or model parameter it protects.
+//!
+//! ```
+//! let text = "
+//!     [gyro]
+//!     f1_hz = 25.1e3
+//!     f2_hz = 25.8e3
+//!     q1 = 3000
+//!     q2 = 3000
+//!     angular_gain = 0.8
+//!     [drive]
+//!     carrier_hz = 25.1e3
+//!     clock_hz = 1.2345e6
+//!     [experiment]
+//!     readout_rates_dps = [50, 100, 150, 200]
+//!     cal_freqs_hz = [2, 4, 6]
+//! ";
+//! let e = gyrocal_sim::config::parse("consumer.toml", text).unwrap();
+//! let d = e.derived().unwrap();
+//! assert!(d.decimation >= 16 && d.butterworth_hz < d.rc_hz);
 //! ```
 
-use crate::experiment::Experiment;
-use serde::Deserialize;
+use crate::gyro::GyroParams;
+use gyrocal_hdl::cic_decimator::MAX_DECIMATION;
+use gyrocal_hdl::filter_design::{MAX_CUTOFF_RATIO, MIN_CUTOFF_RATIO, MIN_DECIMATION};
+use gyrocal_hdl::settings::{MAX_CAL_RATIO, MAX_REF_DELAY};
+use serde::{Deserialize, Serialize};
 
-#[derive(Deserialize, Default)]
+/// Everything an experiment needs, section by section as in the TOML file.
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
-struct File {
+pub struct Experiment {
+    /// `[gyro]`: the two modes and the angular gain.
+    pub gyro: GyroParams,
+    /// `[drive]`: carrier, clock and drive amplitudes.
+    pub drive: Drive,
+    /// `[frontend]`: DACs and ADCs.
     #[serde(default)]
-    gyro: Gyro,
+    pub frontend: Frontend,
+    /// `[filter]`: CIC decimation and IIR cut-offs (derived when unset).
     #[serde(default)]
-    drive: Drive,
+    pub filter: Filter,
+    /// `[experiment]`: the points and how precisely to measure them.
+    #[serde(rename = "experiment")]
+    pub points: Points,
+}
+
+/// `[drive]`.
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Drive {
+    /// Carrier (excitation) frequency (Hz): 0 < carrier < clock / 2.
+    pub carrier_hz: f64,
+    /// FPGA clock (Hz).
+    pub clock_hz: f64,
+    /// Drive 1 amplitude as a fraction of DAC full scale, -1 <= a < 1, not 0.
+    #[serde(default = "Drive::default_amplitude")]
+    pub amplitude1: f64,
+    /// Drive 2 amplitude, as `amplitude1`.
+    #[serde(default = "Drive::default_amplitude")]
+    pub amplitude2: f64,
+    /// Force per unit mass of a full-scale DAC word, channel 1 (N/kg).
+    #[serde(default = "Drive::default_force")]
+    pub force_full_scale1_n_per_kg: f64,
+    /// The same, channel 2 (N/kg).
+    #[serde(default = "Drive::default_force")]
+    pub force_full_scale2_n_per_kg: f64,
+}
+
+impl Drive {
+    fn default_amplitude() -> f64 {
+        0.9
+    }
+    fn default_force() -> f64 {
+        1.0
+    }
+    /// A drive at `carrier_hz` on `clock_hz` with the default amplitudes
+    /// and force gains.
+    pub fn new(carrier_hz: f64, clock_hz: f64) -> Self {
+        Self {
+            carrier_hz,
+            clock_hz,
+            amplitude1: Self::default_amplitude(),
+            amplitude2: Self::default_amplitude(),
+            force_full_scale1_n_per_kg: Self::default_force(),
+            force_full_scale2_n_per_kg: Self::default_force(),
+        }
+    }
+    /// (amplitude1, amplitude2).
+    pub fn amplitude(&self) -> (f64, f64) {
+        (self.amplitude1, self.amplitude2)
+    }
+    /// [force_full_scale1, force_full_scale2] (N/kg).
+    pub fn force_full_scale(&self) -> [f64; 2] {
+        [
+            self.force_full_scale1_n_per_kg,
+            self.force_full_scale2_n_per_kg,
+        ]
+    }
+}
+
+/// Widest converter, in bits (the datapath's 16-bit ports).
+pub const MAX_CONVERTER_BITS: u32 = 16;
+
+/// `[frontend]`.
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Frontend {
+    /// DAC pipeline latency (clocks), at most `frontend::MAX_LATENCY`.
+    pub dac_latency: u32,
+    /// ADC pipeline latency (clocks), at most `frontend::MAX_LATENCY`.
+    pub adc_latency: u32,
+    /// DAC resolution (bits), 1..=`MAX_CONVERTER_BITS`.
+    pub dac_bits: u32,
+    /// ADC resolution (bits), 1..=`MAX_CONVERTER_BITS`.
+    pub adc_bits: u32,
+    /// Peak ADC input as a fraction of full scale, used to set the ADC gains
+    /// from the theory when `adc_per_meter1/2` are not given.
+    pub adc_headroom: f64,
+    /// ADC LSBs per metre, channel 1 (give both or neither).
+    pub adc_per_meter1: Option<f64>,
+    /// ADC LSBs per metre, channel 2.
+    pub adc_per_meter2: Option<f64>,
+    /// RMS noise at the ADC input (LSB). The default, 1 LSB, is a real
+    /// converter's transition noise and dithers the quantizer: its error
+    /// then no longer depends on the signal (Widrow), so no point carries a
+    /// static bias that longer windows cannot average and the batches
+    /// cannot see. 0 gives an ideal quantizer (`run` warns when a rate
+    /// signal is then below one LSB).
+    pub noise_lsb: f64,
+    /// Noise seed.
+    pub seed: u64,
+}
+
+impl Default for Frontend {
+    fn default() -> Self {
+        Self {
+            dac_latency: 2,
+            adc_latency: 3,
+            dac_bits: 16,
+            adc_bits: 16,
+            adc_headroom: 0.9,
+            adc_per_meter1: None,
+            adc_per_meter2: None,
+            noise_lsb: 1.0,
+            seed: 1,
+        }
+    }
+}
+
+/// `[filter]`: unset values are derived from the device.
+#[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Filter {
+    /// CIC decimation R, `MIN_DECIMATION..=MAX_DECIMATION`.
+    pub decimation: Option<u32>,
+    /// Butterworth cut-off (Hz), f_z `MIN_CUTOFF_RATIO`..`MAX_CUTOFF_RATIO`.
+    pub butterworth_hz: Option<f64>,
+    /// RC cut-off (Hz), same range.
+    pub rc_hz: Option<f64>,
+}
+
+/// `[experiment]`.
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Points {
+    /// Readout rates (deg/s), at least 2 distinct, |rate| <= `MAX_RATE_DPS`.
+    pub readout_rates_dps: Vec<f64>,
+    /// Calibration frequencies (Hz), at least 2 distinct.
+    pub cal_freqs_hz: Vec<f64>,
+    /// Each point settles to this fraction of the signal it measures, and
+    /// averaging goes on until each ratio's 1-sigma uncertainty is at most
+    /// this fraction of it (`MIN_TOLERANCE..MAX_TOLERANCE`).
+    #[serde(default = "Points::default_tolerance")]
+    pub tolerance: f64,
+    /// First averaging window (s), derived when unset; averaging is
+    /// extended from there (`(0, MAX_WINDOW_S]`).
     #[serde(default)]
-    frontend: Frontend,
-    #[serde(default)]
-    filter: Filter,
-    #[serde(default)]
-    experiment: Points,
+    pub min_window_s: Option<f64>,
+    /// Wall-time budget of the run (s) for extending the windows
+    /// (`(0, MAX_BUDGET_S]`).
+    #[serde(default = "Points::default_budget")]
+    pub budget_s: f64,
 }
 
-#[derive(Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-struct Gyro {
-    f1_hz: Option<f64>,
-    f2_hz: Option<f64>,
-    q1: Option<f64>,
-    q2: Option<f64>,
-    angular_gain: Option<f64>,
+impl Points {
+    fn default_tolerance() -> f64 {
+        1e-4
+    }
+    fn default_budget() -> f64 {
+        60.0
+    }
+    /// Points with the default tolerance, derived window and budget.
+    pub fn new(readout_rates_dps: Vec<f64>, cal_freqs_hz: Vec<f64>) -> Self {
+        Self {
+            readout_rates_dps,
+            cal_freqs_hz,
+            tolerance: Self::default_tolerance(),
+            min_window_s: None,
+            budget_s: Self::default_budget(),
+        }
+    }
 }
 
-#[derive(Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-struct Drive {
-    carrier_hz: Option<f64>,
-    clock_hz: Option<f64>,
-    amplitude1: Option<f64>,
-    amplitude2: Option<f64>,
-    force_full_scale1_n_per_kg: Option<f64>,
-    force_full_scale2_n_per_kg: Option<f64>,
+/// Largest |readout rate| (deg/s).
+pub const MAX_RATE_DPS: f64 = 1e5;
+/// Tolerance range (exclusive at both ends).
+pub const MIN_TOLERANCE: f64 = 0.0;
+/// Tolerance range (exclusive at both ends).
+pub const MAX_TOLERANCE: f64 = 0.1;
+/// Longest first window (s).
+pub const MAX_WINDOW_S: f64 = 100.0;
+/// Largest wall-time budget (s).
+pub const MAX_BUDGET_S: f64 = 86_400.0;
+/// z samples per period of the calibration ripple (2 f_cal) at least: the
+/// window average integrates the interpolated samples, with an error below
+/// 1e-4 of the ripple from 20 samples per period on (`average.rs`).
+pub const SAMPLES_PER_RIPPLE: f64 = 20.0;
+
+/// The filter and first window derived from the device, with the user's
+/// explicit values where given.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Derived {
+    /// CIC decimation R.
+    pub decimation: u32,
+    /// Butterworth cut-off (Hz).
+    pub butterworth_hz: f64,
+    /// RC cut-off (Hz).
+    pub rc_hz: f64,
+    /// First averaging window (s).
+    pub min_window_s: f64,
 }
 
-#[derive(Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-struct Frontend {
-    dac_latency: Option<u32>,
-    adc_latency: Option<u32>,
-    dac_bits: Option<u32>,
-    adc_bits: Option<u32>,
-    adc_headroom: Option<f64>,
-    adc_per_meter1: Option<f64>,
-    adc_per_meter2: Option<f64>,
-    noise_lsb: Option<f64>,
-    seed: Option<u64>,
-}
-
-#[derive(Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-struct Filter {
-    decimation: Option<u32>,
-    butterworth_hz: Option<f64>,
-    rc_hz: Option<f64>,
-}
-
-#[derive(Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-struct Points {
-    readout_rates_dps: Option<Vec<f64>>,
-    cal_freqs_hz: Option<Vec<f64>>,
-    tolerance: Option<f64>,
-    min_window_s: Option<f64>,
-}
+/// Ratio of the RC cut-off to the Butterworth cut-off, and of the
+/// Butterworth cut-off to the slowest signal (`Experiment::derived`).
+const CUTOFF_STEP: f64 = 4.0;
+/// z rate over the RC cut-off asked of a derived decimation (twice the
+/// least `1 / MAX_CUTOFF_RATIO`, so the cut-offs sit inside the range).
+const Z_RATE_OVER_RC: f64 = 10.0;
+/// Butterworth time constants per batch of the first window: batches
+/// shorter than the filter's memory would be correlated.
+const FILTER_TIMES_PER_BATCH: f64 = 10.0;
 
 /// A numeric key with its range check.
 fn check(section: &str, key: &str, value: f64, ok: bool, allowed: &str) -> Result<(), String> {
@@ -121,242 +298,380 @@ fn parse_error(name: &str, text: &str, e: toml::de::Error) -> String {
     }
 }
 
-/// Parse a configuration file's text into an experiment, checking every
-/// key. `name` labels error messages (usually the file path).
+/// Parse a configuration file's text, checking every key and that the
+/// derived values exist. `name` labels error messages (the file path).
 pub fn parse(name: &str, text: &str) -> Result<Experiment, String> {
-    let file: File = toml::from_str(text).map_err(|e| parse_error(name, text, e))?;
-    let mut e = Experiment::paper();
-    let g = file.gyro;
-    e.gyro.f1_hz = g.f1_hz.unwrap_or(e.gyro.f1_hz);
-    e.gyro.f2_hz = g.f2_hz.unwrap_or(e.gyro.f2_hz);
-    e.gyro.q1 = g.q1.unwrap_or(e.gyro.q1);
-    e.gyro.q2 = g.q2.unwrap_or(e.gyro.q2);
-    e.gyro.angular_gain = g.angular_gain.unwrap_or(e.gyro.angular_gain);
-    let d = file.drive;
-    e.clock_hz = d.clock_hz.unwrap_or(e.clock_hz);
-    e.carrier_hz = d.carrier_hz.unwrap_or(e.gyro.f1_hz);
-    e.amplitude = (
-        d.amplitude1.unwrap_or(e.amplitude.0),
-        d.amplitude2.unwrap_or(e.amplitude.1),
-    );
-    e.force_full_scale = [
-        d.force_full_scale1_n_per_kg
-            .unwrap_or(e.force_full_scale[0]),
-        d.force_full_scale2_n_per_kg
-            .unwrap_or(e.force_full_scale[1]),
-    ];
-    let f = file.frontend;
-    e.dac_latency = f.dac_latency.unwrap_or(e.dac_latency);
-    e.adc_latency = f.adc_latency.unwrap_or(e.adc_latency);
-    e.dac_bits = f.dac_bits.unwrap_or(e.dac_bits);
-    e.adc_bits = f.adc_bits.unwrap_or(e.adc_bits);
-    e.adc_headroom = f.adc_headroom.unwrap_or(e.adc_headroom);
-    e.adc_per_meter = match (f.adc_per_meter1, f.adc_per_meter2) {
-        (None, None) => None,
-        (Some(a), Some(b)) => Some([a, b]),
-        _ => {
-            return Err(
-                "[frontend] adc_per_meter1 and adc_per_meter2: give both or neither (neither: set from adc_headroom)"
-                    .into(),
-            );
-        }
-    };
-    e.noise_lsb = f.noise_lsb.unwrap_or(e.noise_lsb);
-    e.seed = f.seed.unwrap_or(e.seed);
-    let fl = file.filter;
-    e.decimation = fl.decimation.unwrap_or(e.decimation);
-    e.butterworth_hz = fl.butterworth_hz.unwrap_or(e.butterworth_hz);
-    e.rc_hz = fl.rc_hz.unwrap_or(e.rc_hz);
-    let p = file.experiment;
-    if let Some(r) = p.readout_rates_dps {
-        e.readout_rates_dps = r;
-    }
-    if let Some(c) = p.cal_freqs_hz {
-        e.cal_freqs_hz = c;
-    }
-    e.tolerance = p.tolerance.unwrap_or(e.tolerance);
-    e.min_window_s = p.min_window_s.unwrap_or(e.min_window_s);
-    validate(&e)?;
+    let e: Experiment = toml::from_str(text).map_err(|e| parse_error(name, text, e))?;
+    e.validate()?;
+    e.derived()?;
     Ok(e)
 }
 
-/// Range checks with section-qualified names; `experiment::plan` repeats
-/// the ones it depends on.
-pub fn validate(e: &Experiment) -> Result<(), String> {
-    let positive = "must be a positive number";
-    check("drive", "clock_hz", e.clock_hz, e.clock_hz > 0.0, positive)?;
-    let nyquist = e.clock_hz / 2.0;
-    let below = format!("must be above 0 and below clock_hz / 2 = {nyquist} Hz");
-    check(
-        "gyro",
-        "f1_hz",
-        e.gyro.f1_hz,
-        e.gyro.f1_hz > 0.0 && e.gyro.f1_hz < nyquist,
-        &below,
-    )?;
-    check(
-        "gyro",
-        "f2_hz",
-        e.gyro.f2_hz,
-        e.gyro.f2_hz > 0.0 && e.gyro.f2_hz < nyquist,
-        &below,
-    )?;
-    check("gyro", "q1", e.gyro.q1, e.gyro.q1 > 0.0, positive)?;
-    check("gyro", "q2", e.gyro.q2, e.gyro.q2 > 0.0, positive)?;
-    check(
-        "gyro",
-        "angular_gain",
-        e.gyro.angular_gain,
-        true,
-        "must be a finite number",
-    )?;
-    check(
-        "drive",
-        "carrier_hz",
-        e.carrier_hz,
-        e.carrier_hz > 0.0 && e.carrier_hz < nyquist,
-        &below,
-    )?;
-    let amp = "allowed -1 <= amplitude < 1 (fraction of DAC full scale), not 0";
-    let (a1, a2) = e.amplitude;
-    check(
-        "drive",
-        "amplitude1",
-        a1,
-        (-1.0..1.0).contains(&a1) && a1 != 0.0,
-        amp,
-    )?;
-    check(
-        "drive",
-        "amplitude2",
-        a2,
-        (-1.0..1.0).contains(&a2) && a2 != 0.0,
-        amp,
-    )?;
-    let [g1, g2] = e.force_full_scale;
-    check(
-        "drive",
-        "force_full_scale1_n_per_kg",
-        g1,
-        g1 > 0.0,
-        positive,
-    )?;
-    check(
-        "drive",
-        "force_full_scale2_n_per_kg",
-        g2,
-        g2 > 0.0,
-        positive,
-    )?;
-    let latency = |key: &str, v: u32| {
+impl Experiment {
+    /// The paper's device and measurement: mode 1 at 9.64 MHz, mode 2 250 Hz
+    /// above, Q 55,000, lambda 0.6 (n = 3 modes), excited at mode 1,
+    /// 50 MHz clock, rates 1..20 deg/s, staircase 10..15 Hz, with the
+    /// paper's filter (R = 1000, 500 Hz Butterworth, 2 kHz RC), noiseless
+    /// converters, 50 ms first windows and a 9 s wall-time budget.
+    pub fn paper() -> Self {
+        Self {
+            gyro: GyroParams {
+                f1_hz: 9.64e6,
+                f2_hz: 9.64e6 + 250.0,
+                q1: 55_000.0,
+                q2: 55_000.0,
+                angular_gain: 0.6,
+            },
+            drive: Drive::new(9.64e6, 50e6),
+            frontend: Frontend {
+                noise_lsb: 0.0,
+                ..Frontend::default()
+            },
+            filter: Filter {
+                decimation: Some(1000),
+                butterworth_hz: Some(500.0),
+                rc_hz: Some(2000.0),
+            },
+            points: Points {
+                min_window_s: Some(0.05),
+                // `reproduce` promises a result within 10 s of wall time.
+                budget_s: 9.0,
+                ..Points::new(
+                    (1..=20).map(f64::from).collect(),
+                    (10..=15).map(f64::from).collect(),
+                )
+            },
+        }
+    }
+
+    /// A device with the required keys alone: everything else defaulted or
+    /// derived.
+    pub fn with_required(
+        gyro: GyroParams,
+        carrier_hz: f64,
+        clock_hz: f64,
+        readout_rates_dps: Vec<f64>,
+        cal_freqs_hz: Vec<f64>,
+    ) -> Self {
+        Self {
+            gyro,
+            drive: Drive::new(carrier_hz, clock_hz),
+            frontend: Frontend::default(),
+            filter: Filter::default(),
+            points: Points::new(readout_rates_dps, cal_freqs_hz),
+        }
+    }
+
+    /// Both ADC gains, if given.
+    pub fn adc_per_meter(&self) -> Option<[f64; 2]> {
+        match (self.frontend.adc_per_meter1, self.frontend.adc_per_meter2) {
+            (Some(a), Some(b)) => Some([a, b]),
+            _ => None,
+        }
+    }
+
+    /// Every key's own range, with the names of the configuration file.
+    pub fn validate(&self) -> Result<(), String> {
+        self.validate_gyro()?;
+        self.validate_drive()?;
+        self.validate_frontend()?;
+        self.validate_points()
+    }
+
+    fn validate_gyro(&self) -> Result<(), String> {
+        let g = &self.gyro;
+        let positive = "must be a positive number";
+        let nyquist = self.drive.clock_hz / 2.0;
+        let below = format!("must be above 0 and below clock_hz / 2 = {nyquist} Hz");
+        check(
+            "drive",
+            "clock_hz",
+            self.drive.clock_hz,
+            self.drive.clock_hz > 0.0,
+            positive,
+        )?;
+        check(
+            "gyro",
+            "f1_hz",
+            g.f1_hz,
+            g.f1_hz > 0.0 && g.f1_hz < nyquist,
+            &below,
+        )?;
+        check(
+            "gyro",
+            "f2_hz",
+            g.f2_hz,
+            g.f2_hz > 0.0 && g.f2_hz < nyquist,
+            &below,
+        )?;
+        check("gyro", "q1", g.q1, g.q1 > 0.0, positive)?;
+        check("gyro", "q2", g.q2, g.q2 > 0.0, positive)?;
+        check(
+            "gyro",
+            "angular_gain",
+            g.angular_gain,
+            true,
+            "must be a finite number",
+        )
+    }
+
+    fn validate_drive(&self) -> Result<(), String> {
+        let d = &self.drive;
+        let nyquist = d.clock_hz / 2.0;
+        let below = format!("must be above 0 and below clock_hz / 2 = {nyquist} Hz");
+        check(
+            "drive",
+            "carrier_hz",
+            d.carrier_hz,
+            d.carrier_hz > 0.0 && d.carrier_hz < nyquist,
+            &below,
+        )?;
+        let amp = "allowed -1 <= amplitude < 1 (fraction of DAC full scale), not 0";
+        for (key, a) in [("amplitude1", d.amplitude1), ("amplitude2", d.amplitude2)] {
+            check("drive", key, a, (-1.0..1.0).contains(&a) && a != 0.0, amp)?;
+        }
+        for (key, g) in [
+            ("force_full_scale1_n_per_kg", d.force_full_scale1_n_per_kg),
+            ("force_full_scale2_n_per_kg", d.force_full_scale2_n_per_kg),
+        ] {
+            check("drive", key, g, g > 0.0, "must be a positive number")?;
+        }
+        Ok(())
+    }
+
+    fn validate_frontend(&self) -> Result<(), String> {
+        let f = &self.frontend;
+        let max = crate::frontend::MAX_LATENCY;
+        for (key, v) in [
+            ("dac_latency", f.dac_latency),
+            ("adc_latency", f.adc_latency),
+        ] {
+            check(
+                "frontend",
+                key,
+                f64::from(v),
+                v <= max,
+                &format!("allowed 0..={max} clocks"),
+            )?;
+        }
+        let delay = f.dac_latency + f.adc_latency;
+        if delay > MAX_REF_DELAY {
+            return Err(format!(
+                "[frontend] dac_latency + adc_latency = {delay}: at most {MAX_REF_DELAY} clocks (the reference delay line)"
+            ));
+        }
+        let bits = format!("allowed 1..={MAX_CONVERTER_BITS}");
+        for (key, v) in [("dac_bits", f.dac_bits), ("adc_bits", f.adc_bits)] {
+            check(
+                "frontend",
+                key,
+                f64::from(v),
+                (1..=MAX_CONVERTER_BITS).contains(&v),
+                &bits,
+            )?;
+        }
+        let h = f.adc_headroom;
         check(
             "frontend",
-            key,
-            f64::from(v),
-            v <= crate::frontend::MAX_LATENCY,
-            "allowed 0..=31 clocks",
+            "adc_headroom",
+            h,
+            h > 0.0 && h <= 1.0,
+            "allowed 0 < adc_headroom <= 1",
+        )?;
+        match (f.adc_per_meter1, f.adc_per_meter2) {
+            (None, None) => {}
+            (Some(p1), Some(p2)) => {
+                check(
+                    "frontend",
+                    "adc_per_meter1",
+                    p1,
+                    p1 > 0.0,
+                    "must be a positive number",
+                )?;
+                check(
+                    "frontend",
+                    "adc_per_meter2",
+                    p2,
+                    p2 > 0.0,
+                    "must be a positive number",
+                )?;
+            }
+            _ => {
+                return Err(
+                    "[frontend] adc_per_meter1 and adc_per_meter2: give both or neither (neither: set from adc_headroom)"
+                        .into(),
+                );
+            }
+        }
+        check(
+            "frontend",
+            "noise_lsb",
+            f.noise_lsb,
+            f.noise_lsb >= 0.0,
+            "must be >= 0",
         )
-    };
-    latency("dac_latency", e.dac_latency)?;
-    latency("adc_latency", e.adc_latency)?;
-    if e.dac_latency + e.adc_latency > 63 {
+    }
+
+    fn validate_points(&self) -> Result<(), String> {
+        let p = &self.points;
+        check_list(
+            "readout_rates_dps",
+            &p.readout_rates_dps,
+            &|x| x.abs() <= MAX_RATE_DPS,
+            &format!("rates must be finite, |rate| <= {MAX_RATE_DPS} deg/s"),
+        )?;
+        let max_cal = self.drive.clock_hz * MAX_CAL_RATIO;
+        check_list(
+            "cal_freqs_hz",
+            &p.cal_freqs_hz,
+            &|x| x > 0.0 && x <= max_cal,
+            &format!(
+                "frequencies must be above 0 and at most clock_hz x {MAX_CAL_RATIO} = {max_cal} Hz"
+            ),
+        )?;
+        check(
+            "experiment",
+            "tolerance",
+            p.tolerance,
+            p.tolerance > MIN_TOLERANCE && p.tolerance < MAX_TOLERANCE,
+            &format!("allowed {MIN_TOLERANCE} < tolerance < {MAX_TOLERANCE}"),
+        )?;
+        if let Some(w) = p.min_window_s {
+            check(
+                "experiment",
+                "min_window_s",
+                w,
+                w > 0.0 && w <= MAX_WINDOW_S,
+                &format!("allowed 0 < min_window_s <= {MAX_WINDOW_S} s"),
+            )?;
+        }
+        check(
+            "experiment",
+            "budget_s",
+            p.budget_s,
+            p.budget_s > 0.0 && p.budget_s <= MAX_BUDGET_S,
+            &format!("allowed 0 < budget_s <= {MAX_BUDGET_S} s"),
+        )
+    }
+
+    /// The slowest signal the filter must follow (Hz): a mode's half
+    /// bandwidth f_k / (2 Q_k) (its amplitude pole) or the calibration
+    /// ripple 2 f_cal.
+    pub fn signal_band_hz(&self) -> f64 {
+        let g = &self.gyro;
+        let half_bandwidth = (g.f1_hz / (2.0 * g.q1)).max(g.f2_hz / (2.0 * g.q2));
+        let ripple = 2.0 * self.points.cal_freqs_hz.iter().cloned().fold(0.0, f64::max);
+        half_bandwidth.max(ripple)
+    }
+
+    /// The filter and first window, derived from the device where the user
+    /// left them unset (see README "Derived settings"):
+    ///
+    /// - Butterworth cut-off `CUTOFF_STEP` x the signal band, RC cut-off
+    ///   `CUTOFF_STEP` x that;
+    /// - decimation R so that f_z = clock / R is `Z_RATE_OVER_RC` x the RC
+    ///   cut-off, within `MIN_DECIMATION..=MAX_DECIMATION`, and small
+    ///   enough that f_z samples the calibration ripple `SAMPLES_PER_RIPPLE`
+    ///   times per period;
+    /// - both cut-offs then clamped into f_z x
+    ///   [`MIN_CUTOFF_RATIO`, `MAX_CUTOFF_RATIO`];
+    /// - first window: 8 batches of `FILTER_TIMES_PER_BATCH` Butterworth
+    ///   time constants.
+    ///
+    /// An explicit value that conflicts with the others is refused with
+    /// both values and what is allowed.
+    pub fn derived(&self) -> Result<Derived, String> {
+        let clock = self.drive.clock_hz;
+        let band = self.signal_band_hz();
+        let max_cal = self.points.cal_freqs_hz.iter().cloned().fold(0.0, f64::max);
+        // Largest R that still samples the ripple SAMPLES_PER_RIPPLE times.
+        let ripple_limit = (clock / (SAMPLES_PER_RIPPLE * 2.0 * max_cal)).floor();
+        let decimation = match self.filter.decimation {
+            Some(r) => {
+                if !(MIN_DECIMATION..=MAX_DECIMATION).contains(&r) {
+                    return Err(format!(
+                        "[filter] decimation = {r}: allowed {MIN_DECIMATION}..={MAX_DECIMATION}"
+                    ));
+                }
+                if f64::from(r) > ripple_limit {
+                    return Err(format!(
+                        "[filter] decimation = {r}: the calibration ripple at 2 x {max_cal} Hz needs {SAMPLES_PER_RIPPLE} z samples per period, so decimation <= {ripple_limit} (clock_hz / (2 x {SAMPLES_PER_RIPPLE} x max cal_freqs_hz)); lower it or the calibration frequencies"
+                    ));
+                }
+                r
+            }
+            None => {
+                if ripple_limit < f64::from(MIN_DECIMATION) {
+                    let max = clock / (SAMPLES_PER_RIPPLE * 2.0 * f64::from(MIN_DECIMATION));
+                    return Err(format!(
+                        "[experiment] cal_freqs_hz contains {max_cal}: at most {max:.3} Hz on this clock (clock_hz / (2 x {SAMPLES_PER_RIPPLE} z samples per ripple period x decimation {MIN_DECIMATION}))"
+                    ));
+                }
+                let fz_wanted = Z_RATE_OVER_RC * CUTOFF_STEP * CUTOFF_STEP * band;
+                (clock / fz_wanted).round().clamp(
+                    f64::from(MIN_DECIMATION),
+                    f64::from(MAX_DECIMATION).min(ripple_limit),
+                ) as u32
+            }
+        };
+        let fz = clock / f64::from(decimation);
+        let (lo, hi) = (fz * MIN_CUTOFF_RATIO, fz * MAX_CUTOFF_RATIO);
+        let why = match self.filter.decimation {
+            Some(_) => format!("clock_hz / decimation = {fz} Hz"),
+            None => format!(
+                "clock_hz / derived decimation {decimation} = {fz} Hz; set [filter] decimation to move it"
+            ),
+        };
+        let cutoff = |key: &str, given: Option<f64>, wanted: f64| -> Result<f64, String> {
+            match given {
+                Some(v) => check(
+                    "filter",
+                    key,
+                    v,
+                    v >= lo && v <= hi,
+                    &format!("allowed {lo:.6} to {hi:.3} Hz ({MIN_CUTOFF_RATIO} to {MAX_CUTOFF_RATIO} of the z rate, {why})"),
+                )
+                .map(|_| v),
+                None => Ok(wanted.clamp(lo, hi)),
+            }
+        };
+        let rc_hz = cutoff("rc_hz", self.filter.rc_hz, CUTOFF_STEP * CUTOFF_STEP * band)?;
+        let butterworth_hz = cutoff(
+            "butterworth_hz",
+            self.filter.butterworth_hz,
+            (CUTOFF_STEP * band).min(rc_hz),
+        )?;
+        let min_window_s = match self.points.min_window_s {
+            Some(w) => w,
+            None => {
+                let batch = FILTER_TIMES_PER_BATCH / (std::f64::consts::TAU * butterworth_hz);
+                8.0 * batch.max(64.0 / fz)
+            }
+        };
+        Ok(Derived {
+            decimation,
+            butterworth_hz,
+            rc_hz,
+            min_window_s,
+        })
+    }
+}
+
+/// A list of values: not empty, each in range, at least 2 distinct.
+fn check_list(key: &str, v: &[f64], ok: &dyn Fn(f64) -> bool, allowed: &str) -> Result<(), String> {
+    if v.is_empty() {
         return Err(format!(
-            "[frontend] dac_latency + adc_latency = {}: at most 63 clocks (the reference delay line)",
-            e.dac_latency + e.adc_latency
+            "[experiment] {key} is empty: give at least 2 distinct values"
         ));
     }
-    let bits = "allowed 1..=16";
-    check(
-        "frontend",
-        "dac_bits",
-        f64::from(e.dac_bits),
-        (1..=16).contains(&e.dac_bits),
-        bits,
-    )?;
-    check(
-        "frontend",
-        "adc_bits",
-        f64::from(e.adc_bits),
-        (1..=16).contains(&e.adc_bits),
-        bits,
-    )?;
-    let h = e.adc_headroom;
-    check(
-        "frontend",
-        "adc_headroom",
-        h,
-        h > 0.0 && h <= 1.0,
-        "allowed 0 < adc_headroom <= 1",
-    )?;
-    if let Some([p1, p2]) = e.adc_per_meter {
-        check("frontend", "adc_per_meter1", p1, p1 > 0.0, positive)?;
-        check("frontend", "adc_per_meter2", p2, p2 > 0.0, positive)?;
+    if let Some(x) = v.iter().find(|x| !(x.is_finite() && ok(**x))) {
+        return Err(format!("[experiment] {key} contains {x}: {allowed}"));
     }
-    check(
-        "frontend",
-        "noise_lsb",
-        e.noise_lsb,
-        e.noise_lsb >= 0.0,
-        "must be >= 0",
-    )?;
-    let r = e.decimation;
-    if !(16..=4096).contains(&r) {
-        return Err(format!("[filter] decimation = {r}: allowed 16..=4096"));
+    if v.iter().all(|x| *x == v[0]) {
+        return Err(format!(
+            "[experiment] {key}: give at least 2 distinct values for a slope"
+        ));
     }
-    let fz = e.clock_hz / f64::from(r);
-    let cut = format!(
-        "allowed {:.6} to {:.3} Hz (clock_hz / decimation / 1000 to / 5)",
-        fz / 1000.0,
-        fz / 5.0
-    );
-    for (key, v) in [("butterworth_hz", e.butterworth_hz), ("rc_hz", e.rc_hz)] {
-        check("filter", key, v, v >= fz / 1000.0 && v <= fz / 5.0, &cut)?;
-    }
-    let list =
-        |key: &str, v: &[f64], ok: &dyn Fn(f64) -> bool, allowed: &str| -> Result<(), String> {
-            if v.is_empty() {
-                return Err(format!(
-                    "[experiment] {key} is empty: give at least 2 distinct values"
-                ));
-            }
-            if let Some(x) = v.iter().find(|x| !(x.is_finite() && ok(**x))) {
-                return Err(format!("[experiment] {key} contains {x}: {allowed}"));
-            }
-            if v.iter().all(|x| *x == v[0]) {
-                return Err(format!(
-                    "[experiment] {key}: give at least 2 distinct values for a slope"
-                ));
-            }
-            Ok(())
-        };
-    list(
-        "readout_rates_dps",
-        &e.readout_rates_dps,
-        &|x| x.abs() <= 1e5,
-        "rates must be finite, |rate| <= 1e5 deg/s",
-    )?;
-    let max_cal = e.clock_hz / 1000.0;
-    list(
-        "cal_freqs_hz",
-        &e.cal_freqs_hz,
-        &|x| x > 0.0 && x <= max_cal,
-        &format!("frequencies must be above 0 and at most clock_hz / 1000 = {max_cal} Hz"),
-    )?;
-    check(
-        "experiment",
-        "tolerance",
-        e.tolerance,
-        e.tolerance > 0.0 && e.tolerance < 0.1,
-        "allowed 0 < tolerance < 0.1",
-    )?;
-    let w = e.min_window_s;
-    check(
-        "experiment",
-        "min_window_s",
-        w,
-        w > 0.0 && w <= 100.0,
-        "allowed 0 < min_window_s <= 100 s",
-    )?;
     Ok(())
 }
 
@@ -364,54 +679,91 @@ pub fn validate(e: &Experiment) -> Result<(), String> {
 mod tests {
     use super::*;
 
+    const REQUIRED: &str = "[gyro]\nf1_hz = 1.0123e6\nf2_hz = 1.01236e6\nq1 = 5000\nq2 = 5000\nangular_gain = 0.6\n[drive]\ncarrier_hz = 1.0123e6\nclock_hz = 10e6\n[experiment]\nreadout_rates_dps = [100, 200]\ncal_freqs_hz = [2, 4]\n";
+
     #[test]
-    fn empty_file_is_the_paper() {
-        assert_eq!(parse("c.toml", "").unwrap(), Experiment::paper());
+    fn the_required_keys_alone_make_an_experiment() {
+        let e = parse("c.toml", REQUIRED).unwrap();
+        assert_eq!(e.frontend, Frontend::default());
+        assert_eq!(e.filter, Filter::default());
+        assert_eq!(e.points.tolerance, 1e-4);
+        let d = e.derived().unwrap();
+        let fz = 10e6 / f64::from(d.decimation);
+        assert!(d.butterworth_hz >= fz * MIN_CUTOFF_RATIO && d.rc_hz <= fz * MAX_CUTOFF_RATIO);
     }
 
     #[test]
-    fn carrier_follows_mode_1_unless_given() {
-        let e = parse(
-            "c.toml",
-            "[gyro]\nf1_hz = 1.0123e6\nf2_hz = 1.0124e6\n[drive]\nclock_hz = 10e6\n",
-        )
-        .unwrap();
-        assert_eq!(e.carrier_hz, 1.0123e6);
-        let e = parse("c.toml", "[gyro]\nf1_hz = 1.0123e6\nf2_hz = 1.0124e6\n[drive]\nclock_hz = 10e6\ncarrier_hz = 1.01e6\n").unwrap();
-        assert_eq!(e.carrier_hz, 1.01e6);
+    fn the_paper_round_trips_through_toml() {
+        let e = Experiment::paper();
+        let text = toml::to_string(&e).unwrap();
+        assert_eq!(parse("c.toml", &text).unwrap(), e);
+    }
+
+    #[test]
+    fn a_missing_required_key_is_named() {
+        let text = REQUIRED.replace("carrier_hz = 1.0123e6\n", "");
+        let err = parse("c.toml", &text).unwrap_err();
+        assert!(err.contains("missing field `carrier_hz`"), "{err}");
+    }
+
+    #[test]
+    fn a_conflicting_explicit_value_names_both() {
+        // An RC cut-off above the derived z rate's range: the error names the
+        // user's value, the derived decimation and the key that moves it.
+        let text = REQUIRED.replace("[experiment]", "[filter]\nrc_hz = 1e6\n[experiment]");
+        let err = parse("c.toml", &text).unwrap_err();
+        assert!(
+            err.starts_with("[filter] rc_hz = 1000000: allowed"),
+            "{err}"
+        );
+        assert!(
+            err.contains("derived decimation") && err.contains("[filter] decimation"),
+            "{err}"
+        );
     }
 
     #[test]
     fn every_error_is_one_line_naming_the_key() {
         let cases = [
-            ("[gyro]\nq1 = -5.0\n", "[gyro] q1 = -5"),
-            ("[gyro]\nq2 = nan\n", "[gyro] q2 = NaN"),
+            (REQUIRED.replace("q1 = 5000", "q1 = -5.0"), "[gyro] q1 = -5"),
+            (REQUIRED.replace("q2 = 5000", "q2 = nan"), "[gyro] q2 = NaN"),
             (
-                "[gyro]\nbogus = 1\n",
-                "c.toml line 2 in [gyro]: unknown field `bogus`",
+                REQUIRED.replace("q1 = 5000", "q1 = 5000\nbogus = 1"),
+                "c.toml line 5 in [gyro]: unknown field `bogus`",
             ),
-            ("[bogus]\nx = 1\n", "c.toml line 1"),
+            (format!("[bogus]\nx = 1\n{REQUIRED}"), "c.toml line 1"),
             (
-                "[drive]\ncarrier_hz = 30e6\n",
+                REQUIRED.replace("carrier_hz = 1.0123e6", "carrier_hz = 30e6"),
                 "[drive] carrier_hz = 30000000",
             ),
             (
-                "[experiment]\nreadout_rates_dps = []\n",
+                REQUIRED.replace("[100, 200]", "[]"),
                 "[experiment] readout_rates_dps is empty",
             ),
             (
-                "[experiment]\ncal_freqs_hz = [10.0, 10.0]\n",
+                REQUIRED.replace("[2, 4]", "[10.0, 10.0]"),
                 "[experiment] cal_freqs_hz: give at least 2 distinct",
             ),
             (
-                "[gyro]\nq1 = \"high\"\n",
-                "c.toml line 2 in [gyro]: invalid type",
+                REQUIRED.replace("q1 = 5000", "q1 = \"high\""),
+                "c.toml line 4 in [gyro]: invalid type",
             ),
-            ("[gyro\nq1 = 3\n", "c.toml line 1"),
-            ("[filter]\ndecimation = 8\n", "[filter] decimation = 8"),
+            (REQUIRED.replace("[gyro]", "[gyro"), "c.toml line 1"),
+            (
+                format!("{REQUIRED}[filter]\ndecimation = 8\n"),
+                "[filter] decimation = 8: allowed 16..=4096",
+            ),
+            (
+                REQUIRED.replace("cal_freqs_hz", "budget_s = 0\ncal_freqs_hz"),
+                "[experiment] budget_s = 0: allowed",
+            ),
+            (
+                format!("{REQUIRED}[frontend]\nadc_per_meter1 = 1e9\n"),
+                "[frontend] adc_per_meter1 and adc_per_meter2",
+            ),
         ];
         for (text, start) in cases {
-            let err = parse("c.toml", text).unwrap_err();
+            let err = parse("c.toml", &text).unwrap_err();
             assert!(err.starts_with(start), "{text:?} gave {err:?}");
             assert!(!err.contains('\n'), "{err:?}");
         }

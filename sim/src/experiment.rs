@@ -4,23 +4,45 @@
 //! Every point is an independent run from power-up (gyroscope at rest,
 //! datapath at its power-up state), so points run in parallel on all cores.
 //! A point runs for a settling time, then z1, z2 are averaged over a window
-//! (`crate::average`). Both times are derived, never guessed:
+//! made of equal batches (`crate::average`). Both are derived, never guessed:
 //!
 //! - Settling. From rest the resonator's transient decays as exp(-t / tau)
 //!   with tau = 2 Q_k / w_k (the slowest mode). It starts as large as the
 //!   largest low-frequency term of z at that output, Z (the readout offset
 //!   of a detuned mode, or the calibration ripple), and must fall below
-//!   `tolerance` times the signal the fit measures at that output,
-//!   S = |SF| x (span of the rates). So t_res = tau ln(Z / (tolerance S)),
+//!   `tolerance / SETTLE_MARGIN` times the signal the fit measures at that
+//!   output, S = |SF| x (span of the rates). So t_res = tau ln(Z / (tolerance S / SETTLE_MARGIN)),
 //!   both from the exact theory; on the paper's device the detuned readout
 //!   output has Z / S near 8e3 and t_res near 18 tau = 33 ms. The filters
 //!   then need ln(Z / (tolerance S)) / sigma more, sigma the slowest decay
 //!   rate of the Butterworth poles (w_c / sqrt 2) and the RC pole, plus the
 //!   CIC's 4 R clocks.
-//! - Window. Readout: `min_window_s`. Calibration: the smallest whole number
-//!   of periods of the 2 Om ripple (1 / (2 f_cal), with the realized f_cal)
-//!   not shorter than `min_window_s`; any other length leaves part of a
-//!   ripple about 100 / f_cal[Hz] times the DC value in the mean.
+//! - Window and batches. The window is cut into `BATCHES` equal batches.
+//!   A batch is a whole number of units: readout, the first window
+//!   (`Derived::min_window_s`) over `BATCHES`; calibration, one period of
+//!   the 2 Om ripple (1 / (2 f_cal), with the realized f_cal), because any
+//!   other length leaves part of a ripple about 100 / f_cal[Hz] times the
+//!   DC value in the mean.
+//! - Uncertainty. A point's value is the mean of its batch means. A slope's
+//!   1-sigma uncertainty is the spread of the slopes fitted batch by batch
+//!   (`crate::fit::fit_batches`): estimated from the data, never from the
+//!   theory. The number of batches is fixed and their length grows with
+//!   the window (batch means with a fixed number of batches): for a white
+//!   residue this is the usual estimate (t distribution, BATCHES - 1
+//!   degrees of freedom); for the deterministic residue of a clean
+//!   converter (spectral lines from its quantization) it errs high by about
+//!   sqrt(BATCHES / 2) and still falls as fast as the error, 1 / window.
+//!   Points of a sweep share their settling time, so their batches line up.
+//! - Growth. Rounds: all points run; if a sweep's slope uncertainty is above
+//!   its share of the ratio's target, tolerance x max(|ratio|,
+//!   `RATIO_FLOOR`), that sweep runs again from power-up with longer
+//!   windows, unless the next round would overrun the wall-time budget. The
+//!   next length assumes the uncertainty falls as window^-a, a from the
+//!   last two rounds (clamped to 1/2..1; 1/2 before there are two), at most
+//!   `MAX_GROWTH` times per round. Re-running costs the settling again but
+//!   keeps every engine's run independent and reproducible; with growth of
+//!   several times per round the earlier rounds cost a fraction of the
+//!   last.
 //!
 //! Scale factors are least-squares slopes with intercept (`crate::fit`) of
 //! the averaged outputs against the physical rate (readout) or the virtual
@@ -30,103 +52,45 @@
 //! reference words carry no hold, so z scales by that factor once).
 
 use crate::average::window_mean;
+use crate::config::Derived;
+pub use crate::config::Experiment;
 use crate::cosim::CoSim;
 use crate::engine::{Engine, EngineKind, ModelEngine, RtlEngine};
-use crate::fit::linear_fit;
+use crate::fit::{Line, ScaleFactors, fit_batches, linear_fit};
 use crate::frontend::{Converters, FrontEnd};
-use crate::gyro::{GyroModel, GyroParams};
+use crate::gyro::GyroModel;
 use crate::theory::{self, Device};
 use gyrocal_hdl::cic_decimator::OUTPUT_FRACTION_BITS;
 use gyrocal_hdl::filter_design::FilterDesign;
 use gyrocal_hdl::model::gyro_interface::{Outputs, Probes, Registers};
+use gyrocal_hdl::model::q15_multiplier::q15_product;
 use gyrocal_hdl::settings::{self, FrequencyPlan};
 use gyrocal_hdl::sine_table::PEAK;
 use rayon::prelude::*;
 use serde::Serialize;
 use std::f64::consts::{PI, TAU};
+use std::time::Instant;
 
-/// Everything an experiment needs: device, excitation, converters, filter,
-/// points.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Experiment {
-    /// The gyroscope.
-    pub gyro: GyroParams,
-    /// FPGA clock (Hz).
-    pub clock_hz: f64,
-    /// Carrier (excitation) frequency (Hz).
-    pub carrier_hz: f64,
-    /// Drive amplitudes F1, F2 as fractions of full scale.
-    pub amplitude: (f64, f64),
-    /// Force per unit mass of a full-scale DAC word, per channel (N/kg).
-    pub force_full_scale: [f64; 2],
-    /// DAC pipeline latency (clocks).
-    pub dac_latency: u32,
-    /// ADC pipeline latency (clocks).
-    pub adc_latency: u32,
-    /// DAC resolution (bits).
-    pub dac_bits: u32,
-    /// ADC resolution (bits).
-    pub adc_bits: u32,
-    /// Peak ADC input as a fraction of full scale, used to set the ADC gains
-    /// from the theory when `adc_per_meter` is not given.
-    pub adc_headroom: f64,
-    /// ADC LSBs per metre, per channel; `None`: from `adc_headroom`.
-    pub adc_per_meter: Option<[f64; 2]>,
-    /// RMS noise at the ADC input (LSB).
-    pub noise_lsb: f64,
-    /// Noise seed.
-    pub seed: u64,
-    /// CIC decimation R.
-    pub decimation: u32,
-    /// Butterworth cut-off (Hz).
-    pub butterworth_hz: f64,
-    /// RC cut-off (Hz).
-    pub rc_hz: f64,
-    /// Readout rates (deg/s).
-    pub readout_rates_dps: Vec<f64>,
-    /// Calibration frequencies (Hz).
-    pub cal_freqs_hz: Vec<f64>,
-    /// Each point is settled to this fraction of the signal it measures.
-    pub tolerance: f64,
-    /// Shortest averaging window (s).
-    pub min_window_s: f64,
-}
-
-impl Experiment {
-    /// The paper's device and measurement: mode 1 at 9.64 MHz, mode 2 250 Hz
-    /// above, Q 55,000, lambda 0.6 (n = 3 modes), excited at mode 1,
-    /// 50 MHz clock, rates 1..20 deg/s, staircase 10..15 Hz.
-    pub fn paper() -> Self {
-        Self {
-            gyro: GyroParams {
-                f1_hz: 9.64e6,
-                f2_hz: 9.64e6 + 250.0,
-                q1: 55_000.0,
-                q2: 55_000.0,
-                angular_gain: 0.6,
-            },
-            clock_hz: 50e6,
-            carrier_hz: 9.64e6,
-            amplitude: (0.9, 0.9),
-            force_full_scale: [1.0, 1.0],
-            dac_latency: 2,
-            adc_latency: 3,
-            dac_bits: 16,
-            adc_bits: 16,
-            adc_headroom: 0.9,
-            adc_per_meter: None,
-            noise_lsb: 0.0,
-            seed: 1,
-            decimation: 1000,
-            butterworth_hz: 500.0,
-            rc_hz: 2000.0,
-            readout_rates_dps: (1..=20).map(f64::from).collect(),
-            cal_freqs_hz: (10..=15).map(f64::from).collect(),
-            tolerance: 1e-4,
-            min_window_s: 0.05,
-        }
-    }
-}
+/// The transient left at the start of a window is `tolerance / SETTLE_MARGIN`
+/// of the signal: it decays with tau and biases the window's mean by that
+/// times tau / window, which must stay well below the uncertainty the
+/// plan aims at (`tolerance` of the ratio); with a margin of 1 it was 5e-6
+/// of the calibration scale factor of a Q 1e4 device (tau 6 ms, 0.13 s
+/// windows), 40 of its sigmas.
+const SETTLE_MARGIN: f64 = 10.0;
+/// Batches per window; the uncertainty of a mean of n batch means is
+/// estimated with n - 1 degrees of freedom.
+pub const BATCHES: u32 = 8;
+/// A window grows at most this many times per step.
+const MAX_GROWTH: f64 = 8.0;
+/// Share of the ratio's relative variance given to the calibration slope
+/// (its signal is large at the resonant output and its uncertainty small);
+/// the readout slope gets the rest.
+const CAL_SHARE: f64 = 0.1;
+/// Below this |ratio| the ratio's target is `tolerance x RATIO_FLOOR`
+/// instead of `tolerance x |ratio|`: a ratio near zero would otherwise ask
+/// for unbounded averaging.
+pub const RATIO_FLOOR: f64 = 0.5;
 
 /// Readout at a rotation rate, or calibration at a modulation frequency.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -154,10 +118,24 @@ pub struct PointPlan {
     pub regs: Registers,
     /// Clocks before the window.
     pub settle_cycles: u64,
-    /// Window length in clocks (not necessarily whole).
-    pub window_cycles: f64,
-    /// Clocks to simulate.
-    pub total_cycles: u64,
+    /// The unit of a batch's length, in clocks (not necessarily whole).
+    pub unit_cycles: f64,
+    /// Units per batch of the first window.
+    pub units: u32,
+}
+
+impl PointPlan {
+    /// Window length in clocks with `units` units per batch.
+    pub fn window_cycles(&self, units: u32) -> f64 {
+        f64::from(BATCHES) * f64::from(units) * self.unit_cycles
+    }
+
+    /// Clocks to simulate for `units` units per batch (the decimator's and
+    /// the filter's tail included).
+    pub fn cycles_for(&self, units: u32, decimation: u32) -> u64 {
+        let tail = 2 * u64::from(decimation) + 64;
+        self.settle_cycles + self.window_cycles(units).ceil() as u64 + tail
+    }
 }
 
 /// What the planner derived.
@@ -165,18 +143,27 @@ pub struct PointPlan {
 pub struct Plan {
     /// The points, readout first.
     pub points: Vec<PointPlan>,
+    /// Filter and first window, derived or given.
+    pub derived: Derived,
     /// Front end, with the ADC gains set.
     pub front_end: FrontEnd,
     /// Realized carrier (Hz).
     pub carrier_hz: f64,
     /// The output filter.
     pub filter: FilterDesign,
-    /// Amplitude of the DAC words (LSB) per channel, in readout.
+    /// Fundamental amplitude of the DAC and reference words (LSB) per
+    /// channel, in readout (`realized_words`).
     pub drive_words: [f64; 2],
+    /// The same for each sideband's envelope in calibration.
+    pub cal_drive_words: [f64; 2],
     /// Fundamental gain of the DAC's hold at the carrier.
     pub hold_gain: f64,
     /// Slowest resonator amplitude time constant (s).
     pub tau_s: f64,
+    /// The rate signal each output's fit sees, in ADC LSB of in-phase
+    /// amplitude over the whole span of rates, [readout, calibration]
+    /// (below 1 without dither: the converters' quantization decides).
+    pub signal_lsb: [[f64; 2]; 2],
     /// Things a user should know (commensurate frequency plan, ...).
     pub warnings: Vec<String>,
 }
@@ -185,6 +172,16 @@ impl Plan {
     /// The device as the theory sees it: reference forces (DAC word
     /// amplitude times force gain). Multiply its z by `hold_gain`.
     pub fn theory_device(&self, exp: &Experiment) -> Device {
+        self.theory_device_in(exp, Mode::Readout)
+    }
+
+    /// The device as the theory sees it in one mode (the words' realized
+    /// amplitudes differ slightly between readout and calibration).
+    pub fn theory_device_in(&self, exp: &Experiment, mode: Mode) -> Device {
+        let words = match mode {
+            Mode::Readout => self.drive_words,
+            Mode::Calibration => self.cal_drive_words,
+        };
         Device {
             f1_hz: exp.gyro.f1_hz,
             f2_hz: exp.gyro.f2_hz,
@@ -192,66 +189,147 @@ impl Plan {
             q2: exp.gyro.q2,
             angular_gain: exp.gyro.angular_gain,
             carrier_hz: self.carrier_hz,
-            f1_force: self.drive_words[0] * self.front_end.force_per_lsb[0],
-            f2_force: self.drive_words[1] * self.front_end.force_per_lsb[1],
+            f1_force: words[0] * self.front_end.force_per_lsb[0],
+            f2_force: words[1] * self.front_end.force_per_lsb[1],
         }
     }
 
-    /// Total clocks of all points.
+    /// Clocks of all points' first windows.
     pub fn total_cycles(&self) -> u64 {
-        self.points.iter().map(|p| p.total_cycles).sum()
+        let r = self.filter.decimation;
+        self.points.iter().map(|p| p.cycles_for(p.units, r)).sum()
     }
 
     /// Exact theory z (m^2/s^2) at a point, hold included.
     pub fn theory_z(&self, exp: &Experiment, p: &PointPlan) -> [f64; 2] {
-        let dev = self.theory_device(exp);
+        let dev = self.theory_device_in(exp, p.mode);
         let z = match p.mode {
             Mode::Readout => theory::readout_z(&dev, p.omz_rad_s),
-            Mode::Calibration => theory::calibration_z(&dev, p.cal_hz),
+            Mode::Calibration => {
+                let clock = exp.drive.clock_hz;
+                let sinc = |f: f64| {
+                    let x = PI * f / clock;
+                    x.sin() / x
+                };
+                let at_carrier = sinc(self.carrier_hz);
+                theory::calibration_z_of_datapath(
+                    &dev,
+                    p.cal_hz,
+                    envelope_lead_rad(p.cal_hz, clock),
+                    [-1.0, 1.0].map(|s| sinc(self.carrier_hz + s * p.cal_hz) / at_carrier),
+                )
+            }
         };
         [z[0] * self.hold_gain, z[1] * self.hold_gain]
     }
+
+    /// m^2/s^2 per z LSB at each output of a point: z LSB -> mixer LSB (ADC
+    /// word x reference word) -> metres x N/kg.
+    pub fn z_per_lsb(&self, mode: Mode) -> [f64; 2] {
+        let fe = &self.front_end;
+        let reference_channel = |k: usize| match mode {
+            Mode::Readout => k,
+            Mode::Calibration => 1 - k,
+        };
+        std::array::from_fn(|k| {
+            fe.force_per_lsb[reference_channel(k)]
+                / fe.adc_per_meter[k]
+                / (f64::from(1u32 << OUTPUT_FRACTION_BITS) * self.filter.dc_gain)
+        })
+    }
 }
 
-/// Plan an experiment: registers, ADC gains, settling and windows.
+/// The lead of the reference envelopes over the drive envelopes the
+/// datapath leaves in calibration (rad): the references are lined up with
+/// the drives' carrier to the half clock of the DAC's hold by `ref_phase`,
+/// but their envelope is not, so it is off by Om T / 2
+/// (`hdl/src/settings.rs`). Negligible in phase (1e-6 rad), but it mixes
+/// the resonant part of the response into the calibration output: 2e-4 of
+/// the calibration scale factor on a Q 200 device at 100 kHz and 3.33 MHz.
+pub fn envelope_lead_rad(cal_hz: f64, clock_hz: f64) -> f64 {
+    ENVELOPE_LEAD_SIGN * PI * cal_hz / clock_hz
+}
+
+/// The sign of the datapath's envelope lead (see `envelope_lead_rad`).
+const ENVELOPE_LEAD_SIGN: f64 = -1.0;
+
+/// Fundamental gain of the hardware's sine table, sin and cos alike: the
+/// phase average of its output times the exact sine (a carrier whose
+/// frequency is not a small-integer fraction of the clock visits the
+/// phases uniformly). About 1 + 7e-7 for the 256-entry table.
+fn sine_table_gain() -> f64 {
+    const PHASES: u64 = 1 << 16;
+    let sum: f64 = (0..PHASES)
+        .map(|i| {
+            let phase = ((i << 32) / PHASES) as u32 + (1 << 15);
+            let (sin, _) = gyrocal_hdl::model::sincos::evaluate(phase);
+            f64::from(sin) * (f64::from(phase) * TAU / 2f64.powi(32)).sin()
+        })
+        .sum();
+    2.0 * sum / PHASES as f64 / f64::from(PEAK)
+}
+
+/// Fundamental amplitude (LSB) of the drive and reference words per
+/// channel, as the AM mixer realizes them: the envelope amp x am / 2^15
+/// rounded (`q15_product`), times the carrier table (PEAK x its gain)
+/// / 2^15. In readout am is the constant PEAK, so the envelope is one
+/// rounded integer (29490 for amplitude 0.9, where amp x PEAK / 2^15 is
+/// 29490.1: 3.4e-6 less, and z carries it twice); in calibration am is the
+/// table's cosine or sine, so the rounding is noise around the exact
+/// product, and the envelope's amplitude carries the table gain once more.
+fn realized_words(amp: (i16, i16), mode: Mode) -> [f64; 2] {
+    let gain = sine_table_gain();
+    let peak = f64::from(PEAK);
+    let carrier = peak * gain / 32768.0;
+    [amp.0, amp.1].map(|a| {
+        let envelope = match mode {
+            Mode::Readout => f64::from(q15_product(a, PEAK as i16)),
+            Mode::Calibration => f64::from(a) * peak * gain / 32768.0,
+        };
+        (envelope * carrier).abs()
+    })
+}
+
+/// The largest minus the smallest value.
+fn span(v: &[f64]) -> f64 {
+    v.iter().cloned().fold(f64::MIN, f64::max) - v.iter().cloned().fold(f64::MAX, f64::min)
+}
+
+/// Plan an experiment: registers, ADC gains, settling, batches, targets.
 pub fn plan(exp: &Experiment) -> Result<Plan, String> {
-    // Every key's range, with the names of the configuration file.
-    crate::config::validate(exp)?;
-    let rates = &exp.readout_rates_dps;
-    let cals = &exp.cal_freqs_hz;
+    exp.validate()?;
+    let derived = exp.derived()?;
+    let rates = &exp.points.readout_rates_dps;
+    let cals = &exp.points.cal_freqs_hz;
+    let fe = &exp.frontend;
     let base = FrequencyPlan {
-        clock_hz: exp.clock_hz,
-        carrier_hz: exp.carrier_hz,
+        clock_hz: exp.drive.clock_hz,
+        carrier_hz: exp.drive.carrier_hz,
         cal_hz: 0.0,
         calibration: false,
-        amplitude: exp.amplitude,
-        decimation: exp.decimation,
-        butterworth_hz: exp.butterworth_hz,
-        rc_hz: exp.rc_hz,
-        dac_latency: exp.dac_latency,
-        adc_latency: exp.adc_latency,
+        amplitude: exp.drive.amplitude(),
+        decimation: derived.decimation,
+        butterworth_hz: derived.butterworth_hz,
+        rc_hz: derived.rc_hz,
+        dac_latency: fe.dac_latency,
+        adc_latency: fe.adc_latency,
     };
     let (readout_regs, realized) = settings::registers(&base)?;
     let filter = realized.filter.clone();
-    let peak = f64::from(PEAK);
-    let word = |amp: i16| f64::from(amp) * peak * peak / 2f64.powi(30);
-    let drive_words = [
-        word(readout_regs.amp.0).abs(),
-        word(readout_regs.amp.1).abs(),
-    ];
+    let drive_words = realized_words(readout_regs.amp, Mode::Readout);
+    let cal_drive_words = realized_words(readout_regs.amp, Mode::Calibration);
     if drive_words.iter().any(|&w| w < 1.0) {
-        return Err("amplitude: both drives need at least one DAC LSB".into());
+        return Err("[drive] amplitude1, amplitude2: both drives need at least one DAC LSB".into());
     }
-    let force_per_lsb = [
-        exp.force_full_scale[0] / 32768.0,
-        exp.force_full_scale[1] / 32768.0,
-    ];
+    let force_full_scale = exp.drive.force_full_scale();
+    let force_per_lsb = [force_full_scale[0] / 32768.0, force_full_scale[1] / 32768.0];
+    let clock = exp.drive.clock_hz;
     let hold_gain = {
-        let x = PI * realized.carrier_hz / exp.clock_hz;
+        let x = PI * realized.carrier_hz / clock;
         x.sin() / x
     };
     let mut warnings = vec![];
-    if let Some(q) = settings::commensurate_period(exp.carrier_hz, exp.clock_hz) {
+    if let Some(q) = settings::commensurate_period(exp.drive.carrier_hz, clock) {
         warnings.push(format!(
             "carrier_hz / clock_hz is a ratio of small integers (period {q} clocks): the converters see only {q} phases and their quantization errors do not average out (errors of percent); use a non-round carrier or dither (noise_lsb)"
         ));
@@ -260,21 +338,24 @@ pub fn plan(exp: &Experiment) -> Result<Plan, String> {
     // Theory for gains and timing (the hold scales every force alike).
     let mut plan = Plan {
         points: vec![],
+        derived: derived.clone(),
         front_end: FrontEnd {
-            dac_latency: exp.dac_latency,
-            adc_latency: exp.adc_latency,
-            dac_bits: exp.dac_bits,
-            adc_bits: exp.adc_bits,
+            dac_latency: fe.dac_latency,
+            adc_latency: fe.adc_latency,
+            dac_bits: fe.dac_bits,
+            adc_bits: fe.adc_bits,
             force_per_lsb,
             adc_per_meter: [1.0, 1.0],
-            noise_lsb: exp.noise_lsb,
-            seed: exp.seed,
+            noise_lsb: fe.noise_lsb,
+            seed: fe.seed,
         },
         carrier_hz: realized.carrier_hz,
         filter,
         drive_words,
+        cal_drive_words,
         hold_gain,
         tau_s: 0.0,
+        signal_lsb: [[0.0; 2]; 2],
         warnings,
     };
     let mut dev = plan.theory_device(exp);
@@ -302,11 +383,11 @@ pub fn plan(exp: &Experiment) -> Result<Plan, String> {
         let x = theory::calibration_peak_displacement(&dev, *f);
         peak_x = [peak_x[0].max(x[0]), peak_x[1].max(x[1])];
     }
-    plan.front_end.adc_per_meter = match exp.adc_per_meter {
+    plan.front_end.adc_per_meter = match exp.adc_per_meter() {
         Some(g) => g,
         None => [
-            exp.adc_headroom * 32767.0 / peak_x[0],
-            exp.adc_headroom * 32767.0 / peak_x[1],
+            fe.adc_headroom * 32767.0 / peak_x[0],
+            fe.adc_headroom * 32767.0 / peak_x[1],
         ],
     };
     Converters::new(&plan.front_end)?;
@@ -314,62 +395,69 @@ pub fn plan(exp: &Experiment) -> Result<Plan, String> {
     // Settling: see the module header.
     let w = [TAU * exp.gyro.f1_hz, TAU * exp.gyro.f2_hz];
     plan.tau_s = (2.0 * exp.gyro.q1 / w[0]).max(2.0 * exp.gyro.q2 / w[1]);
-    let sigma = (TAU * exp.butterworth_hz / 2f64.sqrt()).min(TAU * exp.rc_hz);
-    let span = |v: &[f64]| {
-        v.iter().cloned().fold(f64::MIN, f64::max) - v.iter().cloned().fold(f64::MAX, f64::min)
-    };
-    let sf_read = theory::sf_read_per_rad_s(&dev);
-    let sf_cal = theory::sf_cal_per_rad_s(&dev);
-    let read_signal = [
-        sf_read[0].abs() * span(rates) * rad,
-        sf_read[1].abs() * span(rates) * rad,
-    ];
-    let virtual_span = TAU * span(&cal_plans.iter().map(|c| c.1).collect::<Vec<_>>());
-    let cal_signal = [
-        sf_cal[0].abs() * virtual_span,
-        sf_cal[1].abs() * virtual_span,
-    ];
-    let clock = exp.clock_hz;
+    let sigma = (TAU * derived.butterworth_hz / 2f64.sqrt()).min(TAU * derived.rc_hz);
+    let sf_read = theory::sf_read_per_rad_s(&dev).map(|v| v * rad);
+    let sf_cal = theory::sf_cal_per_rad_s(&dev).map(|v| v * rad);
+    let virtual_rates: Vec<f64> = cal_plans.iter().map(|c| 360.0 * c.1).collect();
+    let read_signal = sf_read.map(|s| s.abs() * span(rates));
+    let cal_signal = sf_cal.map(|s| s.abs() * span(&virtual_rates));
+    let decimation = derived.decimation;
     let settle = |big: [f64; 2], signal: [f64; 2]| -> u64 {
         let ratio = (0..2)
-            .map(|k| big[k] / (exp.tolerance * signal[k]))
+            .map(|k| big[k] / (exp.points.tolerance * signal[k] / SETTLE_MARGIN))
             .fold(1.0f64, f64::max);
-        let t = plan.tau_s * ratio.ln() + ratio.ln() / sigma + 5.0 * exp.decimation as f64 / clock;
+        let t = plan.tau_s * ratio.ln() + ratio.ln() / sigma + 5.0 * decimation as f64 / clock;
         (t * clock).ceil() as u64
     };
-    let tail = 2 * exp.decimation as u64 + 64;
+
+    // Rate signal in ADC LSB of in-phase amplitude: mean(adc x ref) = A W / 2.
+    let forces = [dev.f1_force, dev.f2_force];
+    let adc = plan.front_end.adc_per_meter;
+    plan.signal_lsb = [
+        std::array::from_fn(|k| 2.0 * read_signal[k] * adc[k] / forces[k]),
+        std::array::from_fn(|k| 2.0 * cal_signal[k] * adc[k] / forces[1 - k]),
+    ];
+    let window_cycles = derived.min_window_s * clock;
+    // One settling time per sweep, so the points' batches line up.
+    let read_settle = rates
+        .iter()
+        .map(|&r| settle(theory::readout_z(&dev, r * rad).map(f64::abs), read_signal))
+        .max()
+        .unwrap_or(0);
+    let cal_settle = cal_plans
+        .iter()
+        .map(|&(_, f)| {
+            // Every low-frequency term of x_k times its reference is at most
+            // the product of their peaks.
+            let x = theory::calibration_peak_displacement(&dev, f);
+            settle([x[0] * dev.f2_force, x[1] * dev.f1_force], cal_signal)
+        })
+        .max()
+        .unwrap_or(0);
     for &r in rates {
-        let z = theory::readout_z(&dev, r * rad);
-        let settle_cycles = settle([z[0].abs(), z[1].abs()], read_signal);
-        let window_cycles = exp.min_window_s * clock;
         plan.points.push(PointPlan {
             mode: Mode::Readout,
             rate_dps: r,
             cal_hz: 0.0,
             omz_rad_s: r * rad,
             regs: readout_regs,
-            settle_cycles,
-            window_cycles,
-            total_cycles: settle_cycles + window_cycles.ceil() as u64 + tail,
+            settle_cycles: read_settle,
+            unit_cycles: window_cycles / f64::from(BATCHES),
+            units: 1,
         });
     }
     for (regs, f) in cal_plans {
-        // Every low-frequency term of x_k times its reference is at most the
-        // product of their peaks.
-        let x = theory::calibration_peak_displacement(&dev, f);
-        let big = [x[0] * dev.f2_force, x[1] * dev.f1_force];
-        let settle_cycles = settle(big, cal_signal);
-        let periods = (exp.min_window_s * 2.0 * f).ceil();
-        let window_cycles = periods / (2.0 * f) * clock;
+        let period = clock / (2.0 * f);
+        let periods = (window_cycles / f64::from(BATCHES) / period).ceil();
         plan.points.push(PointPlan {
             mode: Mode::Calibration,
             rate_dps: 360.0 * f,
             cal_hz: f,
             omz_rad_s: 0.0,
             regs,
-            settle_cycles,
-            window_cycles,
-            total_cycles: settle_cycles + window_cycles.ceil() as u64 + tail,
+            settle_cycles: cal_settle,
+            unit_cycles: period,
+            units: periods as u32,
         });
     }
     Ok(plan)
@@ -391,14 +479,24 @@ pub struct PointResult {
     pub settle_s: f64,
     /// Averaging window (s).
     pub window_s: f64,
+    /// Length of each of the window's `BATCHES` batches (s).
+    pub batch_s: f64,
     /// Clocks simulated.
     pub cycles: u64,
     /// Window means of z1, z2 in z LSBs (2^-8 mixer LSB).
     pub z_lsb: [f64; 2],
+    /// 1-sigma uncertainty of `z_lsb` from its batch means (this point
+    /// alone; the slopes' uncertainties come from `batch_z`).
+    pub z_lsb_uncertainty: [f64; 2],
     /// The same in m^2/s^2 (the theory's units).
     pub z: [f64; 2],
+    /// 1-sigma uncertainty of `z`.
+    pub z_uncertainty: [f64; 2],
     /// Exact theory at this point (m^2/s^2).
     pub z_theory: [f64; 2],
+    /// The batch means of z1, z2 (m^2/s^2).
+    #[serde(skip)]
+    pub batch_z: Vec<[f64; 2]>,
     /// (time s, z1, z2 in m^2/s^2) every few z samples, for plots.
     #[serde(skip)]
     pub trace: Vec<TraceSample>,
@@ -429,6 +527,15 @@ pub trait Observer {
     fn last_cycle(&self) -> u64;
 }
 
+/// Progress of a run, for a progress bar.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Tick {
+    /// This many more clocks were simulated.
+    Clocks(u64),
+    /// A window grew: this many more clocks are planned.
+    Planned(u64),
+}
+
 /// The closed loop of one point at power-up: engine `E`, the plan's
 /// converters, the gyroscope at rest, rotating at the point's rate.
 pub fn point_loop<E: Engine>(
@@ -436,138 +543,335 @@ pub fn point_loop<E: Engine>(
     plan: &Plan,
     point: &PointPlan,
 ) -> Result<CoSim<E>, String> {
-    let gyro = GyroModel::new(&exp.gyro, exp.clock_hz)?;
+    let gyro = GyroModel::new(&exp.gyro, exp.drive.clock_hz)?;
     let converters = Converters::new(&plan.front_end)?;
     let mut sim = CoSim::new(E::power_up()?, converters, gyro, point.regs);
     sim.set_rate(point.omz_rad_s);
     Ok(sim)
 }
 
-/// Simulate one point with engine `E`; `progress` receives clock counts.
+/// The z samples of one point from just before its window, and a thinned
+/// trace of all of them.
+struct Samples {
+    t: Vec<f64>,
+    z: [Vec<f64>; 2],
+    trace: Vec<TraceSample>,
+    trace_every: u64,
+    count: u64,
+    first_kept: u64,
+}
+
+impl Samples {
+    /// Most trace samples kept; beyond, every other one is dropped.
+    const TRACE_MAX: usize = 4000;
+
+    fn push(&mut self, n: u64, z: (i64, i64)) {
+        let z = [z.0 as f64, z.1 as f64];
+        if n >= self.first_kept {
+            self.t.push(n as f64);
+            self.z[0].push(z[0]);
+            self.z[1].push(z[1]);
+        }
+        if self.count.is_multiple_of(self.trace_every) {
+            self.trace.push([n as f64, z[0], z[1]]);
+            if self.trace.len() > Self::TRACE_MAX {
+                self.trace = self.trace.iter().step_by(2).copied().collect();
+                self.trace_every *= 2;
+            }
+        }
+        self.count += 1;
+    }
+
+    /// `BATCHES` batch means of length `batch` from `t0`, per output.
+    fn batch_means(&self, t0: f64, batch: f64) -> Vec<[f64; 2]> {
+        (0..BATCHES)
+            .map(|j| {
+                let a = t0 + f64::from(j) * batch;
+                std::array::from_fn(|k| window_mean(&self.t, &self.z[k], a, a + batch))
+            })
+            .collect()
+    }
+}
+
+/// Simulate up to clock `end`, keeping the z samples.
+fn advance<E: Engine>(
+    sim: &mut CoSim<E>,
+    samples: &mut Samples,
+    end: u64,
+    progress: &(dyn Fn(Tick) + Sync),
+) {
+    const CHUNK: u64 = 1 << 20;
+    let mut done = 0;
+    for n in sim.cycle() + 1..=end {
+        let o = sim.step();
+        if o.z_valid {
+            samples.push(n, o.z);
+        }
+        done += 1;
+        if done == CHUNK {
+            progress(Tick::Clocks(done));
+            done = 0;
+        }
+    }
+    progress(Tick::Clocks(done));
+}
+
+/// Mean and 1-sigma uncertainty of the mean of batch means, per output.
+fn mean_and_uncertainty(batches: &[[f64; 2]]) -> ([f64; 2], [f64; 2]) {
+    let n = batches.len() as f64;
+    let mean: [f64; 2] = std::array::from_fn(|k| batches.iter().map(|b| b[k]).sum::<f64>() / n);
+    let sigma = std::array::from_fn(|k| {
+        let var = batches
+            .iter()
+            .map(|b| (b[k] - mean[k]).powi(2))
+            .sum::<f64>()
+            / (n - 1.0);
+        (var / n).sqrt()
+    });
+    (mean, sigma)
+}
+
+/// Simulate one point with engine `E` and `units` units per batch;
+/// `progress` receives ticks.
 pub fn run_point<E: Engine>(
     exp: &Experiment,
     plan: &Plan,
     point: &PointPlan,
-    progress: &(dyn Fn(u64) + Sync),
+    units: u32,
+    progress: &(dyn Fn(Tick) + Sync),
 ) -> Result<PointResult, String> {
     let mut sim = point_loop::<E>(exp, plan, point)?;
-    let r = exp.decimation as u64;
-    let first_kept = point.settle_cycles.saturating_sub(2 * r);
-    let (mut t, mut z1, mut z2) = (vec![], vec![], vec![]);
-    let mut trace = vec![];
-    let trace_every = (point.total_cycles / r / 2000).max(1);
-    let mut z_count = 0u64;
-    const CHUNK: u64 = 1 << 20;
-    for n in 1..=point.total_cycles {
-        let o = sim.step();
-        if o.z_valid {
-            if n >= first_kept {
-                t.push(n as f64);
-                z1.push(o.z.0 as f64);
-                z2.push(o.z.1 as f64);
-            }
-            if z_count.is_multiple_of(trace_every) {
-                trace.push([n as f64, o.z.0 as f64, o.z.1 as f64]);
-            }
-            z_count += 1;
-        }
-        if n % CHUNK == 0 {
-            progress(CHUNK);
-        }
-    }
-    progress(point.total_cycles % CHUNK);
-    let t0 = point.settle_cycles as f64;
-    let t1 = t0 + point.window_cycles;
-    let z_lsb = [window_mean(&t, &z1, t0, t1), window_mean(&t, &z2, t0, t1)];
-    // z LSB -> mixer LSB (adc word x reference word) -> m^2/s^2.
-    let fe = &plan.front_end;
-    let reference_channel = |k: usize| match point.mode {
-        Mode::Readout => k,
-        Mode::Calibration => 1 - k,
+    let r = plan.filter.decimation;
+    let end = point.cycles_for(units, r);
+    let mut samples = Samples {
+        t: vec![],
+        z: [vec![], vec![]],
+        trace: vec![],
+        trace_every: (end / u64::from(r) / 2000).max(1),
+        count: 0,
+        first_kept: point.settle_cycles.saturating_sub(2 * u64::from(r)),
     };
-    let to_physical: [f64; 2] = std::array::from_fn(|k| {
-        fe.force_per_lsb[reference_channel(k)]
-            / fe.adc_per_meter[k]
-            / (f64::from(1u32 << OUTPUT_FRACTION_BITS) * plan.filter.dc_gain)
-    });
-    let clock = exp.clock_hz;
+    advance(&mut sim, &mut samples, end, progress);
+    let batch = point.window_cycles(units) / f64::from(BATCHES);
+    let batch_lsb = samples.batch_means(point.settle_cycles as f64, batch);
+    let (mean, sigma) = mean_and_uncertainty(&batch_lsb);
+    let per_lsb = plan.z_per_lsb(point.mode);
+    let clock = exp.drive.clock_hz;
     Ok(PointResult {
         mode: point.mode,
         rate_dps: point.rate_dps,
         cal_hz: point.cal_hz,
         settle_s: point.settle_cycles as f64 / clock,
-        window_s: point.window_cycles / clock,
-        cycles: point.total_cycles,
-        z_lsb,
-        z: [z_lsb[0] * to_physical[0], z_lsb[1] * to_physical[1]],
+        window_s: point.window_cycles(units) / clock,
+        batch_s: batch / clock,
+        cycles: end,
+        z_lsb: mean,
+        z_lsb_uncertainty: sigma,
+        z: [mean[0] * per_lsb[0], mean[1] * per_lsb[1]],
+        z_uncertainty: [sigma[0] * per_lsb[0], sigma[1] * per_lsb[1]],
         z_theory: plan.theory_z(exp, point),
-        trace: trace
+        batch_z: batch_lsb
+            .iter()
+            .map(|b| [b[0] * per_lsb[0], b[1] * per_lsb[1]])
+            .collect(),
+        trace: samples
+            .trace
             .into_iter()
-            .map(|[n, a, b]| [n / clock, a * to_physical[0], b * to_physical[1]])
+            .map(|[n, a, b]| [n / clock, a * per_lsb[0], b * per_lsb[1]])
             .collect(),
     })
 }
 
-/// Scale factors per output, in the sign convention of the paper's
-/// equations, (m^2/s^2) per deg/s.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct ScaleFactors {
-    /// Readout scale factor [output 1, output 2].
-    pub sf_read_per_dps: [f64; 2],
-    /// Calibration scale factor per deg/s of virtual rate.
-    pub sf_cal_per_dps: [f64; 2],
-    /// sf_read / sf_cal.
-    pub ratio: [f64; 2],
-}
-
-/// Fit scale factors to points.
-pub fn fit_scale_factors(
-    points: &[PointResult],
-    z: impl Fn(&PointResult) -> [f64; 2],
-) -> ScaleFactors {
-    let slopes = |mode| fit_lines(points, mode, &z).map(|(slope, _)| slope);
-    let sf_read_per_dps = slopes(Mode::Readout);
-    let sf_cal_per_dps = slopes(Mode::Calibration);
-    ScaleFactors {
-        sf_read_per_dps,
-        sf_cal_per_dps,
-        ratio: [
-            sf_read_per_dps[0] / sf_cal_per_dps[0],
-            sf_read_per_dps[1] / sf_cal_per_dps[1],
-        ],
-    }
-}
-
-/// Least-squares `(slope, intercept)` of each output against the rate, over
-/// the points of one mode.
-pub fn fit_lines(
-    points: &[PointResult],
-    mode: Mode,
-    z: impl Fn(&PointResult) -> [f64; 2],
-) -> [(f64, f64); 2] {
+/// Lines of each output against the rate over one sweep, from the points'
+/// batch means (with uncertainties).
+pub fn measured_lines(points: &[PointResult], mode: Mode) -> [Line; 2] {
+    let sweep: Vec<&PointResult> = points.iter().filter(|p| p.mode == mode).collect();
+    let x: Vec<f64> = sweep.iter().map(|p| p.rate_dps).collect();
     std::array::from_fn(|k| {
-        let (x, y): (Vec<f64>, Vec<f64>) = points
+        let batches: Vec<Vec<f64>> = sweep
             .iter()
-            .filter(|p| p.mode == mode)
-            .map(|p| (p.rate_dps, z(p)[k]))
-            .unzip();
-        linear_fit(&x, &y)
+            .map(|p| p.batch_z.iter().map(|b| b[k]).collect())
+            .collect();
+        fit_batches(&x, &batches)
     })
 }
 
-/// Run every point of a plan on `engine`, in parallel.
+/// Lines of the exact theory at the same points, with the same fit.
+pub fn exact_lines(points: &[PointResult], mode: Mode) -> [Line; 2] {
+    let sweep: Vec<&PointResult> = points.iter().filter(|p| p.mode == mode).collect();
+    let x: Vec<f64> = sweep.iter().map(|p| p.rate_dps).collect();
+    std::array::from_fn(|k| {
+        let y: Vec<f64> = sweep.iter().map(|p| p.z_theory[k]).collect();
+        let (slope, intercept) = linear_fit(&x, &y);
+        Line {
+            slope,
+            intercept,
+            slope_uncertainty: 0.0,
+        }
+    })
+}
+
+/// The simulated scale factors with their uncertainties.
+pub fn measured_scale_factors(points: &[PointResult]) -> ScaleFactors {
+    ScaleFactors::from_lines(
+        measured_lines(points, Mode::Readout),
+        measured_lines(points, Mode::Calibration),
+    )
+}
+
+/// The exact theory's scale factors at the same points, with the same fit.
+pub fn exact_scale_factors(points: &[PointResult]) -> ScaleFactors {
+    ScaleFactors::from_lines(
+        exact_lines(points, Mode::Readout),
+        exact_lines(points, Mode::Calibration),
+    )
+}
+
+/// The points of a run and how long they took.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Measured {
+    /// Every point of the last round, in the plan's order.
+    pub points: Vec<PointResult>,
+    /// Engine and speed, all rounds.
+    pub timing: Timing,
+    /// Whether the budget stopped the windows before their targets.
+    pub budget_exhausted: bool,
+}
+
+/// Timing of a run.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Timing {
+    /// Engine that ran the datapath.
+    pub engine: String,
+    /// Clocks simulated, all points and rounds.
+    pub cycles: u64,
+    /// Wall time (s).
+    pub wall_s: f64,
+    /// Clocks per second of wall time (all cores).
+    pub cycles_per_s: f64,
+    /// Wall-time budget for growing the windows (s).
+    pub budget_s: f64,
+    /// Rounds run (the windows grew `rounds - 1` times).
+    pub rounds: u32,
+}
+
+/// Each sweep's [readout, calibration] uncertainty over its target,
+/// worst output: the ratio's target tolerance x max(|ratio|, RATIO_FLOOR)
+/// split `1 - CAL_SHARE` : `CAL_SHARE` in relative variance.
+pub fn excess(exp: &Experiment, sf: &ScaleFactors) -> [f64; 2] {
+    let worst = |f: &dyn Fn(usize) -> f64| (0..2).map(f).fold(0.0f64, f64::max);
+    let relative =
+        |k: usize| exp.points.tolerance * sf.ratio[k].abs().max(RATIO_FLOOR) / sf.ratio[k].abs();
+    [
+        worst(&|k| {
+            sf.sf_read_uncertainty[k]
+                / ((1.0 - CAL_SHARE).sqrt() * relative(k) * sf.sf_read_per_dps[k].abs())
+        }),
+        worst(&|k| {
+            sf.sf_cal_uncertainty[k] / (CAL_SHARE.sqrt() * relative(k) * sf.sf_cal_per_dps[k].abs())
+        }),
+    ]
+}
+
+/// How many times longer a sweep's windows should be: the uncertainty
+/// falls as window^-a (module header), with a 20% margin.
+fn growth(history: &[(f64, f64)]) -> f64 {
+    let (length, excess) = history[history.len() - 1];
+    if excess <= 1.0 {
+        return 1.0;
+    }
+    let a = match history {
+        [.., (l0, e0), _] if *e0 > 0.0 && excess > 0.0 => {
+            ((e0 / excess).ln() / (length / l0).ln()).clamp(0.5, 1.0)
+        }
+        _ => 0.5,
+    };
+    (1.2 * excess).powf(1.0 / a).clamp(1.1, MAX_GROWTH)
+}
+
+/// Run every point of a plan on `engine`, in parallel, in rounds of
+/// growing windows until the targets are met or the experiment's wall-time
+/// budget would be overrun (module header).
 pub fn run_points(
     exp: &Experiment,
     plan: &Plan,
     engine: EngineKind,
-    progress: &(dyn Fn(u64) + Sync),
-) -> Result<Vec<PointResult>, String> {
-    let run = |p: &PointPlan| match engine {
-        EngineKind::Model => run_point::<ModelEngine>(exp, plan, p, progress),
-        EngineKind::Rtl => run_point::<RtlEngine>(exp, plan, p, progress),
-        EngineKind::Verilator => run_verilator(exp, plan, p, progress),
+    progress: &(dyn Fn(Tick) + Sync),
+) -> Result<Measured, String> {
+    let start = Instant::now();
+    let r = plan.filter.decimation;
+    let mut units: Vec<u32> = plan.points.iter().map(|p| p.units).collect();
+    let mut history: [Vec<(f64, f64)>; 2] = [vec![], vec![]];
+    let mut length = [1.0f64; 2];
+    let mut cycles = 0;
+    let mut rounds = 0;
+    let sweep = |p: &PointPlan| match p.mode {
+        Mode::Readout => 0,
+        Mode::Calibration => 1,
     };
-    plan.points.par_iter().map(run).collect()
+    loop {
+        let round_start = Instant::now();
+        let jobs: Vec<(&PointPlan, u32)> = plan.points.iter().zip(units.iter().copied()).collect();
+        let run = |&(p, u): &(&PointPlan, u32)| match engine {
+            EngineKind::Model => run_point::<ModelEngine>(exp, plan, p, u, progress),
+            EngineKind::Rtl => run_point::<RtlEngine>(exp, plan, p, u, progress),
+            EngineKind::Verilator => run_verilator(exp, plan, p, u, progress),
+        };
+        let points: Vec<PointResult> = jobs.par_iter().map(run).collect::<Result<_, _>>()?;
+        let round_cycles: u64 = points.iter().map(|p| p.cycles).sum();
+        cycles += round_cycles;
+        rounds += 1;
+        let over = excess(exp, &measured_scale_factors(&points));
+        for m in 0..2 {
+            history[m].push((length[m], over[m]));
+        }
+        let mut grow = [growth(&history[0]), growth(&history[1])];
+        let finish = |budget_exhausted| {
+            let wall_s = start.elapsed().as_secs_f64();
+            Ok(Measured {
+                points: points.clone(),
+                timing: Timing {
+                    engine: engine.name().into(),
+                    cycles,
+                    wall_s,
+                    cycles_per_s: cycles as f64 / wall_s,
+                    budget_s: exp.points.budget_s,
+                    rounds,
+                },
+                budget_exhausted,
+            })
+        };
+        if grow == [1.0, 1.0] {
+            return finish(false);
+        }
+        // Time the next round from this one's speed; shrink the growth
+        // until it fits what is left of the budget.
+        let seconds_per_cycle = round_start.elapsed().as_secs_f64() / round_cycles as f64;
+        let left = exp.points.budget_s - start.elapsed().as_secs_f64();
+        let next_units = |grow: [f64; 2]| -> Vec<u32> {
+            plan.points
+                .iter()
+                .zip(&units)
+                .map(|(p, &u)| (f64::from(u) * grow[sweep(p)]).ceil() as u32)
+                .collect()
+        };
+        let next_cycles = |u: &[u32]| -> u64 {
+            plan.points
+                .iter()
+                .zip(u)
+                .map(|(p, &u)| p.cycles_for(u, r))
+                .sum()
+        };
+        while next_cycles(&next_units(grow)) as f64 * seconds_per_cycle > left {
+            grow = grow.map(|g| 1.0 + (g - 1.0) / 2.0);
+            if grow.iter().all(|&g| g < 1.1) {
+                return finish(true);
+            }
+        }
+        units = next_units(grow);
+        length = [length[0] * grow[0], length[1] * grow[1]];
+        progress(Tick::Planned(next_cycles(&units)));
+    }
 }
 
 #[cfg(feature = "verilator")]
@@ -575,9 +879,10 @@ fn run_verilator(
     exp: &Experiment,
     plan: &Plan,
     point: &PointPlan,
-    progress: &(dyn Fn(u64) + Sync),
+    units: u32,
+    progress: &(dyn Fn(Tick) + Sync),
 ) -> Result<PointResult, String> {
-    run_point::<crate::verilator::VerilatorEngine>(exp, plan, point, progress)
+    run_point::<crate::verilator::VerilatorEngine>(exp, plan, point, units, progress)
 }
 
 #[cfg(not(feature = "verilator"))]
@@ -585,30 +890,10 @@ fn run_verilator(
     _: &Experiment,
     _: &Plan,
     _: &PointPlan,
-    _: &(dyn Fn(u64) + Sync),
+    _: u32,
+    _: &(dyn Fn(Tick) + Sync),
 ) -> Result<PointResult, String> {
     Err("engine = \"verilator\": this build has no Verilator engine (rebuild with --features verilator)".into())
-}
-
-/// Plan and run an experiment on `engine`, timing it; `progress` receives
-/// clock counts as they are simulated.
-pub fn run(
-    exp: &Experiment,
-    engine: EngineKind,
-    progress: &(dyn Fn(u64) + Sync),
-) -> Result<crate::report::Report, String> {
-    let plan = plan(exp)?;
-    let start = std::time::Instant::now();
-    let points = run_points(exp, &plan, engine, progress)?;
-    let wall_s = start.elapsed().as_secs_f64();
-    let cycles = plan.total_cycles();
-    let timing = crate::report::Timing {
-        engine: engine.name().into(),
-        cycles,
-        wall_s,
-        cycles_per_s: cycles as f64 / wall_s,
-    };
-    Ok(crate::report::Report::new(exp, &plan, points, timing))
 }
 
 /// Simulate the first clocks of one point with an observer, up to the

@@ -10,8 +10,22 @@
 //!
 //! Units: rates in deg/s, f_cal in Hz, z in m^2/s^2, scale factors in
 //! (m^2/s^2) per deg/s, ratio dimensionless.
+//!
+//! Uncertainties, from the data alone. Every point's window is cut into
+//! the same number of batches, and the points of a sweep share their batch
+//! boundaries relative to power-up. Batch j of every point gives one line;
+//! the reported slope is the slope of the points' means, which (the fit
+//! being linear in y) is the mean of the batch slopes, and its 1-sigma
+//! uncertainty is their standard deviation over sqrt(batches). Residues
+//! common to all points of a sweep (the converters' quantization pattern is
+//! nearly the same at every rate) cancel in each batch's slope as they do in
+//! the final one, which a per-point uncertainty propagated as if the points
+//! were independent would miss (it errs high 20-fold on the paper's
+//! readout). Readout and calibration are different runs, so a ratio's
+//! relative variance is the sum of its slopes' (first order).
 
 use crate::theory::{Device, calibration_z, readout_z};
+use serde::Serialize;
 
 /// Least-squares line `y = slope x + intercept`; returns `(slope, intercept)`.
 ///
@@ -34,6 +48,108 @@ pub fn linear_fit(x: &[f64], y: &[f64]) -> (f64, f64) {
     assert!(sxx > 0.0, "linear_fit: all x are equal");
     let slope = sxy / sxx;
     (slope, my - slope * mx)
+}
+
+/// A fitted line and its slope's 1-sigma uncertainty.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Line {
+    /// Slope.
+    pub slope: f64,
+    /// Intercept.
+    pub intercept: f64,
+    /// 1-sigma uncertainty of the slope (0 for exact values).
+    pub slope_uncertainty: f64,
+}
+
+/// Least-squares line through points `x[i]` whose values were measured as
+/// `batches[i]` (batch means, the same number for every point): the line
+/// of the means, with the spread of the batch lines as its uncertainty.
+///
+/// ```
+/// use gyrocal_sim::fit::fit_batches;
+/// // y = 2x + 1, with batch residues common to both points (they cancel)
+/// // plus +-0.1 on the second point.
+/// let line = fit_batches(&[0.0, 1.0], &[vec![1.5, 0.5], vec![3.6, 2.4]]);
+/// assert!((line.slope - 2.0).abs() < 1e-12);
+/// // Batch slopes 2.1 and 1.9: sd 0.1414, over sqrt(2).
+/// assert!((line.slope_uncertainty - 0.1).abs() < 1e-12);
+/// ```
+///
+/// # Panics
+/// As [`linear_fit`], or if the points have different numbers of batches
+/// or fewer than 2.
+pub fn fit_batches(x: &[f64], batches: &[Vec<f64>]) -> Line {
+    let n = batches[0].len();
+    assert!(n >= 2, "fit_batches: needs at least 2 batches");
+    assert!(
+        batches.iter().all(|b| b.len() == n),
+        "fit_batches: unequal batches"
+    );
+    let means: Vec<f64> = batches
+        .iter()
+        .map(|b| b.iter().sum::<f64>() / n as f64)
+        .collect();
+    let (slope, intercept) = linear_fit(x, &means);
+    let slopes: Vec<f64> = (0..n)
+        .map(|j| linear_fit(x, &batches.iter().map(|b| b[j]).collect::<Vec<_>>()).0)
+        .collect();
+    let mean = slopes.iter().sum::<f64>() / n as f64;
+    let var = slopes.iter().map(|s| (s - mean).powi(2)).sum::<f64>() / (n as f64 - 1.0);
+    Line {
+        slope,
+        intercept,
+        slope_uncertainty: (var / n as f64).sqrt(),
+    }
+}
+
+/// 1-sigma uncertainty of `a / b` for independent `a +- sa`, `b +- sb`.
+pub fn ratio_uncertainty(a: f64, sa: f64, b: f64, sb: f64) -> f64 {
+    (a / b).abs() * ((sa / a).powi(2) + (sb / b).powi(2)).sqrt()
+}
+
+/// Scale factors per output with their uncertainties, in the sign
+/// convention of the paper's equations, (m^2/s^2) per deg/s.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ScaleFactors {
+    /// Readout scale factor [output 1, output 2].
+    pub sf_read_per_dps: [f64; 2],
+    /// Its 1-sigma uncertainty.
+    pub sf_read_uncertainty: [f64; 2],
+    /// Calibration scale factor per deg/s of virtual rate.
+    pub sf_cal_per_dps: [f64; 2],
+    /// Its 1-sigma uncertainty.
+    pub sf_cal_uncertainty: [f64; 2],
+    /// sf_read / sf_cal.
+    pub ratio: [f64; 2],
+    /// Its 1-sigma uncertainty.
+    pub ratio_uncertainty: [f64; 2],
+    /// Intercepts of the readout lines.
+    pub intercept_read: [f64; 2],
+    /// Intercepts of the calibration lines.
+    pub intercept_cal: [f64; 2],
+}
+
+impl ScaleFactors {
+    /// From the readout and calibration lines of both outputs.
+    pub fn from_lines(read: [Line; 2], cal: [Line; 2]) -> Self {
+        Self {
+            sf_read_per_dps: read.map(|l| l.slope),
+            sf_read_uncertainty: read.map(|l| l.slope_uncertainty),
+            sf_cal_per_dps: cal.map(|l| l.slope),
+            sf_cal_uncertainty: cal.map(|l| l.slope_uncertainty),
+            ratio: std::array::from_fn(|k| read[k].slope / cal[k].slope),
+            ratio_uncertainty: std::array::from_fn(|k| {
+                ratio_uncertainty(
+                    read[k].slope,
+                    read[k].slope_uncertainty,
+                    cal[k].slope,
+                    cal[k].slope_uncertainty,
+                )
+            }),
+            intercept_read: read.map(|l| l.intercept),
+            intercept_cal: cal.map(|l| l.intercept),
+        }
+    }
 }
 
 /// Scale factors fitted over lists of points, per output `[z1, z2]`.

@@ -36,8 +36,10 @@
 
 use nalgebra::SMatrix;
 
-/// Physical parameters of the two-mode gyroscope.
-#[derive(Clone, Debug, PartialEq)]
+/// Physical parameters of the two-mode gyroscope (the `[gyro]` section of
+/// a configuration file: every key required).
+#[derive(Clone, Debug, PartialEq, serde::Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
 pub struct GyroParams {
     /// Resonance frequency of mode 1 (Hz).
     pub f1_hz: f64,

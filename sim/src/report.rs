@@ -2,9 +2,13 @@
 //! theory at the same points, the paper's closed forms, and the readout
 //! scale factor predicted from calibration, in one serializable value.
 
+use crate::config::{Derived, Experiment};
+use crate::engine::EngineKind;
 use crate::experiment::{
-    Experiment, Mode, Plan, PointResult, ScaleFactors, fit_lines, fit_scale_factors,
+    self, Measured, Plan, PointResult, RATIO_FLOOR, Tick, Timing, exact_scale_factors,
+    measured_scale_factors,
 };
+use crate::fit::ScaleFactors;
 use crate::theory;
 use serde::Serialize;
 
@@ -75,28 +79,23 @@ pub struct Theory {
     pub small_signal: SmallSignal,
 }
 
-/// Timing of the run.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Timing {
-    /// Engine that ran the datapath.
-    pub engine: String,
-    /// Clocks simulated, all points.
-    pub cycles: u64,
-    /// Wall time (s).
-    pub wall_s: f64,
-    /// Clocks per second of wall time (all cores).
-    pub cycles_per_s: f64,
-}
-
 /// Everything `gyrocal run --json` prints and `results.json` holds.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Report {
     /// Simulated readout scale factor [output 1, output 2], (m^2/s^2) per deg/s.
     pub sf_read_per_dps: [f64; 2],
+    /// Its 1-sigma uncertainty, from the points' batch means.
+    pub sf_read_uncertainty: [f64; 2],
     /// Simulated calibration scale factor, per deg/s of virtual rate 360 f_cal.
     pub sf_cal_per_dps: [f64; 2],
+    /// Its 1-sigma uncertainty.
+    pub sf_cal_uncertainty: [f64; 2],
     /// Simulated ratio sf_read / sf_cal.
     pub ratio: [f64; 2],
+    /// Its 1-sigma uncertainty.
+    pub ratio_uncertainty: [f64; 2],
+    /// The ratio's target uncertainty, tolerance x max(|ratio|, 0.5).
+    pub ratio_target_uncertainty: [f64; 2],
     /// Intercepts of the simulated readout and calibration fits.
     pub intercept_read: [f64; 2],
     /// Intercepts of the simulated calibration fits.
@@ -119,6 +118,14 @@ pub struct Report {
     pub detuned_output: Option<usize>,
     /// The device and converters as simulated.
     pub device: DeviceSummary,
+    /// Filter and first window as used (derived or given).
+    pub settings: Derived,
+    /// RMS noise at the ADCs as used (LSB): given, or derived (dither).
+    pub noise_lsb: f64,
+    /// Each sweep's rate signal in ADC LSB of in-phase amplitude over the
+    /// whole span of its points, [readout, calibration] x [output 1, 2]:
+    /// below 1, the quantizer decides unless dithered.
+    pub rate_signal_adc_lsb: [[f64; 2]; 2],
     /// Every point.
     pub points: Vec<PointResult>,
     /// Engine and speed.
@@ -127,15 +134,12 @@ pub struct Report {
     pub warnings: Vec<String>,
 }
 
-fn intercepts(points: &[PointResult], mode: Mode) -> [f64; 2] {
-    fit_lines(points, mode, |p| p.z).map(|(_, intercept)| intercept)
-}
-
 impl Report {
     /// Assemble the report of a finished run.
-    pub fn new(exp: &Experiment, plan: &Plan, points: Vec<PointResult>, timing: Timing) -> Self {
-        let sim: ScaleFactors = fit_scale_factors(&points, |p| p.z);
-        let exact: ScaleFactors = fit_scale_factors(&points, |p| p.z_theory);
+    pub fn new(exp: &Experiment, plan: &Plan, measured: Measured) -> Self {
+        let points = measured.points;
+        let sim: ScaleFactors = measured_scale_factors(&points);
+        let exact: ScaleFactors = exact_scale_factors(&points);
         let mut dev = plan.theory_device(exp);
         dev.f1_force *= plan.hold_gain.sqrt();
         dev.f2_force *= plan.hold_gain.sqrt();
@@ -157,9 +161,20 @@ impl Report {
         } else {
             Some(0)
         };
+        let target: [f64; 2] =
+            std::array::from_fn(|k| exp.points.tolerance * sim.ratio[k].abs().max(RATIO_FLOOR));
+        let mut warnings = plan.warnings.clone();
+        warnings.extend(accuracy_warnings(
+            exp,
+            plan,
+            measured.budget_exhausted,
+            &sim,
+            target,
+        ));
+        let theory_device = plan.theory_device(exp);
         Report {
-            intercept_read: intercepts(&points, Mode::Readout),
-            intercept_cal: intercepts(&points, Mode::Calibration),
+            intercept_read: sim.intercept_read,
+            intercept_cal: sim.intercept_cal,
             ratio_error: std::array::from_fn(|k| rel(sim.ratio[k], exact.ratio[k])),
             predicted_sf_read_per_dps: predicted,
             predicted_sf_read_eq56_per_dps: predicted_eq56,
@@ -168,8 +183,12 @@ impl Report {
                 rel(predicted_eq56[k], sim.sf_read_per_dps[k])
             }),
             sf_read_per_dps: sim.sf_read_per_dps,
+            sf_read_uncertainty: sim.sf_read_uncertainty,
             sf_cal_per_dps: sim.sf_cal_per_dps,
+            sf_cal_uncertainty: sim.sf_cal_uncertainty,
             ratio: sim.ratio,
+            ratio_uncertainty: sim.ratio_uncertainty,
+            ratio_target_uncertainty: target,
             theory: Theory {
                 sf_read_per_dps: exact.sf_read_per_dps,
                 sf_cal_per_dps: exact.sf_cal_per_dps,
@@ -191,11 +210,8 @@ impl Report {
                 q2: exp.gyro.q2,
                 angular_gain: exp.gyro.angular_gain,
                 carrier_hz: plan.carrier_hz,
-                clock_hz: exp.clock_hz,
-                force_n_per_kg: [
-                    plan.theory_device(exp).f1_force,
-                    plan.theory_device(exp).f2_force,
-                ],
+                clock_hz: exp.drive.clock_hz,
+                force_n_per_kg: [theory_device.f1_force, theory_device.f2_force],
                 hold_gain: plan.hold_gain,
                 adc_per_meter: plan.front_end.adc_per_meter,
                 decimation: plan.filter.decimation,
@@ -203,9 +219,61 @@ impl Report {
                 filter_dc_gain: plan.filter.dc_gain,
                 tau_s: plan.tau_s,
             },
+            settings: plan.derived.clone(),
+            noise_lsb: plan.front_end.noise_lsb,
+            rate_signal_adc_lsb: plan.signal_lsb,
             points,
-            timing,
-            warnings: plan.warnings.clone(),
+            timing: measured.timing,
+            warnings,
         }
     }
+}
+
+/// One line per output whose ratio missed its target because the budget
+/// ran out, or whose rate signal is below the ADC's resolution: which
+/// output, the uncertainty reached, and what would lower it.
+fn accuracy_warnings(
+    exp: &Experiment,
+    plan: &Plan,
+    exhausted: bool,
+    sim: &ScaleFactors,
+    target: [f64; 2],
+) -> Vec<String> {
+    let fixes = if plan.front_end.noise_lsb < 0.5 {
+        "dither ([frontend] noise_lsb = 1) or more ADC bits ([frontend] adc_bits)"
+    } else {
+        "more ADC bits ([frontend] adc_bits) or longer first windows ([experiment] min_window_s)"
+    };
+    let mut lines = vec![];
+    for (k, &target) in target.iter().enumerate() {
+        let reached = sim.ratio_uncertainty[k];
+        let signal = plan.signal_lsb[0][k].min(plan.signal_lsb[1][k]);
+        if exhausted && reached > target {
+            lines.push(format!(
+                "output {}: ratio uncertainty {reached:.2e} (target {:.2e}) when the wall-time budget of {} s ran out; raise [experiment] budget_s, or lower the residue: {fixes}",
+                k + 1,
+                target,
+                exp.points.budget_s
+            ));
+        } else if signal < 1.0 && plan.front_end.noise_lsb < 0.5 {
+            lines.push(format!(
+                "output {}: its rate signal spans {signal:.2} ADC LSB over the points, below the ADC's resolution, and the ADCs are not dithered: each point's mean carries a static quantization bias that the uncertainty {reached:.2e} (target {:.2e}) cannot see; dither ([frontend] noise_lsb = 1, the default) or more ADC bits ([frontend] adc_bits) remove it",
+                k + 1,
+                target
+            ));
+        }
+    }
+    lines
+}
+
+/// Plan and run an experiment on `engine`, and report it; `progress`
+/// receives ticks as clocks are simulated.
+pub fn run(
+    exp: &Experiment,
+    engine: EngineKind,
+    progress: &(dyn Fn(Tick) + Sync),
+) -> Result<Report, String> {
+    let plan = experiment::plan(exp)?;
+    let measured = experiment::run_points(exp, &plan, engine, progress)?;
+    Ok(Report::new(exp, &plan, measured))
 }

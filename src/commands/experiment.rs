@@ -3,7 +3,7 @@
 
 use crate::Failure;
 use gyrocal_sim::engine::EngineKind;
-use gyrocal_sim::experiment::{self, Experiment, Mode};
+use gyrocal_sim::experiment::{self, Experiment, Mode, Tick};
 use gyrocal_sim::report::Report;
 use gyrocal_sim::waveform::{Probe, VcdRecorder, parse_window};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -59,7 +59,7 @@ impl RunOptions {
             Some(path) => {
                 let window = parse_window(&self.vcd_cycles).map_err(Failure::Input)?;
                 let probes = Probe::parse_list(&self.vcd_signals).map_err(Failure::Input)?;
-                let points = exp.readout_rates_dps.len() + exp.cal_freqs_hz.len();
+                let points = exp.points.readout_rates_dps.len() + exp.points.cal_freqs_hz.len();
                 if self.vcd_point >= points {
                     return Err(Failure::Input(format!(
                         "--vcd-point {}: this experiment has points 0..={}",
@@ -75,19 +75,27 @@ impl RunOptions {
     }
 }
 
+/// The folder of `path`, which may not exist yet: it is created when the
+/// file is written, as `--out` is (so `--out out/ --vcd out/wave.vcd`
+/// works on a fresh checkout). Its nearest existing ancestor must be a
+/// folder.
 fn check_writable_parent(path: &Path) -> Result<(), Failure> {
     let parent = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
-    if !parent.is_dir() {
-        return Err(Failure::Input(format!(
-            "{}: folder {} does not exist",
+    let existing = parent
+        .ancestors()
+        .find(|a| a.as_os_str().is_empty() || a.exists());
+    match existing {
+        Some(a) if a.as_os_str().is_empty() || a.is_dir() => Ok(()),
+        Some(a) => Err(Failure::Input(format!(
+            "--vcd {}: {} is not a folder",
             path.display(),
-            parent.display()
-        )));
+            a.display()
+        ))),
+        None => Ok(()),
     }
-    Ok(())
 }
 
 /// Run the experiment with a progress bar on stderr (when it is a
@@ -126,8 +134,17 @@ pub fn execute(
         ));
         bar
     };
-    let report = experiment::run(exp, checked.engine, &|n| bar.inc(n)).map_err(Failure::Run)?;
+    let tick = |t: Tick| match t {
+        Tick::Clocks(n) => bar.inc(n),
+        Tick::Planned(n) => bar.inc_length(n),
+    };
+    let measured =
+        experiment::run_points(exp, &plan, checked.engine, &tick).map_err(Failure::Run)?;
     bar.finish_and_clear();
+    let report = Report::new(exp, &plan, measured);
+    for w in report.warnings.iter().skip(plan.warnings.len()) {
+        eprintln!("warning: {w}");
+    }
     if let Some((path, index, window, probes)) = &checked.vcd {
         write_vcd(
             exp,
@@ -163,6 +180,9 @@ fn write_vcd(
     };
     let tmp = path.with_extension("vcd.tmp-write");
     let io = |e: std::io::Error| Failure::Run(format!("cannot write {}: {e}", path.display()));
+    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        std::fs::create_dir_all(parent).map_err(io)?;
+    }
     let file = std::fs::File::create(&tmp).map_err(io)?;
     let comment = format!(
         "gyrocal point {index} ({what}), engine {}, clocks {}..{}",
@@ -174,7 +194,7 @@ fn write_vcd(
         std::io::BufWriter::new(file),
         window,
         probes,
-        exp.clock_hz,
+        exp.drive.clock_hz,
         &comment,
     )
     .map_err(io)?;
@@ -190,7 +210,7 @@ fn write_vcd(
 /// One CSV row per point.
 pub fn points_csv(report: &Report) -> String {
     let mut csv = String::from(
-        "mode,rate_dps,cal_hz,settle_s,window_s,clocks,z1_lsb,z2_lsb,z1,z2,z1_theory,z2_theory\n",
+        "mode,rate_dps,cal_hz,settle_s,window_s,batch_s,clocks,z1_lsb,z2_lsb,z1,z2,z1_uncertainty,z2_uncertainty,z1_theory,z2_theory\n",
     );
     for p in &report.points {
         let mode = match p.mode {
@@ -198,16 +218,19 @@ pub fn points_csv(report: &Report) -> String {
             Mode::Calibration => "calibration",
         };
         csv.push_str(&format!(
-            "{mode},{},{},{},{},{},{},{},{:e},{:e},{:e},{:e}\n",
+            "{mode},{},{},{},{},{},{},{},{},{:e},{:e},{:e},{:e},{:e},{:e}\n",
             p.rate_dps,
             p.cal_hz,
             p.settle_s,
             p.window_s,
+            p.batch_s,
             p.cycles,
             p.z_lsb[0],
             p.z_lsb[1],
             p.z[0],
             p.z[1],
+            p.z_uncertainty[0],
+            p.z_uncertainty[1],
             p.z_theory[0],
             p.z_theory[1]
         ));
@@ -236,44 +259,68 @@ pub fn write_results(report: &Report, dir: &Path) -> Result<Vec<PathBuf>, Failur
     Ok(written)
 }
 
-/// Human summary of scale factors against the exact theory.
+/// `value +- uncertainty` in scientific notation, 4 digits after the point.
+fn with_sigma(value: f64, sigma: f64) -> String {
+    format!("{value:+.4e} +- {sigma:.1e}")
+}
+
+/// Human summary of scale factors, with their 1-sigma uncertainties,
+/// against the exact theory.
 pub fn summary(report: &Report) -> String {
     let t = &report.theory;
     let mut s = String::new();
     s.push_str(&format!(
-        "engine {}: {} clocks in {:.2} s ({:.1} M clocks/s)\n",
+        "engine {}: {} clocks in {:.2} s ({:.1} M clocks/s), budget {} s\n",
         report.timing.engine,
         report.timing.cycles,
         report.timing.wall_s,
-        report.timing.cycles_per_s / 1e6
+        report.timing.cycles_per_s / 1e6,
+        report.timing.budget_s
     ));
-    s.push_str("                                  output 1                output 2\n");
-    let row = |name: &str, v: [f64; 2]| format!("{name:<32}{:>+22.6e}  {:>+22.6e}\n", v[0], v[1]);
-    s.push_str(&row("sf_read (m^2/s^2 per deg/s)", report.sf_read_per_dps));
-    s.push_str(&row("  exact theory, same fit", t.sf_read_per_dps));
-    s.push_str(&row("sf_cal (per deg/s virtual)", report.sf_cal_per_dps));
-    s.push_str(&row("  exact theory, same fit", t.sf_cal_per_dps));
-    s.push_str(&format!(
-        "{:<32}{:>+22.6}  {:>+22.6}\n",
-        "ratio sf_read / sf_cal", report.ratio[0], report.ratio[1]
+    s.push_str("                                          output 1                   output 2\n");
+    let row = |name: &str, v: [f64; 2], u: [f64; 2]| {
+        format!(
+            "{name:<32}{:>26}  {:>26}\n",
+            with_sigma(v[0], u[0]),
+            with_sigma(v[1], u[1])
+        )
+    };
+    let exact =
+        |name: &str, v: [f64; 2]| format!("{name:<32}{:>+17.4e}{:9}  {:>+17.4e}\n", v[0], "", v[1]);
+    s.push_str(&row(
+        "sf_read (m^2/s^2 per deg/s)",
+        report.sf_read_per_dps,
+        report.sf_read_uncertainty,
     ));
-    s.push_str(&format!(
-        "{:<32}{:>+22.6}  {:>+22.6}\n",
-        "  exact theory, same fit", t.ratio[0], t.ratio[1]
+    s.push_str(&exact("  exact theory, same fit", t.sf_read_per_dps));
+    s.push_str(&row(
+        "sf_cal (per deg/s virtual)",
+        report.sf_cal_per_dps,
+        report.sf_cal_uncertainty,
     ));
+    s.push_str(&exact("  exact theory, same fit", t.sf_cal_per_dps));
+    let ratio = |v: f64, u: f64| format!("{v:+.6} +- {u:.1e}");
     s.push_str(&format!(
-        "{:<32}{:>+22.6}  {:>+22.6}\n",
-        "  exact small-signal", t.small_signal.ratio[0], t.small_signal.ratio[1]
+        "{:<32}{:>26}  {:>26}\n",
+        "ratio sf_read / sf_cal",
+        ratio(report.ratio[0], report.ratio_uncertainty[0]),
+        ratio(report.ratio[1], report.ratio_uncertainty[1])
     ));
+    let plain =
+        |name: &str, v: [f64; 2]| format!("{name:<32}{:>+17.6}{:9}  {:>+17.6}\n", v[0], "", v[1]);
+    s.push_str(&plain("  exact theory, same fit", t.ratio));
+    s.push_str(&plain("  exact small-signal", t.small_signal.ratio));
+    s.push_str(&plain("  paper eqs. (5)/(6)", t.small_signal.eq56_ratio));
+    let sigmas: [f64; 2] =
+        std::array::from_fn(|k| (report.ratio[k] - t.ratio[k]) / report.ratio_uncertainty[k]);
     s.push_str(&format!(
-        "{:<32}{:>+22.6}  {:>+22.6}\n",
-        "  paper eqs. (5)/(6)", t.small_signal.eq56_ratio[0], t.small_signal.eq56_ratio[1]
-    ));
-    s.push_str(&format!(
-        "{:<32}{:>+21.4}%  {:>+21.4}%\n",
+        "{:<32}{:>+16.4}% {:>+5.1}s  {:>+16.4}% {:>+5.1}s\n",
         "ratio error vs exact theory",
         100.0 * report.ratio_error[0],
-        100.0 * report.ratio_error[1]
+        sigmas[0],
+        100.0 * report.ratio_error[1],
+        sigmas[1]
     ));
+    s.push_str("(+- is 1 sigma from the points' batch means; s: the error in sigmas)\n");
     s
 }
