@@ -15,6 +15,7 @@ pub mod experiment;
 pub mod fit;
 pub mod frontend;
 pub mod gyro;
+pub mod noise;
 pub mod report;
 pub mod theory;
 #[cfg(feature = "verilator")]
