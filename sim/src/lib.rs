@@ -10,6 +10,7 @@ pub mod average;
 pub mod bench;
 pub mod config;
 pub mod cosim;
+pub mod drift;
 pub mod engine;
 pub mod experiment;
 pub mod fit;
