@@ -6,6 +6,7 @@
 //! `cosim` (the closed loop), `experiment` (readout sweep and calibration
 //! staircase), `fit` (scale factors).
 
+pub mod allan;
 pub mod average;
 pub mod bench;
 pub mod config;
