@@ -127,6 +127,19 @@ impl ThermalNoise {
         BOLTZMANN_J_PER_K * self.temperature_k / (self.mass_kg * w * w)
     }
 
+    /// One-sided displacement PSD (m^2/Hz) at `f_hz` of a mode at `f_mode_hz`
+    /// with quality factor `q`, driven by its Brownian force alone:
+    /// `S_a / ((wk^2 - w^2)^2 + (w wk / Qk)^2)`. Its integral over all
+    /// frequencies is [`ThermalNoise::displacement_variance`]; what a
+    /// demodulator at the carrier sees of the noise is this PSD (times the
+    /// pick-off gain squared) around the carrier.
+    pub fn displacement_psd(&self, f_mode_hz: f64, q: f64, f_hz: f64) -> f64 {
+        let wk = std::f64::consts::TAU * f_mode_hz;
+        let w = std::f64::consts::TAU * f_hz;
+        let detuning = wk * wk - w * w;
+        self.force_psd(f_mode_hz, q) / (detuning * detuning + (w * wk / q).powi(2))
+    }
+
     /// Equilibrium velocity variance `k_B T / m` ((m/s)^2).
     pub fn velocity_variance(&self) -> f64 {
         BOLTZMANN_J_PER_K * self.temperature_k / self.mass_kg
@@ -230,6 +243,29 @@ mod tests {
         let from_psd = n.force_psd(1.0e6, 1000.0) / 4.0 / (w / 1000.0) / (w * w);
         assert!(rel(from_psd, n.displacement_variance(1.0e6)) < 1e-12);
         assert_eq!(zoh_force_variance(2.0, 10.0), 10.0);
+    }
+
+    #[test]
+    fn displacement_psd_integrates_to_equipartition() {
+        // Trapezoid over 0..20 f0 in steps of f0 / (50 Q), a fiftieth of
+        // the half-power bandwidth: the rule's error on a Lorentzian of
+        // that width is below 1e-4, the tail beyond 20 f0 below 1e-5.
+        let n = ThermalNoise {
+            mass_kg: 1.0e-9,
+            temperature_k: 300.0,
+            seed: 0,
+        };
+        let (f0, q) = (1.0e5, 200.0);
+        let df = f0 / (50.0 * q);
+        let steps = (20.0 * f0 / df) as usize;
+        let sum: f64 = (0..=steps)
+            .map(|i| {
+                let w = if i == 0 || i == steps { 0.5 } else { 1.0 };
+                w * n.displacement_psd(f0, q, i as f64 * df)
+            })
+            .sum();
+        let ratio = sum * df / n.displacement_variance(f0);
+        assert!((ratio - 1.0).abs() < 2e-4, "{ratio}");
     }
 
     #[test]
