@@ -1,16 +1,20 @@
-//! The figures of a run (`src/plots.rs`): every file is written, each PNG
+//! The figures of a run (`src/plots/`): every file is written, each PNG
 //! decodes at its size and shows the data (both outputs' colours) and text,
 //! each SVG is well-formed and carries its axis labels, files are replaced
 //! whole, and a target that cannot be written, or a report that cannot be
-//! drawn, is an error naming it, never a panic.
+//! drawn, is an error naming it, never a panic. The Allan deviation figure
+//! is drawn from a synthetic rate series, its readings checked in its text.
 //!
 //! `cargo test --release --test plots -- --ignored paper_figures
 //! --nocapture` draws the paper's run into target/figures-paper (or
-//! $GYROCAL_FIGURES_DIR) and prints the time write_figures takes.
+//! $GYROCAL_FIGURES_DIR) and prints the time write_figures takes;
+//! `-- --ignored allan_figure_to_look_at` draws the synthetic Allan figure
+//! into target/figures-allan.
 
-#[path = "../src/plots.rs"]
+#[path = "../src/plots/mod.rs"]
 mod plots;
 
+use gyrocal_sim::allan;
 use gyrocal_sim::engine::EngineKind;
 use gyrocal_sim::experiment::{Experiment, Mode};
 use gyrocal_sim::gyro::GyroParams;
@@ -342,4 +346,123 @@ fn paper_figures() {
         start.elapsed().as_secs_f64(),
         files.len()
     );
+}
+
+/// Allan analysis of a synthetic rate: white noise (N = 0.05 deg/sqrt(s) =
+/// 3 deg/sqrt(h)) plus a slow random walk of the rate, so that the curve
+/// falls, bottoms out and rises. A xorshift generator summed to
+/// near-Gaussian (12 uniforms less 6) keeps the test free of random crates.
+fn synthetic_allan() -> allan::AllanAnalysis {
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut uniform = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut normal = move || (0..12).map(|_| uniform()).sum::<f64>() - 6.0;
+    let (fs, n) = (100.0, 1 << 18);
+    let mut walk = 0.0;
+    let rate: Vec<f64> = (0..n)
+        .map(|_| {
+            walk += 2e-4 * normal();
+            0.5 * normal() + walk
+        })
+        .collect();
+    allan::analyze(&rate, fs).expect("analysis")
+}
+
+#[test]
+fn draws_the_allan_deviation_with_its_readings() {
+    let analysis = synthetic_allan();
+    let arw = analysis
+        .angle_random_walk
+        .as_ref()
+        .expect("points near 1 s");
+    let dir = tempfile::tempdir().expect("temp dir");
+    let written = plots::write_allan_figure(
+        &analysis,
+        "Allan deviation, synthetic rate",
+        dir.path(),
+        "fig_allan",
+    )
+    .expect("figure");
+    assert_eq!(
+        written,
+        ["png", "svg"].map(|e| dir.path().join(format!("fig_allan.{e}")))
+    );
+    let (w, h, pixels) = decode_png(&written[0]);
+    assert_eq!((w, h), (1000, 720));
+    for rgb in OUTPUT_RGB {
+        let n = pixels.iter().filter(|p| **p == rgb).count();
+        assert!(
+            n > 200,
+            "fig_allan.png: {n} pixels of {rgb:?}, data not drawn"
+        );
+    }
+    let svg = std::fs::read_to_string(&written[1]).expect("svg");
+    check_xml(&written[1], &svg);
+    for label in [
+        "cluster time τ (s)",
+        "(°/h)",
+        "τ^−1/2",
+        "°/√h",
+        "bias instability",
+    ] {
+        assert!(svg.contains(label), "fig_allan.svg lacks {label:?}");
+    }
+    // The readings in the legend are the analysis's, to three significant
+    // digits (a rounding of at most 0.5 %).
+    let reading = |after: &str| -> f64 {
+        let at = svg.find(after).unwrap_or_else(|| panic!("no {after:?}")) + after.len();
+        let text: String = svg[at..]
+            .chars()
+            .take_while(|c| c.is_ascii_digit() || *c == '.')
+            .collect();
+        text.parse()
+            .unwrap_or_else(|_| panic!("{after:?} is followed by {text:?}"))
+    };
+    let n = reading("N = ");
+    assert!(
+        (n / arw.deg_per_sqrt_h - 1.0).abs() < 5e-3,
+        "N = {n} against {}",
+        arw.deg_per_sqrt_h
+    );
+    let b = reading("σ_min / 0.664 = ");
+    let bi = analysis.bias_instability.deg_per_h;
+    assert!((b / bi - 1.0).abs() < 5e-3, "B = {b} against {bi}");
+    for text in svg_texts(&svg) {
+        let missing: String = text.chars().filter(|&c| !in_font(c)).collect();
+        assert!(
+            missing.is_empty(),
+            "{missing:?} in {text:?} is not in the embedded font"
+        );
+    }
+    assert_eq!(strays(dir.path(), &written), Vec::<PathBuf>::new());
+}
+
+#[test]
+fn an_allan_analysis_that_cannot_be_drawn_is_an_error() {
+    let mut zero = synthetic_allan();
+    zero.points[3].adev = 0.0;
+    let dir = tempfile::tempdir().expect("temp dir");
+    let e = plots::write_allan_figure(&zero, "t", dir.path(), "a").expect_err("zero");
+    assert!(e.contains("positive") && !e.contains('\n'), "{e}");
+    zero.points.truncate(1);
+    assert!(plots::write_allan_figure(&zero, "t", dir.path(), "a").is_err());
+    assert_eq!(std::fs::read_dir(dir.path()).expect("dir").count(), 0);
+}
+
+#[test]
+#[ignore = "writes into target/ for a look at the Allan figure"]
+fn allan_figure_to_look_at() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/target/figures-allan");
+    let files = plots::write_allan_figure(
+        &synthetic_allan(),
+        "Allan deviation, synthetic rate",
+        Path::new(dir),
+        "fig_allan",
+    )
+    .expect("figure");
+    println!("{files:?}");
 }

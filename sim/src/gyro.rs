@@ -33,7 +33,16 @@
 //! the matrix handed to `exp` is of order `w T` (at most about pi) or smaller,
 //! instead of mixing 1, 6e7 and 1e-16. A step is then a plain 4x4 plus 4x2
 //! multiply on `[f64; 4]` arrays: no allocation, no nalgebra.
+//!
+//! # Brownian noise
+//!
+//! [`GyroModel::with_thermal_noise`] adds the thermomechanical force noise
+//! of both modes (mass, temperature, Q; [`crate::noise`]) as the exact
+//! per-clock state increment of the continuous process, recomputed with
+//! the matrices at each rate change. Off (the default), `step` is the
+//! noiseless update, result for result.
 
+use crate::noise::{self, Mat4, StateNoise, ThermalNoise};
 use nalgebra::SMatrix;
 
 /// Physical parameters of the two-mode gyroscope (the `[gyro]` section of
@@ -76,6 +85,8 @@ pub struct GyroModel {
     rest: Discrete,
     cur: Discrete,
     s: [f64; 4],
+    /// Brownian noise source and its settings, when on.
+    thermal: Option<(ThermalNoise, StateNoise)>,
 }
 
 fn check(name: &str, value: f64, ok: bool, allowed: &str) -> Result<(), String> {
@@ -129,6 +140,7 @@ impl GyroModel {
                 gamma: [[0.0; 2]; 4],
             },
             s: [0.0; 4],
+            thermal: None,
         };
         let mut rest = model.discretize(0.0);
         // Decoupled modes: the off-diagonal blocks are zero in exact arithmetic
@@ -147,28 +159,77 @@ impl GyroModel {
         Ok(model)
     }
 
-    /// Exact ZOH discretization at rate `omz` (rad/s).
-    fn discretize(&self, omz: f64) -> Discrete {
+    /// The scaled continuous-time state matrix at rate `omz` (rad/s),
+    /// augmented with the input columns (the last two rows are zero).
+    #[rustfmt::skip]
+    fn augmented(&self, omz: f64) -> SMatrix<f64, 6, 6> {
         let p = &self.params;
         let w1 = std::f64::consts::TAU * p.f1_hz;
         let w2 = std::f64::consts::TAU * p.f2_hz;
         let (b1, b2) = (w1 / p.q1, w2 / p.q2);
         let g = 2.0 * p.angular_gain * omz;
         let wr = self.wr;
-        let t = 1.0 / self.clock_hz;
         // Scaled state s = [x1, u1, x2, u2], u = v/wr; scaled input g_k = f_k/wr^2:
         //   x1' = wr u1,  u1' = -(w1^2/wr) x1 - B1 u1 + 2 lam Omz u2 + wr g1
         //   x2' = wr u2,  u2' = -(w2^2/wr) x2 - B2 u2 - 2 lam Omz u1 + wr g2
-        #[rustfmt::skip]
-        let m = SMatrix::<f64, 6, 6>::from_row_slice(&[
+        SMatrix::<f64, 6, 6>::from_row_slice(&[
             0.0,           wr,  0.0,           0.0, 0.0, 0.0,
             -w1 * w1 / wr, -b1, 0.0,           g,   wr,  0.0,
             0.0,           0.0, 0.0,           wr,  0.0, 0.0,
             0.0,           -g,  -w2 * w2 / wr, -b2, 0.0, wr,
             0.0,           0.0, 0.0,           0.0, 0.0, 0.0,
             0.0,           0.0, 0.0,           0.0, 0.0, 0.0,
-        ]) * t;
-        let e = m.exp();
+        ])
+    }
+
+    /// Covariance of the Brownian state increment over one clock at rate
+    /// `omz` (scaled state; [`crate::noise`]). The force of mode k, of
+    /// two-sided intensity `S_a,k / 2`, enters `uk' = ... + fk / wr`.
+    fn thermal_covariance(&self, noise: &ThermalNoise, omz: f64) -> Mat4 {
+        let p = &self.params;
+        let t = 1.0 / self.clock_hz;
+        let a = self.augmented(omz).fixed_view::<4, 4>(0, 0).into_owned() * t;
+        let inv_wr2 = 1.0 / (self.wr * self.wr);
+        let mut intensity = Mat4::zeros();
+        intensity[(1, 1)] = noise.force_psd(p.f1_hz, p.q1) / 2.0 * inv_wr2 * t;
+        intensity[(3, 3)] = noise.force_psd(p.f2_hz, p.q2) / 2.0 * inv_wr2 * t;
+        let mut qd = noise::discrete_covariance(&a, &intensity);
+        if omz == 0.0 || p.angular_gain == 0.0 {
+            // Decoupled modes: independent increments (zero in exact arithmetic).
+            for i in 0..2 {
+                for j in 2..4 {
+                    qd[(i, j)] = 0.0;
+                    qd[(j, i)] = 0.0;
+                }
+            }
+        }
+        qd
+    }
+
+    /// Adds the thermomechanical force noise of `noise` (seeded; its
+    /// temperature 0 K leaves the model noiseless). Errors (one line, naming
+    /// the field) on a mass or temperature out of range.
+    pub fn with_thermal_noise(mut self, noise: &ThermalNoise) -> Result<Self, String> {
+        noise.validate()?;
+        self.thermal = if noise.is_on() {
+            let qd = self.thermal_covariance(noise, self.omz);
+            Some((noise.clone(), StateNoise::new(&qd, noise.seed)?))
+        } else {
+            None
+        };
+        Ok(self)
+    }
+
+    /// The Brownian noise settings, when the noise is on.
+    pub fn thermal_noise(&self) -> Option<&ThermalNoise> {
+        self.thermal.as_ref().map(|(settings, _)| settings)
+    }
+
+    /// Exact ZOH discretization at rate `omz` (rad/s).
+    fn discretize(&self, omz: f64) -> Discrete {
+        let t = 1.0 / self.clock_hz;
+        let wr = self.wr;
+        let e = (self.augmented(omz) * t).exp();
         let inv_wr2 = 1.0 / (wr * wr);
         let mut d = Discrete {
             phi: [[0.0; 4]; 4],
@@ -206,6 +267,14 @@ impl GyroModel {
         } else {
             self.discretize(omz_rad_s)
         };
+        if let Some((settings, _)) = &self.thermal {
+            let qd = self.thermal_covariance(settings, omz_rad_s);
+            if let Some((_, source)) = &mut self.thermal {
+                source
+                    .set_covariance(&qd)
+                    .expect("the covariance at a finite rate is positive definite");
+            }
+        }
     }
 
     /// Advances one clock period with the forces per unit mass `f1`, `f2` (N/kg)
@@ -213,6 +282,7 @@ impl GyroModel {
     ///
     /// At `Omz = 0` the modes are decoupled and only the two 2x2 diagonal blocks
     /// are used (the others are exactly zero): about 1.3x faster, same result.
+    /// With thermal noise on, the clock's Brownian increment is added.
     #[inline]
     pub fn step(&mut self, f1: f64, f2: f64) {
         let p = &self.cur.phi;
@@ -234,6 +304,12 @@ impl GyroModel {
                 (g[3][1] * f2 + p[3][2] * s[2]) + p[3][3] * s[3],
             ]
         };
+        if let Some((_, source)) = &mut self.thermal {
+            let w = source.sample();
+            for (s, w) in self.s.iter_mut().zip(w) {
+                *s += w;
+            }
+        }
     }
 
     /// Position of mode 1 at the current clock edge (m).

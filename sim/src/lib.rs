@@ -6,15 +6,18 @@
 //! `cosim` (the closed loop), `experiment` (readout sweep and calibration
 //! staircase), `fit` (scale factors).
 
+pub mod allan;
 pub mod average;
 pub mod bench;
 pub mod config;
 pub mod cosim;
+pub mod drift;
 pub mod engine;
 pub mod experiment;
 pub mod fit;
 pub mod frontend;
 pub mod gyro;
+pub mod noise;
 pub mod report;
 pub mod theory;
 #[cfg(feature = "verilator")]

@@ -1,0 +1,202 @@
+//! The figures, PNG and SVG of each: the paper's, drawn from a finished
+//! run, one file per figure beside this one, and the Allan deviation of a
+//! rate series (`allan`).
+//!
+//! - `fig4_readout`: readout scale factor (paper Fig. 4). Window means of
+//!   both outputs against the rotation rate, their least-squares lines and
+//!   the exact theory at the same rates, one panel per output. The outputs
+//!   sit on offsets that can be 10^5 times the signal (a detuned mode): a
+//!   panel whose offset would flatten the line shows z less the fitted
+//!   intercept (the theory points less the theory's own intercept; the
+//!   residual figure shows the difference of offsets).
+//! - `fig5a_staircase`: the calibration staircase (paper Fig. 5a). Every
+//!   calibration point is an independent run from power-up; the runs are
+//!   laid end to end on one time axis. Top row: z as simulated, averaging
+//!   windows shaded (the 2 f_cal ripple is far larger than a step). Bottom
+//!   row: z averaged over one ripple period 1 / (2 f_cal), which removes
+//!   the ripple and shows the steps, with the window means (what the fit
+//!   uses) and the exact theory as horizontal segments. One column per
+//!   output; the paper's output is the detuned one.
+//! - `fig5b_calibration`: calibration scale factor (paper Fig. 5b): window
+//!   means against the virtual rate 360 f_cal, fitted lines, theory.
+//! - `fig_residuals`: simulated minus exact theory at every point, in ppm
+//!   of the signal the fit measures at that output (|SF| times the span of
+//!   the rates), less its mean (stated in the legend: an offset error does
+//!   not move the scale factor), readout and calibration, with the relative
+//!   scale-factor errors in the panel captions.
+//!
+//! Text is drawn with a subset of DejaVu Sans embedded in the binary
+//! (`assets/fonts/`), so no font library or installed font is needed at
+//! build or run time. Every file is written to a temporary file in the
+//! target folder and renamed into place: a reader never sees half a file.
+//!
+//! Layout: `data` (the report checked and sorted), `format` (numbers and
+//! ranges), `style` (font, colours, title block), `line_panel` (the
+//! linear-fit panel of Figs. 4 and 5b), then one file per figure. Each
+//! figure computes what a panel shows (fits, intercepts, scales, ranges)
+//! apart from drawing it.
+
+mod allan;
+mod calibration;
+mod data;
+mod format;
+mod line_panel;
+mod readout;
+mod residuals;
+mod staircase;
+mod style;
+
+use gyrocal_sim::allan::AllanAnalysis;
+use gyrocal_sim::report::Report;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::path::{Path, PathBuf};
+
+use data::Data;
+
+/// The figures of a run, in the order they are written.
+#[derive(Clone, Copy, Debug)]
+enum Figure {
+    Readout,
+    Staircase,
+    Calibration,
+    Residuals,
+}
+
+impl Figure {
+    const ALL: [Figure; 4] = [
+        Figure::Readout,
+        Figure::Staircase,
+        Figure::Calibration,
+        Figure::Residuals,
+    ];
+
+    fn name(self) -> &'static str {
+        match self {
+            Figure::Readout => "fig4_readout",
+            Figure::Staircase => "fig5a_staircase",
+            Figure::Calibration => "fig5b_calibration",
+            Figure::Residuals => "fig_residuals",
+        }
+    }
+
+    fn size(self) -> (u32, u32) {
+        match self {
+            Figure::Staircase => (1600, 1000),
+            _ => (1400, 640),
+        }
+    }
+}
+
+/// Something that draws itself on a whole drawing area.
+trait Plot {
+    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String>;
+}
+
+/// One figure of a run.
+struct RunFigure<'a> {
+    fig: Figure,
+    data: &'a Data<'a>,
+}
+
+impl Plot for RunFigure<'_> {
+    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+        root.fill(&WHITE).map_err(err)?;
+        match self.fig {
+            Figure::Readout => readout::draw_readout(root, self.data),
+            Figure::Staircase => staircase::draw_staircase(root, self.data),
+            Figure::Calibration => calibration::draw_calibration(root, self.data),
+            Figure::Residuals => residuals::draw_residuals(root, self.data),
+        }
+    }
+}
+
+/// Write every figure of `report` into `dir` (created if missing) as PNG
+/// and SVG; returns the files written, in order. Errors are one line that
+/// names the file (or folder) at fault; the report is checked before any
+/// file is written, and a file that fails leaves the ones before it whole
+/// and no temporary file behind.
+pub fn write_figures(report: &Report, dir: &Path) -> Result<Vec<PathBuf>, String> {
+    style::register_font()?;
+    let data = Data::new(report)?;
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let mut written = vec![];
+    for fig in Figure::ALL {
+        let plot = RunFigure { fig, data: &data };
+        written.extend(write_plot(&plot, fig.size(), dir, fig.name())?);
+    }
+    Ok(written)
+}
+
+/// Write the Allan deviation of `analysis` into `dir` (created if missing)
+/// as `name`.png and `name`.svg, titled `title`; returns the two files.
+/// Errors as [`write_figures`]; the analysis is checked first (at least two
+/// positive, finite points).
+#[allow(dead_code)] // reason: the field command (issue 9) will call it; tests/plots.rs draws it
+pub fn write_allan_figure(
+    analysis: &AllanAnalysis,
+    title: &str,
+    dir: &Path,
+    name: &str,
+) -> Result<Vec<PathBuf>, String> {
+    style::register_font()?;
+    let plot = allan::AllanFigure::new(analysis, title)?;
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    write_plot(&plot, allan::SIZE, dir, name)
+}
+
+/// `plot` as `dir/name.png` then `dir/name.svg`.
+fn write_plot<P: Plot>(
+    plot: &P,
+    size: (u32, u32),
+    dir: &Path,
+    name: &str,
+) -> Result<Vec<PathBuf>, String> {
+    let png_path = dir.join(format!("{name}.png"));
+    let png = render_png(plot, size)
+        .map_err(|e| format!("{}: drawing failed: {e}", png_path.display()))?;
+    write_atomic(&png_path, &png)?;
+    let svg_path = dir.join(format!("{name}.svg"));
+    let svg = render_svg(plot, size)
+        .map_err(|e| format!("{}: drawing failed: {e}", svg_path.display()))?;
+    write_atomic(&svg_path, svg.as_bytes())?;
+    Ok(vec![png_path, svg_path])
+}
+
+/// Write `bytes` atomically (`gyrocal_hdl::export::write_atomically`),
+/// with the error as one line naming the file.
+fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
+    gyrocal_hdl::export::write_atomically(path, bytes)
+        .map_err(|e| format!("{}: {e}", path.display()))
+}
+
+fn render_png<P: Plot>(plot: &P, (w, h): (u32, u32)) -> Result<Vec<u8>, String> {
+    let mut rgb = vec![0u8; w as usize * h as usize * 3];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, (w, h)).into_drawing_area();
+        plot.draw_on(&root)?;
+        root.present().map_err(|e| e.to_string())?;
+    }
+    let mut out = vec![];
+    let mut encoder = png::Encoder::new(&mut out, w, h);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
+    writer.write_image_data(&rgb).map_err(|e| e.to_string())?;
+    writer.finish().map_err(|e| e.to_string())?;
+    Ok(out)
+}
+
+fn render_svg<P: Plot>(plot: &P, size: (u32, u32)) -> Result<String, String> {
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
+        plot.draw_on(&root)?;
+        root.present().map_err(|e| e.to_string())?;
+    }
+    Ok(svg)
+}
+
+fn err<E: std::fmt::Display>(e: E) -> String {
+    e.to_string()
+}

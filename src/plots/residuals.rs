@@ -1,0 +1,152 @@
+//! Residual figure: simulated minus exact theory at every point, in ppm of
+//! the signal the fit measures at that output (|SF| times the span of the
+//! rates), less its mean (an offset error does not move the scale
+//! factor), readout and calibration side by side.
+
+use gyrocal_sim::experiment::PointResult;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use super::data::Data;
+use super::err;
+use super::format::{fmt_num, fmt_sci, padded_range, tick_formatter};
+use super::style::{GREY, LIGHT, OUT_COLOR, header, text_style};
+
+/// One panel's data: per output, the residuals in ppm less their mean,
+/// and the mean; the axis ranges.
+struct ResidualPanel {
+    series: Vec<(Vec<(f64, f64)>, f64)>,
+    x: (f64, f64),
+    y: (f64, f64),
+}
+
+/// Residuals of `points` against the theory, in ppm of `|sf_theory| x
+/// span of the rates`, less their mean, per output.
+fn residual_panel(points: &[&PointResult], sf_theory: [f64; 2]) -> ResidualPanel {
+    let (xmin, xmax) = padded_range(points.iter().map(|p| p.rate_dps), 0.0, 0.0);
+    let span = xmax - xmin;
+    let series: Vec<(Vec<(f64, f64)>, f64)> = (0..2)
+        .map(|k| {
+            let signal = sf_theory[k].abs() * span;
+            let v: Vec<(f64, f64)> = points
+                .iter()
+                .map(|p| {
+                    let d = p.z[k] - p.z_theory[k];
+                    let v = if signal > 0.0 { d / signal * 1e6 } else { 0.0 };
+                    (p.rate_dps, v)
+                })
+                .collect();
+            let mean = v.iter().map(|q| q.1).sum::<f64>() / v.len() as f64;
+            (v.iter().map(|&(x, y)| (x, y - mean)).collect(), mean)
+        })
+        .collect();
+    let x = padded_range(points.iter().map(|p| p.rate_dps), 0.06, 0.06);
+    let all = series.iter().flat_map(|s| s.0.iter().map(|q| q.1));
+    let y = padded_range(all.chain([0.0]), 0.1, 0.6);
+    ResidualPanel { series, x, y }
+}
+
+pub(super) fn draw_residuals<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    data: &Data,
+) -> Result<(), String> {
+    let r = data.report;
+    let body = header(
+        root,
+        "Simulated − exact theory, per point",
+        "in ppm of the signal the fit measures at that output, |SF_theory|·(span of the rates); each output less its mean (given in the legend), so what is left is what moves the scale factor",
+    )?;
+    let panels = body.split_evenly((1, 2));
+    let sets = [
+        (
+            "readout",
+            "rotation rate Ω (°/s)",
+            &data.readout,
+            r.sf_read_per_dps,
+            r.theory.sf_read_per_dps,
+        ),
+        (
+            "calibration",
+            "virtual rate 360·f_cal (°/s)",
+            &data.cal,
+            r.sf_cal_per_dps,
+            r.theory.sf_cal_per_dps,
+        ),
+    ];
+    for (area, (what, x_label, points, sf, sf_theory)) in panels.iter().zip(sets) {
+        let ResidualPanel {
+            series,
+            x: (x0, x1),
+            y: (y0, y1),
+        } = residual_panel(points, sf_theory);
+        let rel = |k: usize| fmt_sci(sf[k] / sf_theory[k] - 1.0, 2);
+        let mut chart = ChartBuilder::on(area)
+            .caption(
+                format!(
+                    "{what}: SF_sim / SF_theory − 1 = {} (output 1), {} (output 2)",
+                    rel(0),
+                    rel(1)
+                ),
+                text_style(17),
+            )
+            .margin(12)
+            .margin_right(24)
+            .x_label_area_size(56)
+            .y_label_area_size(80)
+            .build_cartesian_2d(x0..x1, y0..y1)
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .max_light_lines(0)
+            .bold_line_style(LIGHT)
+            .x_desc(x_label)
+            .y_desc("(z − z_theory) / (|SF|·span), less its mean  (ppm)")
+            .axis_desc_style(text_style(16))
+            .label_style(text_style(14))
+            .x_labels(8)
+            .y_labels(8)
+            .x_label_formatter(&tick_formatter(x1 - x0))
+            .y_label_formatter(&tick_formatter(y1 - y0))
+            .draw()
+            .map_err(err)?;
+        chart
+            .draw_series(LineSeries::new(
+                [(x0, 0.0), (x1, 0.0)],
+                GREY.stroke_width(1),
+            ))
+            .map_err(err)?;
+        for (k, (s, mean)) in series.iter().enumerate() {
+            let color = OUT_COLOR[k];
+            chart
+                .draw_series(LineSeries::new(
+                    s.iter().copied(),
+                    color.mix(0.5).stroke_width(1),
+                ))
+                .map_err(err)?;
+            chart
+                .draw_series(s.iter().map(|&q| Circle::new(q, 4, color.filled())))
+                .map_err(err)?
+                .label(format!(
+                    "output {}{}: mean {} ppm",
+                    k + 1,
+                    if r.detuned_output == Some(k) {
+                        " (detuned)"
+                    } else {
+                        ""
+                    },
+                    fmt_num(*mean, 3)
+                ))
+                .legend(move |(x, y)| Circle::new((x + 12, y), 4, color.filled()));
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .margin(10)
+            .label_font(text_style(14))
+            .background_style(WHITE.mix(0.9))
+            .border_style(LIGHT)
+            .draw()
+            .map_err(err)?;
+    }
+    Ok(())
+}

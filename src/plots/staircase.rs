@@ -1,0 +1,367 @@
+//! Fig. 5a: the calibration staircase. Every calibration point is an
+//! independent run from power-up; the runs are laid end to end on one time
+//! axis. Top row: z as simulated, averaging windows shaded. Bottom row: z
+//! averaged over one ripple period 1 / (2 f_cal), with the window means and
+//! the exact theory as horizontal segments. One column per output.
+
+use gyrocal_sim::experiment::PointResult;
+use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
+use plotters::prelude::*;
+
+use super::data::Data;
+use super::err;
+use super::format::{
+    clip_polyline, eng_exponent, fmt_num, padded_range, scaled_unit, sub, tick_formatter,
+};
+use super::style::{GREY, LIGHT, OUT_COLOR, header, text_style};
+
+/// One calibration run placed on the common time axis.
+struct Step<'a> {
+    point: &'a PointResult,
+    /// Start of the run on the common axis (s).
+    start: f64,
+    /// z averaged over one ripple period, per output: (common time, z).
+    smooth: [Vec<(f64, f64)>; 2],
+}
+
+/// Centred moving average of the piecewise-linear `trace` column `k + 1`
+/// over `period`, evaluated on `n` times where the whole period lies
+/// within the trace. Exact for the piecewise-linear interpolant, so the
+/// ripple (a multiple of 1 / period) leaves no residue from sampling.
+fn moving_average(trace: &[[f64; 3]], k: usize, period: f64, n: usize) -> Vec<(f64, f64)> {
+    let t: Vec<f64> = trace.iter().map(|s| s[0]).collect();
+    let z: Vec<f64> = trace.iter().map(|s| s[k + 1]).collect();
+    let mut cum = vec![0.0; t.len()];
+    for i in 1..t.len() {
+        cum[i] = cum[i - 1] + 0.5 * (z[i] + z[i - 1]) * (t[i] - t[i - 1]);
+    }
+    // Integral from t[0] to `x` of the interpolant.
+    let integral = |x: f64| -> f64 {
+        let i = t.partition_point(|&v| v <= x).clamp(1, t.len() - 1);
+        let (ta, tb, za, zb) = (t[i - 1], t[i], z[i - 1], z[i]);
+        let u = x - ta;
+        let slope = if tb > ta { (zb - za) / (tb - ta) } else { 0.0 };
+        cum[i - 1] + za * u + 0.5 * slope * u * u
+    };
+    let (first, last) = (t[0] + period / 2.0, t[t.len() - 1] - period / 2.0);
+    if last <= first {
+        return vec![];
+    }
+    (0..n)
+        .map(|j| {
+            let c = first + (last - first) * j as f64 / (n - 1) as f64;
+            let v = (integral(c + period / 2.0) - integral(c - period / 2.0)) / period;
+            (c, v)
+        })
+        .collect()
+}
+
+/// The calibration runs end to end, each with its ripple-free traces;
+/// returns them and the end of the last run (s).
+fn lay_out<'a>(cal: &[&'a PointResult]) -> (Vec<Step<'a>>, f64) {
+    let mut steps = vec![];
+    let mut start = 0.0;
+    for p in cal {
+        let period = 1.0 / (2.0 * p.cal_hz);
+        let smooth = [0, 1].map(|k| {
+            moving_average(&p.trace, k, period, 400)
+                .into_iter()
+                .map(|(t, v)| (start + t, v))
+                .collect()
+        });
+        steps.push(Step {
+            point: p,
+            start,
+            smooth,
+        });
+        start += p.trace[p.trace.len() - 1][0];
+    }
+    (steps, start)
+}
+
+pub(super) fn draw_staircase<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    data: &Data,
+) -> Result<(), String> {
+    let r = data.report;
+    let (steps, end) = lay_out(&data.cal);
+    let freqs: Vec<f64> = data.cal.iter().map(|p| p.cal_hz).collect();
+    let body = header(
+        root,
+        &format!(
+            "Fig. 5a — calibration staircase: f_cal = {}…{} Hz",
+            fmt_num(freqs[0], 4),
+            fmt_num(freqs[freqs.len() - 1], 4),
+        ),
+        &format!(
+            "each step is an independent run from power-up (gyroscope at rest), laid end to end; {} engine",
+            r.timing.engine
+        ),
+    )?;
+    let columns = body.split_evenly((1, 2));
+    for (k, column) in columns.iter().enumerate() {
+        let (top, bottom) = column.split_vertically(column.dim_in_pixel().1 * 45 / 100);
+        staircase_raw(&top, data, &steps, k, end)?;
+        staircase_smooth(&bottom, &steps, k, end)?;
+    }
+    Ok(())
+}
+
+/// Axes of a staircase panel: time on x (runs end to end), z scaled by
+/// 10^exp on y, the averaging windows shaded (labelled in the legend when
+/// `label_windows`) and dashed separators between runs.
+#[allow(clippy::too_many_arguments)]
+fn staircase_axes<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    caption: String,
+    k: usize,
+    exp: i32,
+    (y0, y1): (f64, f64),
+    (end, y_labels): (f64, usize),
+    steps: &[Step],
+    label_windows: bool,
+) -> Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>, String> {
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, text_style(17))
+        .margin(12)
+        .margin_right(24)
+        .x_label_area_size(46)
+        .y_label_area_size(80)
+        .build_cartesian_2d(0.0..end, y0..y1)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .max_light_lines(0)
+        .bold_line_style(LIGHT)
+        .x_desc("time, runs end to end (s)")
+        .y_desc(format!("z{}  ({})", sub(k + 1), scaled_unit(exp, "m²/s²")))
+        .axis_desc_style(text_style(15))
+        .label_style(text_style(13))
+        .x_labels(10)
+        .y_labels(y_labels)
+        .x_label_formatter(&tick_formatter(end))
+        .y_label_formatter(&tick_formatter(y1 - y0))
+        .draw()
+        .map_err(err)?;
+    let windows = chart
+        .draw_series(steps.iter().map(|s| {
+            let a = s.start + s.point.settle_s;
+            Rectangle::new(
+                [(a, y0), (a + s.point.window_s, y1)],
+                LIGHT.mix(0.7).filled(),
+            )
+        }))
+        .map_err(err)?;
+    if label_windows {
+        windows
+            .label("averaging window")
+            .legend(|(x, y)| Rectangle::new([(x, y - 6), (x + 24, y + 6)], LIGHT.filled()));
+    }
+    for s in steps.iter().skip(1) {
+        chart
+            .draw_series(DashedLineSeries::new(
+                [(s.start, y0), (s.start, y1)],
+                4,
+                4,
+                GREY.stroke_width(1),
+            ))
+            .map_err(err)?;
+    }
+    Ok(chart)
+}
+
+/// Power of ten and y range (scaled) of the top panel of output `k`: every
+/// sample, with room on top for the legend.
+fn raw_range(steps: &[Step], k: usize) -> (i32, (f64, f64)) {
+    let values = steps
+        .iter()
+        .flat_map(|s| s.point.trace.iter().map(|q| q[k + 1]));
+    let (lo, hi) = padded_range(values, 0.05, 0.4);
+    let exp = eng_exponent(lo.abs().max(hi.abs()));
+    let scale = 10f64.powi(-exp);
+    (exp, (lo * scale, hi * scale))
+}
+
+/// Top panel: z as simulated, windows shaded.
+fn staircase_raw<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    data: &Data,
+    steps: &[Step],
+    k: usize,
+    end: f64,
+) -> Result<(), String> {
+    let color = OUT_COLOR[k];
+    let (exp, (y0, y1)) = raw_range(steps, k);
+    let scale = 10f64.powi(-exp);
+    let mut chart = staircase_axes(
+        area,
+        format!("{}: z{} as simulated", data.output_name(k), sub(k + 1)),
+        k,
+        exp,
+        (y0, y1),
+        (end, 6),
+        steps,
+        true,
+    )?;
+    for (i, s) in steps.iter().enumerate() {
+        let series = chart
+            .draw_series(LineSeries::new(
+                s.point
+                    .trace
+                    .iter()
+                    .map(|q| (s.start + q[0], q[k + 1] * scale)),
+                color.stroke_width(1),
+            ))
+            .map_err(err)?;
+        if i == 0 {
+            series
+                .label(format!("z{} (each run from power-up)", sub(k + 1)))
+                .legend(move |(x, y)| {
+                    PathElement::new([(x, y), (x + 24, y)], color.stroke_width(1))
+                });
+        }
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .margin(8)
+        .label_font(text_style(13))
+        .background_style(WHITE.mix(0.9))
+        .border_style(LIGHT)
+        .draw()
+        .map_err(err)?;
+    Ok(())
+}
+
+/// Scale and range of a bottom panel.
+struct SmoothRange {
+    /// Power of ten of the axis.
+    exp: i32,
+    /// One step of the staircase (unscaled): the room around it.
+    room: f64,
+    /// The y range, scaled.
+    y: (f64, f64),
+}
+
+/// The steps of output `k` plus half a step of room around them, a third
+/// of the height on top for the labels and the legend.
+fn smooth_range(steps: &[Step], k: usize) -> SmoothRange {
+    let means: Vec<f64> = steps
+        .iter()
+        .flat_map(|s| [s.point.z[k], s.point.z_theory[k]])
+        .collect();
+    let (lo, hi) = padded_range(means.iter().copied(), 0.0, 0.0);
+    let step = (hi - lo) / (steps.len() - 1).max(1) as f64;
+    let room = if step > 0.0 { step } else { lo.abs() * 0.1 };
+    let (lo, hi) = (lo - 0.6 * room, hi + 0.6 * room);
+    let hi = hi + (hi - lo) * 0.5;
+    let exp = eng_exponent(lo.abs().max(hi.abs()));
+    let scale = 10f64.powi(-exp);
+    SmoothRange {
+        exp,
+        room,
+        y: (lo * scale, hi * scale),
+    }
+}
+
+/// Bottom panel: ripple-free z, window means and theory: the staircase.
+fn staircase_smooth<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    steps: &[Step],
+    k: usize,
+    end: f64,
+) -> Result<(), String> {
+    let color = OUT_COLOR[k];
+    let SmoothRange {
+        exp,
+        room,
+        y: (y0, y1),
+    } = smooth_range(steps, k);
+    let scale = 10f64.powi(-exp);
+    let mut chart = staircase_axes(
+        area,
+        format!(
+            "z{} averaged over one ripple period 1/(2 f_cal): the staircase",
+            sub(k + 1)
+        ),
+        k,
+        exp,
+        (y0, y1),
+        (end, 8),
+        steps,
+        false,
+    )?;
+    let mut first = true;
+    for s in steps {
+        let scaled: Vec<(f64, f64)> = s.smooth[k].iter().map(|&(t, v)| (t, v * scale)).collect();
+        for piece in clip_polyline(&scaled, y0, y1) {
+            let series = chart
+                .draw_series(LineSeries::new(piece, color.mix(0.45).stroke_width(2)))
+                .map_err(err)?;
+            if first {
+                series
+                    .label("mean over one ripple period")
+                    .legend(move |(x, y)| {
+                        PathElement::new([(x, y), (x + 24, y)], color.mix(0.45).stroke_width(2))
+                    });
+                first = false;
+            }
+        }
+    }
+    let window = |s: &Step| {
+        let a = s.start + s.point.settle_s;
+        (a, a + s.point.window_s)
+    };
+    chart
+        .draw_series(steps.iter().map(|s| {
+            let (a, b) = window(s);
+            let z = s.point.z[k] * scale;
+            PathElement::new([(a, z), (b, z)], color.stroke_width(4))
+        }))
+        .map_err(err)?
+        .label("window mean (the fit's data point)")
+        .legend(move |(x, y)| PathElement::new([(x, y), (x + 24, y)], color.stroke_width(4)));
+    for (i, s) in steps.iter().enumerate() {
+        let (a, b) = window(s);
+        let z = s.point.z_theory[k] * scale;
+        let series = chart
+            .draw_series(DashedLineSeries::new(
+                [(a, z), (b, z)],
+                5,
+                4,
+                BLACK.stroke_width(1),
+            ))
+            .map_err(err)?;
+        if i == 0 {
+            series
+                .label("exact theory")
+                .legend(|(x, y)| PathElement::new([(x, y), (x + 24, y)], BLACK.stroke_width(1)));
+        }
+    }
+    let label_style = text_style(13).pos(plotters::style::text_anchor::Pos::new(
+        plotters::style::text_anchor::HPos::Center,
+        plotters::style::text_anchor::VPos::Bottom,
+    ));
+    chart
+        .draw_series(steps.iter().map(|s| {
+            let (a, b) = window(s);
+            let z = s.point.z[k].max(s.point.z_theory[k]) * scale;
+            Text::new(
+                format!("{} Hz", fmt_num(s.point.cal_hz, 4)),
+                ((a + b) / 2.0, z + 0.15 * room * scale),
+                label_style.clone(),
+            )
+        }))
+        .map_err(err)?;
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperLeft)
+        .margin(8)
+        .label_font(text_style(13))
+        .background_style(WHITE.mix(0.9))
+        .border_style(LIGHT)
+        .draw()
+        .map_err(err)?;
+    Ok(())
+}

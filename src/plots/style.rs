@@ -1,0 +1,81 @@
+//! Shared look of the figures: the embedded font, colours, text styles,
+//! the title block and the choice of a free corner for a legend.
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::FontStyle;
+use std::sync::OnceLock;
+
+use super::err;
+
+/// DejaVu Sans, Latin-1, Greek and a few symbols (see assets/fonts/README.md).
+static FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans-subset.ttf");
+/// The family every text style names.
+const FAMILY: &str = "sans-serif";
+
+/// Colours of output 1 and output 2.
+pub(super) const OUT_COLOR: [RGBColor; 2] = [RGBColor(31, 119, 180), RGBColor(214, 39, 40)];
+pub(super) const GREY: RGBColor = RGBColor(110, 110, 110);
+pub(super) const LIGHT: RGBColor = RGBColor(225, 225, 225);
+/// Unit of a scale factor.
+pub(super) const SF_UNIT: &str = "(m²/s²)/(°/s)";
+
+pub(super) fn register_font() -> Result<(), String> {
+    static DONE: OnceLock<Result<(), String>> = OnceLock::new();
+    DONE.get_or_init(|| {
+        plotters::style::register_font(FAMILY, FontStyle::Normal, FONT)
+            .map_err(|_| "assets/fonts/DejaVuSans-subset.ttf: not a usable font".to_string())
+    })
+    .clone()
+}
+
+pub(super) fn text_style(size: u32) -> TextStyle<'static> {
+    (FAMILY, size).into_font().color(&BLACK)
+}
+
+/// Title (and subtitle) across the top; returns the area below.
+pub(super) fn header<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    title: &str,
+    subtitle: &str,
+) -> Result<DrawingArea<DB, Shift>, String> {
+    let (top, body) = root.split_vertically(70);
+    let (w, _) = top.dim_in_pixel();
+    let centre = |size| {
+        text_style(size).pos(plotters::style::text_anchor::Pos::new(
+            plotters::style::text_anchor::HPos::Center,
+            plotters::style::text_anchor::VPos::Top,
+        ))
+    };
+    top.draw(&Text::new(
+        title.to_string(),
+        (w as i32 / 2, 10),
+        centre(24),
+    ))
+    .map_err(err)?;
+    top.draw(&Text::new(
+        subtitle.to_string(),
+        (w as i32 / 2, 42),
+        centre(16).color(&GREY),
+    ))
+    .map_err(err)?;
+    Ok(body)
+}
+
+/// The corner of a plot, in fractions of its width and height, where the
+/// points `pts` (normalized to [0, 1]) leave a `w` x `h` box free.
+pub(super) fn free_corner(pts: &[(f64, f64)], w: f64, h: f64) -> Option<SeriesLabelPosition> {
+    use SeriesLabelPosition::*;
+    let boxes = [
+        (UpperLeft, 0.0, 1.0 - h),
+        (UpperRight, 1.0 - w, 1.0 - h),
+        (LowerRight, 1.0 - w, 0.0),
+        (LowerLeft, 0.0, 0.0),
+    ];
+    boxes.into_iter().find_map(|(pos, x0, y0)| {
+        let hit = pts.iter().any(|&(x, y)| {
+            x >= x0 - 0.02 && x <= x0 + w + 0.02 && y >= y0 - 0.02 && y <= y0 + h + 0.02
+        });
+        (!hit).then_some(pos)
+    })
+}
