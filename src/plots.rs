@@ -118,11 +118,10 @@ fn register_font() -> Result<(), String> {
     .clone()
 }
 
-/// Write `bytes` atomically (`gyrocal_hdl::export::write_atomically`),
+/// Write `bytes` atomically (`gyrocal_verify::write_atomically`),
 /// with the error as one line naming the file.
 fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
-    gyrocal_hdl::export::write_atomically(path, bytes)
-        .map_err(|e| format!("{}: {e}", path.display()))
+    gyrocal_verify::write_atomically(path, bytes).map_err(|e| format!("{}: {e}", path.display()))
 }
 
 fn render_png(fig: Figure, data: &Data, (w, h): (u32, u32)) -> Result<Vec<u8>, String> {

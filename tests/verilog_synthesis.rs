@@ -8,8 +8,8 @@
 //! parallel, and take about a minute on a 2-core machine. To rewrite
 //! RESOURCES.md after a design change: `cargo run --release -- synth`.
 
-use gyrocal_hdl::verify::synthesis::{self, SynthesisReport, Target};
-use gyrocal_hdl::verify::{self, ScratchDir, tools};
+use gyrocal_verify::synthesis::{self, SynthesisReport, Target};
+use gyrocal_verify::{self as verify, ScratchDir, tools};
 use std::sync::OnceLock;
 use std::time::Instant;
 

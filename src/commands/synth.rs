@@ -5,7 +5,7 @@
 
 use crate::Failure;
 use gyrocal_hdl::export::VERILOG_FILE;
-use gyrocal_hdl::verify::synthesis::{RESOURCES_FILE, write_resources};
+use gyrocal_verify::synthesis::{RESOURCES_FILE, write_resources};
 use std::path::PathBuf;
 
 /// Options of `gyrocal synth`.

@@ -22,8 +22,8 @@
 //! for in the final statistics. The numbers are Yosys's technology-mapped
 //! estimates, before placement and routing.
 
-use super::{ScratchDir, VerifyError, combined_output, describe, io_error, run_ok, tail, tools};
-use crate::export::TOP_MODULE;
+use crate::{ScratchDir, VerifyError, combined_output, describe, io_error, run_ok, tail, tools};
+use gyrocal_hdl::export::TOP_MODULE;
 use regex::Regex;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -131,12 +131,12 @@ pub fn synthesize(verilog: &Path, target: Target) -> Result<SynthesisReport, Ver
     let yosys = tools::yosys()?;
     let yosys_version = tools::version_line(&yosys, "-V")?;
     let dir = ScratchDir::new("yosys").map_err(io_error("cannot create a scratch folder"))?;
-    let local = dir.path().join(crate::export::VERILOG_FILE);
+    let local = dir.path().join(gyrocal_hdl::export::VERILOG_FILE);
     std::fs::copy(verilog, &local)
         .map_err(io_error(format!("cannot copy {}", verilog.display())))?;
     let script = format!(
         "read_verilog {file}; {synth}; tee -o stat.txt stat; tee -o check.txt check",
-        file = crate::export::VERILOG_FILE,
+        file = gyrocal_hdl::export::VERILOG_FILE,
         synth = target.synth_command()
     );
     let mut cmd = Command::new(&yosys);
@@ -323,7 +323,7 @@ pub fn resources_markdown(reports: &[SynthesisReport]) -> String {
 /// `out` atomically (temporary file in the same folder, then rename).
 pub fn write_resources(verilog: &Path, out: &Path) -> Result<Vec<SynthesisReport>, VerifyError> {
     let reports = synthesize_all(verilog)?;
-    crate::export::write_atomically(out, resources_markdown(&reports))
+    crate::write_atomically(out, resources_markdown(&reports))
         .map_err(io_error(format!("cannot write {}", out.display())))?;
     Ok(reports)
 }

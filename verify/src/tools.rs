@@ -137,11 +137,11 @@ pub fn yosys() -> Result<PathBuf, MissingTool> {
 }
 
 /// The first line a tool prints for `arg` (e.g. `-V`, `--version`).
-pub fn version_line(program: &Path, arg: &str) -> Result<String, super::VerifyError> {
+pub fn version_line(program: &Path, arg: &str) -> Result<String, crate::VerifyError> {
     let mut cmd = std::process::Command::new(program);
     cmd.arg(arg);
-    let (out, _) = super::run_ok(&mut cmd)?;
-    let text = super::combined_output(&out);
+    let (out, _) = crate::run_ok(&mut cmd)?;
+    let text = crate::combined_output(&out);
     Ok(text.lines().next().unwrap_or("").trim().to_owned())
 }
 
