@@ -32,10 +32,15 @@
 
 mod atomic;
 pub mod lint;
+pub mod pnr;
+pub mod pnr_log;
 pub mod replay;
+pub mod resources;
 pub mod synthesis;
+pub mod targets;
 pub mod tools;
 pub mod vectors;
+pub mod wrapper;
 
 mod scratch;
 
@@ -54,6 +59,8 @@ use std::time::Duration;
 pub enum VerifyError {
     /// A program is missing from `PATH`.
     MissingTool(tools::MissingTool),
+    /// A YoWASP program is missing from the FPGA tools' virtual environment.
+    MissingVenvTool(tools::MissingVenvTool),
     /// A file or folder could not be read or written.
     Io {
         /// What was being done.
@@ -76,6 +83,7 @@ impl std::fmt::Display for VerifyError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             VerifyError::MissingTool(m) => write!(f, "{m}"),
+            VerifyError::MissingVenvTool(m) => write!(f, "{m}"),
             VerifyError::Io { context, error } => write!(f, "{context}: {error}"),
             VerifyError::ToolFailed {
                 command,
@@ -91,6 +99,12 @@ impl std::error::Error for VerifyError {}
 impl From<tools::MissingTool> for VerifyError {
     fn from(m: tools::MissingTool) -> Self {
         VerifyError::MissingTool(m)
+    }
+}
+
+impl From<tools::MissingVenvTool> for VerifyError {
+    fn from(m: tools::MissingVenvTool) -> Self {
+        VerifyError::MissingVenvTool(m)
     }
 }
 
