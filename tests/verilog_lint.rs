@@ -4,7 +4,7 @@
 //! Requires Verilator on PATH (Debian package `verilator`); without it the
 //! tests fail with that message, they are never skipped. About 5 s.
 
-use gyrocal_hdl::verify::{self, lint};
+use gyrocal_verify::{self as verify, lint};
 
 fn verilator_present() {
     if let Err(e) = verify::tools::verilator() {

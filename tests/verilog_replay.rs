@@ -9,9 +9,9 @@
 //! on every cycle. Requires `iverilog`/`vvp` and `verilator` + `make` + `g++`
 //! on PATH; a missing tool fails the test with the Debian package to install.
 
-use gyrocal_hdl::verify::replay::{self, Simulator};
-use gyrocal_hdl::verify::vectors::{self, GoldenVectors};
-use gyrocal_hdl::verify::{self, ScratchDir, tools};
+use gyrocal_verify::replay::{self, Simulator};
+use gyrocal_verify::vectors::{self, GoldenVectors};
+use gyrocal_verify::{self as verify, ScratchDir, tools};
 use std::path::PathBuf;
 use std::sync::OnceLock;
 use std::time::Instant;

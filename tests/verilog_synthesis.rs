@@ -1,15 +1,16 @@
 //! Yosys synthesis of the committed `verilog-out/gyro_interface.v` for iCE40
 //! (`synth_ice40 -dsp`) and Xilinx 7-series (`synth_xilinx -flatten`): no
-//! latches, a clean `check`, and `verilog-out/RESOURCES.md` equal to what
-//! Yosys reports now.
+//! latches, a clean `check`, and `verilog-out/RESOURCES.md` starting with
+//! what Yosys reports now (its place-and-route section is checked by
+//! `tests/verilog_pnr.rs`).
 //!
 //! Requires `yosys` on PATH (Debian package `yosys`); without it the tests
 //! fail with that message. The two syntheses run once per test process, in
 //! parallel, and take about a minute on a 2-core machine. To rewrite
 //! RESOURCES.md after a design change: `cargo run --release -- synth`.
 
-use gyrocal_hdl::verify::synthesis::{self, SynthesisReport, Target};
-use gyrocal_hdl::verify::{self, ScratchDir, tools};
+use gyrocal_verify::synthesis::{self, SynthesisReport, Target};
+use gyrocal_verify::{self as verify, ScratchDir, tools};
 use std::sync::OnceLock;
 use std::time::Instant;
 
@@ -83,7 +84,7 @@ fn resources_md_matches_yosys() {
             path.display()
         )
     });
-    if committed != md {
+    if !committed.starts_with(&md) {
         let diff: Vec<String> = committed
             .lines()
             .zip(md.lines())
@@ -93,10 +94,9 @@ fn resources_md_matches_yosys() {
             .map(|(i, (a, b))| format!("line {}:\n  committed: {a}\n  yosys now: {b}", i + 1))
             .collect();
         panic!(
-            "{} differs from what Yosys reports now ({} vs {} lines); after checking the change, rewrite it with \
+            "{} does not start with what Yosys reports now ({} lines); after checking the change, rewrite it with \
              `cargo run --release -- synth`\n{}",
             path.display(),
-            committed.lines().count(),
             md.lines().count(),
             diff.join("\n")
         );

@@ -318,36 +318,6 @@ pub fn files() -> Vec<(&'static str, String)> {
     vec![(VERILOG_FILE, verilog()), (PORTS_FILE, ports_markdown())]
 }
 
-/// Write `bytes` to `path` through a uniquely named temporary file beside
-/// it, flushed to disk and renamed over `path`: a reader sees the old file
-/// or the whole new one, never a part, and a failed write leaves nothing
-/// behind. Permissions are those `File::create` would give (0666 less the
-/// umask), not tempfile's private 0600.
-pub fn write_atomically(path: &std::path::Path, bytes: impl AsRef<[u8]>) -> std::io::Result<()> {
-    use std::io::Write;
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => std::path::Path::new("."),
-    };
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let prefix = format!(".{name}.");
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(&prefix).suffix(".tmp");
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        builder.permissions(std::fs::Permissions::from_mode(0o666));
-    }
-    let mut tmp = builder.tempfile_in(dir)?;
-    tmp.write_all(bytes.as_ref())?;
-    tmp.as_file().sync_all()?;
-    tmp.persist(path).map_err(|e| e.error)?;
-    Ok(())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -20,4 +20,3 @@ pub mod sincos;
 pub mod sine_table;
 #[cfg(test)]
 pub(crate) mod test_util;
-pub mod verify;

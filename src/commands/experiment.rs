@@ -251,7 +251,7 @@ pub fn write_results(report: &Report, dir: &Path) -> Result<Vec<PathBuf>, Failur
     let mut written = vec![];
     for (name, text) in [("results.json", json), ("points.csv", points_csv(report))] {
         let path = dir.join(name);
-        gyrocal_hdl::export::write_atomically(&path, &text)
+        gyrocal_verify::write_atomically(&path, &text)
             .map_err(|e| Failure::Run(format!("cannot write {}: {e}", path.display())))?;
         written.push(path);
     }

@@ -33,7 +33,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         if args.check {
             stale.push(path.display().to_string());
         } else {
-            export::write_atomically(&path, &text)
+            gyrocal_verify::write_atomically(&path, &text)
                 .map_err(|e| Failure::Run(format!("cannot write {}: {e}", path.display())))?;
             println!("wrote {}", path.display());
         }

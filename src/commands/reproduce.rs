@@ -132,7 +132,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     print!("{text}");
     let mut written = write_results(&report, &args.out)?;
     let path = args.out.join("summary.txt");
-    gyrocal_hdl::export::write_atomically(&path, &text)
+    gyrocal_verify::write_atomically(&path, &text)
         .map_err(|e| Failure::Run(format!("cannot write {}: {e}", path.display())))?;
     written.push(path);
     for p in written {

@@ -163,10 +163,10 @@ fn write_plot<P: Plot>(
     Ok(vec![png_path, svg_path])
 }
 
-/// Write `bytes` atomically (`gyrocal_hdl::export::write_atomically`),
+/// Write `bytes` atomically (`gyrocal_verify::write_atomically`),
 /// with the error as one line naming the file.
 fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
-    gyrocal_hdl::export::write_atomically(path, bytes)
+    gyrocal_verify::write_atomically(path, bytes)
         .map_err(|e| format!("{}: {e}", path.display()))
 }
 

@@ -20,7 +20,12 @@ impl ScratchDir {
     /// Create a new, empty folder `gyrocal-<tag>-<pid>-<n>-<nanos>` in the
     /// system temp folder.
     pub fn new(tag: &str) -> std::io::Result<Self> {
-        let base = std::env::temp_dir();
+        Self::new_in(&std::env::temp_dir(), tag)
+    }
+
+    /// The same in `base` (the place-and-route flow uses `/var/tmp`: the
+    /// YoWASP tools run sandboxed and cannot see a private `/tmp`).
+    pub fn new_in(base: &Path, tag: &str) -> std::io::Result<Self> {
         loop {
             let n = COUNTER.fetch_add(1, Ordering::Relaxed);
             let nanos = std::time::SystemTime::now()

@@ -19,8 +19,8 @@
 //! with each waiver removed and records which warnings reappear; a waiver
 //! whose removal changes nothing is stale.
 
-use super::{ScratchDir, VerifyError, combined_output, describe, io_error, run, tail, tools};
-use crate::export::TOP_MODULE;
+use crate::{ScratchDir, VerifyError, combined_output, describe, io_error, run, tail, tools};
+use gyrocal_hdl::export::TOP_MODULE;
 use regex::Regex;
 use std::path::Path;
 use std::process::Command;

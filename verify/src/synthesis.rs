@@ -10,7 +10,7 @@
 //!             SynthesisReport { cells, LUT, FF, DSP, BRAM, latches, problems, warnings }
 //!                              │ resources_markdown()
 //!                              ▼
-//!                       verilog-out/RESOURCES.md (written atomically)
+//!                       verilog-out/RESOURCES.md, first section (crate::resources)
 //! ```
 //!
 //! Each run copies the Verilog into its own scratch folder (so the log never
@@ -22,8 +22,8 @@
 //! for in the final statistics. The numbers are Yosys's technology-mapped
 //! estimates, before placement and routing.
 
-use super::{ScratchDir, VerifyError, combined_output, describe, io_error, run_ok, tail, tools};
-use crate::export::TOP_MODULE;
+use crate::{ScratchDir, VerifyError, combined_output, describe, io_error, run_ok, tail, tools};
+use gyrocal_hdl::export::TOP_MODULE;
 use regex::Regex;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -131,12 +131,12 @@ pub fn synthesize(verilog: &Path, target: Target) -> Result<SynthesisReport, Ver
     let yosys = tools::yosys()?;
     let yosys_version = tools::version_line(&yosys, "-V")?;
     let dir = ScratchDir::new("yosys").map_err(io_error("cannot create a scratch folder"))?;
-    let local = dir.path().join(crate::export::VERILOG_FILE);
+    let local = dir.path().join(gyrocal_hdl::export::VERILOG_FILE);
     std::fs::copy(verilog, &local)
         .map_err(io_error(format!("cannot copy {}", verilog.display())))?;
     let script = format!(
         "read_verilog {file}; {synth}; tee -o stat.txt stat; tee -o check.txt check",
-        file = crate::export::VERILOG_FILE,
+        file = gyrocal_hdl::export::VERILOG_FILE,
         synth = target.synth_command()
     );
     let mut cmd = Command::new(&yosys);
@@ -250,14 +250,16 @@ pub fn synthesize_all(verilog: &Path) -> Result<Vec<SynthesisReport>, VerifyErro
     })
 }
 
-/// `RESOURCES.md` for `reports` (deterministic: no times, no paths).
+/// The Yosys section of `RESOURCES.md`, with which the file starts, for
+/// `reports` (deterministic: no times, no paths).
 pub fn resources_markdown(reports: &[SynthesisReport]) -> String {
     let mut md = String::from(
         "# gyro_interface: FPGA resources\n\n\
          Yosys's estimate for `gyro_interface.v` beside this file, after technology\n\
-         mapping and before placement and routing. Written by `gyrocal synth`;\n\
+         mapping and before placement and routing, then nextpnr's placement and\n\
+         routing on an iCE40 UP5K and an ECP5 LFE5U-25F. Written by `gyrocal synth`;\n\
          the test `tests/verilog_synthesis.rs` re-runs Yosys and fails when this\n\
-         file differs.\n\n",
+         section differs.\n\n",
     );
     let versions: Vec<&str> = reports.iter().map(|r| r.yosys_version.as_str()).collect();
     let _ = writeln!(md, "Tool: {}\n", versions.first().copied().unwrap_or("?"));
@@ -317,15 +319,6 @@ pub fn resources_markdown(reports: &[SynthesisReport]) -> String {
         }
     }
     md
-}
-
-/// Synthesize `verilog` for every target and write [`resources_markdown`] to
-/// `out` atomically (temporary file in the same folder, then rename).
-pub fn write_resources(verilog: &Path, out: &Path) -> Result<Vec<SynthesisReport>, VerifyError> {
-    let reports = synthesize_all(verilog)?;
-    crate::export::write_atomically(out, resources_markdown(&reports))
-        .map_err(io_error(format!("cannot write {}", out.display())))?;
-    Ok(reports)
 }
 
 #[cfg(test)]

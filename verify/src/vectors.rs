@@ -17,7 +17,7 @@
 //! segment, decimations 16, 37, 100, 1000 and 4096 plus a random one, extreme
 //! amplitudes (-32768 and 32767), random carrier and modulation steps,
 //! reference phases and delays (including 0 and 63), and IIR coefficients
-//! designed by `crate::filter_design` for random cut-offs over the whole
+//! designed by `gyrocal_hdl::filter_design` for random cut-offs over the whole
 //! allowed range. The ADC words alternate between bursts of uniform random
 //! words, constant full-scale (32767) and most-negative (-32768) words,
 //! full-scale square waves and slow sines (some clipping at both rails); one
@@ -27,7 +27,7 @@
 //! Everything comes from a seeded SplitMix64 generator: the same seed gives
 //! the same vectors on every machine.
 //!
-//! The expected outputs come from `crate::rtl::RtlGyroInterface`, the
+//! The expected outputs come from `gyrocal_hdl::rtl::RtlGyroInterface`, the
 //! rust-hdl design itself (not the bit-true model), at about 7,000 clocks per
 //! second in a release build.
 //!
@@ -45,10 +45,10 @@
 //!            rising edge, in `export::PORTS` order
 //! ```
 
-use crate::export::{PORTS, Port, PortDirection};
-use crate::filter_design;
-use crate::model::gyro_interface::{Outputs, Registers};
-use crate::rtl::RtlGyroInterface;
+use gyrocal_hdl::export::{PORTS, Port, PortDirection};
+use gyrocal_hdl::filter_design;
+use gyrocal_hdl::model::gyro_interface::{Outputs, Registers};
+use gyrocal_hdl::rtl::RtlGyroInterface;
 
 /// The seed of the standard vectors.
 pub const DEFAULT_SEED: u64 = 0x6779_726f_6361_6c01;

