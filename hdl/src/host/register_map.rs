@@ -545,17 +545,22 @@ pub fn markdown() -> String {
     md
 }
 
-const COHERENCE_NOTES: &str = "\n## Coherent access\n\n\
-- **z snapshot.** Reading `SAMPLE_COUNT` latches z1, z2 and that count together at the\n\
-  same clock edge: then read `Z1_LO`, `Z1_HI`, `Z2_LO`, `Z2_HI` in any order; they hold\n\
-  the sample `SAMPLE_COUNT` returned until the next `SAMPLE_COUNT` read. A read never\n\
-  mixes two samples. z = (HI << 32 | LO) / 256 in mixer LSBs.\n\
-- **mod_step.** Write `MOD_STEP_LO`, then `MOD_STEP_HI`: the 48-bit step reaches the\n\
-  datapath at once when `MOD_STEP_HI` is written, never half-updated.\n\
-- **Stream.** With `STREAM_ENABLE` = 1 every z sample enters a 4-deep FIFO feeding the\n\
-  AXI4-Stream master (`tdata` 96 bits: z1 in 39..0, z2 in 79..40, SAMPLE_COUNT's low 16\n\
-  bits in 95..80; `tlast` = 1, one sample per packet). A sample arriving while the FIFO\n\
-  is full is dropped and counted in `STREAM_OVERFLOW`.\n";
+const COHERENCE_NOTES: &str = r#"
+## Coherent access
+
+- **z snapshot.** Reading `SAMPLE_COUNT` latches z1, z2 and that count together at the
+  same clock edge: then read `Z1_LO`, `Z1_HI`, `Z2_LO`, `Z2_HI` in any order; they hold
+  the sample `SAMPLE_COUNT` returned until the next `SAMPLE_COUNT` read. A read never
+  mixes two samples. z = (HI << 32 | LO) / 256 in mixer LSBs.
+- **mod_step.** Write `MOD_STEP_LO`, then `MOD_STEP_HI`: the 48-bit step reaches the
+  datapath at once when `MOD_STEP_HI` is written, never half-updated.
+- **Stream.** With `STREAM_ENABLE` = 1 every z sample enters a 4-deep FIFO feeding the
+  AXI4-Stream master (`tdata` 96 bits: z1 in 39..0, z2 in 79..40, SAMPLE_COUNT's low 16
+  bits in 95..80; `tlast` = 1, one sample per packet). A sample arriving while the FIFO
+  is full is dropped and counted in `STREAM_OVERFLOW`.
+- **Reset.** `aresetn` low (synchronous) returns every register above to its power-up
+  value and empties the FIFO; the datapath core itself has no reset.
+"#;
 
 /// `verilog-out/gyro_interface_regs.h`: offsets, widths, power-up values.
 pub fn c_header() -> String {
