@@ -15,12 +15,29 @@ command -v yosys >/dev/null 2>&1 || missing+=(yosys)
 # Verilator's C++ build (the replay testbench and the verilator engine).
 command -v make >/dev/null 2>&1 || missing+=(make)
 command -v g++ >/dev/null 2>&1 || missing+=(g++)
+# The cocotb bus tests: a Python venv (below) and cocotb's embedded Python.
+command -v python3 >/dev/null 2>&1 || missing+=(python3)
+python3 -c "import ensurepip" >/dev/null 2>&1 || missing+=(python3-venv)
 if [ ${#missing[@]} -gt 0 ]; then
   echo "installing Debian packages: ${missing[*]}"
   SUDO=""
   [ "$(id -u)" -ne 0 ] && SUDO="sudo"
   $SUDO apt-get update -q
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q "${missing[@]}"
+fi
+
+# The bus tests (tests/axi_bus.rs) run cocotb with cocotbext-axi, a
+# third-party AXI4-Lite master, in a venv of pinned PyPI packages. cocotb 1.9
+# supports Debian's Verilator 5.006 (cocotb 2 needs a newer one); cocotb-bus
+# 0.1.1 because later versions hang Verilator 5.006 (verilator issue 3919).
+COCOTB_VENV=target/cocotb-venv
+COCOTB_PINS=("cocotb==1.9.2" "cocotb-bus==0.1.1" "cocotbext-axi==0.1.24")
+if ! "$COCOTB_VENV/bin/python" -c "
+import importlib.metadata as m, sys
+sys.exit(any(m.version(n) != v for n, v in (p.split('==') for p in sys.argv[1:])))" "${COCOTB_PINS[@]}" >/dev/null 2>&1; then
+  echo "installing cocotb into $COCOTB_VENV"
+  python3 -m venv "$COCOTB_VENV" || { echo "python3 -m venv failed: install the Debian package python3-venv"; exit 1; }
+  "$COCOTB_VENV/bin/pip" install -q --disable-pip-version-check "${COCOTB_PINS[@]}"
 fi
 
 cargo fmt --all -- --check

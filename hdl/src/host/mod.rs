@@ -15,6 +15,7 @@ pub mod rtl;
 pub mod sample_fifo;
 pub mod setting_register;
 pub mod status_word;
+pub mod traffic;
 
 /// Width of z1 and z2 (40-bit two's complement, 8 fractional bits).
 pub const Z_BITS: usize = 40;
