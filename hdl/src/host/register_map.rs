@@ -504,6 +504,24 @@ impl RegisterBank {
     }
 }
 
+/// Register access as host software sees it: whole 32-bit words at byte
+/// offsets of this map. The co-simulation implements it on its engines
+/// (`gyrocal_sim::cosim::CoSim`); a board's driver over a real AXI4-Lite
+/// bus could implement it the same way.
+pub trait RegisterAccess {
+    /// Write a word; `Err` where the slave answers SLVERR.
+    fn write_register(&mut self, offset: u32, word: u32) -> Result<(), BusError>;
+    /// Read a word; `Err` where the slave answers SLVERR.
+    fn read_register(&mut self, offset: u32) -> Result<u32, BusError>;
+}
+
+/// Program every setting of `regs` through `bus` ([`encode`]'s writes).
+pub fn program(bus: &mut impl RegisterAccess, regs: &Registers) -> Result<(), BusError> {
+    encode(regs)
+        .into_iter()
+        .try_for_each(|(offset, word)| bus.write_register(offset, word))
+}
+
 /// The 32-bit mask of the bytes a 4-bit `WSTRB` selects.
 pub fn byte_mask(strobe: u8) -> u32 {
     (0..4)
