@@ -2,7 +2,7 @@
 # Runs every test of gyrocal on a fresh Debian machine.
 #
 # Installs the tools the tests need (iverilog, verilator, yosys, make, g++,
-# nextpnr-ice40, python3-venv) with apt-get when they are missing (root,
+# nextpnr-ice40, python3, python3-venv) with apt-get when they are missing (root,
 # non-interactive) and the YoWASP ECP5 tools into a Python virtual environment
 # (scripts/fpga/install-venv.sh: $GYROCAL_FPGA_VENV, default .venv-fpga/), then runs the whole
 # test suite in release mode (the co-simulation tests need optimized code),
@@ -19,6 +19,8 @@ command -v make >/dev/null 2>&1 || missing+=(make)
 command -v g++ >/dev/null 2>&1 || missing+=(g++)
 # Place and route (tests/verilog_pnr.rs): iCE40 natively, ECP5 from PyPI.
 command -v nextpnr-ice40 >/dev/null 2>&1 || missing+=(nextpnr-ice40)
+# The ECP5 tools and the cocotb bus tests run in Python venvs (below).
+command -v python3 >/dev/null 2>&1 || missing+=(python3)
 python3 -c 'import ensurepip, venv' >/dev/null 2>&1 || missing+=(python3-venv)
 if [ ${#missing[@]} -gt 0 ]; then
   echo "installing Debian packages: ${missing[*]}"
@@ -28,6 +30,20 @@ if [ ${#missing[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q "${missing[@]}"
 fi
 scripts/fpga/install-venv.sh
+
+# The bus tests (tests/axi_bus.rs) run cocotb with cocotbext-axi, a
+# third-party AXI4-Lite master, in a venv of pinned PyPI packages. cocotb 1.9
+# supports Debian's Verilator 5.006 (cocotb 2 needs a newer one); cocotb-bus
+# 0.1.1 because later versions hang Verilator 5.006 (verilator issue 3919).
+COCOTB_VENV=target/cocotb-venv
+COCOTB_PINS=("cocotb==1.9.2" "cocotb-bus==0.1.1" "cocotbext-axi==0.1.24")
+if ! "$COCOTB_VENV/bin/python" -c "
+import importlib.metadata as m, sys
+sys.exit(any(m.version(n) != v for n, v in (p.split('==') for p in sys.argv[1:])))" "${COCOTB_PINS[@]}" >/dev/null 2>&1; then
+  echo "installing cocotb into $COCOTB_VENV"
+  python3 -m venv "$COCOTB_VENV" || { echo "python3 -m venv failed: install the Debian package python3-venv"; exit 1; }
+  "$COCOTB_VENV/bin/pip" install -q --disable-pip-version-check "${COCOTB_PINS[@]}"
+fi
 
 cargo fmt --all -- --check
 cargo clippy --release --workspace --all-targets --all-features -- -D warnings

@@ -13,10 +13,22 @@
 //! The demodulation references are lined up from the converter latencies by
 //! `gyrocal_hdl::settings` (ref_delay = L_dac + L_adc, ref_phase =
 //! carrier_step / 2), which is derived for exactly this timing.
+//!
+//! The settings reach the engine through the register map of
+//! `gyro_interface_axi` (`gyrocal_hdl::host::register_map`), as host
+//! software would program the bus-attached top: `CoSim` keeps the slave's
+//! register bank, every change is a bus write, and the engine's
+//! `Registers` are decoded from the bank once per change (never per
+//! clock). `CoSim` implements `RegisterAccess`, reads included: the z
+//! snapshot is latched by a SAMPLE_COUNT read, as in the hardware.
 
 use crate::engine::Engine;
 use crate::frontend::Converters;
 use crate::gyro::GyroModel;
+use gyrocal_hdl::host::register_map::{
+    self, BusError, RegisterAccess, RegisterBank, SAMPLE_COUNT, STREAM_OVERFLOW, Z1_HI, Z1_LO,
+    Z2_HI, Z2_LO,
+};
 use gyrocal_hdl::model::gyro_interface::{Outputs, Registers};
 
 /// Engine, converters and gyroscope in a loop.
@@ -24,24 +36,34 @@ pub struct CoSim<E: Engine> {
     engine: E,
     converters: Converters,
     gyro: GyroModel,
+    bank: RegisterBank,
     regs: Registers,
     outputs: Outputs,
     adc: (i16, i16),
     cycle: u64,
+    samples: u32,
+    snapshot: (i64, i64),
 }
 
 impl<E: Engine> CoSim<E> {
     /// A loop at power-up with the gyroscope at rest.
+    /// The registers are programmed through the register map.
     pub fn new(engine: E, converters: Converters, gyro: GyroModel, regs: Registers) -> Self {
-        Self {
+        let bank = RegisterBank::power_up();
+        let mut sim = Self {
             engine,
             converters,
             gyro,
-            regs,
+            bank,
+            regs: bank.registers(),
             outputs: Outputs::default(),
             adc: (0, 0),
             cycle: 0,
-        }
+            samples: 0,
+            snapshot: (0, 0),
+        };
+        sim.set_registers(regs);
+        sim
     }
 
     /// One clock; returns the engine's ports after the edge.
@@ -54,6 +76,7 @@ impl<E: Engine> CoSim<E> {
         self.outputs = self.engine.step(adc, &self.regs);
         self.gyro.step(force.0, force.1);
         self.cycle += 1;
+        self.samples = self.samples.wrapping_add(self.outputs.z_valid as u32);
         self.outputs
     }
 
@@ -67,9 +90,15 @@ impl<E: Engine> CoSim<E> {
         self.cycle
     }
 
-    /// Change the registers from the next clock on.
+    /// Change the registers from the next clock on, through the bus
+    /// writes of the register map.
     pub fn set_registers(&mut self, regs: Registers) {
-        self.regs = regs;
+        register_map::program(self, &regs).expect("the register map's own writes are accepted");
+    }
+
+    /// The settings the engine sees (decoded from the register bank).
+    pub fn registers(&self) -> &Registers {
+        &self.regs
     }
 
     /// Change the rotation rate (rad/s) from the next clock on.
@@ -85,5 +114,99 @@ impl<E: Engine> CoSim<E> {
     /// The gyroscope.
     pub fn gyro(&self) -> &GyroModel {
         &self.gyro
+    }
+}
+
+impl<E: Engine> RegisterAccess for CoSim<E> {
+    /// A write between two clocks: acts from the next clock on.
+    fn write_register(&mut self, offset: u32, word: u32) -> Result<(), BusError> {
+        self.bank.write(offset, word, 0xf)?;
+        self.regs = self.bank.registers();
+        Ok(())
+    }
+
+    /// A read between two clocks. STREAM_OVERFLOW is 0: the co-simulation
+    /// has no stream.
+    fn read_register(&mut self, offset: u32) -> Result<u32, BusError> {
+        let reg = register_map::lookup(offset).ok_or(BusError::Unmapped)?;
+        let z = |v: i64, high: bool| if high { (v >> 32) as u32 } else { v as u32 };
+        let (z1, z2) = self.snapshot;
+        let live = match reg.offset {
+            o if o == SAMPLE_COUNT.offset => {
+                self.snapshot = self.outputs.z;
+                self.samples
+            }
+            o if o == STREAM_OVERFLOW.offset => 0,
+            o if o == Z1_LO.offset => z(z1, false),
+            o if o == Z1_HI.offset => z(z1, true),
+            o if o == Z2_LO.offset => z(z2, false),
+            o if o == Z2_HI.offset => z(z2, true),
+            _ => return self.bank.read(offset),
+        };
+        Ok(reg.extend(live))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::engine::ModelEngine;
+    use crate::experiment::{Experiment, plan, point_loop};
+    use gyrocal_hdl::host::register_map::{CIC_DECIMATION, ID, ID_WORD};
+
+    #[test]
+    fn the_engine_is_programmed_through_the_register_map() {
+        let exp = Experiment::paper();
+        let plan = plan(&exp).unwrap();
+        let point = &plan.points[0];
+        let mut sim = point_loop::<ModelEngine>(&exp, &plan, point).unwrap();
+        assert_eq!(*sim.registers(), point.regs.at_ports());
+        assert_eq!(sim.read_register(ID.offset), Ok(ID_WORD));
+        assert_eq!(
+            sim.read_register(CIC_DECIMATION.offset),
+            Ok(u32::from(point.regs.cic_decimation))
+        );
+        assert_eq!(sim.write_register(0xfc, 1), Err(BusError::Unmapped));
+        assert_eq!(sim.write_register(ID.offset, 1), Err(BusError::ReadOnly));
+    }
+
+    #[test]
+    fn the_snapshot_holds_the_sample_the_count_names() {
+        let exp = Experiment::paper();
+        let plan = plan(&exp).unwrap();
+        let mut sim = point_loop::<ModelEngine>(&exp, &plan, &plan.points[0]).unwrap();
+        let r = u64::from(sim.registers().cic_decimation);
+        let mut last_z = (0, 0);
+        for _ in 0..40 * r {
+            let o = sim.step();
+            if o.z_valid {
+                last_z = o.z;
+            }
+        }
+        let count = sim.read_register(SAMPLE_COUNT.offset).unwrap();
+        assert!(count >= 39, "{count} samples in 40 R clocks");
+        for _ in 0..3 * r {
+            sim.step();
+        }
+        let word = |sim: &mut CoSim<ModelEngine>,
+                    lo: &register_map::Register,
+                    hi: &register_map::Register| {
+            let (lo, hi) = (
+                sim.read_register(lo.offset).unwrap(),
+                sim.read_register(hi.offset).unwrap(),
+            );
+            (i64::from(hi as i32) << 32) | i64::from(lo)
+        };
+        assert_eq!(
+            (
+                word(&mut sim, &Z1_LO, &Z1_HI),
+                word(&mut sim, &Z2_LO, &Z2_HI)
+            ),
+            last_z
+        );
+        assert_ne!(
+            last_z, sim.outputs.z,
+            "z moved on after the snapshot (else the test proves nothing)"
+        );
     }
 }

@@ -1,0 +1,27 @@
+//! The host interface: `gyro_interface_axi`, the datapath behind an
+//! AXI4-Lite register slave and an AXI4-Stream z-sample master.
+//!
+//! - [`register_map`]: the one source of the register map (decoding,
+//!   `REGISTERS.md`, the C header, `Registers` <-> bus words);
+//! - [`axi_top`]: the rust-hdl top `GyroInterfaceAxi`, built from
+//!   [`setting_register`], [`status_word`] and [`sample_fifo`];
+//! - [`model`]: its bit-true, cycle-true model; [`rtl`]: the rust-hdl
+//!   design driven directly with the same interface.
+
+pub mod axi_top;
+pub mod model;
+pub mod register_map;
+pub mod rtl;
+pub mod sample_fifo;
+pub mod setting_register;
+pub mod status_word;
+pub mod traffic;
+
+/// Width of z1 and z2 (40-bit two's complement, 8 fractional bits).
+pub const Z_BITS: usize = 40;
+/// Width of an AXI response code.
+pub const RESP_BITS: usize = 2;
+/// AXI response OKAY.
+pub const OKAY: u8 = 0;
+/// AXI response SLVERR.
+pub const SLVERR: u8 = 2;

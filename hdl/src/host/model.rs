@@ -1,0 +1,315 @@
+//! Bit-true, cycle-true model of `super::axi_top::GyroInterfaceAxi`: the
+//! datapath model plus the AXI4-Lite slave, the snapshot, the counters and
+//! the stream FIFO, register for register. `step` plays one rising edge
+//! with the inputs of the current cycle and returns the outputs after it,
+//! like every model in `crate::model`.
+
+use super::register_map::{
+    self, Access, BusError, DATA_BITS, ID_WORD, RegisterBank, SAMPLE_COUNT, STREAM_OVERFLOW,
+    VERSION_WORD, Z1_HI, Z1_LO, Z2_HI, Z2_LO,
+};
+use super::sample_fifo::FIFO_DEPTH;
+use super::{OKAY, SLVERR, Z_BITS};
+use crate::model::gyro_interface::{GyroInterface, Outputs};
+
+/// The input ports of `gyro_interface_axi` during one cycle.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BusInputs {
+    /// `aresetn` (active low).
+    pub aresetn: bool,
+    /// ADC words.
+    pub adc: (i16, i16),
+    /// `s_axil_awvalid`.
+    pub awvalid: bool,
+    /// `s_axil_awaddr` (8 bits).
+    pub awaddr: u8,
+    /// `s_axil_wvalid`.
+    pub wvalid: bool,
+    /// `s_axil_wdata`.
+    pub wdata: u32,
+    /// `s_axil_wstrb` (4 bits).
+    pub wstrb: u8,
+    /// `s_axil_bready`.
+    pub bready: bool,
+    /// `s_axil_arvalid`.
+    pub arvalid: bool,
+    /// `s_axil_araddr` (8 bits).
+    pub araddr: u8,
+    /// `s_axil_rready`.
+    pub rready: bool,
+    /// `m_axis_tready`.
+    pub tready: bool,
+}
+
+impl Default for BusInputs {
+    /// Out of reset, every valid low, every ready high, strobes all set.
+    fn default() -> Self {
+        Self {
+            aresetn: true,
+            adc: (0, 0),
+            awvalid: false,
+            awaddr: 0,
+            wvalid: false,
+            wdata: 0,
+            wstrb: 0xf,
+            bready: true,
+            arvalid: false,
+            araddr: 0,
+            rready: true,
+            tready: true,
+        }
+    }
+}
+
+/// The output ports of `gyro_interface_axi` during one cycle.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct BusOutputs {
+    /// DAC words.
+    pub dac: (i16, i16),
+    /// `s_axil_awready`.
+    pub awready: bool,
+    /// `s_axil_wready`.
+    pub wready: bool,
+    /// `s_axil_bvalid`.
+    pub bvalid: bool,
+    /// `s_axil_bresp`.
+    pub bresp: u8,
+    /// `s_axil_arready`.
+    pub arready: bool,
+    /// `s_axil_rvalid`.
+    pub rvalid: bool,
+    /// `s_axil_rdata`.
+    pub rdata: u32,
+    /// `s_axil_rresp`.
+    pub rresp: u8,
+    /// `m_axis_tvalid`.
+    pub tvalid: bool,
+    /// `m_axis_tdata` (96 bits).
+    pub tdata: u128,
+    /// `m_axis_tlast`.
+    pub tlast: bool,
+}
+
+/// The registers of the bus wrapper (everything `aresetn` resets).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Wrapper {
+    bank: RegisterBank,
+    aw_held: bool,
+    aw_index: u32,
+    w_held: bool,
+    w_data: u32,
+    w_strb: u8,
+    b_valid: bool,
+    b_resp: u8,
+    ar_held: bool,
+    ar_index: u32,
+    r_valid: bool,
+    r_data: u32,
+    r_resp: u8,
+    sample_count: u32,
+    overflow_count: u32,
+    snapshot: (u64, u64),
+    fifo: Fifo,
+}
+
+/// The stream FIFO's registers (`super::sample_fifo`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+struct Fifo {
+    slots: [u128; FIFO_DEPTH],
+    write_ptr: usize,
+    read_ptr: usize,
+    count: usize,
+}
+
+impl Fifo {
+    /// One edge; returns true when the push was dropped.
+    fn step(&mut self, push: Option<u128>, tready: bool) -> bool {
+        let full = self.count == FIFO_DEPTH;
+        let pop = self.count > 0 && tready;
+        let accept = push.is_some() && !full;
+        if let (true, Some(sample)) = (accept, push) {
+            self.slots[self.write_ptr] = sample;
+            self.write_ptr = (self.write_ptr + 1) % FIFO_DEPTH;
+        }
+        if pop {
+            self.read_ptr = (self.read_ptr + 1) % FIFO_DEPTH;
+        }
+        self.count = self.count + accept as usize - pop as usize;
+        push.is_some() && full
+    }
+}
+
+const Z_MASK: u64 = (1 << Z_BITS) - 1;
+
+impl Wrapper {
+    fn power_up() -> Self {
+        Self {
+            bank: RegisterBank::power_up(),
+            aw_held: false,
+            aw_index: 0,
+            w_held: false,
+            w_data: 0,
+            w_strb: 0,
+            b_valid: false,
+            b_resp: 0,
+            ar_held: false,
+            ar_index: 0,
+            r_valid: false,
+            r_data: 0,
+            r_resp: 0,
+            sample_count: 0,
+            overflow_count: 0,
+            snapshot: (0, 0),
+            fifo: Fifo::default(),
+        }
+    }
+
+    /// What a read of word `index` returns during this cycle.
+    fn read_word(&self, index: u32, count_now: u32) -> Result<u32, BusError> {
+        let reg = register_map::lookup(index * 4).ok_or(BusError::Unmapped)?;
+        if reg.access == Access::ReadWrite {
+            return self.bank.read(reg.offset);
+        }
+        let (z1, z2) = self.snapshot;
+        let live = match reg.offset {
+            o if o == STREAM_OVERFLOW.offset => self.overflow_count,
+            o if o == SAMPLE_COUNT.offset => count_now,
+            o if o == Z1_LO.offset => z1 as u32,
+            o if o == Z1_HI.offset => (z1 >> DATA_BITS) as u32,
+            o if o == Z2_LO.offset => z2 as u32,
+            o if o == Z2_HI.offset => (z2 >> DATA_BITS) as u32,
+            o if o == register_map::ID.offset => ID_WORD,
+            o if o == register_map::VERSION.offset => VERSION_WORD,
+            _ => unreachable!("status word {} has no source", reg.name),
+        };
+        Ok(reg.extend(live))
+    }
+}
+
+/// Cycle-true model of the bus top.
+#[derive(Clone, Debug)]
+pub struct GyroInterfaceAxi {
+    core: GyroInterface,
+    bus: Wrapper,
+}
+
+impl Default for GyroInterfaceAxi {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+fn response(result: bool) -> u8 {
+    if result { OKAY } else { SLVERR }
+}
+
+impl GyroInterfaceAxi {
+    /// The bus top at power-up.
+    pub fn new() -> Self {
+        Self {
+            core: GyroInterface::new(),
+            bus: Wrapper::power_up(),
+        }
+    }
+
+    /// The output ports during the current cycle.
+    pub fn outputs(&self) -> BusOutputs {
+        let b = &self.bus;
+        BusOutputs {
+            dac: self.core.outputs().dac,
+            awready: !b.aw_held,
+            wready: !b.w_held,
+            bvalid: b.b_valid,
+            bresp: b.b_resp,
+            arready: !b.ar_held,
+            rvalid: b.r_valid,
+            rdata: b.r_data,
+            rresp: b.r_resp,
+            tvalid: b.fifo.count > 0,
+            tdata: b.fifo.slots[b.fifo.read_ptr],
+            tlast: true,
+        }
+    }
+
+    /// The settings the datapath sees during the current cycle.
+    pub fn bank(&self) -> &RegisterBank {
+        &self.bus.bank
+    }
+
+    /// The datapath's own ports during the current cycle.
+    pub fn core_outputs(&self) -> Outputs {
+        self.core.outputs()
+    }
+
+    /// One rising edge with the inputs `i` of the current cycle.
+    pub fn step(&mut self, i: &BusInputs) -> BusOutputs {
+        let core = self.core.outputs();
+        let regs = self.bus.bank.registers();
+        let count_now = self.bus.sample_count.wrapping_add(core.z_valid as u32);
+        let now = self.bus;
+        let next = &mut self.bus;
+        // Write channel.
+        if i.awvalid && !now.aw_held {
+            next.aw_held = true;
+            next.aw_index = u32::from(i.awaddr) >> 2;
+        }
+        if i.wvalid && !now.w_held {
+            next.w_held = true;
+            next.w_data = i.wdata;
+            next.w_strb = i.wstrb & 0xf;
+        }
+        if now.aw_held && now.w_held && !now.b_valid {
+            let done = next.bank.write(now.aw_index * 4, now.w_data, now.w_strb);
+            next.aw_held = false;
+            next.w_held = false;
+            next.b_valid = true;
+            next.b_resp = response(done.is_ok());
+        }
+        if now.b_valid && i.bready {
+            next.b_valid = false;
+        }
+        // Read channel.
+        if i.arvalid && !now.ar_held {
+            next.ar_held = true;
+            next.ar_index = u32::from(i.araddr) >> 2;
+        }
+        if now.ar_held && !now.r_valid {
+            let word = now.read_word(now.ar_index, count_now);
+            next.ar_held = false;
+            next.r_valid = true;
+            next.r_data = *word.as_ref().unwrap_or(&0);
+            next.r_resp = response(word.is_ok());
+            if now.ar_index == SAMPLE_COUNT.word_index() {
+                next.snapshot = (core.z.0 as u64 & Z_MASK, core.z.1 as u64 & Z_MASK);
+            }
+        }
+        if now.r_valid && i.rready {
+            next.r_valid = false;
+        }
+        // Counters and stream.
+        next.sample_count = count_now;
+        let push =
+            (core.z_valid && now.bank.stream_enabled()).then(|| sample_word(core, count_now));
+        if next.fifo.step(push, i.tready) {
+            next.overflow_count = now.overflow_count.wrapping_add(1);
+        }
+        if !i.aresetn {
+            *next = Wrapper::power_up();
+        }
+        self.core.step(i.adc, &regs);
+        self.outputs()
+    }
+}
+
+/// The stream word of a sample: {count[15:0], z2, z1}.
+pub fn sample_word(core: Outputs, count: u32) -> u128 {
+    let z = |v: i64| u128::from(v as u64 & Z_MASK);
+    z(core.z.0) | (z(core.z.1) << Z_BITS) | (u128::from(count & 0xffff) << (2 * Z_BITS))
+}
+
+/// z1, z2 and the 16-bit sequence number of a stream word.
+pub fn unpack_sample(word: u128) -> (i64, i64, u16) {
+    let z =
+        |shift: usize| (((word >> shift) as u64 & Z_MASK) << (64 - Z_BITS)) as i64 >> (64 - Z_BITS);
+    (z(0), z(Z_BITS), (word >> (2 * Z_BITS)) as u16)
+}

@@ -1,0 +1,226 @@
+//! `gyro_interface_axi.v` under a third-party AXI4-Lite master and
+//! AXI4-Stream sink (cocotbext-axi on cocotb), in Icarus Verilog and in
+//! Verilator: the cases of `tests/axi/test_gyro_axi.py` (AW/W in either
+//! order or together, B and R backpressure, SLVERR, write and read back
+//! every setting, coherent snapshot while z updates, stream backpressure
+//! and overflow counting) plus a replay of golden vectors from the
+//! bit-true model (every output, every cycle, random bus traffic).
+//!
+//! The Python environment is a virtual environment made by
+//! `scripts/test.sh` (pinned cocotb and cocotbext-axi); its interpreter is
+//! `$GYROCAL_COCOTB_PYTHON` or `target/cocotb-venv/bin/python`. A missing
+//! tool fails the test with the package to install; nothing is skipped.
+
+use gyrocal_hdl::export;
+use gyrocal_hdl::host::model::{BusInputs, BusOutputs, GyroInterfaceAxi};
+use gyrocal_hdl::host::register_map;
+use gyrocal_hdl::host::traffic::{Bias, traffic};
+use gyrocal_hdl::settings::{FrequencyPlan, registers};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// Cycles of golden vectors replayed in each simulator.
+const REPLAY_CYCLES: usize = 3_000;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The pinned PyPI packages of the cocotb venv (as in scripts/test.sh).
+const PINS: [&str; 3] = [
+    "cocotb==1.9.2",
+    "cocotb-bus==0.1.1",
+    "cocotbext-axi==0.1.24",
+];
+
+fn python() -> PathBuf {
+    let path = std::env::var_os("GYROCAL_COCOTB_PYTHON")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| root().join("target/cocotb-venv/bin/python"));
+    assert!(
+        path.exists(),
+        "{}: missing; the cocotb tests need a Python venv with the PyPI packages \
+         cocotb==1.9.2, cocotb-bus==0.1.1 and cocotbext-axi==0.1.24 (scripts/test.sh makes it; cocotb-bus 0.1.1 because later versions hang Verilator 5.006, verilator issue 3919)",
+        path.display()
+    );
+    let pinned = Command::new(&path)
+        .arg("-c")
+        .arg(
+            "import importlib.metadata as m, sys\n\
+             sys.exit(any(m.version(n) != v for n, v in (p.split('==') for p in sys.argv[1:])))",
+        )
+        .args(PINS)
+        .status()
+        .is_ok_and(|s| s.success());
+    assert!(
+        pinned,
+        "{}: needs exactly {PINS:?} (scripts/test.sh installs them)",
+        path.display()
+    );
+    path
+}
+
+fn require(tool: &str, package: &str) {
+    let found = Command::new("sh")
+        .args(["-c", &format!("command -v {tool}")])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    assert!(
+        found,
+        "{tool} not found: install the Debian package {package}"
+    );
+}
+
+/// Bus writes for a working plan (R = 16), from the register map.
+fn program() -> String {
+    let plan = FrequencyPlan {
+        clock_hz: 10e6,
+        carrier_hz: 1.0123e6,
+        cal_hz: 5e3,
+        calibration: false,
+        amplitude: (0.9, -0.7),
+        decimation: 16,
+        butterworth_hz: 50e3,
+        rc_hz: 100e3,
+        dac_latency: 1,
+        adc_latency: 2,
+    };
+    let (regs, _) = registers(&plan).unwrap();
+    register_map::encode(&regs)
+        .iter()
+        .map(|(offset, word)| format!("0x{offset:02x} 0x{word:08x}\n"))
+        .collect()
+}
+
+fn input_line(i: &BusInputs) -> String {
+    format!(
+        "{:x} {:x} {:x} {:x} {:x} {:x} {:x} {:x} {:x} {:x} {:x} {:x} {:x}",
+        i.aresetn as u8,
+        i.adc.0 as u16,
+        i.adc.1 as u16,
+        i.awvalid as u8,
+        i.awaddr,
+        i.wvalid as u8,
+        i.wdata,
+        i.wstrb & 0xf,
+        i.bready as u8,
+        i.arvalid as u8,
+        i.araddr,
+        i.rready as u8,
+        i.tready as u8
+    )
+}
+
+fn output_line(o: &BusOutputs) -> String {
+    format!(
+        "{:x} {:x} {:x} {:x} {:x} {:x} {:x} {:x} {:x} {:x} {:x} {:x} {:x}",
+        o.dac.0 as u16,
+        o.dac.1 as u16,
+        o.awready as u8,
+        o.wready as u8,
+        o.bvalid as u8,
+        o.bresp,
+        o.arready as u8,
+        o.rvalid as u8,
+        o.rdata,
+        o.rresp,
+        o.tvalid as u8,
+        o.tdata,
+        o.tlast as u8
+    )
+}
+
+/// Line n: the inputs of cycle n | the outputs before edge n + 1 (line 0:
+/// power-up outputs), as the model computes them.
+fn golden_vectors() -> String {
+    let inputs = traffic(
+        0x00a1_0b05,
+        Bias {
+            valid: 60,
+            ready: 60,
+            tready: 50,
+        },
+        REPLAY_CYCLES,
+    );
+    let mut model = GyroInterfaceAxi::new();
+    let mut text = String::new();
+    let mut before = model.outputs();
+    for i in &inputs {
+        text.push_str(&format!("{} | {}\n", input_line(i), output_line(&before)));
+        before = model.step(i);
+    }
+    text
+}
+
+fn run_cocotb(simulator: &str) {
+    let python = python();
+    let dir = tempfile::tempdir().unwrap();
+    let (program_file, vectors_file) = (
+        dir.path().join("program.txt"),
+        dir.path().join("vectors.txt"),
+    );
+    std::fs::write(&program_file, program()).unwrap();
+    std::fs::write(&vectors_file, golden_vectors()).unwrap();
+    let verilog = root().join("verilog-out").join(export::AXI_VERILOG_FILE);
+    let out = Command::new(&python)
+        .arg(root().join("tests/axi/run.py"))
+        .arg(simulator)
+        .arg(&verilog)
+        .arg(dir.path().join("build"))
+        .env(
+            "GYRO_HEADER",
+            root().join("verilog-out").join(export::C_HEADER_FILE),
+        )
+        .env("GYRO_PROGRAM", &program_file)
+        .env("GYRO_VECTORS", &vectors_file)
+        .output()
+        .unwrap_or_else(|e| panic!("{}: {e}", python.display()));
+    let log =
+        String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr);
+    // The failing tests' tracebacks, then the summary.
+    let lines: Vec<&str> = log.lines().collect();
+    let mut report = Vec::new();
+    for (n, line) in lines.iter().enumerate() {
+        if line.contains(" failed") && line.contains("cocotb.regression") {
+            report.extend_from_slice(&lines[n..(n + 12).min(lines.len())]);
+        }
+    }
+    report.extend(lines.iter().rev().take(25).rev());
+    let tail = report.join("\n");
+    assert!(
+        out.status.success(),
+        "cocotb in {simulator} failed:\n{tail}"
+    );
+    assert!(log.contains("FAIL=0"), "no cocotb summary:\n{tail}");
+}
+
+#[test]
+fn third_party_axi_master_in_icarus() {
+    require("iverilog", "iverilog");
+    run_cocotb("icarus");
+}
+
+#[test]
+fn third_party_axi_master_in_verilator() {
+    require("verilator", "verilator");
+    require("make", "make");
+    require("g++", "g++");
+    run_cocotb("verilator");
+}
+
+#[test]
+fn program_writes_only_settings() {
+    for line in program().lines() {
+        let offset = u32::from_str_radix(
+            line.split_whitespace()
+                .next()
+                .unwrap()
+                .trim_start_matches("0x"),
+            16,
+        )
+        .unwrap();
+        let reg = register_map::lookup(offset).unwrap();
+        assert_eq!(reg.access, register_map::Access::ReadWrite, "{}", reg.name);
+    }
+    assert!(Path::new(&root().join("tests/axi/test_gyro_axi.py")).exists());
+}
