@@ -166,8 +166,7 @@ fn write_plot<P: Plot>(
 /// Write `bytes` atomically (`gyrocal_verify::write_atomically`),
 /// with the error as one line naming the file.
 fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
-    gyrocal_verify::write_atomically(path, bytes)
-        .map_err(|e| format!("{}: {e}", path.display()))
+    gyrocal_verify::write_atomically(path, bytes).map_err(|e| format!("{}: {e}", path.display()))
 }
 
 fn render_png<P: Plot>(plot: &P, (w, h): (u32, u32)) -> Result<Vec<u8>, String> {

@@ -161,6 +161,14 @@ impl Core {
             .expect("export::PORTS describes a valid core")
     }
 
+    /// The exported bus-attached top `gyro_interface_axi` in `verilog` (the
+    /// file holds its own copy of the core).
+    pub fn gyro_interface_axi(verilog: PathBuf) -> Self {
+        use gyrocal_hdl::export::{AXI_PORTS, AXI_TOP_MODULE};
+        Self::from_export(AXI_TOP_MODULE, vec![verilog], "aclk", AXI_PORTS)
+            .expect("export::AXI_PORTS describes a valid core")
+    }
+
     /// Input ports other than the clock, in the given order.
     fn data_inputs(&self) -> impl Iterator<Item = &CorePort> {
         self.ports
