@@ -8,6 +8,7 @@ pub mod drive;
 pub mod export;
 pub mod filter_design;
 pub mod gyro_interface;
+pub mod iir_channel;
 pub mod iir_lowpass;
 pub mod model;
 pub mod modulation_nco;
