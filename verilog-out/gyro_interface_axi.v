@@ -1320,24 +1320,17 @@ module gyro_interface_axi__core(clock,adc1,adc2,dac1,dac2,z1,z2,z_valid,select,c
     reg  [5:0] cic2$shift;
     wire signed [39:0] cic2$y;
     wire  cic2$valid;
-    reg  iir1$clock;
-    reg signed [39:0] iir1$x;
-    reg  iir1$x_valid;
-    reg signed [31:0] iir1$k0;
-    reg signed [31:0] iir1$k1;
-    reg signed [31:0] iir1$k2;
-    reg signed [31:0] iir1$alpha;
-    wire signed [39:0] iir1$z;
-    wire  iir1$z_valid;
-    reg  iir2$clock;
-    reg signed [39:0] iir2$x;
-    reg  iir2$x_valid;
-    reg signed [31:0] iir2$k0;
-    reg signed [31:0] iir2$k1;
-    reg signed [31:0] iir2$k2;
-    reg signed [31:0] iir2$alpha;
-    wire signed [39:0] iir2$z;
-    wire  iir2$z_valid;
+    reg  iir$clock;
+    reg signed [39:0] iir$x1;
+    reg signed [39:0] iir$x2;
+    reg  iir$x_valid;
+    reg signed [31:0] iir$k0;
+    reg signed [31:0] iir$k1;
+    reg signed [31:0] iir$k2;
+    reg signed [31:0] iir$alpha;
+    wire signed [39:0] iir$z1;
+    wire signed [39:0] iir$z2;
+    wire  iir$z_valid;
 
     // Sub module instances
     gyro_interface_axi__core__carrier_nco carrier_nco(
@@ -1405,27 +1398,18 @@ module gyro_interface_axi__core(clock,adc1,adc2,dac1,dac2,z1,z2,z_valid,select,c
         .y(cic2$y),
         .valid(cic2$valid)
     );
-    gyro_interface_axi__core__iir1 iir1(
-        .clock(iir1$clock),
-        .x(iir1$x),
-        .x_valid(iir1$x_valid),
-        .k0(iir1$k0),
-        .k1(iir1$k1),
-        .k2(iir1$k2),
-        .alpha(iir1$alpha),
-        .z(iir1$z),
-        .z_valid(iir1$z_valid)
-    );
-    gyro_interface_axi__core__iir2 iir2(
-        .clock(iir2$clock),
-        .x(iir2$x),
-        .x_valid(iir2$x_valid),
-        .k0(iir2$k0),
-        .k1(iir2$k1),
-        .k2(iir2$k2),
-        .alpha(iir2$alpha),
-        .z(iir2$z),
-        .z_valid(iir2$z_valid)
+    gyro_interface_axi__core__iir iir(
+        .clock(iir$clock),
+        .x1(iir$x1),
+        .x2(iir$x2),
+        .x_valid(iir$x_valid),
+        .k0(iir$k0),
+        .k1(iir$k1),
+        .k2(iir$k2),
+        .alpha(iir$alpha),
+        .z1(iir$z1),
+        .z2(iir$z2),
+        .z_valid(iir$z_valid)
     );
 
     // Update code
@@ -1437,8 +1421,7 @@ module gyro_interface_axi__core(clock,adc1,adc2,dac1,dac2,z1,z2,z_valid,select,c
         demod_mux$clock = clock;
         cic1$clock = clock;
         cic2$clock = clock;
-        iir1$clock = clock;
-        iir2$clock = clock;
+        iir$clock = clock;
         carrier_nco$step = carrier_step;
         carrier_nco$ref_offset = ref_phase;
         modulation_nco$step = mod_step;
@@ -1467,21 +1450,16 @@ module gyro_interface_axi__core(clock,adc1,adc2,dac1,dac2,z1,z2,z_valid,select,c
         cic2$decimation = cic_decimation;
         cic1$shift = cic_shift;
         cic2$shift = cic_shift;
-        iir1$x = cic1$y;
-        iir2$x = cic2$y;
-        iir1$x_valid = cic1$valid;
-        iir2$x_valid = cic2$valid;
-        iir1$k0 = iir_k0;
-        iir2$k0 = iir_k0;
-        iir1$k1 = iir_k1;
-        iir2$k1 = iir_k1;
-        iir1$k2 = iir_k2;
-        iir2$k2 = iir_k2;
-        iir1$alpha = iir_alpha;
-        iir2$alpha = iir_alpha;
-        z1 = iir1$z;
-        z2 = iir2$z;
-        z_valid = iir1$z_valid;
+        iir$x1 = cic1$y;
+        iir$x2 = cic2$y;
+        iir$x_valid = cic1$valid;
+        iir$k0 = iir_k0;
+        iir$k1 = iir_k1;
+        iir$k2 = iir_k2;
+        iir$alpha = iir_alpha;
+        z1 = iir$z1;
+        z2 = iir$z2;
+        z_valid = iir$z_valid;
     end
 
 endmodule // gyro_interface_axi__core
@@ -5228,40 +5206,43 @@ module gyro_interface_axi__core__demod_mux__reference2(d,q,clock);
 endmodule // gyro_interface_axi__core__demod_mux__reference2
 
 
-module gyro_interface_axi__core__iir1(clock,x,x_valid,k0,k1,k2,alpha,z,z_valid);
+module gyro_interface_axi__core__iir(clock,x1,x2,x_valid,k0,k1,k2,alpha,z1,z2,z_valid);
 
     // Module arguments
     input wire  clock;
-    input wire signed [39:0] x;
+    input wire signed [39:0] x1;
+    input wire signed [39:0] x2;
     input wire  x_valid;
     input wire signed [31:0] k0;
     input wire signed [31:0] k1;
     input wire signed [31:0] k2;
     input wire signed [31:0] alpha;
-    output reg signed [39:0] z;
+    output reg signed [39:0] z1;
+    output reg signed [39:0] z2;
     output reg  z_valid;
 
-    // Constant declarations
-    localparam signed half_coefficient_lsb_96 = 96'h20000000;
-    localparam signed half_coefficient_lsb_92 = 92'h20000000;
-    localparam signed half_output_lsb = 58'h8000;
+    // Enums
+    localparam IirStep$Idle = 0;
+    localparam IirStep$IssueY2First = 1;
+    localparam IirStep$IssueVFirst = 2;
+    localparam IirStep$IssueY1Second = 3;
+    localparam IirStep$IssueY2Second = 4;
+    localparam IirStep$IssueVSecond = 5;
+    localparam IirStep$AccumulateFirst = 6;
+    localparam IirStep$FinishFirst = 7;
+    localparam IirStep$AccumulateSecondY1 = 8;
+    localparam IirStep$AccumulateSecondY2 = 9;
+    localparam IirStep$FinishSecond = 10;
+    localparam IirStep$WaitFirstRc = 11;
+    localparam IirStep$UpdateFirstRc = 12;
+    localparam IirStep$WaitSecondRc1 = 13;
+    localparam IirStep$WaitSecondRc2 = 14;
+    localparam IirStep$UpdateSecondRc = 15;
 
     // Stub signals
     reg  [3:0] step$d;
     wire  [3:0] step$q;
     reg  step$clock;
-    reg signed [39:0] x0$d;
-    wire signed [39:0] x0$q;
-    reg  x0$clock;
-    reg signed [39:0] x1$d;
-    wire signed [39:0] x1$q;
-    reg  x1$clock;
-    reg signed [39:0] x2$d;
-    wire signed [39:0] x2$q;
-    reg  x2$clock;
-    reg signed [59:0] v$d;
-    wire signed [59:0] v$q;
-    reg  v$clock;
     reg signed [59:0] operand$d;
     wire signed [59:0] operand$q;
     reg  operand$clock;
@@ -5272,111 +5253,101 @@ module gyro_interface_axi__core__iir1(clock,x,x_valid,k0,k1,k2,alpha,z,z_valid);
     reg signed [59:0] mac$a;
     reg signed [31:0] mac$b;
     wire signed [91:0] mac$p;
-    reg signed [95:0] accumulator$d;
-    wire signed [95:0] accumulator$q;
-    reg  accumulator$clock;
-    reg signed [57:0] y1$d;
-    wire signed [57:0] y1$q;
-    reg  y1$clock;
-    reg signed [57:0] y2$d;
-    wire signed [57:0] y2$q;
-    reg  y2$clock;
-    reg signed [57:0] u$d;
-    wire signed [57:0] u$q;
-    reg  u$clock;
-    reg signed [39:0] z_out$d;
-    wire signed [39:0] z_out$q;
-    reg  z_out$clock;
+    reg  channel1$clock;
+    reg signed [39:0] channel1$x;
+    reg signed [91:0] channel1$product;
+    reg  channel1$start;
+    reg  channel1$preload;
+    reg  channel1$accumulate;
+    reg  channel1$finish;
+    reg  channel1$update_u;
+    reg  channel1$publish;
+    wire signed [59:0] channel1$y1;
+    wire signed [59:0] channel1$y2;
+    wire signed [59:0] channel1$v;
+    wire signed [59:0] channel1$difference;
+    wire signed [39:0] channel1$z;
+    reg  channel2$clock;
+    reg signed [39:0] channel2$x;
+    reg signed [91:0] channel2$product;
+    reg  channel2$start;
+    reg  channel2$preload;
+    reg  channel2$accumulate;
+    reg  channel2$finish;
+    reg  channel2$update_u;
+    reg  channel2$publish;
+    wire signed [59:0] channel2$y1;
+    wire signed [59:0] channel2$y2;
+    wire signed [59:0] channel2$v;
+    wire signed [59:0] channel2$difference;
+    wire signed [39:0] channel2$z;
+    reg  publishing$d;
+    wire  publishing$q;
+    reg  publishing$clock;
     reg  z_valid_out$d;
     wire  z_valid_out$q;
     reg  z_valid_out$clock;
 
-    // Local signals
-    reg signed [59:0] x0_wide;
-    reg signed [59:0] x1_wide;
-    reg signed [59:0] x2_wide;
-    reg signed [59:0] v_sum;
-    reg  [59:0] v_shifted;
-    reg signed [59:0] y1_wide;
-    reg signed [59:0] y2_wide;
-    reg signed [59:0] u_wide;
-    reg signed [95:0] product_wide;
-    reg signed [95:0] accumulator_rounded;
-    reg signed [59:0] accumulator_scaled;
-    reg signed [59:0] y_new;
-    reg signed [91:0] product_rounded;
-    reg signed [59:0] product_scaled;
-    reg signed [59:0] u_new;
-    reg signed [57:0] u_rounded;
-
     // Sub module instances
-    gyro_interface_axi__core__iir1__step step(
+    gyro_interface_axi__core__iir__step step(
         .d(step$d),
         .q(step$q),
         .clock(step$clock)
     );
-    gyro_interface_axi__core__iir1__x0 x0(
-        .d(x0$d),
-        .q(x0$q),
-        .clock(x0$clock)
-    );
-    gyro_interface_axi__core__iir1__x1 x1(
-        .d(x1$d),
-        .q(x1$q),
-        .clock(x1$clock)
-    );
-    gyro_interface_axi__core__iir1__x2 x2(
-        .d(x2$d),
-        .q(x2$q),
-        .clock(x2$clock)
-    );
-    gyro_interface_axi__core__iir1__v v(
-        .d(v$d),
-        .q(v$q),
-        .clock(v$clock)
-    );
-    gyro_interface_axi__core__iir1__operand operand(
+    gyro_interface_axi__core__iir__operand operand(
         .d(operand$d),
         .q(operand$q),
         .clock(operand$clock)
     );
-    gyro_interface_axi__core__iir1__coefficient coefficient(
+    gyro_interface_axi__core__iir__coefficient coefficient(
         .d(coefficient$d),
         .q(coefficient$q),
         .clock(coefficient$clock)
     );
-    gyro_interface_axi__core__iir1__mac mac(
+    gyro_interface_axi__core__iir__mac mac(
         .clock(mac$clock),
         .a(mac$a),
         .b(mac$b),
         .p(mac$p)
     );
-    gyro_interface_axi__core__iir1__accumulator accumulator(
-        .d(accumulator$d),
-        .q(accumulator$q),
-        .clock(accumulator$clock)
+    gyro_interface_axi__core__iir__channel1 channel1(
+        .clock(channel1$clock),
+        .x(channel1$x),
+        .product(channel1$product),
+        .start(channel1$start),
+        .preload(channel1$preload),
+        .accumulate(channel1$accumulate),
+        .finish(channel1$finish),
+        .update_u(channel1$update_u),
+        .publish(channel1$publish),
+        .y1(channel1$y1),
+        .y2(channel1$y2),
+        .v(channel1$v),
+        .difference(channel1$difference),
+        .z(channel1$z)
     );
-    gyro_interface_axi__core__iir1__y1 y1(
-        .d(y1$d),
-        .q(y1$q),
-        .clock(y1$clock)
+    gyro_interface_axi__core__iir__channel2 channel2(
+        .clock(channel2$clock),
+        .x(channel2$x),
+        .product(channel2$product),
+        .start(channel2$start),
+        .preload(channel2$preload),
+        .accumulate(channel2$accumulate),
+        .finish(channel2$finish),
+        .update_u(channel2$update_u),
+        .publish(channel2$publish),
+        .y1(channel2$y1),
+        .y2(channel2$y2),
+        .v(channel2$v),
+        .difference(channel2$difference),
+        .z(channel2$z)
     );
-    gyro_interface_axi__core__iir1__y2 y2(
-        .d(y2$d),
-        .q(y2$q),
-        .clock(y2$clock)
+    gyro_interface_axi__core__iir__publishing publishing(
+        .d(publishing$d),
+        .q(publishing$q),
+        .clock(publishing$clock)
     );
-    gyro_interface_axi__core__iir1__u u(
-        .d(u$d),
-        .q(u$q),
-        .clock(u$clock)
-    );
-    gyro_interface_axi__core__iir1__z_out z_out(
-        .d(z_out$d),
-        .q(z_out$q),
-        .clock(z_out$clock)
-    );
-    gyro_interface_axi__core__iir1__z_valid_out z_valid_out(
+    gyro_interface_axi__core__iir__z_valid_out z_valid_out(
         .d(z_valid_out$d),
         .q(z_valid_out$q),
         .clock(z_valid_out$clock)
@@ -5385,134 +5356,940 @@ module gyro_interface_axi__core__iir1(clock,x,x_valid,k0,k1,k2,alpha,z,z_valid);
     // Update code
     always @(*) begin
         step$clock = clock;
-        x0$clock = clock;
-        x1$clock = clock;
-        x2$clock = clock;
-        v$clock = clock;
         operand$clock = clock;
         coefficient$clock = clock;
-        accumulator$clock = clock;
-        y1$clock = clock;
-        y2$clock = clock;
-        u$clock = clock;
-        z_out$clock = clock;
+        publishing$clock = clock;
         z_valid_out$clock = clock;
         step$d = step$q;
-        x0$d = x0$q;
-        x1$d = x1$q;
-        x2$d = x2$q;
-        v$d = v$q;
         operand$d = operand$q;
         coefficient$d = coefficient$q;
-        accumulator$d = accumulator$q;
-        y1$d = y1$q;
-        y2$d = y2$q;
-        u$d = u$q;
-        z_out$d = z_out$q;
+        publishing$d = publishing$q;
         z_valid_out$d = z_valid_out$q;
         mac$clock = clock;
+        channel1$clock = clock;
+        channel2$clock = clock;
         mac$a = operand$q;
         mac$b = coefficient$q;
-        x0_wide = $signed(x0$q);
-        x1_wide = $signed(x1$q);
-        x2_wide = $signed(x2$q);
-        v_sum = x0_wide + x1_wide + x1_wide + x2_wide;
-        v_shifted = $unsigned(v_sum) << 32'h10;
-        y1_wide = $signed(y1$q);
-        y2_wide = $signed(y2$q);
-        u_wide = $signed(u$q);
-        product_wide = $signed(mac$p);
-        accumulator_rounded = accumulator$q + half_coefficient_lsb_96;
-        accumulator_scaled = accumulator_rounded[(32'h1e)+:(60)];
-        y_new = y1_wide + y1_wide - y2_wide + accumulator_scaled;
-        product_rounded = mac$p + half_coefficient_lsb_92;
-        product_scaled = product_rounded[(32'h1e)+:(60)];
-        u_new = u_wide + product_scaled;
-        u_rounded = u$q + half_output_lsb;
-        z_valid_out$d = 1'b0;
-        if ((step$q == 32'h0) && x_valid) begin
-            x0$d = x;
-            x1$d = x0$q;
-            x2$d = x1$q;
-            step$d = 32'h1;
-        end
-        if (step$q == 32'h1) begin
-            v$d = $signed(v_shifted);
-            step$d = 32'h2;
-        end
-        if (step$q == 32'h2) begin
-            operand$d = v$q;
-            coefficient$d = k0;
-            step$d = 32'h3;
-        end
-        if (step$q == 32'h3) begin
-            operand$d = y1_wide;
-            coefficient$d = k1;
-            step$d = 32'h4;
-        end
-        if (step$q == 32'h4) begin
-            operand$d = y2_wide;
-            coefficient$d = k2;
-            accumulator$d = product_wide;
-            step$d = 32'h5;
-        end
-        if (step$q == 32'h5) begin
-            accumulator$d = accumulator$q + product_wide;
-            step$d = 32'h6;
-        end
-        if (step$q == 32'h6) begin
-            accumulator$d = accumulator$q + product_wide;
-            step$d = 32'h7;
-        end
-        if (step$q == 32'h7) begin
-            y1$d = y_new[(32'h0)+:(58)];
-            y2$d = y1$q;
-            step$d = 32'h8;
-        end
-        if (step$q == 32'h8) begin
-            operand$d = y1_wide - u_wide;
-            coefficient$d = alpha;
-            step$d = 32'h9;
-        end
-        if (step$q == 32'h9) begin
-            step$d = 32'ha;
-        end
-        if (step$q == 32'ha) begin
-            u$d = u_new[(32'h0)+:(58)];
-            step$d = 32'hb;
-        end
-        if (step$q == 32'hb) begin
-            z_out$d = u_rounded[(32'h10)+:(40)];
-            z_valid_out$d = 1'b1;
-            step$d = 32'h0;
-        end
-        z = z_out$q;
+        channel1$x = x1;
+        channel2$x = x2;
+        channel1$product = mac$p;
+        channel2$product = mac$p;
+        channel1$start = 1'b0;
+        channel2$start = 1'b0;
+        channel1$preload = 1'b0;
+        channel2$preload = 1'b0;
+        channel1$accumulate = 1'b0;
+        channel2$accumulate = 1'b0;
+        channel1$finish = 1'b0;
+        channel2$finish = 1'b0;
+        channel1$update_u = 1'b0;
+        channel2$update_u = 1'b0;
+        channel1$publish = publishing$q;
+        channel2$publish = publishing$q;
+        z_valid_out$d = publishing$q;
+        publishing$d = 1'b0;
+        case (step$q)
+            IirStep$Idle:
+                begin
+                    if (x_valid) begin
+                        channel1$start = 1'b1;
+                        channel2$start = 1'b1;
+                        operand$d = channel1$y1;
+                        coefficient$d = k1;
+                        step$d = IirStep$IssueY2First;
+                    end
+                end
+            IirStep$IssueY2First:
+                begin
+                    channel1$preload = 1'b1;
+                    channel2$preload = 1'b1;
+                    operand$d = channel1$y2;
+                    coefficient$d = k2;
+                    step$d = IirStep$IssueVFirst;
+                end
+            IirStep$IssueVFirst:
+                begin
+                    operand$d = channel1$v;
+                    coefficient$d = k0;
+                    step$d = IirStep$IssueY1Second;
+                end
+            IirStep$IssueY1Second:
+                begin
+                    operand$d = channel2$y1;
+                    coefficient$d = k1;
+                    step$d = IirStep$IssueY2Second;
+                end
+            IirStep$IssueY2Second:
+                begin
+                    operand$d = channel2$y2;
+                    coefficient$d = k2;
+                    step$d = IirStep$IssueVSecond;
+                end
+            IirStep$IssueVSecond:
+                begin
+                    operand$d = channel2$v;
+                    coefficient$d = k0;
+                    channel1$accumulate = 1'b1;
+                    step$d = IirStep$AccumulateFirst;
+                end
+            IirStep$AccumulateFirst:
+                begin
+                    channel1$accumulate = 1'b1;
+                    step$d = IirStep$FinishFirst;
+                end
+            IirStep$FinishFirst:
+                begin
+                    channel1$finish = 1'b1;
+                    operand$d = channel1$difference;
+                    coefficient$d = alpha;
+                    step$d = IirStep$AccumulateSecondY1;
+                end
+            IirStep$AccumulateSecondY1:
+                begin
+                    channel2$accumulate = 1'b1;
+                    step$d = IirStep$AccumulateSecondY2;
+                end
+            IirStep$AccumulateSecondY2:
+                begin
+                    channel2$accumulate = 1'b1;
+                    step$d = IirStep$FinishSecond;
+                end
+            IirStep$FinishSecond:
+                begin
+                    channel2$finish = 1'b1;
+                    operand$d = channel2$difference;
+                    coefficient$d = alpha;
+                    step$d = IirStep$WaitFirstRc;
+                end
+            IirStep$WaitFirstRc:
+                begin
+                    step$d = IirStep$UpdateFirstRc;
+                end
+            IirStep$UpdateFirstRc:
+                begin
+                    channel1$update_u = 1'b1;
+                    step$d = IirStep$WaitSecondRc1;
+                end
+            IirStep$WaitSecondRc1:
+                begin
+                    step$d = IirStep$WaitSecondRc2;
+                end
+            IirStep$WaitSecondRc2:
+                begin
+                    step$d = IirStep$UpdateSecondRc;
+                end
+            IirStep$UpdateSecondRc:
+                begin
+                    channel2$update_u = 1'b1;
+                    publishing$d = 1'b1;
+                    step$d = IirStep$Idle;
+                end
+        endcase
+        z1 = channel1$z;
+        z2 = channel2$z;
         z_valid = z_valid_out$q;
     end
 
-endmodule // gyro_interface_axi__core__iir1
+endmodule // gyro_interface_axi__core__iir
 
 
-module gyro_interface_axi__core__iir1__accumulator(d,q,clock);
+module gyro_interface_axi__core__iir__channel1(clock,x,product,start,preload,accumulate,finish,update_u,publish,y1,y2,v,difference,z);
 
     // Module arguments
-    input wire signed [95:0] d;
-    output reg signed [95:0] q;
+    input wire  clock;
+    input wire signed [39:0] x;
+    input wire signed [91:0] product;
+    input wire  start;
+    input wire  preload;
+    input wire  accumulate;
+    input wire  finish;
+    input wire  update_u;
+    input wire  publish;
+    output reg signed [59:0] y1;
+    output reg signed [59:0] y2;
+    output reg signed [59:0] v;
+    output reg signed [59:0] difference;
+    output reg signed [39:0] z;
+
+    // Constant declarations
+    localparam  half_coefficient_lsb = 94'h20000000;
+    localparam signed half_output_lsb = 58'h8000;
+
+    // Stub signals
+    reg signed [39:0] x0$d;
+    wire signed [39:0] x0$q;
+    reg  x0$clock;
+    reg signed [39:0] x1$d;
+    wire signed [39:0] x1$q;
+    reg  x1$clock;
+    reg signed [59:0] v_reg$d;
+    wire signed [59:0] v_reg$q;
+    reg  v_reg$clock;
+    reg signed [59:0] feedback$d;
+    wire signed [59:0] feedback$q;
+    reg  feedback$clock;
+    reg signed [93:0] acc_y$d;
+    wire signed [93:0] acc_y$q;
+    reg  acc_y$clock;
+    reg signed [93:0] acc_d$d;
+    wire signed [93:0] acc_d$q;
+    reg  acc_d$clock;
+    reg signed [57:0] y1_reg$d;
+    wire signed [57:0] y1_reg$q;
+    reg  y1_reg$clock;
+    reg signed [57:0] y2_reg$d;
+    wire signed [57:0] y2_reg$q;
+    reg  y2_reg$clock;
+    reg signed [57:0] u$d;
+    wire signed [57:0] u$q;
+    reg  u$clock;
+    reg signed [39:0] z_out$d;
+    wire signed [39:0] z_out$q;
+    reg  z_out$clock;
+
+    // Local signals
+    reg signed [59:0] x_wide;
+    reg signed [59:0] x0_wide;
+    reg signed [59:0] x1_wide;
+    reg signed [59:0] v_sum;
+    reg  [59:0] v_shifted;
+    reg signed [59:0] y1_wide;
+    reg signed [59:0] y2_wide;
+    reg signed [59:0] u_wide;
+    reg signed [59:0] feedback_minus_u;
+    reg signed [93:0] feedback_long;
+    reg signed [93:0] difference_long;
+    reg signed [93:0] u_long;
+    reg signed [93:0] product_long;
+    reg  [93:0] preload_y;
+    reg  [93:0] preload_d;
+    reg  [93:0] u_scaled;
+    reg signed [93:0] sum_y;
+    reg signed [93:0] sum_d;
+    reg signed [93:0] sum_u;
+    reg signed [57:0] y_new;
+    reg signed [57:0] u_new;
+    reg signed [57:0] u_rounded;
+
+    // Sub module instances
+    gyro_interface_axi__core__iir__channel1__x0 x0(
+        .d(x0$d),
+        .q(x0$q),
+        .clock(x0$clock)
+    );
+    gyro_interface_axi__core__iir__channel1__x1 x1(
+        .d(x1$d),
+        .q(x1$q),
+        .clock(x1$clock)
+    );
+    gyro_interface_axi__core__iir__channel1__v_reg v_reg(
+        .d(v_reg$d),
+        .q(v_reg$q),
+        .clock(v_reg$clock)
+    );
+    gyro_interface_axi__core__iir__channel1__feedback feedback(
+        .d(feedback$d),
+        .q(feedback$q),
+        .clock(feedback$clock)
+    );
+    gyro_interface_axi__core__iir__channel1__acc_y acc_y(
+        .d(acc_y$d),
+        .q(acc_y$q),
+        .clock(acc_y$clock)
+    );
+    gyro_interface_axi__core__iir__channel1__acc_d acc_d(
+        .d(acc_d$d),
+        .q(acc_d$q),
+        .clock(acc_d$clock)
+    );
+    gyro_interface_axi__core__iir__channel1__y1_reg y1_reg(
+        .d(y1_reg$d),
+        .q(y1_reg$q),
+        .clock(y1_reg$clock)
+    );
+    gyro_interface_axi__core__iir__channel1__y2_reg y2_reg(
+        .d(y2_reg$d),
+        .q(y2_reg$q),
+        .clock(y2_reg$clock)
+    );
+    gyro_interface_axi__core__iir__channel1__u u(
+        .d(u$d),
+        .q(u$q),
+        .clock(u$clock)
+    );
+    gyro_interface_axi__core__iir__channel1__z_out z_out(
+        .d(z_out$d),
+        .q(z_out$q),
+        .clock(z_out$clock)
+    );
+
+    // Update code
+    always @(*) begin
+        x0$clock = clock;
+        x1$clock = clock;
+        v_reg$clock = clock;
+        feedback$clock = clock;
+        acc_y$clock = clock;
+        acc_d$clock = clock;
+        y1_reg$clock = clock;
+        y2_reg$clock = clock;
+        u$clock = clock;
+        z_out$clock = clock;
+        x0$d = x0$q;
+        x1$d = x1$q;
+        v_reg$d = v_reg$q;
+        feedback$d = feedback$q;
+        acc_y$d = acc_y$q;
+        acc_d$d = acc_d$q;
+        y1_reg$d = y1_reg$q;
+        y2_reg$d = y2_reg$q;
+        u$d = u$q;
+        z_out$d = z_out$q;
+        x_wide = $signed(x);
+        x0_wide = $signed(x0$q);
+        x1_wide = $signed(x1$q);
+        y1_wide = $signed(y1_reg$q);
+        y2_wide = $signed(y2_reg$q);
+        u_wide = $signed(u$q);
+        v_sum = x_wide + x0_wide + x0_wide + x1_wide;
+        v_shifted = $unsigned(v_sum) << 32'h10;
+        feedback_minus_u = feedback$q - u_wide;
+        feedback_long = $signed(feedback$q);
+        difference_long = $signed(feedback_minus_u);
+        u_long = $signed(u$q);
+        product_long = $signed(product);
+        preload_y = ($unsigned(feedback_long) << 32'h1e) | half_coefficient_lsb;
+        preload_d = ($unsigned(difference_long) << 32'h1e) | half_coefficient_lsb;
+        u_scaled = ($unsigned(u_long) << 32'h1e) | half_coefficient_lsb;
+        sum_y = acc_y$q + product_long;
+        sum_d = acc_d$q + product_long;
+        sum_u = $signed(u_scaled) + product_long;
+        y_new = sum_y[(32'h1e)+:(58)];
+        u_new = sum_u[(32'h1e)+:(58)];
+        difference = sum_d[(32'h1e)+:(60)];
+        u_rounded = u$q + half_output_lsb;
+        if (start) begin
+            x0$d = x;
+            x1$d = x0$q;
+            v_reg$d = $signed(v_shifted);
+            feedback$d = y1_wide + y1_wide - y2_wide;
+        end
+        if (preload) begin
+            acc_y$d = $signed(preload_y);
+            acc_d$d = $signed(preload_d);
+        end
+        if (accumulate) begin
+            acc_y$d = sum_y;
+            acc_d$d = sum_d;
+        end
+        if (finish) begin
+            y1_reg$d = y_new;
+            y2_reg$d = y1_reg$q;
+        end
+        if (update_u) begin
+            u$d = u_new;
+        end
+        if (publish) begin
+            z_out$d = u_rounded[(32'h10)+:(40)];
+        end
+        y1 = y1_wide;
+        y2 = y2_wide;
+        v = v_reg$q;
+        z = z_out$q;
+    end
+
+endmodule // gyro_interface_axi__core__iir__channel1
+
+
+module gyro_interface_axi__core__iir__channel1__acc_d(d,q,clock);
+
+    // Module arguments
+    input wire signed [93:0] d;
+    output reg signed [93:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 96'h0;
+       q = 94'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__iir1__accumulator
+endmodule // gyro_interface_axi__core__iir__channel1__acc_d
 
 
-module gyro_interface_axi__core__iir1__coefficient(d,q,clock);
+module gyro_interface_axi__core__iir__channel1__acc_y(d,q,clock);
+
+    // Module arguments
+    input wire signed [93:0] d;
+    output reg signed [93:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 94'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__iir__channel1__acc_y
+
+
+module gyro_interface_axi__core__iir__channel1__feedback(d,q,clock);
+
+    // Module arguments
+    input wire signed [59:0] d;
+    output reg signed [59:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 60'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__iir__channel1__feedback
+
+
+module gyro_interface_axi__core__iir__channel1__u(d,q,clock);
+
+    // Module arguments
+    input wire signed [57:0] d;
+    output reg signed [57:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 58'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__iir__channel1__u
+
+
+module gyro_interface_axi__core__iir__channel1__v_reg(d,q,clock);
+
+    // Module arguments
+    input wire signed [59:0] d;
+    output reg signed [59:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 60'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__iir__channel1__v_reg
+
+
+module gyro_interface_axi__core__iir__channel1__x0(d,q,clock);
+
+    // Module arguments
+    input wire signed [39:0] d;
+    output reg signed [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__iir__channel1__x0
+
+
+module gyro_interface_axi__core__iir__channel1__x1(d,q,clock);
+
+    // Module arguments
+    input wire signed [39:0] d;
+    output reg signed [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__iir__channel1__x1
+
+
+module gyro_interface_axi__core__iir__channel1__y1_reg(d,q,clock);
+
+    // Module arguments
+    input wire signed [57:0] d;
+    output reg signed [57:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 58'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__iir__channel1__y1_reg
+
+
+module gyro_interface_axi__core__iir__channel1__y2_reg(d,q,clock);
+
+    // Module arguments
+    input wire signed [57:0] d;
+    output reg signed [57:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 58'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__iir__channel1__y2_reg
+
+
+module gyro_interface_axi__core__iir__channel1__z_out(d,q,clock);
+
+    // Module arguments
+    input wire signed [39:0] d;
+    output reg signed [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__iir__channel1__z_out
+
+
+module gyro_interface_axi__core__iir__channel2(clock,x,product,start,preload,accumulate,finish,update_u,publish,y1,y2,v,difference,z);
+
+    // Module arguments
+    input wire  clock;
+    input wire signed [39:0] x;
+    input wire signed [91:0] product;
+    input wire  start;
+    input wire  preload;
+    input wire  accumulate;
+    input wire  finish;
+    input wire  update_u;
+    input wire  publish;
+    output reg signed [59:0] y1;
+    output reg signed [59:0] y2;
+    output reg signed [59:0] v;
+    output reg signed [59:0] difference;
+    output reg signed [39:0] z;
+
+    // Constant declarations
+    localparam  half_coefficient_lsb = 94'h20000000;
+    localparam signed half_output_lsb = 58'h8000;
+
+    // Stub signals
+    reg signed [39:0] x0$d;
+    wire signed [39:0] x0$q;
+    reg  x0$clock;
+    reg signed [39:0] x1$d;
+    wire signed [39:0] x1$q;
+    reg  x1$clock;
+    reg signed [59:0] v_reg$d;
+    wire signed [59:0] v_reg$q;
+    reg  v_reg$clock;
+    reg signed [59:0] feedback$d;
+    wire signed [59:0] feedback$q;
+    reg  feedback$clock;
+    reg signed [93:0] acc_y$d;
+    wire signed [93:0] acc_y$q;
+    reg  acc_y$clock;
+    reg signed [93:0] acc_d$d;
+    wire signed [93:0] acc_d$q;
+    reg  acc_d$clock;
+    reg signed [57:0] y1_reg$d;
+    wire signed [57:0] y1_reg$q;
+    reg  y1_reg$clock;
+    reg signed [57:0] y2_reg$d;
+    wire signed [57:0] y2_reg$q;
+    reg  y2_reg$clock;
+    reg signed [57:0] u$d;
+    wire signed [57:0] u$q;
+    reg  u$clock;
+    reg signed [39:0] z_out$d;
+    wire signed [39:0] z_out$q;
+    reg  z_out$clock;
+
+    // Local signals
+    reg signed [59:0] x_wide;
+    reg signed [59:0] x0_wide;
+    reg signed [59:0] x1_wide;
+    reg signed [59:0] v_sum;
+    reg  [59:0] v_shifted;
+    reg signed [59:0] y1_wide;
+    reg signed [59:0] y2_wide;
+    reg signed [59:0] u_wide;
+    reg signed [59:0] feedback_minus_u;
+    reg signed [93:0] feedback_long;
+    reg signed [93:0] difference_long;
+    reg signed [93:0] u_long;
+    reg signed [93:0] product_long;
+    reg  [93:0] preload_y;
+    reg  [93:0] preload_d;
+    reg  [93:0] u_scaled;
+    reg signed [93:0] sum_y;
+    reg signed [93:0] sum_d;
+    reg signed [93:0] sum_u;
+    reg signed [57:0] y_new;
+    reg signed [57:0] u_new;
+    reg signed [57:0] u_rounded;
+
+    // Sub module instances
+    gyro_interface_axi__core__iir__channel2__x0 x0(
+        .d(x0$d),
+        .q(x0$q),
+        .clock(x0$clock)
+    );
+    gyro_interface_axi__core__iir__channel2__x1 x1(
+        .d(x1$d),
+        .q(x1$q),
+        .clock(x1$clock)
+    );
+    gyro_interface_axi__core__iir__channel2__v_reg v_reg(
+        .d(v_reg$d),
+        .q(v_reg$q),
+        .clock(v_reg$clock)
+    );
+    gyro_interface_axi__core__iir__channel2__feedback feedback(
+        .d(feedback$d),
+        .q(feedback$q),
+        .clock(feedback$clock)
+    );
+    gyro_interface_axi__core__iir__channel2__acc_y acc_y(
+        .d(acc_y$d),
+        .q(acc_y$q),
+        .clock(acc_y$clock)
+    );
+    gyro_interface_axi__core__iir__channel2__acc_d acc_d(
+        .d(acc_d$d),
+        .q(acc_d$q),
+        .clock(acc_d$clock)
+    );
+    gyro_interface_axi__core__iir__channel2__y1_reg y1_reg(
+        .d(y1_reg$d),
+        .q(y1_reg$q),
+        .clock(y1_reg$clock)
+    );
+    gyro_interface_axi__core__iir__channel2__y2_reg y2_reg(
+        .d(y2_reg$d),
+        .q(y2_reg$q),
+        .clock(y2_reg$clock)
+    );
+    gyro_interface_axi__core__iir__channel2__u u(
+        .d(u$d),
+        .q(u$q),
+        .clock(u$clock)
+    );
+    gyro_interface_axi__core__iir__channel2__z_out z_out(
+        .d(z_out$d),
+        .q(z_out$q),
+        .clock(z_out$clock)
+    );
+
+    // Update code
+    always @(*) begin
+        x0$clock = clock;
+        x1$clock = clock;
+        v_reg$clock = clock;
+        feedback$clock = clock;
+        acc_y$clock = clock;
+        acc_d$clock = clock;
+        y1_reg$clock = clock;
+        y2_reg$clock = clock;
+        u$clock = clock;
+        z_out$clock = clock;
+        x0$d = x0$q;
+        x1$d = x1$q;
+        v_reg$d = v_reg$q;
+        feedback$d = feedback$q;
+        acc_y$d = acc_y$q;
+        acc_d$d = acc_d$q;
+        y1_reg$d = y1_reg$q;
+        y2_reg$d = y2_reg$q;
+        u$d = u$q;
+        z_out$d = z_out$q;
+        x_wide = $signed(x);
+        x0_wide = $signed(x0$q);
+        x1_wide = $signed(x1$q);
+        y1_wide = $signed(y1_reg$q);
+        y2_wide = $signed(y2_reg$q);
+        u_wide = $signed(u$q);
+        v_sum = x_wide + x0_wide + x0_wide + x1_wide;
+        v_shifted = $unsigned(v_sum) << 32'h10;
+        feedback_minus_u = feedback$q - u_wide;
+        feedback_long = $signed(feedback$q);
+        difference_long = $signed(feedback_minus_u);
+        u_long = $signed(u$q);
+        product_long = $signed(product);
+        preload_y = ($unsigned(feedback_long) << 32'h1e) | half_coefficient_lsb;
+        preload_d = ($unsigned(difference_long) << 32'h1e) | half_coefficient_lsb;
+        u_scaled = ($unsigned(u_long) << 32'h1e) | half_coefficient_lsb;
+        sum_y = acc_y$q + product_long;
+        sum_d = acc_d$q + product_long;
+        sum_u = $signed(u_scaled) + product_long;
+        y_new = sum_y[(32'h1e)+:(58)];
+        u_new = sum_u[(32'h1e)+:(58)];
+        difference = sum_d[(32'h1e)+:(60)];
+        u_rounded = u$q + half_output_lsb;
+        if (start) begin
+            x0$d = x;
+            x1$d = x0$q;
+            v_reg$d = $signed(v_shifted);
+            feedback$d = y1_wide + y1_wide - y2_wide;
+        end
+        if (preload) begin
+            acc_y$d = $signed(preload_y);
+            acc_d$d = $signed(preload_d);
+        end
+        if (accumulate) begin
+            acc_y$d = sum_y;
+            acc_d$d = sum_d;
+        end
+        if (finish) begin
+            y1_reg$d = y_new;
+            y2_reg$d = y1_reg$q;
+        end
+        if (update_u) begin
+            u$d = u_new;
+        end
+        if (publish) begin
+            z_out$d = u_rounded[(32'h10)+:(40)];
+        end
+        y1 = y1_wide;
+        y2 = y2_wide;
+        v = v_reg$q;
+        z = z_out$q;
+    end
+
+endmodule // gyro_interface_axi__core__iir__channel2
+
+
+module gyro_interface_axi__core__iir__channel2__acc_d(d,q,clock);
+
+    // Module arguments
+    input wire signed [93:0] d;
+    output reg signed [93:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 94'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__iir__channel2__acc_d
+
+
+module gyro_interface_axi__core__iir__channel2__acc_y(d,q,clock);
+
+    // Module arguments
+    input wire signed [93:0] d;
+    output reg signed [93:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 94'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__iir__channel2__acc_y
+
+
+module gyro_interface_axi__core__iir__channel2__feedback(d,q,clock);
+
+    // Module arguments
+    input wire signed [59:0] d;
+    output reg signed [59:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 60'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__iir__channel2__feedback
+
+
+module gyro_interface_axi__core__iir__channel2__u(d,q,clock);
+
+    // Module arguments
+    input wire signed [57:0] d;
+    output reg signed [57:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 58'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__iir__channel2__u
+
+
+module gyro_interface_axi__core__iir__channel2__v_reg(d,q,clock);
+
+    // Module arguments
+    input wire signed [59:0] d;
+    output reg signed [59:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 60'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__iir__channel2__v_reg
+
+
+module gyro_interface_axi__core__iir__channel2__x0(d,q,clock);
+
+    // Module arguments
+    input wire signed [39:0] d;
+    output reg signed [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__iir__channel2__x0
+
+
+module gyro_interface_axi__core__iir__channel2__x1(d,q,clock);
+
+    // Module arguments
+    input wire signed [39:0] d;
+    output reg signed [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__iir__channel2__x1
+
+
+module gyro_interface_axi__core__iir__channel2__y1_reg(d,q,clock);
+
+    // Module arguments
+    input wire signed [57:0] d;
+    output reg signed [57:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 58'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__iir__channel2__y1_reg
+
+
+module gyro_interface_axi__core__iir__channel2__y2_reg(d,q,clock);
+
+    // Module arguments
+    input wire signed [57:0] d;
+    output reg signed [57:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 58'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__iir__channel2__y2_reg
+
+
+module gyro_interface_axi__core__iir__channel2__z_out(d,q,clock);
+
+    // Module arguments
+    input wire signed [39:0] d;
+    output reg signed [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__iir__channel2__z_out
+
+
+module gyro_interface_axi__core__iir__coefficient(d,q,clock);
 
     // Module arguments
     input wire signed [31:0] d;
@@ -5528,10 +6305,10 @@ module gyro_interface_axi__core__iir1__coefficient(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__iir1__coefficient
+endmodule // gyro_interface_axi__core__iir__coefficient
 
 
-module gyro_interface_axi__core__iir1__mac(clock,a,b,p);
+module gyro_interface_axi__core__iir__mac(clock,a,b,p);
 
     // Module arguments
     input wire  clock;
@@ -5540,15 +6317,63 @@ module gyro_interface_axi__core__iir1__mac(clock,a,b,p);
     output reg signed [91:0] p;
 
     // Update code (custom)
+    wire signed [16:0] a_0 = {1'b0, a[15:0]};
+    wire signed [16:0] a_1 = {1'b0, a[31:16]};
+    wire signed [16:0] a_2 = {1'b0, a[47:32]};
+    wire signed [11:0] a_3 = a[59:48];
+    wire signed [16:0] b_0 = {1'b0, b[15:0]};
+    wire signed [15:0] b_1 = b[31:16];
+    reg signed [33:0] pp_0_0;
+    initial pp_0_0 = 0;
+    reg signed [32:0] pp_0_1;
+    initial pp_0_1 = 0;
+    reg signed [48:0] row_0;
+    initial row_0 = 0;
+    reg signed [33:0] pp_1_0;
+    initial pp_1_0 = 0;
+    reg signed [32:0] pp_1_1;
+    initial pp_1_1 = 0;
+    reg signed [48:0] row_1;
+    initial row_1 = 0;
+    reg signed [33:0] pp_2_0;
+    initial pp_2_0 = 0;
+    reg signed [32:0] pp_2_1;
+    initial pp_2_1 = 0;
+    reg signed [48:0] row_2;
+    initial row_2 = 0;
+    reg signed [28:0] pp_3_0;
+    initial pp_3_0 = 0;
+    reg signed [27:0] pp_3_1;
+    initial pp_3_1 = 0;
+    reg signed [43:0] row_3;
+    initial row_3 = 0;
+    reg signed [64:0] pair_0;
+    initial pair_0 = 0;
+    reg signed [59:0] pair_1;
+    initial pair_1 = 0;
     initial p = 0;
 
     always @(posedge clock) begin
-       p <= a * b;
+       pp_0_0 <= a_0 * b_0;
+       pp_0_1 <= a_0 * b_1;
+       pp_1_0 <= a_1 * b_0;
+       pp_1_1 <= a_1 * b_1;
+       pp_2_0 <= a_2 * b_0;
+       pp_2_1 <= a_2 * b_1;
+       pp_3_0 <= a_3 * b_0;
+       pp_3_1 <= a_3 * b_1;
+       row_0 <= {{15{pp_0_0[33]}}, pp_0_0} + {pp_0_1, 16'd0};
+       row_1 <= {{15{pp_1_0[33]}}, pp_1_0} + {pp_1_1, 16'd0};
+       row_2 <= {{15{pp_2_0[33]}}, pp_2_0} + {pp_2_1, 16'd0};
+       row_3 <= {{15{pp_3_0[28]}}, pp_3_0} + {pp_3_1, 16'd0};
+       pair_0 <= {{16{row_0[48]}}, row_0} + {row_1, 16'd0};
+       pair_1 <= {{11{row_2[48]}}, row_2} + {row_3, 16'd0};
+       p <= {{27{pair_0[64]}}, pair_0} + {pair_1, 32'd0};
     end
-endmodule // gyro_interface_axi__core__iir1__mac
+endmodule // gyro_interface_axi__core__iir__mac
 
 
-module gyro_interface_axi__core__iir1__operand(d,q,clock);
+module gyro_interface_axi__core__iir__operand(d,q,clock);
 
     // Module arguments
     input wire signed [59:0] d;
@@ -5564,181 +6389,10 @@ module gyro_interface_axi__core__iir1__operand(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__iir1__operand
+endmodule // gyro_interface_axi__core__iir__operand
 
 
-module gyro_interface_axi__core__iir1__step(d,q,clock);
-
-    // Module arguments
-    input wire  [3:0] d;
-    output reg  [3:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 4'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir1__step
-
-
-module gyro_interface_axi__core__iir1__u(d,q,clock);
-
-    // Module arguments
-    input wire signed [57:0] d;
-    output reg signed [57:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 58'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir1__u
-
-
-module gyro_interface_axi__core__iir1__v(d,q,clock);
-
-    // Module arguments
-    input wire signed [59:0] d;
-    output reg signed [59:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 60'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir1__v
-
-
-module gyro_interface_axi__core__iir1__x0(d,q,clock);
-
-    // Module arguments
-    input wire signed [39:0] d;
-    output reg signed [39:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 40'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir1__x0
-
-
-module gyro_interface_axi__core__iir1__x1(d,q,clock);
-
-    // Module arguments
-    input wire signed [39:0] d;
-    output reg signed [39:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 40'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir1__x1
-
-
-module gyro_interface_axi__core__iir1__x2(d,q,clock);
-
-    // Module arguments
-    input wire signed [39:0] d;
-    output reg signed [39:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 40'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir1__x2
-
-
-module gyro_interface_axi__core__iir1__y1(d,q,clock);
-
-    // Module arguments
-    input wire signed [57:0] d;
-    output reg signed [57:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 58'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir1__y1
-
-
-module gyro_interface_axi__core__iir1__y2(d,q,clock);
-
-    // Module arguments
-    input wire signed [57:0] d;
-    output reg signed [57:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 58'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir1__y2
-
-
-module gyro_interface_axi__core__iir1__z_out(d,q,clock);
-
-    // Module arguments
-    input wire signed [39:0] d;
-    output reg signed [39:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 40'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir1__z_out
-
-
-module gyro_interface_axi__core__iir1__z_valid_out(d,q,clock);
+module gyro_interface_axi__core__iir__publishing(d,q,clock);
 
     // Module arguments
     input wire  d;
@@ -5754,520 +6408,47 @@ module gyro_interface_axi__core__iir1__z_valid_out(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__iir1__z_valid_out
+endmodule // gyro_interface_axi__core__iir__publishing
 
 
-module gyro_interface_axi__core__iir2(clock,x,x_valid,k0,k1,k2,alpha,z,z_valid);
-
-    // Module arguments
-    input wire  clock;
-    input wire signed [39:0] x;
-    input wire  x_valid;
-    input wire signed [31:0] k0;
-    input wire signed [31:0] k1;
-    input wire signed [31:0] k2;
-    input wire signed [31:0] alpha;
-    output reg signed [39:0] z;
-    output reg  z_valid;
-
-    // Constant declarations
-    localparam signed half_coefficient_lsb_96 = 96'h20000000;
-    localparam signed half_coefficient_lsb_92 = 92'h20000000;
-    localparam signed half_output_lsb = 58'h8000;
-
-    // Stub signals
-    reg  [3:0] step$d;
-    wire  [3:0] step$q;
-    reg  step$clock;
-    reg signed [39:0] x0$d;
-    wire signed [39:0] x0$q;
-    reg  x0$clock;
-    reg signed [39:0] x1$d;
-    wire signed [39:0] x1$q;
-    reg  x1$clock;
-    reg signed [39:0] x2$d;
-    wire signed [39:0] x2$q;
-    reg  x2$clock;
-    reg signed [59:0] v$d;
-    wire signed [59:0] v$q;
-    reg  v$clock;
-    reg signed [59:0] operand$d;
-    wire signed [59:0] operand$q;
-    reg  operand$clock;
-    reg signed [31:0] coefficient$d;
-    wire signed [31:0] coefficient$q;
-    reg  coefficient$clock;
-    reg  mac$clock;
-    reg signed [59:0] mac$a;
-    reg signed [31:0] mac$b;
-    wire signed [91:0] mac$p;
-    reg signed [95:0] accumulator$d;
-    wire signed [95:0] accumulator$q;
-    reg  accumulator$clock;
-    reg signed [57:0] y1$d;
-    wire signed [57:0] y1$q;
-    reg  y1$clock;
-    reg signed [57:0] y2$d;
-    wire signed [57:0] y2$q;
-    reg  y2$clock;
-    reg signed [57:0] u$d;
-    wire signed [57:0] u$q;
-    reg  u$clock;
-    reg signed [39:0] z_out$d;
-    wire signed [39:0] z_out$q;
-    reg  z_out$clock;
-    reg  z_valid_out$d;
-    wire  z_valid_out$q;
-    reg  z_valid_out$clock;
-
-    // Local signals
-    reg signed [59:0] x0_wide;
-    reg signed [59:0] x1_wide;
-    reg signed [59:0] x2_wide;
-    reg signed [59:0] v_sum;
-    reg  [59:0] v_shifted;
-    reg signed [59:0] y1_wide;
-    reg signed [59:0] y2_wide;
-    reg signed [59:0] u_wide;
-    reg signed [95:0] product_wide;
-    reg signed [95:0] accumulator_rounded;
-    reg signed [59:0] accumulator_scaled;
-    reg signed [59:0] y_new;
-    reg signed [91:0] product_rounded;
-    reg signed [59:0] product_scaled;
-    reg signed [59:0] u_new;
-    reg signed [57:0] u_rounded;
-
-    // Sub module instances
-    gyro_interface_axi__core__iir2__step step(
-        .d(step$d),
-        .q(step$q),
-        .clock(step$clock)
-    );
-    gyro_interface_axi__core__iir2__x0 x0(
-        .d(x0$d),
-        .q(x0$q),
-        .clock(x0$clock)
-    );
-    gyro_interface_axi__core__iir2__x1 x1(
-        .d(x1$d),
-        .q(x1$q),
-        .clock(x1$clock)
-    );
-    gyro_interface_axi__core__iir2__x2 x2(
-        .d(x2$d),
-        .q(x2$q),
-        .clock(x2$clock)
-    );
-    gyro_interface_axi__core__iir2__v v(
-        .d(v$d),
-        .q(v$q),
-        .clock(v$clock)
-    );
-    gyro_interface_axi__core__iir2__operand operand(
-        .d(operand$d),
-        .q(operand$q),
-        .clock(operand$clock)
-    );
-    gyro_interface_axi__core__iir2__coefficient coefficient(
-        .d(coefficient$d),
-        .q(coefficient$q),
-        .clock(coefficient$clock)
-    );
-    gyro_interface_axi__core__iir2__mac mac(
-        .clock(mac$clock),
-        .a(mac$a),
-        .b(mac$b),
-        .p(mac$p)
-    );
-    gyro_interface_axi__core__iir2__accumulator accumulator(
-        .d(accumulator$d),
-        .q(accumulator$q),
-        .clock(accumulator$clock)
-    );
-    gyro_interface_axi__core__iir2__y1 y1(
-        .d(y1$d),
-        .q(y1$q),
-        .clock(y1$clock)
-    );
-    gyro_interface_axi__core__iir2__y2 y2(
-        .d(y2$d),
-        .q(y2$q),
-        .clock(y2$clock)
-    );
-    gyro_interface_axi__core__iir2__u u(
-        .d(u$d),
-        .q(u$q),
-        .clock(u$clock)
-    );
-    gyro_interface_axi__core__iir2__z_out z_out(
-        .d(z_out$d),
-        .q(z_out$q),
-        .clock(z_out$clock)
-    );
-    gyro_interface_axi__core__iir2__z_valid_out z_valid_out(
-        .d(z_valid_out$d),
-        .q(z_valid_out$q),
-        .clock(z_valid_out$clock)
-    );
-
-    // Update code
-    always @(*) begin
-        step$clock = clock;
-        x0$clock = clock;
-        x1$clock = clock;
-        x2$clock = clock;
-        v$clock = clock;
-        operand$clock = clock;
-        coefficient$clock = clock;
-        accumulator$clock = clock;
-        y1$clock = clock;
-        y2$clock = clock;
-        u$clock = clock;
-        z_out$clock = clock;
-        z_valid_out$clock = clock;
-        step$d = step$q;
-        x0$d = x0$q;
-        x1$d = x1$q;
-        x2$d = x2$q;
-        v$d = v$q;
-        operand$d = operand$q;
-        coefficient$d = coefficient$q;
-        accumulator$d = accumulator$q;
-        y1$d = y1$q;
-        y2$d = y2$q;
-        u$d = u$q;
-        z_out$d = z_out$q;
-        z_valid_out$d = z_valid_out$q;
-        mac$clock = clock;
-        mac$a = operand$q;
-        mac$b = coefficient$q;
-        x0_wide = $signed(x0$q);
-        x1_wide = $signed(x1$q);
-        x2_wide = $signed(x2$q);
-        v_sum = x0_wide + x1_wide + x1_wide + x2_wide;
-        v_shifted = $unsigned(v_sum) << 32'h10;
-        y1_wide = $signed(y1$q);
-        y2_wide = $signed(y2$q);
-        u_wide = $signed(u$q);
-        product_wide = $signed(mac$p);
-        accumulator_rounded = accumulator$q + half_coefficient_lsb_96;
-        accumulator_scaled = accumulator_rounded[(32'h1e)+:(60)];
-        y_new = y1_wide + y1_wide - y2_wide + accumulator_scaled;
-        product_rounded = mac$p + half_coefficient_lsb_92;
-        product_scaled = product_rounded[(32'h1e)+:(60)];
-        u_new = u_wide + product_scaled;
-        u_rounded = u$q + half_output_lsb;
-        z_valid_out$d = 1'b0;
-        if ((step$q == 32'h0) && x_valid) begin
-            x0$d = x;
-            x1$d = x0$q;
-            x2$d = x1$q;
-            step$d = 32'h1;
-        end
-        if (step$q == 32'h1) begin
-            v$d = $signed(v_shifted);
-            step$d = 32'h2;
-        end
-        if (step$q == 32'h2) begin
-            operand$d = v$q;
-            coefficient$d = k0;
-            step$d = 32'h3;
-        end
-        if (step$q == 32'h3) begin
-            operand$d = y1_wide;
-            coefficient$d = k1;
-            step$d = 32'h4;
-        end
-        if (step$q == 32'h4) begin
-            operand$d = y2_wide;
-            coefficient$d = k2;
-            accumulator$d = product_wide;
-            step$d = 32'h5;
-        end
-        if (step$q == 32'h5) begin
-            accumulator$d = accumulator$q + product_wide;
-            step$d = 32'h6;
-        end
-        if (step$q == 32'h6) begin
-            accumulator$d = accumulator$q + product_wide;
-            step$d = 32'h7;
-        end
-        if (step$q == 32'h7) begin
-            y1$d = y_new[(32'h0)+:(58)];
-            y2$d = y1$q;
-            step$d = 32'h8;
-        end
-        if (step$q == 32'h8) begin
-            operand$d = y1_wide - u_wide;
-            coefficient$d = alpha;
-            step$d = 32'h9;
-        end
-        if (step$q == 32'h9) begin
-            step$d = 32'ha;
-        end
-        if (step$q == 32'ha) begin
-            u$d = u_new[(32'h0)+:(58)];
-            step$d = 32'hb;
-        end
-        if (step$q == 32'hb) begin
-            z_out$d = u_rounded[(32'h10)+:(40)];
-            z_valid_out$d = 1'b1;
-            step$d = 32'h0;
-        end
-        z = z_out$q;
-        z_valid = z_valid_out$q;
-    end
-
-endmodule // gyro_interface_axi__core__iir2
-
-
-module gyro_interface_axi__core__iir2__accumulator(d,q,clock);
-
-    // Module arguments
-    input wire signed [95:0] d;
-    output reg signed [95:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 96'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir2__accumulator
-
-
-module gyro_interface_axi__core__iir2__coefficient(d,q,clock);
-
-    // Module arguments
-    input wire signed [31:0] d;
-    output reg signed [31:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 32'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir2__coefficient
-
-
-module gyro_interface_axi__core__iir2__mac(clock,a,b,p);
-
-    // Module arguments
-    input wire  clock;
-    input wire signed [59:0] a;
-    input wire signed [31:0] b;
-    output reg signed [91:0] p;
-
-    // Update code (custom)
-    initial p = 0;
-
-    always @(posedge clock) begin
-       p <= a * b;
-    end
-endmodule // gyro_interface_axi__core__iir2__mac
-
-
-module gyro_interface_axi__core__iir2__operand(d,q,clock);
-
-    // Module arguments
-    input wire signed [59:0] d;
-    output reg signed [59:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 60'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir2__operand
-
-
-module gyro_interface_axi__core__iir2__step(d,q,clock);
+module gyro_interface_axi__core__iir__step(d,q,clock);
 
     // Module arguments
     input wire  [3:0] d;
     output reg  [3:0] q;
     input wire  clock;
 
+    // Enums
+    localparam IirStep$Idle = 0;
+    localparam IirStep$IssueY2First = 1;
+    localparam IirStep$IssueVFirst = 2;
+    localparam IirStep$IssueY1Second = 3;
+    localparam IirStep$IssueY2Second = 4;
+    localparam IirStep$IssueVSecond = 5;
+    localparam IirStep$AccumulateFirst = 6;
+    localparam IirStep$FinishFirst = 7;
+    localparam IirStep$AccumulateSecondY1 = 8;
+    localparam IirStep$AccumulateSecondY2 = 9;
+    localparam IirStep$FinishSecond = 10;
+    localparam IirStep$WaitFirstRc = 11;
+    localparam IirStep$UpdateFirstRc = 12;
+    localparam IirStep$WaitSecondRc1 = 13;
+    localparam IirStep$WaitSecondRc2 = 14;
+    localparam IirStep$UpdateSecondRc = 15;
+
     // Update code (custom)
     initial begin
-       q = 4'h0;
+       q = 64'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__iir2__step
+endmodule // gyro_interface_axi__core__iir__step
 
 
-module gyro_interface_axi__core__iir2__u(d,q,clock);
-
-    // Module arguments
-    input wire signed [57:0] d;
-    output reg signed [57:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 58'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir2__u
-
-
-module gyro_interface_axi__core__iir2__v(d,q,clock);
-
-    // Module arguments
-    input wire signed [59:0] d;
-    output reg signed [59:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 60'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir2__v
-
-
-module gyro_interface_axi__core__iir2__x0(d,q,clock);
-
-    // Module arguments
-    input wire signed [39:0] d;
-    output reg signed [39:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 40'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir2__x0
-
-
-module gyro_interface_axi__core__iir2__x1(d,q,clock);
-
-    // Module arguments
-    input wire signed [39:0] d;
-    output reg signed [39:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 40'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir2__x1
-
-
-module gyro_interface_axi__core__iir2__x2(d,q,clock);
-
-    // Module arguments
-    input wire signed [39:0] d;
-    output reg signed [39:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 40'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir2__x2
-
-
-module gyro_interface_axi__core__iir2__y1(d,q,clock);
-
-    // Module arguments
-    input wire signed [57:0] d;
-    output reg signed [57:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 58'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir2__y1
-
-
-module gyro_interface_axi__core__iir2__y2(d,q,clock);
-
-    // Module arguments
-    input wire signed [57:0] d;
-    output reg signed [57:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 58'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir2__y2
-
-
-module gyro_interface_axi__core__iir2__z_out(d,q,clock);
-
-    // Module arguments
-    input wire signed [39:0] d;
-    output reg signed [39:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 40'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir2__z_out
-
-
-module gyro_interface_axi__core__iir2__z_valid_out(d,q,clock);
+module gyro_interface_axi__core__iir__z_valid_out(d,q,clock);
 
     // Module arguments
     input wire  d;
@@ -6283,7 +6464,7 @@ module gyro_interface_axi__core__iir2__z_valid_out(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__iir2__z_valid_out
+endmodule // gyro_interface_axi__core__iir__z_valid_out
 
 
 module gyro_interface_axi__core__modulation_nco(clock,step,select,am1,am2);
@@ -7194,22 +7375,33 @@ module gyro_interface_axi__core__reference_alignment__line1(clock,d,delay,q);
     output reg signed [15:0] q;
 
     // Update code (custom)
-    reg signed [15:0] taps [0:63];
+    reg signed [15:0] words [0:63];
+    reg [5:0] write_address;
+    // An A-bit wire, so the address wraps modulo 2^A in every simulator.
+    wire [5:0] read_address = write_address - delay;
+    reg signed [15:0] ram_q;
+    reg signed [15:0] bypass_q;
+    reg use_bypass;
     integer init_index;
-    integer shift_index;
 
     initial begin
        for (init_index = 0; init_index < 64; init_index = init_index + 1)
-          taps[init_index] = 0;
+          words[init_index] = 0;
+       write_address = 0;
+       ram_q = 0;
+       bypass_q = 0;
+       use_bypass = 0;
     end
 
     always @(posedge clock) begin
-       taps[0] <= d;
-       for (shift_index = 1; shift_index < 64; shift_index = shift_index + 1)
-          taps[shift_index] <= taps[shift_index - 1];
+       words[write_address] <= d;
+       write_address <= write_address + 1'b1;
+       ram_q <= words[read_address];
+       bypass_q <= d;
+       use_bypass <= (delay == 0);
     end
 
-    always @(*) q = taps[delay];
+    always @(*) q = use_bypass ? bypass_q : ram_q;
 endmodule // gyro_interface_axi__core__reference_alignment__line1
 
 
@@ -7222,22 +7414,33 @@ module gyro_interface_axi__core__reference_alignment__line2(clock,d,delay,q);
     output reg signed [15:0] q;
 
     // Update code (custom)
-    reg signed [15:0] taps [0:63];
+    reg signed [15:0] words [0:63];
+    reg [5:0] write_address;
+    // An A-bit wire, so the address wraps modulo 2^A in every simulator.
+    wire [5:0] read_address = write_address - delay;
+    reg signed [15:0] ram_q;
+    reg signed [15:0] bypass_q;
+    reg use_bypass;
     integer init_index;
-    integer shift_index;
 
     initial begin
        for (init_index = 0; init_index < 64; init_index = init_index + 1)
-          taps[init_index] = 0;
+          words[init_index] = 0;
+       write_address = 0;
+       ram_q = 0;
+       bypass_q = 0;
+       use_bypass = 0;
     end
 
     always @(posedge clock) begin
-       taps[0] <= d;
-       for (shift_index = 1; shift_index < 64; shift_index = shift_index + 1)
-          taps[shift_index] <= taps[shift_index - 1];
+       words[write_address] <= d;
+       write_address <= write_address + 1'b1;
+       ram_q <= words[read_address];
+       bypass_q <= d;
+       use_bypass <= (delay == 0);
     end
 
-    always @(*) q = taps[delay];
+    always @(*) q = use_bypass ? bypass_q : ram_q;
 endmodule // gyro_interface_axi__core__reference_alignment__line2
 
 

@@ -129,6 +129,8 @@ impl Logic for AmMixer {
 
 crate::impl_clocked!(AmMixer);
 
+/// Mutation hooks for the negative control in `crate::rtl` (tests only).
+#[cfg(test)]
 impl AmMixer {
     #[doc(hidden)]
     pub fn mutate_drive_rounding(&mut self) {

@@ -90,6 +90,8 @@ impl Logic for CarrierNco {
 
 crate::impl_clocked!(CarrierNco);
 
+/// Mutation hooks for the negative control in `crate::rtl` (tests only).
+#[cfg(test)]
 impl CarrierNco {
     #[doc(hidden)]
     pub fn mutate_sine_rounding(&mut self) {

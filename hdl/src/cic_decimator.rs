@@ -35,12 +35,18 @@ use rust_hdl::prelude::*;
 pub const STAGES: u32 = 4;
 /// Width of the input word.
 pub const INPUT_BITS: usize = 32;
+/// log2 of the largest decimation.
+pub const MAX_DECIMATION_LOG2: u32 = 12;
 /// Largest decimation: 2^12.
-pub const MAX_DECIMATION: u32 = 4096;
-/// Hogenauer register width: 32 + 4 * 12.
-pub const REGISTER_BITS: usize = 80;
+pub const MAX_DECIMATION: u32 = 1 << MAX_DECIMATION_LOG2;
+/// Hogenauer register width: B_in + N log2(R_max) = 32 + 4 * 12 = 80.
+pub const REGISTER_BITS: usize = INPUT_BITS + (STAGES * MAX_DECIMATION_LOG2) as usize;
 /// Width of the output word.
 pub const OUTPUT_BITS: usize = 40;
+/// Width of the decimation word: R up to 2^12 needs 13 bits.
+pub const DECIMATION_BITS: usize = MAX_DECIMATION_LOG2 as usize + 1;
+/// Width of the output shift word: shifts 0..=40 need 6 bits.
+pub const SHIFT_BITS: usize = 6;
 /// Fractional bits kept at the output (y = average * 2^8 * G).
 pub const OUTPUT_FRACTION_BITS: u32 = 8;
 
@@ -50,44 +56,44 @@ pub struct CicDecimator {
     /// The clock.
     pub clock: Signal<In, Clock>,
     /// Input sample, one per clock.
-    pub x: Signal<In, Signed<32>>,
+    pub x: Signal<In, Signed<INPUT_BITS>>,
     /// Decimation R, 1..=4096.
-    pub decimation: Signal<In, Bits<13>>,
+    pub decimation: Signal<In, Bits<DECIMATION_BITS>>,
     /// Output shift: y = round(comb / 2^shift); use ceil(4 log2 R) - 8.
-    pub shift: Signal<In, Bits<6>>,
+    pub shift: Signal<In, Bits<SHIFT_BITS>>,
     /// Decimated output, updated when `valid` is high.
-    pub y: Signal<Out, Signed<40>>,
+    pub y: Signal<Out, Signed<OUTPUT_BITS>>,
     /// One-clock pulse marking a new `y`.
     pub valid: Signal<Out, Bit>,
-    x_wide: Signal<Local, Signed<80>>,
-    integrator1: DFF<Signed<80>>,
-    integrator2: DFF<Signed<80>>,
-    integrator3: DFF<Signed<80>>,
-    integrator4: DFF<Signed<80>>,
-    count: DFF<Bits<13>>,
-    sample: DFF<Signed<80>>,
+    x_wide: Signal<Local, Signed<REGISTER_BITS>>,
+    integrator1: DFF<Signed<REGISTER_BITS>>,
+    integrator2: DFF<Signed<REGISTER_BITS>>,
+    integrator3: DFF<Signed<REGISTER_BITS>>,
+    integrator4: DFF<Signed<REGISTER_BITS>>,
+    count: DFF<Bits<DECIMATION_BITS>>,
+    sample: DFF<Signed<REGISTER_BITS>>,
     sample_valid: DFF<Bit>,
-    comb1: DFF<Signed<80>>,
-    comb2: DFF<Signed<80>>,
-    comb3: DFF<Signed<80>>,
-    comb4: DFF<Signed<80>>,
-    comb_delay1: DFF<Signed<80>>,
-    comb_delay2: DFF<Signed<80>>,
-    comb_delay3: DFF<Signed<80>>,
-    comb_delay4: DFF<Signed<80>>,
+    comb1: DFF<Signed<REGISTER_BITS>>,
+    comb2: DFF<Signed<REGISTER_BITS>>,
+    comb3: DFF<Signed<REGISTER_BITS>>,
+    comb4: DFF<Signed<REGISTER_BITS>>,
+    comb_delay1: DFF<Signed<REGISTER_BITS>>,
+    comb_delay2: DFF<Signed<REGISTER_BITS>>,
+    comb_delay3: DFF<Signed<REGISTER_BITS>>,
+    comb_delay4: DFF<Signed<REGISTER_BITS>>,
     comb_valid1: DFF<Bit>,
     comb_valid2: DFF<Bit>,
     comb_valid3: DFF<Bit>,
     comb_valid4: DFF<Bit>,
-    rounding: Signal<Local, Bits<80>>,
-    biased: Signal<Local, Signed<80>>,
-    biased_bits: Signal<Local, Bits<80>>,
-    sign_mask: Signal<Local, Bits<80>>,
-    shifted: Signal<Local, Bits<80>>,
-    y_out: DFF<Signed<40>>,
+    rounding: Signal<Local, Bits<REGISTER_BITS>>,
+    biased: Signal<Local, Signed<REGISTER_BITS>>,
+    biased_bits: Signal<Local, Bits<REGISTER_BITS>>,
+    sign_mask: Signal<Local, Bits<REGISTER_BITS>>,
+    shifted: Signal<Local, Bits<REGISTER_BITS>>,
+    y_out: DFF<Signed<OUTPUT_BITS>>,
     valid_out: DFF<Bit>,
-    one: Constant<Bits<80>>,
-    all_ones: Constant<Bits<80>>,
+    one: Constant<Bits<REGISTER_BITS>>,
+    all_ones: Constant<Bits<REGISTER_BITS>>,
 }
 
 impl CicDecimator {
@@ -128,7 +134,7 @@ impl CicDecimator {
             y_out: Default::default(),
             valid_out: Default::default(),
             one: Constant::new(1.into()),
-            all_ones: Constant::new(Bits::<80>::mask()),
+            all_ones: Constant::new(Bits::<REGISTER_BITS>::mask()),
         }
     }
 }
@@ -168,7 +174,7 @@ impl Logic for CicDecimator {
             valid_out
         );
         // Integrators, wrap-around.
-        self.x_wide.next = signed_bit_cast_exact::<80, 32>(self.x.val());
+        self.x_wide.next = signed_bit_cast_exact::<REGISTER_BITS, INPUT_BITS>(self.x.val());
         self.integrator1.d.next = self.integrator1.q.val() + self.x_wide.val();
         self.integrator2.d.next = self.integrator2.q.val() + self.integrator1.q.val();
         self.integrator3.d.next = self.integrator3.q.val() + self.integrator2.q.val();
@@ -209,6 +215,8 @@ impl Logic for CicDecimator {
         self.biased.next = self.comb4.q.val() + signed_cast(self.rounding.val());
         self.biased_bits.next = unsigned_cast(self.biased.val());
         self.sign_mask.next = 0.into();
+        // Sign bit, REGISTER_BITS - 1 (rust-hdl needs a literal index; a
+        // signed compare with 0 costs a comparator in Yosys).
         if self.biased_bits.val().get_bit(79) {
             self.sign_mask.next = self.all_ones.val();
         }
@@ -216,7 +224,7 @@ impl Logic for CicDecimator {
             ^ self.sign_mask.val();
         self.valid_out.d.next = self.comb_valid4.q.val();
         if self.comb_valid4.q.val() {
-            self.y_out.d.next = signed_cast(self.shifted.val().get_bits::<40>(0));
+            self.y_out.d.next = signed_cast(self.shifted.val().get_bits::<OUTPUT_BITS>(0));
         }
         self.y.next = self.y_out.q.val();
         self.valid.next = self.valid_out.q.val();

@@ -556,12 +556,13 @@ pub fn ports_markdown() -> String {
             p.name, p.bits, p.format, p.description
         ));
     }
-    md.push_str(
+    md.push_str(&format!(
         "\nLatencies: carrier phase to DAC word 6 clocks; ADC word to mixer product 2;\n\
-         mixer product to CIC output at most R + 6; CIC output to z 12.\n\
+         mixer product to CIC output at most R + 6; CIC output to z {}.\n\
          Reference alignment for converter latencies L_dac, L_adc (clocks):\n\
          `ref_delay = L_dac + L_adc`, `ref_phase = carrier_step / 2`.\n",
-    );
+        crate::iir_lowpass::LATENCY
+    ));
     md
 }
 

@@ -19,7 +19,7 @@
 //! quantized values and reported, so results never depend on the ideal one.
 //!
 //! Limits, checked with a one-line error: 16 <= R <= 4096 (the filter's
-//! 12-clock schedule needs R >= 12); cut-offs between f_z / 1000 and
+//! schedule takes 16 clocks, `iir_lowpass::SCHEDULE_CLOCKS`); cut-offs between f_z / 1000 and
 //! f_z / 5. Below f_z / 1000 the biquad's dead band would approach half an
 //! output LSB (`dead_band_lsb` bounds it; the guard bits of the states are
 //! sized for this range); above f_z / 5, k1 would leave the Q2.30 range.
@@ -28,8 +28,8 @@ use crate::cic_decimator::{MAX_DECIMATION, OUTPUT_FRACTION_BITS, STAGES};
 use crate::iir_lowpass::{COEFFICIENT_FRACTION_BITS, GUARD_BITS};
 use crate::model::iir_lowpass::Coefficients;
 
-/// Smallest decimation the filter schedule accepts (it needs 12 clocks).
-pub const MIN_DECIMATION: u32 = 16;
+/// Smallest decimation the filter schedule accepts (its length in clocks).
+pub const MIN_DECIMATION: u32 = crate::iir_lowpass::SCHEDULE_CLOCKS as u32;
 /// Lowest cut-off as a fraction of the output rate.
 pub const MIN_CUTOFF_RATIO: f64 = 1.0 / 1000.0;
 /// Highest cut-off as a fraction of the output rate.

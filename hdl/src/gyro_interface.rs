@@ -15,7 +15,7 @@
 //!                                                    └──┬────┬──┘
 //!                                                    w1 │    │ w2
 //!  cic_decimation, cic_shift ──────────────────►  CicDecimator x2
-//!  iir_k0, iir_k1, iir_k2, iir_alpha ──────────►  IirLowpass   x2 ──► z1, z2, z_valid
+//!  iir_k0, iir_k1, iir_k2, iir_alpha ──────────►  IirLowpass (both channels) ──► z1, z2, z_valid
 //! ```
 //!
 //! Follow a sample in file order: `carrier_nco` (with `sincos`,
@@ -31,15 +31,16 @@
 //! `verilog-out/PORTS.md`.
 //!
 //! Latencies (clocks): carrier phase to DAC word 6, ADC word to mixer output
-//! 2, mixer output to CIC output R + 6 at most, CIC output to z 12.
+//! 2, mixer output to CIC output R + 6 at most, CIC output to z 17
+//! (`crate::iir_lowpass::LATENCY`).
 
 use crate::am_mixer::AmMixer;
 use crate::carrier_nco::CarrierNco;
-use crate::cic_decimator::CicDecimator;
+use crate::cic_decimator::{CicDecimator, DECIMATION_BITS, OUTPUT_BITS, SHIFT_BITS};
 use crate::demod_mux::DemodMux;
 use crate::iir_lowpass::IirLowpass;
 use crate::modulation_nco::ModulationNco;
-use crate::reference_alignment::ReferenceAlignment;
+use crate::reference_alignment::{DELAY_BITS, ReferenceAlignment};
 use rust_hdl::prelude::*;
 
 /// The reconfigurable phase-readout and self-calibration datapath.
@@ -56,9 +57,9 @@ pub struct GyroInterface {
     /// DAC word of drive 2, F2 A2 sin(wt): 16-bit two's complement, |dac2| <= 32767.
     pub dac2: Signal<Out, Signed<16>>,
     /// Filtered demodulator output 1: 40-bit two's complement, 8 fractional bits.
-    pub z1: Signal<Out, Signed<40>>,
+    pub z1: Signal<Out, Signed<OUTPUT_BITS>>,
     /// Filtered demodulator output 2: 40-bit two's complement, 8 fractional bits.
-    pub z2: Signal<Out, Signed<40>>,
+    pub z2: Signal<Out, Signed<OUTPUT_BITS>>,
     /// One-clock pulse when z1 and z2 are updated (once per CIC output).
     pub z_valid: Signal<Out, Bit>,
     /// SELECT: 0 readout (A = 1, own references), 1 calibration (A = cos/sin, crossed references).
@@ -68,7 +69,7 @@ pub struct GyroInterface {
     /// Phase advance of the demodulation references over the drives, 2^32 = 360 degrees.
     pub ref_phase: Signal<In, Bits<32>>,
     /// Reference delay: references are delayed by ref_delay + 1 clocks (0..63).
-    pub ref_delay: Signal<In, Bits<6>>,
+    pub ref_delay: Signal<In, Bits<DELAY_BITS>>,
     /// Modulation (calibration rate) phase step: f_cal = mod_step * f_clk / 2^48.
     pub mod_step: Signal<In, Bits<48>>,
     /// Drive amplitude F1, Q1.15 (32767 = full scale).
@@ -76,9 +77,9 @@ pub struct GyroInterface {
     /// Drive amplitude F2, Q1.15 (32767 = full scale).
     pub amp2: Signal<In, Signed<16>>,
     /// CIC decimation R, 16..=4096 (z rate f_clk / R).
-    pub cic_decimation: Signal<In, Bits<13>>,
+    pub cic_decimation: Signal<In, Bits<DECIMATION_BITS>>,
     /// CIC output shift, ceil(4 log2 R) - 8.
-    pub cic_shift: Signal<In, Bits<6>>,
+    pub cic_shift: Signal<In, Bits<SHIFT_BITS>>,
     /// Biquad numerator gain g, Q2.30.
     pub iir_k0: Signal<In, Signed<32>>,
     /// Biquad feedback -a1 - 2, Q2.30.
@@ -94,8 +95,7 @@ pub struct GyroInterface {
     demod_mux: DemodMux,
     cic1: CicDecimator,
     cic2: CicDecimator,
-    iir1: IirLowpass,
-    iir2: IirLowpass,
+    iir: IirLowpass,
 }
 
 impl GyroInterface {
@@ -130,8 +130,7 @@ impl GyroInterface {
             demod_mux: DemodMux::new(),
             cic1: CicDecimator::new(),
             cic2: CicDecimator::new(),
-            iir1: IirLowpass::new(),
-            iir2: IirLowpass::new(),
+            iir: IirLowpass::new(),
         }
     }
 }
@@ -152,8 +151,7 @@ impl Logic for GyroInterface {
         self.demod_mux.clock.next = self.clock.val();
         self.cic1.clock.next = self.clock.val();
         self.cic2.clock.next = self.clock.val();
-        self.iir1.clock.next = self.clock.val();
-        self.iir2.clock.next = self.clock.val();
+        self.iir.clock.next = self.clock.val();
         // Excitation.
         self.carrier_nco.step.next = self.carrier_step.val();
         self.carrier_nco.ref_offset.next = self.ref_phase.val();
@@ -185,21 +183,17 @@ impl Logic for GyroInterface {
         self.cic2.decimation.next = self.cic_decimation.val();
         self.cic1.shift.next = self.cic_shift.val();
         self.cic2.shift.next = self.cic_shift.val();
-        self.iir1.x.next = self.cic1.y.val();
-        self.iir2.x.next = self.cic2.y.val();
-        self.iir1.x_valid.next = self.cic1.valid.val();
-        self.iir2.x_valid.next = self.cic2.valid.val();
-        self.iir1.k0.next = self.iir_k0.val();
-        self.iir2.k0.next = self.iir_k0.val();
-        self.iir1.k1.next = self.iir_k1.val();
-        self.iir2.k1.next = self.iir_k1.val();
-        self.iir1.k2.next = self.iir_k2.val();
-        self.iir2.k2.next = self.iir_k2.val();
-        self.iir1.alpha.next = self.iir_alpha.val();
-        self.iir2.alpha.next = self.iir_alpha.val();
-        self.z1.next = self.iir1.z.val();
-        self.z2.next = self.iir2.z.val();
-        self.z_valid.next = self.iir1.z_valid.val();
+        self.iir.x1.next = self.cic1.y.val();
+        self.iir.x2.next = self.cic2.y.val();
+        // Both CICs share the decimation and start together: one strobe.
+        self.iir.x_valid.next = self.cic1.valid.val();
+        self.iir.k0.next = self.iir_k0.val();
+        self.iir.k1.next = self.iir_k1.val();
+        self.iir.k2.next = self.iir_k2.val();
+        self.iir.alpha.next = self.iir_alpha.val();
+        self.z1.next = self.iir.z1.val();
+        self.z2.next = self.iir.z2.val();
+        self.z_valid.next = self.iir.z_valid.val();
     }
 }
 
@@ -207,7 +201,8 @@ crate::impl_clocked!(GyroInterface);
 
 /// One-constant changes to the hardware, for the negative control of the
 /// model-vs-rtl comparisons (they must fail when the hardware changes).
-#[doc(hidden)]
+/// Test builds only: the exported design cannot carry them.
+#[cfg(test)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Mutation {
     /// The drive 1 rounding adds 2^13 instead of 2^14.
@@ -218,6 +213,7 @@ pub enum Mutation {
     ModulationFullScale,
 }
 
+#[cfg(test)]
 impl Mutation {
     /// Every mutation.
     pub const ALL: [Mutation; 3] = [
@@ -227,9 +223,9 @@ impl Mutation {
     ];
 }
 
+#[cfg(test)]
 impl GyroInterface {
     /// Apply a mutation (before the design is connected).
-    #[doc(hidden)]
     pub fn mutate(&mut self, mutation: Mutation) {
         match mutation {
             Mutation::DriveRounding => self.am_mixer.mutate_drive_rounding(),
@@ -237,7 +233,9 @@ impl GyroInterface {
             Mutation::ModulationFullScale => self.modulation_nco.mutate_full_scale(),
         }
     }
+}
 
+impl GyroInterface {
     /// Internal signals during the current cycle (for waveforms and tests).
     pub fn probes(&self) -> crate::model::gyro_interface::Probes {
         use crate::primitives::convert::signed_to_i128 as v;

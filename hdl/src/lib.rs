@@ -9,6 +9,7 @@ pub mod export;
 pub mod filter_design;
 pub mod gyro_interface;
 pub mod host;
+pub mod iir_channel;
 pub mod iir_lowpass;
 pub mod model;
 pub mod modulation_nco;

@@ -87,6 +87,8 @@ impl Logic for ModulationNco {
 
 crate::impl_clocked!(ModulationNco);
 
+/// Mutation hooks for the negative control in `crate::rtl` (tests only).
+#[cfg(test)]
 impl ModulationNco {
     #[doc(hidden)]
     pub fn mutate_full_scale(&mut self) {

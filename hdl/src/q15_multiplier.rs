@@ -75,6 +75,8 @@ impl Logic for Q15Multiplier {
 
 crate::impl_clocked!(Q15Multiplier);
 
+/// Mutation hooks for the negative control in `crate::rtl` (tests only).
+#[cfg(test)]
 impl Q15Multiplier {
     #[doc(hidden)]
     pub fn mutate_rounding(&mut self) {

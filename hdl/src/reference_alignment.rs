@@ -2,8 +2,8 @@
 //! references up with the loop latency.
 //!
 //! ```text
-//!  ref1 ──► [64-tap shift register] ── tap(delay) ──► aligned1
-//!  ref2 ──► [64-tap shift register] ── tap(delay) ──► aligned2
+//!  ref1 ──► [64-word RAM delay line] ── word(delay) ──► aligned1
+//!  ref2 ──► [64-word RAM delay line] ── word(delay) ──► aligned2
 //! ```
 //!
 //! The samples the demodulators see left the DACs some clocks earlier: the
@@ -13,8 +13,12 @@
 //! both from the converter latencies. The modulation envelope is delayed
 //! with the carrier, so calibration references stay aligned too.
 //!
-//! Timing: during cycle n, `aligned = ref(n - 1 - delay)` (combinational tap
-//! read; the demodulator registers it).
+//! Timing: during cycle n, `aligned = ref(n - 1 - delay)` for a delay held
+//! constant, delay 0..63 as before; the read is registered in the RAM
+//! (`crate::primitives::TappedDelayLine`, with a bypass for delay 0), so a
+//! new `delay` acts one clock later than the combinational tap of the
+//! earlier shift register did. The alignment arithmetic
+//! (`crate::settings`) is unchanged.
 
 use crate::primitives::TappedDelayLine;
 use rust_hdl::prelude::*;
@@ -103,10 +107,10 @@ mod tests {
                 uut.ref2.next = i128_to_signed(r2 as i128);
                 uut.delay.next = u128_to_bits(delay as u128);
                 tick(&mut uut);
-                model.step(r1, r2);
-                // The tap read is combinational in the delay of this cycle.
+                model.step(r1, r2, delay);
+                // The read is registered: it used the delay of the last cycle.
                 let v = |x: Signed<16>| signed_to_i128(x) as i16;
-                prop_assert_eq!((v(uut.aligned1.val()), v(uut.aligned2.val())), model.output(delay), "cycle {}", n);
+                prop_assert_eq!((v(uut.aligned1.val()), v(uut.aligned2.val())), model.output(), "cycle {}", n);
             }
         }
     }
@@ -115,10 +119,13 @@ mod tests {
     fn a_delay_of_d_delays_by_d_plus_one_clocks() {
         let mut model = Model::default();
         for k in 0..100i16 {
-            model.step(k, -k);
+            model.step(k, -k, 9);
             if k >= 10 {
-                assert_eq!(model.output(9), (k - 9, 9 - k));
+                assert_eq!(model.output(), (k - 9, 9 - k));
             }
         }
+        // Delay 0 (the bypass): one clock.
+        model.step(7, -7, 0);
+        assert_eq!(model.output(), (7, -7));
     }
 }

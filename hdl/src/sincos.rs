@@ -184,6 +184,8 @@ impl Logic for SinCos {
 
 crate::impl_clocked!(SinCos);
 
+/// Mutation hooks for the negative control in `crate::rtl` (tests only).
+#[cfg(test)]
 impl SinCos {
     #[doc(hidden)]
     pub fn mutate_rounding(&mut self) {

@@ -38,9 +38,9 @@ impl Registers {
     /// Width of the `mod_step` port (bits).
     pub const MOD_STEP_BITS: u32 = 48;
     /// Width of the `cic_decimation` port (bits).
-    pub const CIC_DECIMATION_BITS: u32 = 13;
+    pub const CIC_DECIMATION_BITS: u32 = crate::cic_decimator::DECIMATION_BITS as u32;
     /// Width of the `cic_shift` port (bits).
-    pub const CIC_SHIFT_BITS: u32 = 6;
+    pub const CIC_SHIFT_BITS: u32 = crate::cic_decimator::SHIFT_BITS as u32;
 
     /// The words as the ports hold them: a register word wider than its port
     /// keeps only its low bits, as in the hardware (and in the rtl and
@@ -93,7 +93,7 @@ pub struct GyroInterface {
     reference_alignment: ReferenceAlignment,
     demod_mux: DemodMux,
     cic: [CicDecimator; 2],
-    iir: [IirLowpass; 2],
+    iir: IirLowpass,
 }
 
 impl GyroInterface {
@@ -106,8 +106,7 @@ impl GyroInterface {
     #[inline(always)]
     pub fn outputs(&self) -> Outputs {
         let drives = self.am_mixer.output();
-        let (z1, z_valid) = self.iir[0].output();
-        let (z2, _) = self.iir[1].output();
+        let (z1, z2, z_valid) = self.iir.output();
         Outputs {
             dac: (drives.dac1, drives.dac2),
             z: (z1, z2),
@@ -137,21 +136,22 @@ impl GyroInterface {
         let carriers = self.carrier_nco.output();
         let am = self.modulation_nco.output();
         let drives = self.am_mixer.output();
-        let aligned = self.reference_alignment.output(regs.ref_delay);
+        let aligned = self.reference_alignment.output();
         let w = self.demod_mux.output();
         let cic = [self.cic[0].output(), self.cic[1].output()];
 
         self.carrier_nco.step(regs.carrier_step, regs.ref_phase);
         self.modulation_nco.step(regs.mod_step, regs.select);
         self.am_mixer.step(regs.amp, am, carriers);
-        self.reference_alignment.step(drives.ref1, drives.ref2);
+        self.reference_alignment
+            .step(drives.ref1, drives.ref2, regs.ref_delay);
         self.demod_mux.step(adc, aligned, regs.select);
         let r = regs.cic_decimation as u32;
         let shift = regs.cic_shift as u32;
         self.cic[0].step(w.0, r, shift);
         self.cic[1].step(w.1, r, shift);
-        self.iir[0].step(cic[0].0, cic[0].1, &regs.iir);
-        self.iir[1].step(cic[1].0, cic[1].1, &regs.iir);
+        // Both CICs share one counter: their strobes coincide.
+        self.iir.step((cic[0].0, cic[1].0), cic[0].1, &regs.iir);
         self.outputs()
     }
 }

@@ -1,14 +1,35 @@
-//! Bit-true model of `crate::iir_lowpass::IirLowpass`.
+//! Bit-true model of `crate::iir_lowpass::IirLowpass` (both channels).
 //!
-//! The schedule is mirrored register by register (step counter, operand and
-//! coefficient registers, the multiplier's output register, accumulator), so
-//! the model matches the hardware on every cycle, including inputs dropped
-//! while a schedule runs.
+//! The schedule is mirrored state by state. The shared multiplier is
+//! modelled by when its products are read: an operand loaded at the edge
+//! that ends state s is in the operand register during s + 1, so its
+//! product is on the multiplier's output during state s + 1 + 4 (every read
+//! falls inside the same schedule, so the products of idle cycles never
+//! matter). Every register wraps at its hardware width.
+
+use crate::iir_channel::SAMPLE_BITS;
+use crate::iir_lowpass::{
+    ACCUMULATOR_BITS, COEFFICIENT_FRACTION_BITS, GUARD_BITS, OPERAND_BITS, SCHEDULE_CLOCKS,
+    STATE_BITS,
+};
+use crate::primitives::pipelined_multiplier::LATENCY as MULTIPLIER_LATENCY;
 
 /// Sign-extend the low `bits` bits of `x`.
 #[inline(always)]
-fn wrap(x: i128, bits: u32) -> i128 {
+fn wrap(x: i128, bits: usize) -> i128 {
     (x << (128 - bits)) >> (128 - bits)
+}
+
+/// Half an LSB of the product's 30 dropped bits.
+const HALF_COEFFICIENT_LSB: i128 = 1 << (COEFFICIENT_FRACTION_BITS - 1);
+
+/// `m 2^30 + 2^29`, the accumulator preload for an integer m.
+#[inline(always)]
+fn preload(m: i128) -> i128 {
+    wrap(
+        (m << COEFFICIENT_FRACTION_BITS) | HALF_COEFFICIENT_LSB,
+        ACCUMULATOR_BITS,
+    )
 }
 
 /// The four filter coefficients, Q2.30.
@@ -24,109 +45,156 @@ pub struct Coefficients {
     pub alpha: i32,
 }
 
-/// Cycle-true model of one filter channel.
-#[derive(Clone, Debug, Default)]
-pub struct IirLowpass {
-    step: u8,
-    x: [i64; 3],
+/// The registers of one channel (`crate::iir_channel::IirChannel`).
+#[derive(Clone, Copy, Debug, Default)]
+struct Channel {
+    x0: i64,
+    x1: i64,
     v: i128,
-    operand: i128,
-    coefficient: i32,
-    product: i128,
-    accumulator: i128,
+    feedback: i128,
+    acc_y: i128,
+    acc_d: i128,
     y1: i128,
     y2: i128,
     u: i128,
     z: i64,
+}
+
+impl Channel {
+    fn start(&mut self, x: i64) {
+        let sum = x as i128 + 2 * self.x0 as i128 + self.x1 as i128;
+        self.v = wrap(sum << GUARD_BITS, OPERAND_BITS);
+        self.feedback = wrap(2 * self.y1 - self.y2, OPERAND_BITS);
+        self.x1 = self.x0;
+        self.x0 = x;
+    }
+
+    fn preload(&mut self) {
+        self.acc_y = preload(self.feedback);
+        self.acc_d = preload(wrap(self.feedback - self.u, OPERAND_BITS));
+    }
+
+    fn accumulate(&mut self, p: i128) {
+        self.acc_y = wrap(self.acc_y + p, ACCUMULATOR_BITS);
+        self.acc_d = wrap(self.acc_d + p, ACCUMULATOR_BITS);
+    }
+
+    /// Finish the biquad; returns y - u, the RC section's operand.
+    fn finish(&mut self, p: i128) -> i128 {
+        let shift = COEFFICIENT_FRACTION_BITS;
+        let y = wrap(wrap(self.acc_y + p, ACCUMULATOR_BITS) >> shift, STATE_BITS);
+        let difference = wrap(
+            wrap(self.acc_d + p, ACCUMULATOR_BITS) >> shift,
+            OPERAND_BITS,
+        );
+        self.y2 = self.y1;
+        self.y1 = y;
+        difference
+    }
+
+    fn update_u(&mut self, p: i128) {
+        let sum = wrap(preload(self.u) + p, ACCUMULATOR_BITS);
+        self.u = wrap(sum >> COEFFICIENT_FRACTION_BITS, STATE_BITS);
+    }
+
+    fn publish(&mut self) {
+        let rounded = wrap(self.u + (1 << (GUARD_BITS - 1)), STATE_BITS);
+        self.z = wrap(rounded >> GUARD_BITS, SAMPLE_BITS) as i64;
+    }
+}
+
+/// Cycle-true model of the two-channel filter.
+#[derive(Clone, Debug, Default)]
+pub struct IirLowpass {
+    /// The schedule state, 0 = Idle, as `IirStep` counts.
+    step: usize,
+    /// Product on the multiplier output during each state of the schedule.
+    product_at: [i128; SCHEDULE_CLOCKS],
+    channels: [Channel; 2],
+    publishing: bool,
     z_valid: bool,
 }
 
 impl IirLowpass {
-    /// `(z, z_valid)` during the current cycle.
+    /// `(z1, z2, z_valid)` during the current cycle.
     #[inline(always)]
-    pub fn output(&self) -> (i64, bool) {
-        (self.z, self.z_valid)
+    pub fn output(&self) -> (i64, i64, bool) {
+        (self.channels[0].z, self.channels[1].z, self.z_valid)
     }
 
-    /// True while a schedule runs (inputs are dropped).
+    /// True while a schedule runs (strobes are dropped).
     #[inline(always)]
     pub fn busy(&self) -> bool {
         self.step != 0
     }
 
-    /// One clock; returns `(z, z_valid)` after the edge.
+    /// Issue `operand * coefficient` at the edge that ends the current state.
     #[inline(always)]
-    pub fn step(&mut self, x: i64, x_valid: bool, k: &Coefficients) -> (i64, bool) {
+    fn issue(&mut self, operand: i128, coefficient: i32) {
+        self.product_at[self.step + 1 + MULTIPLIER_LATENCY] = operand * coefficient as i128;
+    }
+
+    /// One clock with inputs `x` and strobe `x_valid`; returns
+    /// `(z1, z2, z_valid)` after the edge.
+    #[inline(always)]
+    pub fn step(&mut self, x: (i64, i64), x_valid: bool, k: &Coefficients) -> (i64, i64, bool) {
+        self.z_valid = self.publishing;
+        if self.publishing {
+            self.channels[0].publish();
+            self.channels[1].publish();
+        }
+        self.publishing = false;
         if self.step == 0 && !x_valid {
-            // Idle: only the pulse ends. (The multiplier register keeps
-            // multiplying the idle operands, but it is read only in steps
-            // 4, 5, 6 and 10, after it has been reloaded.)
-            self.z_valid = false;
-            return (self.z, false);
+            return self.output();
         }
-        let product = self.product;
-        // The product register during the next cycle: read in steps 4, 5, 6
-        // and 10, so it is loaded in steps 3, 4, 5 and 9.
-        if matches!(self.step, 3 | 4 | 5 | 9) {
-            self.product = self.operand * self.coefficient as i128;
-        }
-        self.z_valid = false;
-        match self.step {
+        let p = self.product_at[self.step];
+        let [first, second] = &mut self.channels;
+        let mut next = self.step + 1;
+        let issue = match self.step {
             0 => {
-                if x_valid {
-                    self.x = [x, self.x[0], self.x[1]];
-                    self.step = 1;
-                }
+                let operand = first.y1;
+                first.start(x.0);
+                second.start(x.1);
+                Some((operand, k.k1))
             }
             1 => {
-                let sum = self.x[0] as i128 + 2 * self.x[1] as i128 + self.x[2] as i128;
-                self.v = wrap(sum << 16, 60);
-                self.step = 2;
+                first.preload();
+                second.preload();
+                Some((first.y2, k.k2))
             }
-            2 => {
-                self.operand = self.v;
-                self.coefficient = k.k0;
-                self.step = 3;
+            2 => Some((first.v, k.k0)),
+            3 => Some((second.y1, k.k1)),
+            4 => Some((second.y2, k.k2)),
+            5 => {
+                first.accumulate(p);
+                Some((second.v, k.k0))
             }
-            3 => {
-                self.operand = self.y1;
-                self.coefficient = k.k1;
-                self.step = 4;
+            6 => {
+                first.accumulate(p);
+                None
             }
-            4 => {
-                self.operand = self.y2;
-                self.coefficient = k.k2;
-                self.accumulator = product;
-                self.step = 5;
+            7 => Some((first.finish(p), k.alpha)),
+            8 | 9 => {
+                second.accumulate(p);
+                None
             }
-            5 | 6 => {
-                self.accumulator = wrap(self.accumulator + product, 96);
-                self.step += 1;
+            10 => Some((second.finish(p), k.alpha)),
+            12 => {
+                first.update_u(p);
+                None
             }
-            7 => {
-                let scaled = wrap(wrap(self.accumulator + (1 << 29), 96) >> 30, 60);
-                let y_new = wrap(2 * self.y1 - self.y2 + scaled, 60);
-                self.y2 = self.y1;
-                self.y1 = wrap(y_new, 58);
-                self.step = 8;
+            15 => {
+                second.update_u(p);
+                self.publishing = true;
+                next = 0;
+                None
             }
-            8 => {
-                self.operand = wrap(self.y1 - self.u, 60);
-                self.coefficient = k.alpha;
-                self.step = 9;
-            }
-            9 => self.step = 10,
-            10 => {
-                let scaled = wrap(wrap(product + (1 << 29), 92) >> 30, 60);
-                self.u = wrap(self.u + scaled, 58);
-                self.step = 11;
-            }
-            _ => {
-                self.z = wrap(wrap(self.u + (1 << 15), 58) >> 16, 40) as i64;
-                self.z_valid = true;
-                self.step = 0;
-            }
+            _ => None,
+        };
+        if let Some((operand, coefficient)) = issue {
+            self.issue(operand, coefficient);
         }
-        (self.z, self.z_valid)
+        self.step = next;
+        self.output()
     }
 }

@@ -1,15 +1,26 @@
-//! Shift register with a run-time tap: q = d delayed by `delay` + 1 clocks.
+//! Delay line in block RAM with a run-time tap: q = d delayed by `delay` + 1
+//! clocks.
 //!
 //! ```text
-//!  d ──► [0] ──► [1] ──► ... ──► [2^A - 1]
-//!         └───────┴──── mux(delay) ────────► q   (combinational read)
+//!  d ──► RAM[wp] (2^A words, wp = cycle count mod 2^A)
+//!        RAM[wp - delay] ──► [ram_q] ──┐
+//!  d ─────────────────────► [bypass] ──┴── mux(delay was 0) ──► q
 //! ```
 //!
-//! `taps[0]` takes `d` at every rising edge and each tap takes the one
-//! before it, so during cycle n, `q = d(n - 1 - delay)`. All taps power up
-//! at 0. The Verilog is a register array with a dynamic read index, which
-//! Xilinx tools map to SRL32 shift registers with a dynamic address and
-//! other tools to flip-flops and a multiplexer.
+//! At every rising edge the RAM writes `d` at the write pointer, which then
+//! advances, and reads, synchronously, the word written `delay` edges
+//! earlier; a delay of 0 asks for the word being written, which comes from
+//! a bypass register instead. So during cycle n + 1, `q = d(n - delay(n))`:
+//! for a constant delay, `q = d(m - 1 - delay)` during cycle m, as a shift
+//! register with a combinational tap would give, and a new delay acts one
+//! clock later than with such a tap. Read and write addresses never meet
+//! (delay >= 1 reads an older word), so the RAM's read-during-write mode
+//! does not matter. Every word powers up at 0.
+//!
+//! The RAM read goes straight into a register, so Yosys maps the words to
+//! one block RAM per line (iCE40 `SB_RAM40_4K`, ECP5 `DP16KD` or LUT RAM)
+//! instead of the 2^A x W flip-flops and the multiplexer of a shift
+//! register.
 //!
 //! Leaf block with hand-written Verilog (not single-source): the top-level
 //! golden-vector replay in Icarus and Verilator covers it.
@@ -17,33 +28,35 @@
 use super::convert::i128_to_signed;
 use rust_hdl::prelude::*;
 
-/// A `2^A`-tap shift register of `W`-bit words with a run-time read tap.
+/// A `2^A`-word delay line of `W`-bit words in RAM with a run-time tap.
 #[derive(Clone, Debug, LogicBlock)]
 pub struct TappedDelayLine<const W: usize, const A: usize> {
     /// The clock.
     pub clock: Signal<In, Clock>,
-    /// Input word, shifted in at every rising edge.
+    /// Input word, written at every rising edge.
     pub d: Signal<In, Signed<W>>,
-    /// Tap to read: `q` is `d` delayed by `delay + 1` clocks.
+    /// Tap to read: `q` is `d` delayed by `delay + 1` clocks (`delay`
+    /// sampled at the edge that reads).
     pub delay: Signal<In, Bits<A>>,
-    /// The selected tap (combinational from `delay` and the taps).
+    /// The selected word (registered).
     pub q: Signal<Out, Signed<W>>,
-    _taps: Vec<Signed<W>>,
+    /// `_words[i]` is `d` from i + 1 edges ago.
+    _words: Vec<Signed<W>>,
 }
 
 impl<const W: usize, const A: usize> TappedDelayLine<W, A> {
-    /// A delay line of `2^A` taps, all zero; `A` must be between 1 and 10.
+    /// A delay line of `2^A` words, all zero; `A` must be between 1 and 10.
     pub fn new() -> Self {
         assert!(
             (1..=10).contains(&A),
-            "TappedDelayLine depth must be 2..1024 taps"
+            "TappedDelayLine depth must be 2..1024 words"
         );
         Self {
             clock: Default::default(),
             d: Default::default(),
             delay: Default::default(),
-            q: Default::default(),
-            _taps: vec![i128_to_signed(0); 1 << A],
+            q: Signal::new_with_default(i128_to_signed(0)),
+            _words: vec![i128_to_signed(0); 1 << A],
         }
     }
 }
@@ -57,10 +70,15 @@ impl<const W: usize, const A: usize> Default for TappedDelayLine<W, A> {
 impl<const W: usize, const A: usize> Logic for TappedDelayLine<W, A> {
     fn update(&mut self) {
         if self.clock.pos_edge() {
-            self._taps.rotate_right(1);
-            self._taps[0] = self.d.val();
+            let delay = self.delay.val().to_u64() as usize;
+            self.q.next = if delay == 0 {
+                self.d.val()
+            } else {
+                self._words[delay - 1]
+            };
+            self._words.rotate_right(1);
+            self._words[0] = self.d.val();
         }
-        self.q.next = self._taps[self.delay.val().to_u64() as usize];
     }
 
     fn connect(&mut self) {
@@ -70,24 +88,36 @@ impl<const W: usize, const A: usize> Logic for TappedDelayLine<W, A> {
     fn hdl(&self) -> Verilog {
         let depth = 1usize << A;
         let msb = W - 1;
+        let amsb = A - 1;
         Verilog::Custom(format!(
             "\
-reg signed [{msb}:0] taps [0:{last}];
+reg signed [{msb}:0] words [0:{last}];
+reg [{amsb}:0] write_address;
+// An A-bit wire, so the address wraps modulo 2^A in every simulator.
+wire [{amsb}:0] read_address = write_address - delay;
+reg signed [{msb}:0] ram_q;
+reg signed [{msb}:0] bypass_q;
+reg use_bypass;
 integer init_index;
-integer shift_index;
 
 initial begin
    for (init_index = 0; init_index < {depth}; init_index = init_index + 1)
-      taps[init_index] = 0;
+      words[init_index] = 0;
+   write_address = 0;
+   ram_q = 0;
+   bypass_q = 0;
+   use_bypass = 0;
 end
 
 always @(posedge clock) begin
-   taps[0] <= d;
-   for (shift_index = 1; shift_index < {depth}; shift_index = shift_index + 1)
-      taps[shift_index] <= taps[shift_index - 1];
+   words[write_address] <= d;
+   write_address <= write_address + 1'b1;
+   ram_q <= words[read_address];
+   bypass_q <= d;
+   use_bypass <= (delay == 0);
 end
 
-always @(*) q = taps[delay];",
+always @(*) q = use_bypass ? bypass_q : ram_q;",
             last = depth - 1
         ))
     }
