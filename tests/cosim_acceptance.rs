@@ -35,7 +35,7 @@ fn scaled_paper(carrier_offset_hz: f64) -> Experiment {
     e.points.readout_rates_dps = vec![1.0, 5.0, 10.0, 15.0, 20.0];
     let scale = bandwidth / (9.64e6 / 55e3);
     e.points.cal_freqs_hz = (10..=15).map(|f| f as f64 * scale).collect();
-    // Averaging windows of 0.1 s instead of the default 0.05 s: on the
+    // Averaging windows of 0.1 s rather than 0.05 s: on the
     // resonant output the readout signal is a small in-phase part of a
     // full-scale quadrature signal, and the 16-bit ADC's deterministic
     // quantization residue averaged over 0.05 s left +0.094% in its
