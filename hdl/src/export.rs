@@ -72,6 +72,43 @@ const fn port(
 
 use PortDirection::{Input, Output};
 
+/// `adc1`, the same port in both tops.
+const ADC1: Port = port(
+    "adc1",
+    Input,
+    16,
+    true,
+    "two's complement",
+    "ADC word of gyroscope output 1 (mode 1 pick-off).",
+);
+/// `adc2`, the same port in both tops.
+const ADC2: Port = port(
+    "adc2",
+    Input,
+    16,
+    true,
+    "two's complement",
+    "ADC word of gyroscope output 2 (mode 2 pick-off).",
+);
+/// `dac1`, the same port in both tops.
+const DAC1: Port = port(
+    "dac1",
+    Output,
+    16,
+    true,
+    "two's complement, -32767..32767",
+    "Drive 1 = F1 A1 cos(wt), to DAC 1 (mode 1).",
+);
+/// `dac2`, the same port in both tops.
+const DAC2: Port = port(
+    "dac2",
+    Output,
+    16,
+    true,
+    "two's complement, -32767..32767",
+    "Drive 2 = F2 A2 sin(wt), to DAC 2 (mode 2).",
+);
+
 /// The ports of `gyro_interface`, in declaration order. A test checks this
 /// table against the generated Verilog.
 pub const PORTS: &[Port] = &[
@@ -83,38 +120,10 @@ pub const PORTS: &[Port] = &[
         "clock",
         "Every register uses its rising edge; one clock domain.",
     ),
-    port(
-        "adc1",
-        Input,
-        16,
-        true,
-        "two's complement",
-        "ADC word of gyroscope output 1 (mode 1 pick-off).",
-    ),
-    port(
-        "adc2",
-        Input,
-        16,
-        true,
-        "two's complement",
-        "ADC word of gyroscope output 2 (mode 2 pick-off).",
-    ),
-    port(
-        "dac1",
-        Output,
-        16,
-        true,
-        "two's complement, -32767..32767",
-        "Drive 1 = F1 A1 cos(wt), to DAC 1 (mode 1).",
-    ),
-    port(
-        "dac2",
-        Output,
-        16,
-        true,
-        "two's complement, -32767..32767",
-        "Drive 2 = F2 A2 sin(wt), to DAC 2 (mode 2).",
-    ),
+    ADC1,
+    ADC2,
+    DAC1,
+    DAC2,
     port(
         "z1",
         Output,
@@ -332,38 +341,10 @@ pub const AXI_PORTS: &[Port] = &[
         "active low",
         "Synchronous AXI reset of the bus wrapper (settings, handshakes, counters, FIFO); the datapath has none.",
     ),
-    port(
-        "adc1",
-        Input,
-        16,
-        true,
-        "two's complement",
-        "ADC word of gyroscope output 1 (mode 1 pick-off).",
-    ),
-    port(
-        "adc2",
-        Input,
-        16,
-        true,
-        "two's complement",
-        "ADC word of gyroscope output 2 (mode 2 pick-off).",
-    ),
-    port(
-        "dac1",
-        Output,
-        16,
-        true,
-        "two's complement",
-        "DAC word of drive 1.",
-    ),
-    port(
-        "dac2",
-        Output,
-        16,
-        true,
-        "two's complement",
-        "DAC word of drive 2.",
-    ),
+    ADC1,
+    ADC2,
+    DAC1,
+    DAC2,
     port(
         "s_axil_awvalid",
         Input,
