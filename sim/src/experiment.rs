@@ -207,16 +207,12 @@ impl Plan {
             Mode::Readout => theory::readout_z(&dev, p.omz_rad_s),
             Mode::Calibration => {
                 let clock = exp.drive.clock_hz;
-                let sinc = |f: f64| {
-                    let x = PI * f / clock;
-                    x.sin() / x
-                };
-                let at_carrier = sinc(self.carrier_hz);
                 theory::calibration_z_of_datapath(
                     &dev,
                     p.cal_hz,
                     envelope_lead_rad(p.cal_hz, clock),
-                    [-1.0, 1.0].map(|s| sinc(self.carrier_hz + s * p.cal_hz) / at_carrier),
+                    [-1.0, 1.0]
+                        .map(|s| hold_gain(self.carrier_hz + s * p.cal_hz, clock) / self.hold_gain),
                 )
             }
         };
@@ -237,6 +233,18 @@ impl Plan {
                 / (f64::from(1u32 << OUTPUT_FRACTION_BITS) * self.filter.dc_gain)
         })
     }
+}
+
+/// Fundamental gain of the DAC's zero-order hold at `f_hz`, sin(x) / x with
+/// x = pi f / f_clk.
+fn hold_gain(f_hz: f64, clock_hz: f64) -> f64 {
+    let x = PI * f_hz / clock_hz;
+    x.sin() / x
+}
+
+/// A ratio's 1-sigma target: `tolerance x max(|ratio|, RATIO_FLOOR)`.
+pub fn ratio_target(tolerance: f64, ratio: f64) -> f64 {
+    tolerance * ratio.abs().max(RATIO_FLOOR)
 }
 
 /// The lead of the reference envelopes over the drive envelopes the
@@ -324,10 +332,7 @@ pub fn plan(exp: &Experiment) -> Result<Plan, String> {
     let force_full_scale = exp.drive.force_full_scale();
     let force_per_lsb = [force_full_scale[0] / 32768.0, force_full_scale[1] / 32768.0];
     let clock = exp.drive.clock_hz;
-    let hold_gain = {
-        let x = PI * realized.carrier_hz / clock;
-        x.sin() / x
-    };
+    let hold_gain = hold_gain(realized.carrier_hz, clock);
     let mut warnings = vec![];
     if let Some(q) = settings::commensurate_period(exp.drive.carrier_hz, clock) {
         warnings.push(format!(
@@ -760,8 +765,7 @@ pub struct Timing {
 /// split `1 - CAL_SHARE` : `CAL_SHARE` in relative variance.
 pub fn excess(exp: &Experiment, sf: &ScaleFactors) -> [f64; 2] {
     let worst = |f: &dyn Fn(usize) -> f64| (0..2).map(f).fold(0.0f64, f64::max);
-    let relative =
-        |k: usize| exp.points.tolerance * sf.ratio[k].abs().max(RATIO_FLOOR) / sf.ratio[k].abs();
+    let relative = |k: usize| ratio_target(exp.points.tolerance, sf.ratio[k]) / sf.ratio[k].abs();
     [
         worst(&|k| {
             sf.sf_read_uncertainty[k]

@@ -5,8 +5,7 @@
 use crate::config::{Derived, Experiment};
 use crate::engine::EngineKind;
 use crate::experiment::{
-    self, Measured, Plan, PointResult, RATIO_FLOOR, Tick, Timing, exact_scale_factors,
-    measured_scale_factors,
+    self, Measured, Plan, PointResult, Tick, Timing, exact_scale_factors, measured_scale_factors,
 };
 use crate::fit::ScaleFactors;
 use crate::theory;
@@ -161,8 +160,9 @@ impl Report {
         } else {
             Some(0)
         };
-        let target: [f64; 2] =
-            std::array::from_fn(|k| exp.points.tolerance * sim.ratio[k].abs().max(RATIO_FLOOR));
+        let target = sim
+            .ratio
+            .map(|r| experiment::ratio_target(exp.points.tolerance, r));
         let mut warnings = plan.warnings.clone();
         warnings.extend(accuracy_warnings(
             exp,
