@@ -137,6 +137,16 @@ pub fn committed_waivers() -> PathBuf {
     verilog_out_dir().join(lint::WAIVER_FILE)
 }
 
+/// The committed bus-attached export, `verilog-out/gyro_interface_axi.v`.
+pub fn committed_axi_verilog() -> PathBuf {
+    verilog_out_dir().join(gyrocal_hdl::export::AXI_VERILOG_FILE)
+}
+
+/// The committed waivers of the bus wrapper, `verilog-out/lint-waivers-axi.vlt`.
+pub fn committed_axi_waivers() -> PathBuf {
+    verilog_out_dir().join(lint::AXI_WAIVER_FILE)
+}
+
 /// The committed resource report, `verilog-out/RESOURCES.md`.
 pub fn committed_resources() -> PathBuf {
     verilog_out_dir().join(synthesis::RESOURCES_FILE)

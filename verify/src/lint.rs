@@ -26,8 +26,13 @@ use std::path::Path;
 use std::process::Command;
 use std::time::Duration;
 
-/// File name of the waiver file inside `verilog-out/`.
+/// File name of the waiver file inside `verilog-out/`: the core's
+/// warnings, in `gyro_interface.v` and in the copy of the core inside
+/// `gyro_interface_axi.v`.
 pub const WAIVER_FILE: &str = "lint-waivers.vlt";
+/// File name of the bus wrapper's own waivers inside `verilog-out/`, read
+/// after [`WAIVER_FILE`] when linting `gyro_interface_axi.v`.
+pub const AXI_WAIVER_FILE: &str = "lint-waivers-axi.vlt";
 
 /// One Verilator warning.
 #[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -82,18 +87,19 @@ impl LintReport {
 /// Lint `verilog` (top module `gyro_interface`) with `verilator --lint-only
 /// -Wall`, reading `waivers` (a `.vlt` file) first if given.
 pub fn lint(verilog: &Path, waivers: Option<&Path>) -> Result<LintReport, VerifyError> {
+    lint_top(verilog, TOP_MODULE, waivers.as_slice())
+}
+
+/// Lint `verilog` with top module `top`, reading the `waivers` files (in
+/// order) first.
+pub fn lint_top(verilog: &Path, top: &str, waivers: &[&Path]) -> Result<LintReport, VerifyError> {
     let verilator = tools::verilator()?;
     let tool_version = tools::version_line(&verilator, "--version")?;
     let dir = ScratchDir::new("lint").map_err(io_error("cannot create a scratch folder"))?;
     let mut cmd = Command::new(&verilator);
-    cmd.current_dir(dir.path()).args([
-        "--lint-only",
-        "-Wall",
-        "-Wno-fatal",
-        "--top-module",
-        TOP_MODULE,
-    ]);
-    if let Some(w) = waivers {
+    cmd.current_dir(dir.path())
+        .args(["--lint-only", "-Wall", "-Wno-fatal", "--top-module", top]);
+    for w in waivers {
         cmd.arg(std::path::absolute(w).map_err(io_error("bad waiver path"))?);
     }
     cmd.arg(std::path::absolute(verilog).map_err(io_error("bad Verilog path"))?);
@@ -219,6 +225,20 @@ pub struct WaiverUse {
 /// and record the warnings that appear in addition to those of the full
 /// waiver file. Runs the lints in parallel (about 0.3 s each).
 pub fn waiver_usage(verilog: &Path, waivers: &Path) -> Result<Vec<WaiverUse>, VerifyError> {
+    waiver_usage_top(verilog, TOP_MODULE, &[], waivers)
+}
+
+/// [`waiver_usage`] for top module `top`, with the waiver files `kept` read
+/// in full before `waivers` in every lint.
+pub fn waiver_usage_top(
+    verilog: &Path,
+    top: &str,
+    kept: &[&Path],
+    waivers: &Path,
+) -> Result<Vec<WaiverUse>, VerifyError> {
+    fn with<'a>(kept: &[&'a Path], last: &'a Path) -> Vec<&'a Path> {
+        kept.iter().copied().chain(std::iter::once(last)).collect()
+    }
     let text = std::fs::read_to_string(waivers)
         .map_err(io_error(format!("cannot read {}", waivers.display())))?;
     let parsed = parse_waivers(&text).map_err(|e| VerifyError::ToolFailed {
@@ -226,7 +246,7 @@ pub fn waiver_usage(verilog: &Path, waivers: &Path) -> Result<Vec<WaiverUse>, Ve
         reason: e,
         output: String::new(),
     })?;
-    let baseline = lint(verilog, Some(waivers))?;
+    let baseline = lint_top(verilog, top, &with(kept, waivers))?;
     let dir = ScratchDir::new("waivers").map_err(io_error("cannot create a scratch folder"))?;
     let lines: Vec<&str> = text.lines().collect();
     let lint_without = |w: &Waiver| -> Result<WaiverUse, VerifyError> {
@@ -240,7 +260,7 @@ pub fn waiver_usage(verilog: &Path, waivers: &Path) -> Result<Vec<WaiverUse>, Ve
         let file = dir.path().join(format!("without-line-{}.vlt", w.line));
         std::fs::write(&file, reduced)
             .map_err(io_error(format!("cannot write {}", file.display())))?;
-        let report = lint(verilog, Some(&file))?;
+        let report = lint_top(verilog, top, &with(kept, &file))?;
         let suppressed = report
             .warnings
             .into_iter()

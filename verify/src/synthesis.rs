@@ -126,6 +126,56 @@ pub struct SynthesisReport {
     pub wall: Duration,
 }
 
+/// What Yosys's `check` says about a design before technology mapping.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct StructuralCheck {
+    /// Problems `check` reported (logic loops, multiple drivers, undriven
+    /// wires used as inputs).
+    pub problems: u64,
+    /// The lines of `check.txt` naming them.
+    pub listing: String,
+}
+
+/// `check` on `verilog` (top `top`) after `hierarchy -check; proc; flatten;
+/// opt_clean`: the netlist bit by bit, before any technology mapping, so a
+/// combinational loop across modules or inside one `always` block shows.
+pub fn structural_check(verilog: &Path, top: &str) -> Result<StructuralCheck, VerifyError> {
+    let yosys = tools::yosys()?;
+    let dir = ScratchDir::new("yosys-check").map_err(io_error("cannot create a scratch folder"))?;
+    let script = format!(
+        "read_verilog {file}; hierarchy -check -top {top}; proc; flatten; opt_clean; \
+         tee -o check.txt check",
+        file = std::path::absolute(verilog)
+            .map_err(io_error("bad Verilog path"))?
+            .display()
+    );
+    let mut cmd = Command::new(&yosys);
+    cmd.current_dir(dir.path()).args(["-q", "-p", &script]);
+    let (out, _) = run_ok(&mut cmd)?;
+    let listing = std::fs::read_to_string(dir.path().join("check.txt")).map_err(|e| {
+        VerifyError::ToolFailed {
+            command: describe(&cmd),
+            reason: format!("did not write check.txt: {e}"),
+            output: tail(&combined_output(&out), 40),
+        }
+    })?;
+    let problems = check_problem_count(&listing).ok_or_else(|| VerifyError::ToolFailed {
+        command: describe(&cmd),
+        reason: "`check` printed no problem count".into(),
+        output: tail(&listing, 20),
+    })?;
+    Ok(StructuralCheck { problems, listing })
+}
+
+/// The count in `check`'s last "Found and reported N problems" line.
+fn check_problem_count(check: &str) -> Option<u64> {
+    Regex::new(r"Found and reported (\d+) problems")
+        .unwrap()
+        .captures_iter(check)
+        .last()
+        .and_then(|c| c[1].parse().ok())
+}
+
 /// Synthesize `verilog` (top `gyro_interface`) for `target`.
 pub fn synthesize(verilog: &Path, target: Target) -> Result<SynthesisReport, VerifyError> {
     let yosys = tools::yosys()?;
@@ -156,16 +206,11 @@ pub fn synthesize(verilog: &Path, target: Target) -> Result<SynthesisReport, Ver
         reason,
         output: tail(&stat, 40),
     })?;
-    let problems = Regex::new(r"Found and reported (\d+) problems").unwrap();
-    let check_problems = problems
-        .captures_iter(&check)
-        .last()
-        .and_then(|c| c[1].parse().ok())
-        .ok_or_else(|| VerifyError::ToolFailed {
-            command: describe(&cmd),
-            reason: "`check` printed no problem count".into(),
-            output: tail(&check, 20),
-        })?;
+    let check_problems = check_problem_count(&check).ok_or_else(|| VerifyError::ToolFailed {
+        command: describe(&cmd),
+        reason: "`check` printed no problem count".into(),
+        output: tail(&check, 20),
+    })?;
     let inferred = Regex::new(r"^\s*Latch inferred for signal").unwrap();
     let mut latches: Vec<String> = log
         .lines()
