@@ -31,6 +31,9 @@ enum Command {
     Bench(commands::bench::Args),
     /// Synthesize the export with Yosys and write verilog-out/RESOURCES.md.
     Synth(commands::synth::Args),
+    /// Print the register words that program a board for a device (table,
+    /// C header or JSON), from the plan `run` co-simulates.
+    Registers(commands::registers::Args),
 }
 
 /// A failure, with the exit status it deserves.
@@ -57,6 +60,7 @@ fn main() -> ExitCode {
         Command::Reproduce(args) => commands::reproduce::run(&args),
         Command::Bench(args) => commands::bench::run(&args),
         Command::Synth(args) => commands::synth::run(&args),
+        Command::Registers(args) => commands::registers::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -25,17 +25,15 @@ fn exported_verilog_is_lint_clean_with_the_waivers() {
         Some(&verify::committed_waivers()),
     )
     .unwrap_or_else(|e| panic!("{e}"));
-    let listing: Vec<String> = report.warnings.iter().map(|w| w.to_string()).collect();
     assert!(
         report.is_clean(),
         "{} ({}): {} warnings and {} errors left after the waivers; fix the design or, if benign, \
-         add a narrow waiver with its reason to verilog-out/lint-waivers.vlt:\n{}\n{}",
+         add a narrow waiver with its reason to verilog-out/lint-waivers.vlt:\n{}",
         report.tool_version,
         verify::committed_verilog().display(),
         report.warnings.len(),
         report.errors.len(),
-        listing.join("\n"),
-        report.errors.join("\n")
+        report.listing()
     );
 }
 
@@ -131,16 +129,14 @@ fn bus_attached_verilog_is_lint_clean_with_the_waivers() {
         ],
     )
     .unwrap_or_else(|e| panic!("{e}"));
-    let listing: Vec<String> = report.warnings.iter().map(|w| w.to_string()).collect();
     assert!(
         report.is_clean(),
         "{}: {} warnings and {} errors left after the waivers; fix the wrapper or, if benign, \
-         add a narrow waiver with its reason to verilog-out/lint-waivers-axi.vlt:\n{}\n{}",
+         add a narrow waiver with its reason to verilog-out/lint-waivers-axi.vlt:\n{}",
         verify::committed_axi_verilog().display(),
         report.warnings.len(),
         report.errors.len(),
-        listing.join("\n"),
-        report.errors.join("\n")
+        report.listing()
     );
 }
 
@@ -166,7 +162,7 @@ fn bus_attached_top_has_no_combinational_loop() {
     if let Err(e) = verify::tools::yosys() {
         panic!("{e}");
     }
-    let check = synthesis::structural_check(&verify::committed_axi_verilog(), AXI_TOP_MODULE)
+    let check = synthesis::structural_check(&[&verify::committed_axi_verilog()], AXI_TOP_MODULE)
         .unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(check.problems, 0, "Yosys check:\n{}", check.listing);
 }
@@ -184,7 +180,7 @@ fn the_structural_check_finds_a_loop() {
          endmodule\n",
     )
     .unwrap();
-    let check = synthesis::structural_check(&file, "looped").unwrap_or_else(|e| panic!("{e}"));
+    let check = synthesis::structural_check(&[&file], "looped").unwrap_or_else(|e| panic!("{e}"));
     assert!(check.problems > 0, "no loop found:\n{}", check.listing);
 }
 

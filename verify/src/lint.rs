@@ -78,6 +78,16 @@ pub struct LintReport {
 }
 
 impl LintReport {
+    /// The warnings, then the errors, one per line (empty when clean).
+    pub fn listing(&self) -> String {
+        self.warnings
+            .iter()
+            .map(|w| w.to_string())
+            .chain(self.errors.iter().cloned())
+            .collect::<Vec<_>>()
+            .join("\n")
+    }
+
     /// No warnings and no errors.
     pub fn is_clean(&self) -> bool {
         self.warnings.is_empty() && self.errors.is_empty()
@@ -93,6 +103,16 @@ pub fn lint(verilog: &Path, waivers: Option<&Path>) -> Result<LintReport, Verify
 /// Lint `verilog` with top module `top`, reading the `waivers` files (in
 /// order) first.
 pub fn lint_top(verilog: &Path, top: &str, waivers: &[&Path]) -> Result<LintReport, VerifyError> {
+    lint_files(&[verilog], top, waivers)
+}
+
+/// Lint the design made of the files `verilog` with top module `top`,
+/// reading the `waivers` files (in order) first.
+pub fn lint_files(
+    verilog: &[&Path],
+    top: &str,
+    waivers: &[&Path],
+) -> Result<LintReport, VerifyError> {
     let verilator = tools::verilator()?;
     let tool_version = tools::version_line(&verilator, "--version")?;
     let dir = ScratchDir::new("lint").map_err(io_error("cannot create a scratch folder"))?;
@@ -102,7 +122,9 @@ pub fn lint_top(verilog: &Path, top: &str, waivers: &[&Path]) -> Result<LintRepo
     for w in waivers {
         cmd.arg(std::path::absolute(w).map_err(io_error("bad waiver path"))?);
     }
-    cmd.arg(std::path::absolute(verilog).map_err(io_error("bad Verilog path"))?);
+    for v in verilog {
+        cmd.arg(std::path::absolute(v).map_err(io_error("bad Verilog path"))?);
+    }
     let (out, wall) = run(&mut cmd)?;
     let output = combined_output(&out);
     let (warnings, errors) = parse_output(&output);

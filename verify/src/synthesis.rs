@@ -136,18 +136,22 @@ pub struct StructuralCheck {
     pub listing: String,
 }
 
-/// `check` on `verilog` (top `top`) after `hierarchy -check; proc; flatten;
-/// opt_clean`: the netlist bit by bit, before any technology mapping, so a
-/// combinational loop across modules or inside one `always` block shows.
-pub fn structural_check(verilog: &Path, top: &str) -> Result<StructuralCheck, VerifyError> {
+/// `check` on the design made of the files `verilog` (top `top`) after
+/// `hierarchy -check; proc; flatten; opt_clean`: the netlist bit by bit,
+/// before any technology mapping, so a combinational loop across modules or
+/// inside one `always` block shows, and so does a missing module or port.
+pub fn structural_check(verilog: &[&Path], top: &str) -> Result<StructuralCheck, VerifyError> {
     let yosys = tools::yosys()?;
     let dir = ScratchDir::new("yosys-check").map_err(io_error("cannot create a scratch folder"))?;
+    let mut files = Vec::new();
+    for v in verilog {
+        let path = std::path::absolute(v).map_err(io_error("bad Verilog path"))?;
+        files.push(format!("\"{}\"", path.display()));
+    }
     let script = format!(
-        "read_verilog {file}; hierarchy -check -top {top}; proc; flatten; opt_clean; \
+        "read_verilog {}; hierarchy -check -top {top}; proc; flatten; opt_clean; \
          tee -o check.txt check",
-        file = std::path::absolute(verilog)
-            .map_err(io_error("bad Verilog path"))?
-            .display()
+        files.join(" ")
     );
     let mut cmd = Command::new(&yosys);
     cmd.current_dir(dir.path()).args(["-q", "-p", &script]);
