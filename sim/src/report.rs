@@ -5,7 +5,8 @@
 use crate::config::{Derived, Experiment};
 use crate::engine::EngineKind;
 use crate::experiment::{
-    self, Measured, Plan, PointResult, Tick, Timing, exact_scale_factors, measured_scale_factors,
+    self, Measured, Mode, Plan, PointResult, Tick, Timing, exact_scale_factors,
+    measured_scale_factors,
 };
 use crate::fit::ScaleFactors;
 use crate::theory;
@@ -95,6 +96,17 @@ pub struct Report {
     pub ratio_uncertainty: [f64; 2],
     /// The ratio's target uncertainty, tolerance x max(|ratio|, 0.5).
     pub ratio_target_uncertainty: [f64; 2],
+    /// The readout scale factor in the gateware's own units, what a board
+    /// measures: z LSB (one unit of the 40-bit z word, 1/256 of a mixer
+    /// LSB) per deg/s. It carries the DAC and ADC gains that the equations'
+    /// units divide out.
+    pub sf_read_lsb_per_dps: [f64; 2],
+    /// Its 1-sigma uncertainty.
+    pub sf_read_lsb_uncertainty: [f64; 2],
+    /// The calibration scale factor in z LSB per deg/s of virtual rate.
+    pub sf_cal_lsb_per_dps: [f64; 2],
+    /// Its 1-sigma uncertainty.
+    pub sf_cal_lsb_uncertainty: [f64; 2],
     /// Intercepts of the simulated readout and calibration fits.
     pub intercept_read: [f64; 2],
     /// Intercepts of the simulated calibration fits.
@@ -138,6 +150,10 @@ impl Report {
     pub fn new(exp: &Experiment, plan: &Plan, measured: Measured) -> Self {
         let points = measured.points;
         let sim: ScaleFactors = measured_scale_factors(&points);
+        // Equations' units per z LSB, per output: a constant of each mode.
+        let read_per_lsb = plan.z_per_lsb(Mode::Readout);
+        let cal_per_lsb = plan.z_per_lsb(Mode::Calibration);
+        let in_lsb = |v: [f64; 2], per_lsb: [f64; 2]| [v[0] / per_lsb[0], v[1] / per_lsb[1]];
         let exact: ScaleFactors = exact_scale_factors(&points);
         let mut dev = plan.theory_device(exp);
         dev.f1_force *= plan.hold_gain.sqrt();
@@ -189,6 +205,10 @@ impl Report {
             ratio: sim.ratio,
             ratio_uncertainty: sim.ratio_uncertainty,
             ratio_target_uncertainty: target,
+            sf_read_lsb_per_dps: in_lsb(sim.sf_read_per_dps, read_per_lsb),
+            sf_read_lsb_uncertainty: in_lsb(sim.sf_read_uncertainty, read_per_lsb),
+            sf_cal_lsb_per_dps: in_lsb(sim.sf_cal_per_dps, cal_per_lsb),
+            sf_cal_lsb_uncertainty: in_lsb(sim.sf_cal_uncertainty, cal_per_lsb),
             theory: Theory {
                 sf_read_per_dps: exact.sf_read_per_dps,
                 sf_cal_per_dps: exact.sf_cal_per_dps,

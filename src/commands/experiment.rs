@@ -299,6 +299,16 @@ pub fn summary(report: &Report) -> String {
         report.sf_cal_uncertainty,
     ));
     s.push_str(&exact("  exact theory, same fit", t.sf_cal_per_dps));
+    s.push_str(&row(
+        "sf_read (z LSB per deg/s)",
+        report.sf_read_lsb_per_dps,
+        report.sf_read_lsb_uncertainty,
+    ));
+    s.push_str(&row(
+        "sf_cal (z LSB per deg/s virtual)",
+        report.sf_cal_lsb_per_dps,
+        report.sf_cal_lsb_uncertainty,
+    ));
     let ratio = |v: f64, u: f64| format!("{v:+.6} +- {u:.1e}");
     s.push_str(&format!(
         "{:<32}{:>26}  {:>26}\n",
