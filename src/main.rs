@@ -31,6 +31,8 @@ enum Command {
     Bench(commands::bench::Args),
     /// Synthesize the export with Yosys and write verilog-out/RESOURCES.md.
     Synth(commands::synth::Args),
+    /// Predict and measure the rate output's noise floor: Allan deviation, angle random walk, bias instability.
+    Allan(commands::allan::Args),
 }
 
 /// A failure, with the exit status it deserves.
@@ -57,6 +59,7 @@ fn main() -> ExitCode {
         Command::Reproduce(args) => commands::reproduce::run(&args),
         Command::Bench(args) => commands::bench::run(&args),
         Command::Synth(args) => commands::synth::run(&args),
+        Command::Allan(args) => commands::allan::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
