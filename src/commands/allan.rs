@@ -21,10 +21,10 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 /// Default run length (simulated s): the reading at tau = 1 s then has
-/// about 1.5 x 300 = 450 equivalent degrees of freedom (white rate noise),
-/// a relative standard deviation of 1 / sqrt(900) = 3.3 %, so 10 % is
+/// about 1.5 x 310 = 463 equivalent degrees of freedom (white rate noise),
+/// a relative standard deviation of 1 / sqrt(2 x 463) = 3.3 %, so 10 % is
 /// 3 sigma.
-pub const DEFAULT_SECONDS: f64 = 300.0;
+pub const DEFAULT_SECONDS: f64 = 310.0;
 
 /// Options of `gyrocal allan`.
 #[derive(clap::Args)]
