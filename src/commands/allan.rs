@@ -310,9 +310,18 @@ fn summary(report: &AllanReport) -> String {
         "  at tau (s)",
         both(&|k| run.outputs[k].analysis.bias_instability.tau_s),
     ));
+    let at_longest = (0..2).any(|k| {
+        let a = &run.outputs[k].analysis;
+        a.points.last().map(|p| p.tau_s) == Some(a.bias_instability.tau_s)
+    });
+    if at_longest {
+        s.push_str(
+            "  (minimum at the longest tau: no floor reached in this run, an upper bound)\n",
+        );
+    }
     s.push_str(&row(
-        "mean rate (deg/s)",
-        both(&|k| run.outputs[k].mean_rate_dps),
+        "mean rate less the applied (deg/s)",
+        both(&|k| run.outputs[k].mean_rate_dps - run.rate_dps),
     ));
     s.push_str(&row(
         "scale factor (z LSB per deg/s)",
