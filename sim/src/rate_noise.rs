@@ -24,9 +24,10 @@
 //! - **Brownian force** on mode k ([`crate::noise`]): one-sided force PSD
 //!   per unit mass `S_a,k = 4 k_B T w_k / (Q_k m)`, through the mode's
 //!   response: `S_x,k(f) = S_a,k / ((w_k^2 - w^2)^2 + (w w_k / Q_k)^2)`.
-//!   The Coriolis coupling moves this by `(2 lam Omz wb / |D_k|)^2`
-//!   relatively, below 1e-8 at the rates of a readout run; the other
-//!   mode's force leaks in by the same factor. Both are left out.
+//!   The Coriolis coupling `c = 2 lam Omz wb` changes this, and lets the
+//!   other mode's force in, by terms of order `c^2 / |D_1 D_2|`
+//!   (`D_k = w_k^2 - wb^2 + j wb w_k / Q_k`): 2e-6 on the test device at
+//!   50 deg/s, 5e-8 on the paper's at 20 deg/s. They are left out.
 //! - **ADC noise**: `noise_lsb` (sigma_n, 16-bit word LSB) Gaussian per
 //!   clock plus the quantization error of a step `D = 2^(16 - adc_bits)`
 //!   word LSB, uniform and white, variance `D^2 / 12` (Widrow: exact once
@@ -64,7 +65,7 @@
 //! baseband spectrum rolls off at `|f_k - fb|` and `f_k / (2 Q_k)`. So
 //! [`RateNoisePrediction::adev`] also evaluates the Allan variance of the
 //! whole spectrum, `sigma^2(tau) = int_0^inf S(f) 2 sin^4(pi f tau) /
-//! (pi f tau)^2 df` (IEEE 952, eq. C.2 with the one-sided `S`), which at
+//! (pi f tau)^2 df` (IEEE 952 annex C, with the one-sided `S`), which at
 //! `tau = 1 s` is within `~3 / (4 pi f_roll tau)` of `N / sqrt(tau)`.
 //!
 //! # Measurement
@@ -215,6 +216,10 @@ pub fn predict(
     })
 }
 
+/// Periods of the Allan kernel integrated exactly before its mean is used
+/// ([`RateNoisePrediction::adev`]).
+const NEAR_PERIODS: u32 = 64;
+
 /// Gauss-Legendre nodes and weights on [-1, 1], 8 points.
 const GAUSS8: [(f64, f64); 4] = [
     (0.183_434_642_495_649_8, 0.362_683_783_378_362),
@@ -255,12 +260,18 @@ impl RateNoisePrediction {
     /// output filter (valid for `tau` well above its time constants).
     ///
     /// The integral runs panel by panel: panels of `1 / (16 tau)` (a
-    /// sixteenth of the kernel's period) up to `64 / tau`, then, with the
-    /// kernel's `sin^4` replaced by its mean 3/8 (the oscillating rest
-    /// integrates to below 1e-4 there), panels of a quarter of the mode's
+    /// sixteenth of the kernel's period) up to `NEAR_PERIODS / tau`, then,
+    /// with the kernel's `sin^4` replaced by its mean 3/8 (a unit test
+    /// bounds what that costs), panels of a quarter of the mode's
     /// half-bandwidth up to 64 half-bandwidths past the mode, and a tail
     /// `S f^-2` beyond.
     pub fn adev(&self, k: usize, tau_s: f64) -> f64 {
+        self.adev_with(k, tau_s, NEAR_PERIODS)
+    }
+
+    /// [`RateNoisePrediction::adev`] with the exact kernel over `near`
+    /// of its periods.
+    fn adev_with(&self, k: usize, tau_s: f64, near: u32) -> f64 {
         let o = &self.outputs[k];
         let white = o.adc_rate_psd / (2.0 * tau_s);
         if self.thermal.temperature_k == 0.0 {
@@ -275,8 +286,8 @@ impl RateNoisePrediction {
                 2.0 * x.sin().powi(4) / (x * x)
             }
         };
-        let f1 = 64.0 / tau_s;
-        let near = integrate(&|f| s(f) * kernel(f), 0.0, f1, 1024);
+        let f1 = f64::from(near) / tau_s;
+        let near = integrate(&|f| s(f) * kernel(f), 0.0, f1, 16 * near as usize);
         let half_bw = o.mode_hz / (2.0 * o.q);
         let f2 = f1.max((o.mode_hz - self.carrier_hz).abs() + 64.0 * half_bw);
         let panels = ((f2 - f1) / (half_bw / 4.0)).ceil().clamp(1.0, 1e6) as usize;
@@ -501,6 +512,11 @@ mod tests {
                 let bound = 3.0 / (4.0 * PI * 50.0 * tau);
                 assert!((got - 1.0).abs() < bound, "output {k} tau {tau}: {got}");
             }
+        }
+        // The mean kernel beyond 64 periods: against 1024 exact periods.
+        for tau in [0.01, 0.1, 1.0, 10.0] {
+            let (a, b) = (p.adev(0, tau), p.adev_with(0, tau, 1024));
+            assert!((a / b - 1.0).abs() < 1e-4, "tau {tau}: {a} vs {b}");
         }
         // With the noise off only the ADC's white part is left.
         let (_, q) = plan_and_predict(&device(0.0), 0.0).unwrap();
