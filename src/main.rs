@@ -34,6 +34,8 @@ enum Command {
     /// Print the register words that program a board for a device (table,
     /// C header or JSON), from the plan `run` co-simulates.
     Registers(commands::registers::Args),
+    /// Predict and measure the rate output's noise floor: Allan deviation, angle random walk, bias instability.
+    Allan(commands::allan::Args),
 }
 
 /// A failure, with the exit status it deserves.
@@ -61,6 +63,7 @@ fn main() -> ExitCode {
         Command::Bench(args) => commands::bench::run(&args),
         Command::Synth(args) => commands::synth::run(&args),
         Command::Registers(args) => commands::registers::run(&args),
+        Command::Allan(args) => commands::allan::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -12,6 +12,8 @@
 //! [filter]      # decimation, butterworth_hz, rc_hz: derived when unset
 //! [experiment]  # required: readout_rates_dps, cal_freqs_hz
 //!               # tolerance (1e-4), min_window_s (derived), budget_s (60)
+//! [noise]       # Brownian force noise: mass_kg (1e-8), temperature_k
+//!               # (0: off), seed (1)
 //! ```
 //!
 //! A file with the required keys alone describes a complete experiment:
@@ -43,6 +45,7 @@
 //! ```
 
 use crate::gyro::GyroParams;
+use crate::noise::ThermalNoise;
 use gyrocal_hdl::cic_decimator::MAX_DECIMATION;
 use gyrocal_hdl::filter_design::{MAX_CUTOFF_RATIO, MIN_CUTOFF_RATIO, MIN_DECIMATION};
 use gyrocal_hdl::settings::{MAX_CAL_RATIO, MAX_REF_DELAY};
@@ -65,6 +68,9 @@ pub struct Experiment {
     /// `[experiment]`: the points and how precisely to measure them.
     #[serde(rename = "experiment")]
     pub points: Points,
+    /// `[noise]`: thermomechanical force noise (off, 0 K, when unset).
+    #[serde(default)]
+    pub noise: ThermalNoise,
 }
 
 /// `[drive]`.
@@ -349,6 +355,7 @@ impl Experiment {
                     (10..=15).map(f64::from).collect(),
                 )
             },
+            noise: ThermalNoise::default(),
         }
     }
 
@@ -367,6 +374,7 @@ impl Experiment {
             frontend: Frontend::default(),
             filter: Filter::default(),
             points: Points::new(readout_rates_dps, cal_freqs_hz),
+            noise: ThermalNoise::default(),
         }
     }
 
@@ -383,7 +391,8 @@ impl Experiment {
         self.validate_gyro()?;
         self.validate_drive()?;
         self.validate_frontend()?;
-        self.validate_points()
+        self.validate_points()?;
+        self.noise.validate().map_err(|e| format!("[noise] {e}"))
     }
 
     fn validate_gyro(&self) -> Result<(), String> {

@@ -18,6 +18,7 @@ pub mod fit;
 pub mod frontend;
 pub mod gyro;
 pub mod noise;
+pub mod rate_noise;
 pub mod report;
 pub mod theory;
 #[cfg(feature = "verilator")]

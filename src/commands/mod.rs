@@ -1,5 +1,6 @@
 //! One module per subcommand.
 
+pub mod allan;
 pub mod bench;
 pub mod experiment;
 pub mod export;

@@ -3,7 +3,8 @@
 //! s, with the angle random walk's tau^-1/2 line drawn through its reading
 //! at 1 s and the bias instability's floor (min sigma) marked and
 //! annotated. [`AllanFigure::new`] computes the series, the line, the
-//! floor and the ranges; drawing only draws them.
+//! floor and the ranges, [`AllanFigure::with_prediction`] adds a predicted
+//! curve (the noise model's); drawing only draws them.
 
 use gyrocal_sim::allan::{AllanAnalysis, BIAS_INSTABILITY_FACTOR};
 use plotters::coord::Shift;
@@ -15,6 +16,9 @@ use super::{Plot, err};
 
 /// Pixel size of the figure.
 pub(super) const SIZE: (u32, u32) = (1000, 720);
+
+/// Colour of a predicted curve (green, apart from both outputs' colours).
+const PREDICTION_COLOR: RGBColor = RGBColor(44, 160, 44);
 
 /// deg/s to deg/h.
 const PER_HOUR: f64 = 3600.0;
@@ -37,6 +41,8 @@ pub(super) struct AllanFigure {
     arw: Option<ArwLine>,
     /// The minimum (tau s, sigma deg/h) and its label.
     floor: ((f64, f64), String),
+    /// A predicted curve (tau s, sigma deg/h) and its label.
+    prediction: Option<(Vec<(f64, f64)>, String)>,
     x: (f64, f64),
     y: (f64, f64),
 }
@@ -107,9 +113,33 @@ impl AllanFigure {
             points,
             arw,
             floor,
+            prediction: None,
             x,
             y,
         })
+    }
+
+    /// Adds a predicted curve, `(tau s, sigma deg/s)` pairs (each finite
+    /// and positive), labelled `label`; the y range widens to hold it.
+    pub(super) fn with_prediction(
+        mut self,
+        curve: &[(f64, f64)],
+        label: &str,
+    ) -> Result<Self, String> {
+        if let Some(p) = curve
+            .iter()
+            .find(|p| !(p.0.is_finite() && p.0 > 0.0 && p.1.is_finite() && p.1 > 0.0))
+        {
+            return Err(format!(
+                "Allan figure: predicted point ({}, {}): a log axis needs finite, positive values",
+                p.0, p.1
+            ));
+        }
+        let curve: Vec<(f64, f64)> = curve.iter().map(|&(t, s)| (t, s * PER_HOUR)).collect();
+        let ys = self.points.iter().chain(&curve).map(|p| p.1);
+        self.y = log_range(ys, 0.3);
+        self.prediction = Some((curve, label.to_string()));
+        Ok(self)
     }
 }
 
@@ -153,6 +183,19 @@ impl Plot for AllanFigure {
             .map_err(err)?
             .label("σ(τ) of the rate output")
             .legend(move |(x, y)| Circle::new((x + 12, y), 4, color.filled()));
+        if let Some((curve, label)) = &self.prediction {
+            let color = PREDICTION_COLOR;
+            chart
+                .draw_series(LineSeries::new(
+                    curve.iter().copied(),
+                    color.stroke_width(2),
+                ))
+                .map_err(err)?
+                .label(label.clone())
+                .legend(move |(x, y)| {
+                    PathElement::new([(x, y), (x + 24, y)], color.stroke_width(2))
+                });
+        }
         if let Some(arw) = &self.arw {
             chart
                 .draw_series(DashedLineSeries::new(arw.ends, 8, 5, BLACK.stroke_width(2)))

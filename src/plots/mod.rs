@@ -145,6 +145,23 @@ pub fn write_allan_figure(
     write_plot(&plot, allan::SIZE, dir, name)
 }
 
+/// [`write_allan_figure`] with a predicted curve, `(tau s, sigma deg/s)`
+/// pairs labelled `label`, drawn over the measured deviation.
+#[allow(dead_code)] // reason: `gyrocal allan` calls it; tests/plots.rs includes this file without it
+pub fn write_allan_figure_with_prediction(
+    analysis: &AllanAnalysis,
+    prediction: &[(f64, f64)],
+    label: &str,
+    title: &str,
+    dir: &Path,
+    name: &str,
+) -> Result<Vec<PathBuf>, String> {
+    style::register_font()?;
+    let plot = allan::AllanFigure::new(analysis, title)?.with_prediction(prediction, label)?;
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    write_plot(&plot, allan::SIZE, dir, name)
+}
+
 /// `plot` as `dir/name.png` then `dir/name.svg`.
 fn write_plot<P: Plot>(
     plot: &P,
