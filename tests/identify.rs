@@ -44,28 +44,27 @@ fn paper_device_identified_within_its_uncertainty() {
     for (t, phase) in [(25.0, 0.0), (33.0, 5.0), (17.0, -5.0)] {
         let (id, at) = identify_at(&exp, &drift(phase), t);
         let truth = [(at.gyro.f1_hz, at.gyro.q1), (at.gyro.f2_hz, at.gyro.q2)];
-        for k in 0..2 {
-            let m = &id.modes[k];
-            let lag = lag_at(phase, truth[k].0, &exp);
+        for (k, (m, truth)) in id.modes.iter().zip(truth).enumerate() {
+            let lag = lag_at(phase, truth.0, &exp);
             eprintln!(
                 "T {t} mode {}: f {:.4} +- {:.1e} Hz (error {:+.1e}), Q {:.2} +- {:.1e} (error {:+.1e}), phase {:.5} +- {:.1e} deg (error {:+.1e})",
                 k + 1,
                 m.f_hz.value,
                 m.f_hz.uncertainty,
-                m.f_hz.value - truth[k].0,
+                m.f_hz.value - truth.0,
                 m.q.value,
                 m.q.uncertainty,
-                m.q.value - truth[k].1,
+                m.q.value - truth.1,
                 m.phase_deg.value,
                 m.phase_deg.uncertainty,
                 m.phase_deg.value - lag,
             );
             // Within 3 sigma of the truth (the host's own claim).
-            assert!((m.f_hz.value - truth[k].0).abs() <= 3.0 * m.f_hz.uncertainty);
-            assert!((m.q.value - truth[k].1).abs() <= 3.0 * m.q.uncertainty);
+            assert!((m.f_hz.value - truth.0).abs() <= 3.0 * m.f_hz.uncertainty);
+            assert!((m.q.value - truth.1).abs() <= 3.0 * m.q.uncertainty);
             assert!((m.phase_deg.value - lag).abs() <= 3.0 * m.phase_deg.uncertainty);
             // The accuracy: Q within 0.1%.
-            assert!((m.q.value / truth[k].1 - 1.0).abs() < 1e-3);
+            assert!((m.q.value / truth.1 - 1.0).abs() < 1e-3);
         }
         // Split within 0.1 Hz.
         let split = id.modes[1].f_hz.value - id.modes[0].f_hz.value;

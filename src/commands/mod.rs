@@ -3,6 +3,7 @@
 pub mod bench;
 pub mod experiment;
 pub mod export;
+pub mod field;
 pub mod reproduce;
 pub mod run;
 pub mod synth;

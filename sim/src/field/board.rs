@@ -89,9 +89,11 @@ impl SimBoard {
             fe.force_per_lsb[k] *= at.drive_gain[k];
             fe.adc_per_meter[k] *= at.adc_gain[k];
         }
-        let phase = match at.front_end_phase_deg {
-            p if p == 0.0 => None,
-            p => Some(PickoffPhase::new(p, phase_reference_hz)?),
+        let p = at.front_end_phase_deg;
+        let phase = if p == 0.0 {
+            None
+        } else {
+            Some(PickoffPhase::new(p, phase_reference_hz)?)
         };
         let bank = RegisterBank::power_up();
         Ok(Self {

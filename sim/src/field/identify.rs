@@ -41,9 +41,15 @@
 //!    times the inverse normal matrix, propagated to Qk = fk / bk and
 //!    phi = -arg C.
 //!
-//! The loop phase is the mean of the two modes' phi, weighted by their
-//! variances; both references go through one REF_PHASE, so one common
-//! correction is what the gateware can apply.
+//! The loop phase is read off the line through the two modes' phi at the
+//! operating carrier (both references go through one REF_PHASE, so one
+//! common correction is what the gateware can apply); the line's slope is
+//! the front end's group delay, which the prediction needs: a front end
+//! that lags the carrier by phi usually delays the envelope too (a pure
+//! delay by phi / w, the pick-off model of `frontend::PickoffPhase` by
+//! about sin(phi) cos(phi) / w), and in calibration that mixes the
+//! resonant part of the response into the output (13% of the detuned
+//! output of a 25 kHz device with 3 deg, measured).
 
 use super::board::Board;
 use crate::config::{Derived, Experiment};
@@ -241,8 +247,14 @@ pub struct ModeFit {
 pub struct Identified {
     /// Mode 1 and mode 2.
     pub modes: [ModeFit; 2],
-    /// Common loop phase lag (deg): the variance-weighted mean of the modes'.
+    /// Loop phase lag at the operating carrier (deg): the line through
+    /// the two modes' phases, evaluated there.
     pub loop_phase_deg: Estimate,
+    /// Group delay of the loop (s): the slope of that line, d phi / d w.
+    /// It delays the response's envelope against the references', which
+    /// REF_PHASE (a carrier phase) cannot undo: the prediction carries it
+    /// as an envelope lead (`selfcal::predicted_ratio`).
+    pub group_delay_s: Estimate,
     /// Clocks the identification took.
     pub clocks: u64,
 }
@@ -562,15 +574,23 @@ pub fn identify(
 ) -> Result<Identified, String> {
     let (m1, c1) = identify_mode(board, knowns, 0, guess.f1_hz)?;
     let (m2, c2) = identify_mode(board, knowns, 1, guess.f2_hz)?;
-    let w = [m1.phase_deg.uncertainty, m2.phase_deg.uncertainty].map(|s| 1.0 / (s * s).max(1e-30));
-    let phase = (w[0] * m1.phase_deg.value + w[1] * m2.phase_deg.value) / (w[0] + w[1]);
+    let carrier = m1.f_hz.value + knowns.carrier_offset_hz;
+    let (f1, f2) = (m1.f_hz.value, m2.f_hz.value);
+    let (p1, p2) = (m1.phase_deg, m2.phase_deg);
+    let w2 = (carrier - f1) / (f2 - f1);
     let loop_phase_deg = Estimate {
-        value: phase,
-        uncertainty: (1.0 / (w[0] + w[1])).sqrt(),
+        value: p1.value + w2 * (p2.value - p1.value),
+        uncertainty: ((1.0 - w2) * p1.uncertainty).hypot(w2 * p2.uncertainty),
+    };
+    let per_hz = 1.0f64.to_radians() / (TAU * (f2 - f1));
+    let group_delay_s = Estimate {
+        value: (p2.value - p1.value) * per_hz,
+        uncertainty: p1.uncertainty.hypot(p2.uncertainty) * per_hz.abs(),
     };
     Ok(Identified {
         modes: [m1, m2],
         loop_phase_deg,
+        group_delay_s,
         clocks: c1 + c2,
     })
 }

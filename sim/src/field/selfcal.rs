@@ -45,7 +45,7 @@ use crate::gyro::GyroParams;
 use crate::theory::{self, Device};
 use gyrocal_hdl::sine_table::PEAK;
 use serde::Serialize;
-use std::f64::consts::PI;
+use std::f64::consts::{PI, TAU};
 
 /// Amplitude time constants waited after leaving the identification (the
 /// resonators' state changes completely; the first staircase point must
@@ -59,6 +59,9 @@ pub struct Operating {
     pub carrier_hz: f64,
     /// Reference phase lag written on top of the aligned REF_PHASE (deg).
     pub ref_lag_deg: f64,
+    /// The loop's group delay (s), which the references' envelope does not
+    /// follow.
+    pub envelope_delay_s: f64,
 }
 
 /// Readout and calibration ratio predictions per output.
@@ -102,6 +105,7 @@ pub fn operating(knowns: &Knowns, id: &Identified) -> Result<Operating, String> 
     Ok(Operating {
         carrier_hz: real.carrier_hz,
         ref_lag_deg: lag,
+        envelope_delay_s: id.group_delay_s.value,
     })
 }
 
@@ -132,14 +136,27 @@ pub fn window_z(
     }))
 }
 
+/// A measured staircase.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Staircase {
+    /// Realized calibration frequencies (Hz).
+    pub cal_hz: Vec<f64>,
+    /// Window means (z LSB).
+    pub z: Vec<[f64; 2]>,
+    /// Least-squares slopes against 360 f_cal (z LSB per deg/s).
+    pub sf_per_dps: [f64; 2],
+    /// Clocks it took.
+    pub clocks: u64,
+}
+
 /// The calibration staircase at `op`: each f_cal settles, then is averaged
 /// over a whole number of ripple periods 1 / (2 f_cal) spanning at least
-/// the first window. Returns (realized f_cal, means, slopes per deg/s).
+/// the first window.
 pub fn staircase(
     board: &mut dyn Board,
     knowns: &Knowns,
     op: &Operating,
-) -> Result<(Vec<f64>, Vec<[f64; 2]>, [f64; 2], u64), String> {
+) -> Result<Staircase, String> {
     let clock = knowns.clock_hz;
     let r = knowns.filter.decimation;
     let mut cal_hz = vec![];
@@ -170,7 +187,12 @@ pub fn staircase(
         let y: Vec<f64> = means.iter().map(|m| m[k]).collect();
         linear_fit(&x, &y).0
     });
-    Ok((cal_hz, means, sf, clocks))
+    Ok(Staircase {
+        cal_hz,
+        z: means,
+        sf_per_dps: sf,
+        clocks,
+    })
 }
 
 /// Fundamental gain of the DAC's zero-order hold at `f_hz`.
@@ -217,7 +239,10 @@ pub fn predicted_ratio(
         .iter()
         .map(|&f| {
             let sidebands = [-1.0, 1.0].map(|s| hold_gain(op.carrier_hz + s * f, clock) / hold);
-            theory::calibration_z_of_datapath(&dev_cal, f, envelope_lead_rad(f, clock), sidebands)
+            // The response's envelope comes late by the group delay: the
+            // references' envelope leads it by that much more.
+            let lead = envelope_lead_rad(f, clock) + TAU * f * op.envelope_delay_s;
+            theory::calibration_z_of_datapath(&dev_cal, f, lead, sidebands)
         })
         .collect();
     let virtual_dps: Vec<f64> = cal_hz.iter().map(|f| 360.0 * f).collect();
@@ -244,7 +269,12 @@ pub fn self_calibrate(
 ) -> Result<SelfCal, String> {
     let identified = identify::identify(board, knowns, guess)?;
     let op = operating(knowns, &identified)?;
-    let (cal_hz, cal_z, sf_cal, clocks) = staircase(board, knowns, &op)?;
+    let Staircase {
+        cal_hz,
+        z: cal_z,
+        sf_per_dps: sf_cal,
+        clocks,
+    } = staircase(board, knowns, &op)?;
     let gyro = identified.gyro(&knowns.nominal);
     let ratio = predicted_ratio(knowns, &gyro, &op, &cal_hz)?;
     let sf_selfcal_per_dps = std::array::from_fn(|k| sf_cal[k] * ratio.exact[k]);
