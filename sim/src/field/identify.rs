@@ -577,15 +577,29 @@ pub fn identify(
     let carrier = m1.f_hz.value + knowns.carrier_offset_hz;
     let (f1, f2) = (m1.f_hz.value, m2.f_hz.value);
     let (p1, p2) = (m1.phase_deg, m2.phase_deg);
-    let w2 = (carrier - f1) / (f2 - f1);
+    // Modes closer than a tenth of a bandwidth: one frequency, one phase;
+    // the delay is not observable (and its envelope lead then negligible).
+    let resolvable = (f2 - f1).abs() > 0.1 * (f1 / m1.q.value).max(f2 / m2.q.value);
+    let w2 = if resolvable {
+        (carrier - f1) / (f2 - f1)
+    } else {
+        0.5
+    };
     let loop_phase_deg = Estimate {
         value: p1.value + w2 * (p2.value - p1.value),
         uncertainty: ((1.0 - w2) * p1.uncertainty).hypot(w2 * p2.uncertainty),
     };
     let per_hz = 1.0f64.to_radians() / (TAU * (f2 - f1));
-    let group_delay_s = Estimate {
-        value: (p2.value - p1.value) * per_hz,
-        uncertainty: p1.uncertainty.hypot(p2.uncertainty) * per_hz.abs(),
+    let group_delay_s = if resolvable {
+        Estimate {
+            value: (p2.value - p1.value) * per_hz,
+            uncertainty: p1.uncertainty.hypot(p2.uncertainty) * per_hz.abs(),
+        }
+    } else {
+        Estimate {
+            value: 0.0,
+            uncertainty: f64::INFINITY,
+        }
     };
     Ok(Identified {
         modes: [m1, m2],
