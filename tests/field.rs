@@ -124,3 +124,30 @@ fn a_differential_drive_gain_enters_as_the_theory_says() {
         }
     }
 }
+
+#[test]
+fn paper_device_self_calibrates_over_ten_kelvin() {
+    let report = run("tests/data/field_paper.toml");
+    for s in &report.steps {
+        eprintln!(
+            "{} deg C: self-cal error {:?}, baseline error {:?}",
+            s.temperature_c, s.selfcal_error, s.baseline_error
+        );
+    }
+    eprintln!("clocks {} wall {:.1} s", report.clocks, report.wall_s);
+    assert_within_target(&report);
+    // The baseline, beside it: a fixed carrier leaves the resonance within
+    // a fraction of a kelvin (290 Hz/K against an 88 Hz half-bandwidth), so
+    // 5 K away its scale factor is off by more than a factor of 2.
+    let far = report
+        .steps
+        .iter()
+        .filter(|s| (s.temperature_c - 25.0).abs() >= 5.0);
+    for s in far {
+        assert!(
+            s.baseline_error.iter().all(|e| e.abs() > 1.0),
+            "{:?}",
+            s.baseline_error
+        );
+    }
+}
