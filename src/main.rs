@@ -29,6 +29,8 @@ enum Command {
     Reproduce(commands::reproduce::Args),
     /// Measure the engines' speed side by side, and the reproduce run.
     Bench(commands::bench::Args),
+    /// Self-calibrate a drifting device over temperature steps (TOML with `[drift]`).
+    Field(commands::field::Args),
     /// Synthesize the export with Yosys and write verilog-out/RESOURCES.md.
     Synth(commands::synth::Args),
     /// Print the register words that program a board for a device (table,
@@ -64,6 +66,7 @@ fn main() -> ExitCode {
         Command::Synth(args) => commands::synth::run(&args),
         Command::Registers(args) => commands::registers::run(&args),
         Command::Allan(args) => commands::allan::run(&args),
+        Command::Field(args) => commands::field::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

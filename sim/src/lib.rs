@@ -14,6 +14,7 @@ pub mod cosim;
 pub mod drift;
 pub mod engine;
 pub mod experiment;
+pub mod field;
 pub mod fit;
 pub mod frontend;
 pub mod gyro;

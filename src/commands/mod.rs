@@ -4,6 +4,7 @@ pub mod allan;
 pub mod bench;
 pub mod experiment;
 pub mod export;
+pub mod field;
 pub mod registers;
 pub mod reproduce;
 pub mod run;

@@ -39,6 +39,7 @@
 mod allan;
 mod calibration;
 mod data;
+mod field;
 mod format;
 mod line_panel;
 mod readout;
@@ -160,6 +161,22 @@ pub fn write_allan_figure_with_prediction(
     let plot = allan::AllanFigure::new(analysis, title)?.with_prediction(prediction, label)?;
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     write_plot(&plot, allan::SIZE, dir, name)
+}
+
+/// Write a field scenario's figure into `dir` (created if missing) as
+/// `name`.png and `name`.svg; returns the two files. Errors as
+/// [`write_figures`]; the report is checked first.
+#[allow(dead_code)] // reason: tests/plots.rs includes this module; `gyrocal field` calls it
+pub fn write_field_figure(
+    report: &gyrocal_sim::field::scenario::FieldReport,
+    title: &str,
+    dir: &Path,
+    name: &str,
+) -> Result<Vec<PathBuf>, String> {
+    style::register_font()?;
+    let plot = field::FieldPanel::new(report, title)?;
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    write_plot(&plot, field::SIZE, dir, name)
 }
 
 /// `plot` as `dir/name.png` then `dir/name.svg`.

@@ -1,0 +1,178 @@
+//! A board as host software sees it: 32-bit registers at the byte offsets
+//! of `gyrocal_hdl::host::register_map` (the map the gateware decodes),
+//! coherent z snapshots, and time passing.
+//!
+//! [`SimBoard`] closes the loop of the bit-true model engine over the
+//! gyroscope at one temperature ([`crate::drift::DeviceAt`]): drive gains
+//! scale the DAC forces, ADC gains the pick-offs, and an unmodelled phase
+//! lag ([`crate::frontend::PickoffPhase`]) sits before both ADCs. Per clock,
+//! as in [`crate::cosim`]: the ADCs sample, the engine plays an edge, the
+//! gyroscope advances under the held force. Register writes act from the
+//! next clock on; the settings are decoded from the bank once per write.
+//!
+//! The rotation rate is not a register: [`SimBoard::set_rate`] is the rate
+//! table of the simulation harness, which host code (that sees a
+//! `&mut dyn Board`) cannot reach.
+
+use crate::drift::DeviceAt;
+use crate::engine::{Engine, ModelEngine};
+use crate::frontend::{Converters, FrontEnd, PickoffPhase};
+use crate::gyro::GyroModel;
+use crate::noise::ThermalNoise;
+use gyrocal_hdl::host::register_map::{
+    self, BusError, RegisterAccess, RegisterBank, SAMPLE_COUNT, STREAM_OVERFLOW, Z1_HI, Z1_LO,
+    Z2_HI, Z2_LO,
+};
+use gyrocal_hdl::model::gyro_interface::{Outputs, Registers};
+
+/// One coherent z snapshot: the count and both outputs, in z LSB
+/// (2^-8 mixer LSB, the register's raw value over 256).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ZSample {
+    /// SAMPLE_COUNT at the snapshot.
+    pub count: u32,
+    /// z1, z2 (z LSB).
+    pub z: [f64; 2],
+}
+
+/// A gateware board: registers, z snapshots, time.
+pub trait Board: RegisterAccess {
+    /// Let `clocks` periods of the FPGA clock pass.
+    fn wait_clocks(&mut self, clocks: u64);
+
+    /// Read SAMPLE_COUNT (which latches z) then the four z words.
+    fn read_z(&mut self) -> Result<ZSample, BusError> {
+        let count = self.read_register(SAMPLE_COUNT.offset)?;
+        let mut word = |lo: u32, hi: u32| -> Result<f64, BusError> {
+            let (lo, hi) = (self.read_register(lo)?, self.read_register(hi)?);
+            Ok(((i64::from(hi as i32) << 32) | i64::from(lo)) as f64 / 256.0)
+        };
+        let z1 = word(Z1_LO.offset, Z1_HI.offset)?;
+        let z2 = word(Z2_LO.offset, Z2_HI.offset)?;
+        Ok(ZSample { count, z: [z1, z2] })
+    }
+
+    /// Write every setting of `regs` (the register map's own encoding).
+    fn program(&mut self, regs: &Registers) -> Result<(), BusError> {
+        register_map::encode(regs)
+            .into_iter()
+            .try_for_each(|(offset, word)| self.write_register(offset, word))
+    }
+}
+
+/// The model engine, converters and gyroscope behind the register map.
+pub struct SimBoard {
+    engine: ModelEngine,
+    converters: Converters,
+    gyro: GyroModel,
+    phase: Option<PickoffPhase>,
+    bank: RegisterBank,
+    regs: Registers,
+    outputs: Outputs,
+    samples: u32,
+    snapshot: (i64, i64),
+    cycle: u64,
+}
+
+impl SimBoard {
+    /// A board at power-up with the device and front end of `at`:
+    /// `front_end` holds the converters as built (gains at T0), which
+    /// `at`'s drive and ADC multipliers scale; the front-end phase lag is
+    /// exact at `phase_reference_hz`; `noise` is the Brownian force noise.
+    pub fn new(
+        at: &DeviceAt,
+        front_end: &FrontEnd,
+        noise: &ThermalNoise,
+        clock_hz: f64,
+        phase_reference_hz: f64,
+    ) -> Result<Self, String> {
+        let mut fe = front_end.clone();
+        for k in 0..2 {
+            fe.force_per_lsb[k] *= at.drive_gain[k];
+            fe.adc_per_meter[k] *= at.adc_gain[k];
+        }
+        let p = at.front_end_phase_deg;
+        let phase = if p == 0.0 {
+            None
+        } else {
+            Some(PickoffPhase::new(p, phase_reference_hz)?)
+        };
+        let bank = RegisterBank::power_up();
+        Ok(Self {
+            engine: ModelEngine::power_up()?,
+            converters: Converters::new(&fe)?,
+            gyro: GyroModel::new(&at.gyro, clock_hz)?.with_thermal_noise(noise)?,
+            phase,
+            bank,
+            regs: bank.registers(),
+            outputs: Outputs::default(),
+            samples: 0,
+            snapshot: (0, 0),
+            cycle: 0,
+        })
+    }
+
+    /// The rate table: rotation rate (rad/s) from the next clock on.
+    pub fn set_rate(&mut self, omz_rad_s: f64) {
+        self.gyro.set_rate(omz_rad_s);
+    }
+
+    /// Clocks played since power-up.
+    pub fn cycle(&self) -> u64 {
+        self.cycle
+    }
+
+    #[inline(always)]
+    fn step(&mut self) {
+        let x = match &self.phase {
+            None => (self.gyro.x1(), self.gyro.x2()),
+            Some(p) => {
+                let s = self.gyro.state();
+                (p.apply(s[0], s[1]), p.apply(s[2], s[3]))
+            }
+        };
+        let (adc, force) = self.converters.step(self.outputs.dac, x);
+        self.outputs = self.engine.step(adc, &self.regs);
+        self.gyro.step(force.0, force.1);
+        self.samples = self.samples.wrapping_add(self.outputs.z_valid as u32);
+        self.cycle += 1;
+    }
+}
+
+impl Board for SimBoard {
+    fn wait_clocks(&mut self, clocks: u64) {
+        for _ in 0..clocks {
+            self.step();
+        }
+    }
+}
+
+impl RegisterAccess for SimBoard {
+    /// A write between two clocks: acts from the next clock on.
+    fn write_register(&mut self, offset: u32, word: u32) -> Result<(), BusError> {
+        self.bank.write(offset, word, 0xf)?;
+        self.regs = self.bank.registers();
+        Ok(())
+    }
+
+    /// A read between two clocks; SAMPLE_COUNT latches z. STREAM_OVERFLOW
+    /// is 0: the board has no stream consumer.
+    fn read_register(&mut self, offset: u32) -> Result<u32, BusError> {
+        let reg = register_map::lookup(offset).ok_or(BusError::Unmapped)?;
+        let z = |v: i64, high: bool| if high { (v >> 32) as u32 } else { v as u32 };
+        let (z1, z2) = self.snapshot;
+        let live = match reg.offset {
+            o if o == SAMPLE_COUNT.offset => {
+                self.snapshot = self.outputs.z;
+                self.samples
+            }
+            o if o == STREAM_OVERFLOW.offset => 0,
+            o if o == Z1_LO.offset => z(z1, false),
+            o if o == Z1_HI.offset => z(z1, true),
+            o if o == Z2_LO.offset => z(z2, false),
+            o if o == Z2_HI.offset => z(z2, true),
+            _ => return self.bank.read(offset),
+        };
+        Ok(reg.extend(live))
+    }
+}

@@ -1,0 +1,293 @@
+//! The self-calibration cycle, host side: identify, retune the carrier,
+//! correct the loop phase, run the calibration staircase, and predict the
+//! readout scale factor in the gateware's own units (z LSB per deg/s).
+//!
+//! # The ratio in z LSB, and which converter gains cancel
+//!
+//! Let a_k be ADC k's gain (LSB per metre), g_k drive k's force per DAC
+//! LSB, W_k the drive words' amplitudes (digital, known from AMP). Output k
+//! in z LSB is the mean of ADC_k times a reference word, so
+//!
+//! ```text
+//! readout     output k: ADC_k x drive k's word;  x_k's rate term is driven by drive (1-k)
+//!             SF_read,k ~ a_k W_k W_(1-k) g_(1-k) S_read,k
+//! calibration output k: ADC_k x drive (1-k)'s word;  x_k is driven by drive k
+//!             SF_cal,k  ~ a_k W_(1-k) W_k g_k S_cal,k
+//! ratio_k = SF_read,k / SF_cal,k = (S_read,k / S_cal,k) x g_(1-k) / g_k
+//! ```
+//!
+//! with S the theory's scale factors per unit force product. The ADC gain
+//! a_k and any gain common to both drives cancel exactly; the drive-gain
+//! ratio g_(1-k) / g_k enters one for one, with opposite signs on the two
+//! outputs. At rest the modes are uncoupled, so every response the gateware
+//! can observe carries a_k g_k together: the differential drive gain cannot
+//! be told from an ADC gain, and the host uses the board's design ratio
+//! (`Knowns::force_full_scale`). Its drift is the one converter drift the
+//! cycle cannot correct (measured in `tests/field.rs`).
+//!
+//! # The prediction
+//!
+//! `ratio` is the exact theory (phasor steady state, `crate::theory`) at
+//! the identified parameters, fitted with the same least-squares lines at
+//! the same rates and calibration frequencies as the measurements (the
+//! paper's 10-15 Hz are not deep in the linear region), with the
+//! datapath's known details: the hold's sinc at each sideband and the
+//! envelope lead (`theory::calibration_z_of_datapath`), and the drive
+//! words' realized amplitudes in each mode. Eqs. (5)/(6) at the same
+//! parameters are given beside it.
+
+use super::board::Board;
+use super::identify::{self, Identified, Knowns, readout_word};
+use crate::average::window_mean;
+use crate::experiment::envelope_lead_rad;
+use crate::fit::linear_fit;
+use crate::gyro::GyroParams;
+use crate::theory::{self, Device};
+use gyrocal_hdl::sine_table::PEAK;
+use serde::Serialize;
+use std::f64::consts::{PI, TAU};
+
+/// Amplitude time constants waited after leaving the identification (the
+/// resonators' state changes completely; the first staircase point must
+/// settle to 1e-4 of a calibration signal some 1e3 times smaller).
+pub const FIRST_SETTLE_TAUS: f64 = 30.0;
+
+/// Where the cycle operates the gateware.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Operating {
+    /// Realized carrier (Hz).
+    pub carrier_hz: f64,
+    /// Reference phase lag written on top of the aligned REF_PHASE (deg).
+    pub ref_lag_deg: f64,
+    /// The loop's group delay (s), which the references' envelope does not
+    /// follow.
+    pub envelope_delay_s: f64,
+}
+
+/// Readout and calibration ratio predictions per output.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Ratio {
+    /// Exact theory, fitted at the measurement points (z LSB units).
+    pub exact: [f64; 2],
+    /// Eqs. (5)/(6), small signal (z LSB units).
+    pub eq56: [f64; 2],
+}
+
+/// One cycle's result.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SelfCal {
+    /// What identification found.
+    pub identified: Identified,
+    /// Carrier and phase correction used.
+    pub operating: Operating,
+    /// Realized calibration frequencies (Hz).
+    pub cal_hz: Vec<f64>,
+    /// Staircase window means (z LSB).
+    pub cal_z: Vec<[f64; 2]>,
+    /// Calibration scale factors (z LSB per deg/s of virtual rate).
+    pub sf_cal_per_dps: [f64; 2],
+    /// The predicted ratios.
+    pub ratio: Ratio,
+    /// SF_cal x ratio.exact (z LSB per deg/s).
+    pub sf_selfcal_per_dps: [f64; 2],
+    /// SF_cal x ratio.eq56 (z LSB per deg/s).
+    pub sf_eq56_per_dps: [f64; 2],
+    /// Clocks of the whole cycle.
+    pub clocks: u64,
+}
+
+/// The operating point for an identification: carrier at identified f1 plus
+/// the configured offset, reference lagged by the identified loop phase.
+pub fn operating(knowns: &Knowns, id: &Identified) -> Result<Operating, String> {
+    let asked = id.modes[0].f_hz.value + knowns.carrier_offset_hz;
+    let lag = id.loop_phase_deg.value;
+    let (_, real) = knowns.registers(asked, None, knowns.amplitude, lag)?;
+    Ok(Operating {
+        carrier_hz: real.carrier_hz,
+        ref_lag_deg: lag,
+        envelope_delay_s: id.group_delay_s.value,
+    })
+}
+
+/// Collect z from now for `span` clocks (one sample per R) and return the
+/// mean over [t0, t0 + length) clocks from now (interpolated: `average`).
+pub fn window_z(
+    board: &mut dyn Board,
+    decimation: u32,
+    t0: f64,
+    length: f64,
+) -> Result<[f64; 2], String> {
+    let r = f64::from(decimation);
+    let mut t = vec![];
+    let mut z = [vec![], vec![]];
+    let mut now = 0.0;
+    while now < t0 + length + r {
+        board.wait_clocks(u64::from(decimation));
+        now += r;
+        let s = board
+            .read_z()
+            .map_err(|e| format!("board refused a register access: {e:?}"))?;
+        t.push(now);
+        z[0].push(s.z[0]);
+        z[1].push(s.z[1]);
+    }
+    Ok(std::array::from_fn(|k| {
+        window_mean(&t, &z[k], t0, t0 + length)
+    }))
+}
+
+/// A measured staircase.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Staircase {
+    /// Realized calibration frequencies (Hz).
+    pub cal_hz: Vec<f64>,
+    /// Window means (z LSB).
+    pub z: Vec<[f64; 2]>,
+    /// Least-squares slopes against 360 f_cal (z LSB per deg/s).
+    pub sf_per_dps: [f64; 2],
+    /// Clocks it took.
+    pub clocks: u64,
+}
+
+/// The calibration staircase at `op`: each f_cal settles, then is averaged
+/// over a whole number of ripple periods 1 / (2 f_cal) spanning at least
+/// the first window.
+pub fn staircase(
+    board: &mut dyn Board,
+    knowns: &Knowns,
+    op: &Operating,
+) -> Result<Staircase, String> {
+    let clock = knowns.clock_hz;
+    let r = knowns.filter.decimation;
+    let mut cal_hz = vec![];
+    let mut means = vec![];
+    let mut clocks = 0;
+    for (i, &f) in knowns.cal_freqs_hz.iter().enumerate() {
+        let (regs, real) =
+            knowns.registers(op.carrier_hz, Some(f), knowns.amplitude, op.ref_lag_deg)?;
+        board
+            .program(&regs)
+            .map_err(|e| format!("board refused a register access: {e:?}"))?;
+        let taus = if i == 0 {
+            FIRST_SETTLE_TAUS
+        } else {
+            identify::SETTLE_TAUS
+        };
+        let settle = knowns.settle_clocks(taus);
+        board.wait_clocks(settle);
+        let period = clock / (2.0 * real.cal_hz);
+        let periods = (knowns.filter.min_window_s * 2.0 * real.cal_hz).ceil();
+        let length = periods * period;
+        means.push(window_z(board, r, f64::from(r), length)?);
+        clocks += settle + length as u64 + 2 * u64::from(r);
+        cal_hz.push(real.cal_hz);
+    }
+    let x: Vec<f64> = cal_hz.iter().map(|f| 360.0 * f).collect();
+    let sf = std::array::from_fn(|k| {
+        let y: Vec<f64> = means.iter().map(|m| m[k]).collect();
+        linear_fit(&x, &y).0
+    });
+    Ok(Staircase {
+        cal_hz,
+        z: means,
+        sf_per_dps: sf,
+        clocks,
+    })
+}
+
+/// Fundamental gain of the DAC's zero-order hold at `f_hz`.
+fn hold_gain(f_hz: f64, clock_hz: f64) -> f64 {
+    let x = PI * f_hz / clock_hz;
+    x.sin() / x
+}
+
+/// The predicted readout over calibration ratio in z LSB (module header)
+/// for a device `gyro` operated at `op`, with calibration frequencies
+/// `cal_hz` (realized).
+pub fn predicted_ratio(
+    knowns: &Knowns,
+    gyro: &GyroParams,
+    op: &Operating,
+    cal_hz: &[f64],
+) -> Result<Ratio, String> {
+    let clock = knowns.clock_hz;
+    let (regs, _) = knowns.registers(op.carrier_hz, None, knowns.amplitude, 0.0)?;
+    let amp = [regs.amp.0, regs.amp.1];
+    let per_lsb = knowns.force_full_scale.map(|f| f / 32768.0);
+    let carrier_word = f64::from(PEAK) / 32768.0;
+    let read_words = amp.map(readout_word);
+    let cal_words = amp.map(|a| (f64::from(a) * f64::from(PEAK) / 32768.0 * carrier_word).abs());
+    let device = |words: [f64; 2]| Device {
+        f1_hz: gyro.f1_hz,
+        f2_hz: gyro.f2_hz,
+        q1: gyro.q1,
+        q2: gyro.q2,
+        angular_gain: gyro.angular_gain,
+        carrier_hz: op.carrier_hz,
+        f1_force: words[0] * per_lsb[0],
+        f2_force: words[1] * per_lsb[1],
+    };
+    let (dev_read, dev_cal) = (device(read_words), device(cal_words));
+    let rad = PI / 180.0;
+    let rates = &knowns.rates_dps;
+    let read_z: Vec<[f64; 2]> = rates
+        .iter()
+        .map(|r| theory::readout_z(&dev_read, r * rad))
+        .collect();
+    let hold = hold_gain(op.carrier_hz, clock);
+    let cal_z: Vec<[f64; 2]> = cal_hz
+        .iter()
+        .map(|&f| {
+            let sidebands = [-1.0, 1.0].map(|s| hold_gain(op.carrier_hz + s * f, clock) / hold);
+            // The response's envelope comes late by the group delay: the
+            // references' envelope leads it by that much more.
+            let lead = envelope_lead_rad(f, clock) + TAU * f * op.envelope_delay_s;
+            theory::calibration_z_of_datapath(&dev_cal, f, lead, sidebands)
+        })
+        .collect();
+    let virtual_dps: Vec<f64> = cal_hz.iter().map(|f| 360.0 * f).collect();
+    let slope = |x: &[f64], z: &[[f64; 2]], k: usize| {
+        let y: Vec<f64> = z.iter().map(|v| v[k]).collect();
+        linear_fit(x, &y).0
+    };
+    // z LSB: readout output k divides by g_k, calibration output k by g_(1-k).
+    let to_lsb = |k: usize| per_lsb[1 - k] / per_lsb[k];
+    let exact = std::array::from_fn(|k| {
+        slope(rates, &read_z, k) / slope(&virtual_dps, &cal_z, k) * to_lsb(k)
+    });
+    let eq5 = theory::eq5_sf_read_per_rad_s(&dev_read);
+    let eq6 = theory::eq6_sf_cal_per_rad_s(&dev_cal);
+    let eq56 = std::array::from_fn(|k| eq5 / eq6[k] * to_lsb(k));
+    Ok(Ratio { exact, eq56 })
+}
+
+/// One self-calibration cycle from a starting guess of the device.
+pub fn self_calibrate(
+    board: &mut dyn Board,
+    knowns: &Knowns,
+    guess: &GyroParams,
+) -> Result<SelfCal, String> {
+    let identified = identify::identify(board, knowns, guess)?;
+    let op = operating(knowns, &identified)?;
+    let Staircase {
+        cal_hz,
+        z: cal_z,
+        sf_per_dps: sf_cal,
+        clocks,
+    } = staircase(board, knowns, &op)?;
+    let gyro = identified.gyro(&knowns.nominal);
+    let ratio = predicted_ratio(knowns, &gyro, &op, &cal_hz)?;
+    let sf_selfcal_per_dps = std::array::from_fn(|k| sf_cal[k] * ratio.exact[k]);
+    let sf_eq56_per_dps = std::array::from_fn(|k| sf_cal[k] * ratio.eq56[k]);
+    Ok(SelfCal {
+        clocks: identified.clocks + clocks,
+        identified,
+        operating: op,
+        cal_hz,
+        cal_z,
+        sf_cal_per_dps: sf_cal,
+        ratio,
+        sf_selfcal_per_dps,
+        sf_eq56_per_dps,
+    })
+}

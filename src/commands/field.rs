@@ -1,0 +1,173 @@
+//! `gyrocal field --config FILE.toml [--json] [--out DIR]`: a device
+//! drifting over the `[drift]` section's temperature steps, self-calibrated
+//! at each step through the registers alone, against the rate table of
+//! the same simulation and the factory-calibrated baseline.
+//!
+//! The file holds the sections of `gyrocal run` plus `[drift]`
+//! (`gyrocal_sim::drift`). Progress and the wall time go to stderr; with
+//! `--json` stdout is one object whose `steps` hold, per temperature,
+//! `temperature_c`, `sf_true_per_dps`, `sf_selfcal_per_dps`,
+//! `sf_baseline_per_dps` (z LSB per deg/s, one per output) and
+//! `identified` (`f1_hz`, `f2_hz`, `q1`, `q2`, `loop_phase_deg`, each with
+//! an `_uncertainty` twin). `--out` writes field.json, field.csv and
+//! fig_field_error.png/.svg.
+
+use crate::Failure;
+use gyrocal_sim::field::scenario::{self, FieldReport};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Options of `gyrocal field`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Scenario: the sections of `gyrocal run` plus `[drift]` (TOML).
+    #[arg(long)]
+    pub config: PathBuf,
+    /// Print one JSON object (the whole report) to stdout instead of the table.
+    #[arg(long)]
+    pub json: bool,
+    /// Also write field.json, field.csv and the figure into this folder.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+/// Run the scenario.
+pub fn run(args: &Args) -> Result<(), Failure> {
+    let name = args.config.display().to_string();
+    let text = std::fs::read_to_string(&args.config)
+        .map_err(|e| Failure::Input(format!("--config {name}: cannot read the file: {e}")))?;
+    let (exp, drift) = scenario::parse(&name, &text).map_err(Failure::Input)?;
+    let report = scenario::run(&exp, &drift, &|line| eprintln!("{line}")).map_err(Failure::Run)?;
+    eprintln!(
+        "{} steps, {:.3e} clocks in {:.1} s wall",
+        report.steps.len(),
+        report.clocks as f64,
+        report.wall_s
+    );
+    let json = serde_json::to_string(&report).map_err(|e| Failure::Run(e.to_string()))?;
+    if let Some(dir) = &args.out {
+        for path in write_results(&report, &json, &name, dir).map_err(Failure::Run)? {
+            eprintln!("wrote {}", path.display());
+        }
+    }
+    if args.json {
+        println!("{json}");
+    } else {
+        print!("{}", summary(&report));
+    }
+    Ok(())
+}
+
+/// One row per step: scale factors, errors and the identified parameters.
+pub fn csv(report: &FieldReport) -> String {
+    let mut s = String::from(
+        "temperature_c,sf_true1_per_dps,sf_true2_per_dps,sf_selfcal1_per_dps,sf_selfcal2_per_dps,\
+         sf_baseline1_per_dps,sf_baseline2_per_dps,sf_true_factory1_per_dps,sf_true_factory2_per_dps,\
+         selfcal_error1,selfcal_error2,baseline_error1,baseline_error2,f1_hz,f1_hz_uncertainty,\
+         f2_hz,f2_hz_uncertainty,q1,q1_uncertainty,q2,q2_uncertainty,loop_phase_deg,\
+         loop_phase_deg_uncertainty\n",
+    );
+    for st in &report.steps {
+        let i = &st.identified;
+        let values = [
+            st.temperature_c,
+            st.sf_true_per_dps[0],
+            st.sf_true_per_dps[1],
+            st.sf_selfcal_per_dps[0],
+            st.sf_selfcal_per_dps[1],
+            st.sf_baseline_per_dps[0],
+            st.sf_baseline_per_dps[1],
+            st.sf_true_at_factory_settings_per_dps[0],
+            st.sf_true_at_factory_settings_per_dps[1],
+            st.selfcal_error[0],
+            st.selfcal_error[1],
+            st.baseline_error[0],
+            st.baseline_error[1],
+            i.f1_hz,
+            i.f1_hz_uncertainty,
+            i.f2_hz,
+            i.f2_hz_uncertainty,
+            i.q1,
+            i.q1_uncertainty,
+            i.q2,
+            i.q2_uncertainty,
+            i.loop_phase_deg,
+            i.loop_phase_deg_uncertainty,
+        ];
+        let row: Vec<String> = values.iter().map(|v| format!("{v:e}")).collect();
+        s.push_str(&row.join(","));
+        s.push('\n');
+    }
+    s
+}
+
+fn write_results(
+    report: &FieldReport,
+    json: &str,
+    name: &str,
+    dir: &Path,
+) -> Result<Vec<PathBuf>, String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let mut written = vec![];
+    for (file, bytes) in [("field.json", json.to_string()), ("field.csv", csv(report))] {
+        let path = dir.join(file);
+        gyrocal_verify::write_atomically(&path, bytes.as_bytes())
+            .map_err(|e| format!("{}: {e}", path.display()))?;
+        written.push(path);
+    }
+    let title = format!("Self-calibration in the field: {name}");
+    written.extend(crate::plots::write_field_figure(
+        report,
+        &title,
+        dir,
+        "fig_field_error",
+    )?);
+    Ok(written)
+}
+
+/// The human-readable table.
+pub fn summary(report: &FieldReport) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "factory: carrier {:.3} Hz, loop phase {:.4} deg, SF {:.6e} / {:.6e} z LSB per deg/s",
+        report.factory.carrier_hz,
+        report.factory.ref_lag_deg,
+        report.sf_factory_per_dps[0],
+        report.sf_factory_per_dps[1]
+    );
+    let _ = writeln!(
+        s,
+        "{:>8}  {:>27}  {:>21}  {:>21}  {:>14}  {:>14}  {:>11}",
+        "T (C)",
+        "SF true (z LSB per deg/s)",
+        "self-cal error",
+        "baseline error",
+        "f1 (Hz)",
+        "f2 - f1 (Hz)",
+        "phase (deg)"
+    );
+    for st in &report.steps {
+        let i = &st.identified;
+        let _ = writeln!(
+            s,
+            "{:>8.2}  {:>13.6e} {:>13.6e}  {:>+9.4}% {:>+9.4}%  {:>+9.2}% {:>+9.2}%  {:>14.4}  {:>14.4}  {:>11.5}",
+            st.temperature_c,
+            st.sf_true_per_dps[0],
+            st.sf_true_per_dps[1],
+            100.0 * st.selfcal_error[0],
+            100.0 * st.selfcal_error[1],
+            100.0 * st.baseline_error[0],
+            100.0 * st.baseline_error[1],
+            i.f1_hz,
+            i.f2_hz - i.f1_hz,
+            i.loop_phase_deg
+        );
+    }
+    let _ = writeln!(
+        s,
+        "wall time {:.1} s, {:.3e} clocks",
+        report.wall_s, report.clocks as f64
+    );
+    s
+}

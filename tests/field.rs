@@ -1,0 +1,153 @@
+//! The self-calibration cycle over temperature: the self-calibrated scale
+//! factor against the rate table of the same simulation, and the
+//! factory-calibrated baseline beside it.
+
+use gyrocal_sim::drift::Drift;
+use gyrocal_sim::field::scenario::{self, FieldReport};
+use gyrocal_sim::field::selfcal;
+
+fn run(path: &str) -> FieldReport {
+    let text = std::fs::read_to_string(path).unwrap();
+    let (exp, drift) = scenario::parse(path, &text).unwrap();
+    scenario::run(&exp, &drift, &|line| eprintln!("{line}")).unwrap()
+}
+
+/// The consumer device of `tests/data/field_consumer.toml` with its
+/// `[drift]` replaced by `drift`.
+fn run_consumer(drift: Drift) -> FieldReport {
+    let path = "tests/data/field_consumer.toml";
+    let text = std::fs::read_to_string(path).unwrap();
+    let (exp, _) = scenario::parse(path, &text).unwrap();
+    scenario::run(&exp, &drift, &|line| eprintln!("{line}")).unwrap()
+}
+
+/// No drift but the converters' gains (ppm/K) over 25, 35, 15 deg C.
+fn gains_only(adc: [f64; 2], drive: [f64; 2]) -> Drift {
+    Drift {
+        temperatures_c: vec![25.0, 35.0, 15.0],
+        tcf1_ppm_per_k: 0.0,
+        tcf2_ppm_per_k: 0.0,
+        q_ppm_per_k: 0.0,
+        front_end_phase_deg: 0.0,
+        front_end_phase_deg_per_k: 0.0,
+        adc_gain_ppm_per_k: adc,
+        drive_gain_ppm_per_k: drive,
+    }
+}
+
+/// Every step's self-calibrated scale factor within 0.1% of the rate
+/// table's (the target).
+fn assert_within_target(report: &FieldReport) {
+    for s in &report.steps {
+        for k in 0..2 {
+            assert!(
+                s.selfcal_error[k].abs() < 1e-3,
+                "{} deg C output {}: {}",
+                s.temperature_c,
+                k + 1,
+                s.selfcal_error[k]
+            );
+        }
+    }
+}
+
+#[test]
+fn consumer_and_high_q_devices_self_calibrate_over_ten_kelvin() {
+    for path in [
+        "tests/data/field_consumer.toml",
+        "tests/data/field_highq.toml",
+    ] {
+        let report = run(path);
+        assert_within_target(&report);
+    }
+}
+
+/// ADC gains and a common drive gain cancel exactly in the ratio
+/// (`selfcal` module header). +-10% of each (ADC up while the drives go
+/// down, so the ADC stays below full scale) must leave the
+/// self-calibration within its 0.1% target, and move it by no more than
+/// the run-to-run scatter of this device's self-calibration error (0.008%
+/// to 0.063% over the steps of `field_consumer.toml`, measured): the two
+/// runs share the noise seed, but the changed signal levels change which
+/// noise the averages see. (Measured: 0.032%, identical at 15 and 35 deg C,
+/// where a x g is 0.99 in both: the level, not the gains' split, moves
+/// it. Showing the < 0.01% the analysis promises needs longer windows
+/// than this test can afford.)
+#[test]
+fn adc_and_common_drive_gains_cancel() {
+    let plain = run_consumer(gains_only([0.0; 2], [0.0; 2]));
+    let gains = run_consumer(gains_only([1e4, 1e4], [-1e4, -1e4]));
+    assert_within_target(&gains);
+    for (a, b) in plain.steps.iter().zip(&gains.steps) {
+        for k in 0..2 {
+            let moved = b.selfcal_error[k] - a.selfcal_error[k];
+            eprintln!(
+                "{} deg C output {}: moved {moved:+.2e}",
+                a.temperature_c,
+                k + 1
+            );
+            assert!(moved.abs() < 6.3e-4, "{moved}");
+        }
+    }
+}
+
+/// A differential drive gain is not observable at rest and is not
+/// corrected: the host predicts with the design force ratio. Its effect is
+/// what the exact theory gives with the true ratio instead: one for one
+/// on the linear rate term (ratio_k carries g_(1-k) / g_k), but the fitted
+/// slope over rates that are not symmetric about 0 also holds the
+/// quadratic term, which scales with the other drive (on this device
+/// output 2 moves -1.98% for +-1%, output 1 only +0.1%). The measured
+/// error must match that prediction to within the self-calibration's own
+/// 0.1%.
+#[test]
+fn a_differential_drive_gain_enters_as_the_theory_says() {
+    let report = run_consumer(gains_only([0.0; 2], [1e3, -1e3]));
+    for s in &report.steps {
+        let op = &s.selfcal.operating;
+        let gyro = s.selfcal.identified.gyro(&report.knowns.nominal);
+        let cal_hz = &s.selfcal.cal_hz;
+        let design = selfcal::predicted_ratio(&report.knowns, &gyro, op, cal_hz).unwrap();
+        let mut true_gains = report.knowns.clone();
+        for k in 0..2 {
+            true_gains.force_full_scale[k] *= s.truth.drive_gain[k];
+        }
+        let truth = selfcal::predicted_ratio(&true_gains, &gyro, op, cal_hz).unwrap();
+        for (k, error) in s.selfcal_error.iter().enumerate() {
+            let want = design.exact[k] / truth.exact[k] - 1.0;
+            eprintln!(
+                "{} deg C output {}: error {error:+.4e}, theory {want:+.4e}",
+                s.temperature_c,
+                k + 1,
+            );
+            assert!((error - want).abs() < 1e-3);
+        }
+    }
+}
+
+#[test]
+fn paper_device_self_calibrates_over_ten_kelvin() {
+    let report = run("tests/data/field_paper.toml");
+    for s in &report.steps {
+        eprintln!(
+            "{} deg C: self-cal error {:?}, baseline error {:?}",
+            s.temperature_c, s.selfcal_error, s.baseline_error
+        );
+    }
+    eprintln!("clocks {} wall {:.1} s", report.clocks, report.wall_s);
+    assert_within_target(&report);
+    // The baseline, beside it: a fixed carrier leaves the resonance within
+    // a fraction of a kelvin (290 Hz/K against an 88 Hz half-bandwidth), so
+    // 5 K away its scale factor is off by more than a factor of 2.
+    let far = report
+        .steps
+        .iter()
+        .filter(|s| (s.temperature_c - 25.0).abs() >= 5.0);
+    for s in far {
+        assert!(
+            s.baseline_error.iter().all(|e| e.abs() > 1.0),
+            "{:?}",
+            s.baseline_error
+        );
+    }
+}

@@ -1,0 +1,49 @@
+//! `gyrocal field` refuses bad scenario files in one line, with exit
+//! status 2, before writing anything.
+
+use std::process::Command;
+
+const GOOD: &str = "[gyro]\nf1_hz = 25.1e3\nf2_hz = 25.8e3\nq1 = 3000\nq2 = 3000\nangular_gain = 0.8\n\
+[drive]\ncarrier_hz = 25.1e3\nclock_hz = 1.2345e6\n\
+[experiment]\nreadout_rates_dps = [50, 100]\ncal_freqs_hz = [2, 4]\n";
+
+#[test]
+fn bad_scenario_files_are_refused_in_one_line() {
+    let drift = "[drift]\ntemperatures_c = [25, 35]\ntcf1_ppm_per_k = -30\ntcf2_ppm_per_k = -30\n";
+    let cases = [
+        (GOOD.to_string(), "drift"),
+        (
+            format!("{GOOD}{drift}tcf3_ppm_per_k = 1\n"),
+            "tcf3_ppm_per_k",
+        ),
+        (
+            format!("{GOOD}{drift}front_end_phase_deg = 1e9\n"),
+            "front_end_phase",
+        ),
+        (GOOD.replace("q1 = 3000", "q1 = -3") + drift, "q1"),
+        (
+            format!("{GOOD}{drift}")
+                .replace("temperatures_c = [25, 35]", "temperatures_c = [25, 400]"),
+            "temperatures_c",
+        ),
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    for (i, (text, key)) in cases.iter().enumerate() {
+        let config = dir.path().join(format!("bad{i}.toml"));
+        std::fs::write(&config, text).unwrap();
+        let out = dir.path().join(format!("out{i}"));
+        let run = Command::new(env!("CARGO_BIN_EXE_gyrocal"))
+            .args(["field", "--config"])
+            .arg(&config)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(run.status.code(), Some(2), "{key}: {stderr}");
+        assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
+        assert!(stderr.contains(key), "{key}: {stderr}");
+        assert!(run.stdout.is_empty());
+        assert!(!out.exists(), "{key}: wrote {}", out.display());
+    }
+}
