@@ -350,6 +350,12 @@ module gyro_interface__am_mixer__drive1(clock,a,b,y);
     localparam signed half_lsb = 32'h4000;
 
     // Stub signals
+    reg signed [15:0] a_in$d;
+    wire signed [15:0] a_in$q;
+    reg  a_in$clock;
+    reg signed [15:0] b_in$d;
+    wire signed [15:0] b_in$q;
+    reg  b_in$clock;
     reg  product$clock;
     reg signed [15:0] product$a;
     reg signed [15:0] product$b;
@@ -362,6 +368,16 @@ module gyro_interface__am_mixer__drive1(clock,a,b,y);
     reg signed [31:0] rounded;
 
     // Sub module instances
+    gyro_interface__am_mixer__drive1__a_in a_in(
+        .d(a_in$d),
+        .q(a_in$q),
+        .clock(a_in$clock)
+    );
+    gyro_interface__am_mixer__drive1__b_in b_in(
+        .d(b_in$d),
+        .q(b_in$q),
+        .clock(b_in$clock)
+    );
     gyro_interface__am_mixer__drive1__product product(
         .clock(product$clock),
         .a(product$a),
@@ -376,17 +392,61 @@ module gyro_interface__am_mixer__drive1(clock,a,b,y);
 
     // Update code
     always @(*) begin
+        a_in$clock = clock;
+        b_in$clock = clock;
         y_out$clock = clock;
+        a_in$d = a_in$q;
+        b_in$d = b_in$q;
         y_out$d = y_out$q;
+        a_in$d = a;
+        b_in$d = b;
         product$clock = clock;
-        product$a = a;
-        product$b = b;
+        product$a = a_in$q;
+        product$b = b_in$q;
         rounded = product$p + half_lsb;
         y_out$d = rounded[(32'hf)+:(16)];
         y = y_out$q;
     end
 
 endmodule // gyro_interface__am_mixer__drive1
+
+
+module gyro_interface__am_mixer__drive1__a_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__am_mixer__drive1__a_in
+
+
+module gyro_interface__am_mixer__drive1__b_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__am_mixer__drive1__b_in
 
 
 module gyro_interface__am_mixer__drive1__product(clock,a,b,p);
@@ -437,6 +497,12 @@ module gyro_interface__am_mixer__drive2(clock,a,b,y);
     localparam signed half_lsb = 32'h4000;
 
     // Stub signals
+    reg signed [15:0] a_in$d;
+    wire signed [15:0] a_in$q;
+    reg  a_in$clock;
+    reg signed [15:0] b_in$d;
+    wire signed [15:0] b_in$q;
+    reg  b_in$clock;
     reg  product$clock;
     reg signed [15:0] product$a;
     reg signed [15:0] product$b;
@@ -449,6 +515,16 @@ module gyro_interface__am_mixer__drive2(clock,a,b,y);
     reg signed [31:0] rounded;
 
     // Sub module instances
+    gyro_interface__am_mixer__drive2__a_in a_in(
+        .d(a_in$d),
+        .q(a_in$q),
+        .clock(a_in$clock)
+    );
+    gyro_interface__am_mixer__drive2__b_in b_in(
+        .d(b_in$d),
+        .q(b_in$q),
+        .clock(b_in$clock)
+    );
     gyro_interface__am_mixer__drive2__product product(
         .clock(product$clock),
         .a(product$a),
@@ -463,17 +539,61 @@ module gyro_interface__am_mixer__drive2(clock,a,b,y);
 
     // Update code
     always @(*) begin
+        a_in$clock = clock;
+        b_in$clock = clock;
         y_out$clock = clock;
+        a_in$d = a_in$q;
+        b_in$d = b_in$q;
         y_out$d = y_out$q;
+        a_in$d = a;
+        b_in$d = b;
         product$clock = clock;
-        product$a = a;
-        product$b = b;
+        product$a = a_in$q;
+        product$b = b_in$q;
         rounded = product$p + half_lsb;
         y_out$d = rounded[(32'hf)+:(16)];
         y = y_out$q;
     end
 
 endmodule // gyro_interface__am_mixer__drive2
+
+
+module gyro_interface__am_mixer__drive2__a_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__am_mixer__drive2__a_in
+
+
+module gyro_interface__am_mixer__drive2__b_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__am_mixer__drive2__b_in
 
 
 module gyro_interface__am_mixer__drive2__product(clock,a,b,p);
@@ -524,6 +644,12 @@ module gyro_interface__am_mixer__envelope1(clock,a,b,y);
     localparam signed half_lsb = 32'h4000;
 
     // Stub signals
+    reg signed [15:0] a_in$d;
+    wire signed [15:0] a_in$q;
+    reg  a_in$clock;
+    reg signed [15:0] b_in$d;
+    wire signed [15:0] b_in$q;
+    reg  b_in$clock;
     reg  product$clock;
     reg signed [15:0] product$a;
     reg signed [15:0] product$b;
@@ -536,6 +662,16 @@ module gyro_interface__am_mixer__envelope1(clock,a,b,y);
     reg signed [31:0] rounded;
 
     // Sub module instances
+    gyro_interface__am_mixer__envelope1__a_in a_in(
+        .d(a_in$d),
+        .q(a_in$q),
+        .clock(a_in$clock)
+    );
+    gyro_interface__am_mixer__envelope1__b_in b_in(
+        .d(b_in$d),
+        .q(b_in$q),
+        .clock(b_in$clock)
+    );
     gyro_interface__am_mixer__envelope1__product product(
         .clock(product$clock),
         .a(product$a),
@@ -550,17 +686,61 @@ module gyro_interface__am_mixer__envelope1(clock,a,b,y);
 
     // Update code
     always @(*) begin
+        a_in$clock = clock;
+        b_in$clock = clock;
         y_out$clock = clock;
+        a_in$d = a_in$q;
+        b_in$d = b_in$q;
         y_out$d = y_out$q;
+        a_in$d = a;
+        b_in$d = b;
         product$clock = clock;
-        product$a = a;
-        product$b = b;
+        product$a = a_in$q;
+        product$b = b_in$q;
         rounded = product$p + half_lsb;
         y_out$d = rounded[(32'hf)+:(16)];
         y = y_out$q;
     end
 
 endmodule // gyro_interface__am_mixer__envelope1
+
+
+module gyro_interface__am_mixer__envelope1__a_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__am_mixer__envelope1__a_in
+
+
+module gyro_interface__am_mixer__envelope1__b_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__am_mixer__envelope1__b_in
 
 
 module gyro_interface__am_mixer__envelope1__product(clock,a,b,p);
@@ -611,6 +791,12 @@ module gyro_interface__am_mixer__envelope2(clock,a,b,y);
     localparam signed half_lsb = 32'h4000;
 
     // Stub signals
+    reg signed [15:0] a_in$d;
+    wire signed [15:0] a_in$q;
+    reg  a_in$clock;
+    reg signed [15:0] b_in$d;
+    wire signed [15:0] b_in$q;
+    reg  b_in$clock;
     reg  product$clock;
     reg signed [15:0] product$a;
     reg signed [15:0] product$b;
@@ -623,6 +809,16 @@ module gyro_interface__am_mixer__envelope2(clock,a,b,y);
     reg signed [31:0] rounded;
 
     // Sub module instances
+    gyro_interface__am_mixer__envelope2__a_in a_in(
+        .d(a_in$d),
+        .q(a_in$q),
+        .clock(a_in$clock)
+    );
+    gyro_interface__am_mixer__envelope2__b_in b_in(
+        .d(b_in$d),
+        .q(b_in$q),
+        .clock(b_in$clock)
+    );
     gyro_interface__am_mixer__envelope2__product product(
         .clock(product$clock),
         .a(product$a),
@@ -637,17 +833,61 @@ module gyro_interface__am_mixer__envelope2(clock,a,b,y);
 
     // Update code
     always @(*) begin
+        a_in$clock = clock;
+        b_in$clock = clock;
         y_out$clock = clock;
+        a_in$d = a_in$q;
+        b_in$d = b_in$q;
         y_out$d = y_out$q;
+        a_in$d = a;
+        b_in$d = b;
         product$clock = clock;
-        product$a = a;
-        product$b = b;
+        product$a = a_in$q;
+        product$b = b_in$q;
         rounded = product$p + half_lsb;
         y_out$d = rounded[(32'hf)+:(16)];
         y = y_out$q;
     end
 
 endmodule // gyro_interface__am_mixer__envelope2
+
+
+module gyro_interface__am_mixer__envelope2__a_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__am_mixer__envelope2__a_in
+
+
+module gyro_interface__am_mixer__envelope2__b_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__am_mixer__envelope2__b_in
 
 
 module gyro_interface__am_mixer__envelope2__product(clock,a,b,p);
@@ -698,6 +938,12 @@ module gyro_interface__am_mixer__reference1(clock,a,b,y);
     localparam signed half_lsb = 32'h4000;
 
     // Stub signals
+    reg signed [15:0] a_in$d;
+    wire signed [15:0] a_in$q;
+    reg  a_in$clock;
+    reg signed [15:0] b_in$d;
+    wire signed [15:0] b_in$q;
+    reg  b_in$clock;
     reg  product$clock;
     reg signed [15:0] product$a;
     reg signed [15:0] product$b;
@@ -710,6 +956,16 @@ module gyro_interface__am_mixer__reference1(clock,a,b,y);
     reg signed [31:0] rounded;
 
     // Sub module instances
+    gyro_interface__am_mixer__reference1__a_in a_in(
+        .d(a_in$d),
+        .q(a_in$q),
+        .clock(a_in$clock)
+    );
+    gyro_interface__am_mixer__reference1__b_in b_in(
+        .d(b_in$d),
+        .q(b_in$q),
+        .clock(b_in$clock)
+    );
     gyro_interface__am_mixer__reference1__product product(
         .clock(product$clock),
         .a(product$a),
@@ -724,17 +980,61 @@ module gyro_interface__am_mixer__reference1(clock,a,b,y);
 
     // Update code
     always @(*) begin
+        a_in$clock = clock;
+        b_in$clock = clock;
         y_out$clock = clock;
+        a_in$d = a_in$q;
+        b_in$d = b_in$q;
         y_out$d = y_out$q;
+        a_in$d = a;
+        b_in$d = b;
         product$clock = clock;
-        product$a = a;
-        product$b = b;
+        product$a = a_in$q;
+        product$b = b_in$q;
         rounded = product$p + half_lsb;
         y_out$d = rounded[(32'hf)+:(16)];
         y = y_out$q;
     end
 
 endmodule // gyro_interface__am_mixer__reference1
+
+
+module gyro_interface__am_mixer__reference1__a_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__am_mixer__reference1__a_in
+
+
+module gyro_interface__am_mixer__reference1__b_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__am_mixer__reference1__b_in
 
 
 module gyro_interface__am_mixer__reference1__product(clock,a,b,p);
@@ -785,6 +1085,12 @@ module gyro_interface__am_mixer__reference2(clock,a,b,y);
     localparam signed half_lsb = 32'h4000;
 
     // Stub signals
+    reg signed [15:0] a_in$d;
+    wire signed [15:0] a_in$q;
+    reg  a_in$clock;
+    reg signed [15:0] b_in$d;
+    wire signed [15:0] b_in$q;
+    reg  b_in$clock;
     reg  product$clock;
     reg signed [15:0] product$a;
     reg signed [15:0] product$b;
@@ -797,6 +1103,16 @@ module gyro_interface__am_mixer__reference2(clock,a,b,y);
     reg signed [31:0] rounded;
 
     // Sub module instances
+    gyro_interface__am_mixer__reference2__a_in a_in(
+        .d(a_in$d),
+        .q(a_in$q),
+        .clock(a_in$clock)
+    );
+    gyro_interface__am_mixer__reference2__b_in b_in(
+        .d(b_in$d),
+        .q(b_in$q),
+        .clock(b_in$clock)
+    );
     gyro_interface__am_mixer__reference2__product product(
         .clock(product$clock),
         .a(product$a),
@@ -811,17 +1127,61 @@ module gyro_interface__am_mixer__reference2(clock,a,b,y);
 
     // Update code
     always @(*) begin
+        a_in$clock = clock;
+        b_in$clock = clock;
         y_out$clock = clock;
+        a_in$d = a_in$q;
+        b_in$d = b_in$q;
         y_out$d = y_out$q;
+        a_in$d = a;
+        b_in$d = b;
         product$clock = clock;
-        product$a = a;
-        product$b = b;
+        product$a = a_in$q;
+        product$b = b_in$q;
         rounded = product$p + half_lsb;
         y_out$d = rounded[(32'hf)+:(16)];
         y = y_out$q;
     end
 
 endmodule // gyro_interface__am_mixer__reference2
+
+
+module gyro_interface__am_mixer__reference2__a_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__am_mixer__reference2__a_in
+
+
+module gyro_interface__am_mixer__reference2__b_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__am_mixer__reference2__b_in
 
 
 module gyro_interface__am_mixer__reference2__product(clock,a,b,p);

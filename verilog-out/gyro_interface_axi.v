@@ -1587,6 +1587,12 @@ module gyro_interface_axi__core__am_mixer__drive1(clock,a,b,y);
     localparam signed half_lsb = 32'h4000;
 
     // Stub signals
+    reg signed [15:0] a_in$d;
+    wire signed [15:0] a_in$q;
+    reg  a_in$clock;
+    reg signed [15:0] b_in$d;
+    wire signed [15:0] b_in$q;
+    reg  b_in$clock;
     reg  product$clock;
     reg signed [15:0] product$a;
     reg signed [15:0] product$b;
@@ -1599,6 +1605,16 @@ module gyro_interface_axi__core__am_mixer__drive1(clock,a,b,y);
     reg signed [31:0] rounded;
 
     // Sub module instances
+    gyro_interface_axi__core__am_mixer__drive1__a_in a_in(
+        .d(a_in$d),
+        .q(a_in$q),
+        .clock(a_in$clock)
+    );
+    gyro_interface_axi__core__am_mixer__drive1__b_in b_in(
+        .d(b_in$d),
+        .q(b_in$q),
+        .clock(b_in$clock)
+    );
     gyro_interface_axi__core__am_mixer__drive1__product product(
         .clock(product$clock),
         .a(product$a),
@@ -1613,17 +1629,61 @@ module gyro_interface_axi__core__am_mixer__drive1(clock,a,b,y);
 
     // Update code
     always @(*) begin
+        a_in$clock = clock;
+        b_in$clock = clock;
         y_out$clock = clock;
+        a_in$d = a_in$q;
+        b_in$d = b_in$q;
         y_out$d = y_out$q;
+        a_in$d = a;
+        b_in$d = b;
         product$clock = clock;
-        product$a = a;
-        product$b = b;
+        product$a = a_in$q;
+        product$b = b_in$q;
         rounded = product$p + half_lsb;
         y_out$d = rounded[(32'hf)+:(16)];
         y = y_out$q;
     end
 
 endmodule // gyro_interface_axi__core__am_mixer__drive1
+
+
+module gyro_interface_axi__core__am_mixer__drive1__a_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__drive1__a_in
+
+
+module gyro_interface_axi__core__am_mixer__drive1__b_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__drive1__b_in
 
 
 module gyro_interface_axi__core__am_mixer__drive1__product(clock,a,b,p);
@@ -1674,6 +1734,12 @@ module gyro_interface_axi__core__am_mixer__drive2(clock,a,b,y);
     localparam signed half_lsb = 32'h4000;
 
     // Stub signals
+    reg signed [15:0] a_in$d;
+    wire signed [15:0] a_in$q;
+    reg  a_in$clock;
+    reg signed [15:0] b_in$d;
+    wire signed [15:0] b_in$q;
+    reg  b_in$clock;
     reg  product$clock;
     reg signed [15:0] product$a;
     reg signed [15:0] product$b;
@@ -1686,6 +1752,16 @@ module gyro_interface_axi__core__am_mixer__drive2(clock,a,b,y);
     reg signed [31:0] rounded;
 
     // Sub module instances
+    gyro_interface_axi__core__am_mixer__drive2__a_in a_in(
+        .d(a_in$d),
+        .q(a_in$q),
+        .clock(a_in$clock)
+    );
+    gyro_interface_axi__core__am_mixer__drive2__b_in b_in(
+        .d(b_in$d),
+        .q(b_in$q),
+        .clock(b_in$clock)
+    );
     gyro_interface_axi__core__am_mixer__drive2__product product(
         .clock(product$clock),
         .a(product$a),
@@ -1700,17 +1776,61 @@ module gyro_interface_axi__core__am_mixer__drive2(clock,a,b,y);
 
     // Update code
     always @(*) begin
+        a_in$clock = clock;
+        b_in$clock = clock;
         y_out$clock = clock;
+        a_in$d = a_in$q;
+        b_in$d = b_in$q;
         y_out$d = y_out$q;
+        a_in$d = a;
+        b_in$d = b;
         product$clock = clock;
-        product$a = a;
-        product$b = b;
+        product$a = a_in$q;
+        product$b = b_in$q;
         rounded = product$p + half_lsb;
         y_out$d = rounded[(32'hf)+:(16)];
         y = y_out$q;
     end
 
 endmodule // gyro_interface_axi__core__am_mixer__drive2
+
+
+module gyro_interface_axi__core__am_mixer__drive2__a_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__drive2__a_in
+
+
+module gyro_interface_axi__core__am_mixer__drive2__b_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__drive2__b_in
 
 
 module gyro_interface_axi__core__am_mixer__drive2__product(clock,a,b,p);
@@ -1761,6 +1881,12 @@ module gyro_interface_axi__core__am_mixer__envelope1(clock,a,b,y);
     localparam signed half_lsb = 32'h4000;
 
     // Stub signals
+    reg signed [15:0] a_in$d;
+    wire signed [15:0] a_in$q;
+    reg  a_in$clock;
+    reg signed [15:0] b_in$d;
+    wire signed [15:0] b_in$q;
+    reg  b_in$clock;
     reg  product$clock;
     reg signed [15:0] product$a;
     reg signed [15:0] product$b;
@@ -1773,6 +1899,16 @@ module gyro_interface_axi__core__am_mixer__envelope1(clock,a,b,y);
     reg signed [31:0] rounded;
 
     // Sub module instances
+    gyro_interface_axi__core__am_mixer__envelope1__a_in a_in(
+        .d(a_in$d),
+        .q(a_in$q),
+        .clock(a_in$clock)
+    );
+    gyro_interface_axi__core__am_mixer__envelope1__b_in b_in(
+        .d(b_in$d),
+        .q(b_in$q),
+        .clock(b_in$clock)
+    );
     gyro_interface_axi__core__am_mixer__envelope1__product product(
         .clock(product$clock),
         .a(product$a),
@@ -1787,17 +1923,61 @@ module gyro_interface_axi__core__am_mixer__envelope1(clock,a,b,y);
 
     // Update code
     always @(*) begin
+        a_in$clock = clock;
+        b_in$clock = clock;
         y_out$clock = clock;
+        a_in$d = a_in$q;
+        b_in$d = b_in$q;
         y_out$d = y_out$q;
+        a_in$d = a;
+        b_in$d = b;
         product$clock = clock;
-        product$a = a;
-        product$b = b;
+        product$a = a_in$q;
+        product$b = b_in$q;
         rounded = product$p + half_lsb;
         y_out$d = rounded[(32'hf)+:(16)];
         y = y_out$q;
     end
 
 endmodule // gyro_interface_axi__core__am_mixer__envelope1
+
+
+module gyro_interface_axi__core__am_mixer__envelope1__a_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__envelope1__a_in
+
+
+module gyro_interface_axi__core__am_mixer__envelope1__b_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__envelope1__b_in
 
 
 module gyro_interface_axi__core__am_mixer__envelope1__product(clock,a,b,p);
@@ -1848,6 +2028,12 @@ module gyro_interface_axi__core__am_mixer__envelope2(clock,a,b,y);
     localparam signed half_lsb = 32'h4000;
 
     // Stub signals
+    reg signed [15:0] a_in$d;
+    wire signed [15:0] a_in$q;
+    reg  a_in$clock;
+    reg signed [15:0] b_in$d;
+    wire signed [15:0] b_in$q;
+    reg  b_in$clock;
     reg  product$clock;
     reg signed [15:0] product$a;
     reg signed [15:0] product$b;
@@ -1860,6 +2046,16 @@ module gyro_interface_axi__core__am_mixer__envelope2(clock,a,b,y);
     reg signed [31:0] rounded;
 
     // Sub module instances
+    gyro_interface_axi__core__am_mixer__envelope2__a_in a_in(
+        .d(a_in$d),
+        .q(a_in$q),
+        .clock(a_in$clock)
+    );
+    gyro_interface_axi__core__am_mixer__envelope2__b_in b_in(
+        .d(b_in$d),
+        .q(b_in$q),
+        .clock(b_in$clock)
+    );
     gyro_interface_axi__core__am_mixer__envelope2__product product(
         .clock(product$clock),
         .a(product$a),
@@ -1874,17 +2070,61 @@ module gyro_interface_axi__core__am_mixer__envelope2(clock,a,b,y);
 
     // Update code
     always @(*) begin
+        a_in$clock = clock;
+        b_in$clock = clock;
         y_out$clock = clock;
+        a_in$d = a_in$q;
+        b_in$d = b_in$q;
         y_out$d = y_out$q;
+        a_in$d = a;
+        b_in$d = b;
         product$clock = clock;
-        product$a = a;
-        product$b = b;
+        product$a = a_in$q;
+        product$b = b_in$q;
         rounded = product$p + half_lsb;
         y_out$d = rounded[(32'hf)+:(16)];
         y = y_out$q;
     end
 
 endmodule // gyro_interface_axi__core__am_mixer__envelope2
+
+
+module gyro_interface_axi__core__am_mixer__envelope2__a_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__envelope2__a_in
+
+
+module gyro_interface_axi__core__am_mixer__envelope2__b_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__envelope2__b_in
 
 
 module gyro_interface_axi__core__am_mixer__envelope2__product(clock,a,b,p);
@@ -1935,6 +2175,12 @@ module gyro_interface_axi__core__am_mixer__reference1(clock,a,b,y);
     localparam signed half_lsb = 32'h4000;
 
     // Stub signals
+    reg signed [15:0] a_in$d;
+    wire signed [15:0] a_in$q;
+    reg  a_in$clock;
+    reg signed [15:0] b_in$d;
+    wire signed [15:0] b_in$q;
+    reg  b_in$clock;
     reg  product$clock;
     reg signed [15:0] product$a;
     reg signed [15:0] product$b;
@@ -1947,6 +2193,16 @@ module gyro_interface_axi__core__am_mixer__reference1(clock,a,b,y);
     reg signed [31:0] rounded;
 
     // Sub module instances
+    gyro_interface_axi__core__am_mixer__reference1__a_in a_in(
+        .d(a_in$d),
+        .q(a_in$q),
+        .clock(a_in$clock)
+    );
+    gyro_interface_axi__core__am_mixer__reference1__b_in b_in(
+        .d(b_in$d),
+        .q(b_in$q),
+        .clock(b_in$clock)
+    );
     gyro_interface_axi__core__am_mixer__reference1__product product(
         .clock(product$clock),
         .a(product$a),
@@ -1961,17 +2217,61 @@ module gyro_interface_axi__core__am_mixer__reference1(clock,a,b,y);
 
     // Update code
     always @(*) begin
+        a_in$clock = clock;
+        b_in$clock = clock;
         y_out$clock = clock;
+        a_in$d = a_in$q;
+        b_in$d = b_in$q;
         y_out$d = y_out$q;
+        a_in$d = a;
+        b_in$d = b;
         product$clock = clock;
-        product$a = a;
-        product$b = b;
+        product$a = a_in$q;
+        product$b = b_in$q;
         rounded = product$p + half_lsb;
         y_out$d = rounded[(32'hf)+:(16)];
         y = y_out$q;
     end
 
 endmodule // gyro_interface_axi__core__am_mixer__reference1
+
+
+module gyro_interface_axi__core__am_mixer__reference1__a_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__reference1__a_in
+
+
+module gyro_interface_axi__core__am_mixer__reference1__b_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__reference1__b_in
 
 
 module gyro_interface_axi__core__am_mixer__reference1__product(clock,a,b,p);
@@ -2022,6 +2322,12 @@ module gyro_interface_axi__core__am_mixer__reference2(clock,a,b,y);
     localparam signed half_lsb = 32'h4000;
 
     // Stub signals
+    reg signed [15:0] a_in$d;
+    wire signed [15:0] a_in$q;
+    reg  a_in$clock;
+    reg signed [15:0] b_in$d;
+    wire signed [15:0] b_in$q;
+    reg  b_in$clock;
     reg  product$clock;
     reg signed [15:0] product$a;
     reg signed [15:0] product$b;
@@ -2034,6 +2340,16 @@ module gyro_interface_axi__core__am_mixer__reference2(clock,a,b,y);
     reg signed [31:0] rounded;
 
     // Sub module instances
+    gyro_interface_axi__core__am_mixer__reference2__a_in a_in(
+        .d(a_in$d),
+        .q(a_in$q),
+        .clock(a_in$clock)
+    );
+    gyro_interface_axi__core__am_mixer__reference2__b_in b_in(
+        .d(b_in$d),
+        .q(b_in$q),
+        .clock(b_in$clock)
+    );
     gyro_interface_axi__core__am_mixer__reference2__product product(
         .clock(product$clock),
         .a(product$a),
@@ -2048,17 +2364,61 @@ module gyro_interface_axi__core__am_mixer__reference2(clock,a,b,y);
 
     // Update code
     always @(*) begin
+        a_in$clock = clock;
+        b_in$clock = clock;
         y_out$clock = clock;
+        a_in$d = a_in$q;
+        b_in$d = b_in$q;
         y_out$d = y_out$q;
+        a_in$d = a;
+        b_in$d = b;
         product$clock = clock;
-        product$a = a;
-        product$b = b;
+        product$a = a_in$q;
+        product$b = b_in$q;
         rounded = product$p + half_lsb;
         y_out$d = rounded[(32'hf)+:(16)];
         y = y_out$q;
     end
 
 endmodule // gyro_interface_axi__core__am_mixer__reference2
+
+
+module gyro_interface_axi__core__am_mixer__reference2__a_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__reference2__a_in
+
+
+module gyro_interface_axi__core__am_mixer__reference2__b_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__reference2__b_in
 
 
 module gyro_interface_axi__core__am_mixer__reference2__product(clock,a,b,p);

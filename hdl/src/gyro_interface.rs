@@ -30,7 +30,7 @@
 //! frequencies in Hz; the port list with formats is in
 //! `verilog-out/PORTS.md`.
 //!
-//! Latencies (clocks): carrier phase to DAC word 7 (`carrier_nco::LATENCY`
+//! Latencies (clocks): carrier phase to DAC word 8 (`carrier_nco::LATENCY`
 //! + `am_mixer::CARRIER_LATENCY`), ADC word to mixer output 2, mixer output
 //! to CIC output R + 8 at most (`cic_decimator::SAMPLE_TO_OUTPUT`), CIC
 //! output to z 17 (`crate::iir_lowpass::LATENCY`).
