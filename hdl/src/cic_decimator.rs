@@ -28,6 +28,7 @@
 //!    bits, with s the sign mask of b (the fine step moves at most 7 bits
 //!    and 40 are kept, so the bits above 47 are never read);
 //! 3. fine: (coarse >> (shift & 0b000111)) ^ s, low 40 bits.
+//!
 //! Logical shifts compose, so this equals ((b ^ s) >> shift) ^ s exactly.
 //!
 //! Run-time settings: `decimation` R in 1..=4096 (a 13-bit word; the down
