@@ -350,6 +350,12 @@ module gyro_interface__am_mixer__drive1(clock,a,b,y);
     localparam signed half_lsb = 32'h4000;
 
     // Stub signals
+    reg signed [15:0] a_in$d;
+    wire signed [15:0] a_in$q;
+    reg  a_in$clock;
+    reg signed [15:0] b_in$d;
+    wire signed [15:0] b_in$q;
+    reg  b_in$clock;
     reg  product$clock;
     reg signed [15:0] product$a;
     reg signed [15:0] product$b;
@@ -362,6 +368,16 @@ module gyro_interface__am_mixer__drive1(clock,a,b,y);
     reg signed [31:0] rounded;
 
     // Sub module instances
+    gyro_interface__am_mixer__drive1__a_in a_in(
+        .d(a_in$d),
+        .q(a_in$q),
+        .clock(a_in$clock)
+    );
+    gyro_interface__am_mixer__drive1__b_in b_in(
+        .d(b_in$d),
+        .q(b_in$q),
+        .clock(b_in$clock)
+    );
     gyro_interface__am_mixer__drive1__product product(
         .clock(product$clock),
         .a(product$a),
@@ -376,17 +392,61 @@ module gyro_interface__am_mixer__drive1(clock,a,b,y);
 
     // Update code
     always @(*) begin
+        a_in$clock = clock;
+        b_in$clock = clock;
         y_out$clock = clock;
+        a_in$d = a_in$q;
+        b_in$d = b_in$q;
         y_out$d = y_out$q;
+        a_in$d = a;
+        b_in$d = b;
         product$clock = clock;
-        product$a = a;
-        product$b = b;
+        product$a = a_in$q;
+        product$b = b_in$q;
         rounded = product$p + half_lsb;
         y_out$d = rounded[(32'hf)+:(16)];
         y = y_out$q;
     end
 
 endmodule // gyro_interface__am_mixer__drive1
+
+
+module gyro_interface__am_mixer__drive1__a_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__am_mixer__drive1__a_in
+
+
+module gyro_interface__am_mixer__drive1__b_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__am_mixer__drive1__b_in
 
 
 module gyro_interface__am_mixer__drive1__product(clock,a,b,p);
@@ -437,6 +497,12 @@ module gyro_interface__am_mixer__drive2(clock,a,b,y);
     localparam signed half_lsb = 32'h4000;
 
     // Stub signals
+    reg signed [15:0] a_in$d;
+    wire signed [15:0] a_in$q;
+    reg  a_in$clock;
+    reg signed [15:0] b_in$d;
+    wire signed [15:0] b_in$q;
+    reg  b_in$clock;
     reg  product$clock;
     reg signed [15:0] product$a;
     reg signed [15:0] product$b;
@@ -449,6 +515,16 @@ module gyro_interface__am_mixer__drive2(clock,a,b,y);
     reg signed [31:0] rounded;
 
     // Sub module instances
+    gyro_interface__am_mixer__drive2__a_in a_in(
+        .d(a_in$d),
+        .q(a_in$q),
+        .clock(a_in$clock)
+    );
+    gyro_interface__am_mixer__drive2__b_in b_in(
+        .d(b_in$d),
+        .q(b_in$q),
+        .clock(b_in$clock)
+    );
     gyro_interface__am_mixer__drive2__product product(
         .clock(product$clock),
         .a(product$a),
@@ -463,17 +539,61 @@ module gyro_interface__am_mixer__drive2(clock,a,b,y);
 
     // Update code
     always @(*) begin
+        a_in$clock = clock;
+        b_in$clock = clock;
         y_out$clock = clock;
+        a_in$d = a_in$q;
+        b_in$d = b_in$q;
         y_out$d = y_out$q;
+        a_in$d = a;
+        b_in$d = b;
         product$clock = clock;
-        product$a = a;
-        product$b = b;
+        product$a = a_in$q;
+        product$b = b_in$q;
         rounded = product$p + half_lsb;
         y_out$d = rounded[(32'hf)+:(16)];
         y = y_out$q;
     end
 
 endmodule // gyro_interface__am_mixer__drive2
+
+
+module gyro_interface__am_mixer__drive2__a_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__am_mixer__drive2__a_in
+
+
+module gyro_interface__am_mixer__drive2__b_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__am_mixer__drive2__b_in
 
 
 module gyro_interface__am_mixer__drive2__product(clock,a,b,p);
@@ -524,6 +644,12 @@ module gyro_interface__am_mixer__envelope1(clock,a,b,y);
     localparam signed half_lsb = 32'h4000;
 
     // Stub signals
+    reg signed [15:0] a_in$d;
+    wire signed [15:0] a_in$q;
+    reg  a_in$clock;
+    reg signed [15:0] b_in$d;
+    wire signed [15:0] b_in$q;
+    reg  b_in$clock;
     reg  product$clock;
     reg signed [15:0] product$a;
     reg signed [15:0] product$b;
@@ -536,6 +662,16 @@ module gyro_interface__am_mixer__envelope1(clock,a,b,y);
     reg signed [31:0] rounded;
 
     // Sub module instances
+    gyro_interface__am_mixer__envelope1__a_in a_in(
+        .d(a_in$d),
+        .q(a_in$q),
+        .clock(a_in$clock)
+    );
+    gyro_interface__am_mixer__envelope1__b_in b_in(
+        .d(b_in$d),
+        .q(b_in$q),
+        .clock(b_in$clock)
+    );
     gyro_interface__am_mixer__envelope1__product product(
         .clock(product$clock),
         .a(product$a),
@@ -550,17 +686,61 @@ module gyro_interface__am_mixer__envelope1(clock,a,b,y);
 
     // Update code
     always @(*) begin
+        a_in$clock = clock;
+        b_in$clock = clock;
         y_out$clock = clock;
+        a_in$d = a_in$q;
+        b_in$d = b_in$q;
         y_out$d = y_out$q;
+        a_in$d = a;
+        b_in$d = b;
         product$clock = clock;
-        product$a = a;
-        product$b = b;
+        product$a = a_in$q;
+        product$b = b_in$q;
         rounded = product$p + half_lsb;
         y_out$d = rounded[(32'hf)+:(16)];
         y = y_out$q;
     end
 
 endmodule // gyro_interface__am_mixer__envelope1
+
+
+module gyro_interface__am_mixer__envelope1__a_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__am_mixer__envelope1__a_in
+
+
+module gyro_interface__am_mixer__envelope1__b_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__am_mixer__envelope1__b_in
 
 
 module gyro_interface__am_mixer__envelope1__product(clock,a,b,p);
@@ -611,6 +791,12 @@ module gyro_interface__am_mixer__envelope2(clock,a,b,y);
     localparam signed half_lsb = 32'h4000;
 
     // Stub signals
+    reg signed [15:0] a_in$d;
+    wire signed [15:0] a_in$q;
+    reg  a_in$clock;
+    reg signed [15:0] b_in$d;
+    wire signed [15:0] b_in$q;
+    reg  b_in$clock;
     reg  product$clock;
     reg signed [15:0] product$a;
     reg signed [15:0] product$b;
@@ -623,6 +809,16 @@ module gyro_interface__am_mixer__envelope2(clock,a,b,y);
     reg signed [31:0] rounded;
 
     // Sub module instances
+    gyro_interface__am_mixer__envelope2__a_in a_in(
+        .d(a_in$d),
+        .q(a_in$q),
+        .clock(a_in$clock)
+    );
+    gyro_interface__am_mixer__envelope2__b_in b_in(
+        .d(b_in$d),
+        .q(b_in$q),
+        .clock(b_in$clock)
+    );
     gyro_interface__am_mixer__envelope2__product product(
         .clock(product$clock),
         .a(product$a),
@@ -637,17 +833,61 @@ module gyro_interface__am_mixer__envelope2(clock,a,b,y);
 
     // Update code
     always @(*) begin
+        a_in$clock = clock;
+        b_in$clock = clock;
         y_out$clock = clock;
+        a_in$d = a_in$q;
+        b_in$d = b_in$q;
         y_out$d = y_out$q;
+        a_in$d = a;
+        b_in$d = b;
         product$clock = clock;
-        product$a = a;
-        product$b = b;
+        product$a = a_in$q;
+        product$b = b_in$q;
         rounded = product$p + half_lsb;
         y_out$d = rounded[(32'hf)+:(16)];
         y = y_out$q;
     end
 
 endmodule // gyro_interface__am_mixer__envelope2
+
+
+module gyro_interface__am_mixer__envelope2__a_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__am_mixer__envelope2__a_in
+
+
+module gyro_interface__am_mixer__envelope2__b_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__am_mixer__envelope2__b_in
 
 
 module gyro_interface__am_mixer__envelope2__product(clock,a,b,p);
@@ -698,6 +938,12 @@ module gyro_interface__am_mixer__reference1(clock,a,b,y);
     localparam signed half_lsb = 32'h4000;
 
     // Stub signals
+    reg signed [15:0] a_in$d;
+    wire signed [15:0] a_in$q;
+    reg  a_in$clock;
+    reg signed [15:0] b_in$d;
+    wire signed [15:0] b_in$q;
+    reg  b_in$clock;
     reg  product$clock;
     reg signed [15:0] product$a;
     reg signed [15:0] product$b;
@@ -710,6 +956,16 @@ module gyro_interface__am_mixer__reference1(clock,a,b,y);
     reg signed [31:0] rounded;
 
     // Sub module instances
+    gyro_interface__am_mixer__reference1__a_in a_in(
+        .d(a_in$d),
+        .q(a_in$q),
+        .clock(a_in$clock)
+    );
+    gyro_interface__am_mixer__reference1__b_in b_in(
+        .d(b_in$d),
+        .q(b_in$q),
+        .clock(b_in$clock)
+    );
     gyro_interface__am_mixer__reference1__product product(
         .clock(product$clock),
         .a(product$a),
@@ -724,17 +980,61 @@ module gyro_interface__am_mixer__reference1(clock,a,b,y);
 
     // Update code
     always @(*) begin
+        a_in$clock = clock;
+        b_in$clock = clock;
         y_out$clock = clock;
+        a_in$d = a_in$q;
+        b_in$d = b_in$q;
         y_out$d = y_out$q;
+        a_in$d = a;
+        b_in$d = b;
         product$clock = clock;
-        product$a = a;
-        product$b = b;
+        product$a = a_in$q;
+        product$b = b_in$q;
         rounded = product$p + half_lsb;
         y_out$d = rounded[(32'hf)+:(16)];
         y = y_out$q;
     end
 
 endmodule // gyro_interface__am_mixer__reference1
+
+
+module gyro_interface__am_mixer__reference1__a_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__am_mixer__reference1__a_in
+
+
+module gyro_interface__am_mixer__reference1__b_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__am_mixer__reference1__b_in
 
 
 module gyro_interface__am_mixer__reference1__product(clock,a,b,p);
@@ -785,6 +1085,12 @@ module gyro_interface__am_mixer__reference2(clock,a,b,y);
     localparam signed half_lsb = 32'h4000;
 
     // Stub signals
+    reg signed [15:0] a_in$d;
+    wire signed [15:0] a_in$q;
+    reg  a_in$clock;
+    reg signed [15:0] b_in$d;
+    wire signed [15:0] b_in$q;
+    reg  b_in$clock;
     reg  product$clock;
     reg signed [15:0] product$a;
     reg signed [15:0] product$b;
@@ -797,6 +1103,16 @@ module gyro_interface__am_mixer__reference2(clock,a,b,y);
     reg signed [31:0] rounded;
 
     // Sub module instances
+    gyro_interface__am_mixer__reference2__a_in a_in(
+        .d(a_in$d),
+        .q(a_in$q),
+        .clock(a_in$clock)
+    );
+    gyro_interface__am_mixer__reference2__b_in b_in(
+        .d(b_in$d),
+        .q(b_in$q),
+        .clock(b_in$clock)
+    );
     gyro_interface__am_mixer__reference2__product product(
         .clock(product$clock),
         .a(product$a),
@@ -811,17 +1127,61 @@ module gyro_interface__am_mixer__reference2(clock,a,b,y);
 
     // Update code
     always @(*) begin
+        a_in$clock = clock;
+        b_in$clock = clock;
         y_out$clock = clock;
+        a_in$d = a_in$q;
+        b_in$d = b_in$q;
         y_out$d = y_out$q;
+        a_in$d = a;
+        b_in$d = b;
         product$clock = clock;
-        product$a = a;
-        product$b = b;
+        product$a = a_in$q;
+        product$b = b_in$q;
         rounded = product$p + half_lsb;
         y_out$d = rounded[(32'hf)+:(16)];
         y = y_out$q;
     end
 
 endmodule // gyro_interface__am_mixer__reference2
+
+
+module gyro_interface__am_mixer__reference2__a_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__am_mixer__reference2__a_in
+
+
+module gyro_interface__am_mixer__reference2__b_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__am_mixer__reference2__b_in
 
 
 module gyro_interface__am_mixer__reference2__product(clock,a,b,p);
@@ -955,6 +1315,24 @@ module gyro_interface__carrier_nco__drive(clock,phase,sin,cos);
     reg signed [15:0] offset_1$d;
     wire signed [15:0] offset_1$q;
     reg  offset_1$clock;
+    reg  [1:0] quadrant_read$d;
+    wire  [1:0] quadrant_read$q;
+    reg  quadrant_read$clock;
+    reg signed [15:0] offset_read$d;
+    wire signed [15:0] offset_read$q;
+    reg  offset_read$clock;
+    reg signed [15:0] sin_value_read$d;
+    wire signed [15:0] sin_value_read$q;
+    reg  sin_value_read$clock;
+    reg signed [15:0] cos_value_read$d;
+    wire signed [15:0] cos_value_read$q;
+    reg  cos_value_read$clock;
+    reg signed [15:0] sin_slope_read$d;
+    wire signed [15:0] sin_slope_read$q;
+    reg  sin_slope_read$clock;
+    reg signed [15:0] cos_slope_read$d;
+    wire signed [15:0] cos_slope_read$q;
+    reg  cos_slope_read$clock;
     reg  [1:0] quadrant_2$d;
     wire  [1:0] quadrant_2$q;
     reg  quadrant_2$clock;
@@ -1021,6 +1399,36 @@ module gyro_interface__carrier_nco__drive(clock,phase,sin,cos);
         .q(offset_1$q),
         .clock(offset_1$clock)
     );
+    gyro_interface__carrier_nco__drive__quadrant_read quadrant_read(
+        .d(quadrant_read$d),
+        .q(quadrant_read$q),
+        .clock(quadrant_read$clock)
+    );
+    gyro_interface__carrier_nco__drive__offset_read offset_read(
+        .d(offset_read$d),
+        .q(offset_read$q),
+        .clock(offset_read$clock)
+    );
+    gyro_interface__carrier_nco__drive__sin_value_read sin_value_read(
+        .d(sin_value_read$d),
+        .q(sin_value_read$q),
+        .clock(sin_value_read$clock)
+    );
+    gyro_interface__carrier_nco__drive__cos_value_read cos_value_read(
+        .d(cos_value_read$d),
+        .q(cos_value_read$q),
+        .clock(cos_value_read$clock)
+    );
+    gyro_interface__carrier_nco__drive__sin_slope_read sin_slope_read(
+        .d(sin_slope_read$d),
+        .q(sin_slope_read$q),
+        .clock(sin_slope_read$clock)
+    );
+    gyro_interface__carrier_nco__drive__cos_slope_read cos_slope_read(
+        .d(cos_slope_read$d),
+        .q(cos_slope_read$q),
+        .clock(cos_slope_read$clock)
+    );
     gyro_interface__carrier_nco__drive__quadrant_2 quadrant_2(
         .d(quadrant_2$d),
         .q(quadrant_2$q),
@@ -1069,6 +1477,12 @@ module gyro_interface__carrier_nco__drive(clock,phase,sin,cos);
         cos_slope_product$clock = clock;
         quadrant_1$clock = clock;
         offset_1$clock = clock;
+        quadrant_read$clock = clock;
+        offset_read$clock = clock;
+        sin_value_read$clock = clock;
+        cos_value_read$clock = clock;
+        sin_slope_read$clock = clock;
+        cos_slope_read$clock = clock;
         quadrant_2$clock = clock;
         sin_sample_2$clock = clock;
         cos_sample_2$clock = clock;
@@ -1079,6 +1493,12 @@ module gyro_interface__carrier_nco__drive(clock,phase,sin,cos);
         cos_out$clock = clock;
         quadrant_1$d = quadrant_1$q;
         offset_1$d = offset_1$q;
+        quadrant_read$d = quadrant_read$q;
+        offset_read$d = offset_read$q;
+        sin_value_read$d = sin_value_read$q;
+        cos_value_read$d = cos_value_read$q;
+        sin_slope_read$d = sin_slope_read$q;
+        cos_slope_read$d = cos_slope_read$q;
         quadrant_2$d = quadrant_2$q;
         sin_sample_2$d = sin_sample_2$q;
         cos_sample_2$d = cos_sample_2$q;
@@ -1092,13 +1512,19 @@ module gyro_interface__carrier_nco__drive(clock,phase,sin,cos);
         quadrant_1$d = phase[(32'h1e)+:(2)];
         fraction = ((phase[(32'h7)+:(15)]) & 16'hffff);
         offset_1$d = $signed(fraction - half_step);
-        sin_slope_product$a = offset_1$q;
-        sin_slope_product$b = rom$slope_a;
-        cos_slope_product$a = offset_1$q;
-        cos_slope_product$b = rom$slope_b;
-        quadrant_2$d = quadrant_1$q;
-        sin_sample_2$d = rom$value_a;
-        cos_sample_2$d = rom$value_b;
+        quadrant_read$d = quadrant_1$q;
+        offset_read$d = offset_1$q;
+        sin_value_read$d = rom$value_a;
+        cos_value_read$d = rom$value_b;
+        sin_slope_read$d = rom$slope_a;
+        cos_slope_read$d = rom$slope_b;
+        sin_slope_product$a = offset_read$q;
+        sin_slope_product$b = sin_slope_read$q;
+        cos_slope_product$a = offset_read$q;
+        cos_slope_product$b = cos_slope_read$q;
+        quadrant_2$d = quadrant_read$q;
+        sin_sample_2$d = sin_value_read$q;
+        cos_sample_2$d = cos_value_read$q;
         sin_rounded = sin_slope_product$p + rounding;
         cos_rounded = cos_slope_product$p + rounding;
         sin_correction_10 = sin_rounded[(32'h16)+:(10)];
@@ -1203,6 +1629,44 @@ module gyro_interface__carrier_nco__drive__cos_slope_product(clock,a,b,p);
 endmodule // gyro_interface__carrier_nco__drive__cos_slope_product
 
 
+module gyro_interface__carrier_nco__drive__cos_slope_read(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive__cos_slope_read
+
+
+module gyro_interface__carrier_nco__drive__cos_value_read(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive__cos_value_read
+
+
 module gyro_interface__carrier_nco__drive__offset_1(d,q,clock);
 
     // Module arguments
@@ -1220,6 +1684,25 @@ module gyro_interface__carrier_nco__drive__offset_1(d,q,clock);
     end
 
 endmodule // gyro_interface__carrier_nco__drive__offset_1
+
+
+module gyro_interface__carrier_nco__drive__offset_read(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive__offset_read
 
 
 module gyro_interface__carrier_nco__drive__quadrant_1(d,q,clock);
@@ -1277,6 +1760,25 @@ module gyro_interface__carrier_nco__drive__quadrant_3(d,q,clock);
     end
 
 endmodule // gyro_interface__carrier_nco__drive__quadrant_3
+
+
+module gyro_interface__carrier_nco__drive__quadrant_read(d,q,clock);
+
+    // Module arguments
+    input wire  [1:0] d;
+    output reg  [1:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 2'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive__quadrant_read
 
 
 module gyro_interface__carrier_nco__drive__rom(clock,addr_a,addr_b,value_a,slope_a,value_b,slope_b);
@@ -1640,6 +2142,44 @@ module gyro_interface__carrier_nco__drive__sin_slope_product(clock,a,b,p);
 endmodule // gyro_interface__carrier_nco__drive__sin_slope_product
 
 
+module gyro_interface__carrier_nco__drive__sin_slope_read(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive__sin_slope_read
+
+
+module gyro_interface__carrier_nco__drive__sin_value_read(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive__sin_value_read
+
+
 module gyro_interface__carrier_nco__phase(d,q,clock);
 
     // Module arguments
@@ -1693,6 +2233,24 @@ module gyro_interface__carrier_nco__reference(clock,phase,sin,cos);
     reg signed [15:0] offset_1$d;
     wire signed [15:0] offset_1$q;
     reg  offset_1$clock;
+    reg  [1:0] quadrant_read$d;
+    wire  [1:0] quadrant_read$q;
+    reg  quadrant_read$clock;
+    reg signed [15:0] offset_read$d;
+    wire signed [15:0] offset_read$q;
+    reg  offset_read$clock;
+    reg signed [15:0] sin_value_read$d;
+    wire signed [15:0] sin_value_read$q;
+    reg  sin_value_read$clock;
+    reg signed [15:0] cos_value_read$d;
+    wire signed [15:0] cos_value_read$q;
+    reg  cos_value_read$clock;
+    reg signed [15:0] sin_slope_read$d;
+    wire signed [15:0] sin_slope_read$q;
+    reg  sin_slope_read$clock;
+    reg signed [15:0] cos_slope_read$d;
+    wire signed [15:0] cos_slope_read$q;
+    reg  cos_slope_read$clock;
     reg  [1:0] quadrant_2$d;
     wire  [1:0] quadrant_2$q;
     reg  quadrant_2$clock;
@@ -1759,6 +2317,36 @@ module gyro_interface__carrier_nco__reference(clock,phase,sin,cos);
         .q(offset_1$q),
         .clock(offset_1$clock)
     );
+    gyro_interface__carrier_nco__reference__quadrant_read quadrant_read(
+        .d(quadrant_read$d),
+        .q(quadrant_read$q),
+        .clock(quadrant_read$clock)
+    );
+    gyro_interface__carrier_nco__reference__offset_read offset_read(
+        .d(offset_read$d),
+        .q(offset_read$q),
+        .clock(offset_read$clock)
+    );
+    gyro_interface__carrier_nco__reference__sin_value_read sin_value_read(
+        .d(sin_value_read$d),
+        .q(sin_value_read$q),
+        .clock(sin_value_read$clock)
+    );
+    gyro_interface__carrier_nco__reference__cos_value_read cos_value_read(
+        .d(cos_value_read$d),
+        .q(cos_value_read$q),
+        .clock(cos_value_read$clock)
+    );
+    gyro_interface__carrier_nco__reference__sin_slope_read sin_slope_read(
+        .d(sin_slope_read$d),
+        .q(sin_slope_read$q),
+        .clock(sin_slope_read$clock)
+    );
+    gyro_interface__carrier_nco__reference__cos_slope_read cos_slope_read(
+        .d(cos_slope_read$d),
+        .q(cos_slope_read$q),
+        .clock(cos_slope_read$clock)
+    );
     gyro_interface__carrier_nco__reference__quadrant_2 quadrant_2(
         .d(quadrant_2$d),
         .q(quadrant_2$q),
@@ -1807,6 +2395,12 @@ module gyro_interface__carrier_nco__reference(clock,phase,sin,cos);
         cos_slope_product$clock = clock;
         quadrant_1$clock = clock;
         offset_1$clock = clock;
+        quadrant_read$clock = clock;
+        offset_read$clock = clock;
+        sin_value_read$clock = clock;
+        cos_value_read$clock = clock;
+        sin_slope_read$clock = clock;
+        cos_slope_read$clock = clock;
         quadrant_2$clock = clock;
         sin_sample_2$clock = clock;
         cos_sample_2$clock = clock;
@@ -1817,6 +2411,12 @@ module gyro_interface__carrier_nco__reference(clock,phase,sin,cos);
         cos_out$clock = clock;
         quadrant_1$d = quadrant_1$q;
         offset_1$d = offset_1$q;
+        quadrant_read$d = quadrant_read$q;
+        offset_read$d = offset_read$q;
+        sin_value_read$d = sin_value_read$q;
+        cos_value_read$d = cos_value_read$q;
+        sin_slope_read$d = sin_slope_read$q;
+        cos_slope_read$d = cos_slope_read$q;
         quadrant_2$d = quadrant_2$q;
         sin_sample_2$d = sin_sample_2$q;
         cos_sample_2$d = cos_sample_2$q;
@@ -1830,13 +2430,19 @@ module gyro_interface__carrier_nco__reference(clock,phase,sin,cos);
         quadrant_1$d = phase[(32'h1e)+:(2)];
         fraction = ((phase[(32'h7)+:(15)]) & 16'hffff);
         offset_1$d = $signed(fraction - half_step);
-        sin_slope_product$a = offset_1$q;
-        sin_slope_product$b = rom$slope_a;
-        cos_slope_product$a = offset_1$q;
-        cos_slope_product$b = rom$slope_b;
-        quadrant_2$d = quadrant_1$q;
-        sin_sample_2$d = rom$value_a;
-        cos_sample_2$d = rom$value_b;
+        quadrant_read$d = quadrant_1$q;
+        offset_read$d = offset_1$q;
+        sin_value_read$d = rom$value_a;
+        cos_value_read$d = rom$value_b;
+        sin_slope_read$d = rom$slope_a;
+        cos_slope_read$d = rom$slope_b;
+        sin_slope_product$a = offset_read$q;
+        sin_slope_product$b = sin_slope_read$q;
+        cos_slope_product$a = offset_read$q;
+        cos_slope_product$b = cos_slope_read$q;
+        quadrant_2$d = quadrant_read$q;
+        sin_sample_2$d = sin_value_read$q;
+        cos_sample_2$d = cos_value_read$q;
         sin_rounded = sin_slope_product$p + rounding;
         cos_rounded = cos_slope_product$p + rounding;
         sin_correction_10 = sin_rounded[(32'h16)+:(10)];
@@ -1941,6 +2547,44 @@ module gyro_interface__carrier_nco__reference__cos_slope_product(clock,a,b,p);
 endmodule // gyro_interface__carrier_nco__reference__cos_slope_product
 
 
+module gyro_interface__carrier_nco__reference__cos_slope_read(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__reference__cos_slope_read
+
+
+module gyro_interface__carrier_nco__reference__cos_value_read(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__reference__cos_value_read
+
+
 module gyro_interface__carrier_nco__reference__offset_1(d,q,clock);
 
     // Module arguments
@@ -1958,6 +2602,25 @@ module gyro_interface__carrier_nco__reference__offset_1(d,q,clock);
     end
 
 endmodule // gyro_interface__carrier_nco__reference__offset_1
+
+
+module gyro_interface__carrier_nco__reference__offset_read(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__reference__offset_read
 
 
 module gyro_interface__carrier_nco__reference__quadrant_1(d,q,clock);
@@ -2015,6 +2678,25 @@ module gyro_interface__carrier_nco__reference__quadrant_3(d,q,clock);
     end
 
 endmodule // gyro_interface__carrier_nco__reference__quadrant_3
+
+
+module gyro_interface__carrier_nco__reference__quadrant_read(d,q,clock);
+
+    // Module arguments
+    input wire  [1:0] d;
+    output reg  [1:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 2'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__reference__quadrant_read
 
 
 module gyro_interface__carrier_nco__reference__rom(clock,addr_a,addr_b,value_a,slope_a,value_b,slope_b);
@@ -2378,6 +3060,44 @@ module gyro_interface__carrier_nco__reference__sin_slope_product(clock,a,b,p);
 endmodule // gyro_interface__carrier_nco__reference__sin_slope_product
 
 
+module gyro_interface__carrier_nco__reference__sin_slope_read(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__reference__sin_slope_read
+
+
+module gyro_interface__carrier_nco__reference__sin_value_read(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__reference__sin_value_read
+
+
 module gyro_interface__cic1(clock,x,decimation,shift,y,valid);
 
     // Module arguments
@@ -2391,6 +3111,9 @@ module gyro_interface__cic1(clock,x,decimation,shift,y,valid);
     // Constant declarations
     localparam  one = 80'h1;
     localparam  all_ones = 80'hffffffffffffffffffff;
+    localparam  coarse_all_ones = 47'h7fffffffffff;
+    localparam  coarse_shift_mask = 6'b111000;
+    localparam  fine_shift_mask = 6'b111;
 
     // Stub signals
     reg signed [79:0] integrator1$d;
@@ -2450,6 +3173,27 @@ module gyro_interface__cic1(clock,x,decimation,shift,y,valid);
     reg  comb_valid4$d;
     wire  comb_valid4$q;
     reg  comb_valid4$clock;
+    reg  [79:0] biased_out$d;
+    wire  [79:0] biased_out$q;
+    reg  biased_out$clock;
+    reg  [5:0] biased_shift$d;
+    wire  [5:0] biased_shift$q;
+    reg  biased_shift$clock;
+    reg  biased_valid$d;
+    wire  biased_valid$q;
+    reg  biased_valid$clock;
+    reg  [46:0] coarse$d;
+    wire  [46:0] coarse$q;
+    reg  coarse$clock;
+    reg  coarse_negative$d;
+    wire  coarse_negative$q;
+    reg  coarse_negative$clock;
+    reg  [5:0] fine_shift$d;
+    wire  [5:0] fine_shift$q;
+    reg  fine_shift$clock;
+    reg  coarse_valid$d;
+    wire  coarse_valid$q;
+    reg  coarse_valid$clock;
     reg signed [39:0] y_out$d;
     wire signed [39:0] y_out$q;
     reg  y_out$clock;
@@ -2461,9 +3205,11 @@ module gyro_interface__cic1(clock,x,decimation,shift,y,valid);
     reg signed [79:0] x_wide;
     reg  [79:0] rounding;
     reg signed [79:0] biased;
-    reg  [79:0] biased_bits;
     reg  [79:0] sign_mask;
-    reg  [79:0] shifted;
+    reg  [5:0] coarse_shift;
+    reg  [79:0] coarse_shifted;
+    reg  [46:0] fine_mask;
+    reg  [46:0] shifted;
 
     // Sub module instances
     gyro_interface__cic1__integrator1 integrator1(
@@ -2561,6 +3307,41 @@ module gyro_interface__cic1(clock,x,decimation,shift,y,valid);
         .q(comb_valid4$q),
         .clock(comb_valid4$clock)
     );
+    gyro_interface__cic1__biased_out biased_out(
+        .d(biased_out$d),
+        .q(biased_out$q),
+        .clock(biased_out$clock)
+    );
+    gyro_interface__cic1__biased_shift biased_shift(
+        .d(biased_shift$d),
+        .q(biased_shift$q),
+        .clock(biased_shift$clock)
+    );
+    gyro_interface__cic1__biased_valid biased_valid(
+        .d(biased_valid$d),
+        .q(biased_valid$q),
+        .clock(biased_valid$clock)
+    );
+    gyro_interface__cic1__coarse coarse(
+        .d(coarse$d),
+        .q(coarse$q),
+        .clock(coarse$clock)
+    );
+    gyro_interface__cic1__coarse_negative coarse_negative(
+        .d(coarse_negative$d),
+        .q(coarse_negative$q),
+        .clock(coarse_negative$clock)
+    );
+    gyro_interface__cic1__fine_shift fine_shift(
+        .d(fine_shift$d),
+        .q(fine_shift$q),
+        .clock(fine_shift$clock)
+    );
+    gyro_interface__cic1__coarse_valid coarse_valid(
+        .d(coarse_valid$d),
+        .q(coarse_valid$q),
+        .clock(coarse_valid$clock)
+    );
     gyro_interface__cic1__y_out y_out(
         .d(y_out$d),
         .q(y_out$q),
@@ -2593,6 +3374,13 @@ module gyro_interface__cic1(clock,x,decimation,shift,y,valid);
         comb_valid2$clock = clock;
         comb_valid3$clock = clock;
         comb_valid4$clock = clock;
+        biased_out$clock = clock;
+        biased_shift$clock = clock;
+        biased_valid$clock = clock;
+        coarse$clock = clock;
+        coarse_negative$clock = clock;
+        fine_shift$clock = clock;
+        coarse_valid$clock = clock;
         y_out$clock = clock;
         valid_out$clock = clock;
         integrator1$d = integrator1$q;
@@ -2614,6 +3402,13 @@ module gyro_interface__cic1(clock,x,decimation,shift,y,valid);
         comb_valid2$d = comb_valid2$q;
         comb_valid3$d = comb_valid3$q;
         comb_valid4$d = comb_valid4$q;
+        biased_out$d = biased_out$q;
+        biased_shift$d = biased_shift$q;
+        biased_valid$d = biased_valid$q;
+        coarse$d = coarse$q;
+        coarse_negative$d = coarse_negative$q;
+        fine_shift$d = fine_shift$q;
+        coarse_valid$d = coarse_valid$q;
         y_out$d = y_out$q;
         valid_out$d = valid_out$q;
         x_wide = $signed(x);
@@ -2652,14 +3447,30 @@ module gyro_interface__cic1(clock,x,decimation,shift,y,valid);
         end
         rounding = (one << shift) >> 32'h1;
         biased = comb4$q + $signed(rounding);
-        biased_bits = $unsigned(biased);
+        biased_valid$d = comb_valid4$q;
+        if (comb_valid4$q) begin
+            biased_out$d = $unsigned(biased);
+            biased_shift$d = shift;
+        end
         sign_mask = 32'h0;
-        if (biased_bits[32'h4f]) begin
+        if (biased_out$q[32'h4f]) begin
             sign_mask = all_ones;
         end
-        shifted = ((biased_bits ^ sign_mask) >> shift) ^ sign_mask;
-        valid_out$d = comb_valid4$q;
-        if (comb_valid4$q) begin
+        coarse_shift = biased_shift$q & coarse_shift_mask;
+        coarse_shifted = (biased_out$q ^ sign_mask) >> coarse_shift;
+        coarse_valid$d = biased_valid$q;
+        if (biased_valid$q) begin
+            coarse$d = coarse_shifted[(32'h0)+:(47)];
+            coarse_negative$d = biased_out$q[32'h4f];
+            fine_shift$d = biased_shift$q & fine_shift_mask;
+        end
+        fine_mask = 32'h0;
+        if (coarse_negative$q) begin
+            fine_mask = coarse_all_ones;
+        end
+        shifted = (coarse$q >> fine_shift$q) ^ fine_mask;
+        valid_out$d = coarse_valid$q;
+        if (coarse_valid$q) begin
             y_out$d = $signed(shifted[(32'h0)+:(40)]);
         end
         y = y_out$q;
@@ -2667,6 +3478,120 @@ module gyro_interface__cic1(clock,x,decimation,shift,y,valid);
     end
 
 endmodule // gyro_interface__cic1
+
+
+module gyro_interface__cic1__biased_out(d,q,clock);
+
+    // Module arguments
+    input wire  [79:0] d;
+    output reg  [79:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 80'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__cic1__biased_out
+
+
+module gyro_interface__cic1__biased_shift(d,q,clock);
+
+    // Module arguments
+    input wire  [5:0] d;
+    output reg  [5:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 6'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__cic1__biased_shift
+
+
+module gyro_interface__cic1__biased_valid(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__cic1__biased_valid
+
+
+module gyro_interface__cic1__coarse(d,q,clock);
+
+    // Module arguments
+    input wire  [46:0] d;
+    output reg  [46:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 47'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__cic1__coarse
+
+
+module gyro_interface__cic1__coarse_negative(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__cic1__coarse_negative
+
+
+module gyro_interface__cic1__coarse_valid(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__cic1__coarse_valid
 
 
 module gyro_interface__cic1__comb1(d,q,clock);
@@ -2916,6 +3841,25 @@ module gyro_interface__cic1__count(d,q,clock);
 endmodule // gyro_interface__cic1__count
 
 
+module gyro_interface__cic1__fine_shift(d,q,clock);
+
+    // Module arguments
+    input wire  [5:0] d;
+    output reg  [5:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 6'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__cic1__fine_shift
+
+
 module gyro_interface__cic1__integrator1(d,q,clock);
 
     // Module arguments
@@ -3081,6 +4025,9 @@ module gyro_interface__cic2(clock,x,decimation,shift,y,valid);
     // Constant declarations
     localparam  one = 80'h1;
     localparam  all_ones = 80'hffffffffffffffffffff;
+    localparam  coarse_all_ones = 47'h7fffffffffff;
+    localparam  coarse_shift_mask = 6'b111000;
+    localparam  fine_shift_mask = 6'b111;
 
     // Stub signals
     reg signed [79:0] integrator1$d;
@@ -3140,6 +4087,27 @@ module gyro_interface__cic2(clock,x,decimation,shift,y,valid);
     reg  comb_valid4$d;
     wire  comb_valid4$q;
     reg  comb_valid4$clock;
+    reg  [79:0] biased_out$d;
+    wire  [79:0] biased_out$q;
+    reg  biased_out$clock;
+    reg  [5:0] biased_shift$d;
+    wire  [5:0] biased_shift$q;
+    reg  biased_shift$clock;
+    reg  biased_valid$d;
+    wire  biased_valid$q;
+    reg  biased_valid$clock;
+    reg  [46:0] coarse$d;
+    wire  [46:0] coarse$q;
+    reg  coarse$clock;
+    reg  coarse_negative$d;
+    wire  coarse_negative$q;
+    reg  coarse_negative$clock;
+    reg  [5:0] fine_shift$d;
+    wire  [5:0] fine_shift$q;
+    reg  fine_shift$clock;
+    reg  coarse_valid$d;
+    wire  coarse_valid$q;
+    reg  coarse_valid$clock;
     reg signed [39:0] y_out$d;
     wire signed [39:0] y_out$q;
     reg  y_out$clock;
@@ -3151,9 +4119,11 @@ module gyro_interface__cic2(clock,x,decimation,shift,y,valid);
     reg signed [79:0] x_wide;
     reg  [79:0] rounding;
     reg signed [79:0] biased;
-    reg  [79:0] biased_bits;
     reg  [79:0] sign_mask;
-    reg  [79:0] shifted;
+    reg  [5:0] coarse_shift;
+    reg  [79:0] coarse_shifted;
+    reg  [46:0] fine_mask;
+    reg  [46:0] shifted;
 
     // Sub module instances
     gyro_interface__cic2__integrator1 integrator1(
@@ -3251,6 +4221,41 @@ module gyro_interface__cic2(clock,x,decimation,shift,y,valid);
         .q(comb_valid4$q),
         .clock(comb_valid4$clock)
     );
+    gyro_interface__cic2__biased_out biased_out(
+        .d(biased_out$d),
+        .q(biased_out$q),
+        .clock(biased_out$clock)
+    );
+    gyro_interface__cic2__biased_shift biased_shift(
+        .d(biased_shift$d),
+        .q(biased_shift$q),
+        .clock(biased_shift$clock)
+    );
+    gyro_interface__cic2__biased_valid biased_valid(
+        .d(biased_valid$d),
+        .q(biased_valid$q),
+        .clock(biased_valid$clock)
+    );
+    gyro_interface__cic2__coarse coarse(
+        .d(coarse$d),
+        .q(coarse$q),
+        .clock(coarse$clock)
+    );
+    gyro_interface__cic2__coarse_negative coarse_negative(
+        .d(coarse_negative$d),
+        .q(coarse_negative$q),
+        .clock(coarse_negative$clock)
+    );
+    gyro_interface__cic2__fine_shift fine_shift(
+        .d(fine_shift$d),
+        .q(fine_shift$q),
+        .clock(fine_shift$clock)
+    );
+    gyro_interface__cic2__coarse_valid coarse_valid(
+        .d(coarse_valid$d),
+        .q(coarse_valid$q),
+        .clock(coarse_valid$clock)
+    );
     gyro_interface__cic2__y_out y_out(
         .d(y_out$d),
         .q(y_out$q),
@@ -3283,6 +4288,13 @@ module gyro_interface__cic2(clock,x,decimation,shift,y,valid);
         comb_valid2$clock = clock;
         comb_valid3$clock = clock;
         comb_valid4$clock = clock;
+        biased_out$clock = clock;
+        biased_shift$clock = clock;
+        biased_valid$clock = clock;
+        coarse$clock = clock;
+        coarse_negative$clock = clock;
+        fine_shift$clock = clock;
+        coarse_valid$clock = clock;
         y_out$clock = clock;
         valid_out$clock = clock;
         integrator1$d = integrator1$q;
@@ -3304,6 +4316,13 @@ module gyro_interface__cic2(clock,x,decimation,shift,y,valid);
         comb_valid2$d = comb_valid2$q;
         comb_valid3$d = comb_valid3$q;
         comb_valid4$d = comb_valid4$q;
+        biased_out$d = biased_out$q;
+        biased_shift$d = biased_shift$q;
+        biased_valid$d = biased_valid$q;
+        coarse$d = coarse$q;
+        coarse_negative$d = coarse_negative$q;
+        fine_shift$d = fine_shift$q;
+        coarse_valid$d = coarse_valid$q;
         y_out$d = y_out$q;
         valid_out$d = valid_out$q;
         x_wide = $signed(x);
@@ -3342,14 +4361,30 @@ module gyro_interface__cic2(clock,x,decimation,shift,y,valid);
         end
         rounding = (one << shift) >> 32'h1;
         biased = comb4$q + $signed(rounding);
-        biased_bits = $unsigned(biased);
+        biased_valid$d = comb_valid4$q;
+        if (comb_valid4$q) begin
+            biased_out$d = $unsigned(biased);
+            biased_shift$d = shift;
+        end
         sign_mask = 32'h0;
-        if (biased_bits[32'h4f]) begin
+        if (biased_out$q[32'h4f]) begin
             sign_mask = all_ones;
         end
-        shifted = ((biased_bits ^ sign_mask) >> shift) ^ sign_mask;
-        valid_out$d = comb_valid4$q;
-        if (comb_valid4$q) begin
+        coarse_shift = biased_shift$q & coarse_shift_mask;
+        coarse_shifted = (biased_out$q ^ sign_mask) >> coarse_shift;
+        coarse_valid$d = biased_valid$q;
+        if (biased_valid$q) begin
+            coarse$d = coarse_shifted[(32'h0)+:(47)];
+            coarse_negative$d = biased_out$q[32'h4f];
+            fine_shift$d = biased_shift$q & fine_shift_mask;
+        end
+        fine_mask = 32'h0;
+        if (coarse_negative$q) begin
+            fine_mask = coarse_all_ones;
+        end
+        shifted = (coarse$q >> fine_shift$q) ^ fine_mask;
+        valid_out$d = coarse_valid$q;
+        if (coarse_valid$q) begin
             y_out$d = $signed(shifted[(32'h0)+:(40)]);
         end
         y = y_out$q;
@@ -3357,6 +4392,120 @@ module gyro_interface__cic2(clock,x,decimation,shift,y,valid);
     end
 
 endmodule // gyro_interface__cic2
+
+
+module gyro_interface__cic2__biased_out(d,q,clock);
+
+    // Module arguments
+    input wire  [79:0] d;
+    output reg  [79:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 80'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__cic2__biased_out
+
+
+module gyro_interface__cic2__biased_shift(d,q,clock);
+
+    // Module arguments
+    input wire  [5:0] d;
+    output reg  [5:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 6'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__cic2__biased_shift
+
+
+module gyro_interface__cic2__biased_valid(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__cic2__biased_valid
+
+
+module gyro_interface__cic2__coarse(d,q,clock);
+
+    // Module arguments
+    input wire  [46:0] d;
+    output reg  [46:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 47'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__cic2__coarse
+
+
+module gyro_interface__cic2__coarse_negative(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__cic2__coarse_negative
+
+
+module gyro_interface__cic2__coarse_valid(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__cic2__coarse_valid
 
 
 module gyro_interface__cic2__comb1(d,q,clock);
@@ -3604,6 +4753,25 @@ module gyro_interface__cic2__count(d,q,clock);
     end
 
 endmodule // gyro_interface__cic2__count
+
+
+module gyro_interface__cic2__fine_shift(d,q,clock);
+
+    // Module arguments
+    input wire  [5:0] d;
+    output reg  [5:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 6'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__cic2__fine_shift
 
 
 module gyro_interface__cic2__integrator1(d,q,clock);
@@ -4282,9 +5450,9 @@ module gyro_interface__iir__channel1(clock,x,product,start,preload,accumulate,fi
     reg signed [39:0] x0$d;
     wire signed [39:0] x0$q;
     reg  x0$clock;
-    reg signed [39:0] x1$d;
-    wire signed [39:0] x1$q;
-    reg  x1$clock;
+    reg signed [41:0] partial$d;
+    wire signed [41:0] partial$q;
+    reg  partial$clock;
     reg signed [59:0] v_reg$d;
     wire signed [59:0] v_reg$q;
     reg  v_reg$clock;
@@ -4312,8 +5480,11 @@ module gyro_interface__iir__channel1(clock,x,product,start,preload,accumulate,fi
 
     // Local signals
     reg signed [59:0] x_wide;
-    reg signed [59:0] x0_wide;
-    reg signed [59:0] x1_wide;
+    reg signed [41:0] x_partial;
+    reg signed [41:0] x0_partial;
+    reg signed [59:0] partial_wide;
+    reg  [41:0] x_doubled;
+    reg  [59:0] y1_doubled;
     reg signed [59:0] v_sum;
     reg  [59:0] v_shifted;
     reg signed [59:0] y1_wide;
@@ -4340,10 +5511,10 @@ module gyro_interface__iir__channel1(clock,x,product,start,preload,accumulate,fi
         .q(x0$q),
         .clock(x0$clock)
     );
-    gyro_interface__iir__channel1__x1 x1(
-        .d(x1$d),
-        .q(x1$q),
-        .clock(x1$clock)
+    gyro_interface__iir__channel1__partial partial(
+        .d(partial$d),
+        .q(partial$q),
+        .clock(partial$clock)
     );
     gyro_interface__iir__channel1__v_reg v_reg(
         .d(v_reg$d),
@@ -4389,7 +5560,7 @@ module gyro_interface__iir__channel1(clock,x,product,start,preload,accumulate,fi
     // Update code
     always @(*) begin
         x0$clock = clock;
-        x1$clock = clock;
+        partial$clock = clock;
         v_reg$clock = clock;
         feedback$clock = clock;
         acc_y$clock = clock;
@@ -4399,7 +5570,7 @@ module gyro_interface__iir__channel1(clock,x,product,start,preload,accumulate,fi
         u$clock = clock;
         z_out$clock = clock;
         x0$d = x0$q;
-        x1$d = x1$q;
+        partial$d = partial$q;
         v_reg$d = v_reg$q;
         feedback$d = feedback$q;
         acc_y$d = acc_y$q;
@@ -4409,12 +5580,15 @@ module gyro_interface__iir__channel1(clock,x,product,start,preload,accumulate,fi
         u$d = u$q;
         z_out$d = z_out$q;
         x_wide = $signed(x);
-        x0_wide = $signed(x0$q);
-        x1_wide = $signed(x1$q);
+        x_partial = $signed(x);
+        x0_partial = $signed(x0$q);
+        partial_wide = $signed(partial$q);
         y1_wide = $signed(y1_reg$q);
         y2_wide = $signed(y2_reg$q);
         u_wide = $signed(u$q);
-        v_sum = x_wide + x0_wide + x0_wide + x1_wide;
+        v_sum = x_wide + partial_wide;
+        x_doubled = $unsigned(x_partial) << 32'h1;
+        y1_doubled = $unsigned(y1_wide) << 32'h1;
         v_shifted = $unsigned(v_sum) << 32'h10;
         feedback_minus_u = feedback$q - u_wide;
         feedback_long = $signed(feedback$q);
@@ -4433,9 +5607,9 @@ module gyro_interface__iir__channel1(clock,x,product,start,preload,accumulate,fi
         u_rounded = u$q + half_output_lsb;
         if (start) begin
             x0$d = x;
-            x1$d = x0$q;
+            partial$d = $signed(x_doubled) + x0_partial;
             v_reg$d = $signed(v_shifted);
-            feedback$d = y1_wide + y1_wide - y2_wide;
+            feedback$d = $signed(y1_doubled) - y2_wide;
         end
         if (preload) begin
             acc_y$d = $signed(preload_y);
@@ -4521,6 +5695,25 @@ module gyro_interface__iir__channel1__feedback(d,q,clock);
 endmodule // gyro_interface__iir__channel1__feedback
 
 
+module gyro_interface__iir__channel1__partial(d,q,clock);
+
+    // Module arguments
+    input wire signed [41:0] d;
+    output reg signed [41:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 42'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__iir__channel1__partial
+
+
 module gyro_interface__iir__channel1__u(d,q,clock);
 
     // Module arguments
@@ -4576,25 +5769,6 @@ module gyro_interface__iir__channel1__x0(d,q,clock);
     end
 
 endmodule // gyro_interface__iir__channel1__x0
-
-
-module gyro_interface__iir__channel1__x1(d,q,clock);
-
-    // Module arguments
-    input wire signed [39:0] d;
-    output reg signed [39:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 40'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__iir__channel1__x1
 
 
 module gyro_interface__iir__channel1__y1_reg(d,q,clock);
@@ -4680,9 +5854,9 @@ module gyro_interface__iir__channel2(clock,x,product,start,preload,accumulate,fi
     reg signed [39:0] x0$d;
     wire signed [39:0] x0$q;
     reg  x0$clock;
-    reg signed [39:0] x1$d;
-    wire signed [39:0] x1$q;
-    reg  x1$clock;
+    reg signed [41:0] partial$d;
+    wire signed [41:0] partial$q;
+    reg  partial$clock;
     reg signed [59:0] v_reg$d;
     wire signed [59:0] v_reg$q;
     reg  v_reg$clock;
@@ -4710,8 +5884,11 @@ module gyro_interface__iir__channel2(clock,x,product,start,preload,accumulate,fi
 
     // Local signals
     reg signed [59:0] x_wide;
-    reg signed [59:0] x0_wide;
-    reg signed [59:0] x1_wide;
+    reg signed [41:0] x_partial;
+    reg signed [41:0] x0_partial;
+    reg signed [59:0] partial_wide;
+    reg  [41:0] x_doubled;
+    reg  [59:0] y1_doubled;
     reg signed [59:0] v_sum;
     reg  [59:0] v_shifted;
     reg signed [59:0] y1_wide;
@@ -4738,10 +5915,10 @@ module gyro_interface__iir__channel2(clock,x,product,start,preload,accumulate,fi
         .q(x0$q),
         .clock(x0$clock)
     );
-    gyro_interface__iir__channel2__x1 x1(
-        .d(x1$d),
-        .q(x1$q),
-        .clock(x1$clock)
+    gyro_interface__iir__channel2__partial partial(
+        .d(partial$d),
+        .q(partial$q),
+        .clock(partial$clock)
     );
     gyro_interface__iir__channel2__v_reg v_reg(
         .d(v_reg$d),
@@ -4787,7 +5964,7 @@ module gyro_interface__iir__channel2(clock,x,product,start,preload,accumulate,fi
     // Update code
     always @(*) begin
         x0$clock = clock;
-        x1$clock = clock;
+        partial$clock = clock;
         v_reg$clock = clock;
         feedback$clock = clock;
         acc_y$clock = clock;
@@ -4797,7 +5974,7 @@ module gyro_interface__iir__channel2(clock,x,product,start,preload,accumulate,fi
         u$clock = clock;
         z_out$clock = clock;
         x0$d = x0$q;
-        x1$d = x1$q;
+        partial$d = partial$q;
         v_reg$d = v_reg$q;
         feedback$d = feedback$q;
         acc_y$d = acc_y$q;
@@ -4807,12 +5984,15 @@ module gyro_interface__iir__channel2(clock,x,product,start,preload,accumulate,fi
         u$d = u$q;
         z_out$d = z_out$q;
         x_wide = $signed(x);
-        x0_wide = $signed(x0$q);
-        x1_wide = $signed(x1$q);
+        x_partial = $signed(x);
+        x0_partial = $signed(x0$q);
+        partial_wide = $signed(partial$q);
         y1_wide = $signed(y1_reg$q);
         y2_wide = $signed(y2_reg$q);
         u_wide = $signed(u$q);
-        v_sum = x_wide + x0_wide + x0_wide + x1_wide;
+        v_sum = x_wide + partial_wide;
+        x_doubled = $unsigned(x_partial) << 32'h1;
+        y1_doubled = $unsigned(y1_wide) << 32'h1;
         v_shifted = $unsigned(v_sum) << 32'h10;
         feedback_minus_u = feedback$q - u_wide;
         feedback_long = $signed(feedback$q);
@@ -4831,9 +6011,9 @@ module gyro_interface__iir__channel2(clock,x,product,start,preload,accumulate,fi
         u_rounded = u$q + half_output_lsb;
         if (start) begin
             x0$d = x;
-            x1$d = x0$q;
+            partial$d = $signed(x_doubled) + x0_partial;
             v_reg$d = $signed(v_shifted);
-            feedback$d = y1_wide + y1_wide - y2_wide;
+            feedback$d = $signed(y1_doubled) - y2_wide;
         end
         if (preload) begin
             acc_y$d = $signed(preload_y);
@@ -4919,6 +6099,25 @@ module gyro_interface__iir__channel2__feedback(d,q,clock);
 endmodule // gyro_interface__iir__channel2__feedback
 
 
+module gyro_interface__iir__channel2__partial(d,q,clock);
+
+    // Module arguments
+    input wire signed [41:0] d;
+    output reg signed [41:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 42'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__iir__channel2__partial
+
+
 module gyro_interface__iir__channel2__u(d,q,clock);
 
     // Module arguments
@@ -4974,25 +6173,6 @@ module gyro_interface__iir__channel2__x0(d,q,clock);
     end
 
 endmodule // gyro_interface__iir__channel2__x0
-
-
-module gyro_interface__iir__channel2__x1(d,q,clock);
-
-    // Module arguments
-    input wire signed [39:0] d;
-    output reg signed [39:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 40'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__iir__channel2__x1
 
 
 module gyro_interface__iir__channel2__y1_reg(d,q,clock);
@@ -5395,6 +6575,24 @@ module gyro_interface__modulation_nco__sincos(clock,phase,sin,cos);
     reg signed [15:0] offset_1$d;
     wire signed [15:0] offset_1$q;
     reg  offset_1$clock;
+    reg  [1:0] quadrant_read$d;
+    wire  [1:0] quadrant_read$q;
+    reg  quadrant_read$clock;
+    reg signed [15:0] offset_read$d;
+    wire signed [15:0] offset_read$q;
+    reg  offset_read$clock;
+    reg signed [15:0] sin_value_read$d;
+    wire signed [15:0] sin_value_read$q;
+    reg  sin_value_read$clock;
+    reg signed [15:0] cos_value_read$d;
+    wire signed [15:0] cos_value_read$q;
+    reg  cos_value_read$clock;
+    reg signed [15:0] sin_slope_read$d;
+    wire signed [15:0] sin_slope_read$q;
+    reg  sin_slope_read$clock;
+    reg signed [15:0] cos_slope_read$d;
+    wire signed [15:0] cos_slope_read$q;
+    reg  cos_slope_read$clock;
     reg  [1:0] quadrant_2$d;
     wire  [1:0] quadrant_2$q;
     reg  quadrant_2$clock;
@@ -5461,6 +6659,36 @@ module gyro_interface__modulation_nco__sincos(clock,phase,sin,cos);
         .q(offset_1$q),
         .clock(offset_1$clock)
     );
+    gyro_interface__modulation_nco__sincos__quadrant_read quadrant_read(
+        .d(quadrant_read$d),
+        .q(quadrant_read$q),
+        .clock(quadrant_read$clock)
+    );
+    gyro_interface__modulation_nco__sincos__offset_read offset_read(
+        .d(offset_read$d),
+        .q(offset_read$q),
+        .clock(offset_read$clock)
+    );
+    gyro_interface__modulation_nco__sincos__sin_value_read sin_value_read(
+        .d(sin_value_read$d),
+        .q(sin_value_read$q),
+        .clock(sin_value_read$clock)
+    );
+    gyro_interface__modulation_nco__sincos__cos_value_read cos_value_read(
+        .d(cos_value_read$d),
+        .q(cos_value_read$q),
+        .clock(cos_value_read$clock)
+    );
+    gyro_interface__modulation_nco__sincos__sin_slope_read sin_slope_read(
+        .d(sin_slope_read$d),
+        .q(sin_slope_read$q),
+        .clock(sin_slope_read$clock)
+    );
+    gyro_interface__modulation_nco__sincos__cos_slope_read cos_slope_read(
+        .d(cos_slope_read$d),
+        .q(cos_slope_read$q),
+        .clock(cos_slope_read$clock)
+    );
     gyro_interface__modulation_nco__sincos__quadrant_2 quadrant_2(
         .d(quadrant_2$d),
         .q(quadrant_2$q),
@@ -5509,6 +6737,12 @@ module gyro_interface__modulation_nco__sincos(clock,phase,sin,cos);
         cos_slope_product$clock = clock;
         quadrant_1$clock = clock;
         offset_1$clock = clock;
+        quadrant_read$clock = clock;
+        offset_read$clock = clock;
+        sin_value_read$clock = clock;
+        cos_value_read$clock = clock;
+        sin_slope_read$clock = clock;
+        cos_slope_read$clock = clock;
         quadrant_2$clock = clock;
         sin_sample_2$clock = clock;
         cos_sample_2$clock = clock;
@@ -5519,6 +6753,12 @@ module gyro_interface__modulation_nco__sincos(clock,phase,sin,cos);
         cos_out$clock = clock;
         quadrant_1$d = quadrant_1$q;
         offset_1$d = offset_1$q;
+        quadrant_read$d = quadrant_read$q;
+        offset_read$d = offset_read$q;
+        sin_value_read$d = sin_value_read$q;
+        cos_value_read$d = cos_value_read$q;
+        sin_slope_read$d = sin_slope_read$q;
+        cos_slope_read$d = cos_slope_read$q;
         quadrant_2$d = quadrant_2$q;
         sin_sample_2$d = sin_sample_2$q;
         cos_sample_2$d = cos_sample_2$q;
@@ -5532,13 +6772,19 @@ module gyro_interface__modulation_nco__sincos(clock,phase,sin,cos);
         quadrant_1$d = phase[(32'h1e)+:(2)];
         fraction = ((phase[(32'h7)+:(15)]) & 16'hffff);
         offset_1$d = $signed(fraction - half_step);
-        sin_slope_product$a = offset_1$q;
-        sin_slope_product$b = rom$slope_a;
-        cos_slope_product$a = offset_1$q;
-        cos_slope_product$b = rom$slope_b;
-        quadrant_2$d = quadrant_1$q;
-        sin_sample_2$d = rom$value_a;
-        cos_sample_2$d = rom$value_b;
+        quadrant_read$d = quadrant_1$q;
+        offset_read$d = offset_1$q;
+        sin_value_read$d = rom$value_a;
+        cos_value_read$d = rom$value_b;
+        sin_slope_read$d = rom$slope_a;
+        cos_slope_read$d = rom$slope_b;
+        sin_slope_product$a = offset_read$q;
+        sin_slope_product$b = sin_slope_read$q;
+        cos_slope_product$a = offset_read$q;
+        cos_slope_product$b = cos_slope_read$q;
+        quadrant_2$d = quadrant_read$q;
+        sin_sample_2$d = sin_value_read$q;
+        cos_sample_2$d = cos_value_read$q;
         sin_rounded = sin_slope_product$p + rounding;
         cos_rounded = cos_slope_product$p + rounding;
         sin_correction_10 = sin_rounded[(32'h16)+:(10)];
@@ -5643,6 +6889,44 @@ module gyro_interface__modulation_nco__sincos__cos_slope_product(clock,a,b,p);
 endmodule // gyro_interface__modulation_nco__sincos__cos_slope_product
 
 
+module gyro_interface__modulation_nco__sincos__cos_slope_read(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__modulation_nco__sincos__cos_slope_read
+
+
+module gyro_interface__modulation_nco__sincos__cos_value_read(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__modulation_nco__sincos__cos_value_read
+
+
 module gyro_interface__modulation_nco__sincos__offset_1(d,q,clock);
 
     // Module arguments
@@ -5660,6 +6944,25 @@ module gyro_interface__modulation_nco__sincos__offset_1(d,q,clock);
     end
 
 endmodule // gyro_interface__modulation_nco__sincos__offset_1
+
+
+module gyro_interface__modulation_nco__sincos__offset_read(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__modulation_nco__sincos__offset_read
 
 
 module gyro_interface__modulation_nco__sincos__quadrant_1(d,q,clock);
@@ -5717,6 +7020,25 @@ module gyro_interface__modulation_nco__sincos__quadrant_3(d,q,clock);
     end
 
 endmodule // gyro_interface__modulation_nco__sincos__quadrant_3
+
+
+module gyro_interface__modulation_nco__sincos__quadrant_read(d,q,clock);
+
+    // Module arguments
+    input wire  [1:0] d;
+    output reg  [1:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 2'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__modulation_nco__sincos__quadrant_read
 
 
 module gyro_interface__modulation_nco__sincos__rom(clock,addr_a,addr_b,value_a,slope_a,value_b,slope_b);
@@ -6078,6 +7400,44 @@ module gyro_interface__modulation_nco__sincos__sin_slope_product(clock,a,b,p);
        p <= a * b;
     end
 endmodule // gyro_interface__modulation_nco__sincos__sin_slope_product
+
+
+module gyro_interface__modulation_nco__sincos__sin_slope_read(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__modulation_nco__sincos__sin_slope_read
+
+
+module gyro_interface__modulation_nco__sincos__sin_value_read(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__modulation_nco__sincos__sin_value_read
 
 
 module gyro_interface__reference_alignment(clock,ref1,ref2,delay,aligned1,aligned2);

@@ -20,14 +20,16 @@
 //! The reference words are the drive words computed from the reference
 //! carrier: in readout they equal the drives up to the phase offset, in
 //! calibration they carry the same modulation. Latency: carriers to outputs
-//! 2 clocks, amplitudes to outputs 4 clocks, the same for drives and
-//! references.
+//! 3 clocks, amplitudes to outputs 6 clocks (`q15_multiplier::LATENCY` per
+//! product), the same for drives and references.
 
 use crate::q15_multiplier::Q15Multiplier;
 use rust_hdl::prelude::*;
 
 /// Clock cycles from the carrier inputs to the drive and reference outputs.
-pub const CARRIER_LATENCY: usize = 2;
+pub const CARRIER_LATENCY: usize = crate::q15_multiplier::LATENCY;
+/// Clock cycles from the amplitudes and modulation factors to the outputs.
+pub const AMPLITUDE_LATENCY: usize = 2 * crate::q15_multiplier::LATENCY;
 
 /// Two AM drive channels with reference copies.
 #[derive(LogicBlock)]
@@ -209,7 +211,7 @@ mod tests {
                         ref_sin: c,
                     };
                     let mut out = Drives::default();
-                    for _ in 0..4 {
+                    for _ in 0..AMPLITUDE_LATENCY {
                         out = model.step((f, f), (a, a), carriers);
                     }
                     assert_eq!(out.dac1 as i64, want, "F {f} A {a} c {c}");

@@ -17,7 +17,7 @@
 //! Frequency: f = step * f_clk / 2^32, resolution f_clk / 2^32 (0.0116 Hz at
 //! 50 MHz). Phase during cycle n: the sum of the steps presented during
 //! cycles 0..n-1 (power-up phase 0), wrapping at 2^32. Outputs during cycle n
-//! belong to the phase of cycle n - 4 (`sincos::LATENCY`); 16-bit, peak
+//! belong to the phase of cycle n - 5 (`sincos::LATENCY`); 16-bit, peak
 //! 32767, spurs below -100 dBc.
 
 use crate::sincos::SinCos;

@@ -20,13 +20,25 @@
 //! folds 1/G into its numerator (`crate::filter_design`), so z has unity
 //! gain. |x| < 2^31 gives |y| < 2^39: 40 bits, no overflow.
 //!
+//! The output stage is pipelined over `OUTPUT_STAGES` = 3 registers so
+//! that no clock carries more than one carry chain or three mux levels:
+//! 1. bias: b = comb4 + 2^(shift-1) (80-bit add; `shift` is sampled here and
+//!    travels with the value, so a shift change never splits a sample);
+//! 2. coarse: ((b ^ s) >> (shift & 0b111000)), low `COARSE_BITS` = 40 + 7
+//!    bits, with s the sign mask of b (the fine step moves at most 7 bits
+//!    and 40 are kept, so the bits above 47 are never read);
+//! 3. fine: (coarse >> (shift & 0b000111)) ^ s, low 40 bits.
+//!
+//! Logical shifts compose, so this equals ((b ^ s) >> shift) ^ s exactly.
+//!
 //! Run-time settings: `decimation` R in 1..=4096 (a 13-bit word; the down
 //! counter reloads R - 1 at each output, so a new R acts from the next
 //! output on), `shift` in 0..=40. Timing: the integrators take x during
 //! cycle n at the next edge; when the counter reaches 0 the fourth
-//! integrator is sampled, the four combs follow on the next four clocks and
-//! `y` and a one-clock `valid` pulse appear 6 clocks after the sampling
-//! cycle. Power-up: all registers 0, the first output after R clocks.
+//! integrator is sampled, the four combs follow on the next four clocks,
+//! the three output steps on the next three, and `y` and a one-clock
+//! `valid` pulse appear 8 clocks after the sampling cycle. Power-up: all
+//! registers 0, the first output after R clocks.
 
 use crate::primitives::convert::signed_bit_cast_exact;
 use rust_hdl::prelude::*;
@@ -49,6 +61,20 @@ pub const DECIMATION_BITS: usize = MAX_DECIMATION_LOG2 as usize + 1;
 pub const SHIFT_BITS: usize = 6;
 /// Fractional bits kept at the output (y = average * 2^8 * G).
 pub const OUTPUT_FRACTION_BITS: u32 = 8;
+/// Low bits of the shift applied by the last (fine) output step: 0..=7.
+pub const FINE_SHIFT_BITS: usize = 3;
+/// The shift bits of the fine step: `shift & 0b000111`.
+pub const FINE_SHIFT_MASK: u64 = (1 << FINE_SHIFT_BITS) - 1;
+/// The shift bits of the coarse step (multiples of 8): `shift & 0b111000`.
+pub const COARSE_SHIFT_MASK: u64 = ((1 << SHIFT_BITS) - 1) & !FINE_SHIFT_MASK;
+/// Width kept after the coarse step: the fine step shifts by at most
+/// 2^3 - 1 = 7 and the output keeps 40 bits, so bits 0..40 + 7 suffice.
+pub const COARSE_BITS: usize = OUTPUT_BITS + (1 << FINE_SHIFT_BITS) - 1;
+/// Clocks from the fourth comb's result to `y`: bias, coarse, fine.
+pub const OUTPUT_STAGES: usize = 3;
+/// Clocks from the sampling cycle to `y`: the sample register, the combs,
+/// the output steps.
+pub const SAMPLE_TO_OUTPUT: usize = 1 + STAGES as usize + OUTPUT_STAGES;
 
 /// Four-stage CIC decimator with run-time rate and output shift.
 #[derive(LogicBlock)]
@@ -87,13 +113,25 @@ pub struct CicDecimator {
     comb_valid4: DFF<Bit>,
     rounding: Signal<Local, Bits<REGISTER_BITS>>,
     biased: Signal<Local, Signed<REGISTER_BITS>>,
-    biased_bits: Signal<Local, Bits<REGISTER_BITS>>,
+    biased_out: DFF<Bits<REGISTER_BITS>>,
+    biased_shift: DFF<Bits<SHIFT_BITS>>,
+    biased_valid: DFF<Bit>,
     sign_mask: Signal<Local, Bits<REGISTER_BITS>>,
-    shifted: Signal<Local, Bits<REGISTER_BITS>>,
+    coarse_shift: Signal<Local, Bits<SHIFT_BITS>>,
+    coarse_shifted: Signal<Local, Bits<REGISTER_BITS>>,
+    coarse: DFF<Bits<COARSE_BITS>>,
+    coarse_negative: DFF<Bit>,
+    fine_shift: DFF<Bits<SHIFT_BITS>>,
+    coarse_valid: DFF<Bit>,
+    fine_mask: Signal<Local, Bits<COARSE_BITS>>,
+    shifted: Signal<Local, Bits<COARSE_BITS>>,
     y_out: DFF<Signed<OUTPUT_BITS>>,
     valid_out: DFF<Bit>,
     one: Constant<Bits<REGISTER_BITS>>,
     all_ones: Constant<Bits<REGISTER_BITS>>,
+    coarse_all_ones: Constant<Bits<COARSE_BITS>>,
+    coarse_shift_mask: Constant<Bits<SHIFT_BITS>>,
+    fine_shift_mask: Constant<Bits<SHIFT_BITS>>,
 }
 
 impl CicDecimator {
@@ -128,13 +166,25 @@ impl CicDecimator {
             comb_valid4: Default::default(),
             rounding: Default::default(),
             biased: Default::default(),
-            biased_bits: Default::default(),
+            biased_out: Default::default(),
+            biased_shift: Default::default(),
+            biased_valid: Default::default(),
             sign_mask: Default::default(),
+            coarse_shift: Default::default(),
+            coarse_shifted: Default::default(),
+            coarse: Default::default(),
+            coarse_negative: Default::default(),
+            fine_shift: Default::default(),
+            coarse_valid: Default::default(),
+            fine_mask: Default::default(),
             shifted: Default::default(),
             y_out: Default::default(),
             valid_out: Default::default(),
             one: Constant::new(1.into()),
             all_ones: Constant::new(Bits::<REGISTER_BITS>::mask()),
+            coarse_all_ones: Constant::new(Bits::<COARSE_BITS>::mask()),
+            coarse_shift_mask: Constant::new(COARSE_SHIFT_MASK.into()),
+            fine_shift_mask: Constant::new(FINE_SHIFT_MASK.into()),
         }
     }
 }
@@ -170,6 +220,13 @@ impl Logic for CicDecimator {
             comb_valid2,
             comb_valid3,
             comb_valid4,
+            biased_out,
+            biased_shift,
+            biased_valid,
+            coarse,
+            coarse_negative,
+            fine_shift,
+            coarse_valid,
             y_out,
             valid_out
         );
@@ -210,20 +267,37 @@ impl Logic for CicDecimator {
             self.comb_delay4.d.next = self.comb3.q.val();
         }
         // Output: arithmetic shift right with round-half-up, as
-        // ((b ^ s) >> shift) ^ s with s the sign mask of b.
+        // ((b ^ s) >> shift) ^ s with s the sign mask of the biased value
+        // b, in three registered steps (module header): bias, coarse, fine.
         self.rounding.next = (self.one.val() << self.shift.val()) >> 1;
         self.biased.next = self.comb4.q.val() + signed_cast(self.rounding.val());
-        self.biased_bits.next = unsigned_cast(self.biased.val());
+        self.biased_valid.d.next = self.comb_valid4.q.val();
+        if self.comb_valid4.q.val() {
+            self.biased_out.d.next = unsigned_cast(self.biased.val());
+            self.biased_shift.d.next = self.shift.val();
+        }
         self.sign_mask.next = 0.into();
         // Sign bit, REGISTER_BITS - 1 (rust-hdl needs a literal index; a
         // signed compare with 0 costs a comparator in Yosys).
-        if self.biased_bits.val().get_bit(79) {
+        if self.biased_out.q.val().get_bit(79) {
             self.sign_mask.next = self.all_ones.val();
         }
-        self.shifted.next = ((self.biased_bits.val() ^ self.sign_mask.val()) >> self.shift.val())
-            ^ self.sign_mask.val();
-        self.valid_out.d.next = self.comb_valid4.q.val();
-        if self.comb_valid4.q.val() {
+        self.coarse_shift.next = self.biased_shift.q.val() & self.coarse_shift_mask.val();
+        self.coarse_shifted.next =
+            (self.biased_out.q.val() ^ self.sign_mask.val()) >> self.coarse_shift.val();
+        self.coarse_valid.d.next = self.biased_valid.q.val();
+        if self.biased_valid.q.val() {
+            self.coarse.d.next = self.coarse_shifted.val().get_bits::<COARSE_BITS>(0);
+            self.coarse_negative.d.next = self.biased_out.q.val().get_bit(79);
+            self.fine_shift.d.next = self.biased_shift.q.val() & self.fine_shift_mask.val();
+        }
+        self.fine_mask.next = 0.into();
+        if self.coarse_negative.q.val() {
+            self.fine_mask.next = self.coarse_all_ones.val();
+        }
+        self.shifted.next = (self.coarse.q.val() >> self.fine_shift.q.val()) ^ self.fine_mask.val();
+        self.valid_out.d.next = self.coarse_valid.q.val();
+        if self.coarse_valid.q.val() {
             self.y_out.d.next = signed_cast(self.shifted.val().get_bits::<OUTPUT_BITS>(0));
         }
         self.y.next = self.y_out.q.val();

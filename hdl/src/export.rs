@@ -538,10 +538,12 @@ pub fn ports_markdown() -> String {
         ));
     }
     md.push_str(&format!(
-        "\nLatencies: carrier phase to DAC word 6 clocks; ADC word to mixer product 2;\n\
-         mixer product to CIC output at most R + 6; CIC output to z {}.\n\
+        "\nLatencies: carrier phase to DAC word {} clocks; ADC word to mixer product 2;\n\
+         mixer product to CIC output at most R + {}; CIC output to z {}.\n\
          Reference alignment for converter latencies L_dac, L_adc (clocks):\n\
          `ref_delay = L_dac + L_adc`, `ref_phase = carrier_step / 2`.\n",
+        crate::carrier_nco::LATENCY + crate::am_mixer::CARRIER_LATENCY,
+        crate::cic_decimator::SAMPLE_TO_OUTPUT,
         crate::iir_lowpass::LATENCY
     ));
     md

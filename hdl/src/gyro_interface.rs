@@ -30,8 +30,10 @@
 //! frequencies in Hz; the port list with formats is in
 //! `verilog-out/PORTS.md`.
 //!
-//! Latencies (clocks): carrier phase to DAC word 6, ADC word to mixer output
-//! 2, mixer output to CIC output R + 6 at most, CIC output to z 17
+//! Latencies (clocks): carrier phase to DAC word 8 (the sum of
+//! `carrier_nco::LATENCY` and `am_mixer::CARRIER_LATENCY`), ADC word to
+//! mixer output 2, mixer output to CIC output R + 8 at most
+//! (`cic_decimator::SAMPLE_TO_OUTPUT`), CIC output to z 17
 //! (`crate::iir_lowpass::LATENCY`).
 
 use crate::am_mixer::AmMixer;

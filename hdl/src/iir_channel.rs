@@ -3,7 +3,8 @@
 //! multiplier.
 //!
 //! ```text
-//!  start:      x0 <= x, x1 <= x0, v <= (x + 2 x0 + x1) 2^16, fb <= 2 y1 - y2
+//!  start:      x0 <= x, p01 <= 2 x + x0, v <= (x + p01) 2^16, fb <= 2 y1 - y2
+//!              (p01 holds 2 x0 + x1 of the next start, so v is one adder)
 //!  preload:    acc_y <= fb 2^30 + 2^29,  acc_d <= (fb - u) 2^30 + 2^29
 //!  accumulate: acc_y += p,  acc_d += p                     (p = k1 y1, k2 y2)
 //!  finish:     y1 <= (acc_y + p) / 2^30,  y2 <= y1         (p = k0 v)
@@ -29,6 +30,8 @@ use rust_hdl::prelude::*;
 
 /// Width of the input and output samples.
 pub const SAMPLE_BITS: usize = crate::cic_decimator::OUTPUT_BITS;
+/// Width of the running partial sum 2 x0 + x1: |.| <= 3 2^39 < 2^41, 42 bits.
+pub const PARTIAL_BITS: usize = SAMPLE_BITS + 2;
 
 /// States and adders of one filter channel.
 #[derive(LogicBlock)]
@@ -62,7 +65,7 @@ pub struct IirChannel {
     /// Filtered output, 8 fractional bits.
     pub z: Signal<Out, Signed<SAMPLE_BITS>>,
     x0: DFF<Signed<SAMPLE_BITS>>,
-    x1: DFF<Signed<SAMPLE_BITS>>,
+    partial: DFF<Signed<PARTIAL_BITS>>,
     v_reg: DFF<Signed<OPERAND_BITS>>,
     feedback: DFF<Signed<OPERAND_BITS>>,
     acc_y: DFF<Signed<ACCUMULATOR_BITS>>,
@@ -72,8 +75,11 @@ pub struct IirChannel {
     u: DFF<Signed<STATE_BITS>>,
     z_out: DFF<Signed<SAMPLE_BITS>>,
     x_wide: Signal<Local, Signed<OPERAND_BITS>>,
-    x0_wide: Signal<Local, Signed<OPERAND_BITS>>,
-    x1_wide: Signal<Local, Signed<OPERAND_BITS>>,
+    x_partial: Signal<Local, Signed<PARTIAL_BITS>>,
+    x0_partial: Signal<Local, Signed<PARTIAL_BITS>>,
+    partial_wide: Signal<Local, Signed<OPERAND_BITS>>,
+    x_doubled: Signal<Local, Bits<PARTIAL_BITS>>,
+    y1_doubled: Signal<Local, Bits<OPERAND_BITS>>,
     v_sum: Signal<Local, Signed<OPERAND_BITS>>,
     v_shifted: Signal<Local, Bits<OPERAND_BITS>>,
     y1_wide: Signal<Local, Signed<OPERAND_BITS>>,
@@ -117,7 +123,7 @@ impl IirChannel {
             difference: Default::default(),
             z: Default::default(),
             x0: Default::default(),
-            x1: Default::default(),
+            partial: Default::default(),
             v_reg: Default::default(),
             feedback: Default::default(),
             acc_y: Default::default(),
@@ -127,8 +133,11 @@ impl IirChannel {
             u: Default::default(),
             z_out: Default::default(),
             x_wide: Default::default(),
-            x0_wide: Default::default(),
-            x1_wide: Default::default(),
+            x_partial: Default::default(),
+            x0_partial: Default::default(),
+            partial_wide: Default::default(),
+            x_doubled: Default::default(),
+            y1_doubled: Default::default(),
             v_sum: Default::default(),
             v_shifted: Default::default(),
             y1_wide: Default::default(),
@@ -164,18 +173,22 @@ impl Logic for IirChannel {
     #[hdl_gen]
     fn update(&mut self) {
         dff_setup!(
-            self, clock, x0, x1, v_reg, feedback, acc_y, acc_d, y1_reg, y2_reg, u, z_out
+            self, clock, x0, partial, v_reg, feedback, acc_y, acc_d, y1_reg, y2_reg, u, z_out
         );
         // Operands, sign-extended (trap: cast into a local first).
         self.x_wide.next = signed_bit_cast_exact::<OPERAND_BITS, SAMPLE_BITS>(self.x.val());
-        self.x0_wide.next = signed_bit_cast_exact::<OPERAND_BITS, SAMPLE_BITS>(self.x0.q.val());
-        self.x1_wide.next = signed_bit_cast_exact::<OPERAND_BITS, SAMPLE_BITS>(self.x1.q.val());
+        self.x_partial.next = signed_bit_cast_exact::<PARTIAL_BITS, SAMPLE_BITS>(self.x.val());
+        self.x0_partial.next = signed_bit_cast_exact::<PARTIAL_BITS, SAMPLE_BITS>(self.x0.q.val());
+        self.partial_wide.next =
+            signed_bit_cast_exact::<OPERAND_BITS, PARTIAL_BITS>(self.partial.q.val());
         self.y1_wide.next = signed_bit_cast_exact::<OPERAND_BITS, STATE_BITS>(self.y1_reg.q.val());
         self.y2_wide.next = signed_bit_cast_exact::<OPERAND_BITS, STATE_BITS>(self.y2_reg.q.val());
         self.u_wide.next = signed_bit_cast_exact::<OPERAND_BITS, STATE_BITS>(self.u.q.val());
-        // Numerator sum (the new x0 is x) and feedback 2 y1 - y2.
-        self.v_sum.next =
-            self.x_wide.val() + self.x0_wide.val() + self.x0_wide.val() + self.x1_wide.val();
+        // Numerator sum x + (2 x0 + x1), one adder (the new x0 is x).
+        self.v_sum.next = self.x_wide.val() + self.partial_wide.val();
+        // Doublings as shifts, so each sum below is a single adder.
+        self.x_doubled.next = unsigned_cast(self.x_partial.val()) << 1;
+        self.y1_doubled.next = unsigned_cast(self.y1_wide.val()) << 1;
         // 16 = GUARD_BITS: the states carry 16 bits below the input LSB.
         self.v_shifted.next = unsigned_cast(self.v_sum.val()) << 16;
         self.feedback_minus_u.next = self.feedback.q.val() - self.u_wide.val();
@@ -203,9 +216,10 @@ impl Logic for IirChannel {
         // Register stages, one per control.
         if self.start.val() {
             self.x0.d.next = self.x.val();
-            self.x1.d.next = self.x0.q.val();
+            // The next start's 2 x0 + x1: x becomes x0 and x0 becomes x1.
+            self.partial.d.next = signed_cast(self.x_doubled.val()) + self.x0_partial.val();
             self.v_reg.d.next = signed_cast(self.v_shifted.val());
-            self.feedback.d.next = self.y1_wide.val() + self.y1_wide.val() - self.y2_wide.val();
+            self.feedback.d.next = signed_cast(self.y1_doubled.val()) - self.y2_wide.val();
         }
         if self.preload.val() {
             self.acc_y.d.next = signed_cast(self.preload_y.val());

@@ -17,7 +17,7 @@
 //! The accumulator has 48 bits: f_cal = step * f_clk / 2^48, resolution
 //! 0.18 uHz at 50 MHz (a 32-bit NCO would be off by up to 0.06% at 10 Hz).
 //! The top 32 bits address the sine generator. Latency from the phase
-//! register to `am1`/`am2`: 5 clocks (4 in `SinCos`, 1 for the select
+//! register to `am1`/`am2`: 6 clocks (5 in `SinCos`, 1 for the select
 //! register); `select` itself acts after 1 clock.
 
 use crate::sincos::SinCos;

@@ -1,9 +1,9 @@
 //! Fractional (Q1.15) multiplier with rounding: y = round(a * b / 2^15).
 //!
 //! ```text
-//!  a[16] ──┐
-//!          ×──► [p: 32 bit] ──► (p + 2^14)[30:15] ──► [y: 16 bit]
-//!  b[16] ──┘
+//!  a[16] ──► [a] ──┐
+//!                   ×──► [p: 32 bit] ──► (p + 2^14)[30:15] ──► [y: 16 bit]
+//!  b[16] ──► [b] ──┘
 //! ```
 //!
 //! Both factors are 16-bit two's complement read as fractions of 2^15
@@ -13,15 +13,20 @@
 //! every use in this design (b is always a sine, cosine or modulation factor,
 //! peak 32767), |a b + 2^14| / 2^15 <= 32767.5 and y lies in [-32767, 32767].
 //!
-//! Latency: 2 clocks (multiplier register, rounding register).
+//! Latency: 3 clocks (factor registers, multiplier register, rounding
+//! register). The factor registers serve this multiplier alone, so the
+//! placer can put them beside the DSP: the factors come from registers that
+//! feed several multipliers, and on an ECP5 the route from such a shared
+//! register to a far DSP plus the DSP itself was the critical path at
+//! 100 MHz.
 
 use crate::primitives::RegisteredMultiplier;
 use rust_hdl::prelude::*;
 
 /// Clock cycles from the factors to `y`.
-pub const LATENCY: usize = 2;
+pub const LATENCY: usize = 3;
 
-/// `y = round(a * b / 2^15)`, registered twice.
+/// `y = round(a * b / 2^15)`, three registers deep.
 #[derive(LogicBlock)]
 pub struct Q15Multiplier {
     /// The clock.
@@ -30,8 +35,10 @@ pub struct Q15Multiplier {
     pub a: Signal<In, Signed<16>>,
     /// Second factor, Q1.15; keep it above -32768 (see the header).
     pub b: Signal<In, Signed<16>>,
-    /// Rounded product, Q1.15, two clocks after the factors.
+    /// Rounded product, Q1.15, three clocks after the factors.
     pub y: Signal<Out, Signed<16>>,
+    a_in: DFF<Signed<16>>,
+    b_in: DFF<Signed<16>>,
     product: RegisteredMultiplier<16, 16, 32>,
     rounded: Signal<Local, Signed<32>>,
     y_out: DFF<Signed<16>>,
@@ -46,6 +53,8 @@ impl Q15Multiplier {
             a: Default::default(),
             b: Default::default(),
             y: Default::default(),
+            a_in: Default::default(),
+            b_in: Default::default(),
             product: RegisteredMultiplier::new(),
             rounded: Default::default(),
             y_out: Default::default(),
@@ -63,10 +72,12 @@ impl Default for Q15Multiplier {
 impl Logic for Q15Multiplier {
     #[hdl_gen]
     fn update(&mut self) {
-        dff_setup!(self, clock, y_out);
+        dff_setup!(self, clock, a_in, b_in, y_out);
+        self.a_in.d.next = self.a.val();
+        self.b_in.d.next = self.b.val();
         self.product.clock.next = self.clock.val();
-        self.product.a.next = self.a.val();
-        self.product.b.next = self.b.val();
+        self.product.a.next = self.a_in.q.val();
+        self.product.b.next = self.b_in.q.val();
         self.rounded.next = self.product.p.val() + self.half_lsb.val();
         self.y_out.d.next = self.rounded.val().get_bits::<16>(15);
         self.y.next = self.y_out.q.val();

@@ -2,9 +2,9 @@
 //! Taylor interpolation.
 //!
 //! ```text
-//!  phase[31:30] quadrant q ─────────────────► [q] ───► [q] ───► [q] ──┐
-//!  phase[29:22] i ──► ROM a: value[i],  slope[i]    (sin, d sin)       │ quadrant
-//!        ~i       ──► ROM b: value[~i], slope[~i]   (cos, d cos)       │ mirror
+//!  phase[31:30] quadrant q ─────────────────► [q] ─► [q] ─► [q] ─► [q] ┐
+//!  phase[29:22] i ──► ROM a: value[i],  slope[i] ─► [reg]  (sin, d sin) │ quadrant
+//!        ~i       ──► ROM b: value[~i], slope[~i] ─► [reg] (cos, d cos) │ mirror
 //!  phase[21:7]  f ──► fs = f - 2^14 ──► fs*slope[i], fs*slope[~i] ─┐   │ and
 //!                                                                  ▼   ▼ negate
 //!     s = value[i]  + round(fs*slope[i]  / 2^22)   ──────────► sin, cos (16 bit)
@@ -28,17 +28,17 @@
 //! overflow. Error against `32767 sin(2 pi phase / 2^32)`: at most 1.2 LSB;
 //! spur-free dynamic range above 100 dBc (measured by FFT in the tests).
 //!
-//! Pipeline: 4 registers (ROM read, slope products, correction, quadrant
-//! mirror). `sin`/`cos` during cycle n belong to the `phase` presented during
-//! cycle n - 4. Resources: 2 table ROMs read twice, 2 16x16 multipliers.
+//! Pipeline: 5 registers (ROM read, table words, slope products,
+//! correction, quadrant mirror). `sin`/`cos` during cycle n belong to the
+//! `phase` presented during cycle n - 5. Resources: 2 table ROMs read twice, 2 16x16 multipliers.
 
 use crate::primitives::{QuarterSineRom, RegisteredMultiplier};
 use rust_hdl::prelude::*;
 
 /// Clock cycles from `phase` to `sin`/`cos`.
-pub const LATENCY: usize = 4;
+pub const LATENCY: usize = 5;
 
-/// Sine and cosine of a 32-bit phase, 16-bit outputs, 4-clock pipeline.
+/// Sine and cosine of a 32-bit phase, 16-bit outputs, 5-clock pipeline.
 #[derive(LogicBlock)]
 pub struct SinCos {
     /// The clock.
@@ -55,15 +55,24 @@ pub struct SinCos {
     // Stage 1 (beside the ROM read).
     quadrant_1: DFF<Bits<2>>,
     offset_1: DFF<Signed<16>>,
-    // Stage 2 (beside the slope products).
+    // Stage 2: the table words registered (the block RAM's read port has
+    // no output register, and its clock-to-out plus a multiplier does not
+    // fit one clock at 100 MHz on an ECP5).
+    quadrant_read: DFF<Bits<2>>,
+    offset_read: DFF<Signed<16>>,
+    sin_value_read: DFF<Signed<16>>,
+    cos_value_read: DFF<Signed<16>>,
+    sin_slope_read: DFF<Signed<16>>,
+    cos_slope_read: DFF<Signed<16>>,
+    // Stage 3 (beside the slope products).
     quadrant_2: DFF<Bits<2>>,
     sin_sample_2: DFF<Signed<16>>,
     cos_sample_2: DFF<Signed<16>>,
-    // Stage 3: first-quadrant sine and cosine.
+    // Stage 4: first-quadrant sine and cosine.
     quadrant_3: DFF<Bits<2>>,
     sin_first_3: DFF<Signed<16>>,
     cos_first_3: DFF<Signed<16>>,
-    // Stage 4: output registers.
+    // Stage 5: output registers.
     sin_out: DFF<Signed<16>>,
     cos_out: DFF<Signed<16>>,
     // Combinational helpers.
@@ -91,6 +100,12 @@ impl SinCos {
             cos_slope_product: RegisteredMultiplier::new(),
             quadrant_1: Default::default(),
             offset_1: Default::default(),
+            quadrant_read: Default::default(),
+            offset_read: Default::default(),
+            sin_value_read: Default::default(),
+            cos_value_read: Default::default(),
+            sin_slope_read: Default::default(),
+            cos_slope_read: Default::default(),
             quadrant_2: Default::default(),
             sin_sample_2: Default::default(),
             cos_sample_2: Default::default(),
@@ -129,6 +144,12 @@ impl Logic for SinCos {
             clock,
             quadrant_1,
             offset_1,
+            quadrant_read,
+            offset_read,
+            sin_value_read,
+            cos_value_read,
+            sin_slope_read,
+            cos_slope_read,
             quadrant_2,
             sin_sample_2,
             cos_sample_2,
@@ -144,15 +165,22 @@ impl Logic for SinCos {
         self.quadrant_1.d.next = self.phase.val().get_bits::<2>(30);
         self.fraction.next = bit_cast::<16, 15>(self.phase.val().get_bits::<15>(7));
         self.offset_1.d.next = signed_cast(self.fraction.val() - self.half_step.val());
-        // Stage 2: derivative times offset.
-        self.sin_slope_product.a.next = self.offset_1.q.val();
-        self.sin_slope_product.b.next = self.rom.slope_a.val();
-        self.cos_slope_product.a.next = self.offset_1.q.val();
-        self.cos_slope_product.b.next = self.rom.slope_b.val();
-        self.quadrant_2.d.next = self.quadrant_1.q.val();
-        self.sin_sample_2.d.next = self.rom.value_a.val();
-        self.cos_sample_2.d.next = self.rom.value_b.val();
-        // Stage 3: first-quadrant values, correction rounded half up.
+        // Stage 2: table words registered.
+        self.quadrant_read.d.next = self.quadrant_1.q.val();
+        self.offset_read.d.next = self.offset_1.q.val();
+        self.sin_value_read.d.next = self.rom.value_a.val();
+        self.cos_value_read.d.next = self.rom.value_b.val();
+        self.sin_slope_read.d.next = self.rom.slope_a.val();
+        self.cos_slope_read.d.next = self.rom.slope_b.val();
+        // Stage 3: derivative times offset.
+        self.sin_slope_product.a.next = self.offset_read.q.val();
+        self.sin_slope_product.b.next = self.sin_slope_read.q.val();
+        self.cos_slope_product.a.next = self.offset_read.q.val();
+        self.cos_slope_product.b.next = self.cos_slope_read.q.val();
+        self.quadrant_2.d.next = self.quadrant_read.q.val();
+        self.sin_sample_2.d.next = self.sin_value_read.q.val();
+        self.cos_sample_2.d.next = self.cos_value_read.q.val();
+        // Stage 4: first-quadrant values, correction rounded half up.
         self.sin_rounded.next = self.sin_slope_product.p.val() + self.rounding.val();
         self.cos_rounded.next = self.cos_slope_product.p.val() + self.rounding.val();
         self.sin_correction_10.next = self.sin_rounded.val().get_bits::<10>(22);
@@ -162,7 +190,7 @@ impl Logic for SinCos {
         self.sin_first_3.d.next = self.sin_sample_2.q.val() + self.sin_correction.val();
         self.cos_first_3.d.next = self.cos_sample_2.q.val() - self.cos_correction.val();
         self.quadrant_3.d.next = self.quadrant_2.q.val();
-        // Stage 4: mirror into the quadrant.
+        // Stage 5: mirror into the quadrant.
         self.sin_out.d.next = self.sin_first_3.q.val();
         self.cos_out.d.next = self.cos_first_3.q.val();
         if self.quadrant_3.q.val() == 1 {

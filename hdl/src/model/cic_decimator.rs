@@ -6,7 +6,7 @@
 //! model register equal the hardware register, and the output stage wraps
 //! to 80 bits before it shifts, where the upper bits would start to matter.
 
-use crate::cic_decimator::{OUTPUT_BITS, REGISTER_BITS};
+use crate::cic_decimator::{OUTPUT_BITS, OUTPUT_STAGES, REGISTER_BITS};
 
 /// Wrap to an 80-bit two's complement value.
 #[inline(always)]
@@ -40,6 +40,11 @@ pub struct CicDecimator {
     comb: [i128; 4],
     comb_delay: [i128; 4],
     comb_valid: [bool; 4],
+    /// The output pipeline: scaled value and strobe after each of the
+    /// first `OUTPUT_STAGES - 1` steps (bias, coarse); the last is `y`.
+    /// The hardware's intermediate words differ, but the scaled value is
+    /// fixed at the bias step (it samples `shift` there) and only moves on.
+    output_pipe: [(i64, bool); OUTPUT_STAGES - 1],
     y: i64,
     valid: bool,
 }
@@ -54,11 +59,23 @@ impl CicDecimator {
     /// One clock with input `x`, decimation R (13-bit word) and output shift.
     #[inline(always)]
     pub fn step(&mut self, x: i32, decimation: u32, shift: u32) -> (i64, bool) {
-        // Output stage (reads comb 4 before it updates).
-        self.valid = self.comb_valid[3];
-        if self.comb_valid[3] {
-            self.y = scale_output(wrap(self.comb[3]), shift);
+        // Output stages, last first (each reads the previous cycle's
+        // values; the first reads comb 4 before it updates).
+        let (last, last_valid) = self.output_pipe[OUTPUT_STAGES - 2];
+        self.valid = last_valid;
+        if last_valid {
+            self.y = last;
         }
+        for k in (1..OUTPUT_STAGES - 1).rev() {
+            if self.output_pipe[k - 1].1 {
+                self.output_pipe[k].0 = self.output_pipe[k - 1].0;
+            }
+            self.output_pipe[k].1 = self.output_pipe[k - 1].1;
+        }
+        if self.comb_valid[3] {
+            self.output_pipe[0].0 = scale_output(wrap(self.comb[3]), shift);
+        }
+        self.output_pipe[0].1 = self.comb_valid[3];
         // Combs, last stage first so each reads the previous cycle's values
         // (nothing moves between outputs: skip them then).
         if self.sample_valid || self.comb_valid != [false; 4] {

@@ -6,9 +6,10 @@ pub fn q15_product(a: i16, b: i16) -> i16 {
     ((a as i32 * b as i32 + (1 << 14)) >> 15) as i16
 }
 
-/// Cycle-true model: the product register and the rounding register.
+/// Cycle-true model: the factor, product and rounding registers.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Q15Multiplier {
+    factors: (i16, i16),
     product: i32,
     y: i16,
 }
@@ -24,7 +25,8 @@ impl Q15Multiplier {
     #[inline(always)]
     pub fn step(&mut self, a: i16, b: i16) -> i16 {
         self.y = ((self.product.wrapping_add(1 << 14)) >> 15) as i16;
-        self.product = a as i32 * b as i32;
+        self.product = self.factors.0 as i32 * self.factors.1 as i32;
+        self.factors = (a, b);
         self.y
     }
 }
