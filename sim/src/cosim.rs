@@ -36,31 +36,26 @@ pub struct CoSim<E: Engine> {
     engine: E,
     converters: Converters,
     gyro: GyroModel,
-    bank: RegisterBank,
-    regs: Registers,
+    host: HostRegisters,
     outputs: Outputs,
     adc: (i16, i16),
     cycle: u64,
     samples: u32,
-    snapshot: (i64, i64),
 }
 
 impl<E: Engine> CoSim<E> {
     /// A loop at power-up with the gyroscope at rest.
     /// The registers are programmed through the register map.
     pub fn new(engine: E, converters: Converters, gyro: GyroModel, regs: Registers) -> Self {
-        let bank = RegisterBank::power_up();
         let mut sim = Self {
             engine,
             converters,
             gyro,
-            bank,
-            regs: bank.registers(),
+            host: HostRegisters::power_up(),
             outputs: Outputs::default(),
             adc: (0, 0),
             cycle: 0,
             samples: 0,
-            snapshot: (0, 0),
         };
         sim.set_registers(regs);
         sim
@@ -73,7 +68,7 @@ impl<E: Engine> CoSim<E> {
             .converters
             .step(self.outputs.dac, (self.gyro.x1(), self.gyro.x2()));
         self.adc = adc;
-        self.outputs = self.engine.step(adc, &self.regs);
+        self.outputs = self.engine.step(adc, self.host.registers());
         self.gyro.step(force.0, force.1);
         self.cycle += 1;
         self.samples = self.samples.wrapping_add(self.outputs.z_valid as u32);
@@ -98,7 +93,7 @@ impl<E: Engine> CoSim<E> {
 
     /// The settings the engine sees (decoded from the register bank).
     pub fn registers(&self) -> &Registers {
-        &self.regs
+        self.host.registers()
     }
 
     /// Change the rotation rate (rad/s) from the next clock on.
@@ -120,21 +115,62 @@ impl<E: Engine> CoSim<E> {
 impl<E: Engine> RegisterAccess for CoSim<E> {
     /// A write between two clocks: acts from the next clock on.
     fn write_register(&mut self, offset: u32, word: u32) -> Result<(), BusError> {
-        self.bank.write(offset, word, 0xf)?;
-        self.regs = self.bank.registers();
-        Ok(())
+        self.host.write(offset, word)
     }
 
     /// A read between two clocks. STREAM_OVERFLOW is 0: the co-simulation
     /// has no stream.
     fn read_register(&mut self, offset: u32) -> Result<u32, BusError> {
+        self.host.read(offset, self.outputs.z, self.samples)
+    }
+}
+
+/// The slave's registers as host software sees them between two clocks:
+/// the register bank, the settings decoded from it (once per write, never
+/// per clock) and the z snapshot a SAMPLE_COUNT read latches. What the
+/// co-simulation and a simulated board (`crate::field::board`) share.
+#[derive(Clone, Copy, Debug)]
+pub struct HostRegisters {
+    bank: RegisterBank,
+    regs: Registers,
+    snapshot: (i64, i64),
+}
+
+impl HostRegisters {
+    /// Every register at its power-up value.
+    pub fn power_up() -> Self {
+        let bank = RegisterBank::power_up();
+        Self {
+            bank,
+            regs: bank.registers(),
+            snapshot: (0, 0),
+        }
+    }
+
+    /// The settings the engine sees.
+    #[inline(always)]
+    pub fn registers(&self) -> &Registers {
+        &self.regs
+    }
+
+    /// A bus write of a whole word.
+    pub fn write(&mut self, offset: u32, word: u32) -> Result<(), BusError> {
+        self.bank.write(offset, word, 0xf)?;
+        self.regs = self.bank.registers();
+        Ok(())
+    }
+
+    /// A bus read with the engine's z now and its sample count: SAMPLE_COUNT
+    /// latches z, the z words read the latched pair, STREAM_OVERFLOW is 0
+    /// (no stream consumer), settings come from the bank.
+    pub fn read(&mut self, offset: u32, z_now: (i64, i64), samples: u32) -> Result<u32, BusError> {
         let reg = register_map::lookup(offset).ok_or(BusError::Unmapped)?;
         let z = |v: i64, high: bool| if high { (v >> 32) as u32 } else { v as u32 };
         let (z1, z2) = self.snapshot;
         let live = match reg.offset {
             o if o == SAMPLE_COUNT.offset => {
-                self.snapshot = self.outputs.z;
-                self.samples
+                self.snapshot = z_now;
+                samples
             }
             o if o == STREAM_OVERFLOW.offset => 0,
             o if o == Z1_LO.offset => z(z1, false),

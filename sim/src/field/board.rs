@@ -14,14 +14,14 @@
 //! table of the simulation harness, which host code (that sees a
 //! `&mut dyn Board`) cannot reach.
 
+use crate::cosim::HostRegisters;
 use crate::drift::DeviceAt;
 use crate::engine::{Engine, ModelEngine};
 use crate::frontend::{Converters, FrontEnd, PickoffPhase};
 use crate::gyro::GyroModel;
 use crate::noise::ThermalNoise;
 use gyrocal_hdl::host::register_map::{
-    self, BusError, RegisterAccess, RegisterBank, SAMPLE_COUNT, STREAM_OVERFLOW, Z1_HI, Z1_LO,
-    Z2_HI, Z2_LO,
+    self, BusError, RegisterAccess, SAMPLE_COUNT, Z1_HI, Z1_LO, Z2_HI, Z2_LO,
 };
 use gyrocal_hdl::model::gyro_interface::{Outputs, Registers};
 
@@ -66,11 +66,9 @@ pub struct SimBoard {
     converters: Converters,
     gyro: GyroModel,
     phase: Option<PickoffPhase>,
-    bank: RegisterBank,
-    regs: Registers,
+    host: HostRegisters,
     outputs: Outputs,
     samples: u32,
-    snapshot: (i64, i64),
     cycle: u64,
 }
 
@@ -97,17 +95,14 @@ impl SimBoard {
         } else {
             Some(PickoffPhase::new(p, phase_reference_hz)?)
         };
-        let bank = RegisterBank::power_up();
         Ok(Self {
             engine: ModelEngine::power_up()?,
             converters: Converters::new(&fe)?,
             gyro: GyroModel::new(&at.gyro, clock_hz)?.with_thermal_noise(noise)?,
             phase,
-            bank,
-            regs: bank.registers(),
+            host: HostRegisters::power_up(),
             outputs: Outputs::default(),
             samples: 0,
-            snapshot: (0, 0),
             cycle: 0,
         })
     }
@@ -132,7 +127,7 @@ impl SimBoard {
             }
         };
         let (adc, force) = self.converters.step(self.outputs.dac, x);
-        self.outputs = self.engine.step(adc, &self.regs);
+        self.outputs = self.engine.step(adc, self.host.registers());
         self.gyro.step(force.0, force.1);
         self.samples = self.samples.wrapping_add(self.outputs.z_valid as u32);
         self.cycle += 1;
@@ -150,29 +145,12 @@ impl Board for SimBoard {
 impl RegisterAccess for SimBoard {
     /// A write between two clocks: acts from the next clock on.
     fn write_register(&mut self, offset: u32, word: u32) -> Result<(), BusError> {
-        self.bank.write(offset, word, 0xf)?;
-        self.regs = self.bank.registers();
-        Ok(())
+        self.host.write(offset, word)
     }
 
     /// A read between two clocks; SAMPLE_COUNT latches z. STREAM_OVERFLOW
     /// is 0: the board has no stream consumer.
     fn read_register(&mut self, offset: u32) -> Result<u32, BusError> {
-        let reg = register_map::lookup(offset).ok_or(BusError::Unmapped)?;
-        let z = |v: i64, high: bool| if high { (v >> 32) as u32 } else { v as u32 };
-        let (z1, z2) = self.snapshot;
-        let live = match reg.offset {
-            o if o == SAMPLE_COUNT.offset => {
-                self.snapshot = self.outputs.z;
-                self.samples
-            }
-            o if o == STREAM_OVERFLOW.offset => 0,
-            o if o == Z1_LO.offset => z(z1, false),
-            o if o == Z1_HI.offset => z(z1, true),
-            o if o == Z2_LO.offset => z(z2, false),
-            o if o == Z2_HI.offset => z(z2, true),
-            _ => return self.bank.read(offset),
-        };
-        Ok(reg.extend(live))
+        self.host.read(offset, self.outputs.z, self.samples)
     }
 }
