@@ -76,10 +76,7 @@ impl AllanReport<'_> {
 
 /// Run the noisy readout and report its Allan deviation.
 pub fn run(args: &Args) -> Result<(), Failure> {
-    let name = args.config.display().to_string();
-    let text = std::fs::read_to_string(&args.config)
-        .map_err(|e| Failure::Input(format!("--config {name}: cannot read the file: {e}")))?;
-    let exp = gyrocal_sim::config::parse(&name, &text).map_err(Failure::Input)?;
+    let exp = super::experiment::load_experiment(&args.config)?;
     rate_noise::check_seconds(args.seconds).map_err(Failure::Input)?;
     let max_rate = gyrocal_sim::config::MAX_RATE_DPS;
     if !(args.rate_dps.is_finite() && args.rate_dps.abs() <= max_rate) {
@@ -114,7 +111,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
             .collect()
     });
     let report = AllanReport {
-        config: name,
+        config: args.config.display().to_string(),
         experiment: &exp,
         prediction: &prediction,
         run: &run,

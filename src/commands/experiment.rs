@@ -10,6 +10,20 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
+/// The text of `--config FILE`, and the name its errors go by (the path).
+pub fn read_config(path: &Path) -> Result<(String, String), Failure> {
+    let name = path.display().to_string();
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| Failure::Input(format!("--config {name}: cannot read the file: {e}")))?;
+    Ok((name, text))
+}
+
+/// `--config FILE` read and checked as the experiment `gyrocal run` runs.
+pub fn load_experiment(path: &Path) -> Result<Experiment, Failure> {
+    let (name, text) = read_config(path)?;
+    gyrocal_sim::config::parse(&name, &text).map_err(Failure::Input)
+}
+
 /// Options every experiment command takes.
 #[derive(clap::Args, Clone, Debug)]
 pub struct RunOptions {

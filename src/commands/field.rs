@@ -33,9 +33,7 @@ pub struct Args {
 
 /// Run the scenario.
 pub fn run(args: &Args) -> Result<(), Failure> {
-    let name = args.config.display().to_string();
-    let text = std::fs::read_to_string(&args.config)
-        .map_err(|e| Failure::Input(format!("--config {name}: cannot read the file: {e}")))?;
+    let (name, text) = super::experiment::read_config(&args.config)?;
     let (exp, drift) = scenario::parse(&name, &text).map_err(Failure::Input)?;
     let report = scenario::run(&exp, &drift, &|line| eprintln!("{line}")).map_err(Failure::Run)?;
     eprintln!(

@@ -10,7 +10,7 @@
 //! any register between the pins and the core (`REF_DELAY` follows them).
 
 use crate::Failure;
-use gyrocal_hdl::host::register_map::{self, REGISTERS, Register};
+use gyrocal_hdl::host::register_map::{self, AMP1, AMP2, REGISTERS, Register};
 use gyrocal_sim::experiment::{self, Mode, Plan};
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -39,8 +39,8 @@ pub struct Args {
 
 /// One block of writes: a mode and its words in write order.
 struct Block {
-    /// `readout` or `calibration`.
-    mode: &'static str,
+    /// Readout or calibration.
+    mode: Mode,
     /// Calibration rate in Hz (0 in readout).
     cal_hz: f64,
     /// C identifier of the block.
@@ -52,8 +52,10 @@ struct Block {
 impl Block {
     fn what(&self) -> String {
         match self.mode {
-            "readout" => "readout".to_owned(),
-            _ => format!("calibration at f_cal = {:.9} Hz (realized)", self.cal_hz),
+            Mode::Readout => "readout".to_owned(),
+            Mode::Calibration => {
+                format!("calibration at f_cal = {:.9} Hz (realized)", self.cal_hz)
+            }
         }
     }
 
@@ -66,7 +68,11 @@ impl Block {
             })
             .collect();
         serde_json::json!({
-            "mode": self.mode, "cal_hz": self.cal_hz, "name": self.name, "writes": writes
+            "mode": match self.mode {
+                Mode::Readout => "readout",
+                Mode::Calibration => "calibration",
+            },
+            "cal_hz": self.cal_hz, "name": self.name, "writes": writes
         })
     }
 }
@@ -83,8 +89,8 @@ fn register_at(offset: u32) -> &'static Register {
 fn blocks(plan: &Plan) -> Vec<Block> {
     let mut out: Vec<Block> = Vec::new();
     for p in &plan.points {
-        let calibration = p.mode == Mode::Calibration;
-        if !calibration && out.iter().any(|b| b.mode == "readout") {
+        // Every readout point has the same settings: one block.
+        if p.mode == Mode::Readout && out.iter().any(|b| b.mode == Mode::Readout) {
             continue;
         }
         let mut writes: Vec<(&'static Register, u32)> = register_map::encode(&p.regs)
@@ -92,18 +98,13 @@ fn blocks(plan: &Plan) -> Vec<Block> {
             .map(|(offset, word)| (register_at(offset), word))
             .collect();
         // Amplitudes last: the drives start on a programmed datapath.
-        writes.sort_by_key(|(r, _)| r.name.starts_with("AMP"));
-        let name = if calibration {
-            format!("gyro_calibration_{}", out.len() - 1)
-        } else {
-            "gyro_readout".to_owned()
+        writes.sort_by_key(|(r, _)| [AMP1.offset, AMP2.offset].contains(&r.offset));
+        let name = match p.mode {
+            Mode::Readout => "gyro_readout".to_owned(),
+            Mode::Calibration => format!("gyro_calibration_{}", out.len() - 1),
         };
         out.push(Block {
-            mode: if calibration {
-                "calibration"
-            } else {
-                "readout"
-            },
+            mode: p.mode,
             cal_hz: p.cal_hz,
             name,
             writes,
@@ -156,15 +157,12 @@ fn c_header(config: &str, plan: &Plan, blocks: &[Block]) -> String {
 
 /// Print the words.
 pub fn run(args: &Args) -> Result<(), Failure> {
-    let name = args.config.display().to_string();
-    let text = std::fs::read_to_string(&args.config)
-        .map_err(|e| Failure::Input(format!("--config {name}: cannot read the file: {e}")))?;
-    let exp = gyrocal_sim::config::parse(&name, &text).map_err(Failure::Input)?;
+    let exp = super::experiment::load_experiment(&args.config)?;
     let plan = experiment::plan(&exp).map_err(Failure::Input)?;
     let blocks = blocks(&plan);
     let out = match args.format {
         Format::Table => table(&plan, &blocks),
-        Format::C => c_header(&name, &plan, &blocks),
+        Format::C => c_header(&args.config.display().to_string(), &plan, &blocks),
         Format::Json => {
             let all: Vec<serde_json::Value> = blocks.iter().map(Block::json).collect();
             serde_json::to_string_pretty(&all).map_err(|e| Failure::Run(e.to_string()))? + "\n"

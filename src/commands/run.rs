@@ -1,6 +1,6 @@
 //! `gyrocal run --config FILE.toml`: co-simulate a user's device.
 
-use super::experiment::{RunOptions, execute, summary, write_results};
+use super::experiment::{RunOptions, execute, load_experiment, summary, write_results};
 use crate::Failure;
 use std::path::PathBuf;
 
@@ -22,10 +22,7 @@ pub struct Args {
 
 /// Run the configured experiment.
 pub fn run(args: &Args) -> Result<(), Failure> {
-    let name = args.config.display().to_string();
-    let text = std::fs::read_to_string(&args.config)
-        .map_err(|e| Failure::Input(format!("--config {name}: cannot read the file: {e}")))?;
-    let exp = gyrocal_sim::config::parse(&name, &text).map_err(Failure::Input)?;
+    let exp = load_experiment(&args.config)?;
     let checked = args.options.check(&exp)?;
     let report = execute(&exp, &args.options, &checked)?;
     if let Some(dir) = &args.out {
