@@ -2,21 +2,12 @@
 //! and writes JSON, CSV and figures; bad input is one line, exit status 2,
 //! and nothing written.
 
+mod common;
+
+use common::{gyrocal, json_object, stderr};
 use std::path::Path;
-use std::process::{Command, Output};
 
 const SMALL: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/allan_small.toml");
-
-fn gyrocal(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_gyrocal"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
 
 #[test]
 fn a_short_run_prints_json_and_writes_its_files() {
@@ -35,14 +26,7 @@ fn a_short_run_prints_json_and_writes_its_files() {
         "--out",
         out.to_str().unwrap(),
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let text = String::from_utf8(o.stdout).unwrap();
-    assert_eq!(
-        text.trim().lines().count(),
-        1,
-        "one JSON object on one line"
-    );
-    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let v = json_object(o);
     assert_eq!(v["run"]["rate_dps"].as_f64(), Some(-20.0));
     for k in 0..2 {
         let predicted = v["prediction"]["outputs"][k]["arw_deg_per_sqrt_h"]

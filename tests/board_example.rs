@@ -8,8 +8,12 @@
 //! Requires Verilator, Yosys and a C compiler (`cc`, Debian `gcc`); a
 //! missing tool fails the test with the package to install.
 
+mod common;
+
+use common::{gyrocal, stderr};
 use gyrocal_hdl::export::AXI_TOP_MODULE;
 use gyrocal_verify::{self as verify, lint, synthesis};
+use std::ffi::OsStr;
 use std::path::PathBuf;
 use std::process::Command;
 
@@ -59,16 +63,15 @@ fn board_top_elaborates_without_loops() {
 #[test]
 fn host_example_compiles_with_a_printed_plan_and_passes_its_self_test() {
     let dir = verify::ScratchDir::new("host-example").unwrap();
-    let plan = Command::new(env!("CARGO_BIN_EXE_gyrocal"))
-        .args(["registers", "--format", "c", "--config"])
-        .arg(verify::workspace_root().join("tests/data/small_device.toml"))
-        .output()
-        .expect("run gyrocal registers");
-    assert!(
-        plan.status.success(),
-        "{}",
-        String::from_utf8_lossy(&plan.stderr)
-    );
+    let config = verify::workspace_root().join("tests/data/small_device.toml");
+    let plan = gyrocal(&[
+        OsStr::new("registers"),
+        OsStr::new("--format"),
+        OsStr::new("c"),
+        OsStr::new("--config"),
+        config.as_os_str(),
+    ]);
+    assert!(plan.status.success(), "{}", stderr(&plan));
     std::fs::write(dir.path().join("gyro_plan.h"), &plan.stdout).unwrap();
     let binary = dir.path().join("gyro_host");
     let cc = Command::new("cc")

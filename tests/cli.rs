@@ -1,32 +1,16 @@
 //! The command line as a user meets it: outputs, errors, waveforms.
 
+mod common;
+
+use common::{gyrocal, json_object, stderr};
 use std::path::Path;
-use std::process::{Command, Output};
 
 const SMALL: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/small_device.toml");
-
-fn gyrocal(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_gyrocal"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
 
 #[test]
 fn run_json_holds_the_scale_factors_and_the_theory() {
     let o = gyrocal(&["run", "--config", SMALL, "--json", "--quiet"]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let text = String::from_utf8(o.stdout).unwrap();
-    assert_eq!(
-        text.trim().lines().count(),
-        1,
-        "one JSON object on one line"
-    );
-    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let v = json_object(o);
     for key in ["sf_read_per_dps", "sf_cal_per_dps", "ratio"] {
         for obj in [&v, &v["theory"]] {
             let pair = obj[key]

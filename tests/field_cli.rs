@@ -1,7 +1,10 @@
 //! `gyrocal field` refuses bad scenario files in one line, with exit
 //! status 2, before writing anything.
 
-use std::process::Command;
+mod common;
+
+use common::gyrocal;
+use std::ffi::OsStr;
 
 const GOOD: &str = "[gyro]\nf1_hz = 25.1e3\nf2_hz = 25.8e3\nq1 = 3000\nq2 = 3000\nangular_gain = 0.8\n\
 [drive]\ncarrier_hz = 25.1e3\nclock_hz = 1.2345e6\n\
@@ -32,14 +35,14 @@ fn bad_scenario_files_are_refused_in_one_line() {
         let config = dir.path().join(format!("bad{i}.toml"));
         std::fs::write(&config, text).unwrap();
         let out = dir.path().join(format!("out{i}"));
-        let run = Command::new(env!("CARGO_BIN_EXE_gyrocal"))
-            .args(["field", "--config"])
-            .arg(&config)
-            .arg("--out")
-            .arg(&out)
-            .output()
-            .unwrap();
-        let stderr = String::from_utf8_lossy(&run.stderr);
+        let run = gyrocal(&[
+            OsStr::new("field"),
+            OsStr::new("--config"),
+            config.as_os_str(),
+            OsStr::new("--out"),
+            out.as_os_str(),
+        ]);
+        let stderr = common::stderr(&run);
         assert_eq!(run.status.code(), Some(2), "{key}: {stderr}");
         assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
         assert!(stderr.contains(key), "{key}: {stderr}");

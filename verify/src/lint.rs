@@ -97,13 +97,7 @@ impl LintReport {
 /// Lint `verilog` (top module `gyro_interface`) with `verilator --lint-only
 /// -Wall`, reading `waivers` (a `.vlt` file) first if given.
 pub fn lint(verilog: &Path, waivers: Option<&Path>) -> Result<LintReport, VerifyError> {
-    lint_top(verilog, TOP_MODULE, waivers.as_slice())
-}
-
-/// Lint `verilog` with top module `top`, reading the `waivers` files (in
-/// order) first.
-pub fn lint_top(verilog: &Path, top: &str, waivers: &[&Path]) -> Result<LintReport, VerifyError> {
-    lint_files(&[verilog], top, waivers)
+    lint_files(&[verilog], TOP_MODULE, waivers.as_slice())
 }
 
 /// Lint the design made of the files `verilog` with top module `top`,
@@ -268,7 +262,7 @@ pub fn waiver_usage_top(
         reason: e,
         output: String::new(),
     })?;
-    let baseline = lint_top(verilog, top, &with(kept, waivers))?;
+    let baseline = lint_files(&[verilog], top, &with(kept, waivers))?;
     let dir = ScratchDir::new("waivers").map_err(io_error("cannot create a scratch folder"))?;
     let lines: Vec<&str> = text.lines().collect();
     let lint_without = |w: &Waiver| -> Result<WaiverUse, VerifyError> {
@@ -282,7 +276,7 @@ pub fn waiver_usage_top(
         let file = dir.path().join(format!("without-line-{}.vlt", w.line));
         std::fs::write(&file, reduced)
             .map_err(io_error(format!("cannot write {}", file.display())))?;
-        let report = lint_top(verilog, top, &with(kept, &file))?;
+        let report = lint_files(&[verilog], top, &with(kept, &file))?;
         let suppressed = report
             .warnings
             .into_iter()
