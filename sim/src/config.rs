@@ -340,14 +340,15 @@ impl Experiment {
                 rc_hz: Some(2000.0),
             },
             points: Points {
-                // One round of 0.1 s readout windows fits the 9 s budget on
-                // 2 idle cores with room to spare, and leaves the detuned
-                // ratio's uncertainty near 3.3e-5 (dithered), a third of
-                // the 1e-4 `reproduce` must reach: longer first windows
-                // spend the budget better than a second round, which
-                // repeats the settling. (Calibration windows are whole
-                // ripple periods, 8 x 1/(2 f_cal), whatever this value.)
-                min_window_s: Some(0.1),
+                // One round of 0.15 s windows fits the 9 s budget on 2
+                // idle cores (4.9 s of simulated time, 2.45e8 clocks) and
+                // leaves the detuned ratio's uncertainty near 3e-5
+                // (dithered; the spread over 16 seeds at 0.1 s was 3.7e-5),
+                // a third of the 1e-4 `reproduce` must reach: longer first
+                // windows spend the budget better than a second round,
+                // which repeats the settling. The calibration windows are
+                // 3 whole ripple periods (0.15 s at 10 Hz, 0.1 s at 15 Hz).
+                min_window_s: Some(0.15),
                 // `reproduce` promises a result within 10 s of wall time.
                 budget_s: 9.0,
                 ..Points::new(
