@@ -169,7 +169,7 @@ fn unequal_q_and_negative_split() {
 #[test]
 fn the_papers_device_at_full_scale() {
     // `gyrocal reproduce`'s experiment: 9.64 MHz, Q 55,000, 250 Hz split,
-    // 50 MHz clock, 1..20 deg/s, 10..15 Hz, dithered converters: 2.6e8 clocks.
+    // 50 MHz clock, 1..20 deg/s, 10..15 Hz, dithered converters: 2.45e8 clocks.
     let r = run(&Experiment::paper());
     assert_eq!(r.detuned_output, Some(1));
     // The exact fitted ratio at the paper's points is about 1.534 and the
@@ -182,17 +182,19 @@ fn the_papers_device_at_full_scale() {
     );
     assert!((r.theory.small_signal.ratio[1] - 1.5365).abs() < 1e-3);
     assert_ratios_match_theory(&r, "paper's device");
-    // The plan's precision for `reproduce`: the detuned ratio's 1-sigma
-    // uncertainty about 3.3e-5 of the ratio (dithered converters, 0.1 s
-    // windows). Issue 7 asks the result to land within 1e-4 of the exact
-    // theory; over 8 dither seeds the error spreads by about 4e-5 around
-    // +3e-5, so a single run lands within 1e-4 about 95% of the time, and
-    // seed 1 on the pipelined datapath does not (+1.02e-4): that is stated
-    // in the README, not asserted here. Agreement with the theory is the
-    // 0.1% above; the honesty of sigma is tests/uncertainty_is_honest.rs.
+    // Issue 7: `reproduce`'s run lands within 1e-4 of the exact theory on
+    // the detuned output. The plan's precision (0.15 s windows, dithered
+    // converters): a 1-sigma uncertainty near 3e-5 of the ratio; over
+    // dither seeds 1..16 the error spread by 3.05e-5 around +1.0e-5 +- 0.8e-5
+    // (no bias at that level), so an unbiased run lands within 1e-4 with
+    // probability 0.999. This run's dither is fixed (seed 1): the assertion
+    // is a regression guard; a bias of a few 1e-5 introduced later (a
+    // latency the theory does not know, a rounding) would push it out.
+    // The honesty of sigma is tests/uncertainty_is_honest.rs.
     let (error, sigma) = (r.ratio_error[1], r.ratio_uncertainty[1] / r.ratio[1].abs());
     eprintln!("paper's device: detuned ratio error {error:+.2e}, 1 sigma {sigma:.2e}");
     assert!(sigma < 5e-5, "1 sigma {sigma:.2e}");
+    assert!(error.abs() < 1e-4, "detuned ratio error {error:+.2e}");
 }
 
 #[test]
