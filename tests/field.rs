@@ -8,8 +8,8 @@ use gyrocal_sim::field::selfcal;
 
 fn run(path: &str) -> FieldReport {
     let text = std::fs::read_to_string(path).unwrap();
-    let (exp, drift) = scenario::parse(path, &text).unwrap();
-    scenario::run(&exp, &drift, &|line| eprintln!("{line}")).unwrap()
+    let sc = scenario::parse(path, &text).unwrap();
+    scenario::run(&sc, &|line| eprintln!("{line}")).unwrap()
 }
 
 /// The consumer device of `tests/data/field_consumer.toml` with its
@@ -17,8 +17,10 @@ fn run(path: &str) -> FieldReport {
 fn run_consumer(drift: Drift) -> FieldReport {
     let path = "tests/data/field_consumer.toml";
     let text = std::fs::read_to_string(path).unwrap();
-    let (exp, _) = scenario::parse(path, &text).unwrap();
-    scenario::run(&exp, &drift, &|line| eprintln!("{line}")).unwrap()
+    let mut sc = scenario::parse(path, &text).unwrap();
+    sc.drift = drift;
+    sc.profile = None;
+    scenario::run(&sc, &|line| eprintln!("{line}")).unwrap()
 }
 
 /// No drift but the converters' gains (ppm/K) over 25, 35, 15 deg C.
@@ -59,6 +61,40 @@ fn consumer_and_high_q_devices_self_calibrate_over_ten_kelvin() {
     ] {
         let report = run(path);
         assert_within_target(&report);
+        if report.profile.is_some() {
+            assert_rate_output_tracks_temperature(&report);
+        }
+    }
+}
+
+/// The calibrated rate output under the profile. At T0 the self-calibrated
+/// and the baseline outputs read the same z (their scale factors differ by
+/// the self-calibration's error); what is left of their error
+/// there is the device's (the readout's curvature against the line fitted
+/// over the readout rates, the output's lag on a ramp), not the
+/// calibration's. Elsewhere the self-calibrated output must keep that
+/// error (its scale factor moves by < 0.1% and its null is measured
+/// again: within 25% of T0's RMS on the rate output, the output whose
+/// scale factor is largest), while the baseline's grows by orders of
+/// magnitude (a fixed null on an output whose offset moves with the
+/// detuning).
+fn assert_rate_output_tracks_temperature(report: &FieldReport) {
+    let k = usize::from(report.sf_factory_per_dps[1].abs() > report.sf_factory_per_dps[0].abs());
+    let at_t0 = report.steps[0].profile.as_ref().unwrap();
+    let reference = at_t0.selfcal_rms_error_dps[k];
+    for s in &report.steps[1..] {
+        let trace = s.profile.as_ref().unwrap();
+        let (own, base) = (
+            trace.selfcal_rms_error_dps[k],
+            trace.baseline_rms_error_dps[k],
+        );
+        eprintln!(
+            "{} deg C output {}: rate RMS error self-cal {own:.4} deg/s, baseline {base:.4e} deg/s (T0 {reference:.4})",
+            s.temperature_c,
+            k + 1
+        );
+        assert!((own / reference - 1.0).abs() < 0.25, "{own} vs {reference}");
+        assert!(base > 100.0 * reference, "{base}");
     }
 }
 
