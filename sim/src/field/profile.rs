@@ -199,7 +199,7 @@ pub fn run_profile(
 ) -> Result<ProfileRun, String> {
     let sample_s = f64::from(decimation) / clock_hz;
     let per_record = (profile.record_length_s() / sample_s).round().max(1.0) as usize;
-    let records = (profile.duration_s / (per_record as f64 * sample_s)).floor() as usize;
+    let records = ((profile.duration_s / (per_record as f64 * sample_s)).floor() as usize).max(1);
     let mut run = ProfileRun {
         time_s: Vec::with_capacity(records),
         true_rate_dps: Vec::with_capacity(records),

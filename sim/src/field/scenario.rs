@@ -8,7 +8,8 @@
 //!   converter gains and the front-end phase are `Drift::at(T)`, on a fresh
 //!   board (quasi-static steps; the steps run in parallel).
 //! - Self-calibration: [`selfcal::self_calibrate`] from the datasheet (the
-//!   host does not know the temperature).
+//!   host does not know the temperature). The first step's (at T0) is the
+//!   factory calibration.
 //! - Truth: the rate table (`SimBoard::set_rate`) at the readout rates of
 //!   `[experiment]`, with the self-calibration's carrier and phase
 //!   correction: the least-squares slope of z against the rate, z LSB per
@@ -16,6 +17,11 @@
 //! - Baseline: the factory calibration at T0 (the cycle, then the rate
 //!   table) fixes the carrier, the phase correction and the scale factor;
 //!   at T its error is against the rate table with those fixed settings.
+//! - With a `[profile]` ([`profile`]): after its cycle each step's board
+//!   switches to readout, measures its null at rest and runs the profile;
+//!   the rate output is (z - null) / SF_selfcal. The baseline runs the
+//!   profile on a fresh board at the factory's settings and reads it with
+//!   the factory's null and scale factor.
 
 use super::board::{Board, SimBoard};
 use super::identify::{Identified, Knowns};
@@ -36,6 +42,10 @@ use std::time::Instant;
 
 /// Amplitude time constants waited before the first rate of a table (the
 /// readout offset of a detuned output can be 1e4 times the rate signal).
+/// Measured on the consumer device's output 1 (its rate term 1e-4 of its
+/// offset), the slope after 20, 25, 30, 40, 60 of these: -188.83, -189.06,
+/// -189.10, -189.08, -189.03 z LSB per deg/s: settled from 30 on, within
+/// the +-0.04% the spurs' beats leave (`rate_table`).
 const TABLE_FIRST_TAUS: f64 = 30.0;
 
 /// A scenario file: the sections of `gyrocal run` plus `[drift]` and,
@@ -302,11 +312,14 @@ struct Cycle {
     cal: SelfCal,
     /// Readout null at rest and the profile's run, with `[profile]`.
     readout: Option<([f64; 2], ProfileRun)>,
+    /// The rate table's slopes at the cycle's settings (z LSB per deg/s).
+    sf_true: [f64; 2],
     clocks: u64,
 }
 
 /// Self-calibrate a fresh board at `t`; with a profile, then switch to
 /// readout, measure the null at rest and run the profile on that board.
+/// The rate table at the cycle's settings follows (its rates in parallel).
 fn cycle_at(sc: &Scenario, fe: &FrontEnd, knowns: &Knowns, t: f64) -> Result<Cycle, String> {
     let at = sc.drift.at(&sc.exp.gyro, t);
     let mut board = board_at(&sc.exp, fe, &at)?;
@@ -325,19 +338,19 @@ fn cycle_at(sc: &Scenario, fe: &FrontEnd, knowns: &Knowns, t: f64) -> Result<Cyc
             ))
         }
     };
+    let (sf_true, table_clocks) = rate_table(&sc.exp, fe, &at, knowns, &cal.operating)?;
     Ok(Cycle {
         at,
         cal,
         readout,
-        clocks: board.cycle(),
+        sf_true,
+        clocks: board.cycle() + table_clocks,
     })
 }
 
-/// The simulation's measurements after the cycles, run as independent
-/// jobs in parallel.
+/// The simulation's measurements at the factory's settings, run as
+/// independent jobs in parallel once the factory calibration is known.
 enum Job {
-    /// Rate-table point of step `step` at its own settings.
-    Own { step: usize, rate: usize },
     /// Rate-table point of step `step` at the factory's settings.
     Factory { step: usize, rate: usize },
     /// The profile of step `step` at the factory's settings.
@@ -349,40 +362,34 @@ enum Done {
     Profile(ProfileRun),
 }
 
+/// Every step but the first (at T0 the factory's settings are its own).
 fn jobs(steps: usize, rates: usize, with_profile: bool) -> Vec<Job> {
     let mut jobs = vec![];
-    for step in 0..steps {
-        // At T0 the factory's settings are the step's own.
-        jobs.extend((0..rates).map(|rate| Job::Own { step, rate }));
-        if step > 0 {
-            jobs.extend((0..rates).map(|rate| Job::Factory { step, rate }));
-            if with_profile {
-                jobs.push(Job::BaselineProfile { step });
-            }
+    for step in 1..steps {
+        jobs.extend((0..rates).map(|rate| Job::Factory { step, rate }));
+        if with_profile {
+            jobs.push(Job::BaselineProfile { step });
         }
     }
     jobs
 }
 
-/// The rate table's z at `rates_dps` from the finished jobs of `step`.
-fn table_z(jobs: &[Job], done: &[Done], step: usize, own: bool, rates: usize) -> Vec<[f64; 2]> {
+/// The factory-settings rate table's z of `step` from the finished jobs.
+fn table_z(jobs: &[Job], done: &[Done], step: usize, rates: usize) -> Vec<[f64; 2]> {
     let mut z = vec![[0.0; 2]; rates];
     for (job, d) in jobs.iter().zip(done) {
-        let (s, r, is_own) = match *job {
-            Job::Own { step, rate } => (step, rate, true),
-            Job::Factory { step, rate } => (step, rate, false),
-            Job::BaselineProfile { .. } => continue,
-        };
-        if let (true, Done::Point(v)) = (s == step && is_own == own, d) {
-            z[r] = *v;
+        match (job, d) {
+            (Job::Factory { step: s, rate }, Done::Point(v)) if *s == step => z[*rate] = *v,
+            _ => {}
         }
     }
     z
 }
 
-/// Run a scenario: every step's cycle in parallel (the first step's is the
-/// factory calibration), then every rate-table point and baseline profile
-/// in parallel; `progress` gets one line per finished step.
+/// Run a scenario: every step's cycle and rate table in parallel (the
+/// first step's cycle is the factory calibration), then every rate-table
+/// point and baseline profile at the factory's settings in parallel;
+/// `progress` gets one line per step.
 pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldReport, String> {
     let (exp, drift) = (&sc.exp, &sc.drift);
     exp.validate()?;
@@ -407,12 +414,6 @@ pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldRepor
         .par_iter()
         .map(|job| -> Result<(Done, u64), String> {
             match *job {
-                Job::Own { step, rate } => {
-                    let c = &cycles[step];
-                    let (z, n) =
-                        table_point(exp, &fe, &c.at, &knowns, &c.cal.operating, rates[rate])?;
-                    Ok((Done::Point(z), n))
-                }
                 Job::Factory { step, rate } => {
                     let at = &cycles[step].at;
                     let (z, n) = table_point(exp, &fe, at, &knowns, &factory, rates[rate])?;
@@ -431,18 +432,15 @@ pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldRepor
         .collect::<Result<_, String>>()?;
     let job_clocks: u64 = done.iter().map(|d| d.1).sum();
     let done: Vec<Done> = done.into_iter().map(|d| d.0).collect();
-    let sf_own: Vec<[f64; 2]> = (0..cycles.len())
-        .map(|i| table_slopes(rates, &table_z(&jobs, &done, i, true, rates.len())))
-        .collect();
-    let sf_factory = sf_own[0];
+    let sf_factory = cycles[0].sf_true;
     let null_factory = cycles[0].readout.as_ref().map(|r| r.0);
     let mut steps = vec![];
     for (i, c) in cycles.into_iter().enumerate() {
-        let sf_true = sf_own[i];
+        let sf_true = c.sf_true;
         let sf_fixed = if i == 0 {
             sf_true
         } else {
-            table_slopes(rates, &table_z(&jobs, &done, i, false, rates.len()))
+            table_slopes(rates, &table_z(&jobs, &done, i, rates.len()))
         };
         let baseline_run = jobs.iter().zip(&done).find_map(|(j, d)| match (j, d) {
             (Job::BaselineProfile { step }, Done::Profile(run)) if *step == i => Some(run),
