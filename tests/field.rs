@@ -111,7 +111,7 @@ fn assert_rate_output_tracks_temperature(report: &FieldReport) {
 /// rounding error, re-drawn when the level moves. On the self-calibration
 /// (the staircase's window means, 6e5 to 1e8 z LSB, and the identification
 /// behind the predicted ratio) that is far below 0.01%: SF_selfcal / level
-/// must move by less than 1e-4 (measured: 2e-6 and 1.4e-5).
+/// must move by less than 1e-4 (measured: 5e-7 and 3.4e-6).
 ///
 /// The truth, the rate table, is another matter on output 1: its rate term
 /// is 189 z LSB per deg/s on an offset of 1e8 (the resonant drive mode at

@@ -399,7 +399,15 @@ pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldRepor
     let cycles: Vec<Cycle> = drift
         .temperatures_c
         .par_iter()
-        .map(|&t| cycle_at(sc, &fe, &knowns, t))
+        .map(|&t| {
+            let c = cycle_at(sc, &fe, &knowns, t)?;
+            progress(&format!(
+                "{t} deg C: cycle and rate table done, self-cal error {:+.4}% / {:+.4}%",
+                100.0 * (c.cal.sf_selfcal_per_dps[0] / c.sf_true[0] - 1.0),
+                100.0 * (c.cal.sf_selfcal_per_dps[1] / c.sf_true[1] - 1.0),
+            ));
+            Ok(c)
+        })
         .collect::<Result<_, String>>()?;
     let factory = cycles[0].cal.operating.clone();
     progress(&format!(
