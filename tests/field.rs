@@ -5,11 +5,13 @@
 use gyrocal_sim::drift::Drift;
 use gyrocal_sim::field::scenario::{self, FieldReport};
 use gyrocal_sim::field::selfcal;
+use gyrocal_sim::noise::ThermalNoise;
+use gyrocal_sim::rate_noise;
 
 fn run(path: &str) -> FieldReport {
     let text = std::fs::read_to_string(path).unwrap();
-    let (exp, drift) = scenario::parse(path, &text).unwrap();
-    scenario::run(&exp, &drift, &|line| eprintln!("{line}")).unwrap()
+    let sc = scenario::parse(path, &text).unwrap();
+    scenario::run(&sc, &|line| eprintln!("{line}")).unwrap()
 }
 
 /// The consumer device of `tests/data/field_consumer.toml` with its
@@ -17,14 +19,16 @@ fn run(path: &str) -> FieldReport {
 fn run_consumer(drift: Drift) -> FieldReport {
     let path = "tests/data/field_consumer.toml";
     let text = std::fs::read_to_string(path).unwrap();
-    let (exp, _) = scenario::parse(path, &text).unwrap();
-    scenario::run(&exp, &drift, &|line| eprintln!("{line}")).unwrap()
+    let mut sc = scenario::parse(path, &text).unwrap();
+    sc.drift = drift;
+    sc.profile = None;
+    scenario::run(&sc, &|line| eprintln!("{line}")).unwrap()
 }
 
-/// No drift but the converters' gains (ppm/K) over 25, 35, 15 deg C.
+/// No drift but the converters' gains (ppm/K), from 25 to 35 deg C.
 fn gains_only(adc: [f64; 2], drive: [f64; 2]) -> Drift {
     Drift {
-        temperatures_c: vec![25.0, 35.0, 15.0],
+        temperatures_c: vec![25.0, 35.0],
         tcf1_ppm_per_k: 0.0,
         tcf2_ppm_per_k: 0.0,
         q_ppm_per_k: 0.0,
@@ -53,40 +57,127 @@ fn assert_within_target(report: &FieldReport) {
 
 #[test]
 fn consumer_and_high_q_devices_self_calibrate_over_ten_kelvin() {
-    for path in [
-        "tests/data/field_consumer.toml",
-        "tests/data/field_highq.toml",
-    ] {
-        let report = run(path);
-        assert_within_target(&report);
+    let report = run("tests/data/field_consumer.toml");
+    assert_within_target(&report);
+    assert_rate_output_tracks_temperature(&report);
+    // The high-Q device at its extremes and T0 only: its identification
+    // waits 12 of its 19 ms time constants per carrier on a 20.3 MHz clock
+    // (240 M clocks a step); `gyrocal field --config
+    // tests/data/field_highq.toml` runs all five steps.
+    let path = "tests/data/field_highq.toml";
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut sc = scenario::parse(path, &text).unwrap();
+    sc.drift.temperatures_c = vec![25.0, 15.0, 35.0];
+    let report = scenario::run(&sc, &|line| eprintln!("{line}")).unwrap();
+    assert_within_target(&report);
+}
+
+/// The calibrated rate output under the profile. At T0 the self-calibrated
+/// and the baseline outputs read the same z (their scale factors differ by
+/// the self-calibration's error); what is left of their error
+/// there is the device's (the readout's curvature against the line fitted
+/// over the readout rates, the output's lag on a ramp), not the
+/// calibration's. Elsewhere the self-calibrated output must keep that
+/// error (its scale factor moves by < 0.1% and its null is measured
+/// again: within 25% of T0's RMS on the rate output, the output whose
+/// scale factor is largest), while the baseline's grows by orders of
+/// magnitude (a fixed null on an output whose offset moves with the
+/// detuning).
+fn assert_rate_output_tracks_temperature(report: &FieldReport) {
+    let k = usize::from(report.sf_factory_per_dps[1].abs() > report.sf_factory_per_dps[0].abs());
+    let at_t0 = report.steps[0].profile.as_ref().unwrap();
+    let reference = at_t0.selfcal_rms_error_dps[k];
+    for s in &report.steps[1..] {
+        let trace = s.profile.as_ref().unwrap();
+        let (own, base) = (
+            trace.selfcal_rms_error_dps[k],
+            trace.baseline_rms_error_dps[k],
+        );
+        eprintln!(
+            "{} deg C output {}: rate RMS error self-cal {own:.4} deg/s, baseline {base:.4e} deg/s (T0 {reference:.4})",
+            s.temperature_c,
+            k + 1
+        );
+        assert!((own / reference - 1.0).abs() < 0.25, "{own} vs {reference}");
+        assert!(base > 100.0 * reference, "{base}");
     }
 }
 
 /// ADC gains and a common drive gain cancel exactly in the ratio
-/// (`selfcal` module header). +-10% of each (ADC up while the drives go
-/// down, so the ADC stays below full scale) must leave the
-/// self-calibration within its 0.1% target, and move it by no more than
-/// the run-to-run scatter of this device's self-calibration error (0.008%
-/// to 0.063% over the steps of `field_consumer.toml`, measured): the two
-/// runs share the noise seed, but the changed signal levels change which
-/// noise the averages see. (Measured: 0.032%, identical at 15 and 35 deg C,
-/// where a x g is 0.99 in both: the level, not the gains' split, moves
-/// it. Showing the < 0.01% the analysis promises needs longer windows
-/// than this test can afford.)
+/// (`selfcal` module header): at 35 deg C the ADCs are up 10% and the
+/// drives down 10% (the ADC stays below full scale), so every signal is
+/// 0.99 of the plain run's, with the same noise seed.
+///
+/// The model is linear up to the converters' rounding: the gyroscope's
+/// response scales with the drive gain, the ADC's input with both, and the
+/// ADC adds the same noise samples in both runs. What differs is the ADC's
+/// rounding error, re-drawn when the level moves. On the self-calibration
+/// (the staircase's window means, 6e5 to 1e8 z LSB, and the identification
+/// behind the predicted ratio) that is far below 0.01%: SF_selfcal / level
+/// must move by less than 1e-4 (measured: 5e-7 and 3.4e-6).
+///
+/// The truth, the rate table, is another matter on output 1: its rate term
+/// is 189 z LSB per deg/s on an offset of 1e8 (the resonant drive mode at
+/// full scale), a change far below one ADC LSB per sample from one rate
+/// to the next, where the rounding's error, with 1 LSB of dither, is some
+/// 1e-4 of that slope and moves with any change of level (measured by
+/// `rounding_moves_the_resonant_outputs_rate_table`: 5e-5 to 9e-4 over
+/// levels 0.5 to 0.99, 6e-4 to 7e-3 without dither; output 2, whose rate
+/// term is larger, 1e-4). So the
+/// self-calibration error (against that truth) may move by that much; it
+/// must stay within the 0.1% target.
 #[test]
 fn adc_and_common_drive_gains_cancel() {
     let plain = run_consumer(gains_only([0.0; 2], [0.0; 2]));
     let gains = run_consumer(gains_only([1e4, 1e4], [-1e4, -1e4]));
     assert_within_target(&gains);
-    for (a, b) in plain.steps.iter().zip(&gains.steps) {
-        for k in 0..2 {
-            let moved = b.selfcal_error[k] - a.selfcal_error[k];
+    let (a, b) = (&plain.steps[1], &gains.steps[1]);
+    for k in 0..2 {
+        let level = b.truth.adc_gain[k] * b.truth.drive_gain[k];
+        let moved = |x: [f64; 2], y: [f64; 2]| y[k] / (x[k] * level) - 1.0;
+        let selfcal = moved(a.sf_selfcal_per_dps, b.sf_selfcal_per_dps);
+        let cal = moved(a.selfcal.sf_cal_per_dps, b.selfcal.sf_cal_per_dps);
+        let ratio = b.selfcal.ratio.exact[k] / a.selfcal.ratio.exact[k] - 1.0;
+        let truth = moved(a.sf_true_per_dps, b.sf_true_per_dps);
+        eprintln!(
+            "output {}: level {level}, SF_selfcal / level moved {selfcal:+.2e} (SF_cal {cal:+.2e}, \
+             ratio {ratio:+.2e}), rate table / level moved {truth:+.2e}",
+            k + 1
+        );
+        assert!(selfcal.abs() < 1e-4, "{selfcal}");
+        assert!(truth.abs() < 1e-3, "{truth}");
+    }
+}
+
+/// The rate table's slope over the ADC level (module note above
+/// `adc_and_common_drive_gains_cancel`), with the plain run's carrier and
+/// zero phase correction on every run: with and without the 1 LSB dither.
+/// A measurement, printed: `cargo test --release --test field --
+/// --ignored --nocapture rounding`.
+#[test]
+#[ignore]
+fn rounding_moves_the_resonant_outputs_rate_table() {
+    let path = "tests/data/field_consumer.toml";
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut sc = scenario::parse(path, &text).unwrap();
+    for noise in [1.0, 0.0] {
+        sc.exp.frontend.noise_lsb = noise;
+        let (fe, knowns) = scenario::build(&sc.exp).unwrap();
+        let mut at = gains_only([0.0; 2], [0.0; 2]).at(&sc.exp.gyro, 25.0);
+        let op = selfcal::Operating {
+            carrier_hz: sc.exp.drive.carrier_hz,
+            ref_lag_deg: 0.0,
+            envelope_delay_s: 0.0,
+        };
+        let (sf0, _) = scenario::rate_table(&sc.exp, &fe, &at, &knowns, &op).unwrap();
+        for level in [0.99, 0.98, 0.9, 0.5] {
+            at.adc_gain = [level; 2];
+            let (sf, _) = scenario::rate_table(&sc.exp, &fe, &at, &knowns, &op).unwrap();
             eprintln!(
-                "{} deg C output {}: moved {moved:+.2e}",
-                a.temperature_c,
-                k + 1
+                "dither {noise} LSB, level {level}: rate table / level moved {:+.2e} / {:+.2e}",
+                sf[0] / (level * sf0[0]) - 1.0,
+                sf[1] / (level * sf0[1]) - 1.0
             );
-            assert!(moved.abs() < 6.3e-4, "{moved}");
         }
     }
 }
@@ -148,6 +239,67 @@ fn paper_device_self_calibrates_over_ten_kelvin() {
             s.baseline_error.iter().all(|e| e.abs() > 1.0),
             "{:?}",
             s.baseline_error
+        );
+    }
+}
+
+/// Brownian force noise on (300 K, the default 1e-8 kg modal mass) with
+/// the ADC's 1 LSB, on the consumer device driven at 100 N/kg full scale
+/// (so that the noise is referred to a physical drive): the noise model
+/// (`rate_noise`) puts the Brownian force at 84% of the rate noise on both
+/// outputs (ARW 19 and 2.1 deg/sqrt(h)), a noisy consumer part. The
+/// self-calibration must stay within its 0.1% at every step, for two noise
+/// seeds; the seed-to-seed difference of the errors, over sqrt(2), is the
+/// Brownian noise's 1-sigma share of each error (printed).
+#[test]
+fn self_calibration_holds_with_brownian_noise() {
+    let path = "tests/data/field_consumer.toml";
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut sc = scenario::parse(path, &text).unwrap();
+    sc.profile = None;
+    sc.drift.temperatures_c = vec![25.0, 15.0, 35.0];
+    sc.exp.drive.force_full_scale1_n_per_kg = 100.0;
+    sc.exp.drive.force_full_scale2_n_per_kg = 100.0;
+    sc.exp.noise = ThermalNoise {
+        mass_kg: 1e-8,
+        temperature_k: 300.0,
+        seed: 1,
+    };
+    let (_, prediction) = rate_noise::plan_and_predict(&sc.exp, 100.0).unwrap();
+    for o in &prediction.outputs {
+        let share = o.thermal_rate_psd / o.rate_psd;
+        eprintln!(
+            "predicted ARW {:.2} deg/sqrt(h), Brownian share {:.0}%",
+            o.arw_deg_per_sqrt_h,
+            100.0 * share
+        );
+        assert!(share > 0.5, "{share}");
+    }
+    let first = scenario::run(&sc, &|line| eprintln!("{line}")).unwrap();
+    sc.exp.noise.seed = 2;
+    let second = scenario::run(&sc, &|line| eprintln!("{line}")).unwrap();
+    assert_within_target(&first);
+    assert_within_target(&second);
+    for k in 0..2 {
+        let diffs: Vec<f64> = first
+            .steps
+            .iter()
+            .zip(&second.steps)
+            .map(|(a, b)| a.selfcal_error[k] - b.selfcal_error[k])
+            .collect();
+        let sigma = (diffs.iter().map(|d| d * d).sum::<f64>() / (2.0 * diffs.len() as f64)).sqrt();
+        let worst = first
+            .steps
+            .iter()
+            .chain(&second.steps)
+            .map(|s| s.selfcal_error[k].abs())
+            .fold(0.0, f64::max);
+        eprintln!(
+            "output {}: worst self-cal error {:.4}%, Brownian 1-sigma {:.4}% ({} steps x 2 seeds)",
+            k + 1,
+            100.0 * worst,
+            100.0 * sigma,
+            diffs.len()
         );
     }
 }

@@ -29,6 +29,22 @@ fn bad_scenario_files_are_refused_in_one_line() {
                 .replace("temperatures_c = [25, 35]", "temperatures_c = [25, 400]"),
             "temperatures_c",
         ),
+        (
+            format!("{GOOD}{drift}[profile]\nduration_s = 1\nrate_points = [[0.5, 1]]\n"),
+            "rate_points",
+        ),
+        (
+            format!("{GOOD}{drift}[profile]\nduration_s = -1\nrate_points = [[0, 1]]\n"),
+            "duration_s",
+        ),
+        (
+            format!("{GOOD}{drift}[profile]\nduration_s = 1\nrate_points = [[0, 1, 2]]\n"),
+            "rate_points",
+        ),
+        (
+            format!("{GOOD}{drift}drive_gain_ppm_per_k = [1, 2, 3]\n"),
+            "length 2",
+        ),
     ];
     let dir = tempfile::tempdir().unwrap();
     for (i, (text, key)) in cases.iter().enumerate() {

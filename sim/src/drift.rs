@@ -69,11 +69,19 @@ pub struct Drift {
     #[serde(default)]
     pub front_end_phase_deg_per_k: f64,
     /// Gain drift of ADC 1 and ADC 2 (ppm/K).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "exactly_two")]
     pub adc_gain_ppm_per_k: [f64; 2],
     /// Gain drift of drive (DAC) 1 and drive 2 (ppm/K).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "exactly_two")]
     pub drive_gain_ppm_per_k: [f64; 2],
+}
+
+/// A two-element list, refusing any other length (serde's `[f64; 2]`
+/// silently drops a third element).
+fn exactly_two<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
+    let v = Vec::<f64>::deserialize(d)?;
+    <[f64; 2]>::try_from(v.as_slice())
+        .map_err(|_| serde::de::Error::invalid_length(v.len(), &"an array of length 2"))
 }
 
 /// The device and front end at one temperature step.
@@ -332,6 +340,10 @@ mod tests {
             ),
             (&format!("{MINIMAL}tcf3_ppm_per_k = 1\n"), "tcf3_ppm_per_k"),
             (&format!("{MINIMAL}adc_gain_ppm_per_k = [1]\n"), "length 2"),
+            (
+                &format!("{MINIMAL}drive_gain_ppm_per_k = [1, 2, 3]\n"),
+                "length 2",
+            ),
             (
                 "temperatures_c = []\ntcf1_ppm_per_k = 1\ntcf2_ppm_per_k = 1\n",
                 "temperatures_c",

@@ -10,7 +10,8 @@
 //! `sf_baseline_per_dps` (z LSB per deg/s, one per output) and
 //! `identified` (`f1_hz`, `f2_hz`, `q1`, `q2`, `loop_phase_deg`, each with
 //! an `_uncertainty` twin). `--out` writes field.json, field.csv and
-//! fig_field_error.png/.svg.
+//! fig_field_error.png/.svg; with a `[profile]`, also the rate output
+//! over time, field_rate.csv and fig_field_rate.png/.svg.
 
 use crate::Failure;
 use gyrocal_sim::field::scenario::{self, FieldReport};
@@ -26,7 +27,7 @@ pub struct Args {
     /// Print one JSON object (the whole report) to stdout instead of the table.
     #[arg(long)]
     pub json: bool,
-    /// Also write field.json, field.csv and the figure into this folder.
+    /// Also write field.json, field.csv, field_rate.csv and the figures into this folder.
     #[arg(long)]
     pub out: Option<PathBuf>,
 }
@@ -34,8 +35,8 @@ pub struct Args {
 /// Run the scenario.
 pub fn run(args: &Args) -> Result<(), Failure> {
     let (name, text) = super::experiment::read_config(&args.config)?;
-    let (exp, drift) = scenario::parse(&name, &text).map_err(Failure::Input)?;
-    let report = scenario::run(&exp, &drift, &|line| eprintln!("{line}")).map_err(Failure::Run)?;
+    let sc = scenario::parse(&name, &text).map_err(Failure::Input)?;
+    let report = scenario::run(&sc, &|line| eprintln!("{line}")).map_err(Failure::Run)?;
     eprintln!(
         "{} steps, {:.3e} clocks in {:.1} s wall",
         report.steps.len(),
@@ -99,6 +100,48 @@ pub fn csv(report: &FieldReport) -> String {
     s
 }
 
+/// The rate output under the profile, one row per record and step:
+/// scenario time (steps end to end), the step's temperature, the time in
+/// the profile, the applied rate, the self-calibrated and baseline rates
+/// and their errors (deg/s). `None` without a profile.
+pub fn rate_csv(report: &FieldReport) -> Option<String> {
+    let duration = report.profile.as_ref()?.duration_s;
+    let mut s = String::from(
+        "scenario_time_s,temperature_c,time_s,true_rate_dps,selfcal_rate1_dps,selfcal_rate2_dps,\
+         baseline_rate1_dps,baseline_rate2_dps,selfcal_error1_dps,selfcal_error2_dps,\
+         baseline_error1_dps,baseline_error2_dps,settled\n",
+    );
+    for (i, st) in report.steps.iter().enumerate() {
+        let tr = st.profile.as_ref()?;
+        for (j, &t) in tr.time_s.iter().enumerate() {
+            let (truth, sc, bl) = (
+                tr.true_rate_dps[j],
+                tr.selfcal_rate_dps[j],
+                tr.baseline_rate_dps[j],
+            );
+            let values = [
+                i as f64 * duration + t,
+                st.temperature_c,
+                t,
+                truth,
+                sc[0],
+                sc[1],
+                bl[0],
+                bl[1],
+                sc[0] - truth,
+                sc[1] - truth,
+                bl[0] - truth,
+                bl[1] - truth,
+                f64::from(u8::from(tr.settled[j])),
+            ];
+            let row: Vec<String> = values.iter().map(|v| format!("{v:e}")).collect();
+            s.push_str(&row.join(","));
+            s.push('\n');
+        }
+    }
+    Some(s)
+}
+
 fn write_results(
     report: &FieldReport,
     json: &str,
@@ -107,7 +150,11 @@ fn write_results(
 ) -> Result<Vec<PathBuf>, String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let mut written = vec![];
-    for (file, bytes) in [("field.json", json.to_string()), ("field.csv", csv(report))] {
+    let mut files = vec![("field.json", json.to_string()), ("field.csv", csv(report))];
+    if let Some(rates) = rate_csv(report) {
+        files.push(("field_rate.csv", rates));
+    }
+    for (file, bytes) in files {
         let path = dir.join(file);
         gyrocal_verify::write_atomically(&path, bytes.as_bytes())
             .map_err(|e| format!("{}: {e}", path.display()))?;
@@ -119,6 +166,12 @@ fn write_results(
         &title,
         dir,
         "fig_field_error",
+    )?);
+    written.extend(crate::plots::field_rate::write_field_rate_figure(
+        report,
+        &title,
+        dir,
+        "fig_field_rate",
     )?);
     Ok(written)
 }
@@ -161,6 +214,16 @@ pub fn summary(report: &FieldReport) -> String {
             i.f2_hz - i.f1_hz,
             i.loop_phase_deg
         );
+    }
+    for st in &report.steps {
+        if let Some(tr) = &st.profile {
+            let (a, b) = (tr.selfcal_rms_error_dps, tr.baseline_rms_error_dps);
+            let _ = writeln!(
+                s,
+                "{:>8.2}  rate profile RMS error, settled records (deg/s): self-cal {:.4} / {:.4}, baseline {:.4e} / {:.4e}",
+                st.temperature_c, a[0], a[1], b[0], b[1]
+            );
+        }
     }
     let _ = writeln!(
         s,

@@ -40,6 +40,7 @@ mod allan;
 mod calibration;
 mod data;
 mod field;
+pub(crate) mod field_rate;
 mod format;
 mod line_panel;
 mod readout;

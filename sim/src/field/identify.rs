@@ -31,11 +31,14 @@
 //!    within a quarter bandwidth. The drive amplitude is set from the
 //!    predicted peak so that the ADC stays below `ADC_TARGET` of full scale
 //!    (a response above `ADC_CLIP` of full scale is measured again at a
-//!    quarter of the amplitude).
+//!    quarter of the amplitude). Mode 2's search starts at mode 1's
+//!    identified frequency plus the datasheet's split.
 //! 2. Fine sweep: `FINE_POINTS` carriers over +-`FINE_SPAN` bandwidths,
 //!    up then down, so that any settling lag shows as a misfit instead of
 //!    a shift. Each point waits `SETTLE_TAUS` amplitude time constants
-//!    after a carrier step and the filter's settling after a REF_PHASE step.
+//!    after a carrier step (the coarse search's bandwidth gives the time
+//!    constant; the datasheet's until then, each with a 20% margin) and the
+//!    filter's settling after a REF_PHASE step.
 //! 3. Gauss-Newton fit of the exact form above (4 real unknowns: C, fk, bk)
 //!    from the narrow-band solution. Uncertainties: the residual variance
 //!    times the inverse normal matrix, propagated to Qk = fk / bk and
@@ -73,7 +76,7 @@ pub const ADC_TARGET: f64 = 0.5;
 /// Above this fraction of full scale a response may be clipped.
 pub const ADC_CLIP: f64 = 0.8;
 /// Carriers of the fine sweep (each measured going up and coming down).
-pub const FINE_POINTS: usize = 9;
+pub const FINE_POINTS: usize = 5;
 /// Half-width of the fine sweep in bandwidths bk.
 pub const FINE_SPAN: f64 = 1.5;
 /// z samples averaged for each of I and Q.
@@ -88,6 +91,8 @@ pub const SAMPLES_PER_PHASE: u64 = 128;
 pub fn settling_residue() -> f64 {
     (-SETTLE_TAUS).exp() + FILTER_SETTLE
 }
+/// Margin on an amplitude time constant estimated from a bandwidth.
+const TAU_MARGIN: f64 = 1.2;
 /// Most coarse-search moves before giving up.
 const MAX_MOVES: usize = 12;
 /// The filter's transient is waited down to this fraction.
@@ -185,7 +190,7 @@ impl Knowns {
             0 => (self.nominal.f1_hz, self.nominal.q1),
             _ => (self.nominal.f2_hz, self.nominal.q2),
         };
-        1.2 * q / (PI * f)
+        TAU_MARGIN * q / (PI * f)
     }
 
     /// Clocks to wait `taus` of the slower mode's time constant plus the
@@ -302,6 +307,9 @@ struct Prober<'a> {
     k: usize,
     /// Drive amplitude in use (fraction of full scale).
     amplitude: f64,
+    /// Amplitude time constant waited on (s): the datasheet's until the
+    /// coarse search has measured the mode's bandwidth.
+    tau_s: f64,
     clocks: u64,
 }
 
@@ -318,7 +326,8 @@ impl Prober<'_> {
         let (regs, real) = kn.registers(carrier_hz, None, amps, 0.0)?;
         self.board.program(&regs).map_err(bus)?;
         let r = kn.filter.decimation;
-        let settle = kn.settle_clocks(SETTLE_TAUS);
+        let settle =
+            (SETTLE_TAUS * self.tau_s * kn.clock_hz).ceil() as u64 + kn.filter_settle_clocks();
         let zi = average_z(self.board, r, settle, SAMPLES_PER_PHASE)?[self.k];
         let mut quarter = regs;
         quarter.ref_phase = regs.ref_phase.wrapping_add(1 << 30);
@@ -516,6 +525,7 @@ pub fn identify_mode(
         knowns,
         k,
         amplitude: max / 8.0,
+        tau_s: knowns.tau_s(k),
         clocks: 0,
     };
     let bw = knowns.bandwidth_hz(k);
@@ -546,6 +556,9 @@ pub fn identify_mode(
             k + 1
         )
     })?;
+    // The mode's own time constant 1 / (pi bk), with the datasheet's 20%
+    // margin for the narrow-band estimate of bk.
+    probe.tau_s = TAU_MARGIN / (PI * bk);
     let offsets: Vec<f64> = (0..FINE_POINTS)
         .map(|i| FINE_SPAN * (2.0 * i as f64 / (FINE_POINTS - 1) as f64 - 1.0))
         .collect();
@@ -573,7 +586,12 @@ pub fn identify(
     guess: &GyroParams,
 ) -> Result<Identified, String> {
     let (m1, c1) = identify_mode(board, knowns, 0, guess.f1_hz)?;
-    let (m2, c2) = identify_mode(board, knowns, 1, guess.f2_hz)?;
+    // Mode 2 from mode 1 plus the guess's split, scaled with mode 1's
+    // move: the common drift (hundreds of Hz per K) is gone, what is left is
+    // the split's drift (a few Hz per K), within the coarse search's first
+    // look.
+    let guess_f2 = m1.f_hz.value + (guess.f2_hz - guess.f1_hz) * (m1.f_hz.value / guess.f1_hz);
+    let (m2, c2) = identify_mode(board, knowns, 1, guess_f2)?;
     let carrier = m1.f_hz.value + knowns.carrier_offset_hz;
     let (f1, f2) = (m1.f_hz.value, m2.f_hz.value);
     let (p1, p2) = (m1.phase_deg, m2.phase_deg);

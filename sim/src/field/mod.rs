@@ -13,11 +13,14 @@
 //!   [`identify::Knowns`], never the true parameters.
 //! - [`selfcal`]: host code. Identify, retune, correct the loop phase, run
 //!   the staircase, predict the readout scale factor in z LSB per deg/s.
+//! - [`profile`]: the `[profile]` section (a rate against time at every
+//!   step) and the calibrated rate output, (z - null) / SF, it gives.
 //! - [`scenario`]: the simulation around it: the device drifting over the
 //!   `[drift]` steps, the rate table that gives the true scale factor, the
 //!   factory-calibrated baseline.
 
 pub mod board;
 pub mod identify;
+pub mod profile;
 pub mod scenario;
 pub mod selfcal;

@@ -8,7 +8,8 @@
 //!   converter gains and the front-end phase are `Drift::at(T)`, on a fresh
 //!   board (quasi-static steps; the steps run in parallel).
 //! - Self-calibration: [`selfcal::self_calibrate`] from the datasheet (the
-//!   host does not know the temperature).
+//!   host does not know the temperature). The first step's (at T0) is the
+//!   factory calibration.
 //! - Truth: the rate table (`SimBoard::set_rate`) at the readout rates of
 //!   `[experiment]`, with the self-calibration's carrier and phase
 //!   correction: the least-squares slope of z against the rate, z LSB per
@@ -16,9 +17,15 @@
 //! - Baseline: the factory calibration at T0 (the cycle, then the rate
 //!   table) fixes the carrier, the phase correction and the scale factor;
 //!   at T its error is against the rate table with those fixed settings.
+//! - With a `[profile]` ([`profile`]): after its cycle each step's board
+//!   switches to readout, measures its null at rest and runs the profile;
+//!   the rate output is (z - null) / SF_selfcal. The baseline runs the
+//!   profile on a fresh board at the factory's settings and reads it with
+//!   the factory's null and scale factor.
 
 use super::board::{Board, SimBoard};
 use super::identify::{Identified, Knowns};
+use super::profile::{self, Profile, ProfileRun, RateTrace};
 use super::selfcal::{self, Operating, SelfCal, window_z};
 use crate::config::Experiment;
 use crate::config::{Drive, Filter, Frontend, Points};
@@ -35,9 +42,14 @@ use std::time::Instant;
 
 /// Amplitude time constants waited before the first rate of a table (the
 /// readout offset of a detuned output can be 1e4 times the rate signal).
+/// Measured on the consumer device's output 1 (its rate term 1e-4 of its
+/// offset), the slope after 20, 25, 30, 40, 60 of these: -188.83, -189.06,
+/// -189.10, -189.08, -189.03 z LSB per deg/s: settled from 30 on, within
+/// the +-0.04% the spurs' beats leave (`rate_table`).
 const TABLE_FIRST_TAUS: f64 = 30.0;
 
-/// A scenario file: the sections of `gyrocal run` plus `[drift]`.
+/// A scenario file: the sections of `gyrocal run` plus `[drift]` and,
+/// optionally, `[profile]`.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct ScenarioFile {
@@ -51,12 +63,26 @@ struct ScenarioFile {
     #[serde(default)]
     noise: ThermalNoise,
     drift: Drift,
+    #[serde(default)]
+    profile: Option<Profile>,
+}
+
+/// A checked scenario.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Scenario {
+    /// The experiment (the device at T0, its drive, front end, filter, points).
+    pub exp: Experiment,
+    /// The temperature steps and drift coefficients.
+    pub drift: Drift,
+    /// The rate profile applied at every step, if any.
+    pub profile: Option<Profile>,
 }
 
 /// Parse a scenario file's text: the experiment (checked as `gyrocal run`
-/// checks it) and its `[drift]` (checked by `Drift::validate`). Errors are
-/// one line; `name` labels them (the file path).
-pub fn parse(name: &str, text: &str) -> Result<(Experiment, Drift), String> {
+/// checks it), its `[drift]` (checked by `Drift::validate`) and its
+/// `[profile]` (`Profile::validate`). Errors are one line; `name` labels
+/// them (the file path).
+pub fn parse(name: &str, text: &str) -> Result<Scenario, String> {
     let file: ScenarioFile = toml::from_str(text).map_err(|e| {
         let message = e.message().replace('\n', " ");
         match e.span() {
@@ -76,9 +102,17 @@ pub fn parse(name: &str, text: &str) -> Result<(Experiment, Drift), String> {
         noise: file.noise,
     };
     exp.validate().map_err(|e| format!("{name}: {e}"))?;
-    exp.derived().map_err(|e| format!("{name}: {e}"))?;
+    let derived = exp.derived().map_err(|e| format!("{name}: {e}"))?;
     file.drift.validate().map_err(|e| format!("{name}: {e}"))?;
-    Ok((exp, file.drift))
+    if let Some(p) = &file.profile {
+        let sample_s = f64::from(derived.decimation) / exp.drive.clock_hz;
+        p.validate(sample_s).map_err(|e| format!("{name}: {e}"))?;
+    }
+    Ok(Scenario {
+        exp,
+        drift: file.drift,
+        profile: file.profile,
+    })
 }
 
 /// One temperature step.
@@ -106,6 +140,8 @@ pub struct FieldStep {
     pub identified: IdentifiedJson,
     /// The whole cycle's result.
     pub selfcal: SelfCal,
+    /// The rate output under `[profile]`, if the scenario has one.
+    pub profile: Option<RateTrace>,
     /// Clocks simulated at this step.
     pub clocks: u64,
 }
@@ -162,6 +198,10 @@ pub struct FieldReport {
     pub factory: Operating,
     /// The factory scale factor (z LSB per deg/s).
     pub sf_factory_per_dps: [f64; 2],
+    /// The factory's readout null at its settings (z LSB).
+    pub null_factory_z: Option<[f64; 2]>,
+    /// The rate profile applied at every step.
+    pub profile: Option<Profile>,
     /// One entry per temperature, in the scenario's order.
     pub steps: Vec<FieldStep>,
     /// Clocks simulated, all steps.
@@ -184,9 +224,58 @@ pub fn board_at(exp: &Experiment, fe: &FrontEnd, at: &DeviceAt) -> Result<SimBoa
     SimBoard::new(at, fe, &exp.noise, exp.drive.clock_hz, reference)
 }
 
-/// The rate table: readout at `op` on a fresh board per rate (from
+/// A fresh board at `at`, programmed in readout at `op` and settled
+/// `TABLE_FIRST_TAUS` from power-up, at rotation rate `rate_dps`.
+fn settled_readout_board(
+    exp: &Experiment,
+    fe: &FrontEnd,
+    at: &DeviceAt,
+    knowns: &Knowns,
+    op: &Operating,
+    rate_dps: f64,
+) -> Result<SimBoard, String> {
+    let mut board = board_at(exp, fe, at)?;
+    program_readout(&mut board, knowns, op)?;
+    board.set_rate(rate_dps.to_radians());
+    board.wait_clocks(knowns.settle_clocks(TABLE_FIRST_TAUS));
+    Ok(board)
+}
+
+fn program_readout(board: &mut dyn Board, knowns: &Knowns, op: &Operating) -> Result<(), String> {
+    let (regs, _) = knowns.registers(op.carrier_hz, None, knowns.amplitude, op.ref_lag_deg)?;
+    board
+        .program(&regs)
+        .map_err(|e| format!("board refused a register access: {e:?}"))
+}
+
+/// One point of the rate table: readout at `op` on a fresh board (from
 /// power-up, as `experiment` runs its points), settled and averaged over
-/// the first window; returns the slopes (z LSB per deg/s) and the clocks.
+/// the first window; returns z (z LSB) and the clocks.
+fn table_point(
+    exp: &Experiment,
+    fe: &FrontEnd,
+    at: &DeviceAt,
+    knowns: &Knowns,
+    op: &Operating,
+    rate_dps: f64,
+) -> Result<([f64; 2], u64), String> {
+    let mut board = settled_readout_board(exp, fe, at, knowns, op, rate_dps)?;
+    let r = knowns.filter.decimation;
+    let length = (knowns.filter.min_window_s * knowns.clock_hz).ceil();
+    let z = window_z(&mut board, r, f64::from(r), length)?;
+    Ok((z, board.cycle()))
+}
+
+/// Least-squares slopes of the table's z against its rates (z LSB per deg/s).
+fn table_slopes(rates_dps: &[f64], z: &[[f64; 2]]) -> [f64; 2] {
+    std::array::from_fn(|k| {
+        let y: Vec<f64> = z.iter().map(|v| v[k]).collect();
+        linear_fit(rates_dps, &y).0
+    })
+}
+
+/// The rate table: readout at `op` on a fresh board per rate, the rates in
+/// parallel; returns the slopes (z LSB per deg/s) and the clocks.
 ///
 /// Fresh boards, not one board stepping through the rates: the carrier
 /// table's residual spurs (below -100 dBc) mix with the resonant output's
@@ -203,90 +292,225 @@ pub fn rate_table(
     knowns: &Knowns,
     op: &Operating,
 ) -> Result<([f64; 2], u64), String> {
-    let (regs, _) = knowns.registers(op.carrier_hz, None, knowns.amplitude, op.ref_lag_deg)?;
-    let r = knowns.filter.decimation;
-    let length = (knowns.filter.min_window_s * knowns.clock_hz).ceil();
-    let mut clocks = 0;
-    let mut z = vec![];
-    for &rate in &knowns.rates_dps {
-        let mut board = board_at(exp, fe, at)?;
-        board
-            .program(&regs)
-            .map_err(|e| format!("board refused a register access: {e:?}"))?;
-        board.set_rate(rate.to_radians());
-        board.wait_clocks(knowns.settle_clocks(TABLE_FIRST_TAUS));
-        z.push(window_z(&mut board, r, f64::from(r), length)?);
-        clocks += board.cycle();
-    }
-    let sf = std::array::from_fn(|k| {
-        let y: Vec<f64> = z.iter().map(|v| v[k]).collect();
-        linear_fit(&knowns.rates_dps, &y).0
-    });
-    Ok((sf, clocks))
+    let points: Vec<([f64; 2], u64)> = knowns
+        .rates_dps
+        .par_iter()
+        .map(|&rate| table_point(exp, fe, at, knowns, op, rate))
+        .collect::<Result<_, String>>()?;
+    let z: Vec<[f64; 2]> = points.iter().map(|p| p.0).collect();
+    let clocks = points.iter().map(|p| p.1).sum();
+    Ok((table_slopes(&knowns.rates_dps, &z), clocks))
 }
 
 fn ratio_error(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
     [a[0] / b[0] - 1.0, a[1] / b[1] - 1.0]
 }
 
-/// Run a scenario: factory calibration at T0, then every step in parallel;
-/// `progress` gets one line per finished step.
-pub fn run(
-    exp: &Experiment,
-    drift: &Drift,
-    progress: &(dyn Fn(&str) + Sync),
-) -> Result<FieldReport, String> {
+/// One step's cycle on its board, and what that board reads afterwards.
+struct Cycle {
+    at: DeviceAt,
+    cal: SelfCal,
+    /// Readout null at rest and the profile's run, with `[profile]`.
+    readout: Option<([f64; 2], ProfileRun)>,
+    /// The rate table's slopes at the cycle's settings (z LSB per deg/s).
+    sf_true: [f64; 2],
+    clocks: u64,
+}
+
+/// Self-calibrate a fresh board at `t`; with a profile, then switch to
+/// readout, measure the null at rest and run the profile on that board.
+/// The rate table at the cycle's settings follows (its rates in parallel).
+fn cycle_at(sc: &Scenario, fe: &FrontEnd, knowns: &Knowns, t: f64) -> Result<Cycle, String> {
+    let at = sc.drift.at(&sc.exp.gyro, t);
+    let mut board = board_at(&sc.exp, fe, &at)?;
+    let cal = selfcal::self_calibrate(&mut board, knowns, &knowns.nominal)?;
+    let readout = match &sc.profile {
+        None => None,
+        Some(p) => {
+            program_readout(&mut board, knowns, &cal.operating)?;
+            board.wait_clocks(knowns.settle_clocks(TABLE_FIRST_TAUS));
+            let r = knowns.filter.decimation;
+            let length = (knowns.filter.min_window_s * knowns.clock_hz).ceil();
+            let null = profile::readout_null(&mut board, r, length)?;
+            Some((
+                null,
+                profile::run_profile(&mut board, p, r, knowns.clock_hz)?,
+            ))
+        }
+    };
+    let (sf_true, table_clocks) = rate_table(&sc.exp, fe, &at, knowns, &cal.operating)?;
+    Ok(Cycle {
+        at,
+        cal,
+        readout,
+        sf_true,
+        clocks: board.cycle() + table_clocks,
+    })
+}
+
+/// The simulation's measurements at the factory's settings, run as
+/// independent jobs in parallel once the factory calibration is known.
+enum Job {
+    /// Rate-table point of step `step` at the factory's settings.
+    Factory { step: usize, rate: usize },
+    /// The profile of step `step` at the factory's settings.
+    BaselineProfile { step: usize },
+}
+
+enum Done {
+    Point([f64; 2]),
+    Profile(ProfileRun),
+}
+
+/// Every step but the first (at T0 the factory's settings are its own).
+fn jobs(steps: usize, rates: usize, with_profile: bool) -> Vec<Job> {
+    let mut jobs = vec![];
+    for step in 1..steps {
+        jobs.extend((0..rates).map(|rate| Job::Factory { step, rate }));
+        if with_profile {
+            jobs.push(Job::BaselineProfile { step });
+        }
+    }
+    jobs
+}
+
+/// The factory-settings rate table's z of `step` from the finished jobs.
+fn table_z(jobs: &[Job], done: &[Done], step: usize, rates: usize) -> Vec<[f64; 2]> {
+    let mut z = vec![[0.0; 2]; rates];
+    for (job, d) in jobs.iter().zip(done) {
+        match (job, d) {
+            (Job::Factory { step: s, rate }, Done::Point(v)) if *s == step => z[*rate] = *v,
+            _ => {}
+        }
+    }
+    z
+}
+
+/// Run a scenario: every step's cycle and rate table in parallel (the
+/// first step's cycle is the factory calibration), then every rate-table
+/// point and baseline profile at the factory's settings in parallel;
+/// `progress` gets one line per step.
+pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldReport, String> {
+    let (exp, drift) = (&sc.exp, &sc.drift);
     exp.validate()?;
     drift.validate()?;
     let start = Instant::now();
     let (fe, knowns) = build(exp)?;
-    let at0 = drift.at(&exp.gyro, drift.reference_c());
-    let mut board0 = board_at(exp, &fe, &at0)?;
-    let factory = selfcal::self_calibrate(&mut board0, &knowns, &knowns.nominal)?;
-    let (sf_factory, factory_table) = rate_table(exp, &fe, &at0, &knowns, &factory.operating)?;
-    progress(&format!(
-        "factory calibration at {} deg C: carrier {:.3} Hz, phase {:.4} deg",
-        drift.reference_c(),
-        factory.operating.carrier_hz,
-        factory.operating.ref_lag_deg
-    ));
-    let steps: Vec<FieldStep> = drift
+    let cycles: Vec<Cycle> = drift
         .temperatures_c
         .par_iter()
         .map(|&t| {
-            let at = drift.at(&exp.gyro, t);
-            let mut board = board_at(exp, &fe, &at)?;
-            let cal = selfcal::self_calibrate(&mut board, &knowns, &knowns.nominal)?;
-            let (sf_true, c1) = rate_table(exp, &fe, &at, &knowns, &cal.operating)?;
-            let (sf_fixed, c2) = rate_table(exp, &fe, &at, &knowns, &factory.operating)?;
+            let c = cycle_at(sc, &fe, &knowns, t)?;
             progress(&format!(
-                "{t} deg C: self-cal error {:+.4}% / {:+.4}%, baseline {:+.2}% / {:+.2}%",
-                100.0 * (cal.sf_selfcal_per_dps[0] / sf_true[0] - 1.0),
-                100.0 * (cal.sf_selfcal_per_dps[1] / sf_true[1] - 1.0),
-                100.0 * (sf_factory[0] / sf_fixed[0] - 1.0),
-                100.0 * (sf_factory[1] / sf_fixed[1] - 1.0),
+                "{t} deg C: cycle and rate table done, self-cal error {:+.4}% / {:+.4}%",
+                100.0 * (c.cal.sf_selfcal_per_dps[0] / c.sf_true[0] - 1.0),
+                100.0 * (c.cal.sf_selfcal_per_dps[1] / c.sf_true[1] - 1.0),
             ));
-            Ok(FieldStep {
-                temperature_c: t,
-                truth: at,
-                sf_true_per_dps: sf_true,
-                sf_selfcal_per_dps: cal.sf_selfcal_per_dps,
-                sf_eq56_per_dps: cal.sf_eq56_per_dps,
-                sf_baseline_per_dps: sf_factory,
-                sf_true_at_factory_settings_per_dps: sf_fixed,
-                selfcal_error: ratio_error(cal.sf_selfcal_per_dps, sf_true),
-                baseline_error: ratio_error(sf_factory, sf_fixed),
-                identified: IdentifiedJson::from(&cal.identified),
-                clocks: board.cycle() + c1 + c2,
-                selfcal: cal,
-            })
+            Ok(c)
         })
         .collect::<Result<_, String>>()?;
-    let clocks = board0.cycle() + factory_table + steps.iter().map(|s| s.clocks).sum::<u64>();
+    let factory = cycles[0].cal.operating.clone();
+    progress(&format!(
+        "factory calibration at {} deg C: carrier {:.3} Hz, phase {:.4} deg",
+        drift.reference_c(),
+        factory.carrier_hz,
+        factory.ref_lag_deg
+    ));
+    let rates = &knowns.rates_dps;
+    let jobs = jobs(cycles.len(), rates.len(), sc.profile.is_some());
+    let done: Vec<(Done, u64)> = jobs
+        .par_iter()
+        .map(|job| -> Result<(Done, u64), String> {
+            match *job {
+                Job::Factory { step, rate } => {
+                    let at = &cycles[step].at;
+                    let (z, n) = table_point(exp, &fe, at, &knowns, &factory, rates[rate])?;
+                    Ok((Done::Point(z), n))
+                }
+                Job::BaselineProfile { step } => {
+                    let at = &cycles[step].at;
+                    let p = sc.profile.as_ref().ok_or("no profile")?;
+                    let mut board = settled_readout_board(exp, &fe, at, &knowns, &factory, 0.0)?;
+                    let r = knowns.filter.decimation;
+                    let run = profile::run_profile(&mut board, p, r, knowns.clock_hz)?;
+                    Ok((Done::Profile(run), board.cycle()))
+                }
+            }
+        })
+        .collect::<Result<_, String>>()?;
+    let job_clocks: u64 = done.iter().map(|d| d.1).sum();
+    let done: Vec<Done> = done.into_iter().map(|d| d.0).collect();
+    let sf_factory = cycles[0].sf_true;
+    let null_factory = cycles[0].readout.as_ref().map(|r| r.0);
+    let mut steps = vec![];
+    for (i, c) in cycles.into_iter().enumerate() {
+        let sf_true = c.sf_true;
+        let sf_fixed = if i == 0 {
+            sf_true
+        } else {
+            table_slopes(rates, &table_z(&jobs, &done, i, rates.len()))
+        };
+        let baseline_run = jobs.iter().zip(&done).find_map(|(j, d)| match (j, d) {
+            (Job::BaselineProfile { step }, Done::Profile(run)) if *step == i => Some(run),
+            _ => None,
+        });
+        let trace = c.readout.as_ref().map(|(null, run)| {
+            let base = baseline_run.unwrap_or(run);
+            let selfcal_rate = profile::calibrated(&run.z, *null, c.cal.sf_selfcal_per_dps);
+            let nf = null_factory.unwrap_or(*null);
+            let baseline_rate = profile::calibrated(&base.z, nf, sf_factory);
+            RateTrace {
+                selfcal_rms_error_dps: profile::rms_error(
+                    &selfcal_rate,
+                    &run.true_rate_dps,
+                    &run.settled,
+                ),
+                baseline_rms_error_dps: profile::rms_error(
+                    &baseline_rate,
+                    &base.true_rate_dps,
+                    &base.settled,
+                ),
+                settled: run.settled.clone(),
+                time_s: run.time_s.clone(),
+                true_rate_dps: run.true_rate_dps.clone(),
+                selfcal_rate_dps: selfcal_rate,
+                baseline_rate_dps: baseline_rate,
+                null_selfcal_z: *null,
+            }
+        });
+        let t = c.at.temperature_c;
+        let selfcal_error = ratio_error(c.cal.sf_selfcal_per_dps, sf_true);
+        let baseline_error = ratio_error(sf_factory, sf_fixed);
+        progress(&format!(
+            "{t} deg C: self-cal error {:+.4}% / {:+.4}%, baseline {:+.2}% / {:+.2}%",
+            100.0 * selfcal_error[0],
+            100.0 * selfcal_error[1],
+            100.0 * baseline_error[0],
+            100.0 * baseline_error[1],
+        ));
+        steps.push(FieldStep {
+            temperature_c: t,
+            truth: c.at,
+            sf_true_per_dps: sf_true,
+            sf_selfcal_per_dps: c.cal.sf_selfcal_per_dps,
+            sf_eq56_per_dps: c.cal.sf_eq56_per_dps,
+            sf_baseline_per_dps: sf_factory,
+            sf_true_at_factory_settings_per_dps: sf_fixed,
+            selfcal_error,
+            baseline_error,
+            identified: IdentifiedJson::from(&c.cal.identified),
+            clocks: c.clocks,
+            selfcal: c.cal,
+            profile: trace,
+        });
+    }
+    let clocks = job_clocks + steps.iter().map(|s| s.clocks).sum::<u64>();
     Ok(FieldReport {
         knowns,
-        factory: factory.operating,
+        factory,
         sf_factory_per_dps: sf_factory,
+        null_factory_z: null_factory,
+        profile: sc.profile.clone(),
         steps,
         clocks,
         wall_s: start.elapsed().as_secs_f64(),

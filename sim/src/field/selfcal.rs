@@ -25,6 +25,24 @@
 //! (`Knowns::force_full_scale`). Its drift is the one converter drift the
 //! cycle cannot correct (measured in `tests/field.rs`).
 //!
+//! It would become observable while the device turns, at any rate and
+//! without knowing it. With H_jk the response at ADC j to drive k
+//! (readout for j = k, the calibration SELECT with the other drive off for
+//! j != k), H_jk = a_j g_k M_jk. To first order in the rate the Coriolis
+//! coupling is antisymmetric, M_12 = -M_21 = 2 lambda Omega j w G_1 G_2,
+//! and M_kk = G_k, the resonators' responses known from the
+//! identification, so
+//!
+//! ```text
+//! (H_12 / H_21) / (H_11 / H_22) = (g_2 / g_1)^2 x (M_12 M_22) / (M_21 M_11)
+//!                               = -(g_2 / g_1)^2 x G_2 / G_1
+//! ```
+//!
+//! holds the drive-gain ratio alone: the rate cancels. The cross responses
+//! are lambda Omega / bandwidth of the direct ones, so it needs a rate well
+//! above the noise; a field cycle at rest, as here, cannot use it, and it
+//! is not implemented.
+//!
 //! # The prediction
 //!
 //! `ratio` is the exact theory (phasor steady state, `crate::theory`) at

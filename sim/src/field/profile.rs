@@ -1,0 +1,375 @@
+//! The rate profile of a field scenario (`[profile]`) and the calibrated
+//! rate output it gives over time.
+//!
+//! At every temperature step the rate table of the simulation applies the
+//! same profile: `rate_points` are `[time_s, rate_dps]` pairs, the rate
+//! linear between them (two points at one time make a step) and held after
+//! the last, for `duration_s` seconds. The board runs in readout; its z
+//! samples (one per R clocks) are averaged over records of `record_s`
+//! (default `duration_s / DEFAULT_RECORDS`), and each record's mean is
+//! turned into a rate in deg/s as a user of the board would:
+//!
+//! ```text
+//! rate_k = (z_k - null_k) / SF_k        (deg/s; z, null in z LSB, SF in z LSB per deg/s)
+//! ```
+//!
+//! with the self-calibration's null (the readout at rest right after the
+//! cycle) and SF_selfcal, and, beside it, the factory's null and scale
+//! factor at the factory's carrier and phase (the baseline). The true rate
+//! of a record is the mean of the rates applied over its samples.
+//!
+//! A record is *settled* when no point of the profile falls within
+//! `settle_s` (default 0) before it or inside it: the RMS errors are over
+//! the settled records, so that the output's own step response (its
+//! bandwidth, not its calibration) does not swamp them; the time series
+//! keeps every record.
+//!
+//! ```toml
+//! [profile]
+//! duration_s = 0.2                                    # required
+//! rate_points = [[0, 0], [0.02, 0], [0.02, 10], [0.1, -10], [0.15, -10]]
+//! record_s = 0.002                                    # optional
+//! settle_s = 0.01                                     # optional
+//! ```
+
+use super::board::{Board, SimBoard};
+use super::selfcal::window_z;
+use crate::config::MAX_RATE_DPS;
+use serde::{Deserialize, Serialize};
+
+/// Records of a profile when `record_s` is not given.
+pub const DEFAULT_RECORDS: f64 = 100.0;
+/// Longest profile per step (s): 100 s is 5e9 clocks at 50 MHz.
+pub const MAX_DURATION_S: f64 = 100.0;
+/// Most points in `rate_points`.
+pub const MAX_POINTS: usize = 1000;
+/// Most records per step (rows of the time series).
+pub const MAX_RECORDS: f64 = 1.0e5;
+
+/// The `[profile]` section.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Profile {
+    /// Length of the profile at each temperature step (s).
+    pub duration_s: f64,
+    /// `[time_s, rate_dps]` points: times from 0, non-decreasing; the rate
+    /// is linear between points and held after the last.
+    /// (A list of lists, not of pairs: serde's pair silently drops a
+    /// third element, which `validate` refuses.)
+    pub rate_points: Vec<Vec<f64>>,
+    /// Length of one record of the output (s); `duration_s /
+    /// DEFAULT_RECORDS` when absent.
+    #[serde(default)]
+    pub record_s: Option<f64>,
+    /// Time after each point of the profile left out of the RMS errors (s).
+    #[serde(default)]
+    pub settle_s: f64,
+}
+
+fn profile_error(key: &str, value: impl std::fmt::Display, allowed: &str) -> String {
+    format!("[profile] {key} = {value}: {allowed}")
+}
+
+impl Profile {
+    /// Checks every key; errors are one line naming the key. `sample_s` is
+    /// the board's z sample period (R / f_clk): a record holds at least one.
+    pub fn validate(&self, sample_s: f64) -> Result<(), String> {
+        let d = self.duration_s;
+        if !(d.is_finite() && d > 0.0 && d <= MAX_DURATION_S) {
+            return Err(profile_error(
+                "duration_s",
+                d,
+                &format!("allowed > 0 and <= {MAX_DURATION_S} s"),
+            ));
+        }
+        let n = self.rate_points.len();
+        if n == 0 || n > MAX_POINTS {
+            return Err(profile_error(
+                "rate_points",
+                format!("a list of {n} points"),
+                &format!("allowed 1..={MAX_POINTS} [time_s, rate_dps] points"),
+            ));
+        }
+        if let Some(p) = self.rate_points.iter().find(|p| p.len() != 2) {
+            return Err(profile_error(
+                "rate_points",
+                format!("{p:?}"),
+                "each point must be [time_s, rate_dps] (length 2)",
+            ));
+        }
+        if self.rate_points[0][0] != 0.0 {
+            return Err(profile_error(
+                "rate_points",
+                format!("[{}, ...] first", self.rate_points[0][0]),
+                "the first point's time must be 0 s",
+            ));
+        }
+        for pair in self.rate_points.windows(2) {
+            let (t0, t1) = (pair[0][0], pair[1][0]);
+            if !(t1.is_finite() && t1 >= t0) {
+                return Err(profile_error(
+                    "rate_points",
+                    format!("time {t1} after {t0}"),
+                    "times must be finite and non-decreasing",
+                ));
+            }
+        }
+        if let Some(p) = self
+            .rate_points
+            .iter()
+            .find(|p| !(p[1].is_finite() && p[1].abs() <= MAX_RATE_DPS))
+        {
+            return Err(profile_error(
+                "rate_points",
+                format!("rate {}", p[1]),
+                &format!("allowed -{MAX_RATE_DPS}..={MAX_RATE_DPS} deg/s"),
+            ));
+        }
+        if !(self.settle_s.is_finite() && self.settle_s >= 0.0 && self.settle_s < d) {
+            return Err(profile_error(
+                "settle_s",
+                self.settle_s,
+                "allowed >= 0 and below duration_s",
+            ));
+        }
+        let r = self.record_length_s();
+        if !(r.is_finite() && r >= sample_s && r <= d && d / r <= MAX_RECORDS) {
+            return Err(profile_error(
+                "record_s",
+                r,
+                &format!(
+                    "allowed from one z sample ({sample_s:e} s) to duration_s, \
+                     at most {MAX_RECORDS} records"
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Length of one record (s).
+    pub fn record_length_s(&self) -> f64 {
+        self.record_s.unwrap_or(self.duration_s / DEFAULT_RECORDS)
+    }
+
+    /// True when no point's time lies in (`t0_s` - settle_s, `t1_s`).
+    pub fn is_settled(&self, t0_s: f64, t1_s: f64) -> bool {
+        !self
+            .rate_points
+            .iter()
+            .any(|p| p[0] > t0_s - self.settle_s && p[0] < t1_s)
+    }
+
+    /// The rate at `t_s` (deg/s): linear between points, held after the
+    /// last (at a step, the later point's rate).
+    pub fn rate_dps_at(&self, t_s: f64) -> f64 {
+        let p = &self.rate_points;
+        let after = p.partition_point(|q| q[0] <= t_s);
+        if after == p.len() {
+            return p[p.len() - 1][1];
+        }
+        let (a, b) = (&p[after - 1], &p[after]);
+        a[1] + (b[1] - a[1]) * (t_s - a[0]) / (b[0] - a[0])
+    }
+}
+
+/// The readout of one board under the profile, record by record.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ProfileRun {
+    /// Mid time of each record from the profile's start (s).
+    pub time_s: Vec<f64>,
+    /// Mean applied rate over each record (deg/s).
+    pub true_rate_dps: Vec<f64>,
+    /// Mean z over each record (z LSB).
+    pub z: Vec<[f64; 2]>,
+    /// Whether each record is settled (module header).
+    pub settled: Vec<bool>,
+    /// Clocks it took.
+    #[serde(skip)]
+    pub clocks: u64,
+}
+
+/// Apply `profile` through the rate table of `board` (already programmed
+/// and settled in readout), the rate updated once per z sample at the
+/// sample period's midpoint, and record block means.
+pub fn run_profile(
+    board: &mut SimBoard,
+    profile: &Profile,
+    decimation: u32,
+    clock_hz: f64,
+) -> Result<ProfileRun, String> {
+    let sample_s = f64::from(decimation) / clock_hz;
+    let per_record = (profile.record_length_s() / sample_s).round().max(1.0) as usize;
+    let records = ((profile.duration_s / (per_record as f64 * sample_s)).floor() as usize).max(1);
+    let mut run = ProfileRun {
+        time_s: Vec::with_capacity(records),
+        true_rate_dps: Vec::with_capacity(records),
+        z: Vec::with_capacity(records),
+        settled: Vec::with_capacity(records),
+        clocks: 0,
+    };
+    let start = board.cycle();
+    let mut sample = 0usize;
+    for _ in 0..records {
+        let (mut rate_sum, mut z_sum) = (0.0, [0.0; 2]);
+        let t_first = sample as f64 * sample_s;
+        for _ in 0..per_record {
+            let rate = profile.rate_dps_at((sample as f64 + 0.5) * sample_s);
+            board.set_rate(rate.to_radians());
+            board.wait_clocks(u64::from(decimation));
+            let s = board
+                .read_z()
+                .map_err(|e| format!("board refused a register access: {e:?}"))?;
+            rate_sum += rate;
+            z_sum[0] += s.z[0];
+            z_sum[1] += s.z[1];
+            sample += 1;
+        }
+        let n = per_record as f64;
+        run.time_s.push(t_first + 0.5 * n * sample_s);
+        run.true_rate_dps.push(rate_sum / n);
+        run.z.push(z_sum.map(|v| v / n));
+        run.settled
+            .push(profile.is_settled(t_first, t_first + n * sample_s));
+    }
+    board.set_rate(0.0);
+    run.clocks = board.cycle() - start;
+    Ok(run)
+}
+
+/// The readout null: z at rest (mean over `length` clocks after one
+/// sample), on a board already programmed and settled in readout. The
+/// host measures it right after the cycle, with the device still.
+pub fn readout_null(
+    board: &mut dyn Board,
+    decimation: u32,
+    length: f64,
+) -> Result<[f64; 2], String> {
+    window_z(board, decimation, f64::from(decimation), length)
+}
+
+/// A calibrated rate series: (z - null) / SF per record and output.
+pub fn calibrated(z: &[[f64; 2]], null: [f64; 2], sf_per_dps: [f64; 2]) -> Vec<[f64; 2]> {
+    z.iter()
+        .map(|v| std::array::from_fn(|k| (v[k] - null[k]) / sf_per_dps[k]))
+        .collect()
+}
+
+/// The rate output of one step under the profile, self-calibrated and
+/// factory baseline, beside the truth.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RateTrace {
+    /// Mid time of each record from the profile's start (s).
+    pub time_s: Vec<f64>,
+    /// Applied rate (deg/s).
+    pub true_rate_dps: Vec<f64>,
+    /// (z - null_selfcal) / SF_selfcal per output (deg/s).
+    pub selfcal_rate_dps: Vec<[f64; 2]>,
+    /// (z - null_factory) / SF_factory at the factory's settings (deg/s).
+    pub baseline_rate_dps: Vec<[f64; 2]>,
+    /// Whether each record is settled (module header).
+    pub settled: Vec<bool>,
+    /// The self-calibration's null (z LSB).
+    pub null_selfcal_z: [f64; 2],
+    /// RMS of selfcal_rate - true_rate over the settled records (deg/s).
+    pub selfcal_rms_error_dps: [f64; 2],
+    /// RMS of baseline_rate - true_rate over the settled records (deg/s).
+    pub baseline_rms_error_dps: [f64; 2],
+}
+
+/// RMS of `rate - truth` per output over the records marked in `keep`
+/// (NaN when none is).
+pub fn rms_error(rate: &[[f64; 2]], truth: &[f64], keep: &[bool]) -> [f64; 2] {
+    std::array::from_fn(|k| {
+        let (ss, n) = rate
+            .iter()
+            .zip(truth)
+            .zip(keep)
+            .filter(|(_, keep)| **keep)
+            .fold((0.0, 0usize), |(ss, n), ((r, t), _)| {
+                (ss + (r[k] - t).powi(2), n + 1)
+            });
+        (ss / n as f64).sqrt()
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn profile(text: &str) -> Result<Profile, String> {
+        let p: Profile = toml::from_str(text).map_err(|e| e.message().to_string())?;
+        p.validate(2e-5)?;
+        Ok(p)
+    }
+
+    #[test]
+    fn the_rate_is_linear_between_points_stepped_at_repeated_times_and_held() {
+        let p = profile("duration_s = 1\nrate_points = [[0, 0], [0.2, 10], [0.2, -4], [0.6, 4]]\n")
+            .unwrap();
+        assert_eq!(p.rate_dps_at(0.0), 0.0);
+        assert!((p.rate_dps_at(0.1) - 5.0).abs() < 1e-12);
+        assert_eq!(p.rate_dps_at(0.2), -4.0);
+        assert!((p.rate_dps_at(0.4) - 0.0).abs() < 1e-12);
+        assert_eq!(p.rate_dps_at(0.9), 4.0);
+        assert!((p.record_length_s() - 0.01).abs() < 1e-15);
+    }
+
+    #[test]
+    fn bad_sections_are_refused_in_one_line_naming_the_key() {
+        let cases = [
+            ("rate_points = [[0, 1]]\n", "duration_s"),
+            ("duration_s = 0\nrate_points = [[0, 1]]\n", "duration_s"),
+            ("duration_s = 1\nrate_points = []\n", "rate_points"),
+            ("duration_s = 1\nrate_points = [[0.1, 1]]\n", "rate_points"),
+            (
+                "duration_s = 1\nrate_points = [[0, 1], [0.5, 1], [0.4, 2]]\n",
+                "non-decreasing",
+            ),
+            ("duration_s = 1\nrate_points = [[0, 1e9]]\n", "rate_points"),
+            (
+                "duration_s = 1\nrate_points = [[0, 1]]\nrecord_s = 1e-6\n",
+                "record_s",
+            ),
+            (
+                "duration_s = 1\nrate_points = [[0, 1]]\nrecord_s = 2\n",
+                "record_s",
+            ),
+            ("duration_s = 1\nrate_points = [[0, 1, 2]]\n", "length 2"),
+            (
+                "duration_s = 1\nrate_points = [[0, 1]]\nspeed = 2\n",
+                "speed",
+            ),
+            (
+                "duration_s = 1\nrate_points = [[0, 1]]\nsettle_s = 1\n",
+                "settle_s",
+            ),
+        ];
+        for (text, key) in cases {
+            let err = profile(text).expect_err(key);
+            assert!(err.contains(key), "{key}: {err}");
+            assert!(!err.trim_end().contains('\n'), "{err}");
+        }
+    }
+
+    #[test]
+    fn calibrated_rate_removes_the_null_and_divides_by_the_scale_factor() {
+        let z = [[110.0, -50.0], [130.0, -90.0]];
+        let rate = calibrated(&z, [100.0, -10.0], [2.0, -4.0]);
+        assert_eq!(rate, vec![[5.0, 10.0], [15.0, 20.0]]);
+        let rms = rms_error(&rate, &[5.0, 15.0], &[true, true]);
+        assert_eq!(rms[0], 0.0);
+        assert!((rms[1] - 5.0f64.hypot(5.0) / 2f64.sqrt()).abs() < 1e-12);
+        assert_eq!(rms_error(&rate, &[5.0, 15.0], &[false, true])[1], 5.0);
+    }
+
+    #[test]
+    fn records_near_a_point_are_not_settled() {
+        let p =
+            profile("duration_s = 1\nrate_points = [[0, 0], [0.5, 10]]\nsettle_s = 0.1\n").unwrap();
+        assert!(!p.is_settled(0.0, 0.01));
+        assert!(p.is_settled(0.1, 0.11));
+        assert!(!p.is_settled(0.49, 0.5 + 1e-9));
+        assert!(!p.is_settled(0.59, 0.6));
+        assert!(p.is_settled(0.6, 0.61));
+    }
+}
