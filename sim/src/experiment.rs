@@ -31,8 +31,9 @@
 //!   4 Om sinusoids fitted out, 10 ms batch means still repeat each period
 //!   with an amplitude of 1.4e-5 (output 1) and 5.6e-5 (output 2) of the DC
 //!   value, and only fitting some 60 harmonics of f_cal removes it. So
-//!   batches shorter than P are not independent samples of the mean. Two-way layout instead: batch s_mi (period m, phase i),
-//!   phase means s_i over the M periods, window mean c; the spread of
+//!   batches shorter than P are not independent samples of the mean.
+//!   Two-way layout instead: batch s_mi (period m, phase i), phase means
+//!   s_i over the M periods, window mean c; the spread of
 //!   s_mi - s_i is noise alone, with I (M - 1) degrees of freedom. The
 //!   point's batches are reported as c + (s_mi - s_i) sqrt((I M - 1) /
 //!   (I (M - 1))), whose mean is c and whose plain batch-mean variance is
@@ -152,6 +153,23 @@ impl PointPlan {
         match self.mode {
             Mode::Readout => f64::from(BATCHES) * f64::from(units) * self.unit_cycles,
             Mode::Calibration => f64::from(units) * self.unit_cycles,
+        }
+    }
+
+    /// Number of batches in the window: readout `BATCHES`; calibration
+    /// `RIPPLE_BATCHES` per ripple period.
+    pub fn batch_count(&self, units: u32) -> u32 {
+        match self.mode {
+            Mode::Readout => BATCHES,
+            Mode::Calibration => RIPPLE_BATCHES * units,
+        }
+    }
+
+    /// Length of one batch in clocks.
+    pub fn batch_cycles(&self, units: u32) -> f64 {
+        match self.mode {
+            Mode::Readout => self.window_cycles(units) / f64::from(BATCHES),
+            Mode::Calibration => self.unit_cycles / f64::from(RIPPLE_BATCHES),
         }
     }
 
@@ -615,45 +633,9 @@ impl Samples {
         self.count += 1;
     }
 
-    /// Calibration: `RIPPLE_BATCHES` batch means per ripple period over
-    /// `periods` whole periods of `period` clocks from `t0`, with the
-    /// ripple's shape taken out (module header): batch (m, i) becomes
-    /// c + (s_mi - s_i) sqrt((I M - 1) / (I (M - 1))), c the window's mean
-    /// and s_i the mean of phase i over the periods.
-    fn ripple_batches(&self, t0: f64, period: f64, periods: u32) -> Vec<[f64; 2]> {
-        let per_period = RIPPLE_BATCHES as usize;
-        let batch = period / f64::from(RIPPLE_BATCHES);
-        let raw: Vec<[f64; 2]> = (0..periods as usize * per_period)
-            .map(|j| {
-                let a = t0 + j as f64 * batch;
-                std::array::from_fn(|k| window_mean(&self.t, &self.z[k], a, a + batch))
-            })
-            .collect();
-        let m = f64::from(periods);
-        let phase_mean = |i: usize, k: usize| -> f64 {
-            raw.iter()
-                .skip(i)
-                .step_by(per_period)
-                .map(|b| b[k])
-                .sum::<f64>()
-                / m
-        };
-        let shape: Vec<[f64; 2]> = (0..per_period)
-            .map(|i| std::array::from_fn(|k| phase_mean(i, k)))
-            .collect();
-        let c: [f64; 2] =
-            std::array::from_fn(|k| shape.iter().map(|s| s[k]).sum::<f64>() / per_period as f64);
-        let n = raw.len() as f64;
-        let scale = ((n - 1.0) / (n - per_period as f64)).sqrt();
-        raw.iter()
-            .enumerate()
-            .map(|(j, b)| std::array::from_fn(|k| c[k] + (b[k] - shape[j % per_period][k]) * scale))
-            .collect()
-    }
-
-    /// `BATCHES` batch means of length `batch` from `t0`, per output.
-    fn batch_means(&self, t0: f64, batch: f64) -> Vec<[f64; 2]> {
-        (0..BATCHES)
+    /// `count` consecutive batch means of length `batch` from `t0`, per output.
+    fn batch_means(&self, t0: f64, batch: f64, count: u32) -> Vec<[f64; 2]> {
+        (0..count)
             .map(|j| {
                 let a = t0 + f64::from(j) * batch;
                 std::array::from_fn(|k| window_mean(&self.t, &self.z[k], a, a + batch))
@@ -683,6 +665,34 @@ fn advance<E: Engine>(
         }
     }
     progress(Tick::Clocks(done));
+}
+
+/// Calibration batches (consecutive, `per_period` to a ripple period, whole
+/// periods) with the ripple's shape taken out (module header): batch
+/// (m, i) becomes c + (s_mi - s_i) sqrt((I M - 1) / (I (M - 1))), c the
+/// window's mean and s_i the mean of phase i over the periods.
+fn without_ripple_shape(raw: &[[f64; 2]], per_period: usize) -> Vec<[f64; 2]> {
+    let periods = (raw.len() / per_period) as f64;
+    let shape: Vec<[f64; 2]> = (0..per_period)
+        .map(|i| {
+            std::array::from_fn(|k| {
+                raw.iter()
+                    .skip(i)
+                    .step_by(per_period)
+                    .map(|b| b[k])
+                    .sum::<f64>()
+                    / periods
+            })
+        })
+        .collect();
+    let c: [f64; 2] =
+        std::array::from_fn(|k| shape.iter().map(|s| s[k]).sum::<f64>() / per_period as f64);
+    let n = raw.len() as f64;
+    let scale = ((n - 1.0) / (n - per_period as f64)).sqrt();
+    raw.iter()
+        .enumerate()
+        .map(|(j, b)| std::array::from_fn(|k| c[k] + (b[k] - shape[j % per_period][k]) * scale))
+        .collect()
 }
 
 /// Mean and 1-sigma uncertainty of the mean of batch means, per output.
@@ -721,16 +731,11 @@ pub fn run_point<E: Engine>(
         first_kept: point.settle_cycles.saturating_sub(2 * u64::from(r)),
     };
     advance(&mut sim, &mut samples, end, progress);
-    let t0 = point.settle_cycles as f64;
-    let (batch, batch_lsb) = match point.mode {
-        Mode::Readout => {
-            let batch = point.window_cycles(units) / f64::from(BATCHES);
-            (batch, samples.batch_means(t0, batch))
-        }
-        Mode::Calibration => {
-            let batch = point.unit_cycles / f64::from(RIPPLE_BATCHES);
-            (batch, samples.ripple_batches(t0, point.unit_cycles, units))
-        }
+    let batch = point.batch_cycles(units);
+    let raw = samples.batch_means(point.settle_cycles as f64, batch, point.batch_count(units));
+    let batch_lsb = match point.mode {
+        Mode::Readout => raw,
+        Mode::Calibration => without_ripple_shape(&raw, RIPPLE_BATCHES as usize),
     };
     let (mean, sigma) = mean_and_uncertainty(&batch_lsb);
     let per_lsb = plan.z_per_lsb(point.mode);
@@ -1072,7 +1077,8 @@ mod tests {
         let mut within = 0;
         for _ in 0..400 {
             let s = calibration_like(&mut rng, period, 0.1);
-            let batches = s.ripple_batches(0.1 * period, period, 2);
+            let raw = s.batch_means(0.1 * period, period / 8.0, 16);
+            let batches = without_ripple_shape(&raw, 8);
             assert_eq!(batches.len(), 16);
             let (mean, sigma) = mean_and_uncertainty(&batches);
             if (mean[0] - 1.0 - 40.0 * 0.05).abs() <= sigma[0] {
