@@ -186,21 +186,12 @@ fn csv(report: &AllanReport) -> String {
 
 /// Write allan.json, allan.csv and the two figures into `dir`.
 fn write_outputs(report: &AllanReport, dir: &Path) -> Result<Vec<PathBuf>, Failure> {
-    std::fs::create_dir_all(dir).map_err(|e| {
-        Failure::Input(format!(
-            "--out {}: cannot create the folder: {e}",
-            dir.display()
-        ))
-    })?;
     let json =
         serde_json::to_string_pretty(&report.json()).map_err(|e| Failure::Run(e.to_string()))?;
-    let mut written = vec![];
-    for (name, text) in [("allan.json", json), ("allan.csv", csv(report))] {
-        let path = dir.join(name);
-        gyrocal_verify::write_atomically(&path, &text)
-            .map_err(|e| Failure::Run(format!("cannot write {}: {e}", path.display())))?;
-        written.push(path);
-    }
+    let mut written = super::experiment::write_files(
+        dir,
+        vec![("allan.json", json), ("allan.csv", csv(report))],
+    )?;
     for k in 0..2 {
         let analysis = &report.run.outputs[k].analysis;
         let curve: Vec<(f64, f64)> = analysis

@@ -18,6 +18,32 @@ pub fn read_config(path: &Path) -> Result<(String, String), Failure> {
     Ok((name, text))
 }
 
+/// Create the `--out` folder if missing; one that cannot be made is the
+/// user's input.
+pub fn create_out_dir(dir: &Path) -> Result<(), Failure> {
+    std::fs::create_dir_all(dir).map_err(|e| {
+        Failure::Input(format!(
+            "--out {}: cannot create the folder: {e}",
+            dir.display()
+        ))
+    })
+}
+
+/// Create `dir` if missing and write each `(file name, text)` into it,
+/// each through a temporary file and a rename; returns the paths written.
+pub fn write_files(dir: &Path, files: Vec<(&str, String)>) -> Result<Vec<PathBuf>, Failure> {
+    create_out_dir(dir)?;
+    files
+        .into_iter()
+        .map(|(name, text)| {
+            let path = dir.join(name);
+            gyrocal_verify::write_atomically(&path, &text)
+                .map_err(|e| Failure::Run(format!("cannot write {}: {e}", path.display())))?;
+            Ok(path)
+        })
+        .collect()
+}
+
 /// `--config FILE` read and checked as the experiment `gyrocal run` runs.
 pub fn load_experiment(path: &Path) -> Result<Experiment, Failure> {
     let (name, text) = read_config(path)?;
@@ -255,20 +281,11 @@ pub fn points_csv(report: &Report) -> String {
 /// Write `results.json`, `points.csv` and the figures into `dir` (created
 /// if missing), each through a temporary file and a rename.
 pub fn write_results(report: &Report, dir: &Path) -> Result<Vec<PathBuf>, Failure> {
-    std::fs::create_dir_all(dir).map_err(|e| {
-        Failure::Input(format!(
-            "--out {}: cannot create the folder: {e}",
-            dir.display()
-        ))
-    })?;
     let json = serde_json::to_string_pretty(report).map_err(|e| Failure::Run(e.to_string()))?;
-    let mut written = vec![];
-    for (name, text) in [("results.json", json), ("points.csv", points_csv(report))] {
-        let path = dir.join(name);
-        gyrocal_verify::write_atomically(&path, &text)
-            .map_err(|e| Failure::Run(format!("cannot write {}: {e}", path.display())))?;
-        written.push(path);
-    }
+    let mut written = write_files(
+        dir,
+        vec![("results.json", json), ("points.csv", points_csv(report))],
+    )?;
     written.extend(crate::plots::write_figures(report, dir).map_err(Failure::Run)?);
     Ok(written)
 }

@@ -45,7 +45,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     );
     let json = serde_json::to_string(&report).map_err(|e| Failure::Run(e.to_string()))?;
     if let Some(dir) = &args.out {
-        for path in write_results(&report, &json, &name, dir).map_err(Failure::Run)? {
+        for path in write_results(&report, &json, &name, dir)? {
             eprintln!("wrote {}", path.display());
         }
     }
@@ -147,32 +147,21 @@ fn write_results(
     json: &str,
     name: &str,
     dir: &Path,
-) -> Result<Vec<PathBuf>, String> {
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    let mut written = vec![];
+) -> Result<Vec<PathBuf>, Failure> {
     let mut files = vec![("field.json", json.to_string()), ("field.csv", csv(report))];
     if let Some(rates) = rate_csv(report) {
         files.push(("field_rate.csv", rates));
     }
-    for (file, bytes) in files {
-        let path = dir.join(file);
-        gyrocal_verify::write_atomically(&path, bytes.as_bytes())
-            .map_err(|e| format!("{}: {e}", path.display()))?;
-        written.push(path);
-    }
+    let mut written = super::experiment::write_files(dir, files)?;
     let title = format!("Self-calibration in the field: {name}");
-    written.extend(crate::plots::write_field_figure(
-        report,
-        &title,
-        dir,
-        "fig_field_error",
-    )?);
-    written.extend(crate::plots::field_rate::write_field_rate_figure(
-        report,
-        &title,
-        dir,
-        "fig_field_rate",
-    )?);
+    written.extend(
+        crate::plots::write_field_figure(report, &title, dir, "fig_field_error")
+            .map_err(Failure::Run)?,
+    );
+    written.extend(
+        crate::plots::field_rate::write_field_rate_figure(report, &title, dir, "fig_field_rate")
+            .map_err(Failure::Run)?,
+    );
     Ok(written)
 }
 

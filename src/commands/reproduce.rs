@@ -6,7 +6,7 @@
 //! the simulated and exact values, and writes results.json, points.csv and
 //! the figures into `--out`.
 
-use super::experiment::{RunOptions, execute, summary, write_results};
+use super::experiment::{RunOptions, create_out_dir, execute, summary, write_files, write_results};
 use crate::Failure;
 use gyrocal_sim::experiment::Experiment;
 use gyrocal_sim::report::Report;
@@ -121,20 +121,12 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let exp = Experiment::paper();
     let checked = args.options.check(&exp)?;
     // Fail on an unusable output folder before the simulation, not after.
-    std::fs::create_dir_all(&args.out).map_err(|e| {
-        Failure::Input(format!(
-            "--out {}: cannot create the folder: {e}",
-            args.out.display()
-        ))
-    })?;
+    create_out_dir(&args.out)?;
     let report = execute(&exp, &args.options, &checked)?;
     let text = format!("{}\n{}", paper_table(&report), summary(&report));
     print!("{text}");
     let mut written = write_results(&report, &args.out)?;
-    let path = args.out.join("summary.txt");
-    gyrocal_verify::write_atomically(&path, &text)
-        .map_err(|e| Failure::Run(format!("cannot write {}: {e}", path.display())))?;
-    written.push(path);
+    written.extend(write_files(&args.out, vec![("summary.txt", text)])?);
     for p in written {
         eprintln!("wrote {}", p.display());
     }
