@@ -45,6 +45,14 @@ fn bad_scenario_files_are_refused_in_one_line() {
             format!("{GOOD}{drift}drive_gain_ppm_per_k = [1, 2, 3]\n"),
             "length 2",
         ),
+        (
+            format!("{GOOD}{drift}[drive_probe]\nrate_dps = 0\n"),
+            "rate_dps",
+        ),
+        (
+            format!("{GOOD}{drift}[drive_probe]\nrate_dps = 100\nseconds = 1\n"),
+            "seconds",
+        ),
     ];
     let dir = tempfile::tempdir().unwrap();
     for (i, (text, key)) in cases.iter().enumerate() {

@@ -64,10 +64,12 @@ pub fn csv(report: &FieldReport) -> String {
          sf_baseline1_per_dps,sf_baseline2_per_dps,sf_true_factory1_per_dps,sf_true_factory2_per_dps,\
          selfcal_error1,selfcal_error2,baseline_error1,baseline_error2,f1_hz,f1_hz_uncertainty,\
          f2_hz,f2_hz_uncertainty,q1,q1_uncertainty,q2,q2_uncertainty,loop_phase_deg,\
-         loop_phase_deg_uncertainty\n",
+         loop_phase_deg_uncertainty,drive_gain_ratio,drive_gain_ratio_uncertainty,\
+         drive_gain_ratio_true\n",
     );
     for st in &report.steps {
         let i = &st.identified;
+        let ratio = st.selfcal.drive_ratio.as_ref().map(|d| d.relative);
         let values = [
             st.temperature_c,
             st.sf_true_per_dps[0],
@@ -92,6 +94,9 @@ pub fn csv(report: &FieldReport) -> String {
             i.q2_uncertainty,
             i.loop_phase_deg,
             i.loop_phase_deg_uncertainty,
+            ratio.map_or(f64::NAN, |r| r.value),
+            ratio.map_or(f64::NAN, |r| r.uncertainty),
+            st.drive_gain_ratio_true,
         ];
         let row: Vec<String> = values.iter().map(|v| format!("{v:e}")).collect();
         s.push_str(&row.join(","));
@@ -203,6 +208,21 @@ pub fn summary(report: &FieldReport) -> String {
             i.f2_hz - i.f1_hz,
             i.loop_phase_deg
         );
+    }
+    for st in &report.steps {
+        if let Some(d) = &st.selfcal.drive_ratio {
+            let _ = writeln!(
+                s,
+                "{:>8.2}  drive-gain ratio g2/g1 over design {:.6} +- {:.1e} (true {:.6}); \
+                 at the design ratio the self-cal error would be {:+.4}% / {:+.4}%",
+                st.temperature_c,
+                d.relative.value,
+                d.relative.uncertainty,
+                st.drive_gain_ratio_true,
+                100.0 * (st.selfcal.sf_design_ratio_per_dps[0] / st.sf_true_per_dps[0] - 1.0),
+                100.0 * (st.selfcal.sf_design_ratio_per_dps[1] / st.sf_true_per_dps[1] - 1.0),
+            );
+        }
     }
     for st in &report.steps {
         if let Some(tr) = &st.profile {

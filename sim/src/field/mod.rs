@@ -13,6 +13,9 @@
 //!   [`identify::Knowns`], never the true parameters.
 //! - [`selfcal`]: host code. Identify, retune, correct the loop phase, run
 //!   the staircase, predict the readout scale factor in z LSB per deg/s.
+//! - [`drive_ratio`]: host code. The drive-gain ratio g2 / g1 from the
+//!   Coriolis cross responses while the device turns, the one converter
+//!   drift the cycle at rest cannot observe.
 //! - [`profile`]: the `[profile]` section (a rate against time at every
 //!   step) and the calibrated rate output, (z - null) / SF, it gives.
 //! - [`scenario`]: the simulation around it: the device drifting over the
@@ -20,6 +23,7 @@
 //!   factory-calibrated baseline.
 
 pub mod board;
+pub mod drive_ratio;
 pub mod identify;
 pub mod profile;
 pub mod scenario;

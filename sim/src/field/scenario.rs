@@ -17,6 +17,9 @@
 //! - Baseline: the factory calibration at T0 (the cycle, then the rate
 //!   table) fixes the carrier, the phase correction and the scale factor;
 //!   at T its error is against the rate table with those fixed settings.
+//! - With a `[drive_probe]` ([`drive_ratio`]): after its cycle each step's
+//!   board turns at the probe's rate while the host measures the drive-gain
+//!   ratio, and the prediction uses it instead of the design ratio.
 //! - With a `[profile]` ([`profile`]): after its cycle each step's board
 //!   switches to readout, measures its null at rest and runs the profile;
 //!   the rate output is (z - null) / SF_selfcal. The baseline runs the
@@ -24,6 +27,7 @@
 //!   the factory's null and scale factor.
 
 use super::board::{Board, SimBoard};
+use super::drive_ratio::{self, DriveProbe};
 use super::identify::{Identified, Knowns};
 use super::profile::{self, Profile, ProfileRun, RateTrace};
 use super::selfcal::{self, Operating, SelfCal, window_z};
@@ -49,7 +53,7 @@ use std::time::Instant;
 const TABLE_FIRST_TAUS: f64 = 30.0;
 
 /// A scenario file: the sections of `gyrocal run` plus `[drift]` and,
-/// optionally, `[profile]`.
+/// optionally, `[profile]` and `[drive_probe]`.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct ScenarioFile {
@@ -65,6 +69,8 @@ struct ScenarioFile {
     drift: Drift,
     #[serde(default)]
     profile: Option<Profile>,
+    #[serde(default)]
+    drive_probe: Option<DriveProbe>,
 }
 
 /// A checked scenario.
@@ -76,6 +82,8 @@ pub struct Scenario {
     pub drift: Drift,
     /// The rate profile applied at every step, if any.
     pub profile: Option<Profile>,
+    /// The turn during which the host measures the drive-gain ratio, if any.
+    pub drive_probe: Option<DriveProbe>,
 }
 
 /// Parse a scenario file's text: the experiment (checked as `gyrocal run`
@@ -108,10 +116,14 @@ pub fn parse(name: &str, text: &str) -> Result<Scenario, String> {
         let sample_s = f64::from(derived.decimation) / exp.drive.clock_hz;
         p.validate(sample_s).map_err(|e| format!("{name}: {e}"))?;
     }
+    if let Some(p) = &file.drive_probe {
+        p.validate().map_err(|e| format!("{name}: {e}"))?;
+    }
     Ok(Scenario {
         exp,
         drift: file.drift,
         profile: file.profile,
+        drive_probe: file.drive_probe,
     })
 }
 
@@ -136,6 +148,9 @@ pub struct FieldStep {
     pub selfcal_error: [f64; 2],
     /// sf_baseline / sf_true_at_factory_settings - 1.
     pub baseline_error: [f64; 2],
+    /// The true g_2 / g_1 over the design ratio (what `[drive_probe]`'s
+    /// measurement, `selfcal.drive_ratio`, estimates).
+    pub drive_gain_ratio_true: f64,
     /// Identified parameters (JSON: f1_hz, ..., with `_uncertainty` twins).
     pub identified: IdentifiedJson,
     /// The whole cycle's result.
@@ -323,7 +338,13 @@ struct Cycle {
 fn cycle_at(sc: &Scenario, fe: &FrontEnd, knowns: &Knowns, t: f64) -> Result<Cycle, String> {
     let at = sc.drift.at(&sc.exp.gyro, t);
     let mut board = board_at(&sc.exp, fe, &at)?;
-    let cal = selfcal::self_calibrate(&mut board, knowns, &knowns.nominal)?;
+    let mut cal = selfcal::self_calibrate(&mut board, knowns, &knowns.nominal)?;
+    if let Some(probe) = &sc.drive_probe {
+        board.set_rate(probe.rate_dps.to_radians());
+        let measured = drive_ratio::measure(&mut board, knowns, &cal.operating, &cal.identified)?;
+        board.set_rate(0.0);
+        selfcal::apply_drive_ratio(knowns, &mut cal, measured)?;
+    }
     let readout = match &sc.profile {
         None => None,
         Some(p) => {
@@ -479,6 +500,7 @@ pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldRepor
             }
         });
         let t = c.at.temperature_c;
+        let drive_gain_ratio_true = c.at.drive_gain[1] / c.at.drive_gain[0];
         let selfcal_error = ratio_error(c.cal.sf_selfcal_per_dps, sf_true);
         let baseline_error = ratio_error(sf_factory, sf_fixed);
         progress(&format!(
@@ -498,6 +520,7 @@ pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldRepor
             sf_true_at_factory_settings_per_dps: sf_fixed,
             selfcal_error,
             baseline_error,
+            drive_gain_ratio_true,
             identified: IdentifiedJson::from(&c.cal.identified),
             clocks: c.clocks,
             selfcal: c.cal,

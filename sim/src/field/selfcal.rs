@@ -21,17 +21,15 @@
 //! ratio g_(1-k) / g_k enters one for one, with opposite signs on the two
 //! outputs. At rest the modes are uncoupled, so every response the gateware
 //! can observe carries a_k g_k together: the differential drive gain cannot
-//! be told from an ADC gain, and the host uses the board's design ratio
-//! (`Knowns::force_full_scale`). Its drift is the one converter drift the
-//! cycle cannot correct (measured in `tests/field.rs`).
+//! be told from an ADC gain, and the cycle at rest uses the board's design
+//! ratio (`Knowns::force_full_scale`). Its drift is the one converter drift
+//! the cycle at rest cannot correct (measured in `tests/field.rs`).
 //!
-//! It would become observable while the device turns, at any rate and
-//! without knowing it. With H_jk the response at ADC j to drive k
-//! (readout for j = k, the calibration SELECT with the other drive off for
-//! j != k), H_jk = a_j g_k M_jk. To first order in the rate the Coriolis
-//! coupling is antisymmetric, M_12 = -M_21 = 2 lambda Omega j w G_1 G_2,
-//! and M_kk = G_k, the resonators' responses known from the
-//! identification, so
+//! It becomes observable while the device turns, at any rate and without
+//! knowing it. With H_jk the response at ADC j to drive k, H_jk = a_j g_k
+//! M_jk. The Coriolis coupling is antisymmetric, M_12 = -M_21, and
+//! M_22 / M_11 = G_2 / G_1, the resonators' responses known from the
+//! identification (both exact: `drive_ratio` module header), so
 //!
 //! ```text
 //! (H_12 / H_21) / (H_11 / H_22) = (g_2 / g_1)^2 x (M_12 M_22) / (M_21 M_11)
@@ -40,8 +38,10 @@
 //!
 //! holds the drive-gain ratio alone: the rate cancels. The cross responses
 //! are lambda Omega / bandwidth of the direct ones, so it needs a rate well
-//! above the noise; a field cycle at rest, as here, cannot use it, and it
-//! is not implemented.
+//! above the noise: the cycle at rest cannot use it. When the device turns
+//! at a steady rate, [`super::drive_ratio`] measures it (the ratio is exact
+//! at any rate, not only to first order) and [`apply_drive_ratio`] predicts
+//! again with it.
 //!
 //! # The prediction
 //!
@@ -55,6 +55,7 @@
 //! parameters are given beside it.
 
 use super::board::Board;
+use super::drive_ratio::DriveRatio;
 use super::identify::{self, Identified, Knowns, readout_word};
 use crate::average::window_mean;
 use crate::experiment::envelope_lead_rad;
@@ -110,6 +111,17 @@ pub struct SelfCal {
     pub sf_selfcal_per_dps: [f64; 2],
     /// SF_cal x ratio.eq56 (z LSB per deg/s).
     pub sf_eq56_per_dps: [f64; 2],
+    /// The drive-gain ratio measured while the device turned, when it
+    /// was (`drive_ratio`); the prediction above then uses it instead of
+    /// the design ratio.
+    pub drive_ratio: Option<DriveRatio>,
+    /// SF_cal x ratio.exact at the design drive-gain ratio (z LSB per
+    /// deg/s): `sf_selfcal_per_dps` before the measured ratio replaced it.
+    pub sf_design_ratio_per_dps: [f64; 2],
+    /// Relative 1-sigma uncertainty of `sf_selfcal_per_dps` from the
+    /// measured drive-gain ratio's (0 at the design ratio, whose own error
+    /// is the unobserved drift).
+    pub sf_drive_ratio_uncertainty: [f64; 2],
     /// Clocks of the whole cycle.
     pub clocks: u64,
 }
@@ -307,5 +319,46 @@ pub fn self_calibrate(
         ratio,
         sf_selfcal_per_dps,
         sf_eq56_per_dps,
+        drive_ratio: None,
+        sf_design_ratio_per_dps: sf_selfcal_per_dps,
+        sf_drive_ratio_uncertainty: [0.0; 2],
     })
+}
+
+/// `knowns` with drive 2's force gain moved by `relative` (g_2 / g_1 over
+/// the design ratio).
+fn with_drive_ratio(knowns: &Knowns, relative: f64) -> Knowns {
+    let mut moved = knowns.clone();
+    moved.force_full_scale[1] *= relative;
+    moved
+}
+
+/// Predict again with a measured drive-gain ratio (`drive_ratio`): the
+/// exact theory at the same identified device, operating point and
+/// staircase, with drive 2's force gain moved by the measured ratio; the
+/// ratio's uncertainty is propagated to each scale factor.
+pub fn apply_drive_ratio(
+    knowns: &Knowns,
+    cal: &mut SelfCal,
+    measured: DriveRatio,
+) -> Result<(), String> {
+    let gyro = cal.identified.gyro(&knowns.nominal);
+    let predict = |relative: f64| {
+        predicted_ratio(
+            &with_drive_ratio(knowns, relative),
+            &gyro,
+            &cal.operating,
+            &cal.cal_hz,
+        )
+    };
+    let rho = measured.relative;
+    let ratio = predict(rho.value)?;
+    let moved = predict(rho.value + rho.uncertainty)?;
+    cal.sf_drive_ratio_uncertainty =
+        std::array::from_fn(|k| (moved.exact[k] / ratio.exact[k] - 1.0).abs());
+    cal.sf_selfcal_per_dps = std::array::from_fn(|k| cal.sf_cal_per_dps[k] * ratio.exact[k]);
+    cal.sf_eq56_per_dps = std::array::from_fn(|k| cal.sf_cal_per_dps[k] * ratio.eq56[k]);
+    cal.ratio = ratio;
+    cal.drive_ratio = Some(measured);
+    Ok(())
 }

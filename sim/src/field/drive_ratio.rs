@@ -1,0 +1,324 @@
+//! Host-side measurement of the drive-gain ratio g2 / g1 while the device
+//! turns: the one converter drift the cycle at rest cannot see
+//! (`selfcal` module header), observed through the Coriolis cross
+//! responses, with nothing but register writes and z reads.
+//!
+//! # Why it needs a rotation, and why the rate cancels
+//!
+//! With H_jk the response at ADC j to drive k, H_jk = a_j g_k M_jk, where
+//! a_j is ADC j's gain, g_k drive k's force per DAC LSB and M the coupled
+//! resonators' response. The gyroscope's phasor equations at the carrier
+//! w are, with G_k = 1 / (w_k^2 - w^2 + j w b_k) and c = j w 2 lambda Omega,
+//!
+//! ```text
+//! [ 1/G_1   -c  ] [X_1]   [F_1]                   1   [ 1/G_2   c  ]
+//! [   c   1/G_2 ] [X_2] = [F_2],   so  M = ------ [             ]
+//!                                           det   [  -c   1/G_1 ]
+//! ```
+//!
+//! exactly, at any rate: M_12 / M_21 = -1 and M_22 / M_11 = G_2 / G_1. So
+//!
+//! ```text
+//! (H_12 H_22) / (H_21 H_11) = (g_2 / g_1)^2 (M_12 M_22) / (M_21 M_11) = -(g_2 / g_1)^2 G_2 / G_1
+//! ```
+//!
+//! The ADC gains, the rate (unknown to the host) and any phase common to
+//! both pick-offs cancel; G_2 / G_1 comes from the identified f_k and Q_k.
+//! At rest H_12 = H_21 = 0 and the ratio is 0 / 0: the device must turn
+//! (the cross responses grow with the rate), at any steady rate.
+//!
+//! # How the gateware exposes the four responses
+//!
+//! In readout, output j is the mean of ADC_j times drive j's own word, and
+//! the reference word of drive j carries drive j's amplitude: with one
+//! drive off, the other output reads zero. So both drives stay on, and
+//! drive 2's amplitude word is negated for a second measurement: with W_k
+//! the drive words' signed amplitudes (drive 2's word is a sine, a phasor
+//! -j W_2), I and Q through REF_PHASE (as `identify` measures them),
+//!
+//! ```text
+//! Z_1(W_2)       = kappa_1 W_1 a_1 (g_1 M_11 W_1 - j g_2 M_12 W_2)  = P_1 + Q_1 W_2
+//! Z_2(W_2) / W_2 = kappa_2     a_2 (g_1 M_21 W_1 - j g_2 M_22 W_2)  = P_2 + Q_2 W_2
+//! ```
+//!
+//! two lines in W_2 from its two signed values (the rounded words, which
+//! differ from exact negatives by at most one LSB of the envelope), whence
+//!
+//! ```text
+//! (g_2 / g_1)^2 = Q_1 Q_2 W_1^2 / (P_1 P_2) x G_1 / G_2
+//! ```
+//!
+//! (kappa_j, the output's reference phase and filter gain, cancels within
+//! each output). |g_2 / g_1| is the estimate; the phase of the right-hand
+//! side, zero for drives that differ in gain only, is reported as a check.
+//!
+//! # Drive 1 at a fraction
+//!
+//! On a device excited at mode 1, output 1's cross term Q_1 W_2 is some
+//! 6e-4 of its direct term P_1 at 200 deg/s (the consumer device), and
+//! anything that moves with the direct term between the windows moves
+//! Q_1: the carrier table's spurs beat with the resonant response at some
+//! 1e-7 of it (`scenario::rate_table`), and the filter's residue after a
+//! REF_PHASE step is 1e-6 of the step. Measured on the consumer device
+//! without ADC noise at drive 1's full readout amplitude, the ratio came
+//! out 2.7e-4 low (-17 sigma); with three times the waits, 1.7e-4 high:
+//! a beat, not a transient. Drive 1 runs at `DRIVE1_FRACTION` of its
+//! amplitude instead: output 1's direct term and everything that scales
+//! with it shrink by that much, while its cross term keeps its size against
+//! output 1's noise (drive 1's word is also output 1's reference, so signal
+//! and noise scale alike); output 2's cross term (drive 1 at ADC 2) loses
+//! the factor against output 2's noise, which the 0.1 cross over direct
+//! ratio of that output affords. Measured, same device: 1.3e-5 +- 0.4e-5
+//! without noise; with the 1 LSB ADC noise at 1/8 and 1/16, every step
+//! within 0.5 sigma.
+//!
+//! # Uncertainty
+//!
+//! Each of the four windows is cut into `BATCHES` consecutive batches; the
+//! estimate is formed from each batch index alone and the spread of those
+//! `BATCHES` estimates gives the noise's standard error. The identified
+//! parameters' uncertainties enter through G_1 / G_2 (propagated by finite
+//! differences). A rate that drifts between the two signs cancels to first
+//! order (each of Q_1 and P_2 is the mean over both); quadrature coupling
+//! (a stiffness term, which this model of the device does not have) would
+//! break M_12 = -M_21 and is not covered.
+
+use super::board::Board;
+use super::identify::{self, Estimate, Identified, Knowns, average_z};
+use super::selfcal::Operating;
+use crate::config::MAX_RATE_DPS;
+use gyrocal_hdl::model::q15_multiplier::q15_product;
+use gyrocal_hdl::sine_table::PEAK;
+use nalgebra::Complex;
+use serde::{Deserialize, Serialize};
+
+type C64 = Complex<f64>;
+
+/// Batches per window: the standard error's degrees of freedom + 1.
+pub const BATCHES: usize = 8;
+
+/// Drive 1's amplitude during the measurement, as a fraction of its
+/// readout amplitude (module header, "Drive 1 at a fraction").
+pub const DRIVE1_FRACTION: f64 = 0.125;
+
+/// The `[drive_probe]` section of a field scenario: after each step's
+/// cycle the simulation's rate table turns the device at `rate_dps` while
+/// the host measures the drive-gain ratio (the host is not told the rate).
+///
+/// ```toml
+/// [drive_probe]
+/// rate_dps = 200      # required: any non-zero rate within the rate limit
+/// ```
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DriveProbe {
+    /// The steady rate during the measurement (deg/s).
+    pub rate_dps: f64,
+}
+
+impl DriveProbe {
+    /// Checks the rate; the error is one line naming the key.
+    pub fn validate(&self) -> Result<(), String> {
+        let r = self.rate_dps;
+        if r.is_finite() && r != 0.0 && r.abs() <= MAX_RATE_DPS {
+            Ok(())
+        } else {
+            Err(format!(
+                "[drive_probe] rate_dps = {r}: allowed non-zero, -{MAX_RATE_DPS}..={MAX_RATE_DPS} \
+                 deg/s (at rest the cross responses vanish)"
+            ))
+        }
+    }
+}
+
+/// The measured drive-gain ratio.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct DriveRatio {
+    /// |g_2 / g_1| over the design ratio (`Knowns::force_full_scale`).
+    pub relative: Estimate,
+    /// Half the phase of the measured (g_2 / g_1)^2 (deg): zero when the
+    /// drives differ in gain only.
+    pub phase_deg: Estimate,
+    /// |H_21 / H_22|: the cross response over the direct one on output 2,
+    /// which sets the precision (it grows with the rate).
+    pub cross_over_direct: f64,
+    /// Clocks the measurement took.
+    pub clocks: u64,
+}
+
+/// Signed fundamental amplitude of a readout drive word for amplitude
+/// word `amp` (`identify::readout_word` with its sign).
+fn signed_word(amp: i16) -> f64 {
+    f64::from(q15_product(amp, PEAK as i16)) * f64::from(PEAK) / 32768.0
+}
+
+/// G_k(f) up to a common factor: 1 / ((f_k - f)(f_k + f) + j f b_k).
+fn resonator(f_k: f64, q_k: f64, f: f64) -> C64 {
+    1.0 / C64::new((f_k - f) * (f_k + f), f * f_k / q_k)
+}
+
+/// (g_2 / g_1)^2 from the four complex window means (outputs 1 and 2 at
+/// drive 2's two signed words `w2`) and G_1 / G_2.
+fn ratio_squared(z: [[C64; 2]; 2], w1: f64, w2: [f64; 2], g1_over_g2: C64) -> C64 {
+    // Output 1: Z_1 = P_1 + Q_1 W_2; output 2: Z_2 / W_2 = P_2 + Q_2 W_2.
+    let line = |y: [C64; 2]| {
+        let q = (y[0] - y[1]) / (w2[0] - w2[1]);
+        (y[0] - q * w2[0], q)
+    };
+    let (p1, q1) = line([z[0][0], z[1][0]]);
+    let (p2, q2) = line([z[0][1] / w2[0], z[1][1] / w2[1]]);
+    q1 * q2 * w1 * w1 / (p1 * p2) * g1_over_g2
+}
+
+/// G_1 / G_2 at the carrier from the identified modes, and the relative
+/// 1-sigma uncertainty of its magnitude (finite differences over f_k, Q_k).
+fn resonator_ratio(id: &Identified, carrier_hz: f64) -> (C64, f64) {
+    let [m1, m2] = &id.modes;
+    let p = [m1.f_hz, m1.q, m2.f_hz, m2.q];
+    let ratio = |v: [f64; 4]| resonator(v[0], v[1], carrier_hz) / resonator(v[2], v[3], carrier_hz);
+    let values = p.map(|e| e.value);
+    let centre = ratio(values);
+    let variance: f64 = (0..4)
+        .map(|i| {
+            let mut moved = values;
+            let h = 1e-3 * p[i].uncertainty.max(1e-9 * p[i].value.abs());
+            moved[i] += h;
+            let slope = (ratio(moved).norm() / centre.norm()).ln() / h;
+            (slope * p[i].uncertainty).powi(2)
+        })
+        .sum();
+    (centre, variance.sqrt())
+}
+
+/// Mean and standard error of `v`.
+fn mean_and_error(v: &[f64]) -> Estimate {
+    let n = v.len() as f64;
+    let mean = v.iter().sum::<f64>() / n;
+    let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    Estimate {
+        value: mean,
+        uncertainty: (var / n).sqrt(),
+    }
+}
+
+/// `BATCHES` batch means of both outputs, `per_batch` z samples each,
+/// after waiting `settle` clocks.
+fn batch_means(
+    board: &mut dyn Board,
+    decimation: u32,
+    settle: u64,
+    per_batch: u64,
+) -> Result<Vec<[f64; 2]>, String> {
+    board.wait_clocks(settle);
+    (0..BATCHES)
+        .map(|_| average_z(board, decimation, 0, per_batch))
+        .collect()
+}
+
+/// Measure g_2 / g_1 on a board that turns at a steady (unknown) rate,
+/// at the operating point `op` of identification `id`: both drives at the
+/// readout amplitudes, drive 2 at its two signs, I and Q of each; every
+/// window `min_window_s` long.
+pub fn measure(
+    board: &mut dyn Board,
+    knowns: &Knowns,
+    op: &Operating,
+    id: &Identified,
+) -> Result<DriveRatio, String> {
+    let r = knowns.filter.decimation;
+    let window = (knowns.filter.min_window_s * knowns.clock_hz / f64::from(r)).ceil() as u64;
+    let per_batch = window.div_ceil(BATCHES as u64).max(1);
+    let settle = knowns.settle_clocks(identify::SETTLE_TAUS);
+    let filter = knowns.filter_settle_clocks();
+    let mut means = vec![]; // [sign][phase] -> batches
+    let mut words = [0.0; 2];
+    let mut w1 = 0.0;
+    let mut clocks = 0;
+    for (s, sign) in [1.0, -1.0].into_iter().enumerate() {
+        let amps = (
+            DRIVE1_FRACTION * knowns.amplitude.0,
+            sign * knowns.amplitude.1,
+        );
+        let (regs, _) = knowns.registers(op.carrier_hz, None, amps, op.ref_lag_deg)?;
+        w1 = signed_word(regs.amp.0);
+        words[s] = signed_word(regs.amp.1);
+        let mut pair = vec![];
+        for quarter in [0u32, 1 << 30] {
+            let mut rotated = regs;
+            rotated.ref_phase = regs.ref_phase.wrapping_add(quarter);
+            board
+                .program(&rotated)
+                .map_err(|e| format!("board refused a register access: {e:?}"))?;
+            let wait = if quarter == 0 { settle } else { filter };
+            pair.push(batch_means(board, r, wait, per_batch)?);
+            clocks += wait + BATCHES as u64 * per_batch * u64::from(r);
+        }
+        means.push(pair);
+    }
+    if words[0] == words[1] || w1 == 0.0 {
+        return Err("drive-gain ratio: both drive amplitudes must be non-zero".into());
+    }
+    let (g_ratio, g_error) = resonator_ratio(id, op.carrier_hz);
+    let squared: Vec<C64> = (0..BATCHES)
+        .map(|b| {
+            let z = |s: usize, k: usize| C64::new(means[s][0][b][k], means[s][1][b][k]);
+            ratio_squared([[z(0, 0), z(0, 1)], [z(1, 0), z(1, 1)]], w1, words, g_ratio)
+        })
+        .collect();
+    let design = knowns.force_full_scale[1] / knowns.force_full_scale[0];
+    let magnitude: Vec<f64> = squared.iter().map(|v| v.norm().sqrt() / design).collect();
+    let phase: Vec<f64> = squared.iter().map(|v| 0.5 * v.arg().to_degrees()).collect();
+    let mut relative = mean_and_error(&magnitude);
+    relative.uncertainty = relative.uncertainty.hypot(0.5 * g_error * relative.value);
+    let cross = {
+        let z = |s: usize, k: usize| {
+            C64::new(
+                means[s][0].iter().map(|m| m[k]).sum::<f64>(),
+                means[s][1].iter().map(|m| m[k]).sum::<f64>(),
+            )
+        };
+        let (y0, y1) = (z(0, 1) / words[0], z(1, 1) / words[1]);
+        let q = (y0 - y1) / (words[0] - words[1]);
+        let p = y0 - q * words[0];
+        (p / (q * w1)).norm()
+    };
+    Ok(DriveRatio {
+        relative,
+        phase_deg: mean_and_error(&phase),
+        cross_over_direct: cross,
+        clocks,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The four window means of the module header's model, built from
+    /// chosen gains, rate coupling and resonators, give back g_2 / g_1.
+    #[test]
+    fn the_ratio_of_cross_responses_returns_the_drive_gain_ratio() {
+        let f = 25.1e3;
+        let (g1, g2) = (resonator(25.1e3, 3000.0, f), resonator(25.8e3, 3000.0, f));
+        for (c, rho) in [(C64::new(0.0, 3e-4), 1.013), (C64::new(0.0, -2e-2), 0.97)] {
+            let c = c * 1e12; // in the units of 1 / G
+            let det = 1.0 / (g1 * g2) + c * c;
+            let m = [[1.0 / (g2 * det), c / det], [-c / det, 1.0 / (g1 * det)]];
+            let (gain1, gain2) = (2.0, 2.0 * rho);
+            let (a1, a2) = (C64::from_polar(3.0, 0.2), C64::from_polar(5.0, 0.2));
+            let (kappa1, kappa2) = (C64::from_polar(0.7, -1.0), C64::from_polar(0.4, 2.0));
+            let w1 = 20000.0;
+            let w2 = [15000.0, -14999.0];
+            let z = |w: f64| {
+                let j = C64::new(0.0, 1.0);
+                let x1 = a1 * (gain1 * m[0][0] * w1 - j * gain2 * m[0][1] * w);
+                let x2 = a2 * (gain1 * m[1][0] * w1 - j * gain2 * m[1][1] * w);
+                [kappa1 * w1 * x1, kappa2 * w * x2]
+            };
+            let got = ratio_squared([z(w2[0]), z(w2[1])], w1, w2, g1 / g2);
+            // Exact algebra; the lines subtract windows whose terms differ
+            // by up to 1e4 in size, so double rounding leaves some 1e-12.
+            assert!((got - rho * rho).norm() < 1e-10, "{got} vs {}", rho * rho);
+        }
+    }
+}
