@@ -231,8 +231,8 @@ fn a_differential_drive_gain_is_measured_while_turning_and_corrected() {
             s.selfcal_error[1],
             design_error[0],
             design_error[1],
-            s.selfcal.sf_drive_ratio_uncertainty[0],
-            s.selfcal.sf_drive_ratio_uncertainty[1],
+            s.selfcal.sf_selfcal_uncertainty.drive_ratio[0],
+            s.selfcal.sf_selfcal_uncertainty.drive_ratio[1],
         );
         assert!(sigmas.abs() < 5.0, "{sigmas}");
         assert!(m.phase_deg.value.abs() < 5.0 * m.phase_deg.uncertainty);
@@ -266,8 +266,8 @@ fn paper_device_self_calibrates_over_ten_kelvin() {
     let report = run("tests/data/field_paper.toml");
     for s in &report.steps {
         eprintln!(
-            "{} deg C: self-cal error {:?}, baseline error {:?}",
-            s.temperature_c, s.selfcal_error, s.baseline_error
+            "{} deg C: self-cal error {:?} (1-sigma {:?}), baseline error {:?}",
+            s.temperature_c, s.selfcal_error, s.sf_selfcal_uncertainty, s.baseline_error
         );
     }
     eprintln!("clocks {} wall {:.1} s", report.clocks, report.wall_s);

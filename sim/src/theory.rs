@@ -133,7 +133,15 @@ impl Norm {
 /// Exact steady-state readout outputs `[z1, z2]` (m^2/s^2) at rate `omz_rad_s`,
 /// offsets included (coupled 2x2 phasor solve at `wb`, no narrow-band approximation).
 pub fn readout_z(dev: &Device, omz_rad_s: f64) -> [f64; 2] {
+    readout_z_lagged(dev, omz_rad_s, 0.0)
+}
+
+/// [`readout_z`] with the responses lagging their references by a further
+/// `lag_rad` (a residual loop phase error): each response phasor times
+/// e^(-j lag) before the mixer's real part.
+pub fn readout_z_lagged(dev: &Device, omz_rad_s: f64, lag_rad: f64) -> [f64; 2] {
     let n = Norm::new(dev);
+    let rot = C64::from_polar(1.0, -lag_rad);
     let (f1, f2) = (dev.f1_force, dev.f2_force);
     let d1 = n.d(0, 0.0);
     let d2 = n.d(1, 0.0);
@@ -141,8 +149,8 @@ pub fn readout_z(dev: &Device, omz_rad_s: f64) -> [f64; 2] {
     let c = 2.0 * dev.angular_gain * omz_rad_s / n.wb;
     let det = d1 * d2 - c * c;
     let scale = 1.0 / (2.0 * n.wb * n.wb);
-    let z1 = f1 * (f1 * d1.inv().re + (c * (f2 * d1 + c * f1) / (d1 * det)).re);
-    let z2 = f2 * (f2 * d2.inv().re + (c * (f1 * d2 + c * f2) / (d2 * det)).re);
+    let z1 = f1 * (rot * (f1 * d1.inv() + c * (f2 * d1 + c * f1) / (d1 * det))).re;
+    let z2 = f2 * (rot * (f2 * d2.inv() + c * (f1 * d2 + c * f2) / (d2 * det))).re;
     [z1 * scale, z2 * scale]
 }
 
@@ -193,7 +201,20 @@ pub fn calibration_z_of_datapath(
     envelope_lead_rad: f64,
     sideband_gain: [f64; 2],
 ) -> [f64; 2] {
+    calibration_z_lagged(dev, f_cal_hz, envelope_lead_rad, sideband_gain, 0.0)
+}
+
+/// [`calibration_z_of_datapath`] with the responses lagging their
+/// references by a further `lag_rad` (as [`readout_z_lagged`]).
+pub fn calibration_z_lagged(
+    dev: &Device,
+    f_cal_hz: f64,
+    envelope_lead_rad: f64,
+    sideband_gain: [f64; 2],
+    lag_rad: f64,
+) -> [f64; 2] {
     let n = Norm::new(dev);
+    let rot = C64::from_polar(1.0, -lag_rad);
     let om = TAU * f_cal_hz;
     let wb2 = n.wb * n.wb;
     let lead = C64::new(envelope_lead_rad.cos(), envelope_lead_rad.sin());
@@ -213,7 +234,7 @@ pub fn calibration_z_of_datapath(
     let z = |k: usize| {
         (0..2)
             .map(|s| {
-                let h = 1.0 / (n.d(k, dw[s]) * wb2);
+                let h = 1.0 / (n.d(k, dw[s]) * wb2) * rot;
                 0.5 * (h * drive[k][s] * reference[1 - k][s].conj()).re
             })
             .sum::<f64>()
@@ -355,6 +376,29 @@ mod tests {
             carrier_hz: 100.3e3 + carrier_offset,
             f1_force: 0.8,
             f2_force: 0.6,
+        }
+    }
+
+    /// A lag of a quarter turn takes the quadrature part: z(lag) =
+    /// cos(lag) z(0) + sin(lag) z(quarter turn) for every lag, and half a
+    /// turn negates (the mixer's real part of a rotated phasor).
+    #[test]
+    fn a_lag_rotates_the_mixed_phasor() {
+        let dev = device(-37.0, [5e4, 3e4], 12.0);
+        let q = std::f64::consts::FRAC_PI_2;
+        for lag in [0.3f64, -1.1, 2.0 * q] {
+            let (c, s) = (lag.cos(), lag.sin());
+            let read = [0.0, q, lag].map(|l| readout_z_lagged(&dev, 0.7, l));
+            let cal = [0.0, q, lag].map(|l| calibration_z_lagged(&dev, 2.5, 0.01, [1.0, 0.99], l));
+            for k in 0..2 {
+                for z in [read, cal] {
+                    let want = c * z[0][k] + s * z[1][k];
+                    assert!(
+                        (z[2][k] - want).abs() <= 1e-12 * z[0][k].hypot(z[1][k]),
+                        "{lag} {k}"
+                    );
+                }
+            }
         }
     }
 

@@ -62,7 +62,7 @@ pub fn csv(report: &FieldReport) -> String {
     let mut s = String::from(
         "temperature_c,sf_true1_per_dps,sf_true2_per_dps,sf_selfcal1_per_dps,sf_selfcal2_per_dps,\
          sf_baseline1_per_dps,sf_baseline2_per_dps,sf_true_factory1_per_dps,sf_true_factory2_per_dps,\
-         selfcal_error1,selfcal_error2,baseline_error1,baseline_error2,f1_hz,f1_hz_uncertainty,\
+         selfcal_error1,selfcal_error2,sf_selfcal_uncertainty1,sf_selfcal_uncertainty2,baseline_error1,baseline_error2,f1_hz,f1_hz_uncertainty,\
          f2_hz,f2_hz_uncertainty,q1,q1_uncertainty,q2,q2_uncertainty,loop_phase_deg,\
          loop_phase_deg_uncertainty,drive_gain_ratio,drive_gain_ratio_uncertainty,\
          drive_gain_ratio_true\n",
@@ -82,6 +82,8 @@ pub fn csv(report: &FieldReport) -> String {
             st.sf_true_at_factory_settings_per_dps[1],
             st.selfcal_error[0],
             st.selfcal_error[1],
+            st.sf_selfcal_uncertainty[0],
+            st.sf_selfcal_uncertainty[1],
             st.baseline_error[0],
             st.baseline_error[1],
             i.f1_hz,
@@ -183,10 +185,11 @@ pub fn summary(report: &FieldReport) -> String {
     );
     let _ = writeln!(
         s,
-        "{:>8}  {:>27}  {:>21}  {:>21}  {:>14}  {:>14}  {:>11}",
+        "{:>8}  {:>27}  {:>21}  {:>19}  {:>21}  {:>14}  {:>14}  {:>11}",
         "T (C)",
         "SF true (z LSB per deg/s)",
         "self-cal error",
+        "its 1-sigma",
         "baseline error",
         "f1 (Hz)",
         "f2 - f1 (Hz)",
@@ -196,12 +199,14 @@ pub fn summary(report: &FieldReport) -> String {
         let i = &st.identified;
         let _ = writeln!(
             s,
-            "{:>8.2}  {:>13.6e} {:>13.6e}  {:>+9.4}% {:>+9.4}%  {:>+9.2}% {:>+9.2}%  {:>14.4}  {:>14.4}  {:>11.5}",
+            "{:>8.2}  {:>13.6e} {:>13.6e}  {:>+9.4}% {:>+9.4}%  {:>8.4}% {:>8.4}%  {:>+9.2}% {:>+9.2}%  {:>14.4}  {:>14.4}  {:>11.5}",
             st.temperature_c,
             st.sf_true_per_dps[0],
             st.sf_true_per_dps[1],
             100.0 * st.selfcal_error[0],
             100.0 * st.selfcal_error[1],
+            100.0 * st.sf_selfcal_uncertainty[0],
+            100.0 * st.sf_selfcal_uncertainty[1],
             100.0 * st.baseline_error[0],
             100.0 * st.baseline_error[1],
             i.f1_hz,

@@ -28,7 +28,7 @@
 
 use super::board::{Board, SimBoard};
 use super::drive_ratio::{self, DriveProbe};
-use super::identify::{Identified, Knowns};
+use super::identify::Knowns;
 use super::profile::{self, Profile, ProfileRun, RateTrace};
 use super::selfcal::{self, Operating, SelfCal, window_z};
 use crate::config::Experiment;
@@ -138,6 +138,9 @@ pub struct FieldStep {
     pub sf_true_per_dps: [f64; 2],
     /// SF_cal x ratio(identified) (z LSB per deg/s).
     pub sf_selfcal_per_dps: [f64; 2],
+    /// Its relative 1-sigma uncertainty (`selfcal.sf_selfcal_uncertainty`
+    /// holds the sources).
+    pub sf_selfcal_uncertainty: [f64; 2],
     /// SF_cal x eqs. (5)/(6) ratio (z LSB per deg/s).
     pub sf_eq56_per_dps: [f64; 2],
     /// The factory scale factor (z LSB per deg/s).
@@ -184,10 +187,17 @@ pub struct IdentifiedJson {
     pub loop_phase_deg: f64,
     /// Its 1-sigma uncertainty.
     pub loop_phase_deg_uncertainty: f64,
+    /// Drive-gain ratio g2 / g1 over the design ratio, measured while the
+    /// device turned (`[drive_probe]`; null without it).
+    pub drive_gain_ratio: Option<f64>,
+    /// Its 1-sigma uncertainty (null without it).
+    pub drive_gain_ratio_uncertainty: Option<f64>,
 }
 
-impl From<&Identified> for IdentifiedJson {
-    fn from(id: &Identified) -> Self {
+impl From<&SelfCal> for IdentifiedJson {
+    fn from(cal: &SelfCal) -> Self {
+        let id = &cal.identified;
+        let ratio = cal.drive_ratio.as_ref().map(|d| d.relative);
         let [m1, m2] = &id.modes;
         Self {
             f1_hz: m1.f_hz.value,
@@ -200,6 +210,8 @@ impl From<&Identified> for IdentifiedJson {
             q2_uncertainty: m2.q.uncertainty,
             loop_phase_deg: id.loop_phase_deg.value,
             loop_phase_deg_uncertainty: id.loop_phase_deg.uncertainty,
+            drive_gain_ratio: ratio.map(|r| r.value),
+            drive_gain_ratio_uncertainty: ratio.map(|r| r.uncertainty),
         }
     }
 }
@@ -515,13 +527,14 @@ pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldRepor
             truth: c.at,
             sf_true_per_dps: sf_true,
             sf_selfcal_per_dps: c.cal.sf_selfcal_per_dps,
+            sf_selfcal_uncertainty: c.cal.sf_selfcal_uncertainty.total,
             sf_eq56_per_dps: c.cal.sf_eq56_per_dps,
             sf_baseline_per_dps: sf_factory,
             sf_true_at_factory_settings_per_dps: sf_fixed,
             selfcal_error,
             baseline_error,
             drive_gain_ratio_true,
-            identified: IdentifiedJson::from(&c.cal.identified),
+            identified: IdentifiedJson::from(&c.cal),
             clocks: c.clocks,
             selfcal: c.cal,
             profile: trace,

@@ -71,6 +71,10 @@ use std::f64::consts::{PI, TAU};
 /// settle to 1e-4 of a calibration signal some 1e3 times smaller).
 pub const FIRST_SETTLE_TAUS: f64 = 30.0;
 
+/// Fewest ripple periods in a staircase window: two, so that the spread of
+/// the period means estimates the window's noise (`staircase`).
+pub const MIN_RIPPLE_PERIODS: usize = 2;
+
 /// Where the cycle operates the gateware.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Operating {
@@ -90,6 +94,36 @@ pub struct Ratio {
     pub exact: [f64; 2],
     /// Eqs. (5)/(6), small signal (z LSB units).
     pub eq56: [f64; 2],
+}
+
+/// Relative 1-sigma uncertainties of the self-calibrated scale factors,
+/// per output, by source, and their quadrature sum.
+///
+/// Not included: a drive-gain ratio that drifted unobserved (without
+/// `[drive_probe]` the design ratio is used as exact).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct SfUncertainty {
+    /// The staircase slope's noise (`staircase`).
+    pub staircase: [f64; 2],
+    /// The predicted ratio's, from the identified f1, f2, Q1, Q2, group
+    /// delay and loop phase (each moved by its uncertainty through the
+    /// exact theory).
+    pub identified: [f64; 2],
+    /// The measured drive-gain ratio's (0 without one).
+    pub drive_ratio: [f64; 2],
+    /// All three in quadrature.
+    pub total: [f64; 2],
+}
+
+impl SfUncertainty {
+    fn with_total(mut self) -> Self {
+        self.total = std::array::from_fn(|k| {
+            self.staircase[k]
+                .hypot(self.identified[k])
+                .hypot(self.drive_ratio[k])
+        });
+        self
+    }
 }
 
 /// One cycle's result.
@@ -118,10 +152,8 @@ pub struct SelfCal {
     /// SF_cal x ratio.exact at the design drive-gain ratio (z LSB per
     /// deg/s): `sf_selfcal_per_dps` before the measured ratio replaced it.
     pub sf_design_ratio_per_dps: [f64; 2],
-    /// Relative 1-sigma uncertainty of `sf_selfcal_per_dps` from the
-    /// measured drive-gain ratio's (0 at the design ratio, whose own error
-    /// is the unobserved drift).
-    pub sf_drive_ratio_uncertainty: [f64; 2],
+    /// Relative 1-sigma uncertainty of `sf_selfcal_per_dps`, by source.
+    pub sf_selfcal_uncertainty: SfUncertainty,
     /// Clocks of the whole cycle.
     pub clocks: u64,
 }
@@ -147,6 +179,18 @@ pub fn window_z(
     t0: f64,
     length: f64,
 ) -> Result<[f64; 2], String> {
+    Ok(period_means(board, decimation, t0, length, 1)?[0])
+}
+
+/// As [`window_z`], the window cut into `periods` equal parts: the mean
+/// of each part, in order (their mean is the window's).
+pub fn period_means(
+    board: &mut dyn Board,
+    decimation: u32,
+    t0: f64,
+    length: f64,
+    periods: usize,
+) -> Result<Vec<[f64; 2]>, String> {
     let r = f64::from(decimation);
     let mut t = vec![];
     let mut z = [vec![], vec![]];
@@ -161,9 +205,13 @@ pub fn window_z(
         z[0].push(s.z[0]);
         z[1].push(s.z[1]);
     }
-    Ok(std::array::from_fn(|k| {
-        window_mean(&t, &z[k], t0, t0 + length)
-    }))
+    let part = length / periods as f64;
+    Ok((0..periods)
+        .map(|p| {
+            let a = t0 + p as f64 * part;
+            std::array::from_fn(|k| window_mean(&t, &z[k], a, a + part))
+        })
+        .collect())
 }
 
 /// A measured staircase.
@@ -175,13 +223,22 @@ pub struct Staircase {
     pub z: Vec<[f64; 2]>,
     /// Least-squares slopes against 360 f_cal (z LSB per deg/s).
     pub sf_per_dps: [f64; 2],
+    /// Their 1-sigma uncertainties (z LSB per deg/s): `staircase`.
+    pub sf_uncertainty: [f64; 2],
     /// Clocks it took.
     pub clocks: u64,
 }
 
 /// The calibration staircase at `op`: each f_cal settles, then is averaged
-/// over a whole number of ripple periods 1 / (2 f_cal) spanning at least
-/// the first window.
+/// over a whole number (at least `MIN_RIPPLE_PERIODS`) of ripple periods
+/// 1 / (2 f_cal) spanning at least the first window.
+///
+/// Uncertainty: each period's mean cancels the ripple's shape, so the
+/// spread of a window's period means is its noise; pooled over the windows
+/// (one variance per output, sum of (M_i - 1) degrees of freedom) it gives
+/// each window mean's variance s^2 / M_i, propagated through the
+/// least-squares slope, sum of c_i^2 s^2 / M_i with c_i = (x_i - mean x) /
+/// Sxx.
 pub fn staircase(
     board: &mut dyn Board,
     knowns: &Knowns,
@@ -190,7 +247,7 @@ pub fn staircase(
     let clock = knowns.clock_hz;
     let r = knowns.filter.decimation;
     let mut cal_hz = vec![];
-    let mut means = vec![];
+    let mut parts = vec![];
     let mut clocks = 0;
     for (i, &f) in knowns.cal_freqs_hz.iter().enumerate() {
         let (regs, real) =
@@ -206,12 +263,24 @@ pub fn staircase(
         let settle = knowns.settle_clocks(taus);
         board.wait_clocks(settle);
         let period = clock / (2.0 * real.cal_hz);
-        let periods = (knowns.filter.min_window_s * 2.0 * real.cal_hz).ceil();
+        let periods = (knowns.filter.min_window_s * 2.0 * real.cal_hz)
+            .ceil()
+            .max(MIN_RIPPLE_PERIODS as f64);
         let length = periods * period;
-        means.push(window_z(board, r, f64::from(r), length)?);
+        parts.push(period_means(
+            board,
+            r,
+            f64::from(r),
+            length,
+            periods as usize,
+        )?);
         clocks += settle + length as u64 + 2 * u64::from(r);
         cal_hz.push(real.cal_hz);
     }
+    let means: Vec<[f64; 2]> = parts
+        .iter()
+        .map(|p| std::array::from_fn(|k| p.iter().map(|m| m[k]).sum::<f64>() / p.len() as f64))
+        .collect();
     let x: Vec<f64> = cal_hz.iter().map(|f| 360.0 * f).collect();
     let sf = std::array::from_fn(|k| {
         let y: Vec<f64> = means.iter().map(|m| m[k]).collect();
@@ -219,10 +288,36 @@ pub fn staircase(
     });
     Ok(Staircase {
         cal_hz,
-        z: means,
         sf_per_dps: sf,
+        sf_uncertainty: std::array::from_fn(|k| pooled_slope_uncertainty(&x, &parts, &means, k)),
+        z: means,
         clocks,
     })
+}
+
+/// The least-squares slope's 1-sigma uncertainty on output `k` from the
+/// windows' period means `parts` (`staircase`).
+fn pooled_slope_uncertainty(
+    x: &[f64],
+    parts: &[Vec<[f64; 2]>],
+    means: &[[f64; 2]],
+    k: usize,
+) -> f64 {
+    let (mut ss, mut dof) = (0.0, 0usize);
+    for (p, m) in parts.iter().zip(means) {
+        ss += p.iter().map(|v| (v[k] - m[k]).powi(2)).sum::<f64>();
+        dof += p.len() - 1;
+    }
+    let s2 = ss / dof as f64;
+    let n = x.len() as f64;
+    let mx = x.iter().sum::<f64>() / n;
+    let sxx: f64 = x.iter().map(|v| (v - mx).powi(2)).sum();
+    let var: f64 = x
+        .iter()
+        .zip(parts)
+        .map(|(xi, p)| ((xi - mx) / sxx).powi(2) * s2 / p.len() as f64)
+        .sum();
+    var.sqrt()
 }
 
 /// Fundamental gain of the DAC's zero-order hold at `f_hz`.
@@ -239,6 +334,18 @@ pub fn predicted_ratio(
     gyro: &GyroParams,
     op: &Operating,
     cal_hz: &[f64],
+) -> Result<Ratio, String> {
+    predicted_ratio_lagged(knowns, gyro, op, cal_hz, 0.0)
+}
+
+/// [`predicted_ratio`] with a residual loop phase error `lag_rad` left by
+/// the correction (the responses lag their references by that much more).
+fn predicted_ratio_lagged(
+    knowns: &Knowns,
+    gyro: &GyroParams,
+    op: &Operating,
+    cal_hz: &[f64],
+    lag_rad: f64,
 ) -> Result<Ratio, String> {
     let clock = knowns.clock_hz;
     let (regs, _) = knowns.registers(op.carrier_hz, None, knowns.amplitude, 0.0)?;
@@ -262,7 +369,7 @@ pub fn predicted_ratio(
     let rates = &knowns.rates_dps;
     let read_z: Vec<[f64; 2]> = rates
         .iter()
-        .map(|r| theory::readout_z(&dev_read, r * rad))
+        .map(|r| theory::readout_z_lagged(&dev_read, r * rad, lag_rad))
         .collect();
     let hold = hold_gain(op.carrier_hz, clock);
     let cal_z: Vec<[f64; 2]> = cal_hz
@@ -272,7 +379,7 @@ pub fn predicted_ratio(
             // The response's envelope comes late by the group delay: the
             // references' envelope leads it by that much more.
             let lead = envelope_lead_rad(f, clock) + TAU * f * op.envelope_delay_s;
-            theory::calibration_z_of_datapath(&dev_cal, f, lead, sidebands)
+            theory::calibration_z_lagged(&dev_cal, f, lead, sidebands, lag_rad)
         })
         .collect();
     let virtual_dps: Vec<f64> = cal_hz.iter().map(|f| 360.0 * f).collect();
@@ -303,10 +410,18 @@ pub fn self_calibrate(
         cal_hz,
         z: cal_z,
         sf_per_dps: sf_cal,
+        sf_uncertainty: sf_cal_sd,
         clocks,
     } = staircase(board, knowns, &op)?;
     let gyro = identified.gyro(&knowns.nominal);
     let ratio = predicted_ratio(knowns, &gyro, &op, &cal_hz)?;
+    let uncertainty = SfUncertainty {
+        staircase: std::array::from_fn(|k| (sf_cal_sd[k] / sf_cal[k]).abs()),
+        identified: identified_uncertainty(knowns, &identified, &op, &cal_hz, &ratio)?,
+        drive_ratio: [0.0; 2],
+        total: [0.0; 2],
+    }
+    .with_total();
     let sf_selfcal_per_dps = std::array::from_fn(|k| sf_cal[k] * ratio.exact[k]);
     let sf_eq56_per_dps = std::array::from_fn(|k| sf_cal[k] * ratio.eq56[k]);
     Ok(SelfCal {
@@ -321,8 +436,47 @@ pub fn self_calibrate(
         sf_eq56_per_dps,
         drive_ratio: None,
         sf_design_ratio_per_dps: sf_selfcal_per_dps,
-        sf_drive_ratio_uncertainty: [0.0; 2],
+        sf_selfcal_uncertainty: uncertainty,
     })
+}
+
+/// The predicted ratio's relative 1-sigma uncertainty per output from the
+/// identified parameters: each of f1, Q1, f2, Q2, the group delay and the
+/// loop phase (as a residual error of the correction) moved by its
+/// uncertainty (independent fits), the changes added in quadrature.
+fn identified_uncertainty(
+    knowns: &Knowns,
+    id: &Identified,
+    op: &Operating,
+    cal_hz: &[f64],
+    ratio: &Ratio,
+) -> Result<[f64; 2], String> {
+    let gyro = id.gyro(&knowns.nominal);
+    let [m1, m2] = &id.modes;
+    let mut moved = vec![];
+    for (i, sd) in [m1.f_hz, m1.q, m2.f_hz, m2.q]
+        .map(|e| e.uncertainty)
+        .into_iter()
+        .enumerate()
+    {
+        let mut g = gyro.clone();
+        *[&mut g.f1_hz, &mut g.q1, &mut g.f2_hz, &mut g.q2][i] += sd;
+        moved.push(predicted_ratio(knowns, &g, op, cal_hz)?);
+    }
+    if id.group_delay_s.uncertainty.is_finite() {
+        let mut o = op.clone();
+        o.envelope_delay_s += id.group_delay_s.uncertainty;
+        moved.push(predicted_ratio(knowns, &gyro, &o, cal_hz)?);
+    }
+    let lag = id.loop_phase_deg.uncertainty.to_radians();
+    moved.push(predicted_ratio_lagged(knowns, &gyro, op, cal_hz, lag)?);
+    Ok(std::array::from_fn(|k| {
+        moved
+            .iter()
+            .map(|m| (m.exact[k] / ratio.exact[k] - 1.0).powi(2))
+            .sum::<f64>()
+            .sqrt()
+    }))
 }
 
 /// `knowns` with drive 2's force gain moved by `relative` (g_2 / g_1 over
@@ -354,8 +508,9 @@ pub fn apply_drive_ratio(
     let rho = measured.relative;
     let ratio = predict(rho.value)?;
     let moved = predict(rho.value + rho.uncertainty)?;
-    cal.sf_drive_ratio_uncertainty =
+    cal.sf_selfcal_uncertainty.drive_ratio =
         std::array::from_fn(|k| (moved.exact[k] / ratio.exact[k] - 1.0).abs());
+    cal.sf_selfcal_uncertainty = cal.sf_selfcal_uncertainty.with_total();
     cal.sf_selfcal_per_dps = std::array::from_fn(|k| cal.sf_cal_per_dps[k] * ratio.exact[k]);
     cal.sf_eq56_per_dps = std::array::from_fn(|k| cal.sf_cal_per_dps[k] * ratio.eq56[k]);
     cal.ratio = ratio;
