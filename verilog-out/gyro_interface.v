@@ -5152,131 +5152,171 @@ module gyro_interface__iir(clock,x1,x2,x_valid,k0,k1,k2,alpha,z1,z2,z_valid);
     output reg signed [39:0] z2;
     output reg  z_valid;
 
-    // Enums
-    localparam IirStep$Idle = 0;
-    localparam IirStep$IssueY2First = 1;
-    localparam IirStep$IssueVFirst = 2;
-    localparam IirStep$IssueY1Second = 3;
-    localparam IirStep$IssueY2Second = 4;
-    localparam IirStep$IssueVSecond = 5;
-    localparam IirStep$AccumulateFirst = 6;
-    localparam IirStep$FinishFirst = 7;
-    localparam IirStep$AccumulateSecondY1 = 8;
-    localparam IirStep$AccumulateSecondY2 = 9;
-    localparam IirStep$FinishSecond = 10;
-    localparam IirStep$WaitFirstRc = 11;
-    localparam IirStep$UpdateFirstRc = 12;
-    localparam IirStep$WaitSecondRc1 = 13;
-    localparam IirStep$WaitSecondRc2 = 14;
-    localparam IirStep$UpdateSecondRc = 15;
+    // Constant declarations
+    localparam  last_pc = 8'ha5;
+    localparam  slot_mask = 7'b1110011;
+    localparam signed pow29 = 36'h20000000;
+    localparam signed pow30 = 34'h40000000;
+    localparam signed pow31 = 34'h80000000;
+    localparam signed one = 16'h1;
+    localparam signed minus_one = 16'hffff;
+    localparam signed pow14 = 16'h4000;
 
     // Stub signals
-    reg  [3:0] step$d;
-    wire  [3:0] step$q;
-    reg  step$clock;
-    reg signed [59:0] operand$d;
-    wire signed [59:0] operand$q;
-    reg  operand$clock;
-    reg signed [31:0] coefficient$d;
-    wire signed [31:0] coefficient$q;
-    reg  coefficient$clock;
-    reg  mac$clock;
-    reg signed [59:0] mac$a;
-    reg signed [31:0] mac$b;
-    wire signed [91:0] mac$p;
-    reg  channel1$clock;
-    reg signed [39:0] channel1$x;
-    reg signed [91:0] channel1$product;
-    reg  channel1$start;
-    reg  channel1$preload;
-    reg  channel1$accumulate;
-    reg  channel1$finish;
-    reg  channel1$update_u;
-    reg  channel1$publish;
-    wire signed [59:0] channel1$y1;
-    wire signed [59:0] channel1$y2;
-    wire signed [59:0] channel1$v;
-    wire signed [59:0] channel1$difference;
-    wire signed [39:0] channel1$z;
-    reg  channel2$clock;
-    reg signed [39:0] channel2$x;
-    reg signed [91:0] channel2$product;
-    reg  channel2$start;
-    reg  channel2$preload;
-    reg  channel2$accumulate;
-    reg  channel2$finish;
-    reg  channel2$update_u;
-    reg  channel2$publish;
-    wire signed [59:0] channel2$y1;
-    wire signed [59:0] channel2$y2;
-    wire signed [59:0] channel2$v;
-    wire signed [59:0] channel2$difference;
-    wire signed [39:0] channel2$z;
-    reg  publishing$d;
-    wire  publishing$q;
-    reg  publishing$clock;
+    reg  rom$clock;
+    reg  [7:0] rom$address;
+    wire  [31:0] rom$q;
+    reg  ram$clock;
+    reg  [6:0] ram$read_address;
+    wire signed [15:0] ram$q;
+    reg  [6:0] ram$write_address;
+    reg signed [15:0] ram$write_data;
+    reg  ram$write_enable;
+    reg  mul$clock;
+    reg signed [15:0] mul$a;
+    reg signed [15:0] mul$b;
+    wire signed [31:0] mul$p;
+    reg  [7:0] pc$d;
+    wire  [7:0] pc$q;
+    reg  pc$clock;
+    reg  [1:0] base$d;
+    wire  [1:0] base$q;
+    reg  base$clock;
+    reg signed [39:0] x1_held$d;
+    wire signed [39:0] x1_held$q;
+    reg  x1_held$clock;
+    reg signed [39:0] x2_held$d;
+    wire signed [39:0] x2_held$q;
+    reg  x2_held$clock;
+    reg signed [15:0] a$d;
+    wire signed [15:0] a$q;
+    reg  a$clock;
+    reg signed [15:0] b$d;
+    wire signed [15:0] b$q;
+    reg  b$clock;
+    reg signed [35:0] acc$d;
+    wire signed [35:0] acc$q;
+    reg  acc$clock;
+    reg  [89:0] stage$d;
+    wire  [89:0] stage$q;
+    reg  stage$clock;
+    reg signed [39:0] z1_out$d;
+    wire signed [39:0] z1_out$q;
+    reg  z1_out$clock;
+    reg signed [39:0] z2_out$d;
+    wire signed [39:0] z2_out$q;
+    reg  z2_out$clock;
     reg  z_valid_out$d;
     wire  z_valid_out$q;
     reg  z_valid_out$clock;
 
+    // Local signals
+    reg  [31:0] word;
+    reg  [6:0] read_field;
+    reg  [6:0] write_field;
+    reg  [4:0] factor;
+    reg  [1:0] op;
+    reg  [2:0] emit;
+    reg  [2:0] x_select;
+    reg  [2:0] read_sum;
+    reg  [2:0] read_wrapped;
+    reg  [1:0] read_slot;
+    reg  [2:0] write_sum;
+    reg  [2:0] write_wrapped;
+    reg  [1:0] write_slot;
+    reg signed [12:0] ram_low;
+    reg signed [15:0] ram_wrapped;
+    reg signed [33:0] k0_wide;
+    reg signed [33:0] k1_wide;
+    reg signed [33:0] k2_wide;
+    reg signed [33:0] alpha_wide;
+    reg signed [33:0] scaled;
+    reg  [33:0] scaled_bits;
+    reg signed [3:0] top_bits;
+    reg signed [15:0] top_digit;
+    reg signed [35:0] product;
+    reg signed [20:0] carry;
+    reg signed [35:0] carry_wide;
+    reg signed [35:0] addend;
+    reg  [35:0] acc_bits;
+    reg  [14:0] digit_bits;
+    reg signed [15:0] column_digit;
+    reg signed [14:0] column_top;
+    reg signed [15:0] column_top_digit;
+    reg  [39:0] x_bits;
+    reg signed [9:0] x_top;
+    reg signed [15:0] input_digit;
+    reg signed [15:0] x_top_digit;
+
     // Sub module instances
-    gyro_interface__iir__step step(
-        .d(step$d),
-        .q(step$q),
-        .clock(step$clock)
+    gyro_interface__iir__rom rom(
+        .clock(rom$clock),
+        .address(rom$address),
+        .q(rom$q)
     );
-    gyro_interface__iir__operand operand(
-        .d(operand$d),
-        .q(operand$q),
-        .clock(operand$clock)
+    gyro_interface__iir__ram ram(
+        .clock(ram$clock),
+        .read_address(ram$read_address),
+        .q(ram$q),
+        .write_address(ram$write_address),
+        .write_data(ram$write_data),
+        .write_enable(ram$write_enable)
     );
-    gyro_interface__iir__coefficient coefficient(
-        .d(coefficient$d),
-        .q(coefficient$q),
-        .clock(coefficient$clock)
+    gyro_interface__iir__mul mul(
+        .clock(mul$clock),
+        .a(mul$a),
+        .b(mul$b),
+        .p(mul$p)
     );
-    gyro_interface__iir__mac mac(
-        .clock(mac$clock),
-        .a(mac$a),
-        .b(mac$b),
-        .p(mac$p)
+    gyro_interface__iir__pc pc(
+        .d(pc$d),
+        .q(pc$q),
+        .clock(pc$clock)
     );
-    gyro_interface__iir__channel1 channel1(
-        .clock(channel1$clock),
-        .x(channel1$x),
-        .product(channel1$product),
-        .start(channel1$start),
-        .preload(channel1$preload),
-        .accumulate(channel1$accumulate),
-        .finish(channel1$finish),
-        .update_u(channel1$update_u),
-        .publish(channel1$publish),
-        .y1(channel1$y1),
-        .y2(channel1$y2),
-        .v(channel1$v),
-        .difference(channel1$difference),
-        .z(channel1$z)
+    gyro_interface__iir__base base(
+        .d(base$d),
+        .q(base$q),
+        .clock(base$clock)
     );
-    gyro_interface__iir__channel2 channel2(
-        .clock(channel2$clock),
-        .x(channel2$x),
-        .product(channel2$product),
-        .start(channel2$start),
-        .preload(channel2$preload),
-        .accumulate(channel2$accumulate),
-        .finish(channel2$finish),
-        .update_u(channel2$update_u),
-        .publish(channel2$publish),
-        .y1(channel2$y1),
-        .y2(channel2$y2),
-        .v(channel2$v),
-        .difference(channel2$difference),
-        .z(channel2$z)
+    gyro_interface__iir__x1_held x1_held(
+        .d(x1_held$d),
+        .q(x1_held$q),
+        .clock(x1_held$clock)
     );
-    gyro_interface__iir__publishing publishing(
-        .d(publishing$d),
-        .q(publishing$q),
-        .clock(publishing$clock)
+    gyro_interface__iir__x2_held x2_held(
+        .d(x2_held$d),
+        .q(x2_held$q),
+        .clock(x2_held$clock)
+    );
+    gyro_interface__iir__a a(
+        .d(a$d),
+        .q(a$q),
+        .clock(a$clock)
+    );
+    gyro_interface__iir__b b(
+        .d(b$d),
+        .q(b$q),
+        .clock(b$clock)
+    );
+    gyro_interface__iir__acc acc(
+        .d(acc$d),
+        .q(acc$q),
+        .clock(acc$clock)
+    );
+    gyro_interface__iir__stage stage(
+        .d(stage$d),
+        .q(stage$q),
+        .clock(stage$clock)
+    );
+    gyro_interface__iir__z1_out z1_out(
+        .d(z1_out$d),
+        .q(z1_out$q),
+        .clock(z1_out$clock)
+    );
+    gyro_interface__iir__z2_out z2_out(
+        .d(z2_out$d),
+        .q(z2_out$q),
+        .clock(z2_out$clock)
     );
     gyro_interface__iir__z_valid_out z_valid_out(
         .d(z_valid_out$d),
@@ -5286,1109 +5326,696 @@ module gyro_interface__iir(clock,x1,x2,x_valid,k0,k1,k2,alpha,z1,z2,z_valid);
 
     // Update code
     always @(*) begin
-        step$clock = clock;
-        operand$clock = clock;
-        coefficient$clock = clock;
-        publishing$clock = clock;
+        pc$clock = clock;
+        base$clock = clock;
+        x1_held$clock = clock;
+        x2_held$clock = clock;
+        a$clock = clock;
+        b$clock = clock;
+        acc$clock = clock;
+        stage$clock = clock;
+        z1_out$clock = clock;
+        z2_out$clock = clock;
         z_valid_out$clock = clock;
-        step$d = step$q;
-        operand$d = operand$q;
-        coefficient$d = coefficient$q;
-        publishing$d = publishing$q;
+        pc$d = pc$q;
+        base$d = base$q;
+        x1_held$d = x1_held$q;
+        x2_held$d = x2_held$q;
+        a$d = a$q;
+        b$d = b$q;
+        acc$d = acc$q;
+        stage$d = stage$q;
+        z1_out$d = z1_out$q;
+        z2_out$d = z2_out$q;
         z_valid_out$d = z_valid_out$q;
-        mac$clock = clock;
-        channel1$clock = clock;
-        channel2$clock = clock;
-        mac$a = operand$q;
-        mac$b = coefficient$q;
-        channel1$x = x1;
-        channel2$x = x2;
-        channel1$product = mac$p;
-        channel2$product = mac$p;
-        channel1$start = 1'b0;
-        channel2$start = 1'b0;
-        channel1$preload = 1'b0;
-        channel2$preload = 1'b0;
-        channel1$accumulate = 1'b0;
-        channel2$accumulate = 1'b0;
-        channel1$finish = 1'b0;
-        channel2$finish = 1'b0;
-        channel1$update_u = 1'b0;
-        channel2$update_u = 1'b0;
-        channel1$publish = publishing$q;
-        channel2$publish = publishing$q;
-        z_valid_out$d = publishing$q;
-        publishing$d = 1'b0;
-        case (step$q)
-            IirStep$Idle:
-                begin
-                    if (x_valid) begin
-                        channel1$start = 1'b1;
-                        channel2$start = 1'b1;
-                        operand$d = channel1$y1;
-                        coefficient$d = k1;
-                        step$d = IirStep$IssueY2First;
-                    end
+        rom$clock = clock;
+        ram$clock = clock;
+        mul$clock = clock;
+        rom$address = pc$q;
+        if (pc$q == 32'h0) begin
+            if (x_valid) begin
+                pc$d = 32'h1;
+                x1_held$d = x1;
+                x2_held$d = x2;
+                base$d = base$q + 32'h1;
+                if (base$q == 32'h2) begin
+                    base$d = 32'h0;
                 end
-            IirStep$IssueY2First:
-                begin
-                    channel1$preload = 1'b1;
-                    channel2$preload = 1'b1;
-                    operand$d = channel1$y2;
-                    coefficient$d = k2;
-                    step$d = IirStep$IssueVFirst;
-                end
-            IirStep$IssueVFirst:
-                begin
-                    operand$d = channel1$v;
-                    coefficient$d = k0;
-                    step$d = IirStep$IssueY1Second;
-                end
-            IirStep$IssueY1Second:
-                begin
-                    operand$d = channel2$y1;
-                    coefficient$d = k1;
-                    step$d = IirStep$IssueY2Second;
-                end
-            IirStep$IssueY2Second:
-                begin
-                    operand$d = channel2$y2;
-                    coefficient$d = k2;
-                    step$d = IirStep$IssueVSecond;
-                end
-            IirStep$IssueVSecond:
-                begin
-                    operand$d = channel2$v;
-                    coefficient$d = k0;
-                    channel1$accumulate = 1'b1;
-                    step$d = IirStep$AccumulateFirst;
-                end
-            IirStep$AccumulateFirst:
-                begin
-                    channel1$accumulate = 1'b1;
-                    step$d = IirStep$FinishFirst;
-                end
-            IirStep$FinishFirst:
-                begin
-                    channel1$finish = 1'b1;
-                    operand$d = channel1$difference;
-                    coefficient$d = alpha;
-                    step$d = IirStep$AccumulateSecondY1;
-                end
-            IirStep$AccumulateSecondY1:
-                begin
-                    channel2$accumulate = 1'b1;
-                    step$d = IirStep$AccumulateSecondY2;
-                end
-            IirStep$AccumulateSecondY2:
-                begin
-                    channel2$accumulate = 1'b1;
-                    step$d = IirStep$FinishSecond;
-                end
-            IirStep$FinishSecond:
-                begin
-                    channel2$finish = 1'b1;
-                    operand$d = channel2$difference;
-                    coefficient$d = alpha;
-                    step$d = IirStep$WaitFirstRc;
-                end
-            IirStep$WaitFirstRc:
-                begin
-                    step$d = IirStep$UpdateFirstRc;
-                end
-            IirStep$UpdateFirstRc:
-                begin
-                    channel1$update_u = 1'b1;
-                    step$d = IirStep$WaitSecondRc1;
-                end
-            IirStep$WaitSecondRc1:
-                begin
-                    step$d = IirStep$WaitSecondRc2;
-                end
-            IirStep$WaitSecondRc2:
-                begin
-                    step$d = IirStep$UpdateSecondRc;
-                end
-            IirStep$UpdateSecondRc:
-                begin
-                    channel2$update_u = 1'b1;
-                    publishing$d = 1'b1;
-                    step$d = IirStep$Idle;
-                end
-        endcase
-        z1 = channel1$z;
-        z2 = channel2$z;
+            end
+        end
+        else begin
+            pc$d = pc$q + 32'h1;
+            if (pc$q == last_pc) begin
+                pc$d = 32'h0;
+            end
+        end
+        word = rom$q;
+        read_field = word[(32'h0)+:(7)];
+        factor = word[(32'h8)+:(5)];
+        op = word[(32'hd)+:(2)];
+        emit = word[(32'h10)+:(3)];
+        write_field = word[(32'h13)+:(7)];
+        x_select = word[(32'h1a)+:(3)];
+        read_sum = ((read_field[(32'h2)+:(2)]) & 3'h7) + ((base$q) & 3'h7);
+        read_wrapped = read_sum - 32'h3;
+        read_slot = read_sum[(32'h0)+:(2)];
+        if (read_sum >= 32'h3) begin
+            read_slot = read_wrapped[(32'h0)+:(2)];
+        end
+        if (read_field[(32'h2)+:(2)] == 32'h3) begin
+            read_slot = 32'h3;
+        end
+        write_sum = ((write_field[(32'h2)+:(2)]) & 3'h7) + ((base$q) & 3'h7);
+        write_wrapped = write_sum - 32'h3;
+        write_slot = write_sum[(32'h0)+:(2)];
+        if (write_sum >= 32'h3) begin
+            write_slot = write_wrapped[(32'h0)+:(2)];
+        end
+        if (write_field[(32'h2)+:(2)] == 32'h3) begin
+            write_slot = 32'h3;
+        end
+        ram$read_address = (read_field & slot_mask) | (((read_slot) & 7'h7f) << 32'h2);
+        ram$write_address = (write_field & slot_mask) | (((write_slot) & 7'h7f) << 32'h2);
+        ram_low = ram$q[(32'h0)+:(13)];
+        ram_wrapped = $signed(ram_low);
+        a$d = ram$q;
+        if (word[32'h7]) begin
+            a$d = ram_wrapped;
+        end
+        k0_wide = $signed(k0);
+        k1_wide = $signed(k1);
+        k2_wide = $signed(k2);
+        alpha_wide = $signed(alpha);
+        scaled = alpha_wide;
+        if (factor[(32'h2)+:(3)] == 32'h1) begin
+            scaled = k1_wide + pow31;
+        end
+        if (factor[(32'h2)+:(3)] == 32'h2) begin
+            scaled = k2_wide - pow30;
+        end
+        if (factor[(32'h2)+:(3)] == 32'h3) begin
+            scaled = $signed($unsigned(k0_wide) << 32'h1);
+        end
+        if (factor[(32'h2)+:(3)] == 32'h4) begin
+            scaled = $signed($unsigned(k0_wide) << 32'h2);
+        end
+        scaled_bits = $unsigned(scaled);
+        top_bits = scaled[(32'h1e)+:(4)];
+        top_digit = $signed(top_bits);
+        b$d = top_digit;
+        if (factor[(32'h0)+:(2)] == 32'h0) begin
+            b$d = $signed(((scaled_bits[(32'h0)+:(15)]) & 16'hffff));
+        end
+        if (factor[(32'h0)+:(2)] == 32'h1) begin
+            b$d = $signed(((scaled_bits[(32'hf)+:(15)]) & 16'hffff));
+        end
+        if (factor[(32'h2)+:(3)] == 32'h0) begin
+            b$d = 32'h0;
+            if (factor[(32'h0)+:(2)] == 32'h1) begin
+                b$d = one;
+            end
+            if (factor[(32'h0)+:(2)] == 32'h2) begin
+                b$d = minus_one;
+            end
+            if (factor[(32'h0)+:(2)] == 32'h3) begin
+                b$d = pow14;
+            end
+        end
+        mul$a = a$q;
+        mul$b = b$q;
+        product = $signed(mul$p);
+        carry = acc$q[(32'hf)+:(21)];
+        carry_wide = $signed(carry);
+        addend = acc$q;
+        if (op == 32'h1) begin
+            addend = 32'h0;
+            if (word[32'hf]) begin
+                addend = pow29;
+            end
+        end
+        if (op == 32'h3) begin
+            addend = carry_wide;
+        end
+        if (op != 32'h0) begin
+            acc$d = addend + product;
+        end
+        acc_bits = $unsigned(acc$q);
+        digit_bits = acc_bits[(32'h0)+:(15)];
+        column_digit = $signed(((digit_bits) & 16'hffff));
+        column_top = acc$q[(32'h0)+:(15)];
+        column_top_digit = $signed(column_top);
+        x_bits = $unsigned(x1_held$q);
+        x_top = x1_held$q[(32'h1e)+:(10)];
+        if (x_select >= 32'h3) begin
+            x_bits = $unsigned(x2_held$q);
+            x_top = x2_held$q[(32'h1e)+:(10)];
+        end
+        x_top_digit = $signed(x_top);
+        input_digit = x_top_digit;
+        if ((x_select == 32'h0) | (x_select == 32'h3)) begin
+            input_digit = $signed(((x_bits[(32'h0)+:(15)]) & 16'hffff));
+        end
+        if ((x_select == 32'h1) | (x_select == 32'h4)) begin
+            input_digit = $signed(((x_bits[(32'hf)+:(15)]) & 16'hffff));
+        end
+        ram$write_enable = 1'b0;
+        ram$write_data = column_digit;
+        if (emit == 32'h1) begin
+            ram$write_enable = 1'b1;
+        end
+        if (emit == 32'h2) begin
+            ram$write_enable = 1'b1;
+            ram$write_data = column_top_digit;
+        end
+        if (emit == 32'h4) begin
+            ram$write_enable = 1'b1;
+            ram$write_data = input_digit;
+        end
+        if (emit == 32'h3) begin
+            stage$d = (stage$q >> 32'hf) | (((digit_bits) & 90'h3ffffffffffffffffffffff) << 32'h4b);
+        end
+        z_valid_out$d = word[32'h1d];
+        if (word[32'h1d]) begin
+            z1_out$d = $signed(stage$q[(32'h0)+:(40)]);
+            z2_out$d = $signed(stage$q[(32'h2d)+:(40)]);
+        end
+        z1 = z1_out$q;
+        z2 = z2_out$q;
         z_valid = z_valid_out$q;
     end
 
 endmodule // gyro_interface__iir
 
 
-module gyro_interface__iir__channel1(clock,x,product,start,preload,accumulate,finish,update_u,publish,y1,y2,v,difference,z);
+module gyro_interface__iir__a(d,q,clock);
 
     // Module arguments
-    input wire  clock;
-    input wire signed [39:0] x;
-    input wire signed [91:0] product;
-    input wire  start;
-    input wire  preload;
-    input wire  accumulate;
-    input wire  finish;
-    input wire  update_u;
-    input wire  publish;
-    output reg signed [59:0] y1;
-    output reg signed [59:0] y2;
-    output reg signed [59:0] v;
-    output reg signed [59:0] difference;
-    output reg signed [39:0] z;
-
-    // Constant declarations
-    localparam  half_coefficient_lsb = 94'h20000000;
-    localparam signed half_output_lsb = 58'h8000;
-
-    // Stub signals
-    reg signed [39:0] x0$d;
-    wire signed [39:0] x0$q;
-    reg  x0$clock;
-    reg signed [41:0] partial$d;
-    wire signed [41:0] partial$q;
-    reg  partial$clock;
-    reg signed [59:0] v_reg$d;
-    wire signed [59:0] v_reg$q;
-    reg  v_reg$clock;
-    reg signed [59:0] feedback$d;
-    wire signed [59:0] feedback$q;
-    reg  feedback$clock;
-    reg signed [93:0] acc_y$d;
-    wire signed [93:0] acc_y$q;
-    reg  acc_y$clock;
-    reg signed [93:0] acc_d$d;
-    wire signed [93:0] acc_d$q;
-    reg  acc_d$clock;
-    reg signed [57:0] y1_reg$d;
-    wire signed [57:0] y1_reg$q;
-    reg  y1_reg$clock;
-    reg signed [57:0] y2_reg$d;
-    wire signed [57:0] y2_reg$q;
-    reg  y2_reg$clock;
-    reg signed [57:0] u$d;
-    wire signed [57:0] u$q;
-    reg  u$clock;
-    reg signed [39:0] z_out$d;
-    wire signed [39:0] z_out$q;
-    reg  z_out$clock;
-
-    // Local signals
-    reg signed [59:0] x_wide;
-    reg signed [41:0] x_partial;
-    reg signed [41:0] x0_partial;
-    reg signed [59:0] partial_wide;
-    reg  [41:0] x_doubled;
-    reg  [59:0] y1_doubled;
-    reg signed [59:0] v_sum;
-    reg  [59:0] v_shifted;
-    reg signed [59:0] y1_wide;
-    reg signed [59:0] y2_wide;
-    reg signed [59:0] u_wide;
-    reg signed [59:0] feedback_minus_u;
-    reg signed [93:0] feedback_long;
-    reg signed [93:0] difference_long;
-    reg signed [93:0] u_long;
-    reg signed [93:0] product_long;
-    reg  [93:0] preload_y;
-    reg  [93:0] preload_d;
-    reg  [93:0] u_scaled;
-    reg signed [93:0] sum_y;
-    reg signed [93:0] sum_d;
-    reg signed [93:0] sum_u;
-    reg signed [57:0] y_new;
-    reg signed [57:0] u_new;
-    reg signed [57:0] u_rounded;
-
-    // Sub module instances
-    gyro_interface__iir__channel1__x0 x0(
-        .d(x0$d),
-        .q(x0$q),
-        .clock(x0$clock)
-    );
-    gyro_interface__iir__channel1__partial partial(
-        .d(partial$d),
-        .q(partial$q),
-        .clock(partial$clock)
-    );
-    gyro_interface__iir__channel1__v_reg v_reg(
-        .d(v_reg$d),
-        .q(v_reg$q),
-        .clock(v_reg$clock)
-    );
-    gyro_interface__iir__channel1__feedback feedback(
-        .d(feedback$d),
-        .q(feedback$q),
-        .clock(feedback$clock)
-    );
-    gyro_interface__iir__channel1__acc_y acc_y(
-        .d(acc_y$d),
-        .q(acc_y$q),
-        .clock(acc_y$clock)
-    );
-    gyro_interface__iir__channel1__acc_d acc_d(
-        .d(acc_d$d),
-        .q(acc_d$q),
-        .clock(acc_d$clock)
-    );
-    gyro_interface__iir__channel1__y1_reg y1_reg(
-        .d(y1_reg$d),
-        .q(y1_reg$q),
-        .clock(y1_reg$clock)
-    );
-    gyro_interface__iir__channel1__y2_reg y2_reg(
-        .d(y2_reg$d),
-        .q(y2_reg$q),
-        .clock(y2_reg$clock)
-    );
-    gyro_interface__iir__channel1__u u(
-        .d(u$d),
-        .q(u$q),
-        .clock(u$clock)
-    );
-    gyro_interface__iir__channel1__z_out z_out(
-        .d(z_out$d),
-        .q(z_out$q),
-        .clock(z_out$clock)
-    );
-
-    // Update code
-    always @(*) begin
-        x0$clock = clock;
-        partial$clock = clock;
-        v_reg$clock = clock;
-        feedback$clock = clock;
-        acc_y$clock = clock;
-        acc_d$clock = clock;
-        y1_reg$clock = clock;
-        y2_reg$clock = clock;
-        u$clock = clock;
-        z_out$clock = clock;
-        x0$d = x0$q;
-        partial$d = partial$q;
-        v_reg$d = v_reg$q;
-        feedback$d = feedback$q;
-        acc_y$d = acc_y$q;
-        acc_d$d = acc_d$q;
-        y1_reg$d = y1_reg$q;
-        y2_reg$d = y2_reg$q;
-        u$d = u$q;
-        z_out$d = z_out$q;
-        x_wide = $signed(x);
-        x_partial = $signed(x);
-        x0_partial = $signed(x0$q);
-        partial_wide = $signed(partial$q);
-        y1_wide = $signed(y1_reg$q);
-        y2_wide = $signed(y2_reg$q);
-        u_wide = $signed(u$q);
-        v_sum = x_wide + partial_wide;
-        x_doubled = $unsigned(x_partial) << 32'h1;
-        y1_doubled = $unsigned(y1_wide) << 32'h1;
-        v_shifted = $unsigned(v_sum) << 32'h10;
-        feedback_minus_u = feedback$q - u_wide;
-        feedback_long = $signed(feedback$q);
-        difference_long = $signed(feedback_minus_u);
-        u_long = $signed(u$q);
-        product_long = $signed(product);
-        preload_y = ($unsigned(feedback_long) << 32'h1e) | half_coefficient_lsb;
-        preload_d = ($unsigned(difference_long) << 32'h1e) | half_coefficient_lsb;
-        u_scaled = ($unsigned(u_long) << 32'h1e) | half_coefficient_lsb;
-        sum_y = acc_y$q + product_long;
-        sum_d = acc_d$q + product_long;
-        sum_u = $signed(u_scaled) + product_long;
-        y_new = sum_y[(32'h1e)+:(58)];
-        u_new = sum_u[(32'h1e)+:(58)];
-        difference = sum_d[(32'h1e)+:(60)];
-        u_rounded = u$q + half_output_lsb;
-        if (start) begin
-            x0$d = x;
-            partial$d = $signed(x_doubled) + x0_partial;
-            v_reg$d = $signed(v_shifted);
-            feedback$d = $signed(y1_doubled) - y2_wide;
-        end
-        if (preload) begin
-            acc_y$d = $signed(preload_y);
-            acc_d$d = $signed(preload_d);
-        end
-        if (accumulate) begin
-            acc_y$d = sum_y;
-            acc_d$d = sum_d;
-        end
-        if (finish) begin
-            y1_reg$d = y_new;
-            y2_reg$d = y1_reg$q;
-        end
-        if (update_u) begin
-            u$d = u_new;
-        end
-        if (publish) begin
-            z_out$d = u_rounded[(32'h10)+:(40)];
-        end
-        y1 = y1_wide;
-        y2 = y2_wide;
-        v = v_reg$q;
-        z = z_out$q;
-    end
-
-endmodule // gyro_interface__iir__channel1
-
-
-module gyro_interface__iir__channel1__acc_d(d,q,clock);
-
-    // Module arguments
-    input wire signed [93:0] d;
-    output reg signed [93:0] q;
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 94'h0;
+       q = 16'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface__iir__channel1__acc_d
+endmodule // gyro_interface__iir__a
 
 
-module gyro_interface__iir__channel1__acc_y(d,q,clock);
+module gyro_interface__iir__acc(d,q,clock);
 
     // Module arguments
-    input wire signed [93:0] d;
-    output reg signed [93:0] q;
+    input wire signed [35:0] d;
+    output reg signed [35:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 94'h0;
+       q = 36'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface__iir__channel1__acc_y
+endmodule // gyro_interface__iir__acc
 
 
-module gyro_interface__iir__channel1__feedback(d,q,clock);
+module gyro_interface__iir__b(d,q,clock);
 
     // Module arguments
-    input wire signed [59:0] d;
-    output reg signed [59:0] q;
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 60'h0;
+       q = 16'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface__iir__channel1__feedback
+endmodule // gyro_interface__iir__b
 
 
-module gyro_interface__iir__channel1__partial(d,q,clock);
+module gyro_interface__iir__base(d,q,clock);
 
     // Module arguments
-    input wire signed [41:0] d;
-    output reg signed [41:0] q;
+    input wire  [1:0] d;
+    output reg  [1:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 42'h0;
+       q = 2'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface__iir__channel1__partial
+endmodule // gyro_interface__iir__base
 
 
-module gyro_interface__iir__channel1__u(d,q,clock);
+module gyro_interface__iir__mul(clock,a,b,p);
 
     // Module arguments
-    input wire signed [57:0] d;
-    output reg signed [57:0] q;
     input wire  clock;
+    input wire signed [15:0] a;
+    input wire signed [15:0] b;
+    output reg signed [31:0] p;
 
     // Update code (custom)
-    initial begin
-       q = 58'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__iir__channel1__u
-
-
-module gyro_interface__iir__channel1__v_reg(d,q,clock);
-
-    // Module arguments
-    input wire signed [59:0] d;
-    output reg signed [59:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 60'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__iir__channel1__v_reg
-
-
-module gyro_interface__iir__channel1__x0(d,q,clock);
-
-    // Module arguments
-    input wire signed [39:0] d;
-    output reg signed [39:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 40'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__iir__channel1__x0
-
-
-module gyro_interface__iir__channel1__y1_reg(d,q,clock);
-
-    // Module arguments
-    input wire signed [57:0] d;
-    output reg signed [57:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 58'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__iir__channel1__y1_reg
-
-
-module gyro_interface__iir__channel1__y2_reg(d,q,clock);
-
-    // Module arguments
-    input wire signed [57:0] d;
-    output reg signed [57:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 58'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__iir__channel1__y2_reg
-
-
-module gyro_interface__iir__channel1__z_out(d,q,clock);
-
-    // Module arguments
-    input wire signed [39:0] d;
-    output reg signed [39:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 40'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__iir__channel1__z_out
-
-
-module gyro_interface__iir__channel2(clock,x,product,start,preload,accumulate,finish,update_u,publish,y1,y2,v,difference,z);
-
-    // Module arguments
-    input wire  clock;
-    input wire signed [39:0] x;
-    input wire signed [91:0] product;
-    input wire  start;
-    input wire  preload;
-    input wire  accumulate;
-    input wire  finish;
-    input wire  update_u;
-    input wire  publish;
-    output reg signed [59:0] y1;
-    output reg signed [59:0] y2;
-    output reg signed [59:0] v;
-    output reg signed [59:0] difference;
-    output reg signed [39:0] z;
-
-    // Constant declarations
-    localparam  half_coefficient_lsb = 94'h20000000;
-    localparam signed half_output_lsb = 58'h8000;
-
-    // Stub signals
-    reg signed [39:0] x0$d;
-    wire signed [39:0] x0$q;
-    reg  x0$clock;
-    reg signed [41:0] partial$d;
-    wire signed [41:0] partial$q;
-    reg  partial$clock;
-    reg signed [59:0] v_reg$d;
-    wire signed [59:0] v_reg$q;
-    reg  v_reg$clock;
-    reg signed [59:0] feedback$d;
-    wire signed [59:0] feedback$q;
-    reg  feedback$clock;
-    reg signed [93:0] acc_y$d;
-    wire signed [93:0] acc_y$q;
-    reg  acc_y$clock;
-    reg signed [93:0] acc_d$d;
-    wire signed [93:0] acc_d$q;
-    reg  acc_d$clock;
-    reg signed [57:0] y1_reg$d;
-    wire signed [57:0] y1_reg$q;
-    reg  y1_reg$clock;
-    reg signed [57:0] y2_reg$d;
-    wire signed [57:0] y2_reg$q;
-    reg  y2_reg$clock;
-    reg signed [57:0] u$d;
-    wire signed [57:0] u$q;
-    reg  u$clock;
-    reg signed [39:0] z_out$d;
-    wire signed [39:0] z_out$q;
-    reg  z_out$clock;
-
-    // Local signals
-    reg signed [59:0] x_wide;
-    reg signed [41:0] x_partial;
-    reg signed [41:0] x0_partial;
-    reg signed [59:0] partial_wide;
-    reg  [41:0] x_doubled;
-    reg  [59:0] y1_doubled;
-    reg signed [59:0] v_sum;
-    reg  [59:0] v_shifted;
-    reg signed [59:0] y1_wide;
-    reg signed [59:0] y2_wide;
-    reg signed [59:0] u_wide;
-    reg signed [59:0] feedback_minus_u;
-    reg signed [93:0] feedback_long;
-    reg signed [93:0] difference_long;
-    reg signed [93:0] u_long;
-    reg signed [93:0] product_long;
-    reg  [93:0] preload_y;
-    reg  [93:0] preload_d;
-    reg  [93:0] u_scaled;
-    reg signed [93:0] sum_y;
-    reg signed [93:0] sum_d;
-    reg signed [93:0] sum_u;
-    reg signed [57:0] y_new;
-    reg signed [57:0] u_new;
-    reg signed [57:0] u_rounded;
-
-    // Sub module instances
-    gyro_interface__iir__channel2__x0 x0(
-        .d(x0$d),
-        .q(x0$q),
-        .clock(x0$clock)
-    );
-    gyro_interface__iir__channel2__partial partial(
-        .d(partial$d),
-        .q(partial$q),
-        .clock(partial$clock)
-    );
-    gyro_interface__iir__channel2__v_reg v_reg(
-        .d(v_reg$d),
-        .q(v_reg$q),
-        .clock(v_reg$clock)
-    );
-    gyro_interface__iir__channel2__feedback feedback(
-        .d(feedback$d),
-        .q(feedback$q),
-        .clock(feedback$clock)
-    );
-    gyro_interface__iir__channel2__acc_y acc_y(
-        .d(acc_y$d),
-        .q(acc_y$q),
-        .clock(acc_y$clock)
-    );
-    gyro_interface__iir__channel2__acc_d acc_d(
-        .d(acc_d$d),
-        .q(acc_d$q),
-        .clock(acc_d$clock)
-    );
-    gyro_interface__iir__channel2__y1_reg y1_reg(
-        .d(y1_reg$d),
-        .q(y1_reg$q),
-        .clock(y1_reg$clock)
-    );
-    gyro_interface__iir__channel2__y2_reg y2_reg(
-        .d(y2_reg$d),
-        .q(y2_reg$q),
-        .clock(y2_reg$clock)
-    );
-    gyro_interface__iir__channel2__u u(
-        .d(u$d),
-        .q(u$q),
-        .clock(u$clock)
-    );
-    gyro_interface__iir__channel2__z_out z_out(
-        .d(z_out$d),
-        .q(z_out$q),
-        .clock(z_out$clock)
-    );
-
-    // Update code
-    always @(*) begin
-        x0$clock = clock;
-        partial$clock = clock;
-        v_reg$clock = clock;
-        feedback$clock = clock;
-        acc_y$clock = clock;
-        acc_d$clock = clock;
-        y1_reg$clock = clock;
-        y2_reg$clock = clock;
-        u$clock = clock;
-        z_out$clock = clock;
-        x0$d = x0$q;
-        partial$d = partial$q;
-        v_reg$d = v_reg$q;
-        feedback$d = feedback$q;
-        acc_y$d = acc_y$q;
-        acc_d$d = acc_d$q;
-        y1_reg$d = y1_reg$q;
-        y2_reg$d = y2_reg$q;
-        u$d = u$q;
-        z_out$d = z_out$q;
-        x_wide = $signed(x);
-        x_partial = $signed(x);
-        x0_partial = $signed(x0$q);
-        partial_wide = $signed(partial$q);
-        y1_wide = $signed(y1_reg$q);
-        y2_wide = $signed(y2_reg$q);
-        u_wide = $signed(u$q);
-        v_sum = x_wide + partial_wide;
-        x_doubled = $unsigned(x_partial) << 32'h1;
-        y1_doubled = $unsigned(y1_wide) << 32'h1;
-        v_shifted = $unsigned(v_sum) << 32'h10;
-        feedback_minus_u = feedback$q - u_wide;
-        feedback_long = $signed(feedback$q);
-        difference_long = $signed(feedback_minus_u);
-        u_long = $signed(u$q);
-        product_long = $signed(product);
-        preload_y = ($unsigned(feedback_long) << 32'h1e) | half_coefficient_lsb;
-        preload_d = ($unsigned(difference_long) << 32'h1e) | half_coefficient_lsb;
-        u_scaled = ($unsigned(u_long) << 32'h1e) | half_coefficient_lsb;
-        sum_y = acc_y$q + product_long;
-        sum_d = acc_d$q + product_long;
-        sum_u = $signed(u_scaled) + product_long;
-        y_new = sum_y[(32'h1e)+:(58)];
-        u_new = sum_u[(32'h1e)+:(58)];
-        difference = sum_d[(32'h1e)+:(60)];
-        u_rounded = u$q + half_output_lsb;
-        if (start) begin
-            x0$d = x;
-            partial$d = $signed(x_doubled) + x0_partial;
-            v_reg$d = $signed(v_shifted);
-            feedback$d = $signed(y1_doubled) - y2_wide;
-        end
-        if (preload) begin
-            acc_y$d = $signed(preload_y);
-            acc_d$d = $signed(preload_d);
-        end
-        if (accumulate) begin
-            acc_y$d = sum_y;
-            acc_d$d = sum_d;
-        end
-        if (finish) begin
-            y1_reg$d = y_new;
-            y2_reg$d = y1_reg$q;
-        end
-        if (update_u) begin
-            u$d = u_new;
-        end
-        if (publish) begin
-            z_out$d = u_rounded[(32'h10)+:(40)];
-        end
-        y1 = y1_wide;
-        y2 = y2_wide;
-        v = v_reg$q;
-        z = z_out$q;
-    end
-
-endmodule // gyro_interface__iir__channel2
-
-
-module gyro_interface__iir__channel2__acc_d(d,q,clock);
-
-    // Module arguments
-    input wire signed [93:0] d;
-    output reg signed [93:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 94'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__iir__channel2__acc_d
-
-
-module gyro_interface__iir__channel2__acc_y(d,q,clock);
-
-    // Module arguments
-    input wire signed [93:0] d;
-    output reg signed [93:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 94'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__iir__channel2__acc_y
-
-
-module gyro_interface__iir__channel2__feedback(d,q,clock);
-
-    // Module arguments
-    input wire signed [59:0] d;
-    output reg signed [59:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 60'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__iir__channel2__feedback
-
-
-module gyro_interface__iir__channel2__partial(d,q,clock);
-
-    // Module arguments
-    input wire signed [41:0] d;
-    output reg signed [41:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 42'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__iir__channel2__partial
-
-
-module gyro_interface__iir__channel2__u(d,q,clock);
-
-    // Module arguments
-    input wire signed [57:0] d;
-    output reg signed [57:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 58'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__iir__channel2__u
-
-
-module gyro_interface__iir__channel2__v_reg(d,q,clock);
-
-    // Module arguments
-    input wire signed [59:0] d;
-    output reg signed [59:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 60'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__iir__channel2__v_reg
-
-
-module gyro_interface__iir__channel2__x0(d,q,clock);
-
-    // Module arguments
-    input wire signed [39:0] d;
-    output reg signed [39:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 40'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__iir__channel2__x0
-
-
-module gyro_interface__iir__channel2__y1_reg(d,q,clock);
-
-    // Module arguments
-    input wire signed [57:0] d;
-    output reg signed [57:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 58'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__iir__channel2__y1_reg
-
-
-module gyro_interface__iir__channel2__y2_reg(d,q,clock);
-
-    // Module arguments
-    input wire signed [57:0] d;
-    output reg signed [57:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 58'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__iir__channel2__y2_reg
-
-
-module gyro_interface__iir__channel2__z_out(d,q,clock);
-
-    // Module arguments
-    input wire signed [39:0] d;
-    output reg signed [39:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 40'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__iir__channel2__z_out
-
-
-module gyro_interface__iir__coefficient(d,q,clock);
-
-    // Module arguments
-    input wire signed [31:0] d;
-    output reg signed [31:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 32'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__iir__coefficient
-
-
-module gyro_interface__iir__mac(clock,a,b,p);
-
-    // Module arguments
-    input wire  clock;
-    input wire signed [59:0] a;
-    input wire signed [31:0] b;
-    output reg signed [91:0] p;
-
-    // Update code (custom)
-    wire signed [16:0] a_0 = {1'b0, a[15:0]};
-    wire signed [16:0] a_1 = {1'b0, a[31:16]};
-    wire signed [16:0] a_2 = {1'b0, a[47:32]};
-    wire signed [11:0] a_3 = a[59:48];
-    wire signed [16:0] b_0 = {1'b0, b[15:0]};
-    wire signed [15:0] b_1 = b[31:16];
-    reg signed [33:0] pp_0_0;
-    initial pp_0_0 = 0;
-    reg signed [32:0] pp_0_1;
-    initial pp_0_1 = 0;
-    reg signed [48:0] row_0;
-    initial row_0 = 0;
-    reg signed [33:0] pp_1_0;
-    initial pp_1_0 = 0;
-    reg signed [32:0] pp_1_1;
-    initial pp_1_1 = 0;
-    reg signed [48:0] row_1;
-    initial row_1 = 0;
-    reg signed [33:0] pp_2_0;
-    initial pp_2_0 = 0;
-    reg signed [32:0] pp_2_1;
-    initial pp_2_1 = 0;
-    reg signed [48:0] row_2;
-    initial row_2 = 0;
-    reg signed [28:0] pp_3_0;
-    initial pp_3_0 = 0;
-    reg signed [27:0] pp_3_1;
-    initial pp_3_1 = 0;
-    reg signed [43:0] row_3;
-    initial row_3 = 0;
-    reg signed [64:0] pair_0;
-    initial pair_0 = 0;
-    reg signed [59:0] pair_1;
-    initial pair_1 = 0;
     initial p = 0;
 
     always @(posedge clock) begin
-       pp_0_0 <= a_0 * b_0;
-       pp_0_1 <= a_0 * b_1;
-       pp_1_0 <= a_1 * b_0;
-       pp_1_1 <= a_1 * b_1;
-       pp_2_0 <= a_2 * b_0;
-       pp_2_1 <= a_2 * b_1;
-       pp_3_0 <= a_3 * b_0;
-       pp_3_1 <= a_3 * b_1;
-       row_0 <= {{15{pp_0_0[33]}}, pp_0_0} + {pp_0_1, 16'd0};
-       row_1 <= {{15{pp_1_0[33]}}, pp_1_0} + {pp_1_1, 16'd0};
-       row_2 <= {{15{pp_2_0[33]}}, pp_2_0} + {pp_2_1, 16'd0};
-       row_3 <= {{15{pp_3_0[28]}}, pp_3_0} + {pp_3_1, 16'd0};
-       pair_0 <= {{16{row_0[48]}}, row_0} + {row_1, 16'd0};
-       pair_1 <= {{11{row_2[48]}}, row_2} + {row_3, 16'd0};
-       p <= {{27{pair_0[64]}}, pair_0} + {pair_1, 32'd0};
+       p <= a * b;
     end
-endmodule // gyro_interface__iir__mac
+endmodule // gyro_interface__iir__mul
 
 
-module gyro_interface__iir__operand(d,q,clock);
+module gyro_interface__iir__pc(d,q,clock);
 
     // Module arguments
-    input wire signed [59:0] d;
-    output reg signed [59:0] q;
+    input wire  [7:0] d;
+    output reg  [7:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 60'h0;
+       q = 8'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface__iir__operand
+endmodule // gyro_interface__iir__pc
 
 
-module gyro_interface__iir__publishing(d,q,clock);
+module gyro_interface__iir__ram(clock,read_address,q,write_address,write_data,write_enable);
 
     // Module arguments
-    input wire  d;
-    output reg  q;
+    input wire  clock;
+    input wire  [6:0] read_address;
+    output reg signed [15:0] q;
+    input wire  [6:0] write_address;
+    input wire signed [15:0] write_data;
+    input wire  write_enable;
+
+    // Update code (custom)
+    reg signed [15:0] words [0:127];
+    integer init_index;
+
+    initial begin
+       for (init_index = 0; init_index < 128; init_index = init_index + 1)
+          words[init_index] = 0;
+       q = 0;
+    end
+
+    always @(posedge clock) begin
+       q <= words[read_address];
+       if (write_enable)
+          words[write_address] <= write_data;
+    end
+endmodule // gyro_interface__iir__ram
+
+
+module gyro_interface__iir__rom(clock,address,q);
+
+    // Module arguments
+    input wire  clock;
+    input wire  [7:0] address;
+    output reg  [31:0] q;
+
+    // Update code (custom)
+    reg [31:0] rom [0:255];
+
+    initial begin
+       rom[0] = 32'h0;
+       rom[1] = 32'h40018;
+       rom[2] = 32'h40c0414;
+       rom[3] = 32'h8140818;
+       rom[4] = 32'he04a519;
+       rom[5] = 32'h120c4414;
+       rom[6] = 32'h16146915;
+       rom[7] = 32'h4800;
+       rom[8] = 32'h4c08;
+       rom[9] = 32'h5004;
+       rom[10] = 32'h4c18;
+       rom[11] = 32'h4619;
+       rom[12] = 32'h451a;
+       rom[13] = 32'h6414;
+       rom[14] = 32'h4a15;
+       rom[15] = 32'h4916;
+       rom[16] = 32'h4800;
+       rom[17] = 32'h4d01;
+       rom[18] = 32'h4c08;
+       rom[19] = 32'h5109;
+       rom[20] = 32'h5004;
+       rom[21] = 32'h4d05;
+       rom[22] = 32'h4c19;
+       rom[23] = 32'h461a;
+       rom[24] = 32'h451b;
+       rom[25] = 32'h816495;
+       rom[26] = 32'h4a16;
+       rom[27] = 32'h4917;
+       rom[28] = 32'h4880;
+       rom[29] = 32'h4e01;
+       rom[30] = 32'h4d02;
+       rom[31] = 32'h4c08;
+       rom[32] = 32'h5209;
+       rom[33] = 32'h510a;
+       rom[34] = 32'h5004;
+       rom[35] = 32'h4e05;
+       rom[36] = 32'h4d06;
+       rom[37] = 32'h4c1a;
+       rom[38] = 32'h461b;
+       rom[39] = 32'h4596;
+       rom[40] = 32'h896a17;
+       rom[41] = 32'h4981;
+       rom[42] = 32'h4e02;
+       rom[43] = 32'h4d09;
+       rom[44] = 32'h520a;
+       rom[45] = 32'h5105;
+       rom[46] = 32'h4e06;
+       rom[47] = 32'h4d1b;
+       rom[48] = 32'h4697;
+       rom[49] = 32'h4a82;
+       rom[50] = 32'h916e0a;
+       rom[51] = 32'h5206;
+       rom[52] = 32'h4e58;
+       rom[53] = 32'h4454;
+       rom[54] = 32'h4858;
+       rom[55] = 32'h9aa559;
+       rom[56] = 32'h4454;
+       rom[57] = 32'h6955;
+       rom[58] = 32'h4840;
+       rom[59] = 32'h4c48;
+       rom[60] = 32'h5044;
+       rom[61] = 32'h4c58;
+       rom[62] = 32'h4659;
+       rom[63] = 32'h455a;
+       rom[64] = 32'h6454;
+       rom[65] = 32'h4a55;
+       rom[66] = 32'h4956;
+       rom[67] = 32'h4840;
+       rom[68] = 32'h4d41;
+       rom[69] = 32'h4c48;
+       rom[70] = 32'h5149;
+       rom[71] = 32'h5044;
+       rom[72] = 32'h4d45;
+       rom[73] = 32'h4c59;
+       rom[74] = 32'h465a;
+       rom[75] = 32'h455b;
+       rom[76] = 32'h28164d5;
+       rom[77] = 32'h4a56;
+       rom[78] = 32'h4957;
+       rom[79] = 32'h48c0;
+       rom[80] = 32'h4e41;
+       rom[81] = 32'h4d42;
+       rom[82] = 32'h4c48;
+       rom[83] = 32'h5249;
+       rom[84] = 32'h514a;
+       rom[85] = 32'h5044;
+       rom[86] = 32'h4e45;
+       rom[87] = 32'h4d46;
+       rom[88] = 32'h4c5a;
+       rom[89] = 32'h465b;
+       rom[90] = 32'h45d6;
+       rom[91] = 32'h2896a57;
+       rom[92] = 32'h49c1;
+       rom[93] = 32'h4e42;
+       rom[94] = 32'h4d49;
+       rom[95] = 32'h524a;
+       rom[96] = 32'h5145;
+       rom[97] = 32'h4e46;
+       rom[98] = 32'h4d5b;
+       rom[99] = 32'h46d7;
+       rom[100] = 32'h4ac2;
+       rom[101] = 32'h2916e4a;
+       rom[102] = 32'h5246;
+       rom[103] = 32'h4e10;
+       rom[104] = 32'h4128;
+       rom[105] = 32'h4211;
+       rom[106] = 32'h29a2129;
+       rom[107] = 32'h4212;
+       rom[108] = 32'h1e1612a;
+       rom[109] = 32'h4213;
+       rom[110] = 32'h1e9612b;
+       rom[111] = 32'h42d0;
+       rom[112] = 32'h1f16168;
+       rom[113] = 32'h4251;
+       rom[114] = 32'h1fa2169;
+       rom[115] = 32'h4252;
+       rom[116] = 32'h3e1616a;
+       rom[117] = 32'h4253;
+       rom[118] = 32'h3e9616b;
+       rom[119] = 32'h42bc;
+       rom[120] = 32'h3f1743c;
+       rom[121] = 32'h553d;
+       rom[122] = 32'h3fab43c;
+       rom[123] = 32'h763d;
+       rom[124] = 32'h553e;
+       rom[125] = 32'h7428;
+       rom[126] = 32'h413d;
+       rom[127] = 32'h563e;
+       rom[128] = 32'h553f;
+       rom[129] = 32'h1017429;
+       rom[130] = 32'h413e;
+       rom[131] = 32'h563f;
+       rom[132] = 32'h552a;
+       rom[133] = 32'h109613f;
+       rom[134] = 32'h562b;
+       rom[135] = 32'h41fc;
+       rom[136] = 32'h111747c;
+       rom[137] = 32'h557d;
+       rom[138] = 32'h11ab47c;
+       rom[139] = 32'h767d;
+       rom[140] = 32'h557e;
+       rom[141] = 32'h7468;
+       rom[142] = 32'h417d;
+       rom[143] = 32'h567e;
+       rom[144] = 32'h557f;
+       rom[145] = 32'h3017469;
+       rom[146] = 32'h417e;
+       rom[147] = 32'h567f;
+       rom[148] = 32'h556a;
+       rom[149] = 32'h309617f;
+       rom[150] = 32'h566b;
+       rom[151] = 32'h41a0;
+       rom[152] = 32'h3116321;
+       rom[153] = 32'h4322;
+       rom[154] = 32'h31aa323;
+       rom[155] = 32'h6380;
+       rom[156] = 32'h6060;
+       rom[157] = 32'h36361;
+       rom[158] = 32'h36362;
+       rom[159] = 32'h3a363;
+       rom[160] = 32'h6380;
+       rom[161] = 32'h6000;
+       rom[162] = 32'h36000;
+       rom[163] = 32'h36000;
+       rom[164] = 32'h30000;
+       rom[165] = 32'h20000000;
+       rom[166] = 32'h0;
+       rom[167] = 32'h0;
+       rom[168] = 32'h0;
+       rom[169] = 32'h0;
+       rom[170] = 32'h0;
+       rom[171] = 32'h0;
+       rom[172] = 32'h0;
+       rom[173] = 32'h0;
+       rom[174] = 32'h0;
+       rom[175] = 32'h0;
+       rom[176] = 32'h0;
+       rom[177] = 32'h0;
+       rom[178] = 32'h0;
+       rom[179] = 32'h0;
+       rom[180] = 32'h0;
+       rom[181] = 32'h0;
+       rom[182] = 32'h0;
+       rom[183] = 32'h0;
+       rom[184] = 32'h0;
+       rom[185] = 32'h0;
+       rom[186] = 32'h0;
+       rom[187] = 32'h0;
+       rom[188] = 32'h0;
+       rom[189] = 32'h0;
+       rom[190] = 32'h0;
+       rom[191] = 32'h0;
+       rom[192] = 32'h0;
+       rom[193] = 32'h0;
+       rom[194] = 32'h0;
+       rom[195] = 32'h0;
+       rom[196] = 32'h0;
+       rom[197] = 32'h0;
+       rom[198] = 32'h0;
+       rom[199] = 32'h0;
+       rom[200] = 32'h0;
+       rom[201] = 32'h0;
+       rom[202] = 32'h0;
+       rom[203] = 32'h0;
+       rom[204] = 32'h0;
+       rom[205] = 32'h0;
+       rom[206] = 32'h0;
+       rom[207] = 32'h0;
+       rom[208] = 32'h0;
+       rom[209] = 32'h0;
+       rom[210] = 32'h0;
+       rom[211] = 32'h0;
+       rom[212] = 32'h0;
+       rom[213] = 32'h0;
+       rom[214] = 32'h0;
+       rom[215] = 32'h0;
+       rom[216] = 32'h0;
+       rom[217] = 32'h0;
+       rom[218] = 32'h0;
+       rom[219] = 32'h0;
+       rom[220] = 32'h0;
+       rom[221] = 32'h0;
+       rom[222] = 32'h0;
+       rom[223] = 32'h0;
+       rom[224] = 32'h0;
+       rom[225] = 32'h0;
+       rom[226] = 32'h0;
+       rom[227] = 32'h0;
+       rom[228] = 32'h0;
+       rom[229] = 32'h0;
+       rom[230] = 32'h0;
+       rom[231] = 32'h0;
+       rom[232] = 32'h0;
+       rom[233] = 32'h0;
+       rom[234] = 32'h0;
+       rom[235] = 32'h0;
+       rom[236] = 32'h0;
+       rom[237] = 32'h0;
+       rom[238] = 32'h0;
+       rom[239] = 32'h0;
+       rom[240] = 32'h0;
+       rom[241] = 32'h0;
+       rom[242] = 32'h0;
+       rom[243] = 32'h0;
+       rom[244] = 32'h0;
+       rom[245] = 32'h0;
+       rom[246] = 32'h0;
+       rom[247] = 32'h0;
+       rom[248] = 32'h0;
+       rom[249] = 32'h0;
+       rom[250] = 32'h0;
+       rom[251] = 32'h0;
+       rom[252] = 32'h0;
+       rom[253] = 32'h0;
+       rom[254] = 32'h0;
+       rom[255] = 32'h0;
+       q = 0;
+    end
+
+    always @(posedge clock) begin
+       q <= rom[address];
+    end
+endmodule // gyro_interface__iir__rom
+
+
+module gyro_interface__iir__stage(d,q,clock);
+
+    // Module arguments
+    input wire  [89:0] d;
+    output reg  [89:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 1'h0;
+       q = 90'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface__iir__publishing
+endmodule // gyro_interface__iir__stage
 
 
-module gyro_interface__iir__step(d,q,clock);
+module gyro_interface__iir__x1_held(d,q,clock);
 
     // Module arguments
-    input wire  [3:0] d;
-    output reg  [3:0] q;
+    input wire signed [39:0] d;
+    output reg signed [39:0] q;
     input wire  clock;
-
-    // Enums
-    localparam IirStep$Idle = 0;
-    localparam IirStep$IssueY2First = 1;
-    localparam IirStep$IssueVFirst = 2;
-    localparam IirStep$IssueY1Second = 3;
-    localparam IirStep$IssueY2Second = 4;
-    localparam IirStep$IssueVSecond = 5;
-    localparam IirStep$AccumulateFirst = 6;
-    localparam IirStep$FinishFirst = 7;
-    localparam IirStep$AccumulateSecondY1 = 8;
-    localparam IirStep$AccumulateSecondY2 = 9;
-    localparam IirStep$FinishSecond = 10;
-    localparam IirStep$WaitFirstRc = 11;
-    localparam IirStep$UpdateFirstRc = 12;
-    localparam IirStep$WaitSecondRc1 = 13;
-    localparam IirStep$WaitSecondRc2 = 14;
-    localparam IirStep$UpdateSecondRc = 15;
 
     // Update code (custom)
     initial begin
-       q = 64'h0;
+       q = 40'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface__iir__step
+endmodule // gyro_interface__iir__x1_held
+
+
+module gyro_interface__iir__x2_held(d,q,clock);
+
+    // Module arguments
+    input wire signed [39:0] d;
+    output reg signed [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__iir__x2_held
+
+
+module gyro_interface__iir__z1_out(d,q,clock);
+
+    // Module arguments
+    input wire signed [39:0] d;
+    output reg signed [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__iir__z1_out
+
+
+module gyro_interface__iir__z2_out(d,q,clock);
+
+    // Module arguments
+    input wire signed [39:0] d;
+    output reg signed [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__iir__z2_out
 
 
 module gyro_interface__iir__z_valid_out(d,q,clock);
