@@ -78,10 +78,12 @@ mod with_verilator {
         let mut exp = small_device();
         exp.gyro.q1 = 150.0;
         exp.gyro.q2 = 150.0;
-        exp.filter.decimation = Some(16);
-        exp.filter.butterworth_hz = Some(30e3);
-        exp.filter.rc_hz = Some(60e3);
-        exp.points.cal_freqs_hz = vec![2000.0, 4000.0];
+        // The least decimation the filter takes; cut-offs within f_z / 5
+        // and calibration ripples (2 f_cal) sampled 20 times per period.
+        exp.filter.decimation = Some(gyrocal_hdl::filter_design::MIN_DECIMATION);
+        exp.filter.butterworth_hz = Some(5e3);
+        exp.filter.rc_hz = Some(10e3);
+        exp.points.cal_freqs_hz = vec![700.0, 1400.0];
         exp.points.min_window_s = Some(5e-4);
         exp.points.budget_s = 1e-6;
         let reports: Vec<_> = [EngineKind::Model, EngineKind::Verilator, EngineKind::Rtl]

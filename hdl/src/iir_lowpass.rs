@@ -173,7 +173,8 @@ pub struct IirLowpass {
     k2_wide: Signal<Local, Signed<SCALED_COEFFICIENT_BITS>>,
     alpha_wide: Signal<Local, Signed<SCALED_COEFFICIENT_BITS>>,
     scaled: Signal<Local, Signed<SCALED_COEFFICIENT_BITS>>,
-    scaled_bits: Signal<Local, Bits<SCALED_COEFFICIENT_BITS>>,
+    scaled_low: Signal<Local, Signed<30>>,
+    scaled_bits: Signal<Local, Bits<30>>,
     top_bits: Signal<Local, Signed<4>>,
     top_digit: Signal<Local, Signed<DIGIT_OPERAND_BITS>>,
     // Accumulator and emissions.
@@ -181,12 +182,12 @@ pub struct IirLowpass {
     carry: Signal<Local, Signed<CARRY_BITS>>,
     carry_wide: Signal<Local, Signed<COLUMN_BITS>>,
     addend: Signal<Local, Signed<COLUMN_BITS>>,
-    acc_bits: Signal<Local, Bits<COLUMN_BITS>>,
     digit_bits: Signal<Local, Bits<15>>,
     column_digit: Signal<Local, Signed<DIGIT_OPERAND_BITS>>,
     column_top: Signal<Local, Signed<15>>,
     column_top_digit: Signal<Local, Signed<DIGIT_OPERAND_BITS>>,
-    x_bits: Signal<Local, Bits<SAMPLE_BITS>>,
+    x_low: Signal<Local, Signed<30>>,
+    x_bits: Signal<Local, Bits<30>>,
     x_top: Signal<Local, Signed<10>>,
     input_digit: Signal<Local, Signed<DIGIT_OPERAND_BITS>>,
     x_top_digit: Signal<Local, Signed<DIGIT_OPERAND_BITS>>,
@@ -251,6 +252,7 @@ impl IirLowpass {
             k2_wide: Default::default(),
             alpha_wide: Default::default(),
             scaled: Default::default(),
+            scaled_low: Default::default(),
             scaled_bits: Default::default(),
             top_bits: Default::default(),
             top_digit: Default::default(),
@@ -258,11 +260,11 @@ impl IirLowpass {
             carry: Default::default(),
             carry_wide: Default::default(),
             addend: Default::default(),
-            acc_bits: Default::default(),
             digit_bits: Default::default(),
             column_digit: Default::default(),
             column_top: Default::default(),
             column_top_digit: Default::default(),
+            x_low: Default::default(),
             x_bits: Default::default(),
             x_top: Default::default(),
             input_digit: Default::default(),
@@ -313,7 +315,13 @@ impl Logic for IirLowpass {
                 self.pc.d.next = 1.into();
                 self.x1_held.d.next = self.x1.val();
                 self.x2_held.d.next = self.x2.val();
-                self.base.d.next = self.base.q.val() + 1;
+                // base counts samples modulo 3 (the slot rotation).
+                if self.base.q.val() == 0 {
+                    self.base.d.next = 1.into();
+                }
+                if self.base.q.val() == 1 {
+                    self.base.d.next = 2.into();
+                }
                 if self.base.q.val() == 2 {
                     self.base.d.next = 0.into();
                 }
@@ -387,7 +395,8 @@ impl Logic for IirLowpass {
         if self.factor.val().get_bits::<3>(2) == 4 {
             self.scaled.next = signed_cast(unsigned_cast(self.k0_wide.val()) << 2);
         }
-        self.scaled_bits.next = unsigned_cast(self.scaled.val());
+        self.scaled_low.next = self.scaled.val().get_bits::<30>(0);
+        self.scaled_bits.next = unsigned_cast(self.scaled_low.val());
         self.top_bits.next = self.scaled.val().get_bits::<4>(30);
         self.top_digit.next = signed_bit_cast_exact::<DIGIT_OPERAND_BITS, 4>(self.top_bits.val());
         self.b.d.next = self.top_digit.val();
@@ -434,19 +443,19 @@ impl Logic for IirLowpass {
             self.acc.d.next = self.addend.val() + self.product.val();
         }
         // Emissions: the finished column digit, or an input digit.
-        self.acc_bits.next = unsigned_cast(self.acc.q.val());
-        self.digit_bits.next = self.acc_bits.val().get_bits::<15>(0);
+        self.column_top.next = self.acc.q.val().get_bits::<15>(0);
+        self.digit_bits.next = unsigned_cast(self.column_top.val());
         self.column_digit.next =
             signed_cast(bit_cast::<DIGIT_OPERAND_BITS, 15>(self.digit_bits.val()));
-        self.column_top.next = self.acc.q.val().get_bits::<15>(0);
         self.column_top_digit.next =
             signed_bit_cast_exact::<DIGIT_OPERAND_BITS, 15>(self.column_top.val());
-        self.x_bits.next = unsigned_cast(self.x1_held.q.val());
+        self.x_low.next = self.x1_held.q.val().get_bits::<30>(0);
         self.x_top.next = self.x1_held.q.val().get_bits::<10>(30);
         if self.x_select.val() >= 3 {
-            self.x_bits.next = unsigned_cast(self.x2_held.q.val());
+            self.x_low.next = self.x2_held.q.val().get_bits::<30>(0);
             self.x_top.next = self.x2_held.q.val().get_bits::<10>(30);
         }
+        self.x_bits.next = unsigned_cast(self.x_low.val());
         self.x_top_digit.next = signed_bit_cast_exact::<DIGIT_OPERAND_BITS, 10>(self.x_top.val());
         self.input_digit.next = self.x_top_digit.val();
         if (self.x_select.val() == 0) | (self.x_select.val() == 3) {

@@ -74,8 +74,8 @@ pub const MAX_COLUMN_PRODUCTS: usize = 15;
 pub const RAM_ADDRESS_BITS: usize = 7;
 /// Width of the program counter (ROM address).
 pub const PC_BITS: usize = 8;
-/// Width of a ROM word.
-pub const WORD_BITS: usize = 32;
+/// Width of a ROM word (the last field, publish, is bit 29).
+pub const WORD_BITS: usize = 30;
 /// Clocks from a slot's RAM read to its accumulation.
 pub const ACCUMULATE_DELAY: usize = 3;
 /// Slots of the rotating words; slot 3 is the fixed one.

@@ -63,18 +63,18 @@ impl<const W: usize, const A: usize> Logic for MicrocodeRom<W, A> {
         let mut init = String::new();
         for a in 0..1usize << A {
             let word = self._image.get(a).copied().unwrap_or(0);
-            init.push_str(&format!("   rom[{a}] = {W}'h{word:x};\n"));
+            init.push_str(&format!("   program_words[{a}] = {W}'h{word:x};\n"));
         }
         Verilog::Custom(format!(
             "\
-reg [{msb}:0] rom [0:{last}];
+reg [{msb}:0] program_words [0:{last}];
 
 initial begin
 {init}   q = 0;
 end
 
 always @(posedge clock) begin
-   q <= rom[address];
+   q <= program_words[address];
 end",
             msb = W - 1,
             last = (1usize << A) - 1
