@@ -5179,6 +5179,9 @@ module gyro_interface__iir(clock,x1,x2,x_valid,k0,k1,k2,alpha,z1,z2,z_valid);
     reg  [7:0] pc$d;
     wire  [7:0] pc$q;
     reg  pc$clock;
+    reg  [29:0] word_reg$d;
+    wire  [29:0] word_reg$q;
+    reg  word_reg$clock;
     reg  [1:0] base$d;
     wire  [1:0] base$q;
     reg  base$clock;
@@ -5274,6 +5277,11 @@ module gyro_interface__iir(clock,x1,x2,x_valid,k0,k1,k2,alpha,z1,z2,z_valid);
         .q(pc$q),
         .clock(pc$clock)
     );
+    gyro_interface__iir__word_reg word_reg(
+        .d(word_reg$d),
+        .q(word_reg$q),
+        .clock(word_reg$clock)
+    );
     gyro_interface__iir__base base(
         .d(base$d),
         .q(base$q),
@@ -5328,6 +5336,7 @@ module gyro_interface__iir(clock,x1,x2,x_valid,k0,k1,k2,alpha,z1,z2,z_valid);
     // Update code
     always @(*) begin
         pc$clock = clock;
+        word_reg$clock = clock;
         base$clock = clock;
         x1_held$clock = clock;
         x2_held$clock = clock;
@@ -5339,6 +5348,7 @@ module gyro_interface__iir(clock,x1,x2,x_valid,k0,k1,k2,alpha,z1,z2,z_valid);
         z2_out$clock = clock;
         z_valid_out$clock = clock;
         pc$d = pc$q;
+        word_reg$d = word_reg$q;
         base$d = base$q;
         x1_held$d = x1_held$q;
         x2_held$d = x2_held$q;
@@ -5375,7 +5385,8 @@ module gyro_interface__iir(clock,x1,x2,x_valid,k0,k1,k2,alpha,z1,z2,z_valid);
                 pc$d = 32'h0;
             end
         end
-        word = rom$q;
+        word_reg$d = rom$q;
+        word = word_reg$q;
         read_field = word[(32'h0)+:(7)];
         factor = word[(32'h8)+:(5)];
         op = word[(32'hd)+:(2)];
@@ -5947,6 +5958,25 @@ module gyro_interface__iir__stage(d,q,clock);
     end
 
 endmodule // gyro_interface__iir__stage
+
+
+module gyro_interface__iir__word_reg(d,q,clock);
+
+    // Module arguments
+    input wire  [29:0] d;
+    output reg  [29:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 30'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__iir__word_reg
 
 
 module gyro_interface__iir__x1_held(d,q,clock);

@@ -6416,6 +6416,9 @@ module gyro_interface_axi__core__iir(clock,x1,x2,x_valid,k0,k1,k2,alpha,z1,z2,z_
     reg  [7:0] pc$d;
     wire  [7:0] pc$q;
     reg  pc$clock;
+    reg  [29:0] word_reg$d;
+    wire  [29:0] word_reg$q;
+    reg  word_reg$clock;
     reg  [1:0] base$d;
     wire  [1:0] base$q;
     reg  base$clock;
@@ -6511,6 +6514,11 @@ module gyro_interface_axi__core__iir(clock,x1,x2,x_valid,k0,k1,k2,alpha,z1,z2,z_
         .q(pc$q),
         .clock(pc$clock)
     );
+    gyro_interface_axi__core__iir__word_reg word_reg(
+        .d(word_reg$d),
+        .q(word_reg$q),
+        .clock(word_reg$clock)
+    );
     gyro_interface_axi__core__iir__base base(
         .d(base$d),
         .q(base$q),
@@ -6565,6 +6573,7 @@ module gyro_interface_axi__core__iir(clock,x1,x2,x_valid,k0,k1,k2,alpha,z1,z2,z_
     // Update code
     always @(*) begin
         pc$clock = clock;
+        word_reg$clock = clock;
         base$clock = clock;
         x1_held$clock = clock;
         x2_held$clock = clock;
@@ -6576,6 +6585,7 @@ module gyro_interface_axi__core__iir(clock,x1,x2,x_valid,k0,k1,k2,alpha,z1,z2,z_
         z2_out$clock = clock;
         z_valid_out$clock = clock;
         pc$d = pc$q;
+        word_reg$d = word_reg$q;
         base$d = base$q;
         x1_held$d = x1_held$q;
         x2_held$d = x2_held$q;
@@ -6612,7 +6622,8 @@ module gyro_interface_axi__core__iir(clock,x1,x2,x_valid,k0,k1,k2,alpha,z1,z2,z_
                 pc$d = 32'h0;
             end
         end
-        word = rom$q;
+        word_reg$d = rom$q;
+        word = word_reg$q;
         read_field = word[(32'h0)+:(7)];
         factor = word[(32'h8)+:(5)];
         op = word[(32'hd)+:(2)];
@@ -7184,6 +7195,25 @@ module gyro_interface_axi__core__iir__stage(d,q,clock);
     end
 
 endmodule // gyro_interface_axi__core__iir__stage
+
+
+module gyro_interface_axi__core__iir__word_reg(d,q,clock);
+
+    // Module arguments
+    input wire  [29:0] d;
+    output reg  [29:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 30'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__iir__word_reg
 
 
 module gyro_interface_axi__core__iir__x1_held(d,q,clock);

@@ -101,7 +101,7 @@ pub const PRODUCT_BITS: usize = OPERAND_BITS + COEFFICIENT_BITS;
 /// Width of the recorded accumulators: four terms below 2^(PRODUCT_BITS - 1) each.
 pub const ACCUMULATOR_BITS: usize = PRODUCT_BITS + 2;
 /// Clock cycles from `x_valid` to `z_valid` (`Program::latency`, checked by a test).
-pub const LATENCY: usize = 167;
+pub const LATENCY: usize = 168;
 /// Clock cycles from a strobe to the next one accepted: the least decimation
 /// (`Program::schedule_clocks`, checked by a test).
 pub const SCHEDULE_CLOCKS: usize = 166;
@@ -140,6 +140,7 @@ pub struct IirLowpass {
     ram: DigitRam<RAM_ADDRESS_BITS>,
     mul: RegisteredMultiplier<DIGIT_OPERAND_BITS, DIGIT_OPERAND_BITS, DIGIT_PRODUCT_BITS>,
     pc: DFF<Bits<PC_BITS>>,
+    word_reg: DFF<Bits<WORD_BITS>>,
     base: DFF<Bits<2>>,
     x1_held: DFF<Signed<SAMPLE_BITS>>,
     x2_held: DFF<Signed<SAMPLE_BITS>>,
@@ -222,6 +223,7 @@ impl IirLowpass {
             ram: DigitRam::new(),
             mul: RegisteredMultiplier::new(),
             pc: Default::default(),
+            word_reg: Default::default(),
             base: Default::default(),
             x1_held: Default::default(),
             x2_held: Default::default(),
@@ -294,6 +296,7 @@ impl Logic for IirLowpass {
             self,
             clock,
             pc,
+            word_reg,
             base,
             x1_held,
             x2_held,
@@ -333,7 +336,10 @@ impl Logic for IirLowpass {
             }
         }
         // Fields of the word (`MicroWord::encode`).
-        self.word.next = self.rom.q.val();
+        // The ROM word is registered once more in the fabric: a block RAM's
+        // clock-to-output is too slow to feed the coefficient multiplexer.
+        self.word_reg.d.next = self.rom.q.val();
+        self.word.next = self.word_reg.q.val();
         self.read_field.next = self.word.val().get_bits::<RAM_ADDRESS_BITS>(0);
         self.factor.next = self.word.val().get_bits::<5>(8);
         self.op.next = self.word.val().get_bits::<2>(13);

@@ -616,9 +616,11 @@ impl Program {
         self.words.len()
     }
 
-    /// Clocks from `x_valid` to `z_valid`.
+    /// Clocks from `x_valid` to `z_valid`: the ROM read and the word
+    /// register put word k in force 2 + k clocks after the strobe; z_valid
+    /// follows the last word by one clock.
     pub fn latency(&self) -> usize {
-        self.words.len() + 1
+        self.words.len() + 2
     }
 
     /// The ROM image.
@@ -640,7 +642,17 @@ mod tests {
         assert!(p.words.len() <= 1 << PC_BITS);
         assert_eq!(p.words[0], MicroWord::IDLE);
         assert_eq!(MicroWord::IDLE.encode(), 0);
-        assert!(p.words.last().unwrap().publish);
+        // The last word runs one clock after the next strobe can be taken
+        // (which steps `base` and the captured x): it must only publish.
+        let last = p.words.last().unwrap();
+        assert_eq!(
+            MicroWord {
+                publish: false,
+                ..*last
+            },
+            MicroWord::IDLE
+        );
+        assert!(last.publish);
         assert!(p.image().iter().all(|&w| w < 1 << WORD_BITS));
     }
 

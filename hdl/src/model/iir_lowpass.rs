@@ -1,7 +1,8 @@
 //! Bit-true model of `crate::iir_lowpass::IirLowpass` (both channels).
 //!
 //! It runs the hardware's micro-program (`crate::iir_program::PROGRAM`)
-//! word by word with the same registers: program counter, ROM output word,
+//! word by word with the same registers: program counter, ROM output and
+//! the word register after it,
 //! digit RAM and its read register, the two operand registers, the product
 //! register, the column accumulator and the output staging register. Each
 //! `step` is one clock: every register takes the value the hardware's takes
@@ -43,7 +44,9 @@ const DIGIT_MASK: i64 = (1 << DIGIT_BITS) - 1;
 pub struct IirLowpass {
     /// ROM address (0 = idle).
     pc: usize,
-    /// Index of the ROM word in the output register.
+    /// Index of the word in the ROM's output register.
+    rom_q: usize,
+    /// Index of the word in the fabric register after it (the one executing).
     word: usize,
     /// Sample counter modulo 3 (slot rotation).
     base: u8,
@@ -71,6 +74,7 @@ impl Default for IirLowpass {
     fn default() -> Self {
         Self {
             pc: 0,
+            rom_q: 0,
             word: 0,
             base: 0,
             x: [0; 2],
@@ -115,7 +119,7 @@ impl IirLowpass {
     /// `(z1, z2, z_valid)` after the edge.
     #[inline(always)]
     pub fn step(&mut self, x: (i64, i64), x_valid: bool, k: &Coefficients) -> (i64, i64, bool) {
-        if self.pc == 0 && self.word == 0 && !x_valid {
+        if self.pc == 0 && self.rom_q == 0 && self.word == 0 && !x_valid {
             // Idle: word 0 does nothing that a schedule reads back.
             self.z_valid = false;
             return self.output();
@@ -168,7 +172,8 @@ impl IirLowpass {
             }
         }
         self.z_valid = w.publish;
-        self.word = self.pc;
+        self.word = self.rom_q;
+        self.rom_q = self.pc;
         self.pc = if accept || (self.pc != 0 && self.pc + 1 < PROGRAM.words.len()) {
             self.pc + 1
         } else {
