@@ -71,7 +71,7 @@ mod with_verilator {
     #[test]
     fn one_experiment_gives_identical_results_on_all_three_engines() {
         // A tiny device (Q 150, short windows) so that rust-hdl's simulation
-        // runs it in seconds: four points of 10,000-30,000 clocks (a
+        // runs it in seconds: four points of 5,000-57,000 clocks (a
         // calibration window is 8 periods of its 2 f_cal ripple). One round
         // of windows: a budget too small for a second one, so that the
         // engines' different speeds cannot change the plan.
@@ -90,8 +90,11 @@ mod with_verilator {
             .into_iter()
             .map(|engine| gyrocal_sim::report::run(&exp, engine, &|_| {}).unwrap())
             .collect();
+        // 101,025 clocks measured: at R = 166 the calibration ripple allows
+        // at most ~1.5 kHz, and windows of 8 ripple periods at 700 Hz are
+        // longer than the 2 kHz ones at R = 16 were (under 80,000 then).
         assert!(
-            reports[0].timing.cycles < 80_000,
+            reports[0].timing.cycles < 110_000,
             "{} clocks",
             reports[0].timing.cycles
         );
