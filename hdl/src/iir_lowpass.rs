@@ -41,9 +41,9 @@
 //! Datapath (the widths of `crate::iir_program`):
 //!
 //! ```text
-//!  ROM[pc] ─► word ─┬─ read ─► digit RAM (128 x 16) ─► [a] ─┐
-//!                   ├─ factor ─► coefficient digit mux ─► [b] ─┴─ 16 x 16 ─► [p] ─► acc[36] ─┬─► RAM (digits)
-//!                   └─ op, emit, publish                              (acc >> 15) + p ─┘   └─► stage[90] ─► z1, z2
+//!  ROM[pc] ─► [word] ─┬─ read ─► digit RAM (128 x 16) ─► [a] ─┐
+//!                     ├─ factor ─► coefficient digit mux ─► [b] ─┴─ 16 x 16 ─► [p] ─► acc[36] ─┬─► RAM (digits)
+//!                     └─ op, emit, publish                              (acc >> 15) + p ─┘   └─► stage[90] ─► z1, z2
 //! ```
 //!
 //! Every product of the header is cut into 15-bit digits and summed column
@@ -72,8 +72,11 @@
 //! (`crate::filter_design::MIN_DECIMATION`); a strobe that arrives while it
 //! runs is dropped. z1 and z2 change only at `publish`.
 //!
-//! Gain: the filter's DC gain, 4 k0 / -(k1 + k2). Resources: one 16 x 16
-//! multiplier, two block RAMs (digits, program), ~350 flip-flops.
+//! Gain: the filter's DC gain, 4 k0 / -(k1 + k2). Resources (Yosys 0.23,
+//! `synth_ice40 -dsp -noflatten`, this module and its children): 1
+//! `SB_MAC16`, 3 `SB_RAM40_4K` (the digit RAM, and the 256 x 30-bit program
+//! in two), 402 flip-flops, 737 `SB_LUT4`; the 60 x 32 design before it took
+//! 8 `SB_MAC16`, 1870 flip-flops and 3379 `SB_LUT4`.
 
 use crate::iir_program::{
     ACCUMULATOR_BITS as COLUMN_BITS, OPERAND_BITS as DIGIT_OPERAND_BITS, PC_BITS,
