@@ -71,7 +71,7 @@ fn require(tool: &str, package: &str) {
     );
 }
 
-/// Bus writes for a working plan (R = 16), from the register map.
+/// Bus writes for a working plan (the least decimation), from the register map.
 fn program() -> String {
     let plan = FrequencyPlan {
         clock_hz: 10e6,
@@ -79,9 +79,9 @@ fn program() -> String {
         cal_hz: 5e3,
         calibration: false,
         amplitude: (0.9, -0.7),
-        decimation: 16,
-        butterworth_hz: 50e3,
-        rc_hz: 100e3,
+        decimation: gyrocal_hdl::filter_design::MIN_DECIMATION,
+        butterworth_hz: 5e3,
+        rc_hz: 10e3,
         dac_latency: 1,
         adc_latency: 2,
     };

@@ -6389,131 +6389,180 @@ module gyro_interface_axi__core__iir(clock,x1,x2,x_valid,k0,k1,k2,alpha,z1,z2,z_
     output reg signed [39:0] z2;
     output reg  z_valid;
 
-    // Enums
-    localparam IirStep$Idle = 0;
-    localparam IirStep$IssueY2First = 1;
-    localparam IirStep$IssueVFirst = 2;
-    localparam IirStep$IssueY1Second = 3;
-    localparam IirStep$IssueY2Second = 4;
-    localparam IirStep$IssueVSecond = 5;
-    localparam IirStep$AccumulateFirst = 6;
-    localparam IirStep$FinishFirst = 7;
-    localparam IirStep$AccumulateSecondY1 = 8;
-    localparam IirStep$AccumulateSecondY2 = 9;
-    localparam IirStep$FinishSecond = 10;
-    localparam IirStep$WaitFirstRc = 11;
-    localparam IirStep$UpdateFirstRc = 12;
-    localparam IirStep$WaitSecondRc1 = 13;
-    localparam IirStep$WaitSecondRc2 = 14;
-    localparam IirStep$UpdateSecondRc = 15;
+    // Constant declarations
+    localparam  last_pc = 8'ha5;
+    localparam  slot_mask = 7'b1110011;
+    localparam signed pow29 = 36'h20000000;
+    localparam signed pow30 = 34'h40000000;
+    localparam signed pow31 = 34'h80000000;
+    localparam signed one = 16'h1;
+    localparam signed minus_one = 16'hffff;
+    localparam signed pow14 = 16'h4000;
 
     // Stub signals
-    reg  [3:0] step$d;
-    wire  [3:0] step$q;
-    reg  step$clock;
-    reg signed [59:0] operand$d;
-    wire signed [59:0] operand$q;
-    reg  operand$clock;
-    reg signed [31:0] coefficient$d;
-    wire signed [31:0] coefficient$q;
-    reg  coefficient$clock;
-    reg  mac$clock;
-    reg signed [59:0] mac$a;
-    reg signed [31:0] mac$b;
-    wire signed [91:0] mac$p;
-    reg  channel1$clock;
-    reg signed [39:0] channel1$x;
-    reg signed [91:0] channel1$product;
-    reg  channel1$start;
-    reg  channel1$preload;
-    reg  channel1$accumulate;
-    reg  channel1$finish;
-    reg  channel1$update_u;
-    reg  channel1$publish;
-    wire signed [59:0] channel1$y1;
-    wire signed [59:0] channel1$y2;
-    wire signed [59:0] channel1$v;
-    wire signed [59:0] channel1$difference;
-    wire signed [39:0] channel1$z;
-    reg  channel2$clock;
-    reg signed [39:0] channel2$x;
-    reg signed [91:0] channel2$product;
-    reg  channel2$start;
-    reg  channel2$preload;
-    reg  channel2$accumulate;
-    reg  channel2$finish;
-    reg  channel2$update_u;
-    reg  channel2$publish;
-    wire signed [59:0] channel2$y1;
-    wire signed [59:0] channel2$y2;
-    wire signed [59:0] channel2$v;
-    wire signed [59:0] channel2$difference;
-    wire signed [39:0] channel2$z;
-    reg  publishing$d;
-    wire  publishing$q;
-    reg  publishing$clock;
+    reg  rom$clock;
+    reg  [7:0] rom$address;
+    wire  [29:0] rom$q;
+    reg  ram$clock;
+    reg  [6:0] ram$read_address;
+    wire signed [15:0] ram$q;
+    reg  [6:0] ram$write_address;
+    reg signed [15:0] ram$write_data;
+    reg  ram$write_enable;
+    reg  mul$clock;
+    reg signed [15:0] mul$a;
+    reg signed [15:0] mul$b;
+    wire signed [31:0] mul$p;
+    reg  [7:0] pc$d;
+    wire  [7:0] pc$q;
+    reg  pc$clock;
+    reg  [29:0] word_reg$d;
+    wire  [29:0] word_reg$q;
+    reg  word_reg$clock;
+    reg  [1:0] base$d;
+    wire  [1:0] base$q;
+    reg  base$clock;
+    reg signed [39:0] x1_held$d;
+    wire signed [39:0] x1_held$q;
+    reg  x1_held$clock;
+    reg signed [39:0] x2_held$d;
+    wire signed [39:0] x2_held$q;
+    reg  x2_held$clock;
+    reg signed [15:0] a$d;
+    wire signed [15:0] a$q;
+    reg  a$clock;
+    reg signed [15:0] b$d;
+    wire signed [15:0] b$q;
+    reg  b$clock;
+    reg signed [35:0] acc$d;
+    wire signed [35:0] acc$q;
+    reg  acc$clock;
+    reg  [89:0] stage$d;
+    wire  [89:0] stage$q;
+    reg  stage$clock;
+    reg signed [39:0] z1_out$d;
+    wire signed [39:0] z1_out$q;
+    reg  z1_out$clock;
+    reg signed [39:0] z2_out$d;
+    wire signed [39:0] z2_out$q;
+    reg  z2_out$clock;
     reg  z_valid_out$d;
     wire  z_valid_out$q;
     reg  z_valid_out$clock;
 
+    // Local signals
+    reg  [29:0] word;
+    reg  [6:0] read_field;
+    reg  [6:0] write_field;
+    reg  [4:0] factor;
+    reg  [1:0] op;
+    reg  [2:0] emit;
+    reg  [2:0] x_select;
+    reg  [2:0] read_sum;
+    reg  [2:0] read_wrapped;
+    reg  [1:0] read_slot;
+    reg  [2:0] write_sum;
+    reg  [2:0] write_wrapped;
+    reg  [1:0] write_slot;
+    reg signed [12:0] ram_low;
+    reg signed [15:0] ram_wrapped;
+    reg signed [33:0] k0_wide;
+    reg signed [33:0] k1_wide;
+    reg signed [33:0] k2_wide;
+    reg signed [33:0] alpha_wide;
+    reg signed [33:0] scaled;
+    reg signed [29:0] scaled_low;
+    reg  [29:0] scaled_bits;
+    reg signed [3:0] top_bits;
+    reg signed [15:0] top_digit;
+    reg signed [35:0] product;
+    reg signed [20:0] carry;
+    reg signed [35:0] carry_wide;
+    reg signed [35:0] addend;
+    reg  [14:0] digit_bits;
+    reg signed [15:0] column_digit;
+    reg signed [14:0] column_top;
+    reg signed [15:0] column_top_digit;
+    reg signed [29:0] x_low;
+    reg  [29:0] x_bits;
+    reg signed [9:0] x_top;
+    reg signed [15:0] input_digit;
+    reg signed [15:0] x_top_digit;
+
     // Sub module instances
-    gyro_interface_axi__core__iir__step step(
-        .d(step$d),
-        .q(step$q),
-        .clock(step$clock)
+    gyro_interface_axi__core__iir__rom rom(
+        .clock(rom$clock),
+        .address(rom$address),
+        .q(rom$q)
     );
-    gyro_interface_axi__core__iir__operand operand(
-        .d(operand$d),
-        .q(operand$q),
-        .clock(operand$clock)
+    gyro_interface_axi__core__iir__ram ram(
+        .clock(ram$clock),
+        .read_address(ram$read_address),
+        .q(ram$q),
+        .write_address(ram$write_address),
+        .write_data(ram$write_data),
+        .write_enable(ram$write_enable)
     );
-    gyro_interface_axi__core__iir__coefficient coefficient(
-        .d(coefficient$d),
-        .q(coefficient$q),
-        .clock(coefficient$clock)
+    gyro_interface_axi__core__iir__mul mul(
+        .clock(mul$clock),
+        .a(mul$a),
+        .b(mul$b),
+        .p(mul$p)
     );
-    gyro_interface_axi__core__iir__mac mac(
-        .clock(mac$clock),
-        .a(mac$a),
-        .b(mac$b),
-        .p(mac$p)
+    gyro_interface_axi__core__iir__pc pc(
+        .d(pc$d),
+        .q(pc$q),
+        .clock(pc$clock)
     );
-    gyro_interface_axi__core__iir__channel1 channel1(
-        .clock(channel1$clock),
-        .x(channel1$x),
-        .product(channel1$product),
-        .start(channel1$start),
-        .preload(channel1$preload),
-        .accumulate(channel1$accumulate),
-        .finish(channel1$finish),
-        .update_u(channel1$update_u),
-        .publish(channel1$publish),
-        .y1(channel1$y1),
-        .y2(channel1$y2),
-        .v(channel1$v),
-        .difference(channel1$difference),
-        .z(channel1$z)
+    gyro_interface_axi__core__iir__word_reg word_reg(
+        .d(word_reg$d),
+        .q(word_reg$q),
+        .clock(word_reg$clock)
     );
-    gyro_interface_axi__core__iir__channel2 channel2(
-        .clock(channel2$clock),
-        .x(channel2$x),
-        .product(channel2$product),
-        .start(channel2$start),
-        .preload(channel2$preload),
-        .accumulate(channel2$accumulate),
-        .finish(channel2$finish),
-        .update_u(channel2$update_u),
-        .publish(channel2$publish),
-        .y1(channel2$y1),
-        .y2(channel2$y2),
-        .v(channel2$v),
-        .difference(channel2$difference),
-        .z(channel2$z)
+    gyro_interface_axi__core__iir__base base(
+        .d(base$d),
+        .q(base$q),
+        .clock(base$clock)
     );
-    gyro_interface_axi__core__iir__publishing publishing(
-        .d(publishing$d),
-        .q(publishing$q),
-        .clock(publishing$clock)
+    gyro_interface_axi__core__iir__x1_held x1_held(
+        .d(x1_held$d),
+        .q(x1_held$q),
+        .clock(x1_held$clock)
+    );
+    gyro_interface_axi__core__iir__x2_held x2_held(
+        .d(x2_held$d),
+        .q(x2_held$q),
+        .clock(x2_held$clock)
+    );
+    gyro_interface_axi__core__iir__a a(
+        .d(a$d),
+        .q(a$q),
+        .clock(a$clock)
+    );
+    gyro_interface_axi__core__iir__b b(
+        .d(b$d),
+        .q(b$q),
+        .clock(b$clock)
+    );
+    gyro_interface_axi__core__iir__acc acc(
+        .d(acc$d),
+        .q(acc$q),
+        .clock(acc$clock)
+    );
+    gyro_interface_axi__core__iir__stage stage(
+        .d(stage$d),
+        .q(stage$q),
+        .clock(stage$clock)
+    );
+    gyro_interface_axi__core__iir__z1_out z1_out(
+        .d(z1_out$d),
+        .q(z1_out$q),
+        .clock(z1_out$clock)
+    );
+    gyro_interface_axi__core__iir__z2_out z2_out(
+        .d(z2_out$d),
+        .q(z2_out$q),
+        .clock(z2_out$clock)
     );
     gyro_interface_axi__core__iir__z_valid_out z_valid_out(
         .d(z_valid_out$d),
@@ -6523,1109 +6572,724 @@ module gyro_interface_axi__core__iir(clock,x1,x2,x_valid,k0,k1,k2,alpha,z1,z2,z_
 
     // Update code
     always @(*) begin
-        step$clock = clock;
-        operand$clock = clock;
-        coefficient$clock = clock;
-        publishing$clock = clock;
+        pc$clock = clock;
+        word_reg$clock = clock;
+        base$clock = clock;
+        x1_held$clock = clock;
+        x2_held$clock = clock;
+        a$clock = clock;
+        b$clock = clock;
+        acc$clock = clock;
+        stage$clock = clock;
+        z1_out$clock = clock;
+        z2_out$clock = clock;
         z_valid_out$clock = clock;
-        step$d = step$q;
-        operand$d = operand$q;
-        coefficient$d = coefficient$q;
-        publishing$d = publishing$q;
+        pc$d = pc$q;
+        word_reg$d = word_reg$q;
+        base$d = base$q;
+        x1_held$d = x1_held$q;
+        x2_held$d = x2_held$q;
+        a$d = a$q;
+        b$d = b$q;
+        acc$d = acc$q;
+        stage$d = stage$q;
+        z1_out$d = z1_out$q;
+        z2_out$d = z2_out$q;
         z_valid_out$d = z_valid_out$q;
-        mac$clock = clock;
-        channel1$clock = clock;
-        channel2$clock = clock;
-        mac$a = operand$q;
-        mac$b = coefficient$q;
-        channel1$x = x1;
-        channel2$x = x2;
-        channel1$product = mac$p;
-        channel2$product = mac$p;
-        channel1$start = 1'b0;
-        channel2$start = 1'b0;
-        channel1$preload = 1'b0;
-        channel2$preload = 1'b0;
-        channel1$accumulate = 1'b0;
-        channel2$accumulate = 1'b0;
-        channel1$finish = 1'b0;
-        channel2$finish = 1'b0;
-        channel1$update_u = 1'b0;
-        channel2$update_u = 1'b0;
-        channel1$publish = publishing$q;
-        channel2$publish = publishing$q;
-        z_valid_out$d = publishing$q;
-        publishing$d = 1'b0;
-        case (step$q)
-            IirStep$Idle:
-                begin
-                    if (x_valid) begin
-                        channel1$start = 1'b1;
-                        channel2$start = 1'b1;
-                        operand$d = channel1$y1;
-                        coefficient$d = k1;
-                        step$d = IirStep$IssueY2First;
-                    end
+        rom$clock = clock;
+        ram$clock = clock;
+        mul$clock = clock;
+        rom$address = pc$q;
+        if (pc$q == 32'h0) begin
+            if (x_valid) begin
+                pc$d = 32'h1;
+                x1_held$d = x1;
+                x2_held$d = x2;
+                if (base$q == 32'h0) begin
+                    base$d = 32'h1;
                 end
-            IirStep$IssueY2First:
-                begin
-                    channel1$preload = 1'b1;
-                    channel2$preload = 1'b1;
-                    operand$d = channel1$y2;
-                    coefficient$d = k2;
-                    step$d = IirStep$IssueVFirst;
+                if (base$q == 32'h1) begin
+                    base$d = 32'h2;
                 end
-            IirStep$IssueVFirst:
-                begin
-                    operand$d = channel1$v;
-                    coefficient$d = k0;
-                    step$d = IirStep$IssueY1Second;
+                if (base$q == 32'h2) begin
+                    base$d = 32'h0;
                 end
-            IirStep$IssueY1Second:
-                begin
-                    operand$d = channel2$y1;
-                    coefficient$d = k1;
-                    step$d = IirStep$IssueY2Second;
-                end
-            IirStep$IssueY2Second:
-                begin
-                    operand$d = channel2$y2;
-                    coefficient$d = k2;
-                    step$d = IirStep$IssueVSecond;
-                end
-            IirStep$IssueVSecond:
-                begin
-                    operand$d = channel2$v;
-                    coefficient$d = k0;
-                    channel1$accumulate = 1'b1;
-                    step$d = IirStep$AccumulateFirst;
-                end
-            IirStep$AccumulateFirst:
-                begin
-                    channel1$accumulate = 1'b1;
-                    step$d = IirStep$FinishFirst;
-                end
-            IirStep$FinishFirst:
-                begin
-                    channel1$finish = 1'b1;
-                    operand$d = channel1$difference;
-                    coefficient$d = alpha;
-                    step$d = IirStep$AccumulateSecondY1;
-                end
-            IirStep$AccumulateSecondY1:
-                begin
-                    channel2$accumulate = 1'b1;
-                    step$d = IirStep$AccumulateSecondY2;
-                end
-            IirStep$AccumulateSecondY2:
-                begin
-                    channel2$accumulate = 1'b1;
-                    step$d = IirStep$FinishSecond;
-                end
-            IirStep$FinishSecond:
-                begin
-                    channel2$finish = 1'b1;
-                    operand$d = channel2$difference;
-                    coefficient$d = alpha;
-                    step$d = IirStep$WaitFirstRc;
-                end
-            IirStep$WaitFirstRc:
-                begin
-                    step$d = IirStep$UpdateFirstRc;
-                end
-            IirStep$UpdateFirstRc:
-                begin
-                    channel1$update_u = 1'b1;
-                    step$d = IirStep$WaitSecondRc1;
-                end
-            IirStep$WaitSecondRc1:
-                begin
-                    step$d = IirStep$WaitSecondRc2;
-                end
-            IirStep$WaitSecondRc2:
-                begin
-                    step$d = IirStep$UpdateSecondRc;
-                end
-            IirStep$UpdateSecondRc:
-                begin
-                    channel2$update_u = 1'b1;
-                    publishing$d = 1'b1;
-                    step$d = IirStep$Idle;
-                end
-        endcase
-        z1 = channel1$z;
-        z2 = channel2$z;
+            end
+        end
+        else begin
+            pc$d = pc$q + 32'h1;
+            if (pc$q == last_pc) begin
+                pc$d = 32'h0;
+            end
+        end
+        word_reg$d = rom$q;
+        word = word_reg$q;
+        read_field = word[(32'h0)+:(7)];
+        factor = word[(32'h8)+:(5)];
+        op = word[(32'hd)+:(2)];
+        emit = word[(32'h10)+:(3)];
+        write_field = word[(32'h13)+:(7)];
+        x_select = word[(32'h1a)+:(3)];
+        read_sum = ((read_field[(32'h2)+:(2)]) & 3'h7) + ((base$q) & 3'h7);
+        read_wrapped = read_sum - 32'h3;
+        read_slot = read_sum[(32'h0)+:(2)];
+        if (read_sum >= 32'h3) begin
+            read_slot = read_wrapped[(32'h0)+:(2)];
+        end
+        if (read_field[(32'h2)+:(2)] == 32'h3) begin
+            read_slot = 32'h3;
+        end
+        write_sum = ((write_field[(32'h2)+:(2)]) & 3'h7) + ((base$q) & 3'h7);
+        write_wrapped = write_sum - 32'h3;
+        write_slot = write_sum[(32'h0)+:(2)];
+        if (write_sum >= 32'h3) begin
+            write_slot = write_wrapped[(32'h0)+:(2)];
+        end
+        if (write_field[(32'h2)+:(2)] == 32'h3) begin
+            write_slot = 32'h3;
+        end
+        ram$read_address = (read_field & slot_mask) | (((read_slot) & 7'h7f) << 32'h2);
+        ram$write_address = (write_field & slot_mask) | (((write_slot) & 7'h7f) << 32'h2);
+        ram_low = ram$q[(32'h0)+:(13)];
+        ram_wrapped = $signed(ram_low);
+        a$d = ram$q;
+        if (word[32'h7]) begin
+            a$d = ram_wrapped;
+        end
+        k0_wide = $signed(k0);
+        k1_wide = $signed(k1);
+        k2_wide = $signed(k2);
+        alpha_wide = $signed(alpha);
+        scaled = alpha_wide;
+        if (factor[(32'h2)+:(3)] == 32'h1) begin
+            scaled = k1_wide + pow31;
+        end
+        if (factor[(32'h2)+:(3)] == 32'h2) begin
+            scaled = k2_wide - pow30;
+        end
+        if (factor[(32'h2)+:(3)] == 32'h3) begin
+            scaled = $signed($unsigned(k0_wide) << 32'h1);
+        end
+        if (factor[(32'h2)+:(3)] == 32'h4) begin
+            scaled = $signed($unsigned(k0_wide) << 32'h2);
+        end
+        scaled_low = scaled[(32'h0)+:(30)];
+        scaled_bits = $unsigned(scaled_low);
+        top_bits = scaled[(32'h1e)+:(4)];
+        top_digit = $signed(top_bits);
+        b$d = top_digit;
+        if (factor[(32'h0)+:(2)] == 32'h0) begin
+            b$d = $signed(((scaled_bits[(32'h0)+:(15)]) & 16'hffff));
+        end
+        if (factor[(32'h0)+:(2)] == 32'h1) begin
+            b$d = $signed(((scaled_bits[(32'hf)+:(15)]) & 16'hffff));
+        end
+        if (factor[(32'h2)+:(3)] == 32'h0) begin
+            b$d = 32'h0;
+            if (factor[(32'h0)+:(2)] == 32'h1) begin
+                b$d = one;
+            end
+            if (factor[(32'h0)+:(2)] == 32'h2) begin
+                b$d = minus_one;
+            end
+            if (factor[(32'h0)+:(2)] == 32'h3) begin
+                b$d = pow14;
+            end
+        end
+        mul$a = a$q;
+        mul$b = b$q;
+        product = $signed(mul$p);
+        carry = acc$q[(32'hf)+:(21)];
+        carry_wide = $signed(carry);
+        addend = acc$q;
+        if (op == 32'h1) begin
+            addend = 32'h0;
+            if (word[32'hf]) begin
+                addend = pow29;
+            end
+        end
+        if (op == 32'h3) begin
+            addend = carry_wide;
+        end
+        if (op != 32'h0) begin
+            acc$d = addend + product;
+        end
+        column_top = acc$q[(32'h0)+:(15)];
+        digit_bits = $unsigned(column_top);
+        column_digit = $signed(((digit_bits) & 16'hffff));
+        column_top_digit = $signed(column_top);
+        x_low = x1_held$q[(32'h0)+:(30)];
+        x_top = x1_held$q[(32'h1e)+:(10)];
+        if (x_select >= 32'h3) begin
+            x_low = x2_held$q[(32'h0)+:(30)];
+            x_top = x2_held$q[(32'h1e)+:(10)];
+        end
+        x_bits = $unsigned(x_low);
+        x_top_digit = $signed(x_top);
+        input_digit = x_top_digit;
+        if ((x_select == 32'h0) | (x_select == 32'h3)) begin
+            input_digit = $signed(((x_bits[(32'h0)+:(15)]) & 16'hffff));
+        end
+        if ((x_select == 32'h1) | (x_select == 32'h4)) begin
+            input_digit = $signed(((x_bits[(32'hf)+:(15)]) & 16'hffff));
+        end
+        ram$write_enable = 1'b0;
+        ram$write_data = column_digit;
+        if (emit == 32'h1) begin
+            ram$write_enable = 1'b1;
+        end
+        if (emit == 32'h2) begin
+            ram$write_enable = 1'b1;
+            ram$write_data = column_top_digit;
+        end
+        if (emit == 32'h4) begin
+            ram$write_enable = 1'b1;
+            ram$write_data = input_digit;
+        end
+        if (emit == 32'h3) begin
+            stage$d = (stage$q >> 32'hf) | (((digit_bits) & 90'h3ffffffffffffffffffffff) << 32'h4b);
+        end
+        z_valid_out$d = word[32'h1d];
+        if (word[32'h1d]) begin
+            z1_out$d = $signed(stage$q[(32'h0)+:(40)]);
+            z2_out$d = $signed(stage$q[(32'h2d)+:(40)]);
+        end
+        z1 = z1_out$q;
+        z2 = z2_out$q;
         z_valid = z_valid_out$q;
     end
 
 endmodule // gyro_interface_axi__core__iir
 
 
-module gyro_interface_axi__core__iir__channel1(clock,x,product,start,preload,accumulate,finish,update_u,publish,y1,y2,v,difference,z);
+module gyro_interface_axi__core__iir__a(d,q,clock);
 
     // Module arguments
-    input wire  clock;
-    input wire signed [39:0] x;
-    input wire signed [91:0] product;
-    input wire  start;
-    input wire  preload;
-    input wire  accumulate;
-    input wire  finish;
-    input wire  update_u;
-    input wire  publish;
-    output reg signed [59:0] y1;
-    output reg signed [59:0] y2;
-    output reg signed [59:0] v;
-    output reg signed [59:0] difference;
-    output reg signed [39:0] z;
-
-    // Constant declarations
-    localparam  half_coefficient_lsb = 94'h20000000;
-    localparam signed half_output_lsb = 58'h8000;
-
-    // Stub signals
-    reg signed [39:0] x0$d;
-    wire signed [39:0] x0$q;
-    reg  x0$clock;
-    reg signed [41:0] partial$d;
-    wire signed [41:0] partial$q;
-    reg  partial$clock;
-    reg signed [59:0] v_reg$d;
-    wire signed [59:0] v_reg$q;
-    reg  v_reg$clock;
-    reg signed [59:0] feedback$d;
-    wire signed [59:0] feedback$q;
-    reg  feedback$clock;
-    reg signed [93:0] acc_y$d;
-    wire signed [93:0] acc_y$q;
-    reg  acc_y$clock;
-    reg signed [93:0] acc_d$d;
-    wire signed [93:0] acc_d$q;
-    reg  acc_d$clock;
-    reg signed [57:0] y1_reg$d;
-    wire signed [57:0] y1_reg$q;
-    reg  y1_reg$clock;
-    reg signed [57:0] y2_reg$d;
-    wire signed [57:0] y2_reg$q;
-    reg  y2_reg$clock;
-    reg signed [57:0] u$d;
-    wire signed [57:0] u$q;
-    reg  u$clock;
-    reg signed [39:0] z_out$d;
-    wire signed [39:0] z_out$q;
-    reg  z_out$clock;
-
-    // Local signals
-    reg signed [59:0] x_wide;
-    reg signed [41:0] x_partial;
-    reg signed [41:0] x0_partial;
-    reg signed [59:0] partial_wide;
-    reg  [41:0] x_doubled;
-    reg  [59:0] y1_doubled;
-    reg signed [59:0] v_sum;
-    reg  [59:0] v_shifted;
-    reg signed [59:0] y1_wide;
-    reg signed [59:0] y2_wide;
-    reg signed [59:0] u_wide;
-    reg signed [59:0] feedback_minus_u;
-    reg signed [93:0] feedback_long;
-    reg signed [93:0] difference_long;
-    reg signed [93:0] u_long;
-    reg signed [93:0] product_long;
-    reg  [93:0] preload_y;
-    reg  [93:0] preload_d;
-    reg  [93:0] u_scaled;
-    reg signed [93:0] sum_y;
-    reg signed [93:0] sum_d;
-    reg signed [93:0] sum_u;
-    reg signed [57:0] y_new;
-    reg signed [57:0] u_new;
-    reg signed [57:0] u_rounded;
-
-    // Sub module instances
-    gyro_interface_axi__core__iir__channel1__x0 x0(
-        .d(x0$d),
-        .q(x0$q),
-        .clock(x0$clock)
-    );
-    gyro_interface_axi__core__iir__channel1__partial partial(
-        .d(partial$d),
-        .q(partial$q),
-        .clock(partial$clock)
-    );
-    gyro_interface_axi__core__iir__channel1__v_reg v_reg(
-        .d(v_reg$d),
-        .q(v_reg$q),
-        .clock(v_reg$clock)
-    );
-    gyro_interface_axi__core__iir__channel1__feedback feedback(
-        .d(feedback$d),
-        .q(feedback$q),
-        .clock(feedback$clock)
-    );
-    gyro_interface_axi__core__iir__channel1__acc_y acc_y(
-        .d(acc_y$d),
-        .q(acc_y$q),
-        .clock(acc_y$clock)
-    );
-    gyro_interface_axi__core__iir__channel1__acc_d acc_d(
-        .d(acc_d$d),
-        .q(acc_d$q),
-        .clock(acc_d$clock)
-    );
-    gyro_interface_axi__core__iir__channel1__y1_reg y1_reg(
-        .d(y1_reg$d),
-        .q(y1_reg$q),
-        .clock(y1_reg$clock)
-    );
-    gyro_interface_axi__core__iir__channel1__y2_reg y2_reg(
-        .d(y2_reg$d),
-        .q(y2_reg$q),
-        .clock(y2_reg$clock)
-    );
-    gyro_interface_axi__core__iir__channel1__u u(
-        .d(u$d),
-        .q(u$q),
-        .clock(u$clock)
-    );
-    gyro_interface_axi__core__iir__channel1__z_out z_out(
-        .d(z_out$d),
-        .q(z_out$q),
-        .clock(z_out$clock)
-    );
-
-    // Update code
-    always @(*) begin
-        x0$clock = clock;
-        partial$clock = clock;
-        v_reg$clock = clock;
-        feedback$clock = clock;
-        acc_y$clock = clock;
-        acc_d$clock = clock;
-        y1_reg$clock = clock;
-        y2_reg$clock = clock;
-        u$clock = clock;
-        z_out$clock = clock;
-        x0$d = x0$q;
-        partial$d = partial$q;
-        v_reg$d = v_reg$q;
-        feedback$d = feedback$q;
-        acc_y$d = acc_y$q;
-        acc_d$d = acc_d$q;
-        y1_reg$d = y1_reg$q;
-        y2_reg$d = y2_reg$q;
-        u$d = u$q;
-        z_out$d = z_out$q;
-        x_wide = $signed(x);
-        x_partial = $signed(x);
-        x0_partial = $signed(x0$q);
-        partial_wide = $signed(partial$q);
-        y1_wide = $signed(y1_reg$q);
-        y2_wide = $signed(y2_reg$q);
-        u_wide = $signed(u$q);
-        v_sum = x_wide + partial_wide;
-        x_doubled = $unsigned(x_partial) << 32'h1;
-        y1_doubled = $unsigned(y1_wide) << 32'h1;
-        v_shifted = $unsigned(v_sum) << 32'h10;
-        feedback_minus_u = feedback$q - u_wide;
-        feedback_long = $signed(feedback$q);
-        difference_long = $signed(feedback_minus_u);
-        u_long = $signed(u$q);
-        product_long = $signed(product);
-        preload_y = ($unsigned(feedback_long) << 32'h1e) | half_coefficient_lsb;
-        preload_d = ($unsigned(difference_long) << 32'h1e) | half_coefficient_lsb;
-        u_scaled = ($unsigned(u_long) << 32'h1e) | half_coefficient_lsb;
-        sum_y = acc_y$q + product_long;
-        sum_d = acc_d$q + product_long;
-        sum_u = $signed(u_scaled) + product_long;
-        y_new = sum_y[(32'h1e)+:(58)];
-        u_new = sum_u[(32'h1e)+:(58)];
-        difference = sum_d[(32'h1e)+:(60)];
-        u_rounded = u$q + half_output_lsb;
-        if (start) begin
-            x0$d = x;
-            partial$d = $signed(x_doubled) + x0_partial;
-            v_reg$d = $signed(v_shifted);
-            feedback$d = $signed(y1_doubled) - y2_wide;
-        end
-        if (preload) begin
-            acc_y$d = $signed(preload_y);
-            acc_d$d = $signed(preload_d);
-        end
-        if (accumulate) begin
-            acc_y$d = sum_y;
-            acc_d$d = sum_d;
-        end
-        if (finish) begin
-            y1_reg$d = y_new;
-            y2_reg$d = y1_reg$q;
-        end
-        if (update_u) begin
-            u$d = u_new;
-        end
-        if (publish) begin
-            z_out$d = u_rounded[(32'h10)+:(40)];
-        end
-        y1 = y1_wide;
-        y2 = y2_wide;
-        v = v_reg$q;
-        z = z_out$q;
-    end
-
-endmodule // gyro_interface_axi__core__iir__channel1
-
-
-module gyro_interface_axi__core__iir__channel1__acc_d(d,q,clock);
-
-    // Module arguments
-    input wire signed [93:0] d;
-    output reg signed [93:0] q;
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 94'h0;
+       q = 16'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__iir__channel1__acc_d
+endmodule // gyro_interface_axi__core__iir__a
 
 
-module gyro_interface_axi__core__iir__channel1__acc_y(d,q,clock);
+module gyro_interface_axi__core__iir__acc(d,q,clock);
 
     // Module arguments
-    input wire signed [93:0] d;
-    output reg signed [93:0] q;
+    input wire signed [35:0] d;
+    output reg signed [35:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 94'h0;
+       q = 36'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__iir__channel1__acc_y
+endmodule // gyro_interface_axi__core__iir__acc
 
 
-module gyro_interface_axi__core__iir__channel1__feedback(d,q,clock);
+module gyro_interface_axi__core__iir__b(d,q,clock);
 
     // Module arguments
-    input wire signed [59:0] d;
-    output reg signed [59:0] q;
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 60'h0;
+       q = 16'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__iir__channel1__feedback
+endmodule // gyro_interface_axi__core__iir__b
 
 
-module gyro_interface_axi__core__iir__channel1__partial(d,q,clock);
+module gyro_interface_axi__core__iir__base(d,q,clock);
 
     // Module arguments
-    input wire signed [41:0] d;
-    output reg signed [41:0] q;
+    input wire  [1:0] d;
+    output reg  [1:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 42'h0;
+       q = 2'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__iir__channel1__partial
+endmodule // gyro_interface_axi__core__iir__base
 
 
-module gyro_interface_axi__core__iir__channel1__u(d,q,clock);
+module gyro_interface_axi__core__iir__mul(clock,a,b,p);
 
     // Module arguments
-    input wire signed [57:0] d;
-    output reg signed [57:0] q;
     input wire  clock;
+    input wire signed [15:0] a;
+    input wire signed [15:0] b;
+    output reg signed [31:0] p;
 
     // Update code (custom)
-    initial begin
-       q = 58'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir__channel1__u
-
-
-module gyro_interface_axi__core__iir__channel1__v_reg(d,q,clock);
-
-    // Module arguments
-    input wire signed [59:0] d;
-    output reg signed [59:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 60'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir__channel1__v_reg
-
-
-module gyro_interface_axi__core__iir__channel1__x0(d,q,clock);
-
-    // Module arguments
-    input wire signed [39:0] d;
-    output reg signed [39:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 40'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir__channel1__x0
-
-
-module gyro_interface_axi__core__iir__channel1__y1_reg(d,q,clock);
-
-    // Module arguments
-    input wire signed [57:0] d;
-    output reg signed [57:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 58'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir__channel1__y1_reg
-
-
-module gyro_interface_axi__core__iir__channel1__y2_reg(d,q,clock);
-
-    // Module arguments
-    input wire signed [57:0] d;
-    output reg signed [57:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 58'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir__channel1__y2_reg
-
-
-module gyro_interface_axi__core__iir__channel1__z_out(d,q,clock);
-
-    // Module arguments
-    input wire signed [39:0] d;
-    output reg signed [39:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 40'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir__channel1__z_out
-
-
-module gyro_interface_axi__core__iir__channel2(clock,x,product,start,preload,accumulate,finish,update_u,publish,y1,y2,v,difference,z);
-
-    // Module arguments
-    input wire  clock;
-    input wire signed [39:0] x;
-    input wire signed [91:0] product;
-    input wire  start;
-    input wire  preload;
-    input wire  accumulate;
-    input wire  finish;
-    input wire  update_u;
-    input wire  publish;
-    output reg signed [59:0] y1;
-    output reg signed [59:0] y2;
-    output reg signed [59:0] v;
-    output reg signed [59:0] difference;
-    output reg signed [39:0] z;
-
-    // Constant declarations
-    localparam  half_coefficient_lsb = 94'h20000000;
-    localparam signed half_output_lsb = 58'h8000;
-
-    // Stub signals
-    reg signed [39:0] x0$d;
-    wire signed [39:0] x0$q;
-    reg  x0$clock;
-    reg signed [41:0] partial$d;
-    wire signed [41:0] partial$q;
-    reg  partial$clock;
-    reg signed [59:0] v_reg$d;
-    wire signed [59:0] v_reg$q;
-    reg  v_reg$clock;
-    reg signed [59:0] feedback$d;
-    wire signed [59:0] feedback$q;
-    reg  feedback$clock;
-    reg signed [93:0] acc_y$d;
-    wire signed [93:0] acc_y$q;
-    reg  acc_y$clock;
-    reg signed [93:0] acc_d$d;
-    wire signed [93:0] acc_d$q;
-    reg  acc_d$clock;
-    reg signed [57:0] y1_reg$d;
-    wire signed [57:0] y1_reg$q;
-    reg  y1_reg$clock;
-    reg signed [57:0] y2_reg$d;
-    wire signed [57:0] y2_reg$q;
-    reg  y2_reg$clock;
-    reg signed [57:0] u$d;
-    wire signed [57:0] u$q;
-    reg  u$clock;
-    reg signed [39:0] z_out$d;
-    wire signed [39:0] z_out$q;
-    reg  z_out$clock;
-
-    // Local signals
-    reg signed [59:0] x_wide;
-    reg signed [41:0] x_partial;
-    reg signed [41:0] x0_partial;
-    reg signed [59:0] partial_wide;
-    reg  [41:0] x_doubled;
-    reg  [59:0] y1_doubled;
-    reg signed [59:0] v_sum;
-    reg  [59:0] v_shifted;
-    reg signed [59:0] y1_wide;
-    reg signed [59:0] y2_wide;
-    reg signed [59:0] u_wide;
-    reg signed [59:0] feedback_minus_u;
-    reg signed [93:0] feedback_long;
-    reg signed [93:0] difference_long;
-    reg signed [93:0] u_long;
-    reg signed [93:0] product_long;
-    reg  [93:0] preload_y;
-    reg  [93:0] preload_d;
-    reg  [93:0] u_scaled;
-    reg signed [93:0] sum_y;
-    reg signed [93:0] sum_d;
-    reg signed [93:0] sum_u;
-    reg signed [57:0] y_new;
-    reg signed [57:0] u_new;
-    reg signed [57:0] u_rounded;
-
-    // Sub module instances
-    gyro_interface_axi__core__iir__channel2__x0 x0(
-        .d(x0$d),
-        .q(x0$q),
-        .clock(x0$clock)
-    );
-    gyro_interface_axi__core__iir__channel2__partial partial(
-        .d(partial$d),
-        .q(partial$q),
-        .clock(partial$clock)
-    );
-    gyro_interface_axi__core__iir__channel2__v_reg v_reg(
-        .d(v_reg$d),
-        .q(v_reg$q),
-        .clock(v_reg$clock)
-    );
-    gyro_interface_axi__core__iir__channel2__feedback feedback(
-        .d(feedback$d),
-        .q(feedback$q),
-        .clock(feedback$clock)
-    );
-    gyro_interface_axi__core__iir__channel2__acc_y acc_y(
-        .d(acc_y$d),
-        .q(acc_y$q),
-        .clock(acc_y$clock)
-    );
-    gyro_interface_axi__core__iir__channel2__acc_d acc_d(
-        .d(acc_d$d),
-        .q(acc_d$q),
-        .clock(acc_d$clock)
-    );
-    gyro_interface_axi__core__iir__channel2__y1_reg y1_reg(
-        .d(y1_reg$d),
-        .q(y1_reg$q),
-        .clock(y1_reg$clock)
-    );
-    gyro_interface_axi__core__iir__channel2__y2_reg y2_reg(
-        .d(y2_reg$d),
-        .q(y2_reg$q),
-        .clock(y2_reg$clock)
-    );
-    gyro_interface_axi__core__iir__channel2__u u(
-        .d(u$d),
-        .q(u$q),
-        .clock(u$clock)
-    );
-    gyro_interface_axi__core__iir__channel2__z_out z_out(
-        .d(z_out$d),
-        .q(z_out$q),
-        .clock(z_out$clock)
-    );
-
-    // Update code
-    always @(*) begin
-        x0$clock = clock;
-        partial$clock = clock;
-        v_reg$clock = clock;
-        feedback$clock = clock;
-        acc_y$clock = clock;
-        acc_d$clock = clock;
-        y1_reg$clock = clock;
-        y2_reg$clock = clock;
-        u$clock = clock;
-        z_out$clock = clock;
-        x0$d = x0$q;
-        partial$d = partial$q;
-        v_reg$d = v_reg$q;
-        feedback$d = feedback$q;
-        acc_y$d = acc_y$q;
-        acc_d$d = acc_d$q;
-        y1_reg$d = y1_reg$q;
-        y2_reg$d = y2_reg$q;
-        u$d = u$q;
-        z_out$d = z_out$q;
-        x_wide = $signed(x);
-        x_partial = $signed(x);
-        x0_partial = $signed(x0$q);
-        partial_wide = $signed(partial$q);
-        y1_wide = $signed(y1_reg$q);
-        y2_wide = $signed(y2_reg$q);
-        u_wide = $signed(u$q);
-        v_sum = x_wide + partial_wide;
-        x_doubled = $unsigned(x_partial) << 32'h1;
-        y1_doubled = $unsigned(y1_wide) << 32'h1;
-        v_shifted = $unsigned(v_sum) << 32'h10;
-        feedback_minus_u = feedback$q - u_wide;
-        feedback_long = $signed(feedback$q);
-        difference_long = $signed(feedback_minus_u);
-        u_long = $signed(u$q);
-        product_long = $signed(product);
-        preload_y = ($unsigned(feedback_long) << 32'h1e) | half_coefficient_lsb;
-        preload_d = ($unsigned(difference_long) << 32'h1e) | half_coefficient_lsb;
-        u_scaled = ($unsigned(u_long) << 32'h1e) | half_coefficient_lsb;
-        sum_y = acc_y$q + product_long;
-        sum_d = acc_d$q + product_long;
-        sum_u = $signed(u_scaled) + product_long;
-        y_new = sum_y[(32'h1e)+:(58)];
-        u_new = sum_u[(32'h1e)+:(58)];
-        difference = sum_d[(32'h1e)+:(60)];
-        u_rounded = u$q + half_output_lsb;
-        if (start) begin
-            x0$d = x;
-            partial$d = $signed(x_doubled) + x0_partial;
-            v_reg$d = $signed(v_shifted);
-            feedback$d = $signed(y1_doubled) - y2_wide;
-        end
-        if (preload) begin
-            acc_y$d = $signed(preload_y);
-            acc_d$d = $signed(preload_d);
-        end
-        if (accumulate) begin
-            acc_y$d = sum_y;
-            acc_d$d = sum_d;
-        end
-        if (finish) begin
-            y1_reg$d = y_new;
-            y2_reg$d = y1_reg$q;
-        end
-        if (update_u) begin
-            u$d = u_new;
-        end
-        if (publish) begin
-            z_out$d = u_rounded[(32'h10)+:(40)];
-        end
-        y1 = y1_wide;
-        y2 = y2_wide;
-        v = v_reg$q;
-        z = z_out$q;
-    end
-
-endmodule // gyro_interface_axi__core__iir__channel2
-
-
-module gyro_interface_axi__core__iir__channel2__acc_d(d,q,clock);
-
-    // Module arguments
-    input wire signed [93:0] d;
-    output reg signed [93:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 94'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir__channel2__acc_d
-
-
-module gyro_interface_axi__core__iir__channel2__acc_y(d,q,clock);
-
-    // Module arguments
-    input wire signed [93:0] d;
-    output reg signed [93:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 94'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir__channel2__acc_y
-
-
-module gyro_interface_axi__core__iir__channel2__feedback(d,q,clock);
-
-    // Module arguments
-    input wire signed [59:0] d;
-    output reg signed [59:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 60'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir__channel2__feedback
-
-
-module gyro_interface_axi__core__iir__channel2__partial(d,q,clock);
-
-    // Module arguments
-    input wire signed [41:0] d;
-    output reg signed [41:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 42'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir__channel2__partial
-
-
-module gyro_interface_axi__core__iir__channel2__u(d,q,clock);
-
-    // Module arguments
-    input wire signed [57:0] d;
-    output reg signed [57:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 58'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir__channel2__u
-
-
-module gyro_interface_axi__core__iir__channel2__v_reg(d,q,clock);
-
-    // Module arguments
-    input wire signed [59:0] d;
-    output reg signed [59:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 60'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir__channel2__v_reg
-
-
-module gyro_interface_axi__core__iir__channel2__x0(d,q,clock);
-
-    // Module arguments
-    input wire signed [39:0] d;
-    output reg signed [39:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 40'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir__channel2__x0
-
-
-module gyro_interface_axi__core__iir__channel2__y1_reg(d,q,clock);
-
-    // Module arguments
-    input wire signed [57:0] d;
-    output reg signed [57:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 58'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir__channel2__y1_reg
-
-
-module gyro_interface_axi__core__iir__channel2__y2_reg(d,q,clock);
-
-    // Module arguments
-    input wire signed [57:0] d;
-    output reg signed [57:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 58'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir__channel2__y2_reg
-
-
-module gyro_interface_axi__core__iir__channel2__z_out(d,q,clock);
-
-    // Module arguments
-    input wire signed [39:0] d;
-    output reg signed [39:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 40'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir__channel2__z_out
-
-
-module gyro_interface_axi__core__iir__coefficient(d,q,clock);
-
-    // Module arguments
-    input wire signed [31:0] d;
-    output reg signed [31:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 32'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir__coefficient
-
-
-module gyro_interface_axi__core__iir__mac(clock,a,b,p);
-
-    // Module arguments
-    input wire  clock;
-    input wire signed [59:0] a;
-    input wire signed [31:0] b;
-    output reg signed [91:0] p;
-
-    // Update code (custom)
-    wire signed [16:0] a_0 = {1'b0, a[15:0]};
-    wire signed [16:0] a_1 = {1'b0, a[31:16]};
-    wire signed [16:0] a_2 = {1'b0, a[47:32]};
-    wire signed [11:0] a_3 = a[59:48];
-    wire signed [16:0] b_0 = {1'b0, b[15:0]};
-    wire signed [15:0] b_1 = b[31:16];
-    reg signed [33:0] pp_0_0;
-    initial pp_0_0 = 0;
-    reg signed [32:0] pp_0_1;
-    initial pp_0_1 = 0;
-    reg signed [48:0] row_0;
-    initial row_0 = 0;
-    reg signed [33:0] pp_1_0;
-    initial pp_1_0 = 0;
-    reg signed [32:0] pp_1_1;
-    initial pp_1_1 = 0;
-    reg signed [48:0] row_1;
-    initial row_1 = 0;
-    reg signed [33:0] pp_2_0;
-    initial pp_2_0 = 0;
-    reg signed [32:0] pp_2_1;
-    initial pp_2_1 = 0;
-    reg signed [48:0] row_2;
-    initial row_2 = 0;
-    reg signed [28:0] pp_3_0;
-    initial pp_3_0 = 0;
-    reg signed [27:0] pp_3_1;
-    initial pp_3_1 = 0;
-    reg signed [43:0] row_3;
-    initial row_3 = 0;
-    reg signed [64:0] pair_0;
-    initial pair_0 = 0;
-    reg signed [59:0] pair_1;
-    initial pair_1 = 0;
     initial p = 0;
 
     always @(posedge clock) begin
-       pp_0_0 <= a_0 * b_0;
-       pp_0_1 <= a_0 * b_1;
-       pp_1_0 <= a_1 * b_0;
-       pp_1_1 <= a_1 * b_1;
-       pp_2_0 <= a_2 * b_0;
-       pp_2_1 <= a_2 * b_1;
-       pp_3_0 <= a_3 * b_0;
-       pp_3_1 <= a_3 * b_1;
-       row_0 <= {{15{pp_0_0[33]}}, pp_0_0} + {pp_0_1, 16'd0};
-       row_1 <= {{15{pp_1_0[33]}}, pp_1_0} + {pp_1_1, 16'd0};
-       row_2 <= {{15{pp_2_0[33]}}, pp_2_0} + {pp_2_1, 16'd0};
-       row_3 <= {{15{pp_3_0[28]}}, pp_3_0} + {pp_3_1, 16'd0};
-       pair_0 <= {{16{row_0[48]}}, row_0} + {row_1, 16'd0};
-       pair_1 <= {{11{row_2[48]}}, row_2} + {row_3, 16'd0};
-       p <= {{27{pair_0[64]}}, pair_0} + {pair_1, 32'd0};
+       p <= a * b;
     end
-endmodule // gyro_interface_axi__core__iir__mac
+endmodule // gyro_interface_axi__core__iir__mul
 
 
-module gyro_interface_axi__core__iir__operand(d,q,clock);
+module gyro_interface_axi__core__iir__pc(d,q,clock);
 
     // Module arguments
-    input wire signed [59:0] d;
-    output reg signed [59:0] q;
+    input wire  [7:0] d;
+    output reg  [7:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 60'h0;
+       q = 8'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__iir__operand
+endmodule // gyro_interface_axi__core__iir__pc
 
 
-module gyro_interface_axi__core__iir__publishing(d,q,clock);
+module gyro_interface_axi__core__iir__ram(clock,read_address,q,write_address,write_data,write_enable);
 
     // Module arguments
-    input wire  d;
-    output reg  q;
+    input wire  clock;
+    input wire  [6:0] read_address;
+    output reg signed [15:0] q;
+    input wire  [6:0] write_address;
+    input wire signed [15:0] write_data;
+    input wire  write_enable;
+
+    // Update code (custom)
+    reg signed [15:0] words [0:127];
+    integer init_index;
+
+    initial begin
+       for (init_index = 0; init_index < 128; init_index = init_index + 1)
+          words[init_index] = 0;
+       q = 0;
+    end
+
+    always @(posedge clock) begin
+       q <= words[read_address];
+       if (write_enable)
+          words[write_address] <= write_data;
+    end
+endmodule // gyro_interface_axi__core__iir__ram
+
+
+module gyro_interface_axi__core__iir__rom(clock,address,q);
+
+    // Module arguments
+    input wire  clock;
+    input wire  [7:0] address;
+    output reg  [29:0] q;
+
+    // Update code (custom)
+    reg [29:0] program_words [0:255];
+
+    initial begin
+       program_words[0] = 30'h0;
+       program_words[1] = 30'h40018;
+       program_words[2] = 30'h40c0414;
+       program_words[3] = 30'h8140818;
+       program_words[4] = 30'he04a519;
+       program_words[5] = 30'h120c4414;
+       program_words[6] = 30'h16146915;
+       program_words[7] = 30'h4800;
+       program_words[8] = 30'h4c08;
+       program_words[9] = 30'h5004;
+       program_words[10] = 30'h4c18;
+       program_words[11] = 30'h4619;
+       program_words[12] = 30'h451a;
+       program_words[13] = 30'h6414;
+       program_words[14] = 30'h4a15;
+       program_words[15] = 30'h4916;
+       program_words[16] = 30'h4800;
+       program_words[17] = 30'h4d01;
+       program_words[18] = 30'h4c08;
+       program_words[19] = 30'h5109;
+       program_words[20] = 30'h5004;
+       program_words[21] = 30'h4d05;
+       program_words[22] = 30'h4c19;
+       program_words[23] = 30'h461a;
+       program_words[24] = 30'h451b;
+       program_words[25] = 30'h816495;
+       program_words[26] = 30'h4a16;
+       program_words[27] = 30'h4917;
+       program_words[28] = 30'h4880;
+       program_words[29] = 30'h4e01;
+       program_words[30] = 30'h4d02;
+       program_words[31] = 30'h4c08;
+       program_words[32] = 30'h5209;
+       program_words[33] = 30'h510a;
+       program_words[34] = 30'h5004;
+       program_words[35] = 30'h4e05;
+       program_words[36] = 30'h4d06;
+       program_words[37] = 30'h4c1a;
+       program_words[38] = 30'h461b;
+       program_words[39] = 30'h4596;
+       program_words[40] = 30'h896a17;
+       program_words[41] = 30'h4981;
+       program_words[42] = 30'h4e02;
+       program_words[43] = 30'h4d09;
+       program_words[44] = 30'h520a;
+       program_words[45] = 30'h5105;
+       program_words[46] = 30'h4e06;
+       program_words[47] = 30'h4d1b;
+       program_words[48] = 30'h4697;
+       program_words[49] = 30'h4a82;
+       program_words[50] = 30'h916e0a;
+       program_words[51] = 30'h5206;
+       program_words[52] = 30'h4e58;
+       program_words[53] = 30'h4454;
+       program_words[54] = 30'h4858;
+       program_words[55] = 30'h9aa559;
+       program_words[56] = 30'h4454;
+       program_words[57] = 30'h6955;
+       program_words[58] = 30'h4840;
+       program_words[59] = 30'h4c48;
+       program_words[60] = 30'h5044;
+       program_words[61] = 30'h4c58;
+       program_words[62] = 30'h4659;
+       program_words[63] = 30'h455a;
+       program_words[64] = 30'h6454;
+       program_words[65] = 30'h4a55;
+       program_words[66] = 30'h4956;
+       program_words[67] = 30'h4840;
+       program_words[68] = 30'h4d41;
+       program_words[69] = 30'h4c48;
+       program_words[70] = 30'h5149;
+       program_words[71] = 30'h5044;
+       program_words[72] = 30'h4d45;
+       program_words[73] = 30'h4c59;
+       program_words[74] = 30'h465a;
+       program_words[75] = 30'h455b;
+       program_words[76] = 30'h28164d5;
+       program_words[77] = 30'h4a56;
+       program_words[78] = 30'h4957;
+       program_words[79] = 30'h48c0;
+       program_words[80] = 30'h4e41;
+       program_words[81] = 30'h4d42;
+       program_words[82] = 30'h4c48;
+       program_words[83] = 30'h5249;
+       program_words[84] = 30'h514a;
+       program_words[85] = 30'h5044;
+       program_words[86] = 30'h4e45;
+       program_words[87] = 30'h4d46;
+       program_words[88] = 30'h4c5a;
+       program_words[89] = 30'h465b;
+       program_words[90] = 30'h45d6;
+       program_words[91] = 30'h2896a57;
+       program_words[92] = 30'h49c1;
+       program_words[93] = 30'h4e42;
+       program_words[94] = 30'h4d49;
+       program_words[95] = 30'h524a;
+       program_words[96] = 30'h5145;
+       program_words[97] = 30'h4e46;
+       program_words[98] = 30'h4d5b;
+       program_words[99] = 30'h46d7;
+       program_words[100] = 30'h4ac2;
+       program_words[101] = 30'h2916e4a;
+       program_words[102] = 30'h5246;
+       program_words[103] = 30'h4e10;
+       program_words[104] = 30'h4128;
+       program_words[105] = 30'h4211;
+       program_words[106] = 30'h29a2129;
+       program_words[107] = 30'h4212;
+       program_words[108] = 30'h1e1612a;
+       program_words[109] = 30'h4213;
+       program_words[110] = 30'h1e9612b;
+       program_words[111] = 30'h42d0;
+       program_words[112] = 30'h1f16168;
+       program_words[113] = 30'h4251;
+       program_words[114] = 30'h1fa2169;
+       program_words[115] = 30'h4252;
+       program_words[116] = 30'h3e1616a;
+       program_words[117] = 30'h4253;
+       program_words[118] = 30'h3e9616b;
+       program_words[119] = 30'h42bc;
+       program_words[120] = 30'h3f1743c;
+       program_words[121] = 30'h553d;
+       program_words[122] = 30'h3fab43c;
+       program_words[123] = 30'h763d;
+       program_words[124] = 30'h553e;
+       program_words[125] = 30'h7428;
+       program_words[126] = 30'h413d;
+       program_words[127] = 30'h563e;
+       program_words[128] = 30'h553f;
+       program_words[129] = 30'h1017429;
+       program_words[130] = 30'h413e;
+       program_words[131] = 30'h563f;
+       program_words[132] = 30'h552a;
+       program_words[133] = 30'h109613f;
+       program_words[134] = 30'h562b;
+       program_words[135] = 30'h41fc;
+       program_words[136] = 30'h111747c;
+       program_words[137] = 30'h557d;
+       program_words[138] = 30'h11ab47c;
+       program_words[139] = 30'h767d;
+       program_words[140] = 30'h557e;
+       program_words[141] = 30'h7468;
+       program_words[142] = 30'h417d;
+       program_words[143] = 30'h567e;
+       program_words[144] = 30'h557f;
+       program_words[145] = 30'h3017469;
+       program_words[146] = 30'h417e;
+       program_words[147] = 30'h567f;
+       program_words[148] = 30'h556a;
+       program_words[149] = 30'h309617f;
+       program_words[150] = 30'h566b;
+       program_words[151] = 30'h41a0;
+       program_words[152] = 30'h3116321;
+       program_words[153] = 30'h4322;
+       program_words[154] = 30'h31aa323;
+       program_words[155] = 30'h6380;
+       program_words[156] = 30'h6060;
+       program_words[157] = 30'h36361;
+       program_words[158] = 30'h36362;
+       program_words[159] = 30'h3a363;
+       program_words[160] = 30'h6380;
+       program_words[161] = 30'h6000;
+       program_words[162] = 30'h36000;
+       program_words[163] = 30'h36000;
+       program_words[164] = 30'h30000;
+       program_words[165] = 30'h20000000;
+       program_words[166] = 30'h0;
+       program_words[167] = 30'h0;
+       program_words[168] = 30'h0;
+       program_words[169] = 30'h0;
+       program_words[170] = 30'h0;
+       program_words[171] = 30'h0;
+       program_words[172] = 30'h0;
+       program_words[173] = 30'h0;
+       program_words[174] = 30'h0;
+       program_words[175] = 30'h0;
+       program_words[176] = 30'h0;
+       program_words[177] = 30'h0;
+       program_words[178] = 30'h0;
+       program_words[179] = 30'h0;
+       program_words[180] = 30'h0;
+       program_words[181] = 30'h0;
+       program_words[182] = 30'h0;
+       program_words[183] = 30'h0;
+       program_words[184] = 30'h0;
+       program_words[185] = 30'h0;
+       program_words[186] = 30'h0;
+       program_words[187] = 30'h0;
+       program_words[188] = 30'h0;
+       program_words[189] = 30'h0;
+       program_words[190] = 30'h0;
+       program_words[191] = 30'h0;
+       program_words[192] = 30'h0;
+       program_words[193] = 30'h0;
+       program_words[194] = 30'h0;
+       program_words[195] = 30'h0;
+       program_words[196] = 30'h0;
+       program_words[197] = 30'h0;
+       program_words[198] = 30'h0;
+       program_words[199] = 30'h0;
+       program_words[200] = 30'h0;
+       program_words[201] = 30'h0;
+       program_words[202] = 30'h0;
+       program_words[203] = 30'h0;
+       program_words[204] = 30'h0;
+       program_words[205] = 30'h0;
+       program_words[206] = 30'h0;
+       program_words[207] = 30'h0;
+       program_words[208] = 30'h0;
+       program_words[209] = 30'h0;
+       program_words[210] = 30'h0;
+       program_words[211] = 30'h0;
+       program_words[212] = 30'h0;
+       program_words[213] = 30'h0;
+       program_words[214] = 30'h0;
+       program_words[215] = 30'h0;
+       program_words[216] = 30'h0;
+       program_words[217] = 30'h0;
+       program_words[218] = 30'h0;
+       program_words[219] = 30'h0;
+       program_words[220] = 30'h0;
+       program_words[221] = 30'h0;
+       program_words[222] = 30'h0;
+       program_words[223] = 30'h0;
+       program_words[224] = 30'h0;
+       program_words[225] = 30'h0;
+       program_words[226] = 30'h0;
+       program_words[227] = 30'h0;
+       program_words[228] = 30'h0;
+       program_words[229] = 30'h0;
+       program_words[230] = 30'h0;
+       program_words[231] = 30'h0;
+       program_words[232] = 30'h0;
+       program_words[233] = 30'h0;
+       program_words[234] = 30'h0;
+       program_words[235] = 30'h0;
+       program_words[236] = 30'h0;
+       program_words[237] = 30'h0;
+       program_words[238] = 30'h0;
+       program_words[239] = 30'h0;
+       program_words[240] = 30'h0;
+       program_words[241] = 30'h0;
+       program_words[242] = 30'h0;
+       program_words[243] = 30'h0;
+       program_words[244] = 30'h0;
+       program_words[245] = 30'h0;
+       program_words[246] = 30'h0;
+       program_words[247] = 30'h0;
+       program_words[248] = 30'h0;
+       program_words[249] = 30'h0;
+       program_words[250] = 30'h0;
+       program_words[251] = 30'h0;
+       program_words[252] = 30'h0;
+       program_words[253] = 30'h0;
+       program_words[254] = 30'h0;
+       program_words[255] = 30'h0;
+       q = 0;
+    end
+
+    always @(posedge clock) begin
+       q <= program_words[address];
+    end
+endmodule // gyro_interface_axi__core__iir__rom
+
+
+module gyro_interface_axi__core__iir__stage(d,q,clock);
+
+    // Module arguments
+    input wire  [89:0] d;
+    output reg  [89:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 1'h0;
+       q = 90'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__iir__publishing
+endmodule // gyro_interface_axi__core__iir__stage
 
 
-module gyro_interface_axi__core__iir__step(d,q,clock);
+module gyro_interface_axi__core__iir__word_reg(d,q,clock);
 
     // Module arguments
-    input wire  [3:0] d;
-    output reg  [3:0] q;
+    input wire  [29:0] d;
+    output reg  [29:0] q;
     input wire  clock;
-
-    // Enums
-    localparam IirStep$Idle = 0;
-    localparam IirStep$IssueY2First = 1;
-    localparam IirStep$IssueVFirst = 2;
-    localparam IirStep$IssueY1Second = 3;
-    localparam IirStep$IssueY2Second = 4;
-    localparam IirStep$IssueVSecond = 5;
-    localparam IirStep$AccumulateFirst = 6;
-    localparam IirStep$FinishFirst = 7;
-    localparam IirStep$AccumulateSecondY1 = 8;
-    localparam IirStep$AccumulateSecondY2 = 9;
-    localparam IirStep$FinishSecond = 10;
-    localparam IirStep$WaitFirstRc = 11;
-    localparam IirStep$UpdateFirstRc = 12;
-    localparam IirStep$WaitSecondRc1 = 13;
-    localparam IirStep$WaitSecondRc2 = 14;
-    localparam IirStep$UpdateSecondRc = 15;
 
     // Update code (custom)
     initial begin
-       q = 64'h0;
+       q = 30'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__iir__step
+endmodule // gyro_interface_axi__core__iir__word_reg
+
+
+module gyro_interface_axi__core__iir__x1_held(d,q,clock);
+
+    // Module arguments
+    input wire signed [39:0] d;
+    output reg signed [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__iir__x1_held
+
+
+module gyro_interface_axi__core__iir__x2_held(d,q,clock);
+
+    // Module arguments
+    input wire signed [39:0] d;
+    output reg signed [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__iir__x2_held
+
+
+module gyro_interface_axi__core__iir__z1_out(d,q,clock);
+
+    // Module arguments
+    input wire signed [39:0] d;
+    output reg signed [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__iir__z1_out
+
+
+module gyro_interface_axi__core__iir__z2_out(d,q,clock);
+
+    // Module arguments
+    input wire signed [39:0] d;
+    output reg signed [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__iir__z2_out
 
 
 module gyro_interface_axi__core__iir__z_valid_out(d,q,clock);

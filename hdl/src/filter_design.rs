@@ -18,8 +18,9 @@
 //! the realized DC gain, 4 k0 / -(k1 + k2) G_cic, is computed from the
 //! quantized values and reported, so results never depend on the ideal one.
 //!
-//! Limits, checked with a one-line error: 16 <= R <= 4096 (the filter's
-//! schedule takes 16 clocks, `iir_lowpass::SCHEDULE_CLOCKS`); cut-offs between f_z / 1000 and
+//! Limits, checked with a one-line error: `MIN_DECIMATION` <= R <= 4096
+//! (the filter's micro-program takes `iir_lowpass::SCHEDULE_CLOCKS` = 166
+//! clocks per sample); cut-offs between f_z / 1000 and
 //! f_z / 5. Below f_z / 1000 the biquad's dead band would approach half an
 //! output LSB (`dead_band_lsb` bounds it; the guard bits of the states are
 //! sized for this range); above f_z / 5, k1 would leave the Q2.30 range.
@@ -164,7 +165,7 @@ mod tests {
         // below 2^-31 (1 / k0 + 2 / |k1 + k2|) * 2^30.
         for (r, fb, frc) in [
             (1000, 500.0, 2000.0),
-            (16, 1e5, 2e5),
+            (200, 8e3, 1.6e4),
             (4096, 13.0, 30.0),
             (333, 2e3, 1e3),
         ] {

@@ -1,6 +1,6 @@
 //! IIR low-pass at the decimated rate, both channels: a 2nd-order
 //! Butterworth section and a first-order RC section (the paper's output
-//! filter) on one shared, pipelined multiplier.
+//! filter) on ONE 16 x 16 multiplier, digit-serial.
 //!
 //! ```text
 //!  x[40] ─► v = x0 + 2 x1 + x2 ─► y = 2 y1 - y2 + round((k0 v + k1 y1 + k2 y2) / 2^30)   (biquad)
@@ -15,7 +15,9 @@
 //! (`crate::filter_design` computes k0 = g, k1, k2, alpha from cut-offs in
 //! Hz and quantizes them; its DC gain is 4 k0 / -(k1 + k2)).
 //!
-//! Formats and widths (LSB of the CIC output = 2^-8 of a mixer LSB):
+//! Arithmetic of record (unchanged; the micro-program computes exactly it,
+//! `model::iir_lowpass` proves it against an i128 reference). Formats and
+//! widths (LSB of the CIC output = 2^-8 of a mixer LSB):
 //! - x: CIC output, 40 bits, 8 fractional bits;
 //! - coefficients k0, k1, k2, alpha: 32-bit two's complement, Q2.30;
 //! - states y1, y2, u: `STATE_BITS` = 40 + 16 + 2 = 58 bits with 24
@@ -33,26 +35,60 @@
 //!   products, each below 2^91 in magnitude: the sum of four such terms
 //!   stays below 2^93, so `ACCUMULATOR_BITS` = 92 + 2 = 94 never overflows.
 //!   Each section rounds once (half up) when dropping 30 bits; z is u
-//!   rounded half up to 8 fractional bits, 40 bits.
+//!   rounded half up to 8 fractional bits, 40 bits. The 60-bit difference
+//!   y - u is taken from the 94-bit sum before y is cut to 58 bits.
 //!
-//! Schedule (`IirStep`, one state per clock; `crate::iir_channel` holds
-//! each channel's registers): the multiplier (`PipelinedMultiplier`, 4
-//! clocks) takes one product per clock, channel 1 first. During the cycle
-//! with `x_valid` (Idle) k1 y1 of channel 1 is issued, then k2 y2 and k0 v
-//! (v is formed at the Idle edge), then the same three for channel 2.
-//! Their products come back in states 5..7 (channel 1) and 8..10
-//! (channel 2), where they are accumulated; at the last one y is updated
-//! and alpha (y - u) issued at once; its product comes back 5 clocks later
-//! and updates u (states 12 and 15). The edge after state 15 rounds both
-//! u into z, and `z_valid` pulses during the next cycle: z appears
-//! `LATENCY` = 17 clocks after `x_valid`. The schedule is back in Idle 16
-//! clocks after it left it, so the decimation must be at least 16; a strobe
-//! that arrives while it runs is dropped.
+//! Datapath (the widths of `crate::iir_program`):
+//!
+//! ```text
+//!  ROM[pc] ─► [word] ─┬─ read ─► digit RAM (128 x 16) ─► [a] ─┐
+//!                     ├─ factor ─► coefficient digit mux ─► [b] ─┴─ 16 x 16 ─► [p] ─► acc[36] ─┬─► RAM (digits)
+//!                     └─ op, emit, publish                              (acc >> 15) + p ─┘   └─► stage[90] ─► z1, z2
+//! ```
+//!
+//! Every product of the header is cut into 15-bit digits and summed column
+//! by column (`crate::iir_program`): one 16 x 16 signed product per clock
+//! (one iCE40 `SB_MAC16`, one ECP5 `MULT18X18D`), a 36-bit accumulator
+//! that shifts 15 bits right between columns, and finished digits written
+//! back to the RAM. The states x0, x1, y1, y2, u and the difference live in
+//! one block RAM as digits; the flip-flops are the two captured inputs, the
+//! operand, product and accumulator registers, the 90-bit output staging
+//! register and the outputs.
+//!
+//! Schedule: a program counter and a micro-program ROM (one block RAM),
+//! not a state enum: the schedule is `SCHEDULE_CLOCKS` words, and each word
+//! drives four pipeline stages at once (a read, an operand, an
+//! accumulation, a write), so one enum state per clock would be a flat
+//! list of ~170 states with no structure to read. The structure lives in
+//! `crate::iir_program`, written with typed Rust (`Location`, `Factor`,
+//! `AccumulatorOp`, `Emit`) and encoded into the ROM; the model runs the
+//! same words, so the two cannot drift apart.
+//!
+//! Timing: `x_valid` in idle (pc = 0) captures x1, x2 and starts the
+//! program; `publish`, its last word, copies the staged z1, z2 to the
+//! outputs and `z_valid` pulses during the next cycle: z appears `LATENCY`
+//! clocks after `x_valid`. The program is back in idle `SCHEDULE_CLOCKS`
+//! clocks after the strobe, so the decimation must be at least that
+//! (`crate::filter_design::MIN_DECIMATION`); a strobe that arrives while it
+//! runs is dropped. z1 and z2 change only at `publish`.
+//!
+//! Gain: the filter's DC gain, 4 k0 / -(k1 + k2). Resources (Yosys 0.23,
+//! `synth_ice40 -dsp -noflatten`, this module and its children): 1
+//! `SB_MAC16`, 3 `SB_RAM40_4K` (the digit RAM, and the 256 x 30-bit program
+//! in two), 402 flip-flops, 737 `SB_LUT4`; the 60 x 32 design before it took
+//! 8 `SB_MAC16`, 1870 flip-flops and 3379 `SB_LUT4`.
 
-use crate::iir_channel::{IirChannel, SAMPLE_BITS};
-use crate::primitives::PipelinedMultiplier;
+use crate::iir_program::{
+    ACCUMULATOR_BITS as COLUMN_BITS, OPERAND_BITS as DIGIT_OPERAND_BITS, PC_BITS,
+    PRODUCT_BITS as DIGIT_PRODUCT_BITS, PROGRAM, RAM_ADDRESS_BITS, SCALED_COEFFICIENT_BITS,
+    STATE_TOP_BITS, WORD_BITS,
+};
+use crate::primitives::convert::signed_bit_cast_exact;
+use crate::primitives::{DigitRam, MicrocodeRom, RegisteredMultiplier};
 use rust_hdl::prelude::*;
 
+/// Width of the input and output samples.
+pub const SAMPLE_BITS: usize = crate::cic_decimator::OUTPUT_BITS;
 /// Fractional bits of the coefficients (Q2.30).
 pub const COEFFICIENT_FRACTION_BITS: u32 = 30;
 /// Width of the coefficients.
@@ -61,56 +97,24 @@ pub const COEFFICIENT_BITS: usize = 32;
 pub const GUARD_BITS: u32 = 16;
 /// Width of the states y1, y2, u: 40-bit samples, guard bits, 2 bits of headroom.
 pub const STATE_BITS: usize = SAMPLE_BITS + GUARD_BITS as usize + 2;
-/// Width of the multiplier's first operand: 2 y1 - y2 and y - u fit exactly.
+/// Width of the recorded multiplier operand: 2 y1 - y2 and y - u fit exactly.
 pub const OPERAND_BITS: usize = STATE_BITS + 2;
-/// Width of the exact product.
+/// Width of the recorded exact product.
 pub const PRODUCT_BITS: usize = OPERAND_BITS + COEFFICIENT_BITS;
-/// Width of the accumulators: four terms below 2^(PRODUCT_BITS - 1) each.
+/// Width of the recorded accumulators: four terms below 2^(PRODUCT_BITS - 1) each.
 pub const ACCUMULATOR_BITS: usize = PRODUCT_BITS + 2;
-/// Clock cycles from `x_valid` to `z_valid`.
-pub const LATENCY: usize = 17;
-/// Clock cycles from leaving Idle to being back in it: the least decimation.
-pub const SCHEDULE_CLOCKS: usize = 16;
+/// Clock cycles from `x_valid` to `z_valid` (`Program::latency`, checked by a test).
+pub const LATENCY: usize = 168;
+/// Clock cycles from a strobe to the next one accepted: the least decimation
+/// (`Program::schedule_clocks`, checked by a test).
+pub const SCHEDULE_CLOCKS: usize = 166;
+/// Width of the output staging register: two samples of three digits.
+const STAGE_BITS: usize = 6 * crate::iir_program::DIGIT_BITS;
+/// Width of the accumulator after dropping a finished 15-bit column digit.
+const CARRY_BITS: usize = COLUMN_BITS - crate::iir_program::DIGIT_BITS;
 
-/// The filter schedule, one state per clock (see the module header).
-#[derive(Copy, Clone, Debug, PartialEq, LogicState)]
-pub enum IirStep {
-    /// Waiting for `x_valid`; on it: history, v, feedback; issue k1 y1 (1).
-    Idle,
-    /// Preload the accumulators; issue k2 y2 (channel 1).
-    IssueY2First,
-    /// Issue k0 v (channel 1).
-    IssueVFirst,
-    /// Issue k1 y1 (channel 2).
-    IssueY1Second,
-    /// Issue k2 y2 (channel 2).
-    IssueY2Second,
-    /// Issue k0 v (channel 2); accumulate k1 y1 (channel 1).
-    IssueVSecond,
-    /// Accumulate k2 y2 (channel 1).
-    AccumulateFirst,
-    /// Add k0 v, update y (channel 1); issue alpha (y - u) (channel 1).
-    FinishFirst,
-    /// Accumulate k1 y1 (channel 2).
-    AccumulateSecondY1,
-    /// Accumulate k2 y2 (channel 2).
-    AccumulateSecondY2,
-    /// Add k0 v, update y (channel 2); issue alpha (y - u) (channel 2).
-    FinishSecond,
-    /// Wait for alpha (y - u) (channel 1).
-    WaitFirstRc,
-    /// Update u (channel 1).
-    UpdateFirstRc,
-    /// Wait for alpha (y - u) (channel 2).
-    WaitSecondRc1,
-    /// Wait for alpha (y - u) (channel 2).
-    WaitSecondRc2,
-    /// Update u (channel 2); publish z at the next edge.
-    UpdateSecondRc,
-}
-
-/// Butterworth biquad plus RC section for two channels, one shared
-/// pipelined 60 x 32 multiplier.
+/// Butterworth biquad plus RC section for two channels on one 16 x 16
+/// multiplier, run by a micro-program.
 #[derive(LogicBlock)]
 pub struct IirLowpass {
     /// The clock.
@@ -135,19 +139,77 @@ pub struct IirLowpass {
     pub z2: Signal<Out, Signed<SAMPLE_BITS>>,
     /// One-clock pulse marking new `z1`, `z2`.
     pub z_valid: Signal<Out, Bit>,
-    step: DFF<IirStep>,
-    operand: DFF<Signed<OPERAND_BITS>>,
-    coefficient: DFF<Signed<COEFFICIENT_BITS>>,
-    mac: PipelinedMultiplier<OPERAND_BITS, COEFFICIENT_BITS, PRODUCT_BITS>,
-    channel1: IirChannel,
-    channel2: IirChannel,
-    publishing: DFF<Bit>,
+    rom: MicrocodeRom<WORD_BITS, PC_BITS>,
+    ram: DigitRam<RAM_ADDRESS_BITS>,
+    mul: RegisteredMultiplier<DIGIT_OPERAND_BITS, DIGIT_OPERAND_BITS, DIGIT_PRODUCT_BITS>,
+    pc: DFF<Bits<PC_BITS>>,
+    word_reg: DFF<Bits<WORD_BITS>>,
+    base: DFF<Bits<2>>,
+    x1_held: DFF<Signed<SAMPLE_BITS>>,
+    x2_held: DFF<Signed<SAMPLE_BITS>>,
+    a: DFF<Signed<DIGIT_OPERAND_BITS>>,
+    b: DFF<Signed<DIGIT_OPERAND_BITS>>,
+    acc: DFF<Signed<COLUMN_BITS>>,
+    stage: DFF<Bits<STAGE_BITS>>,
+    z1_out: DFF<Signed<SAMPLE_BITS>>,
+    z2_out: DFF<Signed<SAMPLE_BITS>>,
     z_valid_out: DFF<Bit>,
+    // Fields of the ROM word (layout: `MicroWord::encode`).
+    word: Signal<Local, Bits<WORD_BITS>>,
+    read_field: Signal<Local, Bits<RAM_ADDRESS_BITS>>,
+    write_field: Signal<Local, Bits<RAM_ADDRESS_BITS>>,
+    factor: Signal<Local, Bits<5>>,
+    op: Signal<Local, Bits<2>>,
+    emit: Signal<Local, Bits<3>>,
+    x_select: Signal<Local, Bits<3>>,
+    // Slot rotation.
+    read_sum: Signal<Local, Bits<3>>,
+    read_wrapped: Signal<Local, Bits<3>>,
+    read_slot: Signal<Local, Bits<2>>,
+    write_sum: Signal<Local, Bits<3>>,
+    write_wrapped: Signal<Local, Bits<3>>,
+    write_slot: Signal<Local, Bits<2>>,
+    // Operands.
+    ram_low: Signal<Local, Signed<STATE_TOP_BITS>>,
+    ram_wrapped: Signal<Local, Signed<DIGIT_OPERAND_BITS>>,
+    k0_wide: Signal<Local, Signed<SCALED_COEFFICIENT_BITS>>,
+    k1_wide: Signal<Local, Signed<SCALED_COEFFICIENT_BITS>>,
+    k2_wide: Signal<Local, Signed<SCALED_COEFFICIENT_BITS>>,
+    alpha_wide: Signal<Local, Signed<SCALED_COEFFICIENT_BITS>>,
+    scaled: Signal<Local, Signed<SCALED_COEFFICIENT_BITS>>,
+    scaled_low: Signal<Local, Signed<30>>,
+    scaled_bits: Signal<Local, Bits<30>>,
+    top_bits: Signal<Local, Signed<4>>,
+    top_digit: Signal<Local, Signed<DIGIT_OPERAND_BITS>>,
+    // Accumulator and emissions.
+    product: Signal<Local, Signed<COLUMN_BITS>>,
+    carry: Signal<Local, Signed<CARRY_BITS>>,
+    carry_wide: Signal<Local, Signed<COLUMN_BITS>>,
+    addend: Signal<Local, Signed<COLUMN_BITS>>,
+    digit_bits: Signal<Local, Bits<15>>,
+    column_digit: Signal<Local, Signed<DIGIT_OPERAND_BITS>>,
+    column_top: Signal<Local, Signed<15>>,
+    column_top_digit: Signal<Local, Signed<DIGIT_OPERAND_BITS>>,
+    x_low: Signal<Local, Signed<30>>,
+    x_bits: Signal<Local, Bits<30>>,
+    x_top: Signal<Local, Signed<10>>,
+    input_digit: Signal<Local, Signed<DIGIT_OPERAND_BITS>>,
+    x_top_digit: Signal<Local, Signed<DIGIT_OPERAND_BITS>>,
+    last_pc: Constant<Bits<PC_BITS>>,
+    slot_mask: Constant<Bits<RAM_ADDRESS_BITS>>,
+    pow29: Constant<Signed<COLUMN_BITS>>,
+    pow30: Constant<Signed<SCALED_COEFFICIENT_BITS>>,
+    pow31: Constant<Signed<SCALED_COEFFICIENT_BITS>>,
+    one: Constant<Signed<DIGIT_OPERAND_BITS>>,
+    minus_one: Constant<Signed<DIGIT_OPERAND_BITS>>,
+    pow14: Constant<Signed<DIGIT_OPERAND_BITS>>,
 }
 
 impl IirLowpass {
-    /// An idle filter with zero state.
+    /// An idle filter with zero state, holding the program of `crate::iir_program`.
     pub fn new() -> Self {
+        assert_eq!(STATE_TOP_BITS, 13);
+        assert_eq!(SAMPLE_BITS - 2 * 15, 10);
         Self {
             clock: Default::default(),
             x1: Default::default(),
@@ -160,14 +222,66 @@ impl IirLowpass {
             z1: Default::default(),
             z2: Default::default(),
             z_valid: Default::default(),
-            step: Default::default(),
-            operand: Default::default(),
-            coefficient: Default::default(),
-            mac: PipelinedMultiplier::new(),
-            channel1: IirChannel::new(),
-            channel2: IirChannel::new(),
-            publishing: Default::default(),
+            rom: MicrocodeRom::new(PROGRAM.image()),
+            ram: DigitRam::new(),
+            mul: RegisteredMultiplier::new(),
+            pc: Default::default(),
+            word_reg: Default::default(),
+            base: Default::default(),
+            x1_held: Default::default(),
+            x2_held: Default::default(),
+            a: Default::default(),
+            b: Default::default(),
+            acc: Default::default(),
+            stage: Default::default(),
+            z1_out: Default::default(),
+            z2_out: Default::default(),
             z_valid_out: Default::default(),
+            word: Default::default(),
+            read_field: Default::default(),
+            write_field: Default::default(),
+            factor: Default::default(),
+            op: Default::default(),
+            emit: Default::default(),
+            x_select: Default::default(),
+            read_sum: Default::default(),
+            read_wrapped: Default::default(),
+            read_slot: Default::default(),
+            write_sum: Default::default(),
+            write_wrapped: Default::default(),
+            write_slot: Default::default(),
+            ram_low: Default::default(),
+            ram_wrapped: Default::default(),
+            k0_wide: Default::default(),
+            k1_wide: Default::default(),
+            k2_wide: Default::default(),
+            alpha_wide: Default::default(),
+            scaled: Default::default(),
+            scaled_low: Default::default(),
+            scaled_bits: Default::default(),
+            top_bits: Default::default(),
+            top_digit: Default::default(),
+            product: Default::default(),
+            carry: Default::default(),
+            carry_wide: Default::default(),
+            addend: Default::default(),
+            digit_bits: Default::default(),
+            column_digit: Default::default(),
+            column_top: Default::default(),
+            column_top_digit: Default::default(),
+            x_low: Default::default(),
+            x_bits: Default::default(),
+            x_top: Default::default(),
+            input_digit: Default::default(),
+            x_top_digit: Default::default(),
+            last_pc: Constant::new(((PROGRAM.words.len() - 1) as u64).into()),
+            slot_mask: Constant::new(0b111_0011u64.into()),
+            pow29: Constant::new((1i64 << 29).into()),
+            pow30: Constant::new((1i64 << 30).into()),
+            pow31: Constant::new((1i64 << 31).into()),
+            one: Constant::new((1i64).into()),
+            minus_one: Constant::new((-1i64).into()),
+            pow14: Constant::new((1i64 << 14).into()),
         }
     }
 }
@@ -184,119 +298,211 @@ impl Logic for IirLowpass {
         dff_setup!(
             self,
             clock,
-            step,
-            operand,
-            coefficient,
-            publishing,
+            pc,
+            word_reg,
+            base,
+            x1_held,
+            x2_held,
+            a,
+            b,
+            acc,
+            stage,
+            z1_out,
+            z2_out,
             z_valid_out
         );
-        self.mac.clock.next = self.clock.val();
-        self.channel1.clock.next = self.clock.val();
-        self.channel2.clock.next = self.clock.val();
-        self.mac.a.next = self.operand.q.val();
-        self.mac.b.next = self.coefficient.q.val();
-        self.channel1.x.next = self.x1.val();
-        self.channel2.x.next = self.x2.val();
-        self.channel1.product.next = self.mac.p.val();
-        self.channel2.product.next = self.mac.p.val();
-        // Controls default to idle.
-        self.channel1.start.next = false;
-        self.channel2.start.next = false;
-        self.channel1.preload.next = false;
-        self.channel2.preload.next = false;
-        self.channel1.accumulate.next = false;
-        self.channel2.accumulate.next = false;
-        self.channel1.finish.next = false;
-        self.channel2.finish.next = false;
-        self.channel1.update_u.next = false;
-        self.channel2.update_u.next = false;
-        self.channel1.publish.next = self.publishing.q.val();
-        self.channel2.publish.next = self.publishing.q.val();
-        self.z_valid_out.d.next = self.publishing.q.val();
-        self.publishing.d.next = false;
-        match self.step.q.val() {
-            IirStep::Idle => {
-                if self.x_valid.val() {
-                    self.channel1.start.next = true;
-                    self.channel2.start.next = true;
-                    self.operand.d.next = self.channel1.y1.val();
-                    self.coefficient.d.next = self.k1.val();
-                    self.step.d.next = IirStep::IssueY2First;
+        self.rom.clock.next = self.clock.val();
+        self.ram.clock.next = self.clock.val();
+        self.mul.clock.next = self.clock.val();
+        // Program counter: idle at 0 until a strobe, then 1..=last, then 0.
+        self.rom.address.next = self.pc.q.val();
+        if self.pc.q.val() == 0 {
+            if self.x_valid.val() {
+                self.pc.d.next = 1.into();
+                self.x1_held.d.next = self.x1.val();
+                self.x2_held.d.next = self.x2.val();
+                // base counts samples modulo 3 (the slot rotation).
+                if self.base.q.val() == 0 {
+                    self.base.d.next = 1.into();
+                }
+                if self.base.q.val() == 1 {
+                    self.base.d.next = 2.into();
+                }
+                if self.base.q.val() == 2 {
+                    self.base.d.next = 0.into();
                 }
             }
-            IirStep::IssueY2First => {
-                self.channel1.preload.next = true;
-                self.channel2.preload.next = true;
-                self.operand.d.next = self.channel1.y2.val();
-                self.coefficient.d.next = self.k2.val();
-                self.step.d.next = IirStep::IssueVFirst;
-            }
-            IirStep::IssueVFirst => {
-                self.operand.d.next = self.channel1.v.val();
-                self.coefficient.d.next = self.k0.val();
-                self.step.d.next = IirStep::IssueY1Second;
-            }
-            IirStep::IssueY1Second => {
-                self.operand.d.next = self.channel2.y1.val();
-                self.coefficient.d.next = self.k1.val();
-                self.step.d.next = IirStep::IssueY2Second;
-            }
-            IirStep::IssueY2Second => {
-                self.operand.d.next = self.channel2.y2.val();
-                self.coefficient.d.next = self.k2.val();
-                self.step.d.next = IirStep::IssueVSecond;
-            }
-            IirStep::IssueVSecond => {
-                self.operand.d.next = self.channel2.v.val();
-                self.coefficient.d.next = self.k0.val();
-                self.channel1.accumulate.next = true;
-                self.step.d.next = IirStep::AccumulateFirst;
-            }
-            IirStep::AccumulateFirst => {
-                self.channel1.accumulate.next = true;
-                self.step.d.next = IirStep::FinishFirst;
-            }
-            IirStep::FinishFirst => {
-                self.channel1.finish.next = true;
-                self.operand.d.next = self.channel1.difference.val();
-                self.coefficient.d.next = self.alpha.val();
-                self.step.d.next = IirStep::AccumulateSecondY1;
-            }
-            IirStep::AccumulateSecondY1 => {
-                self.channel2.accumulate.next = true;
-                self.step.d.next = IirStep::AccumulateSecondY2;
-            }
-            IirStep::AccumulateSecondY2 => {
-                self.channel2.accumulate.next = true;
-                self.step.d.next = IirStep::FinishSecond;
-            }
-            IirStep::FinishSecond => {
-                self.channel2.finish.next = true;
-                self.operand.d.next = self.channel2.difference.val();
-                self.coefficient.d.next = self.alpha.val();
-                self.step.d.next = IirStep::WaitFirstRc;
-            }
-            IirStep::WaitFirstRc => {
-                self.step.d.next = IirStep::UpdateFirstRc;
-            }
-            IirStep::UpdateFirstRc => {
-                self.channel1.update_u.next = true;
-                self.step.d.next = IirStep::WaitSecondRc1;
-            }
-            IirStep::WaitSecondRc1 => {
-                self.step.d.next = IirStep::WaitSecondRc2;
-            }
-            IirStep::WaitSecondRc2 => {
-                self.step.d.next = IirStep::UpdateSecondRc;
-            }
-            IirStep::UpdateSecondRc => {
-                self.channel2.update_u.next = true;
-                self.publishing.d.next = true;
-                self.step.d.next = IirStep::Idle;
+        } else {
+            self.pc.d.next = self.pc.q.val() + 1;
+            if self.pc.q.val() == self.last_pc.val() {
+                self.pc.d.next = 0.into();
             }
         }
-        self.z1.next = self.channel1.z.val();
-        self.z2.next = self.channel2.z.val();
+        // Fields of the word (`MicroWord::encode`).
+        // The ROM word is registered once more in the fabric: a block RAM's
+        // clock-to-output is too slow to feed the coefficient multiplexer.
+        self.word_reg.d.next = self.rom.q.val();
+        self.word.next = self.word_reg.q.val();
+        self.read_field.next = self.word.val().get_bits::<RAM_ADDRESS_BITS>(0);
+        self.factor.next = self.word.val().get_bits::<5>(8);
+        self.op.next = self.word.val().get_bits::<2>(13);
+        self.emit.next = self.word.val().get_bits::<3>(16);
+        self.write_field.next = self.word.val().get_bits::<RAM_ADDRESS_BITS>(19);
+        self.x_select.next = self.word.val().get_bits::<3>(26);
+        // Slot rotation: slot r < 3 becomes (r + base) mod 3; slot 3 stays.
+        self.read_sum.next = bit_cast::<3, 2>(self.read_field.val().get_bits::<2>(2))
+            + bit_cast::<3, 2>(self.base.q.val());
+        self.read_wrapped.next = self.read_sum.val() - 3;
+        self.read_slot.next = self.read_sum.val().get_bits::<2>(0);
+        if self.read_sum.val() >= 3 {
+            self.read_slot.next = self.read_wrapped.val().get_bits::<2>(0);
+        }
+        if self.read_field.val().get_bits::<2>(2) == 3 {
+            self.read_slot.next = 3.into();
+        }
+        self.write_sum.next = bit_cast::<3, 2>(self.write_field.val().get_bits::<2>(2))
+            + bit_cast::<3, 2>(self.base.q.val());
+        self.write_wrapped.next = self.write_sum.val() - 3;
+        self.write_slot.next = self.write_sum.val().get_bits::<2>(0);
+        if self.write_sum.val() >= 3 {
+            self.write_slot.next = self.write_wrapped.val().get_bits::<2>(0);
+        }
+        if self.write_field.val().get_bits::<2>(2) == 3 {
+            self.write_slot.next = 3.into();
+        }
+        self.ram.read_address.next = (self.read_field.val() & self.slot_mask.val())
+            | (bit_cast::<RAM_ADDRESS_BITS, 2>(self.read_slot.val()) << 2);
+        self.ram.write_address.next = (self.write_field.val() & self.slot_mask.val())
+            | (bit_cast::<RAM_ADDRESS_BITS, 2>(self.write_slot.val()) << 2);
+        // Operand a: the RAM digit, a state's top digit sign-extended from bit 12.
+        self.ram_low.next = self.ram.q.val().get_bits::<STATE_TOP_BITS>(0);
+        self.ram_wrapped.next =
+            signed_bit_cast_exact::<DIGIT_OPERAND_BITS, STATE_TOP_BITS>(self.ram_low.val());
+        self.a.d.next = self.ram.q.val();
+        if self.word.val().get_bit(7) {
+            self.a.d.next = self.ram_wrapped.val();
+        }
+        // Operand b: a digit of a scaled coefficient, or a constant.
+        self.k0_wide.next =
+            signed_bit_cast_exact::<SCALED_COEFFICIENT_BITS, COEFFICIENT_BITS>(self.k0.val());
+        self.k1_wide.next =
+            signed_bit_cast_exact::<SCALED_COEFFICIENT_BITS, COEFFICIENT_BITS>(self.k1.val());
+        self.k2_wide.next =
+            signed_bit_cast_exact::<SCALED_COEFFICIENT_BITS, COEFFICIENT_BITS>(self.k2.val());
+        self.alpha_wide.next =
+            signed_bit_cast_exact::<SCALED_COEFFICIENT_BITS, COEFFICIENT_BITS>(self.alpha.val());
+        self.scaled.next = self.alpha_wide.val();
+        if self.factor.val().get_bits::<3>(2) == 1 {
+            self.scaled.next = self.k1_wide.val() + self.pow31.val();
+        }
+        if self.factor.val().get_bits::<3>(2) == 2 {
+            self.scaled.next = self.k2_wide.val() - self.pow30.val();
+        }
+        if self.factor.val().get_bits::<3>(2) == 3 {
+            self.scaled.next = signed_cast(unsigned_cast(self.k0_wide.val()) << 1);
+        }
+        if self.factor.val().get_bits::<3>(2) == 4 {
+            self.scaled.next = signed_cast(unsigned_cast(self.k0_wide.val()) << 2);
+        }
+        self.scaled_low.next = self.scaled.val().get_bits::<30>(0);
+        self.scaled_bits.next = unsigned_cast(self.scaled_low.val());
+        self.top_bits.next = self.scaled.val().get_bits::<4>(30);
+        self.top_digit.next = signed_bit_cast_exact::<DIGIT_OPERAND_BITS, 4>(self.top_bits.val());
+        self.b.d.next = self.top_digit.val();
+        if self.factor.val().get_bits::<2>(0) == 0 {
+            self.b.d.next = signed_cast(bit_cast::<DIGIT_OPERAND_BITS, 15>(
+                self.scaled_bits.val().get_bits::<15>(0),
+            ));
+        }
+        if self.factor.val().get_bits::<2>(0) == 1 {
+            self.b.d.next = signed_cast(bit_cast::<DIGIT_OPERAND_BITS, 15>(
+                self.scaled_bits.val().get_bits::<15>(15),
+            ));
+        }
+        if self.factor.val().get_bits::<3>(2) == 0 {
+            self.b.d.next = 0.into();
+            if self.factor.val().get_bits::<2>(0) == 1 {
+                self.b.d.next = self.one.val();
+            }
+            if self.factor.val().get_bits::<2>(0) == 2 {
+                self.b.d.next = self.minus_one.val();
+            }
+            if self.factor.val().get_bits::<2>(0) == 3 {
+                self.b.d.next = self.pow14.val();
+            }
+        }
+        self.mul.a.next = self.a.q.val();
+        self.mul.b.next = self.b.q.val();
+        // Accumulator: hold, start (+ 2^29), add, or shift a column and add.
+        self.product.next =
+            signed_bit_cast_exact::<COLUMN_BITS, DIGIT_PRODUCT_BITS>(self.mul.p.val());
+        self.carry.next = self.acc.q.val().get_bits::<CARRY_BITS>(15);
+        self.carry_wide.next = signed_bit_cast_exact::<COLUMN_BITS, CARRY_BITS>(self.carry.val());
+        self.addend.next = self.acc.q.val();
+        if self.op.val() == 1 {
+            self.addend.next = 0.into();
+            if self.word.val().get_bit(15) {
+                self.addend.next = self.pow29.val();
+            }
+        }
+        if self.op.val() == 3 {
+            self.addend.next = self.carry_wide.val();
+        }
+        if self.op.val() != 0 {
+            self.acc.d.next = self.addend.val() + self.product.val();
+        }
+        // Emissions: the finished column digit, or an input digit.
+        self.column_top.next = self.acc.q.val().get_bits::<15>(0);
+        self.digit_bits.next = unsigned_cast(self.column_top.val());
+        self.column_digit.next =
+            signed_cast(bit_cast::<DIGIT_OPERAND_BITS, 15>(self.digit_bits.val()));
+        self.column_top_digit.next =
+            signed_bit_cast_exact::<DIGIT_OPERAND_BITS, 15>(self.column_top.val());
+        self.x_low.next = self.x1_held.q.val().get_bits::<30>(0);
+        self.x_top.next = self.x1_held.q.val().get_bits::<10>(30);
+        if self.x_select.val() >= 3 {
+            self.x_low.next = self.x2_held.q.val().get_bits::<30>(0);
+            self.x_top.next = self.x2_held.q.val().get_bits::<10>(30);
+        }
+        self.x_bits.next = unsigned_cast(self.x_low.val());
+        self.x_top_digit.next = signed_bit_cast_exact::<DIGIT_OPERAND_BITS, 10>(self.x_top.val());
+        self.input_digit.next = self.x_top_digit.val();
+        if (self.x_select.val() == 0) | (self.x_select.val() == 3) {
+            self.input_digit.next = signed_cast(bit_cast::<DIGIT_OPERAND_BITS, 15>(
+                self.x_bits.val().get_bits::<15>(0),
+            ));
+        }
+        if (self.x_select.val() == 1) | (self.x_select.val() == 4) {
+            self.input_digit.next = signed_cast(bit_cast::<DIGIT_OPERAND_BITS, 15>(
+                self.x_bits.val().get_bits::<15>(15),
+            ));
+        }
+        self.ram.write_enable.next = false;
+        self.ram.write_data.next = self.column_digit.val();
+        if self.emit.val() == 1 {
+            self.ram.write_enable.next = true;
+        }
+        if self.emit.val() == 2 {
+            self.ram.write_enable.next = true;
+            self.ram.write_data.next = self.column_top_digit.val();
+        }
+        if self.emit.val() == 4 {
+            self.ram.write_enable.next = true;
+            self.ram.write_data.next = self.input_digit.val();
+        }
+        if self.emit.val() == 3 {
+            // 75 = STAGE_BITS - 15: the new digit enters at the top.
+            self.stage.d.next = (self.stage.q.val() >> 15)
+                | (bit_cast::<STAGE_BITS, 15>(self.digit_bits.val()) << 75);
+        }
+        // Publish: z1 = staged digits 0..2, z2 = 3..5 (45 = 3 x 15).
+        self.z_valid_out.d.next = self.word.val().get_bit(29);
+        if self.word.val().get_bit(29) {
+            self.z1_out.d.next = signed_cast(self.stage.q.val().get_bits::<SAMPLE_BITS>(0));
+            self.z2_out.d.next = signed_cast(self.stage.q.val().get_bits::<SAMPLE_BITS>(45));
+        }
+        self.z1.next = self.z1_out.q.val();
+        self.z2.next = self.z2_out.q.val();
         self.z_valid.next = self.z_valid_out.q.val();
     }
 }
@@ -320,7 +526,7 @@ mod tests {
     fn designs() -> Vec<FilterDesign> {
         [
             (1000, 500.0, 2000.0),
-            (16, 6e5, 3e5),
+            (200, 4.8e4, 2.4e4),
             (4096, 12.3, 100.0),
             (333, 30e3, 1e3),
         ]
@@ -376,10 +582,11 @@ mod tests {
         #![proptest_config(ProptestConfig::with_cases(6))]
         #[test]
         fn rtl_matches_model_with_random_inputs_and_dropped_strobes(
-            design in segments(0usize..4, 3..5, 500..700),
-            // Strobes one clock in 12 on average: some land while a
-            // schedule runs and must be dropped by both.
-            inputs in prop::collection::vec((prop::bool::weighted(1.0 / 12.0), -FULL_SCALE..=FULL_SCALE, -FULL_SCALE..=FULL_SCALE), 1500),
+            design in segments(0usize..4, 3..5, 1500..2000),
+            // Strobes one clock in 120 on average, against a schedule of
+            // SCHEDULE_CLOCKS: many land while a schedule runs and must be
+            // dropped by both.
+            inputs in prop::collection::vec((prop::bool::weighted(1.0 / 120.0), -FULL_SCALE..=FULL_SCALE, -FULL_SCALE..=FULL_SCALE), 4500),
         ) {
             let designs = designs();
             let mut uut = IirLowpass::new();
@@ -402,7 +609,8 @@ mod tests {
                 prop_assert_eq!(hw, model.step((x1, x2), valid, &k), "cycle {}", n);
                 outputs += hw.2 as u32;
             }
-            prop_assert!(outputs > 40, "only {} outputs", outputs);
+            // About 4500 / (SCHEDULE_CLOCKS + 120) = 16 expected.
+            prop_assert!(outputs > 8, "only {} outputs", outputs);
         }
     }
 

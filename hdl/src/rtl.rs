@@ -145,9 +145,10 @@ mod tests {
             cal_hz: 5e3,
             calibration,
             amplitude: (0.9, -0.7),
-            decimation: 16,
-            butterworth_hz: 50e3,
-            rc_hz: 100e3,
+            // The least decimation: strobes as fast as the filter takes them.
+            decimation: crate::filter_design::MIN_DECIMATION,
+            butterworth_hz: 5e3,
+            rc_hz: 10e3,
             dac_latency: 1,
             adc_latency: 2,
         };

@@ -4,6 +4,7 @@
 //! and most-negative words included. 12 cases of 9,000 cycles: 108,000
 //! cycles per run (about 15 s in release).
 
+use gyrocal_hdl::filter_design::MIN_DECIMATION;
 use gyrocal_hdl::model::gyro_interface::Registers;
 use gyrocal_hdl::model::iir_lowpass::Coefficients;
 use gyrocal_hdl::rtl::{RtlGyroInterface, first_mismatch};
@@ -51,7 +52,7 @@ fn any_registers() -> impl Strategy<Value = Registers> {
         0.01f64..0.49,
         1.0f64..5e4,
         -0.99f64..0.99,
-        16u32..64,
+        MIN_DECIMATION..MIN_DECIMATION + 48,
         0u32..30,
     )
         .prop_map(|(calibration, carrier, cal_hz, amp, r, latency)| {
@@ -110,7 +111,7 @@ proptest! {
 
 /// Named case: register words wider than their ports (`cic_shift = 64`
 /// holds 0 at the 6-bit port, `ref_delay = 200` holds 8, `cic_decimation =
-/// 8192 + 20` holds 20, `mod_step` with bits above 48). Before the model
+/// 8192 + R` holds R, `mod_step` with bits above 48). Before the model
 /// masked its words, `cic_shift = 64` alone made it differ from clock 50.
 #[test]
 fn words_wider_than_their_ports_are_cut_as_the_ports_cut_them() {
@@ -120,9 +121,9 @@ fn words_wider_than_their_ports_are_cut_as_the_ports_cut_them() {
         cal_hz: 12.5,
         calibration: true,
         amplitude: (0.9, 0.9),
-        decimation: 20,
-        butterworth_hz: 10e6 / 20.0 / 20.0,
-        rc_hz: 10e6 / 20.0 / 10.0,
+        decimation: MIN_DECIMATION,
+        butterworth_hz: 10e6 / MIN_DECIMATION as f64 / 20.0,
+        rc_hz: 10e6 / MIN_DECIMATION as f64 / 10.0,
         dac_latency: 2,
         adc_latency: 3,
     };
@@ -137,7 +138,7 @@ fn words_wider_than_their_ports_are_cut_as_the_ports_cut_them() {
             ..base
         },
         Registers {
-            cic_decimation: 8192 + 20,
+            cic_decimation: 8192 + MIN_DECIMATION as u16,
             ..base
         },
         Registers {

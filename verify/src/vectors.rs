@@ -14,7 +14,8 @@
 //! The stimulus is one continuous run from power-up, made of segments with
 //! different settings (the registers are reprogrammed between segments, as a
 //! CPU would): readout and calibration, SELECT toggling in the middle of a
-//! segment, decimations 16, 37, 100, 1000 and 4096 plus a random one, extreme
+//! segment, decimations 166 (the least, `MIN_DECIMATION`), 199, 250, 1000 and
+//! 4096 plus a random one, extreme
 //! amplitudes (-32768 and 32767), random carrier and modulation steps,
 //! reference phases and delays (including 0 and 63), and IIR coefficients
 //! designed by `gyrocal_hdl::filter_design` for random cut-offs over the whole
@@ -310,7 +311,7 @@ enum SelectPlan {
 struct SegmentPlan {
     name: &'static str,
     cycles: usize,
-    /// `None`: random in 16..=200.
+    /// `None`: random in MIN_DECIMATION..=MIN_DECIMATION + 200.
     decimation: Option<u32>,
     select: SelectPlan,
     /// `None`: random.
@@ -325,35 +326,35 @@ struct SegmentPlan {
 
 const PLANS: &[SegmentPlan] = &[
     SegmentPlan {
-        name: "readout, R = 16, amplitudes (32767, -32768), ref_delay 0",
-        cycles: 3500,
-        decimation: Some(16),
+        name: "readout, least R (166), amplitudes (32767, -32768), ref_delay 0",
+        cycles: 10000,
+        decimation: Some(filter_design::MIN_DECIMATION),
         select: SelectPlan::Fixed(false),
         amp: Some((32767, -32768)),
         ref_delay: Some(0),
         correlated: false,
     },
     SegmentPlan {
-        name: "readout, R = 16, ADC following the carrier at full scale, fastest filter",
-        cycles: 4000,
-        decimation: Some(16),
+        name: "readout, least R (166), ADC following the carrier at full scale, fastest filter",
+        cycles: 10000,
+        decimation: Some(filter_design::MIN_DECIMATION),
         select: SelectPlan::Fixed(false),
         amp: Some((32767, -32768)),
         ref_delay: None,
         correlated: true,
     },
     SegmentPlan {
-        name: "calibration, R = 37, ref_delay 63",
-        cycles: 3500,
-        decimation: Some(37),
+        name: "calibration, R = 199, ref_delay 63",
+        cycles: 8000,
+        decimation: Some(199),
         select: SelectPlan::Fixed(true),
         amp: None,
         ref_delay: Some(63),
         correlated: false,
     },
     SegmentPlan {
-        name: "SELECT toggling every 37..900 cycles, random R in 16..=200",
-        cycles: 4500,
+        name: "SELECT toggling every 37..900 cycles, random R in 166..=366",
+        cycles: 9000,
         decimation: None,
         select: SelectPlan::Toggle { min: 37, max: 900 },
         amp: None,
@@ -361,9 +362,9 @@ const PLANS: &[SegmentPlan] = &[
         correlated: false,
     },
     SegmentPlan {
-        name: "calibration, R = 100, amplitudes (-32768, -32768)",
-        cycles: 3000,
-        decimation: Some(100),
+        name: "calibration, R = 250, amplitudes (-32768, -32768)",
+        cycles: 6000,
+        decimation: Some(250),
         select: SelectPlan::Fixed(true),
         amp: Some((-32768, -32768)),
         ref_delay: None,
@@ -394,7 +395,10 @@ const PLANS: &[SegmentPlan] = &[
 
 /// Random valid registers for a segment.
 fn registers(rng: &mut Rng, plan: &SegmentPlan) -> Registers {
-    let decimation = plan.decimation.unwrap_or_else(|| rng.range(16, 200) as u32);
+    let least = filter_design::MIN_DECIMATION as i64;
+    let decimation = plan
+        .decimation
+        .unwrap_or_else(|| rng.range(least, least + 200) as u32);
     let clock_hz = rng.log_uniform(10e6, 125e6);
     let fz = clock_hz / decimation as f64;
     let (lo, hi) = (

@@ -1,17 +1,21 @@
 //! Leaf blocks whose Verilog is written by hand, like rust-hdl's own `DFF`:
 //! the registered and the pipelined multipliers (rust-hdl only multiplies
 //! 16 x 16), the sine
-//! table ROM (with power-up values, unlike `SyncROM`) and the reference delay
+//! table ROM, the output filter's digit RAM and micro-program ROM (with power-up values, unlike `SyncROM`) and the reference delay
 //! line in RAM. Each is a few lines of Verilog beside its Rust `update()`; the
 //! golden-vector replay of the whole design in Icarus and Verilator proves
 //! the two agree.
 
 pub mod convert;
+mod digit_ram;
+mod microcode_rom;
 pub mod pipelined_multiplier;
 mod quarter_sine_rom;
 mod registered_multiplier;
 mod tapped_delay_line;
 
+pub use digit_ram::DigitRam;
+pub use microcode_rom::MicrocodeRom;
 pub use pipelined_multiplier::PipelinedMultiplier;
 pub use quarter_sine_rom::QuarterSineRom;
 pub use registered_multiplier::RegisteredMultiplier;
