@@ -769,7 +769,7 @@ mod tests {
             (REQUIRED.replace("[gyro]", "[gyro"), "c.toml line 1"),
             (
                 format!("{REQUIRED}[filter]\ndecimation = 8\n"),
-                "[filter] decimation = 8: allowed 16..=4096",
+                &format!("[filter] decimation = 8: allowed {MIN_DECIMATION}..=4096"),
             ),
             (
                 REQUIRED.replace("cal_freqs_hz", "budget_s = 0\ncal_freqs_hz"),
