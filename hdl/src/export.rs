@@ -209,7 +209,7 @@ pub const PORTS: &[Port] = &[
         Input,
         13,
         false,
-        "16..4096",
+        "166..4096",
         "CIC decimation R; z is updated every R clocks.",
     ),
     port(

@@ -245,8 +245,8 @@ pub const CIC_DECIMATION: Register = setting(
     0x28,
     Registers::CIC_DECIMATION_BITS,
     false,
-    16,
-    "Port `cic_decimation`: R, 16..4096; z is updated every R clocks.",
+    256,
+    "Port `cic_decimation`: R, 166..4096; z is updated every R clocks.",
 );
 /// CIC output shift.
 pub const CIC_SHIFT: Register = setting(
@@ -254,8 +254,8 @@ pub const CIC_SHIFT: Register = setting(
     0x2c,
     Registers::CIC_SHIFT_BITS,
     false,
-    8,
-    "Port `cic_shift`: ceil(4 log2 R) - 8 (8 for the power-up R = 16).",
+    24,
+    "Port `cic_shift`: ceil(4 log2 R) - 8 (24 for the power-up R = 256).",
 );
 /// IIR numerator gain.
 pub const IIR_K0: Register = setting(
@@ -635,6 +635,24 @@ pub fn c_header() -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The decimation's documented range is the limits of record
+    /// (`filter_design`), and the power-up R and shift are a valid pair.
+    #[test]
+    fn decimation_text_and_power_up_follow_the_limits() {
+        use crate::cic_decimator::MAX_DECIMATION;
+        use crate::filter_design::MIN_DECIMATION;
+        let range = format!("{MIN_DECIMATION}..{MAX_DECIMATION}");
+        assert!(CIC_DECIMATION.doc.contains(&range));
+        let port = crate::export::PORTS
+            .iter()
+            .find(|p| p.name == "cic_decimation");
+        assert_eq!(port.map(|p| p.format), Some(range.as_str()));
+        let r = CIC_DECIMATION.power_up;
+        assert!((MIN_DECIMATION..=MAX_DECIMATION).contains(&r));
+        let shift = (4.0 * f64::from(r).log2()).ceil() as u32 - 8;
+        assert_eq!(CIC_SHIFT.power_up, shift);
+    }
 
     #[test]
     fn offsets_are_distinct_aligned_sorted_and_inside_the_window() {
