@@ -4340,6 +4340,7 @@ module gyro_interface_axi__core__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
     localparam  coarse_all_ones = 47'h7fffffffffff;
     localparam  coarse_shift_mask = 6'b111000;
     localparam  fine_shift_mask = 6'b111;
+    localparam  next_address = 3'b1;
 
     // Enums
     localparam CicStep$Idle = 0;
@@ -4641,8 +4642,8 @@ module gyro_interface_axi__core__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
         delays$read_address = delay_address$q;
         if (combing) begin
             acc$d = acc$q - delays$q;
-            delay_address$d = delay_address$q + 32'h1;
-            delays$read_address = delay_address$q + 32'h1;
+            delay_address$d = delay_address$q + next_address;
+            delays$read_address = delay_address$q + next_address;
         end
         y1 = y1_out$q;
         y2 = y2_out$q;
