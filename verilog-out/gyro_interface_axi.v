@@ -1308,18 +1308,14 @@ module gyro_interface_axi__core(clock,adc1,adc2,dac1,dac2,z1,z2,z_valid,select,c
     reg  demod_mux$select;
     wire signed [31:0] demod_mux$w1;
     wire signed [31:0] demod_mux$w2;
-    reg  cic1$clock;
-    reg signed [31:0] cic1$x;
-    reg  [12:0] cic1$decimation;
-    reg  [5:0] cic1$shift;
-    wire signed [39:0] cic1$y;
-    wire  cic1$valid;
-    reg  cic2$clock;
-    reg signed [31:0] cic2$x;
-    reg  [12:0] cic2$decimation;
-    reg  [5:0] cic2$shift;
-    wire signed [39:0] cic2$y;
-    wire  cic2$valid;
+    reg  cic$clock;
+    reg signed [31:0] cic$x1;
+    reg signed [31:0] cic$x2;
+    reg  [12:0] cic$decimation;
+    reg  [5:0] cic$shift;
+    wire signed [39:0] cic$y1;
+    wire signed [39:0] cic$y2;
+    wire  cic$valid;
     reg  iir$clock;
     reg signed [39:0] iir$x1;
     reg signed [39:0] iir$x2;
@@ -1382,21 +1378,15 @@ module gyro_interface_axi__core(clock,adc1,adc2,dac1,dac2,z1,z2,z_valid,select,c
         .w1(demod_mux$w1),
         .w2(demod_mux$w2)
     );
-    gyro_interface_axi__core__cic1 cic1(
-        .clock(cic1$clock),
-        .x(cic1$x),
-        .decimation(cic1$decimation),
-        .shift(cic1$shift),
-        .y(cic1$y),
-        .valid(cic1$valid)
-    );
-    gyro_interface_axi__core__cic2 cic2(
-        .clock(cic2$clock),
-        .x(cic2$x),
-        .decimation(cic2$decimation),
-        .shift(cic2$shift),
-        .y(cic2$y),
-        .valid(cic2$valid)
+    gyro_interface_axi__core__cic cic(
+        .clock(cic$clock),
+        .x1(cic$x1),
+        .x2(cic$x2),
+        .decimation(cic$decimation),
+        .shift(cic$shift),
+        .y1(cic$y1),
+        .y2(cic$y2),
+        .valid(cic$valid)
     );
     gyro_interface_axi__core__iir iir(
         .clock(iir$clock),
@@ -1419,8 +1409,7 @@ module gyro_interface_axi__core(clock,adc1,adc2,dac1,dac2,z1,z2,z_valid,select,c
         am_mixer$clock = clock;
         reference_alignment$clock = clock;
         demod_mux$clock = clock;
-        cic1$clock = clock;
-        cic2$clock = clock;
+        cic$clock = clock;
         iir$clock = clock;
         carrier_nco$step = carrier_step;
         carrier_nco$ref_offset = ref_phase;
@@ -1444,15 +1433,13 @@ module gyro_interface_axi__core(clock,adc1,adc2,dac1,dac2,z1,z2,z_valid,select,c
         demod_mux$aligned1 = reference_alignment$aligned1;
         demod_mux$aligned2 = reference_alignment$aligned2;
         demod_mux$select = select;
-        cic1$x = demod_mux$w1;
-        cic2$x = demod_mux$w2;
-        cic1$decimation = cic_decimation;
-        cic2$decimation = cic_decimation;
-        cic1$shift = cic_shift;
-        cic2$shift = cic_shift;
-        iir$x1 = cic1$y;
-        iir$x2 = cic2$y;
-        iir$x_valid = cic1$valid;
+        cic$x1 = demod_mux$w1;
+        cic$x2 = demod_mux$w2;
+        cic$decimation = cic_decimation;
+        cic$shift = cic_shift;
+        iir$x1 = cic$y1;
+        iir$x2 = cic$y2;
+        iir$x_valid = cic$valid;
         iir$k0 = iir_k0;
         iir$k1 = iir_k1;
         iir$k2 = iir_k2;
@@ -4335,14 +4322,16 @@ module gyro_interface_axi__core__carrier_nco__reference__sin_value_read(d,q,cloc
 endmodule // gyro_interface_axi__core__carrier_nco__reference__sin_value_read
 
 
-module gyro_interface_axi__core__cic1(clock,x,decimation,shift,y,valid);
+module gyro_interface_axi__core__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
 
     // Module arguments
     input wire  clock;
-    input wire signed [31:0] x;
+    input wire signed [31:0] x1;
+    input wire signed [31:0] x2;
     input wire  [12:0] decimation;
     input wire  [5:0] shift;
-    output reg signed [39:0] y;
+    output reg signed [39:0] y1;
+    output reg signed [39:0] y2;
     output reg  valid;
 
     // Constant declarations
@@ -4351,240 +4340,167 @@ module gyro_interface_axi__core__cic1(clock,x,decimation,shift,y,valid);
     localparam  coarse_all_ones = 47'h7fffffffffff;
     localparam  coarse_shift_mask = 6'b111000;
     localparam  fine_shift_mask = 6'b111;
+    localparam  next_address = 3'b1;
+
+    // Enums
+    localparam CicStep$Idle = 0;
+    localparam CicStep$FirstComb1 = 1;
+    localparam CicStep$FirstComb2 = 2;
+    localparam CicStep$FirstComb3 = 3;
+    localparam CicStep$FirstComb4 = 4;
+    localparam CicStep$SecondLoad = 5;
+    localparam CicStep$SecondComb1 = 6;
+    localparam CicStep$SecondComb2 = 7;
+    localparam CicStep$SecondComb3 = 8;
+    localparam CicStep$SecondComb4 = 9;
+    localparam CicStep$SecondBias = 10;
+    localparam CicStep$SecondCoarse = 11;
+    localparam CicStep$SecondFine = 12;
 
     // Stub signals
-    reg signed [79:0] integrator1$d;
-    wire signed [79:0] integrator1$q;
-    reg  integrator1$clock;
-    reg signed [79:0] integrator2$d;
-    wire signed [79:0] integrator2$q;
-    reg  integrator2$clock;
-    reg signed [79:0] integrator3$d;
-    wire signed [79:0] integrator3$q;
-    reg  integrator3$clock;
-    reg signed [79:0] integrator4$d;
-    wire signed [79:0] integrator4$q;
-    reg  integrator4$clock;
+    reg  integrators1$clock;
+    reg signed [31:0] integrators1$x;
+    wire signed [79:0] integrators1$integral;
+    reg  integrators2$clock;
+    reg signed [31:0] integrators2$x;
+    wire signed [79:0] integrators2$integral;
     reg  [12:0] count$d;
     wire  [12:0] count$q;
     reg  count$clock;
-    reg signed [79:0] sample$d;
-    wire signed [79:0] sample$q;
-    reg  sample$clock;
-    reg  sample_valid$d;
-    wire  sample_valid$q;
-    reg  sample_valid$clock;
-    reg signed [79:0] comb1$d;
-    wire signed [79:0] comb1$q;
-    reg  comb1$clock;
-    reg signed [79:0] comb2$d;
-    wire signed [79:0] comb2$q;
-    reg  comb2$clock;
-    reg signed [79:0] comb3$d;
-    wire signed [79:0] comb3$q;
-    reg  comb3$clock;
-    reg signed [79:0] comb4$d;
-    wire signed [79:0] comb4$q;
-    reg  comb4$clock;
-    reg signed [79:0] comb_delay1$d;
-    wire signed [79:0] comb_delay1$q;
-    reg  comb_delay1$clock;
-    reg signed [79:0] comb_delay2$d;
-    wire signed [79:0] comb_delay2$q;
-    reg  comb_delay2$clock;
-    reg signed [79:0] comb_delay3$d;
-    wire signed [79:0] comb_delay3$q;
-    reg  comb_delay3$clock;
-    reg signed [79:0] comb_delay4$d;
-    wire signed [79:0] comb_delay4$q;
-    reg  comb_delay4$clock;
-    reg  comb_valid1$d;
-    wire  comb_valid1$q;
-    reg  comb_valid1$clock;
-    reg  comb_valid2$d;
-    wire  comb_valid2$q;
-    reg  comb_valid2$clock;
-    reg  comb_valid3$d;
-    wire  comb_valid3$q;
-    reg  comb_valid3$clock;
-    reg  comb_valid4$d;
-    wire  comb_valid4$q;
-    reg  comb_valid4$clock;
-    reg  [79:0] biased_out$d;
-    wire  [79:0] biased_out$q;
-    reg  biased_out$clock;
-    reg  [5:0] biased_shift$d;
-    wire  [5:0] biased_shift$q;
-    reg  biased_shift$clock;
-    reg  biased_valid$d;
-    wire  biased_valid$q;
-    reg  biased_valid$clock;
+    reg  [3:0] step$d;
+    wire  [3:0] step$q;
+    reg  step$clock;
+    reg signed [79:0] acc$d;
+    wire signed [79:0] acc$q;
+    reg  acc$clock;
+    reg signed [79:0] sample2$d;
+    wire signed [79:0] sample2$q;
+    reg  sample2$clock;
+    reg  [5:0] held_shift$d;
+    wire  [5:0] held_shift$q;
+    reg  held_shift$clock;
+    reg  delays$clock;
+    reg  delays$write_enable;
+    reg  [2:0] delays$write_address;
+    reg signed [79:0] delays$write_data;
+    reg  [2:0] delays$read_address;
+    wire signed [79:0] delays$q;
+    reg  [2:0] delay_address$d;
+    wire  [2:0] delay_address$q;
+    reg  delay_address$clock;
+    reg  [79:0] biased$d;
+    wire  [79:0] biased$q;
+    reg  biased$clock;
     reg  [46:0] coarse$d;
     wire  [46:0] coarse$q;
     reg  coarse$clock;
     reg  coarse_negative$d;
     wire  coarse_negative$q;
     reg  coarse_negative$clock;
-    reg  [5:0] fine_shift$d;
-    wire  [5:0] fine_shift$q;
-    reg  fine_shift$clock;
-    reg  coarse_valid$d;
-    wire  coarse_valid$q;
-    reg  coarse_valid$clock;
-    reg signed [39:0] y_out$d;
-    wire signed [39:0] y_out$q;
-    reg  y_out$clock;
+    reg signed [39:0] y_first$d;
+    wire signed [39:0] y_first$q;
+    reg  y_first$clock;
+    reg signed [39:0] y1_out$d;
+    wire signed [39:0] y1_out$q;
+    reg  y1_out$clock;
+    reg signed [39:0] y2_out$d;
+    wire signed [39:0] y2_out$q;
+    reg  y2_out$clock;
     reg  valid_out$d;
     wire  valid_out$q;
     reg  valid_out$clock;
 
     // Local signals
-    reg signed [79:0] x_wide;
+    reg  combing;
     reg  [79:0] rounding;
-    reg signed [79:0] biased;
     reg  [79:0] sign_mask;
     reg  [5:0] coarse_shift;
     reg  [79:0] coarse_shifted;
+    reg  [5:0] fine_shift;
     reg  [46:0] fine_mask;
-    reg  [46:0] shifted;
+    reg  [46:0] fine_word;
+    reg signed [39:0] fine;
 
     // Sub module instances
-    gyro_interface_axi__core__cic1__integrator1 integrator1(
-        .d(integrator1$d),
-        .q(integrator1$q),
-        .clock(integrator1$clock)
+    gyro_interface_axi__core__cic__integrators1 integrators1(
+        .clock(integrators1$clock),
+        .x(integrators1$x),
+        .integral(integrators1$integral)
     );
-    gyro_interface_axi__core__cic1__integrator2 integrator2(
-        .d(integrator2$d),
-        .q(integrator2$q),
-        .clock(integrator2$clock)
+    gyro_interface_axi__core__cic__integrators2 integrators2(
+        .clock(integrators2$clock),
+        .x(integrators2$x),
+        .integral(integrators2$integral)
     );
-    gyro_interface_axi__core__cic1__integrator3 integrator3(
-        .d(integrator3$d),
-        .q(integrator3$q),
-        .clock(integrator3$clock)
-    );
-    gyro_interface_axi__core__cic1__integrator4 integrator4(
-        .d(integrator4$d),
-        .q(integrator4$q),
-        .clock(integrator4$clock)
-    );
-    gyro_interface_axi__core__cic1__count count(
+    gyro_interface_axi__core__cic__count count(
         .d(count$d),
         .q(count$q),
         .clock(count$clock)
     );
-    gyro_interface_axi__core__cic1__sample sample(
-        .d(sample$d),
-        .q(sample$q),
-        .clock(sample$clock)
+    gyro_interface_axi__core__cic__step step(
+        .d(step$d),
+        .q(step$q),
+        .clock(step$clock)
     );
-    gyro_interface_axi__core__cic1__sample_valid sample_valid(
-        .d(sample_valid$d),
-        .q(sample_valid$q),
-        .clock(sample_valid$clock)
+    gyro_interface_axi__core__cic__acc acc(
+        .d(acc$d),
+        .q(acc$q),
+        .clock(acc$clock)
     );
-    gyro_interface_axi__core__cic1__comb1 comb1(
-        .d(comb1$d),
-        .q(comb1$q),
-        .clock(comb1$clock)
+    gyro_interface_axi__core__cic__sample2 sample2(
+        .d(sample2$d),
+        .q(sample2$q),
+        .clock(sample2$clock)
     );
-    gyro_interface_axi__core__cic1__comb2 comb2(
-        .d(comb2$d),
-        .q(comb2$q),
-        .clock(comb2$clock)
+    gyro_interface_axi__core__cic__held_shift held_shift(
+        .d(held_shift$d),
+        .q(held_shift$q),
+        .clock(held_shift$clock)
     );
-    gyro_interface_axi__core__cic1__comb3 comb3(
-        .d(comb3$d),
-        .q(comb3$q),
-        .clock(comb3$clock)
+    gyro_interface_axi__core__cic__delays delays(
+        .clock(delays$clock),
+        .write_enable(delays$write_enable),
+        .write_address(delays$write_address),
+        .write_data(delays$write_data),
+        .read_address(delays$read_address),
+        .q(delays$q)
     );
-    gyro_interface_axi__core__cic1__comb4 comb4(
-        .d(comb4$d),
-        .q(comb4$q),
-        .clock(comb4$clock)
+    gyro_interface_axi__core__cic__delay_address delay_address(
+        .d(delay_address$d),
+        .q(delay_address$q),
+        .clock(delay_address$clock)
     );
-    gyro_interface_axi__core__cic1__comb_delay1 comb_delay1(
-        .d(comb_delay1$d),
-        .q(comb_delay1$q),
-        .clock(comb_delay1$clock)
+    gyro_interface_axi__core__cic__biased biased(
+        .d(biased$d),
+        .q(biased$q),
+        .clock(biased$clock)
     );
-    gyro_interface_axi__core__cic1__comb_delay2 comb_delay2(
-        .d(comb_delay2$d),
-        .q(comb_delay2$q),
-        .clock(comb_delay2$clock)
-    );
-    gyro_interface_axi__core__cic1__comb_delay3 comb_delay3(
-        .d(comb_delay3$d),
-        .q(comb_delay3$q),
-        .clock(comb_delay3$clock)
-    );
-    gyro_interface_axi__core__cic1__comb_delay4 comb_delay4(
-        .d(comb_delay4$d),
-        .q(comb_delay4$q),
-        .clock(comb_delay4$clock)
-    );
-    gyro_interface_axi__core__cic1__comb_valid1 comb_valid1(
-        .d(comb_valid1$d),
-        .q(comb_valid1$q),
-        .clock(comb_valid1$clock)
-    );
-    gyro_interface_axi__core__cic1__comb_valid2 comb_valid2(
-        .d(comb_valid2$d),
-        .q(comb_valid2$q),
-        .clock(comb_valid2$clock)
-    );
-    gyro_interface_axi__core__cic1__comb_valid3 comb_valid3(
-        .d(comb_valid3$d),
-        .q(comb_valid3$q),
-        .clock(comb_valid3$clock)
-    );
-    gyro_interface_axi__core__cic1__comb_valid4 comb_valid4(
-        .d(comb_valid4$d),
-        .q(comb_valid4$q),
-        .clock(comb_valid4$clock)
-    );
-    gyro_interface_axi__core__cic1__biased_out biased_out(
-        .d(biased_out$d),
-        .q(biased_out$q),
-        .clock(biased_out$clock)
-    );
-    gyro_interface_axi__core__cic1__biased_shift biased_shift(
-        .d(biased_shift$d),
-        .q(biased_shift$q),
-        .clock(biased_shift$clock)
-    );
-    gyro_interface_axi__core__cic1__biased_valid biased_valid(
-        .d(biased_valid$d),
-        .q(biased_valid$q),
-        .clock(biased_valid$clock)
-    );
-    gyro_interface_axi__core__cic1__coarse coarse(
+    gyro_interface_axi__core__cic__coarse coarse(
         .d(coarse$d),
         .q(coarse$q),
         .clock(coarse$clock)
     );
-    gyro_interface_axi__core__cic1__coarse_negative coarse_negative(
+    gyro_interface_axi__core__cic__coarse_negative coarse_negative(
         .d(coarse_negative$d),
         .q(coarse_negative$q),
         .clock(coarse_negative$clock)
     );
-    gyro_interface_axi__core__cic1__fine_shift fine_shift(
-        .d(fine_shift$d),
-        .q(fine_shift$q),
-        .clock(fine_shift$clock)
+    gyro_interface_axi__core__cic__y_first y_first(
+        .d(y_first$d),
+        .q(y_first$q),
+        .clock(y_first$clock)
     );
-    gyro_interface_axi__core__cic1__coarse_valid coarse_valid(
-        .d(coarse_valid$d),
-        .q(coarse_valid$q),
-        .clock(coarse_valid$clock)
+    gyro_interface_axi__core__cic__y1_out y1_out(
+        .d(y1_out$d),
+        .q(y1_out$q),
+        .clock(y1_out$clock)
     );
-    gyro_interface_axi__core__cic1__y_out y_out(
-        .d(y_out$d),
-        .q(y_out$q),
-        .clock(y_out$clock)
+    gyro_interface_axi__core__cic__y2_out y2_out(
+        .d(y2_out$d),
+        .q(y2_out$q),
+        .clock(y2_out$clock)
     );
-    gyro_interface_axi__core__cic1__valid_out valid_out(
+    gyro_interface_axi__core__cic__valid_out valid_out(
         .d(valid_out$d),
         .q(valid_out$q),
         .clock(valid_out$clock)
@@ -4592,132 +4508,171 @@ module gyro_interface_axi__core__cic1(clock,x,decimation,shift,y,valid);
 
     // Update code
     always @(*) begin
-        integrator1$clock = clock;
-        integrator2$clock = clock;
-        integrator3$clock = clock;
-        integrator4$clock = clock;
         count$clock = clock;
-        sample$clock = clock;
-        sample_valid$clock = clock;
-        comb1$clock = clock;
-        comb2$clock = clock;
-        comb3$clock = clock;
-        comb4$clock = clock;
-        comb_delay1$clock = clock;
-        comb_delay2$clock = clock;
-        comb_delay3$clock = clock;
-        comb_delay4$clock = clock;
-        comb_valid1$clock = clock;
-        comb_valid2$clock = clock;
-        comb_valid3$clock = clock;
-        comb_valid4$clock = clock;
-        biased_out$clock = clock;
-        biased_shift$clock = clock;
-        biased_valid$clock = clock;
+        step$clock = clock;
+        acc$clock = clock;
+        sample2$clock = clock;
+        held_shift$clock = clock;
+        delay_address$clock = clock;
+        biased$clock = clock;
         coarse$clock = clock;
         coarse_negative$clock = clock;
-        fine_shift$clock = clock;
-        coarse_valid$clock = clock;
-        y_out$clock = clock;
+        y_first$clock = clock;
+        y1_out$clock = clock;
+        y2_out$clock = clock;
         valid_out$clock = clock;
-        integrator1$d = integrator1$q;
-        integrator2$d = integrator2$q;
-        integrator3$d = integrator3$q;
-        integrator4$d = integrator4$q;
         count$d = count$q;
-        sample$d = sample$q;
-        sample_valid$d = sample_valid$q;
-        comb1$d = comb1$q;
-        comb2$d = comb2$q;
-        comb3$d = comb3$q;
-        comb4$d = comb4$q;
-        comb_delay1$d = comb_delay1$q;
-        comb_delay2$d = comb_delay2$q;
-        comb_delay3$d = comb_delay3$q;
-        comb_delay4$d = comb_delay4$q;
-        comb_valid1$d = comb_valid1$q;
-        comb_valid2$d = comb_valid2$q;
-        comb_valid3$d = comb_valid3$q;
-        comb_valid4$d = comb_valid4$q;
-        biased_out$d = biased_out$q;
-        biased_shift$d = biased_shift$q;
-        biased_valid$d = biased_valid$q;
+        step$d = step$q;
+        acc$d = acc$q;
+        sample2$d = sample2$q;
+        held_shift$d = held_shift$q;
+        delay_address$d = delay_address$q;
+        biased$d = biased$q;
         coarse$d = coarse$q;
         coarse_negative$d = coarse_negative$q;
-        fine_shift$d = fine_shift$q;
-        coarse_valid$d = coarse_valid$q;
-        y_out$d = y_out$q;
+        y_first$d = y_first$q;
+        y1_out$d = y1_out$q;
+        y2_out$d = y2_out$q;
         valid_out$d = valid_out$q;
-        x_wide = $signed(x);
-        integrator1$d = integrator1$q + x_wide;
-        integrator2$d = integrator2$q + integrator1$q;
-        integrator3$d = integrator3$q + integrator2$q;
-        integrator4$d = integrator4$q + integrator3$q;
-        sample_valid$d = 1'b0;
+        integrators1$clock = clock;
+        integrators2$clock = clock;
+        delays$clock = clock;
+        integrators1$x = x1;
+        integrators2$x = x2;
         if (count$q == 32'h0) begin
             count$d = decimation - 32'h1;
-            sample$d = integrator4$q;
-            sample_valid$d = 1'b1;
         end
         else begin
             count$d = count$q - 32'h1;
         end
-        comb_valid1$d = sample_valid$q;
-        comb_valid2$d = comb_valid1$q;
-        comb_valid3$d = comb_valid2$q;
-        comb_valid4$d = comb_valid3$q;
-        if (sample_valid$q) begin
-            comb1$d = sample$q - comb_delay1$q;
-            comb_delay1$d = sample$q;
-        end
-        if (comb_valid1$q) begin
-            comb2$d = comb1$q - comb_delay2$q;
-            comb_delay2$d = comb1$q;
-        end
-        if (comb_valid2$q) begin
-            comb3$d = comb2$q - comb_delay3$q;
-            comb_delay3$d = comb2$q;
-        end
-        if (comb_valid3$q) begin
-            comb4$d = comb3$q - comb_delay4$q;
-            comb_delay4$d = comb3$q;
-        end
-        rounding = (one << shift) >> 32'h1;
-        biased = comb4$q + $signed(rounding);
-        biased_valid$d = comb_valid4$q;
-        if (comb_valid4$q) begin
-            biased_out$d = $unsigned(biased);
-            biased_shift$d = shift;
-        end
+        rounding = (one << held_shift$q) >> 32'h1;
+        biased$d = $unsigned(acc$q + $signed(rounding));
         sign_mask = 32'h0;
-        if (biased_out$q[32'h4f]) begin
+        if (biased$q[32'h4f]) begin
             sign_mask = all_ones;
         end
-        coarse_shift = biased_shift$q & coarse_shift_mask;
-        coarse_shifted = (biased_out$q ^ sign_mask) >> coarse_shift;
-        coarse_valid$d = biased_valid$q;
-        if (biased_valid$q) begin
-            coarse$d = coarse_shifted[(32'h0)+:(47)];
-            coarse_negative$d = biased_out$q[32'h4f];
-            fine_shift$d = biased_shift$q & fine_shift_mask;
-        end
+        coarse_shift = held_shift$q & coarse_shift_mask;
+        coarse_shifted = (biased$q ^ sign_mask) >> coarse_shift;
+        coarse$d = coarse_shifted[(32'h0)+:(47)];
+        coarse_negative$d = biased$q[32'h4f];
         fine_mask = 32'h0;
         if (coarse_negative$q) begin
             fine_mask = coarse_all_ones;
         end
-        shifted = (coarse$q >> fine_shift$q) ^ fine_mask;
-        valid_out$d = coarse_valid$q;
-        if (coarse_valid$q) begin
-            y_out$d = $signed(shifted[(32'h0)+:(40)]);
+        fine_shift = held_shift$q & fine_shift_mask;
+        fine_word = (coarse$q >> fine_shift) ^ fine_mask;
+        fine = $signed(fine_word[(32'h0)+:(40)]);
+        combing = 1'b0;
+        valid_out$d = 1'b0;
+        case (step$q)
+            CicStep$Idle:
+                begin
+                    if (count$q == 32'h0) begin
+                        acc$d = integrators1$integral;
+                        sample2$d = integrators2$integral;
+                        held_shift$d = shift;
+                        step$d = CicStep$FirstComb1;
+                    end
+                end
+            CicStep$FirstComb1:
+                begin
+                    combing = 1'b1;
+                    step$d = CicStep$FirstComb2;
+                end
+            CicStep$FirstComb2:
+                begin
+                    combing = 1'b1;
+                    step$d = CicStep$FirstComb3;
+                end
+            CicStep$FirstComb3:
+                begin
+                    combing = 1'b1;
+                    step$d = CicStep$FirstComb4;
+                end
+            CicStep$FirstComb4:
+                begin
+                    combing = 1'b1;
+                    step$d = CicStep$SecondLoad;
+                end
+            CicStep$SecondLoad:
+                begin
+                    acc$d = sample2$q;
+                    step$d = CicStep$SecondComb1;
+                end
+            CicStep$SecondComb1:
+                begin
+                    combing = 1'b1;
+                    step$d = CicStep$SecondComb2;
+                end
+            CicStep$SecondComb2:
+                begin
+                    combing = 1'b1;
+                    y_first$d = fine;
+                    step$d = CicStep$SecondComb3;
+                end
+            CicStep$SecondComb3:
+                begin
+                    combing = 1'b1;
+                    step$d = CicStep$SecondComb4;
+                end
+            CicStep$SecondComb4:
+                begin
+                    combing = 1'b1;
+                    step$d = CicStep$SecondBias;
+                end
+            CicStep$SecondBias:
+                begin
+                    step$d = CicStep$SecondCoarse;
+                end
+            CicStep$SecondCoarse:
+                begin
+                    step$d = CicStep$SecondFine;
+                end
+            CicStep$SecondFine:
+                begin
+                    y1_out$d = y_first$q;
+                    y2_out$d = fine;
+                    valid_out$d = 1'b1;
+                    step$d = CicStep$Idle;
+                end
+        endcase
+        delays$write_enable = combing;
+        delays$write_address = delay_address$q;
+        delays$write_data = acc$q;
+        delays$read_address = delay_address$q;
+        if (combing) begin
+            acc$d = acc$q - delays$q;
+            delay_address$d = delay_address$q + next_address;
+            delays$read_address = delay_address$q + next_address;
         end
-        y = y_out$q;
+        y1 = y1_out$q;
+        y2 = y2_out$q;
         valid = valid_out$q;
     end
 
-endmodule // gyro_interface_axi__core__cic1
+endmodule // gyro_interface_axi__core__cic
 
 
-module gyro_interface_axi__core__cic1__biased_out(d,q,clock);
+module gyro_interface_axi__core__cic__acc(d,q,clock);
+
+    // Module arguments
+    input wire signed [79:0] d;
+    output reg signed [79:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 80'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__acc
+
+
+module gyro_interface_axi__core__cic__biased(d,q,clock);
 
     // Module arguments
     input wire  [79:0] d;
@@ -4733,48 +4688,10 @@ module gyro_interface_axi__core__cic1__biased_out(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__cic1__biased_out
+endmodule // gyro_interface_axi__core__cic__biased
 
 
-module gyro_interface_axi__core__cic1__biased_shift(d,q,clock);
-
-    // Module arguments
-    input wire  [5:0] d;
-    output reg  [5:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 6'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic1__biased_shift
-
-
-module gyro_interface_axi__core__cic1__biased_valid(d,q,clock);
-
-    // Module arguments
-    input wire  d;
-    output reg  q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 1'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic1__biased_valid
-
-
-module gyro_interface_axi__core__cic1__coarse(d,q,clock);
+module gyro_interface_axi__core__cic__coarse(d,q,clock);
 
     // Module arguments
     input wire  [46:0] d;
@@ -4790,29 +4707,10 @@ module gyro_interface_axi__core__cic1__coarse(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__cic1__coarse
+endmodule // gyro_interface_axi__core__cic__coarse
 
 
-module gyro_interface_axi__core__cic1__coarse_negative(d,q,clock);
-
-    // Module arguments
-    input wire  d;
-    output reg  q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 1'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic1__coarse_negative
-
-
-module gyro_interface_axi__core__cic1__coarse_valid(d,q,clock);
+module gyro_interface_axi__core__cic__coarse_negative(d,q,clock);
 
     // Module arguments
     input wire  d;
@@ -4828,238 +4726,10 @@ module gyro_interface_axi__core__cic1__coarse_valid(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__cic1__coarse_valid
+endmodule // gyro_interface_axi__core__cic__coarse_negative
 
 
-module gyro_interface_axi__core__cic1__comb1(d,q,clock);
-
-    // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 80'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic1__comb1
-
-
-module gyro_interface_axi__core__cic1__comb2(d,q,clock);
-
-    // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 80'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic1__comb2
-
-
-module gyro_interface_axi__core__cic1__comb3(d,q,clock);
-
-    // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 80'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic1__comb3
-
-
-module gyro_interface_axi__core__cic1__comb4(d,q,clock);
-
-    // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 80'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic1__comb4
-
-
-module gyro_interface_axi__core__cic1__comb_delay1(d,q,clock);
-
-    // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 80'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic1__comb_delay1
-
-
-module gyro_interface_axi__core__cic1__comb_delay2(d,q,clock);
-
-    // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 80'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic1__comb_delay2
-
-
-module gyro_interface_axi__core__cic1__comb_delay3(d,q,clock);
-
-    // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 80'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic1__comb_delay3
-
-
-module gyro_interface_axi__core__cic1__comb_delay4(d,q,clock);
-
-    // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 80'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic1__comb_delay4
-
-
-module gyro_interface_axi__core__cic1__comb_valid1(d,q,clock);
-
-    // Module arguments
-    input wire  d;
-    output reg  q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 1'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic1__comb_valid1
-
-
-module gyro_interface_axi__core__cic1__comb_valid2(d,q,clock);
-
-    // Module arguments
-    input wire  d;
-    output reg  q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 1'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic1__comb_valid2
-
-
-module gyro_interface_axi__core__cic1__comb_valid3(d,q,clock);
-
-    // Module arguments
-    input wire  d;
-    output reg  q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 1'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic1__comb_valid3
-
-
-module gyro_interface_axi__core__cic1__comb_valid4(d,q,clock);
-
-    // Module arguments
-    input wire  d;
-    output reg  q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 1'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic1__comb_valid4
-
-
-module gyro_interface_axi__core__cic1__count(d,q,clock);
+module gyro_interface_axi__core__cic__count(d,q,clock);
 
     // Module arguments
     input wire  [12:0] d;
@@ -5075,10 +4745,57 @@ module gyro_interface_axi__core__cic1__count(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__cic1__count
+endmodule // gyro_interface_axi__core__cic__count
 
 
-module gyro_interface_axi__core__cic1__fine_shift(d,q,clock);
+module gyro_interface_axi__core__cic__delay_address(d,q,clock);
+
+    // Module arguments
+    input wire  [2:0] d;
+    output reg  [2:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 3'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__delay_address
+
+
+module gyro_interface_axi__core__cic__delays(clock,write_enable,write_address,write_data,read_address,q);
+
+    // Module arguments
+    input wire  clock;
+    input wire  write_enable;
+    input wire  [2:0] write_address;
+    input wire signed [79:0] write_data;
+    input wire  [2:0] read_address;
+    output reg signed [79:0] q;
+
+    // Update code (custom)
+    (* no_rw_check *)
+    reg signed [79:0] words [0:7];
+    integer init_index;
+
+    initial begin
+       for (init_index = 0; init_index < 8; init_index = init_index + 1)
+          words[init_index] = 0;
+    end
+
+    always @(posedge clock) begin
+       if (write_enable)
+          words[write_address] <= write_data;
+       q <= words[read_address];
+    end
+endmodule // gyro_interface_axi__core__cic__delays
+
+
+module gyro_interface_axi__core__cic__held_shift(d,q,clock);
 
     // Module arguments
     input wire  [5:0] d;
@@ -5094,177 +4811,15 @@ module gyro_interface_axi__core__cic1__fine_shift(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__cic1__fine_shift
+endmodule // gyro_interface_axi__core__cic__held_shift
 
 
-module gyro_interface_axi__core__cic1__integrator1(d,q,clock);
-
-    // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 80'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic1__integrator1
-
-
-module gyro_interface_axi__core__cic1__integrator2(d,q,clock);
-
-    // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 80'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic1__integrator2
-
-
-module gyro_interface_axi__core__cic1__integrator3(d,q,clock);
-
-    // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 80'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic1__integrator3
-
-
-module gyro_interface_axi__core__cic1__integrator4(d,q,clock);
-
-    // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 80'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic1__integrator4
-
-
-module gyro_interface_axi__core__cic1__sample(d,q,clock);
-
-    // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 80'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic1__sample
-
-
-module gyro_interface_axi__core__cic1__sample_valid(d,q,clock);
-
-    // Module arguments
-    input wire  d;
-    output reg  q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 1'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic1__sample_valid
-
-
-module gyro_interface_axi__core__cic1__valid_out(d,q,clock);
-
-    // Module arguments
-    input wire  d;
-    output reg  q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 1'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic1__valid_out
-
-
-module gyro_interface_axi__core__cic1__y_out(d,q,clock);
-
-    // Module arguments
-    input wire signed [39:0] d;
-    output reg signed [39:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 40'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic1__y_out
-
-
-module gyro_interface_axi__core__cic2(clock,x,decimation,shift,y,valid);
+module gyro_interface_axi__core__cic__integrators1(clock,x,integral);
 
     // Module arguments
     input wire  clock;
     input wire signed [31:0] x;
-    input wire  [12:0] decimation;
-    input wire  [5:0] shift;
-    output reg signed [39:0] y;
-    output reg  valid;
-
-    // Constant declarations
-    localparam  one = 80'h1;
-    localparam  all_ones = 80'hffffffffffffffffffff;
-    localparam  coarse_all_ones = 47'h7fffffffffff;
-    localparam  coarse_shift_mask = 6'b111000;
-    localparam  fine_shift_mask = 6'b111;
+    output reg signed [79:0] integral;
 
     // Stub signals
     reg signed [79:0] integrator1$d;
@@ -5279,229 +4834,30 @@ module gyro_interface_axi__core__cic2(clock,x,decimation,shift,y,valid);
     reg signed [79:0] integrator4$d;
     wire signed [79:0] integrator4$q;
     reg  integrator4$clock;
-    reg  [12:0] count$d;
-    wire  [12:0] count$q;
-    reg  count$clock;
-    reg signed [79:0] sample$d;
-    wire signed [79:0] sample$q;
-    reg  sample$clock;
-    reg  sample_valid$d;
-    wire  sample_valid$q;
-    reg  sample_valid$clock;
-    reg signed [79:0] comb1$d;
-    wire signed [79:0] comb1$q;
-    reg  comb1$clock;
-    reg signed [79:0] comb2$d;
-    wire signed [79:0] comb2$q;
-    reg  comb2$clock;
-    reg signed [79:0] comb3$d;
-    wire signed [79:0] comb3$q;
-    reg  comb3$clock;
-    reg signed [79:0] comb4$d;
-    wire signed [79:0] comb4$q;
-    reg  comb4$clock;
-    reg signed [79:0] comb_delay1$d;
-    wire signed [79:0] comb_delay1$q;
-    reg  comb_delay1$clock;
-    reg signed [79:0] comb_delay2$d;
-    wire signed [79:0] comb_delay2$q;
-    reg  comb_delay2$clock;
-    reg signed [79:0] comb_delay3$d;
-    wire signed [79:0] comb_delay3$q;
-    reg  comb_delay3$clock;
-    reg signed [79:0] comb_delay4$d;
-    wire signed [79:0] comb_delay4$q;
-    reg  comb_delay4$clock;
-    reg  comb_valid1$d;
-    wire  comb_valid1$q;
-    reg  comb_valid1$clock;
-    reg  comb_valid2$d;
-    wire  comb_valid2$q;
-    reg  comb_valid2$clock;
-    reg  comb_valid3$d;
-    wire  comb_valid3$q;
-    reg  comb_valid3$clock;
-    reg  comb_valid4$d;
-    wire  comb_valid4$q;
-    reg  comb_valid4$clock;
-    reg  [79:0] biased_out$d;
-    wire  [79:0] biased_out$q;
-    reg  biased_out$clock;
-    reg  [5:0] biased_shift$d;
-    wire  [5:0] biased_shift$q;
-    reg  biased_shift$clock;
-    reg  biased_valid$d;
-    wire  biased_valid$q;
-    reg  biased_valid$clock;
-    reg  [46:0] coarse$d;
-    wire  [46:0] coarse$q;
-    reg  coarse$clock;
-    reg  coarse_negative$d;
-    wire  coarse_negative$q;
-    reg  coarse_negative$clock;
-    reg  [5:0] fine_shift$d;
-    wire  [5:0] fine_shift$q;
-    reg  fine_shift$clock;
-    reg  coarse_valid$d;
-    wire  coarse_valid$q;
-    reg  coarse_valid$clock;
-    reg signed [39:0] y_out$d;
-    wire signed [39:0] y_out$q;
-    reg  y_out$clock;
-    reg  valid_out$d;
-    wire  valid_out$q;
-    reg  valid_out$clock;
 
     // Local signals
     reg signed [79:0] x_wide;
-    reg  [79:0] rounding;
-    reg signed [79:0] biased;
-    reg  [79:0] sign_mask;
-    reg  [5:0] coarse_shift;
-    reg  [79:0] coarse_shifted;
-    reg  [46:0] fine_mask;
-    reg  [46:0] shifted;
 
     // Sub module instances
-    gyro_interface_axi__core__cic2__integrator1 integrator1(
+    gyro_interface_axi__core__cic__integrators1__integrator1 integrator1(
         .d(integrator1$d),
         .q(integrator1$q),
         .clock(integrator1$clock)
     );
-    gyro_interface_axi__core__cic2__integrator2 integrator2(
+    gyro_interface_axi__core__cic__integrators1__integrator2 integrator2(
         .d(integrator2$d),
         .q(integrator2$q),
         .clock(integrator2$clock)
     );
-    gyro_interface_axi__core__cic2__integrator3 integrator3(
+    gyro_interface_axi__core__cic__integrators1__integrator3 integrator3(
         .d(integrator3$d),
         .q(integrator3$q),
         .clock(integrator3$clock)
     );
-    gyro_interface_axi__core__cic2__integrator4 integrator4(
+    gyro_interface_axi__core__cic__integrators1__integrator4 integrator4(
         .d(integrator4$d),
         .q(integrator4$q),
         .clock(integrator4$clock)
-    );
-    gyro_interface_axi__core__cic2__count count(
-        .d(count$d),
-        .q(count$q),
-        .clock(count$clock)
-    );
-    gyro_interface_axi__core__cic2__sample sample(
-        .d(sample$d),
-        .q(sample$q),
-        .clock(sample$clock)
-    );
-    gyro_interface_axi__core__cic2__sample_valid sample_valid(
-        .d(sample_valid$d),
-        .q(sample_valid$q),
-        .clock(sample_valid$clock)
-    );
-    gyro_interface_axi__core__cic2__comb1 comb1(
-        .d(comb1$d),
-        .q(comb1$q),
-        .clock(comb1$clock)
-    );
-    gyro_interface_axi__core__cic2__comb2 comb2(
-        .d(comb2$d),
-        .q(comb2$q),
-        .clock(comb2$clock)
-    );
-    gyro_interface_axi__core__cic2__comb3 comb3(
-        .d(comb3$d),
-        .q(comb3$q),
-        .clock(comb3$clock)
-    );
-    gyro_interface_axi__core__cic2__comb4 comb4(
-        .d(comb4$d),
-        .q(comb4$q),
-        .clock(comb4$clock)
-    );
-    gyro_interface_axi__core__cic2__comb_delay1 comb_delay1(
-        .d(comb_delay1$d),
-        .q(comb_delay1$q),
-        .clock(comb_delay1$clock)
-    );
-    gyro_interface_axi__core__cic2__comb_delay2 comb_delay2(
-        .d(comb_delay2$d),
-        .q(comb_delay2$q),
-        .clock(comb_delay2$clock)
-    );
-    gyro_interface_axi__core__cic2__comb_delay3 comb_delay3(
-        .d(comb_delay3$d),
-        .q(comb_delay3$q),
-        .clock(comb_delay3$clock)
-    );
-    gyro_interface_axi__core__cic2__comb_delay4 comb_delay4(
-        .d(comb_delay4$d),
-        .q(comb_delay4$q),
-        .clock(comb_delay4$clock)
-    );
-    gyro_interface_axi__core__cic2__comb_valid1 comb_valid1(
-        .d(comb_valid1$d),
-        .q(comb_valid1$q),
-        .clock(comb_valid1$clock)
-    );
-    gyro_interface_axi__core__cic2__comb_valid2 comb_valid2(
-        .d(comb_valid2$d),
-        .q(comb_valid2$q),
-        .clock(comb_valid2$clock)
-    );
-    gyro_interface_axi__core__cic2__comb_valid3 comb_valid3(
-        .d(comb_valid3$d),
-        .q(comb_valid3$q),
-        .clock(comb_valid3$clock)
-    );
-    gyro_interface_axi__core__cic2__comb_valid4 comb_valid4(
-        .d(comb_valid4$d),
-        .q(comb_valid4$q),
-        .clock(comb_valid4$clock)
-    );
-    gyro_interface_axi__core__cic2__biased_out biased_out(
-        .d(biased_out$d),
-        .q(biased_out$q),
-        .clock(biased_out$clock)
-    );
-    gyro_interface_axi__core__cic2__biased_shift biased_shift(
-        .d(biased_shift$d),
-        .q(biased_shift$q),
-        .clock(biased_shift$clock)
-    );
-    gyro_interface_axi__core__cic2__biased_valid biased_valid(
-        .d(biased_valid$d),
-        .q(biased_valid$q),
-        .clock(biased_valid$clock)
-    );
-    gyro_interface_axi__core__cic2__coarse coarse(
-        .d(coarse$d),
-        .q(coarse$q),
-        .clock(coarse$clock)
-    );
-    gyro_interface_axi__core__cic2__coarse_negative coarse_negative(
-        .d(coarse_negative$d),
-        .q(coarse_negative$q),
-        .clock(coarse_negative$clock)
-    );
-    gyro_interface_axi__core__cic2__fine_shift fine_shift(
-        .d(fine_shift$d),
-        .q(fine_shift$q),
-        .clock(fine_shift$clock)
-    );
-    gyro_interface_axi__core__cic2__coarse_valid coarse_valid(
-        .d(coarse_valid$d),
-        .q(coarse_valid$q),
-        .clock(coarse_valid$clock)
-    );
-    gyro_interface_axi__core__cic2__y_out y_out(
-        .d(y_out$d),
-        .q(y_out$q),
-        .clock(y_out$clock)
-    );
-    gyro_interface_axi__core__cic2__valid_out valid_out(
-        .d(valid_out$d),
-        .q(valid_out$q),
-        .clock(valid_out$clock)
     );
 
     // Update code
@@ -5510,132 +4866,26 @@ module gyro_interface_axi__core__cic2(clock,x,decimation,shift,y,valid);
         integrator2$clock = clock;
         integrator3$clock = clock;
         integrator4$clock = clock;
-        count$clock = clock;
-        sample$clock = clock;
-        sample_valid$clock = clock;
-        comb1$clock = clock;
-        comb2$clock = clock;
-        comb3$clock = clock;
-        comb4$clock = clock;
-        comb_delay1$clock = clock;
-        comb_delay2$clock = clock;
-        comb_delay3$clock = clock;
-        comb_delay4$clock = clock;
-        comb_valid1$clock = clock;
-        comb_valid2$clock = clock;
-        comb_valid3$clock = clock;
-        comb_valid4$clock = clock;
-        biased_out$clock = clock;
-        biased_shift$clock = clock;
-        biased_valid$clock = clock;
-        coarse$clock = clock;
-        coarse_negative$clock = clock;
-        fine_shift$clock = clock;
-        coarse_valid$clock = clock;
-        y_out$clock = clock;
-        valid_out$clock = clock;
         integrator1$d = integrator1$q;
         integrator2$d = integrator2$q;
         integrator3$d = integrator3$q;
         integrator4$d = integrator4$q;
-        count$d = count$q;
-        sample$d = sample$q;
-        sample_valid$d = sample_valid$q;
-        comb1$d = comb1$q;
-        comb2$d = comb2$q;
-        comb3$d = comb3$q;
-        comb4$d = comb4$q;
-        comb_delay1$d = comb_delay1$q;
-        comb_delay2$d = comb_delay2$q;
-        comb_delay3$d = comb_delay3$q;
-        comb_delay4$d = comb_delay4$q;
-        comb_valid1$d = comb_valid1$q;
-        comb_valid2$d = comb_valid2$q;
-        comb_valid3$d = comb_valid3$q;
-        comb_valid4$d = comb_valid4$q;
-        biased_out$d = biased_out$q;
-        biased_shift$d = biased_shift$q;
-        biased_valid$d = biased_valid$q;
-        coarse$d = coarse$q;
-        coarse_negative$d = coarse_negative$q;
-        fine_shift$d = fine_shift$q;
-        coarse_valid$d = coarse_valid$q;
-        y_out$d = y_out$q;
-        valid_out$d = valid_out$q;
         x_wide = $signed(x);
         integrator1$d = integrator1$q + x_wide;
         integrator2$d = integrator2$q + integrator1$q;
         integrator3$d = integrator3$q + integrator2$q;
         integrator4$d = integrator4$q + integrator3$q;
-        sample_valid$d = 1'b0;
-        if (count$q == 32'h0) begin
-            count$d = decimation - 32'h1;
-            sample$d = integrator4$q;
-            sample_valid$d = 1'b1;
-        end
-        else begin
-            count$d = count$q - 32'h1;
-        end
-        comb_valid1$d = sample_valid$q;
-        comb_valid2$d = comb_valid1$q;
-        comb_valid3$d = comb_valid2$q;
-        comb_valid4$d = comb_valid3$q;
-        if (sample_valid$q) begin
-            comb1$d = sample$q - comb_delay1$q;
-            comb_delay1$d = sample$q;
-        end
-        if (comb_valid1$q) begin
-            comb2$d = comb1$q - comb_delay2$q;
-            comb_delay2$d = comb1$q;
-        end
-        if (comb_valid2$q) begin
-            comb3$d = comb2$q - comb_delay3$q;
-            comb_delay3$d = comb2$q;
-        end
-        if (comb_valid3$q) begin
-            comb4$d = comb3$q - comb_delay4$q;
-            comb_delay4$d = comb3$q;
-        end
-        rounding = (one << shift) >> 32'h1;
-        biased = comb4$q + $signed(rounding);
-        biased_valid$d = comb_valid4$q;
-        if (comb_valid4$q) begin
-            biased_out$d = $unsigned(biased);
-            biased_shift$d = shift;
-        end
-        sign_mask = 32'h0;
-        if (biased_out$q[32'h4f]) begin
-            sign_mask = all_ones;
-        end
-        coarse_shift = biased_shift$q & coarse_shift_mask;
-        coarse_shifted = (biased_out$q ^ sign_mask) >> coarse_shift;
-        coarse_valid$d = biased_valid$q;
-        if (biased_valid$q) begin
-            coarse$d = coarse_shifted[(32'h0)+:(47)];
-            coarse_negative$d = biased_out$q[32'h4f];
-            fine_shift$d = biased_shift$q & fine_shift_mask;
-        end
-        fine_mask = 32'h0;
-        if (coarse_negative$q) begin
-            fine_mask = coarse_all_ones;
-        end
-        shifted = (coarse$q >> fine_shift$q) ^ fine_mask;
-        valid_out$d = coarse_valid$q;
-        if (coarse_valid$q) begin
-            y_out$d = $signed(shifted[(32'h0)+:(40)]);
-        end
-        y = y_out$q;
-        valid = valid_out$q;
+        integral = integrator4$q;
     end
 
-endmodule // gyro_interface_axi__core__cic2
+endmodule // gyro_interface_axi__core__cic__integrators1
 
 
-module gyro_interface_axi__core__cic2__biased_out(d,q,clock);
+module gyro_interface_axi__core__cic__integrators1__integrator1(d,q,clock);
 
     // Module arguments
-    input wire  [79:0] d;
-    output reg  [79:0] q;
+    input wire signed [79:0] d;
+    output reg signed [79:0] q;
     input wire  clock;
 
     // Update code (custom)
@@ -5647,29 +4897,263 @@ module gyro_interface_axi__core__cic2__biased_out(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__cic2__biased_out
+endmodule // gyro_interface_axi__core__cic__integrators1__integrator1
 
 
-module gyro_interface_axi__core__cic2__biased_shift(d,q,clock);
+module gyro_interface_axi__core__cic__integrators1__integrator2(d,q,clock);
 
     // Module arguments
-    input wire  [5:0] d;
-    output reg  [5:0] q;
+    input wire signed [79:0] d;
+    output reg signed [79:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 6'h0;
+       q = 80'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__cic2__biased_shift
+endmodule // gyro_interface_axi__core__cic__integrators1__integrator2
 
 
-module gyro_interface_axi__core__cic2__biased_valid(d,q,clock);
+module gyro_interface_axi__core__cic__integrators1__integrator3(d,q,clock);
+
+    // Module arguments
+    input wire signed [79:0] d;
+    output reg signed [79:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 80'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators1__integrator3
+
+
+module gyro_interface_axi__core__cic__integrators1__integrator4(d,q,clock);
+
+    // Module arguments
+    input wire signed [79:0] d;
+    output reg signed [79:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 80'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators1__integrator4
+
+
+module gyro_interface_axi__core__cic__integrators2(clock,x,integral);
+
+    // Module arguments
+    input wire  clock;
+    input wire signed [31:0] x;
+    output reg signed [79:0] integral;
+
+    // Stub signals
+    reg signed [79:0] integrator1$d;
+    wire signed [79:0] integrator1$q;
+    reg  integrator1$clock;
+    reg signed [79:0] integrator2$d;
+    wire signed [79:0] integrator2$q;
+    reg  integrator2$clock;
+    reg signed [79:0] integrator3$d;
+    wire signed [79:0] integrator3$q;
+    reg  integrator3$clock;
+    reg signed [79:0] integrator4$d;
+    wire signed [79:0] integrator4$q;
+    reg  integrator4$clock;
+
+    // Local signals
+    reg signed [79:0] x_wide;
+
+    // Sub module instances
+    gyro_interface_axi__core__cic__integrators2__integrator1 integrator1(
+        .d(integrator1$d),
+        .q(integrator1$q),
+        .clock(integrator1$clock)
+    );
+    gyro_interface_axi__core__cic__integrators2__integrator2 integrator2(
+        .d(integrator2$d),
+        .q(integrator2$q),
+        .clock(integrator2$clock)
+    );
+    gyro_interface_axi__core__cic__integrators2__integrator3 integrator3(
+        .d(integrator3$d),
+        .q(integrator3$q),
+        .clock(integrator3$clock)
+    );
+    gyro_interface_axi__core__cic__integrators2__integrator4 integrator4(
+        .d(integrator4$d),
+        .q(integrator4$q),
+        .clock(integrator4$clock)
+    );
+
+    // Update code
+    always @(*) begin
+        integrator1$clock = clock;
+        integrator2$clock = clock;
+        integrator3$clock = clock;
+        integrator4$clock = clock;
+        integrator1$d = integrator1$q;
+        integrator2$d = integrator2$q;
+        integrator3$d = integrator3$q;
+        integrator4$d = integrator4$q;
+        x_wide = $signed(x);
+        integrator1$d = integrator1$q + x_wide;
+        integrator2$d = integrator2$q + integrator1$q;
+        integrator3$d = integrator3$q + integrator2$q;
+        integrator4$d = integrator4$q + integrator3$q;
+        integral = integrator4$q;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators2
+
+
+module gyro_interface_axi__core__cic__integrators2__integrator1(d,q,clock);
+
+    // Module arguments
+    input wire signed [79:0] d;
+    output reg signed [79:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 80'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators2__integrator1
+
+
+module gyro_interface_axi__core__cic__integrators2__integrator2(d,q,clock);
+
+    // Module arguments
+    input wire signed [79:0] d;
+    output reg signed [79:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 80'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators2__integrator2
+
+
+module gyro_interface_axi__core__cic__integrators2__integrator3(d,q,clock);
+
+    // Module arguments
+    input wire signed [79:0] d;
+    output reg signed [79:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 80'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators2__integrator3
+
+
+module gyro_interface_axi__core__cic__integrators2__integrator4(d,q,clock);
+
+    // Module arguments
+    input wire signed [79:0] d;
+    output reg signed [79:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 80'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators2__integrator4
+
+
+module gyro_interface_axi__core__cic__sample2(d,q,clock);
+
+    // Module arguments
+    input wire signed [79:0] d;
+    output reg signed [79:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 80'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__sample2
+
+
+module gyro_interface_axi__core__cic__step(d,q,clock);
+
+    // Module arguments
+    input wire  [3:0] d;
+    output reg  [3:0] q;
+    input wire  clock;
+
+    // Enums
+    localparam CicStep$Idle = 0;
+    localparam CicStep$FirstComb1 = 1;
+    localparam CicStep$FirstComb2 = 2;
+    localparam CicStep$FirstComb3 = 3;
+    localparam CicStep$FirstComb4 = 4;
+    localparam CicStep$SecondLoad = 5;
+    localparam CicStep$SecondComb1 = 6;
+    localparam CicStep$SecondComb2 = 7;
+    localparam CicStep$SecondComb3 = 8;
+    localparam CicStep$SecondComb4 = 9;
+    localparam CicStep$SecondBias = 10;
+    localparam CicStep$SecondCoarse = 11;
+    localparam CicStep$SecondFine = 12;
+
+    // Update code (custom)
+    initial begin
+       q = 64'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__step
+
+
+module gyro_interface_axi__core__cic__valid_out(d,q,clock);
 
     // Module arguments
     input wire  d;
@@ -5685,466 +5169,10 @@ module gyro_interface_axi__core__cic2__biased_valid(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__cic2__biased_valid
+endmodule // gyro_interface_axi__core__cic__valid_out
 
 
-module gyro_interface_axi__core__cic2__coarse(d,q,clock);
-
-    // Module arguments
-    input wire  [46:0] d;
-    output reg  [46:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 47'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic2__coarse
-
-
-module gyro_interface_axi__core__cic2__coarse_negative(d,q,clock);
-
-    // Module arguments
-    input wire  d;
-    output reg  q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 1'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic2__coarse_negative
-
-
-module gyro_interface_axi__core__cic2__coarse_valid(d,q,clock);
-
-    // Module arguments
-    input wire  d;
-    output reg  q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 1'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic2__coarse_valid
-
-
-module gyro_interface_axi__core__cic2__comb1(d,q,clock);
-
-    // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 80'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic2__comb1
-
-
-module gyro_interface_axi__core__cic2__comb2(d,q,clock);
-
-    // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 80'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic2__comb2
-
-
-module gyro_interface_axi__core__cic2__comb3(d,q,clock);
-
-    // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 80'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic2__comb3
-
-
-module gyro_interface_axi__core__cic2__comb4(d,q,clock);
-
-    // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 80'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic2__comb4
-
-
-module gyro_interface_axi__core__cic2__comb_delay1(d,q,clock);
-
-    // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 80'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic2__comb_delay1
-
-
-module gyro_interface_axi__core__cic2__comb_delay2(d,q,clock);
-
-    // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 80'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic2__comb_delay2
-
-
-module gyro_interface_axi__core__cic2__comb_delay3(d,q,clock);
-
-    // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 80'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic2__comb_delay3
-
-
-module gyro_interface_axi__core__cic2__comb_delay4(d,q,clock);
-
-    // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 80'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic2__comb_delay4
-
-
-module gyro_interface_axi__core__cic2__comb_valid1(d,q,clock);
-
-    // Module arguments
-    input wire  d;
-    output reg  q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 1'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic2__comb_valid1
-
-
-module gyro_interface_axi__core__cic2__comb_valid2(d,q,clock);
-
-    // Module arguments
-    input wire  d;
-    output reg  q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 1'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic2__comb_valid2
-
-
-module gyro_interface_axi__core__cic2__comb_valid3(d,q,clock);
-
-    // Module arguments
-    input wire  d;
-    output reg  q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 1'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic2__comb_valid3
-
-
-module gyro_interface_axi__core__cic2__comb_valid4(d,q,clock);
-
-    // Module arguments
-    input wire  d;
-    output reg  q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 1'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic2__comb_valid4
-
-
-module gyro_interface_axi__core__cic2__count(d,q,clock);
-
-    // Module arguments
-    input wire  [12:0] d;
-    output reg  [12:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 13'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic2__count
-
-
-module gyro_interface_axi__core__cic2__fine_shift(d,q,clock);
-
-    // Module arguments
-    input wire  [5:0] d;
-    output reg  [5:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 6'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic2__fine_shift
-
-
-module gyro_interface_axi__core__cic2__integrator1(d,q,clock);
-
-    // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 80'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic2__integrator1
-
-
-module gyro_interface_axi__core__cic2__integrator2(d,q,clock);
-
-    // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 80'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic2__integrator2
-
-
-module gyro_interface_axi__core__cic2__integrator3(d,q,clock);
-
-    // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 80'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic2__integrator3
-
-
-module gyro_interface_axi__core__cic2__integrator4(d,q,clock);
-
-    // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 80'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic2__integrator4
-
-
-module gyro_interface_axi__core__cic2__sample(d,q,clock);
-
-    // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 80'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic2__sample
-
-
-module gyro_interface_axi__core__cic2__sample_valid(d,q,clock);
-
-    // Module arguments
-    input wire  d;
-    output reg  q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 1'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic2__sample_valid
-
-
-module gyro_interface_axi__core__cic2__valid_out(d,q,clock);
-
-    // Module arguments
-    input wire  d;
-    output reg  q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 1'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic2__valid_out
-
-
-module gyro_interface_axi__core__cic2__y_out(d,q,clock);
+module gyro_interface_axi__core__cic__y1_out(d,q,clock);
 
     // Module arguments
     input wire signed [39:0] d;
@@ -6160,7 +5188,45 @@ module gyro_interface_axi__core__cic2__y_out(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__cic2__y_out
+endmodule // gyro_interface_axi__core__cic__y1_out
+
+
+module gyro_interface_axi__core__cic__y2_out(d,q,clock);
+
+    // Module arguments
+    input wire signed [39:0] d;
+    output reg signed [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__y2_out
+
+
+module gyro_interface_axi__core__cic__y_first(d,q,clock);
+
+    // Module arguments
+    input wire signed [39:0] d;
+    output reg signed [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__y_first
 
 
 module gyro_interface_axi__core__demod_mux(clock,adc1,adc2,aligned1,aligned2,select,w1,w2);

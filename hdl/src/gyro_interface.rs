@@ -14,14 +14,14 @@
 //!  select ──────────────────────────────────────────►│ DemodMux │◄──────────┘
 //!                                                    └──┬────┬──┘
 //!                                                    w1 │    │ w2
-//!  cic_decimation, cic_shift ──────────────────►  CicDecimator x2
+//!  cic_decimation, cic_shift ──────────────────►  CicDecimator (both channels)
 //!  iir_k0, iir_k1, iir_k2, iir_alpha ──────────►  IirLowpass (both channels) ──► z1, z2, z_valid
 //! ```
 //!
 //! Follow a sample in file order: `carrier_nco` (with `sincos`,
 //! `sine_table`), `modulation_nco`, `am_mixer` (with `q15_multiplier`), the
 //! DACs and the gyroscope (in the simulator), `reference_alignment`,
-//! `demod_mux`, `cic_decimator`, `iir_lowpass`.
+//! `demod_mux`, `cic_integrators`, `cic_decimator`, `iir_lowpass`.
 //!
 //! Every input is sampled at the rising edge of `clock`; the run-time
 //! settings are meant to be driven from a register bank in the same clock
@@ -32,7 +32,7 @@
 //!
 //! Latencies (clocks): carrier phase to DAC word 8 (the sum of
 //! `carrier_nco::LATENCY` and `am_mixer::CARRIER_LATENCY`), ADC word to
-//! mixer output 2, mixer output to CIC output R + 8 at most
+//! mixer output 2, mixer output to CIC output R + 13 at most
 //! (`cic_decimator::SAMPLE_TO_OUTPUT`), CIC output to z 17
 //! (`crate::iir_lowpass::LATENCY`).
 
@@ -78,7 +78,7 @@ pub struct GyroInterface {
     pub amp1: Signal<In, Signed<16>>,
     /// Drive amplitude F2, Q1.15 (32767 = full scale).
     pub amp2: Signal<In, Signed<16>>,
-    /// CIC decimation R, 16..=4096 (z rate f_clk / R).
+    /// CIC decimation R, 166..=4096 (`filter_design::MIN_DECIMATION`; z rate f_clk / R).
     pub cic_decimation: Signal<In, Bits<DECIMATION_BITS>>,
     /// CIC output shift, ceil(4 log2 R) - 8.
     pub cic_shift: Signal<In, Bits<SHIFT_BITS>>,
@@ -95,8 +95,7 @@ pub struct GyroInterface {
     am_mixer: AmMixer,
     reference_alignment: ReferenceAlignment,
     demod_mux: DemodMux,
-    cic1: CicDecimator,
-    cic2: CicDecimator,
+    cic: CicDecimator,
     iir: IirLowpass,
 }
 
@@ -130,8 +129,7 @@ impl GyroInterface {
             am_mixer: AmMixer::new(),
             reference_alignment: ReferenceAlignment::new(),
             demod_mux: DemodMux::new(),
-            cic1: CicDecimator::new(),
-            cic2: CicDecimator::new(),
+            cic: CicDecimator::new(),
             iir: IirLowpass::new(),
         }
     }
@@ -151,8 +149,7 @@ impl Logic for GyroInterface {
         self.am_mixer.clock.next = self.clock.val();
         self.reference_alignment.clock.next = self.clock.val();
         self.demod_mux.clock.next = self.clock.val();
-        self.cic1.clock.next = self.clock.val();
-        self.cic2.clock.next = self.clock.val();
+        self.cic.clock.next = self.clock.val();
         self.iir.clock.next = self.clock.val();
         // Excitation.
         self.carrier_nco.step.next = self.carrier_step.val();
@@ -179,16 +176,13 @@ impl Logic for GyroInterface {
         self.demod_mux.aligned2.next = self.reference_alignment.aligned2.val();
         self.demod_mux.select.next = self.select.val();
         // Decimation and filtering.
-        self.cic1.x.next = self.demod_mux.w1.val();
-        self.cic2.x.next = self.demod_mux.w2.val();
-        self.cic1.decimation.next = self.cic_decimation.val();
-        self.cic2.decimation.next = self.cic_decimation.val();
-        self.cic1.shift.next = self.cic_shift.val();
-        self.cic2.shift.next = self.cic_shift.val();
-        self.iir.x1.next = self.cic1.y.val();
-        self.iir.x2.next = self.cic2.y.val();
-        // Both CICs share the decimation and start together: one strobe.
-        self.iir.x_valid.next = self.cic1.valid.val();
+        self.cic.x1.next = self.demod_mux.w1.val();
+        self.cic.x2.next = self.demod_mux.w2.val();
+        self.cic.decimation.next = self.cic_decimation.val();
+        self.cic.shift.next = self.cic_shift.val();
+        self.iir.x1.next = self.cic.y1.val();
+        self.iir.x2.next = self.cic.y2.val();
+        self.iir.x_valid.next = self.cic.valid.val();
         self.iir.k0.next = self.iir_k0.val();
         self.iir.k1.next = self.iir_k1.val();
         self.iir.k2.next = self.iir_k2.val();
@@ -248,8 +242,8 @@ impl GyroInterface {
                 v(self.demod_mux.w1.val()) as i32,
                 v(self.demod_mux.w2.val()) as i32,
             ),
-            cic: (v(self.cic1.y.val()) as i64, v(self.cic2.y.val()) as i64),
-            cic_valid: self.cic1.valid.val(),
+            cic: (v(self.cic.y1.val()) as i64, v(self.cic.y2.val()) as i64),
+            cic_valid: self.cic.valid.val(),
             am: (
                 v(self.modulation_nco.am1.val()) as i16,
                 v(self.modulation_nco.am2.val()) as i16,

@@ -3,6 +3,7 @@
 pub mod am_mixer;
 pub mod carrier_nco;
 pub mod cic_decimator;
+pub mod cic_integrators;
 pub mod demod_mux;
 pub mod drive;
 pub mod export;

@@ -41,7 +41,7 @@
 //! ";
 //! let e = gyrocal_sim::config::parse("consumer.toml", text).unwrap();
 //! let d = e.derived().unwrap();
-//! assert!(d.decimation >= 16 && d.butterworth_hz < d.rc_hz);
+//! assert!(d.decimation >= 166 && d.butterworth_hz < d.rc_hz);
 //! ```
 
 use crate::gyro::GyroParams;

@@ -101,9 +101,9 @@ void gyrocal_verilator_probes(const GyrocalVerilator* g, GyrocalProbes* p) {
     p->ref2 = static_cast<int16_t>(r->gyro_interface__DOT__am_mixer__DOT__reference2__DOT__y_out__024q);
     p->w1 = static_cast<int32_t>(r->gyro_interface__DOT__demod_mux__DOT__mixer1__024p);
     p->w2 = static_cast<int32_t>(r->gyro_interface__DOT__demod_mux__DOT__mixer2__024p);
-    p->cic1 = sign_extend(r->gyro_interface__DOT__cic1__DOT__y_out__024q, 40);
-    p->cic2 = sign_extend(r->gyro_interface__DOT__cic2__DOT__y_out__024q, 40);
-    p->cic_valid = r->gyro_interface__DOT__cic1__DOT__valid_out__024q;
+    p->cic1 = sign_extend(r->gyro_interface__DOT__cic__DOT__y1_out__024q, 40);
+    p->cic2 = sign_extend(r->gyro_interface__DOT__cic__DOT__y2_out__024q, 40);
+    p->cic_valid = r->gyro_interface__DOT__cic__DOT__valid_out__024q;
     p->am1 = static_cast<int16_t>(r->gyro_interface__DOT__modulation_nco__DOT__am1_out__024q);
     p->am2 = static_cast<int16_t>(r->gyro_interface__DOT__modulation_nco__DOT__am2_out__024q);
 }

@@ -1,12 +1,22 @@
-//! Bit-true model of `crate::cic_decimator::CicDecimator`.
+//! Bit-true, cycle-true model of `crate::cic_decimator::CicDecimator`.
 //!
-//! Registers mirror the hardware one for one. The hardware's 80-bit
-//! wrap-around is modelled by wrapping i128 arithmetic: reduction modulo
-//! 2^80 commutes with addition and subtraction, so the low 80 bits of every
-//! model register equal the hardware register, and the output stage wraps
-//! to 80 bits before it shifts, where the upper bits would start to matter.
+//! Cycle-true on the ports, not register for register: the hardware's
+//! back-end spends `SCHEDULE_CLOCKS` clocks on the combs and the rounding
+//! of both channels, but nothing else reads or writes the comb delays in
+//! that time, and the shift is held from the strobe. So the model does the
+//! whole arithmetic at the strobe and publishes the result
+//! `SAMPLE_TO_OUTPUT` clocks later, dropping strobes while it is busy, as
+//! the hardware's schedule does.
+//!
+//! The hardware's 80-bit wrap-around is modelled by wrapping i128
+//! arithmetic: reduction modulo 2^80 commutes with addition and
+//! subtraction, so the low 80 bits of every model value equal the hardware
+//! register, and the output stage wraps to 80 bits before it shifts, where
+//! the upper bits would start to matter.
 
-use crate::cic_decimator::{OUTPUT_BITS, OUTPUT_STAGES, REGISTER_BITS};
+use crate::cic_decimator::{
+    CHANNELS, DECIMATION_BITS, OUTPUT_BITS, REGISTER_BITS, SAMPLE_TO_OUTPUT, STAGES,
+};
 
 /// Wrap to an 80-bit two's complement value.
 #[inline(always)]
@@ -24,100 +34,92 @@ pub fn scale_output(x: i128, shift: u32) -> i64 {
     ((shifted << OUT_SHIFT) >> OUT_SHIFT) as i64
 }
 
-/// Cycle-true model of one CIC channel.
+/// Cycle-true model of the two-channel CIC.
 ///
 /// The integrators are brought up to date lazily: inputs wait in `pending`
 /// and are integrated in one tight loop when the counter samples the fourth
-/// integrator, the only place their values are read. The result is the
+/// integrators, the only place their values are read. The result is the
 /// same register values the hardware has at that cycle.
 #[derive(Clone, Debug, Default)]
 pub struct CicDecimator {
-    integrator: [i128; 4],
-    pending: Vec<i32>,
+    integrator: [[i128; STAGES as usize]; CHANNELS],
+    pending: Vec<(i32, i32)>,
     count: u32,
-    sample: i128,
-    sample_valid: bool,
-    comb: [i128; 4],
-    comb_delay: [i128; 4],
-    comb_valid: [bool; 4],
-    /// The output pipeline: scaled value and strobe after each of the
-    /// first `OUTPUT_STAGES - 1` steps (bias, coarse); the last is `y`.
-    /// The hardware's intermediate words differ, but the scaled value is
-    /// fixed at the bias step (it samples `shift` there) and only moves on.
-    output_pipe: [(i64, bool); OUTPUT_STAGES - 1],
-    y: i64,
+    comb_delay: [[i128; STAGES as usize]; CHANNELS],
+    /// Clocks of the schedule still to run after the current one (0: idle).
+    busy: usize,
+    /// The outputs the running schedule will publish.
+    result: (i64, i64),
+    y: (i64, i64),
     valid: bool,
 }
 
 impl CicDecimator {
-    /// `(y, valid)` during the current cycle.
+    /// `((y1, y2), valid)` during the current cycle.
     #[inline(always)]
-    pub fn output(&self) -> (i64, bool) {
+    pub fn output(&self) -> ((i64, i64), bool) {
         (self.y, self.valid)
     }
 
-    /// One clock with input `x`, decimation R (13-bit word) and output shift.
+    /// One clock with inputs `x = (x1, x2)`, decimation R (13-bit word) and
+    /// output shift.
     #[inline(always)]
-    pub fn step(&mut self, x: i32, decimation: u32, shift: u32) -> (i64, bool) {
-        // Output stages, last first (each reads the previous cycle's
-        // values; the first reads comb 4 before it updates).
-        let (last, last_valid) = self.output_pipe[OUTPUT_STAGES - 2];
-        self.valid = last_valid;
-        if last_valid {
-            self.y = last;
-        }
-        for k in (1..OUTPUT_STAGES - 1).rev() {
-            if self.output_pipe[k - 1].1 {
-                self.output_pipe[k].0 = self.output_pipe[k - 1].0;
+    pub fn step(&mut self, x: (i32, i32), decimation: u32, shift: u32) -> ((i64, i64), bool) {
+        self.valid = false;
+        if self.busy > 0 {
+            // Non-idle schedule state; its last clock publishes.
+            self.busy -= 1;
+            if self.busy == 0 {
+                self.y = self.result;
+                self.valid = true;
             }
-            self.output_pipe[k].1 = self.output_pipe[k - 1].1;
-        }
-        if self.comb_valid[3] {
-            self.output_pipe[0].0 = scale_output(wrap(self.comb[3]), shift);
-        }
-        self.output_pipe[0].1 = self.comb_valid[3];
-        // Combs, last stage first so each reads the previous cycle's values
-        // (nothing moves between outputs: skip them then).
-        if self.sample_valid || self.comb_valid != [false; 4] {
-            for k in (1..4).rev() {
-                if self.comb_valid[k - 1] {
-                    self.comb[k] = self.comb[k - 1].wrapping_sub(self.comb_delay[k]);
-                    self.comb_delay[k] = self.comb[k - 1];
-                }
-                self.comb_valid[k] = self.comb_valid[k - 1];
-            }
-            if self.sample_valid {
-                self.comb[0] = self.sample.wrapping_sub(self.comb_delay[0]);
-                self.comb_delay[0] = self.sample;
-            }
-            self.comb_valid[0] = self.sample_valid;
-        }
-        // Counter and decimation.
-        self.sample_valid = self.count == 0;
-        if self.count == 0 {
+        } else if self.count == 0 {
             self.integrate_pending();
-            self.sample = self.integrator[3];
-            self.count = decimation.wrapping_sub(1) & 0x1fff;
-        } else {
-            self.count -= 1;
+            self.result = (self.comb_and_round(0, shift), self.comb_and_round(1, shift));
+            self.busy = SAMPLE_TO_OUTPUT - 1;
         }
+        // Counter: it runs whatever the schedule does.
+        self.count = if self.count == 0 {
+            decimation.wrapping_sub(1) & ((1 << DECIMATION_BITS) - 1)
+        } else {
+            self.count - 1
+        };
         // Integrators: x enters at this edge (see `integrate_pending`).
         self.pending.push(x);
         (self.y, self.valid)
     }
 
+    /// The four combs of one channel on its sampled fourth integrator, then
+    /// the output rounding.
+    #[inline(always)]
+    fn comb_and_round(&mut self, channel: usize, shift: u32) -> i64 {
+        let mut value = self.integrator[channel][STAGES as usize - 1];
+        for delay in &mut self.comb_delay[channel] {
+            let previous = std::mem::replace(delay, value);
+            value = value.wrapping_sub(previous);
+        }
+        scale_output(wrap(value), shift)
+    }
+
     /// Play the integrators' edges for the inputs still pending.
     #[inline(never)]
     fn integrate_pending(&mut self) {
-        let [mut i1, mut i2, mut i3, mut i4] = self.integrator;
-        for &x in &self.pending {
+        let [
+            [mut a1, mut a2, mut a3, mut a4],
+            [mut b1, mut b2, mut b3, mut b4],
+        ] = self.integrator;
+        for &(x1, x2) in &self.pending {
             // Every stage takes its predecessor's value before the edge.
-            i4 = i4.wrapping_add(i3);
-            i3 = i3.wrapping_add(i2);
-            i2 = i2.wrapping_add(i1);
-            i1 = i1.wrapping_add(x as i128);
+            a4 = a4.wrapping_add(a3);
+            a3 = a3.wrapping_add(a2);
+            a2 = a2.wrapping_add(a1);
+            a1 = a1.wrapping_add(x1 as i128);
+            b4 = b4.wrapping_add(b3);
+            b3 = b3.wrapping_add(b2);
+            b2 = b2.wrapping_add(b1);
+            b1 = b1.wrapping_add(x2 as i128);
         }
-        self.integrator = [i1, i2, i3, i4];
+        self.integrator = [[a1, a2, a3, a4], [b1, b2, b3, b4]];
         self.pending.clear();
     }
 }

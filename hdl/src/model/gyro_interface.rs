@@ -92,7 +92,7 @@ pub struct GyroInterface {
     am_mixer: AmMixer,
     reference_alignment: ReferenceAlignment,
     demod_mux: DemodMux,
-    cic: [CicDecimator; 2],
+    cic: CicDecimator,
     iir: IirLowpass,
 }
 
@@ -117,11 +117,11 @@ impl GyroInterface {
     /// Internal signals during the current cycle.
     pub fn probes(&self) -> Probes {
         let drives = self.am_mixer.output();
-        let (cic1, cic_valid) = self.cic[0].output();
+        let (cic, cic_valid) = self.cic.output();
         Probes {
             reference: (drives.ref1, drives.ref2),
             w: self.demod_mux.output(),
-            cic: (cic1, self.cic[1].output().0),
+            cic,
             cic_valid,
             am: self.modulation_nco.output(),
         }
@@ -138,7 +138,7 @@ impl GyroInterface {
         let drives = self.am_mixer.output();
         let aligned = self.reference_alignment.output();
         let w = self.demod_mux.output();
-        let cic = [self.cic[0].output(), self.cic[1].output()];
+        let (cic, cic_valid) = self.cic.output();
 
         self.carrier_nco.step(regs.carrier_step, regs.ref_phase);
         self.modulation_nco.step(regs.mod_step, regs.select);
@@ -148,10 +148,8 @@ impl GyroInterface {
         self.demod_mux.step(adc, aligned, regs.select);
         let r = regs.cic_decimation as u32;
         let shift = regs.cic_shift as u32;
-        self.cic[0].step(w.0, r, shift);
-        self.cic[1].step(w.1, r, shift);
-        // Both CICs share one counter: their strobes coincide.
-        self.iir.step((cic[0].0, cic[1].0), cic[0].1, &regs.iir);
+        self.cic.step(w, r, shift);
+        self.iir.step(cic, cic_valid, &regs.iir);
         self.outputs()
     }
 }
