@@ -9344,7 +9344,7 @@ module gyro_interface_axi__settings__8(clock,reset,write,write_index,write_data,
     localparam  field_mask = 32'h1fff;
     localparam  sign_bit = 32'h0;
     localparam  extension = 32'h0;
-    localparam  power_up = 32'h10;
+    localparam  power_up = 32'h100;
 
     // Stub signals
     reg  [31:0] field$d;
@@ -9388,7 +9388,7 @@ module gyro_interface_axi__settings__8__field(d,q,clock);
     input wire  clock;
 
     // Constant declarations
-    localparam  init = 32'h10;
+    localparam  init = 32'h100;
 
     // Stub signals
     reg  [31:0] dff$d;
@@ -9451,7 +9451,7 @@ module gyro_interface_axi__settings__9(clock,reset,write,write_index,write_data,
     localparam  field_mask = 32'h3f;
     localparam  sign_bit = 32'h0;
     localparam  extension = 32'h0;
-    localparam  power_up = 32'h8;
+    localparam  power_up = 32'h18;
 
     // Stub signals
     reg  [31:0] field$d;
@@ -9495,7 +9495,7 @@ module gyro_interface_axi__settings__9__field(d,q,clock);
     input wire  clock;
 
     // Constant declarations
-    localparam  init = 32'h8;
+    localparam  init = 32'h18;
 
     // Stub signals
     reg  [31:0] dff$d;

@@ -66,17 +66,17 @@
 #define GYRO_AMP2_MASK 0x0000ffffu
 #define GYRO_AMP2_POWER_UP 0x00000000u
 
-/* CIC_DECIMATION: read-write, 13 bits. Port `cic_decimation`: R, 16..4096; z is updated every R clocks. */
+/* CIC_DECIMATION: read-write, 13 bits. Port `cic_decimation`: R, 166..4096; z is updated every R clocks. */
 #define GYRO_CIC_DECIMATION_OFFSET 0x28u
 #define GYRO_CIC_DECIMATION_BITS 13u
 #define GYRO_CIC_DECIMATION_MASK 0x00001fffu
-#define GYRO_CIC_DECIMATION_POWER_UP 0x00000010u
+#define GYRO_CIC_DECIMATION_POWER_UP 0x00000100u
 
-/* CIC_SHIFT: read-write, 6 bits. Port `cic_shift`: ceil(4 log2 R) - 8 (8 for the power-up R = 16). */
+/* CIC_SHIFT: read-write, 6 bits. Port `cic_shift`: ceil(4 log2 R) - 8 (24 for the power-up R = 256). */
 #define GYRO_CIC_SHIFT_OFFSET 0x2cu
 #define GYRO_CIC_SHIFT_BITS 6u
 #define GYRO_CIC_SHIFT_MASK 0x0000003fu
-#define GYRO_CIC_SHIFT_POWER_UP 0x00000008u
+#define GYRO_CIC_SHIFT_POWER_UP 0x00000018u
 
 /* IIR_K0: read-write, 32 bits signed. Port `iir_k0`: biquad numerator gain, Q2.30. */
 #define GYRO_IIR_K0_OFFSET 0x30u

@@ -11,7 +11,10 @@ use gyrocal_hdl::host::rtl::first_mismatch;
 use gyrocal_hdl::host::traffic::{Bias, traffic};
 use proptest::prelude::*;
 
-const CYCLES: usize = 2_500;
+/// Cycles per case: enough for more than 10 z samples at the least R
+/// (`MIN_DECIMATION` = 166) between the traffic's random resets and rate
+/// writes.
+const CYCLES: usize = 5_000;
 
 /// What the traffic exercised, counted on the model.
 #[derive(Debug, Default)]

@@ -70,14 +70,17 @@ fn data(rng: &mut Rng) -> u32 {
     }
 }
 
-/// `cycles` cycles of traffic after a preamble that sets R = 16 and turns
-/// the stream on through the bus.
+/// `cycles` cycles of traffic after a preamble that sets the least R
+/// (`MIN_DECIMATION`, the fastest z) and turns the stream on through the
+/// bus.
 pub fn traffic(seed: u64, bias: Bias, cycles: usize) -> Vec<BusInputs> {
     let mut rng = Rng(seed);
-    // Start with R = 16 and the stream on, through the bus itself.
+    // Start with the least R and the stream on, through the bus itself.
+    let r = crate::filter_design::MIN_DECIMATION;
+    let shift = (4.0 * f64::from(r).log2()).ceil() as u32 - 8;
     let preamble = [
-        (CIC_DECIMATION.offset, 16),
-        (CIC_SHIFT.offset, 8),
+        (CIC_DECIMATION.offset, r),
+        (CIC_SHIFT.offset, shift),
         (STREAM_ENABLE.offset, 1),
     ];
     let mut out = Vec::with_capacity(cycles);
