@@ -515,7 +515,7 @@ mod tests {
         #![proptest_config(ProptestConfig::with_cases(24))]
         #[test]
         fn model_matches_a_plain_reference_with_rate_changes(
-            settings in segments(rate_and_shift(vec![16, 17, 20, 31, 64, 100]), 3..6, 300..700),
+            settings in segments(rate_and_shift(vec![16, 17, 20, 31, 64, 100]), 3..6, 700..1400),
             inputs in prop::collection::vec((input(), input()), 3500),
         ) {
             // Shifts above 40 are outside the supported range, where the
@@ -538,7 +538,10 @@ mod tests {
                 .map(|(n, y)| (n + SAMPLE_TO_OUTPUT, y))
                 .filter(|&(n, _)| n <= settings.len().min(inputs.len()))
                 .collect();
-            prop_assert!(want.len() > 20, "only {} outputs", want.len());
+            // At least 3 x 700 = 2100 clocks (the inputs hold 3500): even
+            // at R = 100 throughout, strobes at 0, 100, ..., 2000 give 21
+            // outputs by clock 2013, so a comparison of fewer is a bug.
+            prop_assert!(want.len() >= 20, "only {} outputs", want.len());
             prop_assert_eq!(got, want);
         }
     }
