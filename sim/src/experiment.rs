@@ -73,7 +73,7 @@ use crate::config::Derived;
 pub use crate::config::Experiment;
 use crate::cosim::CoSim;
 use crate::engine::{Engine, EngineKind, ModelEngine, RtlEngine};
-use crate::fit::{Line, ScaleFactors, fit_batches, linear_fit};
+use crate::fit::{Line, ScaleFactors, fit_batches, linear_fit, mean_and_standard_error};
 use crate::frontend::{Converters, FrontEnd};
 use crate::gyro::GyroModel;
 use crate::theory::{self, Device};
@@ -697,17 +697,11 @@ fn without_ripple_shape(raw: &[[f64; 2]], per_period: usize) -> Vec<[f64; 2]> {
 
 /// Mean and 1-sigma uncertainty of the mean of batch means, per output.
 fn mean_and_uncertainty(batches: &[[f64; 2]]) -> ([f64; 2], [f64; 2]) {
-    let n = batches.len() as f64;
-    let mean: [f64; 2] = std::array::from_fn(|k| batches.iter().map(|b| b[k]).sum::<f64>() / n);
-    let sigma = std::array::from_fn(|k| {
-        let var = batches
-            .iter()
-            .map(|b| (b[k] - mean[k]).powi(2))
-            .sum::<f64>()
-            / (n - 1.0);
-        (var / n).sqrt()
+    let [a, b] = std::array::from_fn(|k| {
+        let column: Vec<f64> = batches.iter().map(|v| v[k]).collect();
+        mean_and_standard_error(&column)
     });
-    (mean, sigma)
+    ([a.0, b.0], [a.1, b.1])
 }
 
 /// Simulate one point with engine `E` and `units` units per batch;

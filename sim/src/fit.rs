@@ -50,6 +50,23 @@ pub fn linear_fit(x: &[f64], y: &[f64]) -> (f64, f64) {
     (slope, my - slope * mx)
 }
 
+/// Mean of `v` and the 1-sigma uncertainty of that mean: the sample
+/// standard deviation (n - 1) over sqrt(n).
+///
+/// ```
+/// use gyrocal_sim::fit::mean_and_standard_error;
+/// let (mean, error) = mean_and_standard_error(&[1.0, 2.0, 3.0, 6.0]);
+/// assert_eq!(mean, 3.0);
+/// // Sample variance (4 + 1 + 0 + 9) / 3 = 14 / 3, over 4.
+/// assert!((error - (14.0f64 / 12.0).sqrt()).abs() < 1e-15);
+/// ```
+pub fn mean_and_standard_error(v: &[f64]) -> (f64, f64) {
+    let n = v.len() as f64;
+    let mean = v.iter().sum::<f64>() / n;
+    let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (mean, (var / n).sqrt())
+}
+
 /// A fitted line and its slope's 1-sigma uncertainty.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Line {
@@ -93,12 +110,10 @@ pub fn fit_batches(x: &[f64], batches: &[Vec<f64>]) -> Line {
     let slopes: Vec<f64> = (0..n)
         .map(|j| linear_fit(x, &batches.iter().map(|b| b[j]).collect::<Vec<_>>()).0)
         .collect();
-    let mean = slopes.iter().sum::<f64>() / n as f64;
-    let var = slopes.iter().map(|s| (s - mean).powi(2)).sum::<f64>() / (n as f64 - 1.0);
     Line {
         slope,
         intercept,
-        slope_uncertainty: (var / n as f64).sqrt(),
+        slope_uncertainty: mean_and_standard_error(&slopes).1,
     }
 }
 

@@ -84,11 +84,10 @@
 //! break M_12 = -M_21 and is not covered.
 
 use super::board::Board;
-use super::identify::{self, Estimate, Identified, Knowns, average_z};
+use super::identify::{self, Estimate, Identified, Knowns, average_z, bus, signed_readout_word};
 use super::selfcal::Operating;
 use crate::config::MAX_RATE_DPS;
-use gyrocal_hdl::model::q15_multiplier::q15_product;
-use gyrocal_hdl::sine_table::PEAK;
+use crate::fit::mean_and_standard_error;
 use nalgebra::Complex;
 use serde::{Deserialize, Serialize};
 
@@ -146,27 +145,24 @@ pub struct DriveRatio {
     pub clocks: u64,
 }
 
-/// Signed fundamental amplitude of a readout drive word for amplitude
-/// word `amp` (`identify::readout_word` with its sign).
-fn signed_word(amp: i16) -> f64 {
-    f64::from(q15_product(amp, PEAK as i16)) * f64::from(PEAK) / 32768.0
-}
-
 /// G_k(f) up to a common factor: 1 / ((f_k - f)(f_k + f) + j f b_k).
 fn resonator(f_k: f64, q_k: f64, f: f64) -> C64 {
     1.0 / C64::new((f_k - f) * (f_k + f), f * f_k / q_k)
+}
+
+/// The line y = P + Q W_2 through `y` measured at drive 2's two signed
+/// words `w2`: (P, Q).
+fn line(y: [C64; 2], w2: [f64; 2]) -> (C64, C64) {
+    let q = (y[0] - y[1]) / (w2[0] - w2[1]);
+    (y[0] - q * w2[0], q)
 }
 
 /// (g_2 / g_1)^2 from the four complex window means (outputs 1 and 2 at
 /// drive 2's two signed words `w2`) and G_1 / G_2.
 fn ratio_squared(z: [[C64; 2]; 2], w1: f64, w2: [f64; 2], g1_over_g2: C64) -> C64 {
     // Output 1: Z_1 = P_1 + Q_1 W_2; output 2: Z_2 / W_2 = P_2 + Q_2 W_2.
-    let line = |y: [C64; 2]| {
-        let q = (y[0] - y[1]) / (w2[0] - w2[1]);
-        (y[0] - q * w2[0], q)
-    };
-    let (p1, q1) = line([z[0][0], z[1][0]]);
-    let (p2, q2) = line([z[0][1] / w2[0], z[1][1] / w2[1]]);
+    let (p1, q1) = line([z[0][0], z[1][0]], w2);
+    let (p2, q2) = line([z[0][1] / w2[0], z[1][1] / w2[1]], w2);
     q1 * q2 * w1 * w1 / (p1 * p2) * g1_over_g2
 }
 
@@ -192,13 +188,8 @@ fn resonator_ratio(id: &Identified, carrier_hz: f64) -> (C64, f64) {
 
 /// Mean and standard error of `v`.
 fn mean_and_error(v: &[f64]) -> Estimate {
-    let n = v.len() as f64;
-    let mean = v.iter().sum::<f64>() / n;
-    let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
-    Estimate {
-        value: mean,
-        uncertainty: (var / n).sqrt(),
-    }
+    let (value, uncertainty) = mean_and_standard_error(v);
+    Estimate { value, uncertainty }
 }
 
 /// `BATCHES` batch means of both outputs, `per_batch` z samples each,
@@ -240,15 +231,13 @@ pub fn measure(
             sign * knowns.amplitude.1,
         );
         let (regs, _) = knowns.registers(op.carrier_hz, None, amps, op.ref_lag_deg)?;
-        w1 = signed_word(regs.amp.0);
-        words[s] = signed_word(regs.amp.1);
+        w1 = signed_readout_word(regs.amp.0);
+        words[s] = signed_readout_word(regs.amp.1);
         let mut pair = vec![];
         for quarter in [0u32, 1 << 30] {
             let mut rotated = regs;
             rotated.ref_phase = regs.ref_phase.wrapping_add(quarter);
-            board
-                .program(&rotated)
-                .map_err(|e| format!("board refused a register access: {e:?}"))?;
+            board.program(&rotated).map_err(bus)?;
             let wait = if quarter == 0 { settle } else { filter };
             pair.push(batch_means(board, r, wait, per_batch)?);
             clocks += wait + BATCHES as u64 * per_batch * u64::from(r);
@@ -277,9 +266,7 @@ pub fn measure(
                 means[s][1].iter().map(|m| m[k]).sum::<f64>(),
             )
         };
-        let (y0, y1) = (z(0, 1) / words[0], z(1, 1) / words[1]);
-        let q = (y0 - y1) / (words[0] - words[1]);
-        let p = y0 - q * words[0];
+        let (p, q) = line([z(0, 1) / words[0], z(1, 1) / words[1]], words);
         (p / (q * w1)).norm()
     };
     Ok(DriveRatio {

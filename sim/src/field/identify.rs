@@ -219,7 +219,13 @@ pub fn phase_word(deg: f64) -> u32 {
 /// mixer rounds it, times the carrier table's amplitude PEAK / 2^15 (the
 /// table's own gain, 1 + 7e-7, is below anything this module resolves).
 pub fn readout_word(amp: i16) -> f64 {
-    f64::from(q15_product(amp, PEAK as i16)).abs() * f64::from(PEAK) / 32768.0
+    signed_readout_word(amp).abs()
+}
+
+/// [`readout_word`] with its sign: the word follows the sign of `amp`
+/// (rounded half up, so -amp's word is not always the exact negative).
+pub fn signed_readout_word(amp: i16) -> f64 {
+    f64::from(q15_product(amp, PEAK as i16)) * f64::from(PEAK) / 32768.0
 }
 
 /// A value and its 1-sigma uncertainty.
@@ -277,7 +283,8 @@ impl Identified {
     }
 }
 
-fn bus(e: BusError) -> String {
+/// The one-line error of a refused register access.
+pub(super) fn bus(e: BusError) -> String {
     format!("board refused a register access: {e:?}")
 }
 

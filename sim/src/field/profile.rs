@@ -33,6 +33,7 @@
 //! ```
 
 use super::board::{Board, SimBoard};
+use super::identify::bus;
 use super::selfcal::window_z;
 use crate::config::MAX_RATE_DPS;
 use serde::{Deserialize, Serialize};
@@ -216,9 +217,7 @@ pub fn run_profile(
             let rate = profile.rate_dps_at((sample as f64 + 0.5) * sample_s);
             board.set_rate(rate.to_radians());
             board.wait_clocks(u64::from(decimation));
-            let s = board
-                .read_z()
-                .map_err(|e| format!("board refused a register access: {e:?}"))?;
+            let s = board.read_z().map_err(bus)?;
             rate_sum += rate;
             z_sum[0] += s.z[0];
             z_sum[1] += s.z[1];

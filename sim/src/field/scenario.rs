@@ -28,7 +28,7 @@
 
 use super::board::{Board, SimBoard};
 use super::drive_ratio::{self, DriveProbe};
-use super::identify::Knowns;
+use super::identify::{Knowns, bus};
 use super::profile::{self, Profile, ProfileRun, RateTrace};
 use super::selfcal::{self, Operating, SelfCal, window_z};
 use crate::config::Experiment;
@@ -270,9 +270,7 @@ fn settled_readout_board(
 
 fn program_readout(board: &mut dyn Board, knowns: &Knowns, op: &Operating) -> Result<(), String> {
     let (regs, _) = knowns.registers(op.carrier_hz, None, knowns.amplitude, op.ref_lag_deg)?;
-    board
-        .program(&regs)
-        .map_err(|e| format!("board refused a register access: {e:?}"))
+    board.program(&regs).map_err(bus)
 }
 
 /// One point of the rate table: readout at `op` on a fresh board (from

@@ -56,7 +56,7 @@
 
 use super::board::Board;
 use super::drive_ratio::DriveRatio;
-use super::identify::{self, Identified, Knowns, readout_word};
+use super::identify::{self, Identified, Knowns, bus, readout_word};
 use crate::average::window_mean;
 use crate::experiment::envelope_lead_rad;
 use crate::fit::linear_fit;
@@ -198,9 +198,7 @@ pub fn period_means(
     while now < t0 + length + r {
         board.wait_clocks(u64::from(decimation));
         now += r;
-        let s = board
-            .read_z()
-            .map_err(|e| format!("board refused a register access: {e:?}"))?;
+        let s = board.read_z().map_err(bus)?;
         t.push(now);
         z[0].push(s.z[0]);
         z[1].push(s.z[1]);
@@ -252,9 +250,7 @@ pub fn staircase(
     for (i, &f) in knowns.cal_freqs_hz.iter().enumerate() {
         let (regs, real) =
             knowns.registers(op.carrier_hz, Some(f), knowns.amplitude, op.ref_lag_deg)?;
-        board
-            .program(&regs)
-            .map_err(|e| format!("board refused a register access: {e:?}"))?;
+        board.program(&regs).map_err(bus)?;
         let taus = if i == 0 {
             FIRST_SETTLE_TAUS
         } else {
