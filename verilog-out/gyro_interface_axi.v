@@ -4335,9 +4335,7 @@ module gyro_interface_axi__core__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
     output reg  valid;
 
     // Constant declarations
-    localparam  one = 80'h1;
-    localparam  all_ones = 80'hffffffffffffffffffff;
-    localparam  coarse_all_ones = 47'h7fffffffffff;
+    localparam  one = 41'h1;
     localparam  coarse_shift_mask = 6'b111000;
     localparam  fine_shift_mask = 6'b111;
     localparam  next_address = 3'b1;
@@ -4353,9 +4351,9 @@ module gyro_interface_axi__core__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
     localparam CicStep$SecondComb2 = 7;
     localparam CicStep$SecondComb3 = 8;
     localparam CicStep$SecondComb4 = 9;
-    localparam CicStep$SecondBias = 10;
-    localparam CicStep$SecondCoarse = 11;
-    localparam CicStep$SecondFine = 12;
+    localparam CicStep$SecondCoarse = 10;
+    localparam CicStep$SecondFine = 11;
+    localparam CicStep$SecondRound = 12;
 
     // Stub signals
     reg  integrators1$clock;
@@ -4388,15 +4386,12 @@ module gyro_interface_axi__core__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
     reg  [2:0] delay_address$d;
     wire  [2:0] delay_address$q;
     reg  delay_address$clock;
-    reg  [79:0] biased$d;
-    wire  [79:0] biased$q;
-    reg  biased$clock;
-    reg  [46:0] coarse$d;
-    wire  [46:0] coarse$q;
+    reg  [47:0] coarse$d;
+    wire  [47:0] coarse$q;
     reg  coarse$clock;
-    reg  coarse_negative$d;
-    wire  coarse_negative$q;
-    reg  coarse_negative$clock;
+    reg  [40:0] fine$d;
+    wire  [40:0] fine$q;
+    reg  fine$clock;
     reg signed [39:0] y_first$d;
     wire signed [39:0] y_first$q;
     reg  y_first$clock;
@@ -4412,14 +4407,14 @@ module gyro_interface_axi__core__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
 
     // Local signals
     reg  combing;
-    reg  [79:0] rounding;
-    reg  [79:0] sign_mask;
+    reg signed [103:0] extended;
+    reg  [103:0] doubled;
     reg  [5:0] coarse_shift;
-    reg  [79:0] coarse_shifted;
+    reg  [103:0] coarse_shifted;
     reg  [5:0] fine_shift;
-    reg  [46:0] fine_mask;
-    reg  [46:0] fine_word;
-    reg signed [39:0] fine;
+    reg  [47:0] fine_shifted;
+    reg  [40:0] rounded_half;
+    reg signed [39:0] rounded;
 
     // Sub module instances
     gyro_interface_axi__core__cic__integrators1 integrators1(
@@ -4470,20 +4465,15 @@ module gyro_interface_axi__core__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
         .q(delay_address$q),
         .clock(delay_address$clock)
     );
-    gyro_interface_axi__core__cic__biased biased(
-        .d(biased$d),
-        .q(biased$q),
-        .clock(biased$clock)
-    );
     gyro_interface_axi__core__cic__coarse coarse(
         .d(coarse$d),
         .q(coarse$q),
         .clock(coarse$clock)
     );
-    gyro_interface_axi__core__cic__coarse_negative coarse_negative(
-        .d(coarse_negative$d),
-        .q(coarse_negative$q),
-        .clock(coarse_negative$clock)
+    gyro_interface_axi__core__cic__fine fine(
+        .d(fine$d),
+        .q(fine$q),
+        .clock(fine$clock)
     );
     gyro_interface_axi__core__cic__y_first y_first(
         .d(y_first$d),
@@ -4514,9 +4504,8 @@ module gyro_interface_axi__core__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
         sample2$clock = clock;
         held_shift$clock = clock;
         delay_address$clock = clock;
-        biased$clock = clock;
         coarse$clock = clock;
-        coarse_negative$clock = clock;
+        fine$clock = clock;
         y_first$clock = clock;
         y1_out$clock = clock;
         y2_out$clock = clock;
@@ -4527,9 +4516,8 @@ module gyro_interface_axi__core__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
         sample2$d = sample2$q;
         held_shift$d = held_shift$q;
         delay_address$d = delay_address$q;
-        biased$d = biased$q;
         coarse$d = coarse$q;
-        coarse_negative$d = coarse_negative$q;
+        fine$d = fine$q;
         y_first$d = y_first$q;
         y1_out$d = y1_out$q;
         y2_out$d = y2_out$q;
@@ -4545,23 +4533,16 @@ module gyro_interface_axi__core__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
         else begin
             count$d = count$q - 32'h1;
         end
-        rounding = (one << held_shift$q) >> 32'h1;
-        biased$d = $unsigned(acc$q + $signed(rounding));
-        sign_mask = 32'h0;
-        if (biased$q[32'h4f]) begin
-            sign_mask = all_ones;
-        end
+        extended = $signed(acc$q);
+        doubled = $unsigned(extended) << 32'h1;
         coarse_shift = held_shift$q & coarse_shift_mask;
-        coarse_shifted = (biased$q ^ sign_mask) >> coarse_shift;
-        coarse$d = coarse_shifted[(32'h0)+:(47)];
-        coarse_negative$d = biased$q[32'h4f];
-        fine_mask = 32'h0;
-        if (coarse_negative$q) begin
-            fine_mask = coarse_all_ones;
-        end
+        coarse_shifted = doubled >> coarse_shift;
+        coarse$d = coarse_shifted[(32'h0)+:(48)];
         fine_shift = held_shift$q & fine_shift_mask;
-        fine_word = (coarse$q >> fine_shift) ^ fine_mask;
-        fine = $signed(fine_word[(32'h0)+:(40)]);
+        fine_shifted = coarse$q >> fine_shift;
+        fine$d = fine_shifted[(32'h0)+:(41)];
+        rounded_half = (fine$q + one) >> 32'h1;
+        rounded = $signed(rounded_half[(32'h0)+:(40)]);
         combing = 1'b0;
         valid_out$d = 1'b0;
         case (step$q)
@@ -4607,7 +4588,7 @@ module gyro_interface_axi__core__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
             CicStep$SecondComb2:
                 begin
                     combing = 1'b1;
-                    y_first$d = fine;
+                    y_first$d = rounded;
                     step$d = CicStep$SecondComb3;
                 end
             CicStep$SecondComb3:
@@ -4618,10 +4599,6 @@ module gyro_interface_axi__core__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
             CicStep$SecondComb4:
                 begin
                     combing = 1'b1;
-                    step$d = CicStep$SecondBias;
-                end
-            CicStep$SecondBias:
-                begin
                     step$d = CicStep$SecondCoarse;
                 end
             CicStep$SecondCoarse:
@@ -4630,8 +4607,12 @@ module gyro_interface_axi__core__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
                 end
             CicStep$SecondFine:
                 begin
+                    step$d = CicStep$SecondRound;
+                end
+            CicStep$SecondRound:
+                begin
                     y1_out$d = y_first$q;
-                    y2_out$d = fine;
+                    y2_out$d = rounded;
                     valid_out$d = 1'b1;
                     step$d = CicStep$Idle;
                 end
@@ -4672,35 +4653,16 @@ module gyro_interface_axi__core__cic__acc(d,q,clock);
 endmodule // gyro_interface_axi__core__cic__acc
 
 
-module gyro_interface_axi__core__cic__biased(d,q,clock);
-
-    // Module arguments
-    input wire  [79:0] d;
-    output reg  [79:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 80'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic__biased
-
-
 module gyro_interface_axi__core__cic__coarse(d,q,clock);
 
     // Module arguments
-    input wire  [46:0] d;
-    output reg  [46:0] q;
+    input wire  [47:0] d;
+    output reg  [47:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 47'h0;
+       q = 48'h0;
     end
 
     always @(posedge clock) begin
@@ -4708,25 +4670,6 @@ module gyro_interface_axi__core__cic__coarse(d,q,clock);
     end
 
 endmodule // gyro_interface_axi__core__cic__coarse
-
-
-module gyro_interface_axi__core__cic__coarse_negative(d,q,clock);
-
-    // Module arguments
-    input wire  d;
-    output reg  q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 1'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic__coarse_negative
 
 
 module gyro_interface_axi__core__cic__count(d,q,clock);
@@ -4793,6 +4736,25 @@ module gyro_interface_axi__core__cic__delays(clock,write_enable,write_address,wr
        q <= words[read_address];
     end
 endmodule // gyro_interface_axi__core__cic__delays
+
+
+module gyro_interface_axi__core__cic__fine(d,q,clock);
+
+    // Module arguments
+    input wire  [40:0] d;
+    output reg  [40:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 41'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__fine
 
 
 module gyro_interface_axi__core__cic__held_shift(d,q,clock);
@@ -5137,9 +5099,9 @@ module gyro_interface_axi__core__cic__step(d,q,clock);
     localparam CicStep$SecondComb2 = 7;
     localparam CicStep$SecondComb3 = 8;
     localparam CicStep$SecondComb4 = 9;
-    localparam CicStep$SecondBias = 10;
-    localparam CicStep$SecondCoarse = 11;
-    localparam CicStep$SecondFine = 12;
+    localparam CicStep$SecondCoarse = 10;
+    localparam CicStep$SecondFine = 11;
+    localparam CicStep$SecondRound = 12;
 
     // Update code (custom)
     initial begin

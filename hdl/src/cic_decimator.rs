@@ -25,19 +25,27 @@
 //! folds 1/G into its numerator (`crate::filter_design`), so z has unity
 //! gain. |x| < 2^31 gives |y| < 2^39: 40 bits, no overflow.
 //!
-//! The output stage takes `OUTPUT_STAGES` = 3 clocks, so that no clock
-//! carries more than one carry chain or three mux levels:
-//! 1. bias: b = comb4 + 2^(shift-1) (80-bit add; the rounding constant is
-//!    a decoded one-hot word, no shifter);
-//! 2. coarse: ((b ^ s) >> (shift & 0b111000)), low `COARSE_BITS` = 40 + 7
-//!    bits, with s the sign mask of b (the fine step moves at most 7 bits
-//!    and 40 are kept, so the bits above 47 are never read);
-//! 3. fine: (coarse >> (shift & 0b000111)) ^ s, low 40 bits.
+//! The rounding needs no adder as wide as the comb: with b the comb output
+//! and s the shift, floor(b / 2^s + 1/2) = floor((floor(2b / 2^s) + 1) / 2)
+//! (for real t, floor((floor(t) + 1) / 2) = floor((t + 1) / 2)). So the
+//! output stage shifts the doubled comb word right by s, keeping
+//! `HALF_BITS` = 41 bits (the output and one bit below it), adds 1 and
+//! drops that bit. The doubled word is b sign-extended to `DOUBLED_BITS` =
+//! 41 + 63 = 104 bits, so every shift the 6-bit setting can hold reads
+//! bits that exist and the shifts can be logical. It takes
+//! `OUTPUT_STAGES` = 3 clocks, so that no clock carries more than one
+//! carry chain or three mux levels:
+//! 1. coarse: (2b >> (shift & 0b111000)), low `COARSE_BITS` = 41 + 7 bits
+//!    (the fine step moves at most 7 bits);
+//! 2. fine: (coarse >> (shift & 0b000111)), low 41 bits;
+//! 3. round: (fine + 1) >> 1, low 40 bits (a 41-bit increment).
 //!
-//! Logical shifts compose, so this equals ((b ^ s) >> shift) ^ s exactly,
-//! the arithmetic shift of b. The bias and coarse registers run every
-//! clock on whatever the accumulator holds; the schedule reads the fine
-//! result at the two clocks where it belongs to a comb output.
+//! The coarse and fine registers run every clock on whatever the
+//! accumulator holds; the schedule reads the rounded result at the two
+//! clocks where it belongs to a comb output. (An earlier version added
+//! 2^(shift-1) to the 80-bit comb word first: the same outputs for every
+//! shift up to 40, at the cost of an 80-bit adder, a one-hot decoder and
+//! two XOR layers.)
 //!
 //! Schedule (`CicStep`, one state per clock; t0 is the strobe cycle, when
 //! the down counter is 0 and the schedule is `Idle`):
@@ -46,17 +54,17 @@
 //! |---|---|---|---|
 //! | t0 | `Idle` | acc <- integral 1, sample2 <- integral 2, shift held | |
 //! | t1..t4 | `FirstComb1..4` | acc <- acc - delay[k], delay[k] <- acc (channel 1) | |
-//! | t5 | `SecondLoad` | acc <- sample2 | bias (channel 1) |
-//! | t6..t9 | `SecondComb1..4` | the same for channel 2 | coarse (t6), fine (t7) -> y_first |
-//! | t10 | `SecondBias` | | bias (channel 2) |
-//! | t11 | `SecondCoarse` | | coarse |
-//! | t12 | `SecondFine` | | fine -> y2, y_first -> y1, valid |
+//! | t5 | `SecondLoad` | acc <- sample2 | coarse (channel 1) |
+//! | t6..t9 | `SecondComb1..4` | the same for channel 2 | fine (t6), round (t7) -> y_first |
+//! | t10 | `SecondCoarse` | | coarse (channel 2) |
+//! | t11 | `SecondFine` | | fine |
+//! | t12 | `SecondRound` | | round -> y2, y_first -> y1, valid |
 //!
 //! `y1`, `y2` and a one-clock `valid` appear during t13, `SAMPLE_TO_OUTPUT`
 //! = 13 clocks after the strobe cycle, and the schedule is back in `Idle`
-//! then: `SCHEDULE_CLOCKS` = 13 clocks. The decimation floor of the design
-//! (`crate::filter_design::MIN_DECIMATION` = 16) leaves a margin of 3
-//! clocks, checked at compile time. A strobe that arrives while the
+//! then: `SCHEDULE_CLOCKS` = 13 clocks, at most the decimation floor of the
+//! design (`crate::filter_design::MIN_DECIMATION`, set by the IIR's
+//! schedule), checked at compile time. A strobe that arrives while the
 //! schedule runs (R < 13, outside the supported range) is dropped; the
 //! counter reloads all the same. The RAM is read one clock ahead of each
 //! comb step and written at the step (the old value of the word it reads
@@ -69,10 +77,11 @@
 //! saved for five of the iCE40's 30 block RAMs.
 //!
 //! Resources (Yosys 0.23 `synth_ice40 -dsp`, this module alone, both
-//! channels): 1484 `SB_LUT4`, 813 `SB_CARRY`, 1075 flip-flops, 5
+//! channels): 1384 `SB_LUT4`, 773 `SB_CARRY`, 1036 flip-flops, 5
 //! `SB_RAM40_4K`; of these the two `CicIntegrators` are 640 LUT4 and 640
-//! flip-flops. The two single-channel decimators this block replaces took
-//! 2 x 1459 LUT4 and 2 x 1238 flip-flops.
+//! flip-flops. The bias-first output stage took 1483 LUT4, 813 carries and
+//! 1075 flip-flops; the two single-channel decimators the shared back-end
+//! replaced took 2 x 1459 LUT4 and 2 x 1238 flip-flops.
 //!
 //! Run-time settings: `decimation` R in 16..=4096 (a 13-bit word; the down
 //! counter reloads R - 1 at each strobe, so a new R acts from the next
@@ -83,6 +92,7 @@
 
 use crate::cic_integrators::CicIntegrators;
 use crate::primitives::WordRam;
+use crate::primitives::convert::signed_bit_cast_exact;
 use rust_hdl::prelude::*;
 
 /// Number of integrator and comb stages.
@@ -109,11 +119,17 @@ pub const FINE_SHIFT_BITS: usize = 3;
 pub const FINE_SHIFT_MASK: u64 = (1 << FINE_SHIFT_BITS) - 1;
 /// The shift bits of the coarse step (multiples of 8): `shift & 0b111000`.
 pub const COARSE_SHIFT_MASK: u64 = ((1 << SHIFT_BITS) - 1) & !FINE_SHIFT_MASK;
+/// Width of floor(2b / 2^shift) as the output stage keeps it: the output
+/// and the one bit below it that decides the rounding.
+pub const HALF_BITS: usize = OUTPUT_BITS + 1;
+/// Width of the doubled, sign-extended comb word 2b: the largest shift the
+/// setting holds (63) plus `HALF_BITS` bits, so every read bit exists.
+pub const DOUBLED_BITS: usize = HALF_BITS + (1 << SHIFT_BITS) - 1;
 /// Width kept after the coarse step: the fine step shifts by at most
-/// 2^3 - 1 = 7 and the output keeps 40 bits, so bits 0..40 + 7 suffice.
-pub const COARSE_BITS: usize = OUTPUT_BITS + (1 << FINE_SHIFT_BITS) - 1;
+/// 2^3 - 1 = 7 and keeps `HALF_BITS`, so bits 0..41 + 7 suffice.
+pub const COARSE_BITS: usize = HALF_BITS + (1 << FINE_SHIFT_BITS) - 1;
 /// Clocks from a comb output in the accumulator to its rounded value:
-/// bias, coarse, fine.
+/// coarse, fine, round.
 pub const OUTPUT_STAGES: usize = 3;
 /// Channels sharing the back-end.
 pub const CHANNELS: usize = 2;
@@ -127,6 +143,7 @@ pub const SCHEDULE_CLOCKS: usize = CHANNELS * (1 + STAGES as usize) + OUTPUT_STA
 pub const SAMPLE_TO_OUTPUT: usize = SCHEDULE_CLOCKS;
 
 const _: () = assert!(CHANNELS * STAGES as usize == 1 << DELAY_ADDRESS_BITS);
+const _: () = assert!(DOUBLED_BITS > REGISTER_BITS);
 const _: () = assert!(SCHEDULE_CLOCKS as u32 <= crate::filter_design::MIN_DECIMATION);
 
 /// The back-end schedule, one state per clock (see the module header).
@@ -142,22 +159,22 @@ pub enum CicStep {
     FirstComb3,
     /// Comb 4 of channel 1.
     FirstComb4,
-    /// Load channel 2's sample; bias channel 1's comb output.
+    /// Load channel 2's sample; coarse step of channel 1's comb output.
     SecondLoad,
-    /// Comb 1 of channel 2; coarse step of channel 1.
+    /// Comb 1 of channel 2; fine step of channel 1.
     SecondComb1,
-    /// Comb 2 of channel 2; channel 1's fine result into `y_first`.
+    /// Comb 2 of channel 2; channel 1's rounded result into `y_first`.
     SecondComb2,
     /// Comb 3 of channel 2.
     SecondComb3,
     /// Comb 4 of channel 2.
     SecondComb4,
-    /// Bias channel 2's comb output.
-    SecondBias,
-    /// Coarse step of channel 2.
+    /// Coarse step of channel 2's comb output.
     SecondCoarse,
-    /// Publish both outputs at the next edge.
+    /// Fine step of channel 2.
     SecondFine,
+    /// Round channel 2 and publish both outputs at the next edge.
+    SecondRound,
 }
 
 /// Two-channel four-stage CIC decimator with run-time rate and output
@@ -190,24 +207,21 @@ pub struct CicDecimator {
     delays: WordRam<REGISTER_BITS, DELAY_ADDRESS_BITS>,
     delay_address: DFF<Bits<DELAY_ADDRESS_BITS>>,
     combing: Signal<Local, Bit>,
-    rounding: Signal<Local, Bits<REGISTER_BITS>>,
-    biased: DFF<Bits<REGISTER_BITS>>,
-    sign_mask: Signal<Local, Bits<REGISTER_BITS>>,
+    extended: Signal<Local, Signed<DOUBLED_BITS>>,
+    doubled: Signal<Local, Bits<DOUBLED_BITS>>,
     coarse_shift: Signal<Local, Bits<SHIFT_BITS>>,
-    coarse_shifted: Signal<Local, Bits<REGISTER_BITS>>,
+    coarse_shifted: Signal<Local, Bits<DOUBLED_BITS>>,
     coarse: DFF<Bits<COARSE_BITS>>,
-    coarse_negative: DFF<Bit>,
     fine_shift: Signal<Local, Bits<SHIFT_BITS>>,
-    fine_mask: Signal<Local, Bits<COARSE_BITS>>,
-    fine_word: Signal<Local, Bits<COARSE_BITS>>,
-    fine: Signal<Local, Signed<OUTPUT_BITS>>,
+    fine_shifted: Signal<Local, Bits<COARSE_BITS>>,
+    fine: DFF<Bits<HALF_BITS>>,
+    rounded_half: Signal<Local, Bits<HALF_BITS>>,
+    rounded: Signal<Local, Signed<OUTPUT_BITS>>,
     y_first: DFF<Signed<OUTPUT_BITS>>,
     y1_out: DFF<Signed<OUTPUT_BITS>>,
     y2_out: DFF<Signed<OUTPUT_BITS>>,
     valid_out: DFF<Bit>,
-    one: Constant<Bits<REGISTER_BITS>>,
-    all_ones: Constant<Bits<REGISTER_BITS>>,
-    coarse_all_ones: Constant<Bits<COARSE_BITS>>,
+    one: Constant<Bits<HALF_BITS>>,
     coarse_shift_mask: Constant<Bits<SHIFT_BITS>>,
     fine_shift_mask: Constant<Bits<SHIFT_BITS>>,
     next_address: Constant<Bits<DELAY_ADDRESS_BITS>>,
@@ -235,24 +249,21 @@ impl CicDecimator {
             delays: WordRam::new(),
             delay_address: Default::default(),
             combing: Default::default(),
-            rounding: Default::default(),
-            biased: Default::default(),
-            sign_mask: Default::default(),
+            extended: Default::default(),
+            doubled: Default::default(),
             coarse_shift: Default::default(),
             coarse_shifted: Default::default(),
             coarse: Default::default(),
-            coarse_negative: Default::default(),
             fine_shift: Default::default(),
-            fine_mask: Default::default(),
-            fine_word: Default::default(),
+            fine_shifted: Default::default(),
             fine: Default::default(),
+            rounded_half: Default::default(),
+            rounded: Default::default(),
             y_first: Default::default(),
             y1_out: Default::default(),
             y2_out: Default::default(),
             valid_out: Default::default(),
             one: Constant::new(1.into()),
-            all_ones: Constant::new(Bits::<REGISTER_BITS>::mask()),
-            coarse_all_ones: Constant::new(Bits::<COARSE_BITS>::mask()),
             coarse_shift_mask: Constant::new(COARSE_SHIFT_MASK.into()),
             fine_shift_mask: Constant::new(FINE_SHIFT_MASK.into()),
             next_address: Constant::new(1.into()),
@@ -278,9 +289,8 @@ impl Logic for CicDecimator {
             sample2,
             held_shift,
             delay_address,
-            biased,
             coarse,
-            coarse_negative,
+            fine,
             y_first,
             y1_out,
             y2_out,
@@ -298,26 +308,16 @@ impl Logic for CicDecimator {
             self.count.d.next = self.count.q.val() - 1;
         }
         // Output stage (module header), every clock on the accumulator.
-        self.rounding.next = (self.one.val() << self.held_shift.q.val()) >> 1;
-        self.biased.d.next = unsigned_cast(self.acc.q.val() + signed_cast(self.rounding.val()));
-        self.sign_mask.next = 0.into();
-        // Sign bit, REGISTER_BITS - 1 (rust-hdl needs a literal index; a
-        // signed compare with 0 costs a comparator in Yosys).
-        if self.biased.q.val().get_bit(79) {
-            self.sign_mask.next = self.all_ones.val();
-        }
+        self.extended.next = signed_bit_cast_exact::<DOUBLED_BITS, REGISTER_BITS>(self.acc.q.val());
+        self.doubled.next = unsigned_cast(self.extended.val()) << 1;
         self.coarse_shift.next = self.held_shift.q.val() & self.coarse_shift_mask.val();
-        self.coarse_shifted.next =
-            (self.biased.q.val() ^ self.sign_mask.val()) >> self.coarse_shift.val();
+        self.coarse_shifted.next = self.doubled.val() >> self.coarse_shift.val();
         self.coarse.d.next = self.coarse_shifted.val().get_bits::<COARSE_BITS>(0);
-        self.coarse_negative.d.next = self.biased.q.val().get_bit(79);
-        self.fine_mask.next = 0.into();
-        if self.coarse_negative.q.val() {
-            self.fine_mask.next = self.coarse_all_ones.val();
-        }
         self.fine_shift.next = self.held_shift.q.val() & self.fine_shift_mask.val();
-        self.fine_word.next = (self.coarse.q.val() >> self.fine_shift.val()) ^ self.fine_mask.val();
-        self.fine.next = signed_cast(self.fine_word.val().get_bits::<OUTPUT_BITS>(0));
+        self.fine_shifted.next = self.coarse.q.val() >> self.fine_shift.val();
+        self.fine.d.next = self.fine_shifted.val().get_bits::<HALF_BITS>(0);
+        self.rounded_half.next = (self.fine.q.val() + self.one.val()) >> 1;
+        self.rounded.next = signed_cast(self.rounded_half.val().get_bits::<OUTPUT_BITS>(0));
         // Schedule.
         self.combing.next = false;
         self.valid_out.d.next = false;
@@ -356,7 +356,7 @@ impl Logic for CicDecimator {
             }
             CicStep::SecondComb2 => {
                 self.combing.next = true;
-                self.y_first.d.next = self.fine.val();
+                self.y_first.d.next = self.rounded.val();
                 self.step.d.next = CicStep::SecondComb3;
             }
             CicStep::SecondComb3 => {
@@ -365,17 +365,17 @@ impl Logic for CicDecimator {
             }
             CicStep::SecondComb4 => {
                 self.combing.next = true;
-                self.step.d.next = CicStep::SecondBias;
-            }
-            CicStep::SecondBias => {
                 self.step.d.next = CicStep::SecondCoarse;
             }
             CicStep::SecondCoarse => {
                 self.step.d.next = CicStep::SecondFine;
             }
             CicStep::SecondFine => {
+                self.step.d.next = CicStep::SecondRound;
+            }
+            CicStep::SecondRound => {
                 self.y1_out.d.next = self.y_first.q.val();
-                self.y2_out.d.next = self.fine.val();
+                self.y2_out.d.next = self.rounded.val();
                 self.valid_out.d.next = true;
                 self.step.d.next = CicStep::Idle;
             }

@@ -11,8 +11,8 @@
 //! The hardware's 80-bit wrap-around is modelled by wrapping i128
 //! arithmetic: reduction modulo 2^80 commutes with addition and
 //! subtraction, so the low 80 bits of every model value equal the hardware
-//! register, and the output stage wraps to 80 bits before it shifts, where
-//! the upper bits would start to matter.
+//! register; the output stage starts from the wrapped 80-bit comb word,
+//! where the upper bits would start to matter.
 
 use crate::cic_decimator::{
     CHANNELS, DECIMATION_BITS, OUTPUT_BITS, REGISTER_BITS, SAMPLE_TO_OUTPUT, STAGES,
@@ -25,13 +25,15 @@ fn wrap(x: i128) -> i128 {
     (x << SHIFT) >> SHIFT
 }
 
-/// `round(x / 2^shift)` (half up) on an 80-bit value, wrapped to 40 bits.
+/// `round(x / 2^shift)` (half up) of the 80-bit value `wrap(x)`, wrapped
+/// to 40 bits, computed as the hardware does it:
+/// floor((floor(2x / 2^shift) + 1) / 2) (`crate::cic_decimator`'s header).
 #[inline(always)]
 pub fn scale_output(x: i128, shift: u32) -> i64 {
-    let rounding = if shift == 0 { 0 } else { 1i128 << (shift - 1) };
-    let shifted = wrap(x + rounding) >> shift;
+    let half = (wrap(x) << 1) >> shift;
+    let rounded = (half + 1) >> 1;
     const OUT_SHIFT: u32 = 128 - OUTPUT_BITS as u32;
-    ((shifted << OUT_SHIFT) >> OUT_SHIFT) as i64
+    ((rounded << OUT_SHIFT) >> OUT_SHIFT) as i64
 }
 
 /// Cycle-true model of the two-channel CIC.
@@ -121,5 +123,64 @@ impl CicDecimator {
         }
         self.integrator = [[a1, a2, a3, a4], [b1, b2, b3, b4]];
         self.pending.clear();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// round(x / 2^shift) half up, exact in i128 (no 80-bit wrap), low 40 bits.
+    fn round_half_up(x: i128, shift: u32) -> i64 {
+        let rounded = (x + ((1i128 << shift) >> 1)) >> shift;
+        let out_shift = 128 - OUTPUT_BITS as u32;
+        ((rounded << out_shift) >> out_shift) as i64
+    }
+
+    const FULL_SCALE: i128 = 1 << (REGISTER_BITS - 1);
+
+    #[test]
+    fn ties_round_up_at_every_shift() {
+        for shift in 1..=40u32 {
+            let half = 1i128 << (shift - 1);
+            for k in [-3i128, -1, 0, 1, 5] {
+                let x = (k << shift) + half;
+                assert_eq!(
+                    scale_output(x, shift),
+                    (k + 1) as i64,
+                    "tie {k}.5, shift {shift}"
+                );
+                assert_eq!(scale_output(x - 1, shift), k as i64, "below tie {k}.5");
+            }
+        }
+        assert_eq!(scale_output(-7, 0), -7);
+    }
+
+    #[test]
+    fn full_scale_words_match_the_exact_rounding() {
+        for shift in 0..=40u32 {
+            for x in [
+                FULL_SCALE - 1,
+                -FULL_SCALE,
+                FULL_SCALE - (1 << 20),
+                -FULL_SCALE + 1,
+            ] {
+                assert_eq!(
+                    scale_output(x, shift),
+                    round_half_up(x, shift),
+                    "x {x}, shift {shift}"
+                );
+            }
+        }
+    }
+
+    proptest! {
+        /// For every shift the datapath uses (0..=40) the adder-free form
+        /// equals round half up of the 80-bit comb word.
+        #[test]
+        fn doubled_word_form_is_round_half_up(x in -FULL_SCALE..FULL_SCALE, shift in 0u32..=40) {
+            prop_assert_eq!(scale_output(x, shift), round_half_up(x, shift));
+        }
     }
 }
