@@ -194,8 +194,8 @@ fn stale_waiver_detection_works() {
     std::fs::write(
         &file,
         "`verilator_config\n\
-         // Live: the sincos quadrant compare with a 32-bit literal.\n\
-         lint_off -rule WIDTH -file \"*gyro_interface.v\" -match \"Operator EQ expects 32 bits on the LHS, but LHS's VARREF 'quadrant_3$q' generates 2 bits.\"\n\
+         // Live: the CIC counter compare with a 32-bit literal.\n\
+         lint_off -rule WIDTH -file \"*gyro_interface.v\" -match \"Operator EQ expects 32 bits on the LHS, but LHS's VARREF 'count$q' generates 13 bits.\"\n\
          // Stale: there is no signal of this name in the design.\n\
          lint_off -rule WIDTH -file \"*gyro_interface.v\" -match \"Operator EQ expects 32 bits on the LHS, but LHS's VARREF 'no_such_signal' generates 2 bits.\"\n",
     )
@@ -208,7 +208,7 @@ fn stale_waiver_detection_works() {
         uses[0]
             .suppressed
             .iter()
-            .all(|w| w.message.contains("'quadrant_3$q'"))
+            .all(|w| w.message.contains("'count$q'"))
     );
     assert!(uses[1].suppressed.is_empty(), "stale waiver not detected");
 }

@@ -232,15 +232,23 @@ module gyro_interface__am_mixer(clock,amp1,amp2,am1,am2,drive_cos,drive_sin,ref_
     output reg signed [15:0] ref1;
     output reg signed [15:0] ref2;
 
+    // Constant declarations
+    localparam  channel1_out_turn = 1'b1;
+
     // Stub signals
-    reg  envelope1$clock;
-    reg signed [15:0] envelope1$a;
-    reg signed [15:0] envelope1$b;
-    wire signed [15:0] envelope1$y;
-    reg  envelope2$clock;
-    reg signed [15:0] envelope2$a;
-    reg signed [15:0] envelope2$b;
-    wire signed [15:0] envelope2$y;
+    reg  envelope$clock;
+    reg signed [15:0] envelope$a;
+    reg signed [15:0] envelope$b;
+    wire signed [15:0] envelope$y;
+    reg  turn$d;
+    wire  turn$q;
+    reg  turn$clock;
+    reg signed [15:0] fa1$d;
+    wire signed [15:0] fa1$q;
+    reg  fa1$clock;
+    reg signed [15:0] fa2$d;
+    wire signed [15:0] fa2$q;
+    reg  fa2$clock;
     reg  drive1$clock;
     reg signed [15:0] drive1$a;
     reg signed [15:0] drive1$b;
@@ -259,17 +267,26 @@ module gyro_interface__am_mixer(clock,amp1,amp2,am1,am2,drive_cos,drive_sin,ref_
     wire signed [15:0] reference2$y;
 
     // Sub module instances
-    gyro_interface__am_mixer__envelope1 envelope1(
-        .clock(envelope1$clock),
-        .a(envelope1$a),
-        .b(envelope1$b),
-        .y(envelope1$y)
+    gyro_interface__am_mixer__envelope envelope(
+        .clock(envelope$clock),
+        .a(envelope$a),
+        .b(envelope$b),
+        .y(envelope$y)
     );
-    gyro_interface__am_mixer__envelope2 envelope2(
-        .clock(envelope2$clock),
-        .a(envelope2$a),
-        .b(envelope2$b),
-        .y(envelope2$y)
+    gyro_interface__am_mixer__turn turn(
+        .d(turn$d),
+        .q(turn$q),
+        .clock(turn$clock)
+    );
+    gyro_interface__am_mixer__fa1 fa1(
+        .d(fa1$d),
+        .q(fa1$q),
+        .clock(fa1$clock)
+    );
+    gyro_interface__am_mixer__fa2 fa2(
+        .d(fa2$d),
+        .q(fa2$q),
+        .clock(fa2$clock)
     );
     gyro_interface__am_mixer__drive1 drive1(
         .clock(drive1$clock),
@@ -298,23 +315,37 @@ module gyro_interface__am_mixer(clock,amp1,amp2,am1,am2,drive_cos,drive_sin,ref_
 
     // Update code
     always @(*) begin
-        envelope1$clock = clock;
-        envelope2$clock = clock;
+        turn$clock = clock;
+        fa1$clock = clock;
+        fa2$clock = clock;
+        turn$d = turn$q;
+        fa1$d = fa1$q;
+        fa2$d = fa2$q;
+        envelope$clock = clock;
         drive1$clock = clock;
         drive2$clock = clock;
         reference1$clock = clock;
         reference2$clock = clock;
-        envelope1$a = amp1;
-        envelope1$b = am1;
-        envelope2$a = amp2;
-        envelope2$b = am2;
-        drive1$a = envelope1$y;
+        turn$d = ~turn$q;
+        envelope$a = amp1;
+        envelope$b = am1;
+        if (turn$q) begin
+            envelope$a = amp2;
+            envelope$b = am2;
+        end
+        if (turn$q == channel1_out_turn) begin
+            fa1$d = envelope$y;
+        end
+        else begin
+            fa2$d = envelope$y;
+        end
+        drive1$a = fa1$q;
         drive1$b = drive_cos;
-        drive2$a = envelope2$y;
+        drive2$a = fa2$q;
         drive2$b = drive_sin;
-        reference1$a = envelope1$y;
+        reference1$a = fa1$q;
         reference1$b = ref_cos;
-        reference2$a = envelope2$y;
+        reference2$a = fa2$q;
         reference2$b = ref_sin;
         dac1 = drive1$y;
         dac2 = drive2$y;
@@ -619,7 +650,7 @@ module gyro_interface__am_mixer__drive2__y_out(d,q,clock);
 endmodule // gyro_interface__am_mixer__drive2__y_out
 
 
-module gyro_interface__am_mixer__envelope1(clock,a,b,y);
+module gyro_interface__am_mixer__envelope(clock,a,b,y);
 
     // Module arguments
     input wire  clock;
@@ -649,23 +680,23 @@ module gyro_interface__am_mixer__envelope1(clock,a,b,y);
     reg signed [31:0] rounded;
 
     // Sub module instances
-    gyro_interface__am_mixer__envelope1__a_in a_in(
+    gyro_interface__am_mixer__envelope__a_in a_in(
         .d(a_in$d),
         .q(a_in$q),
         .clock(a_in$clock)
     );
-    gyro_interface__am_mixer__envelope1__b_in b_in(
+    gyro_interface__am_mixer__envelope__b_in b_in(
         .d(b_in$d),
         .q(b_in$q),
         .clock(b_in$clock)
     );
-    gyro_interface__am_mixer__envelope1__product product(
+    gyro_interface__am_mixer__envelope__product product(
         .clock(product$clock),
         .a(product$a),
         .b(product$b),
         .p(product$p)
     );
-    gyro_interface__am_mixer__envelope1__y_out y_out(
+    gyro_interface__am_mixer__envelope__y_out y_out(
         .d(y_out$d),
         .q(y_out$q),
         .clock(y_out$clock)
@@ -689,29 +720,10 @@ module gyro_interface__am_mixer__envelope1(clock,a,b,y);
         y = y_out$q;
     end
 
-endmodule // gyro_interface__am_mixer__envelope1
+endmodule // gyro_interface__am_mixer__envelope
 
 
-module gyro_interface__am_mixer__envelope1__a_in(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__am_mixer__envelope1__a_in
-
-
-module gyro_interface__am_mixer__envelope1__b_in(d,q,clock);
+module gyro_interface__am_mixer__envelope__a_in(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -727,10 +739,29 @@ module gyro_interface__am_mixer__envelope1__b_in(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__am_mixer__envelope1__b_in
+endmodule // gyro_interface__am_mixer__envelope__a_in
 
 
-module gyro_interface__am_mixer__envelope1__product(clock,a,b,p);
+module gyro_interface__am_mixer__envelope__b_in(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__am_mixer__envelope__b_in
+
+
+module gyro_interface__am_mixer__envelope__product(clock,a,b,p);
 
     // Module arguments
     input wire  clock;
@@ -744,102 +775,10 @@ module gyro_interface__am_mixer__envelope1__product(clock,a,b,p);
     always @(posedge clock) begin
        p <= a * b;
     end
-endmodule // gyro_interface__am_mixer__envelope1__product
+endmodule // gyro_interface__am_mixer__envelope__product
 
 
-module gyro_interface__am_mixer__envelope1__y_out(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__am_mixer__envelope1__y_out
-
-
-module gyro_interface__am_mixer__envelope2(clock,a,b,y);
-
-    // Module arguments
-    input wire  clock;
-    input wire signed [15:0] a;
-    input wire signed [15:0] b;
-    output reg signed [15:0] y;
-
-    // Constant declarations
-    localparam signed half_lsb = 32'h4000;
-
-    // Stub signals
-    reg signed [15:0] a_in$d;
-    wire signed [15:0] a_in$q;
-    reg  a_in$clock;
-    reg signed [15:0] b_in$d;
-    wire signed [15:0] b_in$q;
-    reg  b_in$clock;
-    reg  product$clock;
-    reg signed [15:0] product$a;
-    reg signed [15:0] product$b;
-    wire signed [31:0] product$p;
-    reg signed [15:0] y_out$d;
-    wire signed [15:0] y_out$q;
-    reg  y_out$clock;
-
-    // Local signals
-    reg signed [31:0] rounded;
-
-    // Sub module instances
-    gyro_interface__am_mixer__envelope2__a_in a_in(
-        .d(a_in$d),
-        .q(a_in$q),
-        .clock(a_in$clock)
-    );
-    gyro_interface__am_mixer__envelope2__b_in b_in(
-        .d(b_in$d),
-        .q(b_in$q),
-        .clock(b_in$clock)
-    );
-    gyro_interface__am_mixer__envelope2__product product(
-        .clock(product$clock),
-        .a(product$a),
-        .b(product$b),
-        .p(product$p)
-    );
-    gyro_interface__am_mixer__envelope2__y_out y_out(
-        .d(y_out$d),
-        .q(y_out$q),
-        .clock(y_out$clock)
-    );
-
-    // Update code
-    always @(*) begin
-        a_in$clock = clock;
-        b_in$clock = clock;
-        y_out$clock = clock;
-        a_in$d = a_in$q;
-        b_in$d = b_in$q;
-        y_out$d = y_out$q;
-        a_in$d = a;
-        b_in$d = b;
-        product$clock = clock;
-        product$a = a_in$q;
-        product$b = b_in$q;
-        rounded = product$p + half_lsb;
-        y_out$d = rounded[(32'hf)+:(16)];
-        y = y_out$q;
-    end
-
-endmodule // gyro_interface__am_mixer__envelope2
-
-
-module gyro_interface__am_mixer__envelope2__a_in(d,q,clock);
+module gyro_interface__am_mixer__envelope__y_out(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -855,46 +794,10 @@ module gyro_interface__am_mixer__envelope2__a_in(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__am_mixer__envelope2__a_in
+endmodule // gyro_interface__am_mixer__envelope__y_out
 
 
-module gyro_interface__am_mixer__envelope2__b_in(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__am_mixer__envelope2__b_in
-
-
-module gyro_interface__am_mixer__envelope2__product(clock,a,b,p);
-
-    // Module arguments
-    input wire  clock;
-    input wire signed [15:0] a;
-    input wire signed [15:0] b;
-    output reg signed [31:0] p;
-
-    // Update code (custom)
-    initial p = 0;
-
-    always @(posedge clock) begin
-       p <= a * b;
-    end
-endmodule // gyro_interface__am_mixer__envelope2__product
-
-
-module gyro_interface__am_mixer__envelope2__y_out(d,q,clock);
+module gyro_interface__am_mixer__fa1(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -910,7 +813,26 @@ module gyro_interface__am_mixer__envelope2__y_out(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__am_mixer__envelope2__y_out
+endmodule // gyro_interface__am_mixer__fa1
+
+
+module gyro_interface__am_mixer__fa2(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__am_mixer__fa2
 
 
 module gyro_interface__am_mixer__reference1(clock,a,b,y);
@@ -1207,6 +1129,25 @@ module gyro_interface__am_mixer__reference2__y_out(d,q,clock);
 endmodule // gyro_interface__am_mixer__reference2__y_out
 
 
+module gyro_interface__am_mixer__turn(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__am_mixer__turn
+
+
 module gyro_interface__carrier_nco(clock,step,ref_offset,drive_cos,drive_sin,ref_cos,ref_sin);
 
     // Module arguments
@@ -1277,272 +1218,270 @@ module gyro_interface__carrier_nco__drive(clock,phase,sin,cos);
     output reg signed [15:0] cos;
 
     // Constant declarations
+    localparam  no_turn = 2'b0;
+    localparam  quarter_turn = 2'b1;
+
+    // Stub signals
+    reg  sine$clock;
+    reg  [31:0] sine$phase;
+    reg  [1:0] sine$advance;
+    wire signed [15:0] sine$sin;
+    reg  cosine$clock;
+    reg  [31:0] cosine$phase;
+    reg  [1:0] cosine$advance;
+    wire signed [15:0] cosine$sin;
+
+    // Sub module instances
+    gyro_interface__carrier_nco__drive__sine sine(
+        .clock(sine$clock),
+        .phase(sine$phase),
+        .advance(sine$advance),
+        .sin(sine$sin)
+    );
+    gyro_interface__carrier_nco__drive__cosine cosine(
+        .clock(cosine$clock),
+        .phase(cosine$phase),
+        .advance(cosine$advance),
+        .sin(cosine$sin)
+    );
+
+    // Update code
+    always @(*) begin
+        sine$clock = clock;
+        cosine$clock = clock;
+        sine$phase = phase;
+        cosine$phase = phase;
+        sine$advance = no_turn;
+        cosine$advance = quarter_turn;
+        sin = sine$sin;
+        cos = cosine$sin;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive
+
+
+module gyro_interface__carrier_nco__drive__cosine(clock,phase,advance,sin);
+
+    // Module arguments
+    input wire  clock;
+    input wire  [31:0] phase;
+    input wire  [1:0] advance;
+    output reg signed [15:0] sin;
+
+    // Constant declarations
     localparam  half_step = 16'h4000;
     localparam signed rounding = 32'h200000;
 
     // Stub signals
     reg  rom$clock;
-    reg  [7:0] rom$addr_a;
-    reg  [7:0] rom$addr_b;
-    wire signed [15:0] rom$value_a;
-    wire signed [15:0] rom$slope_a;
-    wire signed [15:0] rom$value_b;
-    wire signed [15:0] rom$slope_b;
-    reg  sin_slope_product$clock;
-    reg signed [15:0] sin_slope_product$a;
-    reg signed [15:0] sin_slope_product$b;
-    wire signed [31:0] sin_slope_product$p;
-    reg  cos_slope_product$clock;
-    reg signed [15:0] cos_slope_product$a;
-    reg signed [15:0] cos_slope_product$b;
-    wire signed [31:0] cos_slope_product$p;
+    reg  [7:0] rom$addr;
+    wire signed [15:0] rom$value;
+    wire signed [15:0] rom$slope;
+    reg  slope_product$clock;
+    reg signed [15:0] slope_product$a;
+    reg signed [15:0] slope_product$b;
+    wire signed [31:0] slope_product$p;
+    reg  [7:0] index_1$d;
+    wire  [7:0] index_1$q;
+    reg  index_1$clock;
     reg  [1:0] quadrant_1$d;
     wire  [1:0] quadrant_1$q;
     reg  quadrant_1$clock;
     reg signed [15:0] offset_1$d;
     wire signed [15:0] offset_1$q;
     reg  offset_1$clock;
+    reg  [1:0] quadrant_2$d;
+    wire  [1:0] quadrant_2$q;
+    reg  quadrant_2$clock;
+    reg signed [15:0] offset_2$d;
+    wire signed [15:0] offset_2$q;
+    reg  offset_2$clock;
     reg  [1:0] quadrant_read$d;
     wire  [1:0] quadrant_read$q;
     reg  quadrant_read$clock;
     reg signed [15:0] offset_read$d;
     wire signed [15:0] offset_read$q;
     reg  offset_read$clock;
-    reg signed [15:0] sin_value_read$d;
-    wire signed [15:0] sin_value_read$q;
-    reg  sin_value_read$clock;
-    reg signed [15:0] cos_value_read$d;
-    wire signed [15:0] cos_value_read$q;
-    reg  cos_value_read$clock;
-    reg signed [15:0] sin_slope_read$d;
-    wire signed [15:0] sin_slope_read$q;
-    reg  sin_slope_read$clock;
-    reg signed [15:0] cos_slope_read$d;
-    wire signed [15:0] cos_slope_read$q;
-    reg  cos_slope_read$clock;
-    reg  [1:0] quadrant_2$d;
-    wire  [1:0] quadrant_2$q;
-    reg  quadrant_2$clock;
-    reg signed [15:0] sin_sample_2$d;
-    wire signed [15:0] sin_sample_2$q;
-    reg  sin_sample_2$clock;
-    reg signed [15:0] cos_sample_2$d;
-    wire signed [15:0] cos_sample_2$q;
-    reg  cos_sample_2$clock;
-    reg  [1:0] quadrant_3$d;
-    wire  [1:0] quadrant_3$q;
-    reg  quadrant_3$clock;
-    reg signed [15:0] sin_first_3$d;
-    wire signed [15:0] sin_first_3$q;
-    reg  sin_first_3$clock;
-    reg signed [15:0] cos_first_3$d;
-    wire signed [15:0] cos_first_3$q;
-    reg  cos_first_3$clock;
+    reg signed [15:0] value_read$d;
+    wire signed [15:0] value_read$q;
+    reg  value_read$clock;
+    reg signed [15:0] slope_read$d;
+    wire signed [15:0] slope_read$q;
+    reg  slope_read$clock;
+    reg  [1:0] quadrant_4$d;
+    wire  [1:0] quadrant_4$q;
+    reg  quadrant_4$clock;
+    reg signed [15:0] signed_sample_4$d;
+    wire signed [15:0] signed_sample_4$q;
+    reg  signed_sample_4$clock;
     reg signed [15:0] sin_out$d;
     wire signed [15:0] sin_out$q;
     reg  sin_out$clock;
-    reg signed [15:0] cos_out$d;
-    wire signed [15:0] cos_out$q;
-    reg  cos_out$clock;
 
     // Local signals
+    reg  [1:0] quadrant;
     reg  [15:0] fraction;
-    reg signed [31:0] sin_rounded;
-    reg signed [31:0] cos_rounded;
-    reg signed [9:0] sin_correction_10;
-    reg signed [9:0] cos_correction_10;
-    reg signed [15:0] sin_correction;
-    reg signed [15:0] cos_correction;
+    reg signed [31:0] rounded;
+    reg signed [9:0] correction_10;
+    reg signed [15:0] correction;
 
     // Sub module instances
-    gyro_interface__carrier_nco__drive__rom rom(
+    gyro_interface__carrier_nco__drive__cosine__rom rom(
         .clock(rom$clock),
-        .addr_a(rom$addr_a),
-        .addr_b(rom$addr_b),
-        .value_a(rom$value_a),
-        .slope_a(rom$slope_a),
-        .value_b(rom$value_b),
-        .slope_b(rom$slope_b)
+        .addr(rom$addr),
+        .value(rom$value),
+        .slope(rom$slope)
     );
-    gyro_interface__carrier_nco__drive__sin_slope_product sin_slope_product(
-        .clock(sin_slope_product$clock),
-        .a(sin_slope_product$a),
-        .b(sin_slope_product$b),
-        .p(sin_slope_product$p)
+    gyro_interface__carrier_nco__drive__cosine__slope_product slope_product(
+        .clock(slope_product$clock),
+        .a(slope_product$a),
+        .b(slope_product$b),
+        .p(slope_product$p)
     );
-    gyro_interface__carrier_nco__drive__cos_slope_product cos_slope_product(
-        .clock(cos_slope_product$clock),
-        .a(cos_slope_product$a),
-        .b(cos_slope_product$b),
-        .p(cos_slope_product$p)
+    gyro_interface__carrier_nco__drive__cosine__index_1 index_1(
+        .d(index_1$d),
+        .q(index_1$q),
+        .clock(index_1$clock)
     );
-    gyro_interface__carrier_nco__drive__quadrant_1 quadrant_1(
+    gyro_interface__carrier_nco__drive__cosine__quadrant_1 quadrant_1(
         .d(quadrant_1$d),
         .q(quadrant_1$q),
         .clock(quadrant_1$clock)
     );
-    gyro_interface__carrier_nco__drive__offset_1 offset_1(
+    gyro_interface__carrier_nco__drive__cosine__offset_1 offset_1(
         .d(offset_1$d),
         .q(offset_1$q),
         .clock(offset_1$clock)
     );
-    gyro_interface__carrier_nco__drive__quadrant_read quadrant_read(
-        .d(quadrant_read$d),
-        .q(quadrant_read$q),
-        .clock(quadrant_read$clock)
-    );
-    gyro_interface__carrier_nco__drive__offset_read offset_read(
-        .d(offset_read$d),
-        .q(offset_read$q),
-        .clock(offset_read$clock)
-    );
-    gyro_interface__carrier_nco__drive__sin_value_read sin_value_read(
-        .d(sin_value_read$d),
-        .q(sin_value_read$q),
-        .clock(sin_value_read$clock)
-    );
-    gyro_interface__carrier_nco__drive__cos_value_read cos_value_read(
-        .d(cos_value_read$d),
-        .q(cos_value_read$q),
-        .clock(cos_value_read$clock)
-    );
-    gyro_interface__carrier_nco__drive__sin_slope_read sin_slope_read(
-        .d(sin_slope_read$d),
-        .q(sin_slope_read$q),
-        .clock(sin_slope_read$clock)
-    );
-    gyro_interface__carrier_nco__drive__cos_slope_read cos_slope_read(
-        .d(cos_slope_read$d),
-        .q(cos_slope_read$q),
-        .clock(cos_slope_read$clock)
-    );
-    gyro_interface__carrier_nco__drive__quadrant_2 quadrant_2(
+    gyro_interface__carrier_nco__drive__cosine__quadrant_2 quadrant_2(
         .d(quadrant_2$d),
         .q(quadrant_2$q),
         .clock(quadrant_2$clock)
     );
-    gyro_interface__carrier_nco__drive__sin_sample_2 sin_sample_2(
-        .d(sin_sample_2$d),
-        .q(sin_sample_2$q),
-        .clock(sin_sample_2$clock)
+    gyro_interface__carrier_nco__drive__cosine__offset_2 offset_2(
+        .d(offset_2$d),
+        .q(offset_2$q),
+        .clock(offset_2$clock)
     );
-    gyro_interface__carrier_nco__drive__cos_sample_2 cos_sample_2(
-        .d(cos_sample_2$d),
-        .q(cos_sample_2$q),
-        .clock(cos_sample_2$clock)
+    gyro_interface__carrier_nco__drive__cosine__quadrant_read quadrant_read(
+        .d(quadrant_read$d),
+        .q(quadrant_read$q),
+        .clock(quadrant_read$clock)
     );
-    gyro_interface__carrier_nco__drive__quadrant_3 quadrant_3(
-        .d(quadrant_3$d),
-        .q(quadrant_3$q),
-        .clock(quadrant_3$clock)
+    gyro_interface__carrier_nco__drive__cosine__offset_read offset_read(
+        .d(offset_read$d),
+        .q(offset_read$q),
+        .clock(offset_read$clock)
     );
-    gyro_interface__carrier_nco__drive__sin_first_3 sin_first_3(
-        .d(sin_first_3$d),
-        .q(sin_first_3$q),
-        .clock(sin_first_3$clock)
+    gyro_interface__carrier_nco__drive__cosine__value_read value_read(
+        .d(value_read$d),
+        .q(value_read$q),
+        .clock(value_read$clock)
     );
-    gyro_interface__carrier_nco__drive__cos_first_3 cos_first_3(
-        .d(cos_first_3$d),
-        .q(cos_first_3$q),
-        .clock(cos_first_3$clock)
+    gyro_interface__carrier_nco__drive__cosine__slope_read slope_read(
+        .d(slope_read$d),
+        .q(slope_read$q),
+        .clock(slope_read$clock)
     );
-    gyro_interface__carrier_nco__drive__sin_out sin_out(
+    gyro_interface__carrier_nco__drive__cosine__quadrant_4 quadrant_4(
+        .d(quadrant_4$d),
+        .q(quadrant_4$q),
+        .clock(quadrant_4$clock)
+    );
+    gyro_interface__carrier_nco__drive__cosine__signed_sample_4 signed_sample_4(
+        .d(signed_sample_4$d),
+        .q(signed_sample_4$q),
+        .clock(signed_sample_4$clock)
+    );
+    gyro_interface__carrier_nco__drive__cosine__sin_out sin_out(
         .d(sin_out$d),
         .q(sin_out$q),
         .clock(sin_out$clock)
-    );
-    gyro_interface__carrier_nco__drive__cos_out cos_out(
-        .d(cos_out$d),
-        .q(cos_out$q),
-        .clock(cos_out$clock)
     );
 
     // Update code
     always @(*) begin
         rom$clock = clock;
-        sin_slope_product$clock = clock;
-        cos_slope_product$clock = clock;
+        slope_product$clock = clock;
+        index_1$clock = clock;
         quadrant_1$clock = clock;
         offset_1$clock = clock;
+        quadrant_2$clock = clock;
+        offset_2$clock = clock;
         quadrant_read$clock = clock;
         offset_read$clock = clock;
-        sin_value_read$clock = clock;
-        cos_value_read$clock = clock;
-        sin_slope_read$clock = clock;
-        cos_slope_read$clock = clock;
-        quadrant_2$clock = clock;
-        sin_sample_2$clock = clock;
-        cos_sample_2$clock = clock;
-        quadrant_3$clock = clock;
-        sin_first_3$clock = clock;
-        cos_first_3$clock = clock;
+        value_read$clock = clock;
+        slope_read$clock = clock;
+        quadrant_4$clock = clock;
+        signed_sample_4$clock = clock;
         sin_out$clock = clock;
-        cos_out$clock = clock;
+        index_1$d = index_1$q;
         quadrant_1$d = quadrant_1$q;
         offset_1$d = offset_1$q;
+        quadrant_2$d = quadrant_2$q;
+        offset_2$d = offset_2$q;
         quadrant_read$d = quadrant_read$q;
         offset_read$d = offset_read$q;
-        sin_value_read$d = sin_value_read$q;
-        cos_value_read$d = cos_value_read$q;
-        sin_slope_read$d = sin_slope_read$q;
-        cos_slope_read$d = cos_slope_read$q;
-        quadrant_2$d = quadrant_2$q;
-        sin_sample_2$d = sin_sample_2$q;
-        cos_sample_2$d = cos_sample_2$q;
-        quadrant_3$d = quadrant_3$q;
-        sin_first_3$d = sin_first_3$q;
-        cos_first_3$d = cos_first_3$q;
+        value_read$d = value_read$q;
+        slope_read$d = slope_read$q;
+        quadrant_4$d = quadrant_4$q;
+        signed_sample_4$d = signed_sample_4$q;
         sin_out$d = sin_out$q;
-        cos_out$d = cos_out$q;
-        rom$addr_a = phase[(32'h16)+:(8)];
-        rom$addr_b = ~(phase[(32'h16)+:(8)]);
-        quadrant_1$d = phase[(32'h1e)+:(2)];
+        quadrant = phase[(32'h1e)+:(2)] + advance;
+        index_1$d = phase[(32'h16)+:(8)];
+        if (quadrant[32'h0]) begin
+            index_1$d = ~(phase[(32'h16)+:(8)]);
+        end
+        quadrant_1$d = quadrant;
         fraction = ((phase[(32'h7)+:(15)]) & 16'hffff);
         offset_1$d = $signed(fraction - half_step);
-        quadrant_read$d = quadrant_1$q;
-        offset_read$d = offset_1$q;
-        sin_value_read$d = rom$value_a;
-        cos_value_read$d = rom$value_b;
-        sin_slope_read$d = rom$slope_a;
-        cos_slope_read$d = rom$slope_b;
-        sin_slope_product$a = offset_read$q;
-        sin_slope_product$b = sin_slope_read$q;
-        cos_slope_product$a = offset_read$q;
-        cos_slope_product$b = cos_slope_read$q;
-        quadrant_2$d = quadrant_read$q;
-        sin_sample_2$d = sin_value_read$q;
-        cos_sample_2$d = cos_value_read$q;
-        sin_rounded = sin_slope_product$p + rounding;
-        cos_rounded = cos_slope_product$p + rounding;
-        sin_correction_10 = sin_rounded[(32'h16)+:(10)];
-        cos_correction_10 = cos_rounded[(32'h16)+:(10)];
-        sin_correction = $signed(sin_correction_10);
-        cos_correction = $signed(cos_correction_10);
-        sin_first_3$d = sin_sample_2$q + sin_correction;
-        cos_first_3$d = cos_sample_2$q - cos_correction;
-        quadrant_3$d = quadrant_2$q;
-        sin_out$d = sin_first_3$q;
-        cos_out$d = cos_first_3$q;
-        if (quadrant_3$q == 32'h1) begin
-            sin_out$d = cos_first_3$q;
-            cos_out$d = -sin_first_3$q;
+        rom$addr = index_1$q;
+        quadrant_2$d = quadrant_1$q;
+        offset_2$d = offset_1$q;
+        quadrant_read$d = quadrant_2$q;
+        offset_read$d = offset_2$q;
+        value_read$d = rom$value;
+        slope_read$d = rom$slope;
+        slope_product$a = offset_read$q;
+        slope_product$b = slope_read$q;
+        quadrant_4$d = quadrant_read$q;
+        signed_sample_4$d = value_read$q;
+        if (quadrant_read$q[32'h1]) begin
+            signed_sample_4$d = -value_read$q;
         end
-        if (quadrant_3$q == 32'h2) begin
-            sin_out$d = -sin_first_3$q;
-            cos_out$d = -cos_first_3$q;
-        end
-        if (quadrant_3$q == 32'h3) begin
-            sin_out$d = -cos_first_3$q;
-            cos_out$d = sin_first_3$q;
+        rounded = slope_product$p + rounding;
+        correction_10 = rounded[(32'h16)+:(10)];
+        correction = $signed(correction_10);
+        sin_out$d = signed_sample_4$q + correction;
+        if (quadrant_4$q[32'h0] ^ quadrant_4$q[32'h1]) begin
+            sin_out$d = signed_sample_4$q - correction;
         end
         sin = sin_out$q;
-        cos = cos_out$q;
     end
 
-endmodule // gyro_interface__carrier_nco__drive
+endmodule // gyro_interface__carrier_nco__drive__cosine
 
 
-module gyro_interface__carrier_nco__drive__cos_first_3(d,q,clock);
+module gyro_interface__carrier_nco__drive__cosine__index_1(d,q,clock);
+
+    // Module arguments
+    input wire  [7:0] d;
+    output reg  [7:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 8'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive__cosine__index_1
+
+
+module gyro_interface__carrier_nco__drive__cosine__offset_1(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -1558,29 +1497,10 @@ module gyro_interface__carrier_nco__drive__cos_first_3(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive__cos_first_3
+endmodule // gyro_interface__carrier_nco__drive__cosine__offset_1
 
 
-module gyro_interface__carrier_nco__drive__cos_out(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__drive__cos_out
-
-
-module gyro_interface__carrier_nco__drive__cos_sample_2(d,q,clock);
+module gyro_interface__carrier_nco__drive__cosine__offset_2(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -1596,27 +1516,10 @@ module gyro_interface__carrier_nco__drive__cos_sample_2(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive__cos_sample_2
+endmodule // gyro_interface__carrier_nco__drive__cosine__offset_2
 
 
-module gyro_interface__carrier_nco__drive__cos_slope_product(clock,a,b,p);
-
-    // Module arguments
-    input wire  clock;
-    input wire signed [15:0] a;
-    input wire signed [15:0] b;
-    output reg signed [31:0] p;
-
-    // Update code (custom)
-    initial p = 0;
-
-    always @(posedge clock) begin
-       p <= a * b;
-    end
-endmodule // gyro_interface__carrier_nco__drive__cos_slope_product
-
-
-module gyro_interface__carrier_nco__drive__cos_slope_read(d,q,clock);
+module gyro_interface__carrier_nco__drive__cosine__offset_read(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -1632,67 +1535,10 @@ module gyro_interface__carrier_nco__drive__cos_slope_read(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive__cos_slope_read
+endmodule // gyro_interface__carrier_nco__drive__cosine__offset_read
 
 
-module gyro_interface__carrier_nco__drive__cos_value_read(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__drive__cos_value_read
-
-
-module gyro_interface__carrier_nco__drive__offset_1(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__drive__offset_1
-
-
-module gyro_interface__carrier_nco__drive__offset_read(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__drive__offset_read
-
-
-module gyro_interface__carrier_nco__drive__quadrant_1(d,q,clock);
+module gyro_interface__carrier_nco__drive__cosine__quadrant_1(d,q,clock);
 
     // Module arguments
     input wire  [1:0] d;
@@ -1708,29 +1554,10 @@ module gyro_interface__carrier_nco__drive__quadrant_1(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive__quadrant_1
+endmodule // gyro_interface__carrier_nco__drive__cosine__quadrant_1
 
 
-module gyro_interface__carrier_nco__drive__quadrant_2(d,q,clock);
-
-    // Module arguments
-    input wire  [1:0] d;
-    output reg  [1:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 2'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__drive__quadrant_2
-
-
-module gyro_interface__carrier_nco__drive__quadrant_3(d,q,clock);
+module gyro_interface__carrier_nco__drive__cosine__quadrant_2(d,q,clock);
 
     // Module arguments
     input wire  [1:0] d;
@@ -1746,10 +1573,10 @@ module gyro_interface__carrier_nco__drive__quadrant_3(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive__quadrant_3
+endmodule // gyro_interface__carrier_nco__drive__cosine__quadrant_2
 
 
-module gyro_interface__carrier_nco__drive__quadrant_read(d,q,clock);
+module gyro_interface__carrier_nco__drive__cosine__quadrant_4(d,q,clock);
 
     // Module arguments
     input wire  [1:0] d;
@@ -1765,19 +1592,35 @@ module gyro_interface__carrier_nco__drive__quadrant_read(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive__quadrant_read
+endmodule // gyro_interface__carrier_nco__drive__cosine__quadrant_4
 
 
-module gyro_interface__carrier_nco__drive__rom(clock,addr_a,addr_b,value_a,slope_a,value_b,slope_b);
+module gyro_interface__carrier_nco__drive__cosine__quadrant_read(d,q,clock);
+
+    // Module arguments
+    input wire  [1:0] d;
+    output reg  [1:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 2'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive__cosine__quadrant_read
+
+
+module gyro_interface__carrier_nco__drive__cosine__rom(clock,addr,value,slope);
 
     // Module arguments
     input wire  clock;
-    input wire  [7:0] addr_a;
-    input wire  [7:0] addr_b;
-    output reg signed [15:0] value_a;
-    output reg signed [15:0] slope_a;
-    output reg signed [15:0] value_b;
-    output reg signed [15:0] slope_b;
+    input wire  [7:0] addr;
+    output reg signed [15:0] value;
+    output reg signed [15:0] slope;
 
     // Update code (custom)
     reg signed [15:0] value_rom [0:255];
@@ -2040,22 +1883,18 @@ module gyro_interface__carrier_nco__drive__rom(clock,addr_a,addr_b,value_a,slope
        value_rom[253] = 16'sd32763; slope_rom[253] = 16'sd395;
        value_rom[254] = 16'sd32766; slope_rom[254] = 16'sd237;
        value_rom[255] = 16'sd32767; slope_rom[255] = 16'sd79;
-       value_a = 0;
-       slope_a = 0;
-       value_b = 0;
-       slope_b = 0;
+       value = 0;
+       slope = 0;
     end
 
     always @(posedge clock) begin
-       value_a <= value_rom[addr_a];
-       slope_a <= slope_rom[addr_a];
-       value_b <= value_rom[addr_b];
-       slope_b <= slope_rom[addr_b];
+       value <= value_rom[addr];
+       slope <= slope_rom[addr];
     end
-endmodule // gyro_interface__carrier_nco__drive__rom
+endmodule // gyro_interface__carrier_nco__drive__cosine__rom
 
 
-module gyro_interface__carrier_nco__drive__sin_first_3(d,q,clock);
+module gyro_interface__carrier_nco__drive__cosine__signed_sample_4(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -2071,29 +1910,10 @@ module gyro_interface__carrier_nco__drive__sin_first_3(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive__sin_first_3
+endmodule // gyro_interface__carrier_nco__drive__cosine__signed_sample_4
 
 
-module gyro_interface__carrier_nco__drive__sin_out(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__drive__sin_out
-
-
-module gyro_interface__carrier_nco__drive__sin_sample_2(d,q,clock);
+module gyro_interface__carrier_nco__drive__cosine__sin_out(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -2109,10 +1929,10 @@ module gyro_interface__carrier_nco__drive__sin_sample_2(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive__sin_sample_2
+endmodule // gyro_interface__carrier_nco__drive__cosine__sin_out
 
 
-module gyro_interface__carrier_nco__drive__sin_slope_product(clock,a,b,p);
+module gyro_interface__carrier_nco__drive__cosine__slope_product(clock,a,b,p);
 
     // Module arguments
     input wire  clock;
@@ -2126,29 +1946,10 @@ module gyro_interface__carrier_nco__drive__sin_slope_product(clock,a,b,p);
     always @(posedge clock) begin
        p <= a * b;
     end
-endmodule // gyro_interface__carrier_nco__drive__sin_slope_product
+endmodule // gyro_interface__carrier_nco__drive__cosine__slope_product
 
 
-module gyro_interface__carrier_nco__drive__sin_slope_read(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__drive__sin_slope_read
-
-
-module gyro_interface__carrier_nco__drive__sin_value_read(d,q,clock);
+module gyro_interface__carrier_nco__drive__cosine__slope_read(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -2164,7 +1965,753 @@ module gyro_interface__carrier_nco__drive__sin_value_read(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive__sin_value_read
+endmodule // gyro_interface__carrier_nco__drive__cosine__slope_read
+
+
+module gyro_interface__carrier_nco__drive__cosine__value_read(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive__cosine__value_read
+
+
+module gyro_interface__carrier_nco__drive__sine(clock,phase,advance,sin);
+
+    // Module arguments
+    input wire  clock;
+    input wire  [31:0] phase;
+    input wire  [1:0] advance;
+    output reg signed [15:0] sin;
+
+    // Constant declarations
+    localparam  half_step = 16'h4000;
+    localparam signed rounding = 32'h200000;
+
+    // Stub signals
+    reg  rom$clock;
+    reg  [7:0] rom$addr;
+    wire signed [15:0] rom$value;
+    wire signed [15:0] rom$slope;
+    reg  slope_product$clock;
+    reg signed [15:0] slope_product$a;
+    reg signed [15:0] slope_product$b;
+    wire signed [31:0] slope_product$p;
+    reg  [7:0] index_1$d;
+    wire  [7:0] index_1$q;
+    reg  index_1$clock;
+    reg  [1:0] quadrant_1$d;
+    wire  [1:0] quadrant_1$q;
+    reg  quadrant_1$clock;
+    reg signed [15:0] offset_1$d;
+    wire signed [15:0] offset_1$q;
+    reg  offset_1$clock;
+    reg  [1:0] quadrant_2$d;
+    wire  [1:0] quadrant_2$q;
+    reg  quadrant_2$clock;
+    reg signed [15:0] offset_2$d;
+    wire signed [15:0] offset_2$q;
+    reg  offset_2$clock;
+    reg  [1:0] quadrant_read$d;
+    wire  [1:0] quadrant_read$q;
+    reg  quadrant_read$clock;
+    reg signed [15:0] offset_read$d;
+    wire signed [15:0] offset_read$q;
+    reg  offset_read$clock;
+    reg signed [15:0] value_read$d;
+    wire signed [15:0] value_read$q;
+    reg  value_read$clock;
+    reg signed [15:0] slope_read$d;
+    wire signed [15:0] slope_read$q;
+    reg  slope_read$clock;
+    reg  [1:0] quadrant_4$d;
+    wire  [1:0] quadrant_4$q;
+    reg  quadrant_4$clock;
+    reg signed [15:0] signed_sample_4$d;
+    wire signed [15:0] signed_sample_4$q;
+    reg  signed_sample_4$clock;
+    reg signed [15:0] sin_out$d;
+    wire signed [15:0] sin_out$q;
+    reg  sin_out$clock;
+
+    // Local signals
+    reg  [1:0] quadrant;
+    reg  [15:0] fraction;
+    reg signed [31:0] rounded;
+    reg signed [9:0] correction_10;
+    reg signed [15:0] correction;
+
+    // Sub module instances
+    gyro_interface__carrier_nco__drive__sine__rom rom(
+        .clock(rom$clock),
+        .addr(rom$addr),
+        .value(rom$value),
+        .slope(rom$slope)
+    );
+    gyro_interface__carrier_nco__drive__sine__slope_product slope_product(
+        .clock(slope_product$clock),
+        .a(slope_product$a),
+        .b(slope_product$b),
+        .p(slope_product$p)
+    );
+    gyro_interface__carrier_nco__drive__sine__index_1 index_1(
+        .d(index_1$d),
+        .q(index_1$q),
+        .clock(index_1$clock)
+    );
+    gyro_interface__carrier_nco__drive__sine__quadrant_1 quadrant_1(
+        .d(quadrant_1$d),
+        .q(quadrant_1$q),
+        .clock(quadrant_1$clock)
+    );
+    gyro_interface__carrier_nco__drive__sine__offset_1 offset_1(
+        .d(offset_1$d),
+        .q(offset_1$q),
+        .clock(offset_1$clock)
+    );
+    gyro_interface__carrier_nco__drive__sine__quadrant_2 quadrant_2(
+        .d(quadrant_2$d),
+        .q(quadrant_2$q),
+        .clock(quadrant_2$clock)
+    );
+    gyro_interface__carrier_nco__drive__sine__offset_2 offset_2(
+        .d(offset_2$d),
+        .q(offset_2$q),
+        .clock(offset_2$clock)
+    );
+    gyro_interface__carrier_nco__drive__sine__quadrant_read quadrant_read(
+        .d(quadrant_read$d),
+        .q(quadrant_read$q),
+        .clock(quadrant_read$clock)
+    );
+    gyro_interface__carrier_nco__drive__sine__offset_read offset_read(
+        .d(offset_read$d),
+        .q(offset_read$q),
+        .clock(offset_read$clock)
+    );
+    gyro_interface__carrier_nco__drive__sine__value_read value_read(
+        .d(value_read$d),
+        .q(value_read$q),
+        .clock(value_read$clock)
+    );
+    gyro_interface__carrier_nco__drive__sine__slope_read slope_read(
+        .d(slope_read$d),
+        .q(slope_read$q),
+        .clock(slope_read$clock)
+    );
+    gyro_interface__carrier_nco__drive__sine__quadrant_4 quadrant_4(
+        .d(quadrant_4$d),
+        .q(quadrant_4$q),
+        .clock(quadrant_4$clock)
+    );
+    gyro_interface__carrier_nco__drive__sine__signed_sample_4 signed_sample_4(
+        .d(signed_sample_4$d),
+        .q(signed_sample_4$q),
+        .clock(signed_sample_4$clock)
+    );
+    gyro_interface__carrier_nco__drive__sine__sin_out sin_out(
+        .d(sin_out$d),
+        .q(sin_out$q),
+        .clock(sin_out$clock)
+    );
+
+    // Update code
+    always @(*) begin
+        rom$clock = clock;
+        slope_product$clock = clock;
+        index_1$clock = clock;
+        quadrant_1$clock = clock;
+        offset_1$clock = clock;
+        quadrant_2$clock = clock;
+        offset_2$clock = clock;
+        quadrant_read$clock = clock;
+        offset_read$clock = clock;
+        value_read$clock = clock;
+        slope_read$clock = clock;
+        quadrant_4$clock = clock;
+        signed_sample_4$clock = clock;
+        sin_out$clock = clock;
+        index_1$d = index_1$q;
+        quadrant_1$d = quadrant_1$q;
+        offset_1$d = offset_1$q;
+        quadrant_2$d = quadrant_2$q;
+        offset_2$d = offset_2$q;
+        quadrant_read$d = quadrant_read$q;
+        offset_read$d = offset_read$q;
+        value_read$d = value_read$q;
+        slope_read$d = slope_read$q;
+        quadrant_4$d = quadrant_4$q;
+        signed_sample_4$d = signed_sample_4$q;
+        sin_out$d = sin_out$q;
+        quadrant = phase[(32'h1e)+:(2)] + advance;
+        index_1$d = phase[(32'h16)+:(8)];
+        if (quadrant[32'h0]) begin
+            index_1$d = ~(phase[(32'h16)+:(8)]);
+        end
+        quadrant_1$d = quadrant;
+        fraction = ((phase[(32'h7)+:(15)]) & 16'hffff);
+        offset_1$d = $signed(fraction - half_step);
+        rom$addr = index_1$q;
+        quadrant_2$d = quadrant_1$q;
+        offset_2$d = offset_1$q;
+        quadrant_read$d = quadrant_2$q;
+        offset_read$d = offset_2$q;
+        value_read$d = rom$value;
+        slope_read$d = rom$slope;
+        slope_product$a = offset_read$q;
+        slope_product$b = slope_read$q;
+        quadrant_4$d = quadrant_read$q;
+        signed_sample_4$d = value_read$q;
+        if (quadrant_read$q[32'h1]) begin
+            signed_sample_4$d = -value_read$q;
+        end
+        rounded = slope_product$p + rounding;
+        correction_10 = rounded[(32'h16)+:(10)];
+        correction = $signed(correction_10);
+        sin_out$d = signed_sample_4$q + correction;
+        if (quadrant_4$q[32'h0] ^ quadrant_4$q[32'h1]) begin
+            sin_out$d = signed_sample_4$q - correction;
+        end
+        sin = sin_out$q;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive__sine
+
+
+module gyro_interface__carrier_nco__drive__sine__index_1(d,q,clock);
+
+    // Module arguments
+    input wire  [7:0] d;
+    output reg  [7:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 8'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive__sine__index_1
+
+
+module gyro_interface__carrier_nco__drive__sine__offset_1(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive__sine__offset_1
+
+
+module gyro_interface__carrier_nco__drive__sine__offset_2(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive__sine__offset_2
+
+
+module gyro_interface__carrier_nco__drive__sine__offset_read(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive__sine__offset_read
+
+
+module gyro_interface__carrier_nco__drive__sine__quadrant_1(d,q,clock);
+
+    // Module arguments
+    input wire  [1:0] d;
+    output reg  [1:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 2'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive__sine__quadrant_1
+
+
+module gyro_interface__carrier_nco__drive__sine__quadrant_2(d,q,clock);
+
+    // Module arguments
+    input wire  [1:0] d;
+    output reg  [1:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 2'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive__sine__quadrant_2
+
+
+module gyro_interface__carrier_nco__drive__sine__quadrant_4(d,q,clock);
+
+    // Module arguments
+    input wire  [1:0] d;
+    output reg  [1:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 2'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive__sine__quadrant_4
+
+
+module gyro_interface__carrier_nco__drive__sine__quadrant_read(d,q,clock);
+
+    // Module arguments
+    input wire  [1:0] d;
+    output reg  [1:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 2'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive__sine__quadrant_read
+
+
+module gyro_interface__carrier_nco__drive__sine__rom(clock,addr,value,slope);
+
+    // Module arguments
+    input wire  clock;
+    input wire  [7:0] addr;
+    output reg signed [15:0] value;
+    output reg signed [15:0] slope;
+
+    // Update code (custom)
+    reg signed [15:0] value_rom [0:255];
+    reg signed [15:0] slope_rom [0:255];
+
+    initial begin
+       value_rom[0] = 16'sd101; slope_rom[0] = 16'sd25735;
+       value_rom[1] = 16'sd302; slope_rom[1] = 16'sd25734;
+       value_rom[2] = 16'sd503; slope_rom[2] = 16'sd25732;
+       value_rom[3] = 16'sd704; slope_rom[3] = 16'sd25729;
+       value_rom[4] = 16'sd905; slope_rom[4] = 16'sd25725;
+       value_rom[5] = 16'sd1106; slope_rom[5] = 16'sd25720;
+       value_rom[6] = 16'sd1307; slope_rom[6] = 16'sd25715;
+       value_rom[7] = 16'sd1507; slope_rom[7] = 16'sd25708;
+       value_rom[8] = 16'sd1708; slope_rom[8] = 16'sd25700;
+       value_rom[9] = 16'sd1909; slope_rom[9] = 16'sd25691;
+       value_rom[10] = 16'sd2110; slope_rom[10] = 16'sd25682;
+       value_rom[11] = 16'sd2310; slope_rom[11] = 16'sd25671;
+       value_rom[12] = 16'sd2511; slope_rom[12] = 16'sd25659;
+       value_rom[13] = 16'sd2711; slope_rom[13] = 16'sd25647;
+       value_rom[14] = 16'sd2911; slope_rom[14] = 16'sd25633;
+       value_rom[15] = 16'sd3112; slope_rom[15] = 16'sd25619;
+       value_rom[16] = 16'sd3312; slope_rom[16] = 16'sd25603;
+       value_rom[17] = 16'sd3512; slope_rom[17] = 16'sd25587;
+       value_rom[18] = 16'sd3712; slope_rom[18] = 16'sd25570;
+       value_rom[19] = 16'sd3911; slope_rom[19] = 16'sd25551;
+       value_rom[20] = 16'sd4111; slope_rom[20] = 16'sd25532;
+       value_rom[21] = 16'sd4310; slope_rom[21] = 16'sd25512;
+       value_rom[22] = 16'sd4509; slope_rom[22] = 16'sd25490;
+       value_rom[23] = 16'sd4708; slope_rom[23] = 16'sd25468;
+       value_rom[24] = 16'sd4907; slope_rom[24] = 16'sd25445;
+       value_rom[25] = 16'sd5106; slope_rom[25] = 16'sd25421;
+       value_rom[26] = 16'sd5305; slope_rom[26] = 16'sd25396;
+       value_rom[27] = 16'sd5503; slope_rom[27] = 16'sd25370;
+       value_rom[28] = 16'sd5701; slope_rom[28] = 16'sd25343;
+       value_rom[29] = 16'sd5899; slope_rom[29] = 16'sd25315;
+       value_rom[30] = 16'sd6096; slope_rom[30] = 16'sd25286;
+       value_rom[31] = 16'sd6294; slope_rom[31] = 16'sd25256;
+       value_rom[32] = 16'sd6491; slope_rom[32] = 16'sd25225;
+       value_rom[33] = 16'sd6688; slope_rom[33] = 16'sd25193;
+       value_rom[34] = 16'sd6885; slope_rom[34] = 16'sd25161;
+       value_rom[35] = 16'sd7081; slope_rom[35] = 16'sd25127;
+       value_rom[36] = 16'sd7277; slope_rom[36] = 16'sd25092;
+       value_rom[37] = 16'sd7473; slope_rom[37] = 16'sd25057;
+       value_rom[38] = 16'sd7669; slope_rom[38] = 16'sd25020;
+       value_rom[39] = 16'sd7864; slope_rom[39] = 16'sd24983;
+       value_rom[40] = 16'sd8059; slope_rom[40] = 16'sd24945;
+       value_rom[41] = 16'sd8254; slope_rom[41] = 16'sd24905;
+       value_rom[42] = 16'sd8448; slope_rom[42] = 16'sd24865;
+       value_rom[43] = 16'sd8642; slope_rom[43] = 16'sd24824;
+       value_rom[44] = 16'sd8836; slope_rom[44] = 16'sd24782;
+       value_rom[45] = 16'sd9030; slope_rom[45] = 16'sd24739;
+       value_rom[46] = 16'sd9223; slope_rom[46] = 16'sd24695;
+       value_rom[47] = 16'sd9416; slope_rom[47] = 16'sd24650;
+       value_rom[48] = 16'sd9608; slope_rom[48] = 16'sd24604;
+       value_rom[49] = 16'sd9800; slope_rom[49] = 16'sd24557;
+       value_rom[50] = 16'sd9992; slope_rom[50] = 16'sd24510;
+       value_rom[51] = 16'sd10183; slope_rom[51] = 16'sd24461;
+       value_rom[52] = 16'sd10374; slope_rom[52] = 16'sd24411;
+       value_rom[53] = 16'sd10564; slope_rom[53] = 16'sd24361;
+       value_rom[54] = 16'sd10754; slope_rom[54] = 16'sd24310;
+       value_rom[55] = 16'sd10944; slope_rom[55] = 16'sd24257;
+       value_rom[56] = 16'sd11133; slope_rom[56] = 16'sd24204;
+       value_rom[57] = 16'sd11322; slope_rom[57] = 16'sd24150;
+       value_rom[58] = 16'sd11511; slope_rom[58] = 16'sd24095;
+       value_rom[59] = 16'sd11699; slope_rom[59] = 16'sd24039;
+       value_rom[60] = 16'sd11886; slope_rom[60] = 16'sd23982;
+       value_rom[61] = 16'sd12074; slope_rom[61] = 16'sd23924;
+       value_rom[62] = 16'sd12260; slope_rom[62] = 16'sd23866;
+       value_rom[63] = 16'sd12446; slope_rom[63] = 16'sd23806;
+       value_rom[64] = 16'sd12632; slope_rom[64] = 16'sd23746;
+       value_rom[65] = 16'sd12817; slope_rom[65] = 16'sd23685;
+       value_rom[66] = 16'sd13002; slope_rom[66] = 16'sd23622;
+       value_rom[67] = 16'sd13187; slope_rom[67] = 16'sd23559;
+       value_rom[68] = 16'sd13370; slope_rom[68] = 16'sd23495;
+       value_rom[69] = 16'sd13554; slope_rom[69] = 16'sd23430;
+       value_rom[70] = 16'sd13736; slope_rom[70] = 16'sd23365;
+       value_rom[71] = 16'sd13919; slope_rom[71] = 16'sd23298;
+       value_rom[72] = 16'sd14101; slope_rom[72] = 16'sd23230;
+       value_rom[73] = 16'sd14282; slope_rom[73] = 16'sd23162;
+       value_rom[74] = 16'sd14462; slope_rom[74] = 16'sd23093;
+       value_rom[75] = 16'sd14643; slope_rom[75] = 16'sd23023;
+       value_rom[76] = 16'sd14822; slope_rom[76] = 16'sd22952;
+       value_rom[77] = 16'sd15001; slope_rom[77] = 16'sd22880;
+       value_rom[78] = 16'sd15180; slope_rom[78] = 16'sd22807;
+       value_rom[79] = 16'sd15358; slope_rom[79] = 16'sd22733;
+       value_rom[80] = 16'sd15535; slope_rom[80] = 16'sd22659;
+       value_rom[81] = 16'sd15712; slope_rom[81] = 16'sd22584;
+       value_rom[82] = 16'sd15888; slope_rom[82] = 16'sd22508;
+       value_rom[83] = 16'sd16063; slope_rom[83] = 16'sd22431;
+       value_rom[84] = 16'sd16238; slope_rom[84] = 16'sd22353;
+       value_rom[85] = 16'sd16413; slope_rom[85] = 16'sd22274;
+       value_rom[86] = 16'sd16586; slope_rom[86] = 16'sd22195;
+       value_rom[87] = 16'sd16759; slope_rom[87] = 16'sd22114;
+       value_rom[88] = 16'sd16932; slope_rom[88] = 16'sd22033;
+       value_rom[89] = 16'sd17104; slope_rom[89] = 16'sd21951;
+       value_rom[90] = 16'sd17275; slope_rom[90] = 16'sd21868;
+       value_rom[91] = 16'sd17445; slope_rom[91] = 16'sd21785;
+       value_rom[92] = 16'sd17615; slope_rom[92] = 16'sd21700;
+       value_rom[93] = 16'sd17784; slope_rom[93] = 16'sd21615;
+       value_rom[94] = 16'sd17953; slope_rom[94] = 16'sd21529;
+       value_rom[95] = 16'sd18121; slope_rom[95] = 16'sd21442;
+       value_rom[96] = 16'sd18288; slope_rom[96] = 16'sd21354;
+       value_rom[97] = 16'sd18454; slope_rom[97] = 16'sd21265;
+       value_rom[98] = 16'sd18620; slope_rom[98] = 16'sd21176;
+       value_rom[99] = 16'sd18785; slope_rom[99] = 16'sd21086;
+       value_rom[100] = 16'sd18950; slope_rom[100] = 16'sd20995;
+       value_rom[101] = 16'sd19113; slope_rom[101] = 16'sd20903;
+       value_rom[102] = 16'sd19276; slope_rom[102] = 16'sd20811;
+       value_rom[103] = 16'sd19438; slope_rom[103] = 16'sd20718;
+       value_rom[104] = 16'sd19600; slope_rom[104] = 16'sd20624;
+       value_rom[105] = 16'sd19761; slope_rom[105] = 16'sd20529;
+       value_rom[106] = 16'sd19921; slope_rom[106] = 16'sd20433;
+       value_rom[107] = 16'sd20080; slope_rom[107] = 16'sd20337;
+       value_rom[108] = 16'sd20238; slope_rom[108] = 16'sd20240;
+       value_rom[109] = 16'sd20396; slope_rom[109] = 16'sd20142;
+       value_rom[110] = 16'sd20553; slope_rom[110] = 16'sd20043;
+       value_rom[111] = 16'sd20709; slope_rom[111] = 16'sd19944;
+       value_rom[112] = 16'sd20865; slope_rom[112] = 16'sd19843;
+       value_rom[113] = 16'sd21019; slope_rom[113] = 16'sd19742;
+       value_rom[114] = 16'sd21173; slope_rom[114] = 16'sd19641;
+       value_rom[115] = 16'sd21326; slope_rom[115] = 16'sd19538;
+       value_rom[116] = 16'sd21479; slope_rom[116] = 16'sd19435;
+       value_rom[117] = 16'sd21630; slope_rom[117] = 16'sd19331;
+       value_rom[118] = 16'sd21781; slope_rom[118] = 16'sd19227;
+       value_rom[119] = 16'sd21930; slope_rom[119] = 16'sd19121;
+       value_rom[120] = 16'sd22079; slope_rom[120] = 16'sd19015;
+       value_rom[121] = 16'sd22227; slope_rom[121] = 16'sd18909;
+       value_rom[122] = 16'sd22375; slope_rom[122] = 16'sd18801;
+       value_rom[123] = 16'sd22521; slope_rom[123] = 16'sd18693;
+       value_rom[124] = 16'sd22667; slope_rom[124] = 16'sd18584;
+       value_rom[125] = 16'sd22812; slope_rom[125] = 16'sd18474;
+       value_rom[126] = 16'sd22956; slope_rom[126] = 16'sd18364;
+       value_rom[127] = 16'sd23099; slope_rom[127] = 16'sd18253;
+       value_rom[128] = 16'sd23241; slope_rom[128] = 16'sd18142;
+       value_rom[129] = 16'sd23382; slope_rom[129] = 16'sd18029;
+       value_rom[130] = 16'sd23522; slope_rom[130] = 16'sd17916;
+       value_rom[131] = 16'sd23662; slope_rom[131] = 16'sd17803;
+       value_rom[132] = 16'sd23801; slope_rom[132] = 16'sd17688;
+       value_rom[133] = 16'sd23938; slope_rom[133] = 16'sd17573;
+       value_rom[134] = 16'sd24075; slope_rom[134] = 16'sd17457;
+       value_rom[135] = 16'sd24211; slope_rom[135] = 16'sd17341;
+       value_rom[136] = 16'sd24346; slope_rom[136] = 16'sd17224;
+       value_rom[137] = 16'sd24480; slope_rom[137] = 16'sd17106;
+       value_rom[138] = 16'sd24613; slope_rom[138] = 16'sd16988;
+       value_rom[139] = 16'sd24746; slope_rom[139] = 16'sd16869;
+       value_rom[140] = 16'sd24877; slope_rom[140] = 16'sd16750;
+       value_rom[141] = 16'sd25007; slope_rom[141] = 16'sd16629;
+       value_rom[142] = 16'sd25137; slope_rom[142] = 16'sd16509;
+       value_rom[143] = 16'sd25265; slope_rom[143] = 16'sd16387;
+       value_rom[144] = 16'sd25393; slope_rom[144] = 16'sd16265;
+       value_rom[145] = 16'sd25519; slope_rom[145] = 16'sd16142;
+       value_rom[146] = 16'sd25645; slope_rom[146] = 16'sd16019;
+       value_rom[147] = 16'sd25770; slope_rom[147] = 16'sd15895;
+       value_rom[148] = 16'sd25893; slope_rom[148] = 16'sd15771;
+       value_rom[149] = 16'sd26016; slope_rom[149] = 16'sd15646;
+       value_rom[150] = 16'sd26138; slope_rom[150] = 16'sd15520;
+       value_rom[151] = 16'sd26259; slope_rom[151] = 16'sd15394;
+       value_rom[152] = 16'sd26378; slope_rom[152] = 16'sd15267;
+       value_rom[153] = 16'sd26497; slope_rom[153] = 16'sd15140;
+       value_rom[154] = 16'sd26615; slope_rom[154] = 16'sd15012;
+       value_rom[155] = 16'sd26732; slope_rom[155] = 16'sd14883;
+       value_rom[156] = 16'sd26848; slope_rom[156] = 16'sd14754;
+       value_rom[157] = 16'sd26962; slope_rom[157] = 16'sd14624;
+       value_rom[158] = 16'sd27076; slope_rom[158] = 16'sd14494;
+       value_rom[159] = 16'sd27189; slope_rom[159] = 16'sd14363;
+       value_rom[160] = 16'sd27300; slope_rom[160] = 16'sd14232;
+       value_rom[161] = 16'sd27411; slope_rom[161] = 16'sd14100;
+       value_rom[162] = 16'sd27521; slope_rom[162] = 16'sd13968;
+       value_rom[163] = 16'sd27629; slope_rom[163] = 16'sd13835;
+       value_rom[164] = 16'sd27737; slope_rom[164] = 16'sd13701;
+       value_rom[165] = 16'sd27843; slope_rom[165] = 16'sd13568;
+       value_rom[166] = 16'sd27949; slope_rom[166] = 16'sd13433;
+       value_rom[167] = 16'sd28053; slope_rom[167] = 16'sd13298;
+       value_rom[168] = 16'sd28157; slope_rom[168] = 16'sd13163;
+       value_rom[169] = 16'sd28259; slope_rom[169] = 16'sd13027;
+       value_rom[170] = 16'sd28360; slope_rom[170] = 16'sd12890;
+       value_rom[171] = 16'sd28460; slope_rom[171] = 16'sd12753;
+       value_rom[172] = 16'sd28560; slope_rom[172] = 16'sd12616;
+       value_rom[173] = 16'sd28658; slope_rom[173] = 16'sd12478;
+       value_rom[174] = 16'sd28755; slope_rom[174] = 16'sd12340;
+       value_rom[175] = 16'sd28850; slope_rom[175] = 16'sd12201;
+       value_rom[176] = 16'sd28945; slope_rom[176] = 16'sd12062;
+       value_rom[177] = 16'sd29039; slope_rom[177] = 16'sd11922;
+       value_rom[178] = 16'sd29131; slope_rom[178] = 16'sd11782;
+       value_rom[179] = 16'sd29223; slope_rom[179] = 16'sd11641;
+       value_rom[180] = 16'sd29313; slope_rom[180] = 16'sd11500;
+       value_rom[181] = 16'sd29403; slope_rom[181] = 16'sd11359;
+       value_rom[182] = 16'sd29491; slope_rom[182] = 16'sd11217;
+       value_rom[183] = 16'sd29578; slope_rom[183] = 16'sd11075;
+       value_rom[184] = 16'sd29664; slope_rom[184] = 16'sd10932;
+       value_rom[185] = 16'sd29749; slope_rom[185] = 16'sd10789;
+       value_rom[186] = 16'sd29832; slope_rom[186] = 16'sd10645;
+       value_rom[187] = 16'sd29915; slope_rom[187] = 16'sd10501;
+       value_rom[188] = 16'sd29997; slope_rom[188] = 16'sd10357;
+       value_rom[189] = 16'sd30077; slope_rom[189] = 16'sd10212;
+       value_rom[190] = 16'sd30156; slope_rom[190] = 16'sd10067;
+       value_rom[191] = 16'sd30234; slope_rom[191] = 16'sd9921;
+       value_rom[192] = 16'sd30311; slope_rom[192] = 16'sd9775;
+       value_rom[193] = 16'sd30387; slope_rom[193] = 16'sd9629;
+       value_rom[194] = 16'sd30462; slope_rom[194] = 16'sd9483;
+       value_rom[195] = 16'sd30535; slope_rom[195] = 16'sd9336;
+       value_rom[196] = 16'sd30607; slope_rom[196] = 16'sd9188;
+       value_rom[197] = 16'sd30679; slope_rom[197] = 16'sd9041;
+       value_rom[198] = 16'sd30749; slope_rom[198] = 16'sd8893;
+       value_rom[199] = 16'sd30818; slope_rom[199] = 16'sd8744;
+       value_rom[200] = 16'sd30885; slope_rom[200] = 16'sd8596;
+       value_rom[201] = 16'sd30952; slope_rom[201] = 16'sd8447;
+       value_rom[202] = 16'sd31017; slope_rom[202] = 16'sd8297;
+       value_rom[203] = 16'sd31082; slope_rom[203] = 16'sd8148;
+       value_rom[204] = 16'sd31145; slope_rom[204] = 16'sd7998;
+       value_rom[205] = 16'sd31206; slope_rom[205] = 16'sd7847;
+       value_rom[206] = 16'sd31267; slope_rom[206] = 16'sd7697;
+       value_rom[207] = 16'sd31327; slope_rom[207] = 16'sd7546;
+       value_rom[208] = 16'sd31385; slope_rom[208] = 16'sd7395;
+       value_rom[209] = 16'sd31442; slope_rom[209] = 16'sd7244;
+       value_rom[210] = 16'sd31498; slope_rom[210] = 16'sd7092;
+       value_rom[211] = 16'sd31553; slope_rom[211] = 16'sd6940;
+       value_rom[212] = 16'sd31607; slope_rom[212] = 16'sd6788;
+       value_rom[213] = 16'sd31659; slope_rom[213] = 16'sd6635;
+       value_rom[214] = 16'sd31710; slope_rom[214] = 16'sd6483;
+       value_rom[215] = 16'sd31760; slope_rom[215] = 16'sd6330;
+       value_rom[216] = 16'sd31809; slope_rom[216] = 16'sd6177;
+       value_rom[217] = 16'sd31857; slope_rom[217] = 16'sd6023;
+       value_rom[218] = 16'sd31903; slope_rom[218] = 16'sd5869;
+       value_rom[219] = 16'sd31949; slope_rom[219] = 16'sd5716;
+       value_rom[220] = 16'sd31993; slope_rom[220] = 16'sd5562;
+       value_rom[221] = 16'sd32036; slope_rom[221] = 16'sd5407;
+       value_rom[222] = 16'sd32077; slope_rom[222] = 16'sd5253;
+       value_rom[223] = 16'sd32118; slope_rom[223] = 16'sd5098;
+       value_rom[224] = 16'sd32157; slope_rom[224] = 16'sd4943;
+       value_rom[225] = 16'sd32195; slope_rom[225] = 16'sd4788;
+       value_rom[226] = 16'sd32232; slope_rom[226] = 16'sd4633;
+       value_rom[227] = 16'sd32267; slope_rom[227] = 16'sd4477;
+       value_rom[228] = 16'sd32302; slope_rom[228] = 16'sd4322;
+       value_rom[229] = 16'sd32335; slope_rom[229] = 16'sd4166;
+       value_rom[230] = 16'sd32367; slope_rom[230] = 16'sd4010;
+       value_rom[231] = 16'sd32397; slope_rom[231] = 16'sd3854;
+       value_rom[232] = 16'sd32427; slope_rom[232] = 16'sd3698;
+       value_rom[233] = 16'sd32455; slope_rom[233] = 16'sd3542;
+       value_rom[234] = 16'sd32482; slope_rom[234] = 16'sd3385;
+       value_rom[235] = 16'sd32508; slope_rom[235] = 16'sd3229;
+       value_rom[236] = 16'sd32533; slope_rom[236] = 16'sd3072;
+       value_rom[237] = 16'sd32556; slope_rom[237] = 16'sd2915;
+       value_rom[238] = 16'sd32578; slope_rom[238] = 16'sd2758;
+       value_rom[239] = 16'sd32599; slope_rom[239] = 16'sd2601;
+       value_rom[240] = 16'sd32619; slope_rom[240] = 16'sd2444;
+       value_rom[241] = 16'sd32637; slope_rom[241] = 16'sd2287;
+       value_rom[242] = 16'sd32655; slope_rom[242] = 16'sd2129;
+       value_rom[243] = 16'sd32671; slope_rom[243] = 16'sd1972;
+       value_rom[244] = 16'sd32685; slope_rom[244] = 16'sd1814;
+       value_rom[245] = 16'sd32699; slope_rom[245] = 16'sd1657;
+       value_rom[246] = 16'sd32711; slope_rom[246] = 16'sd1499;
+       value_rom[247] = 16'sd32722; slope_rom[247] = 16'sd1342;
+       value_rom[248] = 16'sd32732; slope_rom[248] = 16'sd1184;
+       value_rom[249] = 16'sd32741; slope_rom[249] = 16'sd1026;
+       value_rom[250] = 16'sd32748; slope_rom[250] = 16'sd868;
+       value_rom[251] = 16'sd32755; slope_rom[251] = 16'sd710;
+       value_rom[252] = 16'sd32759; slope_rom[252] = 16'sd553;
+       value_rom[253] = 16'sd32763; slope_rom[253] = 16'sd395;
+       value_rom[254] = 16'sd32766; slope_rom[254] = 16'sd237;
+       value_rom[255] = 16'sd32767; slope_rom[255] = 16'sd79;
+       value = 0;
+       slope = 0;
+    end
+
+    always @(posedge clock) begin
+       value <= value_rom[addr];
+       slope <= slope_rom[addr];
+    end
+endmodule // gyro_interface__carrier_nco__drive__sine__rom
+
+
+module gyro_interface__carrier_nco__drive__sine__signed_sample_4(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive__sine__signed_sample_4
+
+
+module gyro_interface__carrier_nco__drive__sine__sin_out(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive__sine__sin_out
+
+
+module gyro_interface__carrier_nco__drive__sine__slope_product(clock,a,b,p);
+
+    // Module arguments
+    input wire  clock;
+    input wire signed [15:0] a;
+    input wire signed [15:0] b;
+    output reg signed [31:0] p;
+
+    // Update code (custom)
+    initial p = 0;
+
+    always @(posedge clock) begin
+       p <= a * b;
+    end
+endmodule // gyro_interface__carrier_nco__drive__sine__slope_product
+
+
+module gyro_interface__carrier_nco__drive__sine__slope_read(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive__sine__slope_read
+
+
+module gyro_interface__carrier_nco__drive__sine__value_read(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive__sine__value_read
 
 
 module gyro_interface__carrier_nco__phase(d,q,clock);
@@ -2195,272 +2742,270 @@ module gyro_interface__carrier_nco__reference(clock,phase,sin,cos);
     output reg signed [15:0] cos;
 
     // Constant declarations
+    localparam  no_turn = 2'b0;
+    localparam  quarter_turn = 2'b1;
+
+    // Stub signals
+    reg  sine$clock;
+    reg  [31:0] sine$phase;
+    reg  [1:0] sine$advance;
+    wire signed [15:0] sine$sin;
+    reg  cosine$clock;
+    reg  [31:0] cosine$phase;
+    reg  [1:0] cosine$advance;
+    wire signed [15:0] cosine$sin;
+
+    // Sub module instances
+    gyro_interface__carrier_nco__reference__sine sine(
+        .clock(sine$clock),
+        .phase(sine$phase),
+        .advance(sine$advance),
+        .sin(sine$sin)
+    );
+    gyro_interface__carrier_nco__reference__cosine cosine(
+        .clock(cosine$clock),
+        .phase(cosine$phase),
+        .advance(cosine$advance),
+        .sin(cosine$sin)
+    );
+
+    // Update code
+    always @(*) begin
+        sine$clock = clock;
+        cosine$clock = clock;
+        sine$phase = phase;
+        cosine$phase = phase;
+        sine$advance = no_turn;
+        cosine$advance = quarter_turn;
+        sin = sine$sin;
+        cos = cosine$sin;
+    end
+
+endmodule // gyro_interface__carrier_nco__reference
+
+
+module gyro_interface__carrier_nco__reference__cosine(clock,phase,advance,sin);
+
+    // Module arguments
+    input wire  clock;
+    input wire  [31:0] phase;
+    input wire  [1:0] advance;
+    output reg signed [15:0] sin;
+
+    // Constant declarations
     localparam  half_step = 16'h4000;
     localparam signed rounding = 32'h200000;
 
     // Stub signals
     reg  rom$clock;
-    reg  [7:0] rom$addr_a;
-    reg  [7:0] rom$addr_b;
-    wire signed [15:0] rom$value_a;
-    wire signed [15:0] rom$slope_a;
-    wire signed [15:0] rom$value_b;
-    wire signed [15:0] rom$slope_b;
-    reg  sin_slope_product$clock;
-    reg signed [15:0] sin_slope_product$a;
-    reg signed [15:0] sin_slope_product$b;
-    wire signed [31:0] sin_slope_product$p;
-    reg  cos_slope_product$clock;
-    reg signed [15:0] cos_slope_product$a;
-    reg signed [15:0] cos_slope_product$b;
-    wire signed [31:0] cos_slope_product$p;
+    reg  [7:0] rom$addr;
+    wire signed [15:0] rom$value;
+    wire signed [15:0] rom$slope;
+    reg  slope_product$clock;
+    reg signed [15:0] slope_product$a;
+    reg signed [15:0] slope_product$b;
+    wire signed [31:0] slope_product$p;
+    reg  [7:0] index_1$d;
+    wire  [7:0] index_1$q;
+    reg  index_1$clock;
     reg  [1:0] quadrant_1$d;
     wire  [1:0] quadrant_1$q;
     reg  quadrant_1$clock;
     reg signed [15:0] offset_1$d;
     wire signed [15:0] offset_1$q;
     reg  offset_1$clock;
+    reg  [1:0] quadrant_2$d;
+    wire  [1:0] quadrant_2$q;
+    reg  quadrant_2$clock;
+    reg signed [15:0] offset_2$d;
+    wire signed [15:0] offset_2$q;
+    reg  offset_2$clock;
     reg  [1:0] quadrant_read$d;
     wire  [1:0] quadrant_read$q;
     reg  quadrant_read$clock;
     reg signed [15:0] offset_read$d;
     wire signed [15:0] offset_read$q;
     reg  offset_read$clock;
-    reg signed [15:0] sin_value_read$d;
-    wire signed [15:0] sin_value_read$q;
-    reg  sin_value_read$clock;
-    reg signed [15:0] cos_value_read$d;
-    wire signed [15:0] cos_value_read$q;
-    reg  cos_value_read$clock;
-    reg signed [15:0] sin_slope_read$d;
-    wire signed [15:0] sin_slope_read$q;
-    reg  sin_slope_read$clock;
-    reg signed [15:0] cos_slope_read$d;
-    wire signed [15:0] cos_slope_read$q;
-    reg  cos_slope_read$clock;
-    reg  [1:0] quadrant_2$d;
-    wire  [1:0] quadrant_2$q;
-    reg  quadrant_2$clock;
-    reg signed [15:0] sin_sample_2$d;
-    wire signed [15:0] sin_sample_2$q;
-    reg  sin_sample_2$clock;
-    reg signed [15:0] cos_sample_2$d;
-    wire signed [15:0] cos_sample_2$q;
-    reg  cos_sample_2$clock;
-    reg  [1:0] quadrant_3$d;
-    wire  [1:0] quadrant_3$q;
-    reg  quadrant_3$clock;
-    reg signed [15:0] sin_first_3$d;
-    wire signed [15:0] sin_first_3$q;
-    reg  sin_first_3$clock;
-    reg signed [15:0] cos_first_3$d;
-    wire signed [15:0] cos_first_3$q;
-    reg  cos_first_3$clock;
+    reg signed [15:0] value_read$d;
+    wire signed [15:0] value_read$q;
+    reg  value_read$clock;
+    reg signed [15:0] slope_read$d;
+    wire signed [15:0] slope_read$q;
+    reg  slope_read$clock;
+    reg  [1:0] quadrant_4$d;
+    wire  [1:0] quadrant_4$q;
+    reg  quadrant_4$clock;
+    reg signed [15:0] signed_sample_4$d;
+    wire signed [15:0] signed_sample_4$q;
+    reg  signed_sample_4$clock;
     reg signed [15:0] sin_out$d;
     wire signed [15:0] sin_out$q;
     reg  sin_out$clock;
-    reg signed [15:0] cos_out$d;
-    wire signed [15:0] cos_out$q;
-    reg  cos_out$clock;
 
     // Local signals
+    reg  [1:0] quadrant;
     reg  [15:0] fraction;
-    reg signed [31:0] sin_rounded;
-    reg signed [31:0] cos_rounded;
-    reg signed [9:0] sin_correction_10;
-    reg signed [9:0] cos_correction_10;
-    reg signed [15:0] sin_correction;
-    reg signed [15:0] cos_correction;
+    reg signed [31:0] rounded;
+    reg signed [9:0] correction_10;
+    reg signed [15:0] correction;
 
     // Sub module instances
-    gyro_interface__carrier_nco__reference__rom rom(
+    gyro_interface__carrier_nco__reference__cosine__rom rom(
         .clock(rom$clock),
-        .addr_a(rom$addr_a),
-        .addr_b(rom$addr_b),
-        .value_a(rom$value_a),
-        .slope_a(rom$slope_a),
-        .value_b(rom$value_b),
-        .slope_b(rom$slope_b)
+        .addr(rom$addr),
+        .value(rom$value),
+        .slope(rom$slope)
     );
-    gyro_interface__carrier_nco__reference__sin_slope_product sin_slope_product(
-        .clock(sin_slope_product$clock),
-        .a(sin_slope_product$a),
-        .b(sin_slope_product$b),
-        .p(sin_slope_product$p)
+    gyro_interface__carrier_nco__reference__cosine__slope_product slope_product(
+        .clock(slope_product$clock),
+        .a(slope_product$a),
+        .b(slope_product$b),
+        .p(slope_product$p)
     );
-    gyro_interface__carrier_nco__reference__cos_slope_product cos_slope_product(
-        .clock(cos_slope_product$clock),
-        .a(cos_slope_product$a),
-        .b(cos_slope_product$b),
-        .p(cos_slope_product$p)
+    gyro_interface__carrier_nco__reference__cosine__index_1 index_1(
+        .d(index_1$d),
+        .q(index_1$q),
+        .clock(index_1$clock)
     );
-    gyro_interface__carrier_nco__reference__quadrant_1 quadrant_1(
+    gyro_interface__carrier_nco__reference__cosine__quadrant_1 quadrant_1(
         .d(quadrant_1$d),
         .q(quadrant_1$q),
         .clock(quadrant_1$clock)
     );
-    gyro_interface__carrier_nco__reference__offset_1 offset_1(
+    gyro_interface__carrier_nco__reference__cosine__offset_1 offset_1(
         .d(offset_1$d),
         .q(offset_1$q),
         .clock(offset_1$clock)
     );
-    gyro_interface__carrier_nco__reference__quadrant_read quadrant_read(
-        .d(quadrant_read$d),
-        .q(quadrant_read$q),
-        .clock(quadrant_read$clock)
-    );
-    gyro_interface__carrier_nco__reference__offset_read offset_read(
-        .d(offset_read$d),
-        .q(offset_read$q),
-        .clock(offset_read$clock)
-    );
-    gyro_interface__carrier_nco__reference__sin_value_read sin_value_read(
-        .d(sin_value_read$d),
-        .q(sin_value_read$q),
-        .clock(sin_value_read$clock)
-    );
-    gyro_interface__carrier_nco__reference__cos_value_read cos_value_read(
-        .d(cos_value_read$d),
-        .q(cos_value_read$q),
-        .clock(cos_value_read$clock)
-    );
-    gyro_interface__carrier_nco__reference__sin_slope_read sin_slope_read(
-        .d(sin_slope_read$d),
-        .q(sin_slope_read$q),
-        .clock(sin_slope_read$clock)
-    );
-    gyro_interface__carrier_nco__reference__cos_slope_read cos_slope_read(
-        .d(cos_slope_read$d),
-        .q(cos_slope_read$q),
-        .clock(cos_slope_read$clock)
-    );
-    gyro_interface__carrier_nco__reference__quadrant_2 quadrant_2(
+    gyro_interface__carrier_nco__reference__cosine__quadrant_2 quadrant_2(
         .d(quadrant_2$d),
         .q(quadrant_2$q),
         .clock(quadrant_2$clock)
     );
-    gyro_interface__carrier_nco__reference__sin_sample_2 sin_sample_2(
-        .d(sin_sample_2$d),
-        .q(sin_sample_2$q),
-        .clock(sin_sample_2$clock)
+    gyro_interface__carrier_nco__reference__cosine__offset_2 offset_2(
+        .d(offset_2$d),
+        .q(offset_2$q),
+        .clock(offset_2$clock)
     );
-    gyro_interface__carrier_nco__reference__cos_sample_2 cos_sample_2(
-        .d(cos_sample_2$d),
-        .q(cos_sample_2$q),
-        .clock(cos_sample_2$clock)
+    gyro_interface__carrier_nco__reference__cosine__quadrant_read quadrant_read(
+        .d(quadrant_read$d),
+        .q(quadrant_read$q),
+        .clock(quadrant_read$clock)
     );
-    gyro_interface__carrier_nco__reference__quadrant_3 quadrant_3(
-        .d(quadrant_3$d),
-        .q(quadrant_3$q),
-        .clock(quadrant_3$clock)
+    gyro_interface__carrier_nco__reference__cosine__offset_read offset_read(
+        .d(offset_read$d),
+        .q(offset_read$q),
+        .clock(offset_read$clock)
     );
-    gyro_interface__carrier_nco__reference__sin_first_3 sin_first_3(
-        .d(sin_first_3$d),
-        .q(sin_first_3$q),
-        .clock(sin_first_3$clock)
+    gyro_interface__carrier_nco__reference__cosine__value_read value_read(
+        .d(value_read$d),
+        .q(value_read$q),
+        .clock(value_read$clock)
     );
-    gyro_interface__carrier_nco__reference__cos_first_3 cos_first_3(
-        .d(cos_first_3$d),
-        .q(cos_first_3$q),
-        .clock(cos_first_3$clock)
+    gyro_interface__carrier_nco__reference__cosine__slope_read slope_read(
+        .d(slope_read$d),
+        .q(slope_read$q),
+        .clock(slope_read$clock)
     );
-    gyro_interface__carrier_nco__reference__sin_out sin_out(
+    gyro_interface__carrier_nco__reference__cosine__quadrant_4 quadrant_4(
+        .d(quadrant_4$d),
+        .q(quadrant_4$q),
+        .clock(quadrant_4$clock)
+    );
+    gyro_interface__carrier_nco__reference__cosine__signed_sample_4 signed_sample_4(
+        .d(signed_sample_4$d),
+        .q(signed_sample_4$q),
+        .clock(signed_sample_4$clock)
+    );
+    gyro_interface__carrier_nco__reference__cosine__sin_out sin_out(
         .d(sin_out$d),
         .q(sin_out$q),
         .clock(sin_out$clock)
-    );
-    gyro_interface__carrier_nco__reference__cos_out cos_out(
-        .d(cos_out$d),
-        .q(cos_out$q),
-        .clock(cos_out$clock)
     );
 
     // Update code
     always @(*) begin
         rom$clock = clock;
-        sin_slope_product$clock = clock;
-        cos_slope_product$clock = clock;
+        slope_product$clock = clock;
+        index_1$clock = clock;
         quadrant_1$clock = clock;
         offset_1$clock = clock;
+        quadrant_2$clock = clock;
+        offset_2$clock = clock;
         quadrant_read$clock = clock;
         offset_read$clock = clock;
-        sin_value_read$clock = clock;
-        cos_value_read$clock = clock;
-        sin_slope_read$clock = clock;
-        cos_slope_read$clock = clock;
-        quadrant_2$clock = clock;
-        sin_sample_2$clock = clock;
-        cos_sample_2$clock = clock;
-        quadrant_3$clock = clock;
-        sin_first_3$clock = clock;
-        cos_first_3$clock = clock;
+        value_read$clock = clock;
+        slope_read$clock = clock;
+        quadrant_4$clock = clock;
+        signed_sample_4$clock = clock;
         sin_out$clock = clock;
-        cos_out$clock = clock;
+        index_1$d = index_1$q;
         quadrant_1$d = quadrant_1$q;
         offset_1$d = offset_1$q;
+        quadrant_2$d = quadrant_2$q;
+        offset_2$d = offset_2$q;
         quadrant_read$d = quadrant_read$q;
         offset_read$d = offset_read$q;
-        sin_value_read$d = sin_value_read$q;
-        cos_value_read$d = cos_value_read$q;
-        sin_slope_read$d = sin_slope_read$q;
-        cos_slope_read$d = cos_slope_read$q;
-        quadrant_2$d = quadrant_2$q;
-        sin_sample_2$d = sin_sample_2$q;
-        cos_sample_2$d = cos_sample_2$q;
-        quadrant_3$d = quadrant_3$q;
-        sin_first_3$d = sin_first_3$q;
-        cos_first_3$d = cos_first_3$q;
+        value_read$d = value_read$q;
+        slope_read$d = slope_read$q;
+        quadrant_4$d = quadrant_4$q;
+        signed_sample_4$d = signed_sample_4$q;
         sin_out$d = sin_out$q;
-        cos_out$d = cos_out$q;
-        rom$addr_a = phase[(32'h16)+:(8)];
-        rom$addr_b = ~(phase[(32'h16)+:(8)]);
-        quadrant_1$d = phase[(32'h1e)+:(2)];
+        quadrant = phase[(32'h1e)+:(2)] + advance;
+        index_1$d = phase[(32'h16)+:(8)];
+        if (quadrant[32'h0]) begin
+            index_1$d = ~(phase[(32'h16)+:(8)]);
+        end
+        quadrant_1$d = quadrant;
         fraction = ((phase[(32'h7)+:(15)]) & 16'hffff);
         offset_1$d = $signed(fraction - half_step);
-        quadrant_read$d = quadrant_1$q;
-        offset_read$d = offset_1$q;
-        sin_value_read$d = rom$value_a;
-        cos_value_read$d = rom$value_b;
-        sin_slope_read$d = rom$slope_a;
-        cos_slope_read$d = rom$slope_b;
-        sin_slope_product$a = offset_read$q;
-        sin_slope_product$b = sin_slope_read$q;
-        cos_slope_product$a = offset_read$q;
-        cos_slope_product$b = cos_slope_read$q;
-        quadrant_2$d = quadrant_read$q;
-        sin_sample_2$d = sin_value_read$q;
-        cos_sample_2$d = cos_value_read$q;
-        sin_rounded = sin_slope_product$p + rounding;
-        cos_rounded = cos_slope_product$p + rounding;
-        sin_correction_10 = sin_rounded[(32'h16)+:(10)];
-        cos_correction_10 = cos_rounded[(32'h16)+:(10)];
-        sin_correction = $signed(sin_correction_10);
-        cos_correction = $signed(cos_correction_10);
-        sin_first_3$d = sin_sample_2$q + sin_correction;
-        cos_first_3$d = cos_sample_2$q - cos_correction;
-        quadrant_3$d = quadrant_2$q;
-        sin_out$d = sin_first_3$q;
-        cos_out$d = cos_first_3$q;
-        if (quadrant_3$q == 32'h1) begin
-            sin_out$d = cos_first_3$q;
-            cos_out$d = -sin_first_3$q;
+        rom$addr = index_1$q;
+        quadrant_2$d = quadrant_1$q;
+        offset_2$d = offset_1$q;
+        quadrant_read$d = quadrant_2$q;
+        offset_read$d = offset_2$q;
+        value_read$d = rom$value;
+        slope_read$d = rom$slope;
+        slope_product$a = offset_read$q;
+        slope_product$b = slope_read$q;
+        quadrant_4$d = quadrant_read$q;
+        signed_sample_4$d = value_read$q;
+        if (quadrant_read$q[32'h1]) begin
+            signed_sample_4$d = -value_read$q;
         end
-        if (quadrant_3$q == 32'h2) begin
-            sin_out$d = -sin_first_3$q;
-            cos_out$d = -cos_first_3$q;
-        end
-        if (quadrant_3$q == 32'h3) begin
-            sin_out$d = -cos_first_3$q;
-            cos_out$d = sin_first_3$q;
+        rounded = slope_product$p + rounding;
+        correction_10 = rounded[(32'h16)+:(10)];
+        correction = $signed(correction_10);
+        sin_out$d = signed_sample_4$q + correction;
+        if (quadrant_4$q[32'h0] ^ quadrant_4$q[32'h1]) begin
+            sin_out$d = signed_sample_4$q - correction;
         end
         sin = sin_out$q;
-        cos = cos_out$q;
     end
 
-endmodule // gyro_interface__carrier_nco__reference
+endmodule // gyro_interface__carrier_nco__reference__cosine
 
 
-module gyro_interface__carrier_nco__reference__cos_first_3(d,q,clock);
+module gyro_interface__carrier_nco__reference__cosine__index_1(d,q,clock);
+
+    // Module arguments
+    input wire  [7:0] d;
+    output reg  [7:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 8'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__reference__cosine__index_1
+
+
+module gyro_interface__carrier_nco__reference__cosine__offset_1(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -2476,29 +3021,10 @@ module gyro_interface__carrier_nco__reference__cos_first_3(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__reference__cos_first_3
+endmodule // gyro_interface__carrier_nco__reference__cosine__offset_1
 
 
-module gyro_interface__carrier_nco__reference__cos_out(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__reference__cos_out
-
-
-module gyro_interface__carrier_nco__reference__cos_sample_2(d,q,clock);
+module gyro_interface__carrier_nco__reference__cosine__offset_2(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -2514,27 +3040,10 @@ module gyro_interface__carrier_nco__reference__cos_sample_2(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__reference__cos_sample_2
+endmodule // gyro_interface__carrier_nco__reference__cosine__offset_2
 
 
-module gyro_interface__carrier_nco__reference__cos_slope_product(clock,a,b,p);
-
-    // Module arguments
-    input wire  clock;
-    input wire signed [15:0] a;
-    input wire signed [15:0] b;
-    output reg signed [31:0] p;
-
-    // Update code (custom)
-    initial p = 0;
-
-    always @(posedge clock) begin
-       p <= a * b;
-    end
-endmodule // gyro_interface__carrier_nco__reference__cos_slope_product
-
-
-module gyro_interface__carrier_nco__reference__cos_slope_read(d,q,clock);
+module gyro_interface__carrier_nco__reference__cosine__offset_read(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -2550,67 +3059,10 @@ module gyro_interface__carrier_nco__reference__cos_slope_read(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__reference__cos_slope_read
+endmodule // gyro_interface__carrier_nco__reference__cosine__offset_read
 
 
-module gyro_interface__carrier_nco__reference__cos_value_read(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__reference__cos_value_read
-
-
-module gyro_interface__carrier_nco__reference__offset_1(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__reference__offset_1
-
-
-module gyro_interface__carrier_nco__reference__offset_read(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__reference__offset_read
-
-
-module gyro_interface__carrier_nco__reference__quadrant_1(d,q,clock);
+module gyro_interface__carrier_nco__reference__cosine__quadrant_1(d,q,clock);
 
     // Module arguments
     input wire  [1:0] d;
@@ -2626,29 +3078,10 @@ module gyro_interface__carrier_nco__reference__quadrant_1(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__reference__quadrant_1
+endmodule // gyro_interface__carrier_nco__reference__cosine__quadrant_1
 
 
-module gyro_interface__carrier_nco__reference__quadrant_2(d,q,clock);
-
-    // Module arguments
-    input wire  [1:0] d;
-    output reg  [1:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 2'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__reference__quadrant_2
-
-
-module gyro_interface__carrier_nco__reference__quadrant_3(d,q,clock);
+module gyro_interface__carrier_nco__reference__cosine__quadrant_2(d,q,clock);
 
     // Module arguments
     input wire  [1:0] d;
@@ -2664,10 +3097,10 @@ module gyro_interface__carrier_nco__reference__quadrant_3(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__reference__quadrant_3
+endmodule // gyro_interface__carrier_nco__reference__cosine__quadrant_2
 
 
-module gyro_interface__carrier_nco__reference__quadrant_read(d,q,clock);
+module gyro_interface__carrier_nco__reference__cosine__quadrant_4(d,q,clock);
 
     // Module arguments
     input wire  [1:0] d;
@@ -2683,19 +3116,35 @@ module gyro_interface__carrier_nco__reference__quadrant_read(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__reference__quadrant_read
+endmodule // gyro_interface__carrier_nco__reference__cosine__quadrant_4
 
 
-module gyro_interface__carrier_nco__reference__rom(clock,addr_a,addr_b,value_a,slope_a,value_b,slope_b);
+module gyro_interface__carrier_nco__reference__cosine__quadrant_read(d,q,clock);
+
+    // Module arguments
+    input wire  [1:0] d;
+    output reg  [1:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 2'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__reference__cosine__quadrant_read
+
+
+module gyro_interface__carrier_nco__reference__cosine__rom(clock,addr,value,slope);
 
     // Module arguments
     input wire  clock;
-    input wire  [7:0] addr_a;
-    input wire  [7:0] addr_b;
-    output reg signed [15:0] value_a;
-    output reg signed [15:0] slope_a;
-    output reg signed [15:0] value_b;
-    output reg signed [15:0] slope_b;
+    input wire  [7:0] addr;
+    output reg signed [15:0] value;
+    output reg signed [15:0] slope;
 
     // Update code (custom)
     reg signed [15:0] value_rom [0:255];
@@ -2958,22 +3407,18 @@ module gyro_interface__carrier_nco__reference__rom(clock,addr_a,addr_b,value_a,s
        value_rom[253] = 16'sd32763; slope_rom[253] = 16'sd395;
        value_rom[254] = 16'sd32766; slope_rom[254] = 16'sd237;
        value_rom[255] = 16'sd32767; slope_rom[255] = 16'sd79;
-       value_a = 0;
-       slope_a = 0;
-       value_b = 0;
-       slope_b = 0;
+       value = 0;
+       slope = 0;
     end
 
     always @(posedge clock) begin
-       value_a <= value_rom[addr_a];
-       slope_a <= slope_rom[addr_a];
-       value_b <= value_rom[addr_b];
-       slope_b <= slope_rom[addr_b];
+       value <= value_rom[addr];
+       slope <= slope_rom[addr];
     end
-endmodule // gyro_interface__carrier_nco__reference__rom
+endmodule // gyro_interface__carrier_nco__reference__cosine__rom
 
 
-module gyro_interface__carrier_nco__reference__sin_first_3(d,q,clock);
+module gyro_interface__carrier_nco__reference__cosine__signed_sample_4(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -2989,29 +3434,10 @@ module gyro_interface__carrier_nco__reference__sin_first_3(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__reference__sin_first_3
+endmodule // gyro_interface__carrier_nco__reference__cosine__signed_sample_4
 
 
-module gyro_interface__carrier_nco__reference__sin_out(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__reference__sin_out
-
-
-module gyro_interface__carrier_nco__reference__sin_sample_2(d,q,clock);
+module gyro_interface__carrier_nco__reference__cosine__sin_out(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -3027,10 +3453,10 @@ module gyro_interface__carrier_nco__reference__sin_sample_2(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__reference__sin_sample_2
+endmodule // gyro_interface__carrier_nco__reference__cosine__sin_out
 
 
-module gyro_interface__carrier_nco__reference__sin_slope_product(clock,a,b,p);
+module gyro_interface__carrier_nco__reference__cosine__slope_product(clock,a,b,p);
 
     // Module arguments
     input wire  clock;
@@ -3044,29 +3470,10 @@ module gyro_interface__carrier_nco__reference__sin_slope_product(clock,a,b,p);
     always @(posedge clock) begin
        p <= a * b;
     end
-endmodule // gyro_interface__carrier_nco__reference__sin_slope_product
+endmodule // gyro_interface__carrier_nco__reference__cosine__slope_product
 
 
-module gyro_interface__carrier_nco__reference__sin_slope_read(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__reference__sin_slope_read
-
-
-module gyro_interface__carrier_nco__reference__sin_value_read(d,q,clock);
+module gyro_interface__carrier_nco__reference__cosine__slope_read(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -3082,7 +3489,753 @@ module gyro_interface__carrier_nco__reference__sin_value_read(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__reference__sin_value_read
+endmodule // gyro_interface__carrier_nco__reference__cosine__slope_read
+
+
+module gyro_interface__carrier_nco__reference__cosine__value_read(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__reference__cosine__value_read
+
+
+module gyro_interface__carrier_nco__reference__sine(clock,phase,advance,sin);
+
+    // Module arguments
+    input wire  clock;
+    input wire  [31:0] phase;
+    input wire  [1:0] advance;
+    output reg signed [15:0] sin;
+
+    // Constant declarations
+    localparam  half_step = 16'h4000;
+    localparam signed rounding = 32'h200000;
+
+    // Stub signals
+    reg  rom$clock;
+    reg  [7:0] rom$addr;
+    wire signed [15:0] rom$value;
+    wire signed [15:0] rom$slope;
+    reg  slope_product$clock;
+    reg signed [15:0] slope_product$a;
+    reg signed [15:0] slope_product$b;
+    wire signed [31:0] slope_product$p;
+    reg  [7:0] index_1$d;
+    wire  [7:0] index_1$q;
+    reg  index_1$clock;
+    reg  [1:0] quadrant_1$d;
+    wire  [1:0] quadrant_1$q;
+    reg  quadrant_1$clock;
+    reg signed [15:0] offset_1$d;
+    wire signed [15:0] offset_1$q;
+    reg  offset_1$clock;
+    reg  [1:0] quadrant_2$d;
+    wire  [1:0] quadrant_2$q;
+    reg  quadrant_2$clock;
+    reg signed [15:0] offset_2$d;
+    wire signed [15:0] offset_2$q;
+    reg  offset_2$clock;
+    reg  [1:0] quadrant_read$d;
+    wire  [1:0] quadrant_read$q;
+    reg  quadrant_read$clock;
+    reg signed [15:0] offset_read$d;
+    wire signed [15:0] offset_read$q;
+    reg  offset_read$clock;
+    reg signed [15:0] value_read$d;
+    wire signed [15:0] value_read$q;
+    reg  value_read$clock;
+    reg signed [15:0] slope_read$d;
+    wire signed [15:0] slope_read$q;
+    reg  slope_read$clock;
+    reg  [1:0] quadrant_4$d;
+    wire  [1:0] quadrant_4$q;
+    reg  quadrant_4$clock;
+    reg signed [15:0] signed_sample_4$d;
+    wire signed [15:0] signed_sample_4$q;
+    reg  signed_sample_4$clock;
+    reg signed [15:0] sin_out$d;
+    wire signed [15:0] sin_out$q;
+    reg  sin_out$clock;
+
+    // Local signals
+    reg  [1:0] quadrant;
+    reg  [15:0] fraction;
+    reg signed [31:0] rounded;
+    reg signed [9:0] correction_10;
+    reg signed [15:0] correction;
+
+    // Sub module instances
+    gyro_interface__carrier_nco__reference__sine__rom rom(
+        .clock(rom$clock),
+        .addr(rom$addr),
+        .value(rom$value),
+        .slope(rom$slope)
+    );
+    gyro_interface__carrier_nco__reference__sine__slope_product slope_product(
+        .clock(slope_product$clock),
+        .a(slope_product$a),
+        .b(slope_product$b),
+        .p(slope_product$p)
+    );
+    gyro_interface__carrier_nco__reference__sine__index_1 index_1(
+        .d(index_1$d),
+        .q(index_1$q),
+        .clock(index_1$clock)
+    );
+    gyro_interface__carrier_nco__reference__sine__quadrant_1 quadrant_1(
+        .d(quadrant_1$d),
+        .q(quadrant_1$q),
+        .clock(quadrant_1$clock)
+    );
+    gyro_interface__carrier_nco__reference__sine__offset_1 offset_1(
+        .d(offset_1$d),
+        .q(offset_1$q),
+        .clock(offset_1$clock)
+    );
+    gyro_interface__carrier_nco__reference__sine__quadrant_2 quadrant_2(
+        .d(quadrant_2$d),
+        .q(quadrant_2$q),
+        .clock(quadrant_2$clock)
+    );
+    gyro_interface__carrier_nco__reference__sine__offset_2 offset_2(
+        .d(offset_2$d),
+        .q(offset_2$q),
+        .clock(offset_2$clock)
+    );
+    gyro_interface__carrier_nco__reference__sine__quadrant_read quadrant_read(
+        .d(quadrant_read$d),
+        .q(quadrant_read$q),
+        .clock(quadrant_read$clock)
+    );
+    gyro_interface__carrier_nco__reference__sine__offset_read offset_read(
+        .d(offset_read$d),
+        .q(offset_read$q),
+        .clock(offset_read$clock)
+    );
+    gyro_interface__carrier_nco__reference__sine__value_read value_read(
+        .d(value_read$d),
+        .q(value_read$q),
+        .clock(value_read$clock)
+    );
+    gyro_interface__carrier_nco__reference__sine__slope_read slope_read(
+        .d(slope_read$d),
+        .q(slope_read$q),
+        .clock(slope_read$clock)
+    );
+    gyro_interface__carrier_nco__reference__sine__quadrant_4 quadrant_4(
+        .d(quadrant_4$d),
+        .q(quadrant_4$q),
+        .clock(quadrant_4$clock)
+    );
+    gyro_interface__carrier_nco__reference__sine__signed_sample_4 signed_sample_4(
+        .d(signed_sample_4$d),
+        .q(signed_sample_4$q),
+        .clock(signed_sample_4$clock)
+    );
+    gyro_interface__carrier_nco__reference__sine__sin_out sin_out(
+        .d(sin_out$d),
+        .q(sin_out$q),
+        .clock(sin_out$clock)
+    );
+
+    // Update code
+    always @(*) begin
+        rom$clock = clock;
+        slope_product$clock = clock;
+        index_1$clock = clock;
+        quadrant_1$clock = clock;
+        offset_1$clock = clock;
+        quadrant_2$clock = clock;
+        offset_2$clock = clock;
+        quadrant_read$clock = clock;
+        offset_read$clock = clock;
+        value_read$clock = clock;
+        slope_read$clock = clock;
+        quadrant_4$clock = clock;
+        signed_sample_4$clock = clock;
+        sin_out$clock = clock;
+        index_1$d = index_1$q;
+        quadrant_1$d = quadrant_1$q;
+        offset_1$d = offset_1$q;
+        quadrant_2$d = quadrant_2$q;
+        offset_2$d = offset_2$q;
+        quadrant_read$d = quadrant_read$q;
+        offset_read$d = offset_read$q;
+        value_read$d = value_read$q;
+        slope_read$d = slope_read$q;
+        quadrant_4$d = quadrant_4$q;
+        signed_sample_4$d = signed_sample_4$q;
+        sin_out$d = sin_out$q;
+        quadrant = phase[(32'h1e)+:(2)] + advance;
+        index_1$d = phase[(32'h16)+:(8)];
+        if (quadrant[32'h0]) begin
+            index_1$d = ~(phase[(32'h16)+:(8)]);
+        end
+        quadrant_1$d = quadrant;
+        fraction = ((phase[(32'h7)+:(15)]) & 16'hffff);
+        offset_1$d = $signed(fraction - half_step);
+        rom$addr = index_1$q;
+        quadrant_2$d = quadrant_1$q;
+        offset_2$d = offset_1$q;
+        quadrant_read$d = quadrant_2$q;
+        offset_read$d = offset_2$q;
+        value_read$d = rom$value;
+        slope_read$d = rom$slope;
+        slope_product$a = offset_read$q;
+        slope_product$b = slope_read$q;
+        quadrant_4$d = quadrant_read$q;
+        signed_sample_4$d = value_read$q;
+        if (quadrant_read$q[32'h1]) begin
+            signed_sample_4$d = -value_read$q;
+        end
+        rounded = slope_product$p + rounding;
+        correction_10 = rounded[(32'h16)+:(10)];
+        correction = $signed(correction_10);
+        sin_out$d = signed_sample_4$q + correction;
+        if (quadrant_4$q[32'h0] ^ quadrant_4$q[32'h1]) begin
+            sin_out$d = signed_sample_4$q - correction;
+        end
+        sin = sin_out$q;
+    end
+
+endmodule // gyro_interface__carrier_nco__reference__sine
+
+
+module gyro_interface__carrier_nco__reference__sine__index_1(d,q,clock);
+
+    // Module arguments
+    input wire  [7:0] d;
+    output reg  [7:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 8'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__reference__sine__index_1
+
+
+module gyro_interface__carrier_nco__reference__sine__offset_1(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__reference__sine__offset_1
+
+
+module gyro_interface__carrier_nco__reference__sine__offset_2(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__reference__sine__offset_2
+
+
+module gyro_interface__carrier_nco__reference__sine__offset_read(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__reference__sine__offset_read
+
+
+module gyro_interface__carrier_nco__reference__sine__quadrant_1(d,q,clock);
+
+    // Module arguments
+    input wire  [1:0] d;
+    output reg  [1:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 2'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__reference__sine__quadrant_1
+
+
+module gyro_interface__carrier_nco__reference__sine__quadrant_2(d,q,clock);
+
+    // Module arguments
+    input wire  [1:0] d;
+    output reg  [1:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 2'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__reference__sine__quadrant_2
+
+
+module gyro_interface__carrier_nco__reference__sine__quadrant_4(d,q,clock);
+
+    // Module arguments
+    input wire  [1:0] d;
+    output reg  [1:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 2'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__reference__sine__quadrant_4
+
+
+module gyro_interface__carrier_nco__reference__sine__quadrant_read(d,q,clock);
+
+    // Module arguments
+    input wire  [1:0] d;
+    output reg  [1:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 2'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__reference__sine__quadrant_read
+
+
+module gyro_interface__carrier_nco__reference__sine__rom(clock,addr,value,slope);
+
+    // Module arguments
+    input wire  clock;
+    input wire  [7:0] addr;
+    output reg signed [15:0] value;
+    output reg signed [15:0] slope;
+
+    // Update code (custom)
+    reg signed [15:0] value_rom [0:255];
+    reg signed [15:0] slope_rom [0:255];
+
+    initial begin
+       value_rom[0] = 16'sd101; slope_rom[0] = 16'sd25735;
+       value_rom[1] = 16'sd302; slope_rom[1] = 16'sd25734;
+       value_rom[2] = 16'sd503; slope_rom[2] = 16'sd25732;
+       value_rom[3] = 16'sd704; slope_rom[3] = 16'sd25729;
+       value_rom[4] = 16'sd905; slope_rom[4] = 16'sd25725;
+       value_rom[5] = 16'sd1106; slope_rom[5] = 16'sd25720;
+       value_rom[6] = 16'sd1307; slope_rom[6] = 16'sd25715;
+       value_rom[7] = 16'sd1507; slope_rom[7] = 16'sd25708;
+       value_rom[8] = 16'sd1708; slope_rom[8] = 16'sd25700;
+       value_rom[9] = 16'sd1909; slope_rom[9] = 16'sd25691;
+       value_rom[10] = 16'sd2110; slope_rom[10] = 16'sd25682;
+       value_rom[11] = 16'sd2310; slope_rom[11] = 16'sd25671;
+       value_rom[12] = 16'sd2511; slope_rom[12] = 16'sd25659;
+       value_rom[13] = 16'sd2711; slope_rom[13] = 16'sd25647;
+       value_rom[14] = 16'sd2911; slope_rom[14] = 16'sd25633;
+       value_rom[15] = 16'sd3112; slope_rom[15] = 16'sd25619;
+       value_rom[16] = 16'sd3312; slope_rom[16] = 16'sd25603;
+       value_rom[17] = 16'sd3512; slope_rom[17] = 16'sd25587;
+       value_rom[18] = 16'sd3712; slope_rom[18] = 16'sd25570;
+       value_rom[19] = 16'sd3911; slope_rom[19] = 16'sd25551;
+       value_rom[20] = 16'sd4111; slope_rom[20] = 16'sd25532;
+       value_rom[21] = 16'sd4310; slope_rom[21] = 16'sd25512;
+       value_rom[22] = 16'sd4509; slope_rom[22] = 16'sd25490;
+       value_rom[23] = 16'sd4708; slope_rom[23] = 16'sd25468;
+       value_rom[24] = 16'sd4907; slope_rom[24] = 16'sd25445;
+       value_rom[25] = 16'sd5106; slope_rom[25] = 16'sd25421;
+       value_rom[26] = 16'sd5305; slope_rom[26] = 16'sd25396;
+       value_rom[27] = 16'sd5503; slope_rom[27] = 16'sd25370;
+       value_rom[28] = 16'sd5701; slope_rom[28] = 16'sd25343;
+       value_rom[29] = 16'sd5899; slope_rom[29] = 16'sd25315;
+       value_rom[30] = 16'sd6096; slope_rom[30] = 16'sd25286;
+       value_rom[31] = 16'sd6294; slope_rom[31] = 16'sd25256;
+       value_rom[32] = 16'sd6491; slope_rom[32] = 16'sd25225;
+       value_rom[33] = 16'sd6688; slope_rom[33] = 16'sd25193;
+       value_rom[34] = 16'sd6885; slope_rom[34] = 16'sd25161;
+       value_rom[35] = 16'sd7081; slope_rom[35] = 16'sd25127;
+       value_rom[36] = 16'sd7277; slope_rom[36] = 16'sd25092;
+       value_rom[37] = 16'sd7473; slope_rom[37] = 16'sd25057;
+       value_rom[38] = 16'sd7669; slope_rom[38] = 16'sd25020;
+       value_rom[39] = 16'sd7864; slope_rom[39] = 16'sd24983;
+       value_rom[40] = 16'sd8059; slope_rom[40] = 16'sd24945;
+       value_rom[41] = 16'sd8254; slope_rom[41] = 16'sd24905;
+       value_rom[42] = 16'sd8448; slope_rom[42] = 16'sd24865;
+       value_rom[43] = 16'sd8642; slope_rom[43] = 16'sd24824;
+       value_rom[44] = 16'sd8836; slope_rom[44] = 16'sd24782;
+       value_rom[45] = 16'sd9030; slope_rom[45] = 16'sd24739;
+       value_rom[46] = 16'sd9223; slope_rom[46] = 16'sd24695;
+       value_rom[47] = 16'sd9416; slope_rom[47] = 16'sd24650;
+       value_rom[48] = 16'sd9608; slope_rom[48] = 16'sd24604;
+       value_rom[49] = 16'sd9800; slope_rom[49] = 16'sd24557;
+       value_rom[50] = 16'sd9992; slope_rom[50] = 16'sd24510;
+       value_rom[51] = 16'sd10183; slope_rom[51] = 16'sd24461;
+       value_rom[52] = 16'sd10374; slope_rom[52] = 16'sd24411;
+       value_rom[53] = 16'sd10564; slope_rom[53] = 16'sd24361;
+       value_rom[54] = 16'sd10754; slope_rom[54] = 16'sd24310;
+       value_rom[55] = 16'sd10944; slope_rom[55] = 16'sd24257;
+       value_rom[56] = 16'sd11133; slope_rom[56] = 16'sd24204;
+       value_rom[57] = 16'sd11322; slope_rom[57] = 16'sd24150;
+       value_rom[58] = 16'sd11511; slope_rom[58] = 16'sd24095;
+       value_rom[59] = 16'sd11699; slope_rom[59] = 16'sd24039;
+       value_rom[60] = 16'sd11886; slope_rom[60] = 16'sd23982;
+       value_rom[61] = 16'sd12074; slope_rom[61] = 16'sd23924;
+       value_rom[62] = 16'sd12260; slope_rom[62] = 16'sd23866;
+       value_rom[63] = 16'sd12446; slope_rom[63] = 16'sd23806;
+       value_rom[64] = 16'sd12632; slope_rom[64] = 16'sd23746;
+       value_rom[65] = 16'sd12817; slope_rom[65] = 16'sd23685;
+       value_rom[66] = 16'sd13002; slope_rom[66] = 16'sd23622;
+       value_rom[67] = 16'sd13187; slope_rom[67] = 16'sd23559;
+       value_rom[68] = 16'sd13370; slope_rom[68] = 16'sd23495;
+       value_rom[69] = 16'sd13554; slope_rom[69] = 16'sd23430;
+       value_rom[70] = 16'sd13736; slope_rom[70] = 16'sd23365;
+       value_rom[71] = 16'sd13919; slope_rom[71] = 16'sd23298;
+       value_rom[72] = 16'sd14101; slope_rom[72] = 16'sd23230;
+       value_rom[73] = 16'sd14282; slope_rom[73] = 16'sd23162;
+       value_rom[74] = 16'sd14462; slope_rom[74] = 16'sd23093;
+       value_rom[75] = 16'sd14643; slope_rom[75] = 16'sd23023;
+       value_rom[76] = 16'sd14822; slope_rom[76] = 16'sd22952;
+       value_rom[77] = 16'sd15001; slope_rom[77] = 16'sd22880;
+       value_rom[78] = 16'sd15180; slope_rom[78] = 16'sd22807;
+       value_rom[79] = 16'sd15358; slope_rom[79] = 16'sd22733;
+       value_rom[80] = 16'sd15535; slope_rom[80] = 16'sd22659;
+       value_rom[81] = 16'sd15712; slope_rom[81] = 16'sd22584;
+       value_rom[82] = 16'sd15888; slope_rom[82] = 16'sd22508;
+       value_rom[83] = 16'sd16063; slope_rom[83] = 16'sd22431;
+       value_rom[84] = 16'sd16238; slope_rom[84] = 16'sd22353;
+       value_rom[85] = 16'sd16413; slope_rom[85] = 16'sd22274;
+       value_rom[86] = 16'sd16586; slope_rom[86] = 16'sd22195;
+       value_rom[87] = 16'sd16759; slope_rom[87] = 16'sd22114;
+       value_rom[88] = 16'sd16932; slope_rom[88] = 16'sd22033;
+       value_rom[89] = 16'sd17104; slope_rom[89] = 16'sd21951;
+       value_rom[90] = 16'sd17275; slope_rom[90] = 16'sd21868;
+       value_rom[91] = 16'sd17445; slope_rom[91] = 16'sd21785;
+       value_rom[92] = 16'sd17615; slope_rom[92] = 16'sd21700;
+       value_rom[93] = 16'sd17784; slope_rom[93] = 16'sd21615;
+       value_rom[94] = 16'sd17953; slope_rom[94] = 16'sd21529;
+       value_rom[95] = 16'sd18121; slope_rom[95] = 16'sd21442;
+       value_rom[96] = 16'sd18288; slope_rom[96] = 16'sd21354;
+       value_rom[97] = 16'sd18454; slope_rom[97] = 16'sd21265;
+       value_rom[98] = 16'sd18620; slope_rom[98] = 16'sd21176;
+       value_rom[99] = 16'sd18785; slope_rom[99] = 16'sd21086;
+       value_rom[100] = 16'sd18950; slope_rom[100] = 16'sd20995;
+       value_rom[101] = 16'sd19113; slope_rom[101] = 16'sd20903;
+       value_rom[102] = 16'sd19276; slope_rom[102] = 16'sd20811;
+       value_rom[103] = 16'sd19438; slope_rom[103] = 16'sd20718;
+       value_rom[104] = 16'sd19600; slope_rom[104] = 16'sd20624;
+       value_rom[105] = 16'sd19761; slope_rom[105] = 16'sd20529;
+       value_rom[106] = 16'sd19921; slope_rom[106] = 16'sd20433;
+       value_rom[107] = 16'sd20080; slope_rom[107] = 16'sd20337;
+       value_rom[108] = 16'sd20238; slope_rom[108] = 16'sd20240;
+       value_rom[109] = 16'sd20396; slope_rom[109] = 16'sd20142;
+       value_rom[110] = 16'sd20553; slope_rom[110] = 16'sd20043;
+       value_rom[111] = 16'sd20709; slope_rom[111] = 16'sd19944;
+       value_rom[112] = 16'sd20865; slope_rom[112] = 16'sd19843;
+       value_rom[113] = 16'sd21019; slope_rom[113] = 16'sd19742;
+       value_rom[114] = 16'sd21173; slope_rom[114] = 16'sd19641;
+       value_rom[115] = 16'sd21326; slope_rom[115] = 16'sd19538;
+       value_rom[116] = 16'sd21479; slope_rom[116] = 16'sd19435;
+       value_rom[117] = 16'sd21630; slope_rom[117] = 16'sd19331;
+       value_rom[118] = 16'sd21781; slope_rom[118] = 16'sd19227;
+       value_rom[119] = 16'sd21930; slope_rom[119] = 16'sd19121;
+       value_rom[120] = 16'sd22079; slope_rom[120] = 16'sd19015;
+       value_rom[121] = 16'sd22227; slope_rom[121] = 16'sd18909;
+       value_rom[122] = 16'sd22375; slope_rom[122] = 16'sd18801;
+       value_rom[123] = 16'sd22521; slope_rom[123] = 16'sd18693;
+       value_rom[124] = 16'sd22667; slope_rom[124] = 16'sd18584;
+       value_rom[125] = 16'sd22812; slope_rom[125] = 16'sd18474;
+       value_rom[126] = 16'sd22956; slope_rom[126] = 16'sd18364;
+       value_rom[127] = 16'sd23099; slope_rom[127] = 16'sd18253;
+       value_rom[128] = 16'sd23241; slope_rom[128] = 16'sd18142;
+       value_rom[129] = 16'sd23382; slope_rom[129] = 16'sd18029;
+       value_rom[130] = 16'sd23522; slope_rom[130] = 16'sd17916;
+       value_rom[131] = 16'sd23662; slope_rom[131] = 16'sd17803;
+       value_rom[132] = 16'sd23801; slope_rom[132] = 16'sd17688;
+       value_rom[133] = 16'sd23938; slope_rom[133] = 16'sd17573;
+       value_rom[134] = 16'sd24075; slope_rom[134] = 16'sd17457;
+       value_rom[135] = 16'sd24211; slope_rom[135] = 16'sd17341;
+       value_rom[136] = 16'sd24346; slope_rom[136] = 16'sd17224;
+       value_rom[137] = 16'sd24480; slope_rom[137] = 16'sd17106;
+       value_rom[138] = 16'sd24613; slope_rom[138] = 16'sd16988;
+       value_rom[139] = 16'sd24746; slope_rom[139] = 16'sd16869;
+       value_rom[140] = 16'sd24877; slope_rom[140] = 16'sd16750;
+       value_rom[141] = 16'sd25007; slope_rom[141] = 16'sd16629;
+       value_rom[142] = 16'sd25137; slope_rom[142] = 16'sd16509;
+       value_rom[143] = 16'sd25265; slope_rom[143] = 16'sd16387;
+       value_rom[144] = 16'sd25393; slope_rom[144] = 16'sd16265;
+       value_rom[145] = 16'sd25519; slope_rom[145] = 16'sd16142;
+       value_rom[146] = 16'sd25645; slope_rom[146] = 16'sd16019;
+       value_rom[147] = 16'sd25770; slope_rom[147] = 16'sd15895;
+       value_rom[148] = 16'sd25893; slope_rom[148] = 16'sd15771;
+       value_rom[149] = 16'sd26016; slope_rom[149] = 16'sd15646;
+       value_rom[150] = 16'sd26138; slope_rom[150] = 16'sd15520;
+       value_rom[151] = 16'sd26259; slope_rom[151] = 16'sd15394;
+       value_rom[152] = 16'sd26378; slope_rom[152] = 16'sd15267;
+       value_rom[153] = 16'sd26497; slope_rom[153] = 16'sd15140;
+       value_rom[154] = 16'sd26615; slope_rom[154] = 16'sd15012;
+       value_rom[155] = 16'sd26732; slope_rom[155] = 16'sd14883;
+       value_rom[156] = 16'sd26848; slope_rom[156] = 16'sd14754;
+       value_rom[157] = 16'sd26962; slope_rom[157] = 16'sd14624;
+       value_rom[158] = 16'sd27076; slope_rom[158] = 16'sd14494;
+       value_rom[159] = 16'sd27189; slope_rom[159] = 16'sd14363;
+       value_rom[160] = 16'sd27300; slope_rom[160] = 16'sd14232;
+       value_rom[161] = 16'sd27411; slope_rom[161] = 16'sd14100;
+       value_rom[162] = 16'sd27521; slope_rom[162] = 16'sd13968;
+       value_rom[163] = 16'sd27629; slope_rom[163] = 16'sd13835;
+       value_rom[164] = 16'sd27737; slope_rom[164] = 16'sd13701;
+       value_rom[165] = 16'sd27843; slope_rom[165] = 16'sd13568;
+       value_rom[166] = 16'sd27949; slope_rom[166] = 16'sd13433;
+       value_rom[167] = 16'sd28053; slope_rom[167] = 16'sd13298;
+       value_rom[168] = 16'sd28157; slope_rom[168] = 16'sd13163;
+       value_rom[169] = 16'sd28259; slope_rom[169] = 16'sd13027;
+       value_rom[170] = 16'sd28360; slope_rom[170] = 16'sd12890;
+       value_rom[171] = 16'sd28460; slope_rom[171] = 16'sd12753;
+       value_rom[172] = 16'sd28560; slope_rom[172] = 16'sd12616;
+       value_rom[173] = 16'sd28658; slope_rom[173] = 16'sd12478;
+       value_rom[174] = 16'sd28755; slope_rom[174] = 16'sd12340;
+       value_rom[175] = 16'sd28850; slope_rom[175] = 16'sd12201;
+       value_rom[176] = 16'sd28945; slope_rom[176] = 16'sd12062;
+       value_rom[177] = 16'sd29039; slope_rom[177] = 16'sd11922;
+       value_rom[178] = 16'sd29131; slope_rom[178] = 16'sd11782;
+       value_rom[179] = 16'sd29223; slope_rom[179] = 16'sd11641;
+       value_rom[180] = 16'sd29313; slope_rom[180] = 16'sd11500;
+       value_rom[181] = 16'sd29403; slope_rom[181] = 16'sd11359;
+       value_rom[182] = 16'sd29491; slope_rom[182] = 16'sd11217;
+       value_rom[183] = 16'sd29578; slope_rom[183] = 16'sd11075;
+       value_rom[184] = 16'sd29664; slope_rom[184] = 16'sd10932;
+       value_rom[185] = 16'sd29749; slope_rom[185] = 16'sd10789;
+       value_rom[186] = 16'sd29832; slope_rom[186] = 16'sd10645;
+       value_rom[187] = 16'sd29915; slope_rom[187] = 16'sd10501;
+       value_rom[188] = 16'sd29997; slope_rom[188] = 16'sd10357;
+       value_rom[189] = 16'sd30077; slope_rom[189] = 16'sd10212;
+       value_rom[190] = 16'sd30156; slope_rom[190] = 16'sd10067;
+       value_rom[191] = 16'sd30234; slope_rom[191] = 16'sd9921;
+       value_rom[192] = 16'sd30311; slope_rom[192] = 16'sd9775;
+       value_rom[193] = 16'sd30387; slope_rom[193] = 16'sd9629;
+       value_rom[194] = 16'sd30462; slope_rom[194] = 16'sd9483;
+       value_rom[195] = 16'sd30535; slope_rom[195] = 16'sd9336;
+       value_rom[196] = 16'sd30607; slope_rom[196] = 16'sd9188;
+       value_rom[197] = 16'sd30679; slope_rom[197] = 16'sd9041;
+       value_rom[198] = 16'sd30749; slope_rom[198] = 16'sd8893;
+       value_rom[199] = 16'sd30818; slope_rom[199] = 16'sd8744;
+       value_rom[200] = 16'sd30885; slope_rom[200] = 16'sd8596;
+       value_rom[201] = 16'sd30952; slope_rom[201] = 16'sd8447;
+       value_rom[202] = 16'sd31017; slope_rom[202] = 16'sd8297;
+       value_rom[203] = 16'sd31082; slope_rom[203] = 16'sd8148;
+       value_rom[204] = 16'sd31145; slope_rom[204] = 16'sd7998;
+       value_rom[205] = 16'sd31206; slope_rom[205] = 16'sd7847;
+       value_rom[206] = 16'sd31267; slope_rom[206] = 16'sd7697;
+       value_rom[207] = 16'sd31327; slope_rom[207] = 16'sd7546;
+       value_rom[208] = 16'sd31385; slope_rom[208] = 16'sd7395;
+       value_rom[209] = 16'sd31442; slope_rom[209] = 16'sd7244;
+       value_rom[210] = 16'sd31498; slope_rom[210] = 16'sd7092;
+       value_rom[211] = 16'sd31553; slope_rom[211] = 16'sd6940;
+       value_rom[212] = 16'sd31607; slope_rom[212] = 16'sd6788;
+       value_rom[213] = 16'sd31659; slope_rom[213] = 16'sd6635;
+       value_rom[214] = 16'sd31710; slope_rom[214] = 16'sd6483;
+       value_rom[215] = 16'sd31760; slope_rom[215] = 16'sd6330;
+       value_rom[216] = 16'sd31809; slope_rom[216] = 16'sd6177;
+       value_rom[217] = 16'sd31857; slope_rom[217] = 16'sd6023;
+       value_rom[218] = 16'sd31903; slope_rom[218] = 16'sd5869;
+       value_rom[219] = 16'sd31949; slope_rom[219] = 16'sd5716;
+       value_rom[220] = 16'sd31993; slope_rom[220] = 16'sd5562;
+       value_rom[221] = 16'sd32036; slope_rom[221] = 16'sd5407;
+       value_rom[222] = 16'sd32077; slope_rom[222] = 16'sd5253;
+       value_rom[223] = 16'sd32118; slope_rom[223] = 16'sd5098;
+       value_rom[224] = 16'sd32157; slope_rom[224] = 16'sd4943;
+       value_rom[225] = 16'sd32195; slope_rom[225] = 16'sd4788;
+       value_rom[226] = 16'sd32232; slope_rom[226] = 16'sd4633;
+       value_rom[227] = 16'sd32267; slope_rom[227] = 16'sd4477;
+       value_rom[228] = 16'sd32302; slope_rom[228] = 16'sd4322;
+       value_rom[229] = 16'sd32335; slope_rom[229] = 16'sd4166;
+       value_rom[230] = 16'sd32367; slope_rom[230] = 16'sd4010;
+       value_rom[231] = 16'sd32397; slope_rom[231] = 16'sd3854;
+       value_rom[232] = 16'sd32427; slope_rom[232] = 16'sd3698;
+       value_rom[233] = 16'sd32455; slope_rom[233] = 16'sd3542;
+       value_rom[234] = 16'sd32482; slope_rom[234] = 16'sd3385;
+       value_rom[235] = 16'sd32508; slope_rom[235] = 16'sd3229;
+       value_rom[236] = 16'sd32533; slope_rom[236] = 16'sd3072;
+       value_rom[237] = 16'sd32556; slope_rom[237] = 16'sd2915;
+       value_rom[238] = 16'sd32578; slope_rom[238] = 16'sd2758;
+       value_rom[239] = 16'sd32599; slope_rom[239] = 16'sd2601;
+       value_rom[240] = 16'sd32619; slope_rom[240] = 16'sd2444;
+       value_rom[241] = 16'sd32637; slope_rom[241] = 16'sd2287;
+       value_rom[242] = 16'sd32655; slope_rom[242] = 16'sd2129;
+       value_rom[243] = 16'sd32671; slope_rom[243] = 16'sd1972;
+       value_rom[244] = 16'sd32685; slope_rom[244] = 16'sd1814;
+       value_rom[245] = 16'sd32699; slope_rom[245] = 16'sd1657;
+       value_rom[246] = 16'sd32711; slope_rom[246] = 16'sd1499;
+       value_rom[247] = 16'sd32722; slope_rom[247] = 16'sd1342;
+       value_rom[248] = 16'sd32732; slope_rom[248] = 16'sd1184;
+       value_rom[249] = 16'sd32741; slope_rom[249] = 16'sd1026;
+       value_rom[250] = 16'sd32748; slope_rom[250] = 16'sd868;
+       value_rom[251] = 16'sd32755; slope_rom[251] = 16'sd710;
+       value_rom[252] = 16'sd32759; slope_rom[252] = 16'sd553;
+       value_rom[253] = 16'sd32763; slope_rom[253] = 16'sd395;
+       value_rom[254] = 16'sd32766; slope_rom[254] = 16'sd237;
+       value_rom[255] = 16'sd32767; slope_rom[255] = 16'sd79;
+       value = 0;
+       slope = 0;
+    end
+
+    always @(posedge clock) begin
+       value <= value_rom[addr];
+       slope <= slope_rom[addr];
+    end
+endmodule // gyro_interface__carrier_nco__reference__sine__rom
+
+
+module gyro_interface__carrier_nco__reference__sine__signed_sample_4(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__reference__sine__signed_sample_4
+
+
+module gyro_interface__carrier_nco__reference__sine__sin_out(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__reference__sine__sin_out
+
+
+module gyro_interface__carrier_nco__reference__sine__slope_product(clock,a,b,p);
+
+    // Module arguments
+    input wire  clock;
+    input wire signed [15:0] a;
+    input wire signed [15:0] b;
+    output reg signed [31:0] p;
+
+    // Update code (custom)
+    initial p = 0;
+
+    always @(posedge clock) begin
+       p <= a * b;
+    end
+endmodule // gyro_interface__carrier_nco__reference__sine__slope_product
+
+
+module gyro_interface__carrier_nco__reference__sine__slope_read(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__reference__sine__slope_read
+
+
+module gyro_interface__carrier_nco__reference__sine__value_read(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__reference__sine__value_read
 
 
 module gyro_interface__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
@@ -5113,15 +6266,21 @@ module gyro_interface__modulation_nco(clock,step,select,am1,am2);
 
     // Constant declarations
     localparam signed full_scale = 16'h7fff;
+    localparam  cosine_advance = 2'b1;
+    localparam  sine_advance = 2'b0;
+    localparam  cosine_out_turn = 1'b1;
 
     // Stub signals
     reg  [47:0] phase$d;
     wire  [47:0] phase$q;
     reg  phase$clock;
-    reg  sincos$clock;
-    reg  [31:0] sincos$phase;
-    wire signed [15:0] sincos$sin;
-    wire signed [15:0] sincos$cos;
+    reg  sine$clock;
+    reg  [31:0] sine$phase;
+    reg  [1:0] sine$advance;
+    wire signed [15:0] sine$sin;
+    reg  turn$d;
+    wire  turn$q;
+    reg  turn$clock;
     reg signed [15:0] am1_out$d;
     wire signed [15:0] am1_out$q;
     reg  am1_out$clock;
@@ -5135,11 +6294,16 @@ module gyro_interface__modulation_nco(clock,step,select,am1,am2);
         .q(phase$q),
         .clock(phase$clock)
     );
-    gyro_interface__modulation_nco__sincos sincos(
-        .clock(sincos$clock),
-        .phase(sincos$phase),
-        .sin(sincos$sin),
-        .cos(sincos$cos)
+    gyro_interface__modulation_nco__sine sine(
+        .clock(sine$clock),
+        .phase(sine$phase),
+        .advance(sine$advance),
+        .sin(sine$sin)
+    );
+    gyro_interface__modulation_nco__turn turn(
+        .d(turn$d),
+        .q(turn$q),
+        .clock(turn$clock)
     );
     gyro_interface__modulation_nco__am1_out am1_out(
         .d(am1_out$d),
@@ -5155,19 +6319,32 @@ module gyro_interface__modulation_nco(clock,step,select,am1,am2);
     // Update code
     always @(*) begin
         phase$clock = clock;
+        turn$clock = clock;
         am1_out$clock = clock;
         am2_out$clock = clock;
         phase$d = phase$q;
+        turn$d = turn$q;
         am1_out$d = am1_out$q;
         am2_out$d = am2_out$q;
-        sincos$clock = clock;
+        sine$clock = clock;
         phase$d = phase$q + step;
-        sincos$phase = phase$q[(32'h10)+:(32)];
-        am1_out$d = full_scale;
-        am2_out$d = full_scale;
+        turn$d = ~turn$q;
+        sine$phase = phase$q[(32'h10)+:(32)];
+        sine$advance = cosine_advance;
+        if (turn$q) begin
+            sine$advance = sine_advance;
+        end
         if (select) begin
-            am1_out$d = sincos$cos;
-            am2_out$d = sincos$sin;
+            if (turn$q == cosine_out_turn) begin
+                am1_out$d = sine$sin;
+            end
+            else begin
+                am2_out$d = sine$sin;
+            end
+        end
+        else begin
+            am1_out$d = full_scale;
+            am2_out$d = full_scale;
         end
         am1 = am1_out$q;
         am2 = am2_out$q;
@@ -5233,13 +6410,13 @@ module gyro_interface__modulation_nco__phase(d,q,clock);
 endmodule // gyro_interface__modulation_nco__phase
 
 
-module gyro_interface__modulation_nco__sincos(clock,phase,sin,cos);
+module gyro_interface__modulation_nco__sine(clock,phase,advance,sin);
 
     // Module arguments
     input wire  clock;
     input wire  [31:0] phase;
+    input wire  [1:0] advance;
     output reg signed [15:0] sin;
-    output reg signed [15:0] cos;
 
     // Constant declarations
     localparam  half_step = 16'h4000;
@@ -5247,267 +6424,214 @@ module gyro_interface__modulation_nco__sincos(clock,phase,sin,cos);
 
     // Stub signals
     reg  rom$clock;
-    reg  [7:0] rom$addr_a;
-    reg  [7:0] rom$addr_b;
-    wire signed [15:0] rom$value_a;
-    wire signed [15:0] rom$slope_a;
-    wire signed [15:0] rom$value_b;
-    wire signed [15:0] rom$slope_b;
-    reg  sin_slope_product$clock;
-    reg signed [15:0] sin_slope_product$a;
-    reg signed [15:0] sin_slope_product$b;
-    wire signed [31:0] sin_slope_product$p;
-    reg  cos_slope_product$clock;
-    reg signed [15:0] cos_slope_product$a;
-    reg signed [15:0] cos_slope_product$b;
-    wire signed [31:0] cos_slope_product$p;
+    reg  [7:0] rom$addr;
+    wire signed [15:0] rom$value;
+    wire signed [15:0] rom$slope;
+    reg  slope_product$clock;
+    reg signed [15:0] slope_product$a;
+    reg signed [15:0] slope_product$b;
+    wire signed [31:0] slope_product$p;
+    reg  [7:0] index_1$d;
+    wire  [7:0] index_1$q;
+    reg  index_1$clock;
     reg  [1:0] quadrant_1$d;
     wire  [1:0] quadrant_1$q;
     reg  quadrant_1$clock;
     reg signed [15:0] offset_1$d;
     wire signed [15:0] offset_1$q;
     reg  offset_1$clock;
+    reg  [1:0] quadrant_2$d;
+    wire  [1:0] quadrant_2$q;
+    reg  quadrant_2$clock;
+    reg signed [15:0] offset_2$d;
+    wire signed [15:0] offset_2$q;
+    reg  offset_2$clock;
     reg  [1:0] quadrant_read$d;
     wire  [1:0] quadrant_read$q;
     reg  quadrant_read$clock;
     reg signed [15:0] offset_read$d;
     wire signed [15:0] offset_read$q;
     reg  offset_read$clock;
-    reg signed [15:0] sin_value_read$d;
-    wire signed [15:0] sin_value_read$q;
-    reg  sin_value_read$clock;
-    reg signed [15:0] cos_value_read$d;
-    wire signed [15:0] cos_value_read$q;
-    reg  cos_value_read$clock;
-    reg signed [15:0] sin_slope_read$d;
-    wire signed [15:0] sin_slope_read$q;
-    reg  sin_slope_read$clock;
-    reg signed [15:0] cos_slope_read$d;
-    wire signed [15:0] cos_slope_read$q;
-    reg  cos_slope_read$clock;
-    reg  [1:0] quadrant_2$d;
-    wire  [1:0] quadrant_2$q;
-    reg  quadrant_2$clock;
-    reg signed [15:0] sin_sample_2$d;
-    wire signed [15:0] sin_sample_2$q;
-    reg  sin_sample_2$clock;
-    reg signed [15:0] cos_sample_2$d;
-    wire signed [15:0] cos_sample_2$q;
-    reg  cos_sample_2$clock;
-    reg  [1:0] quadrant_3$d;
-    wire  [1:0] quadrant_3$q;
-    reg  quadrant_3$clock;
-    reg signed [15:0] sin_first_3$d;
-    wire signed [15:0] sin_first_3$q;
-    reg  sin_first_3$clock;
-    reg signed [15:0] cos_first_3$d;
-    wire signed [15:0] cos_first_3$q;
-    reg  cos_first_3$clock;
+    reg signed [15:0] value_read$d;
+    wire signed [15:0] value_read$q;
+    reg  value_read$clock;
+    reg signed [15:0] slope_read$d;
+    wire signed [15:0] slope_read$q;
+    reg  slope_read$clock;
+    reg  [1:0] quadrant_4$d;
+    wire  [1:0] quadrant_4$q;
+    reg  quadrant_4$clock;
+    reg signed [15:0] signed_sample_4$d;
+    wire signed [15:0] signed_sample_4$q;
+    reg  signed_sample_4$clock;
     reg signed [15:0] sin_out$d;
     wire signed [15:0] sin_out$q;
     reg  sin_out$clock;
-    reg signed [15:0] cos_out$d;
-    wire signed [15:0] cos_out$q;
-    reg  cos_out$clock;
 
     // Local signals
+    reg  [1:0] quadrant;
     reg  [15:0] fraction;
-    reg signed [31:0] sin_rounded;
-    reg signed [31:0] cos_rounded;
-    reg signed [9:0] sin_correction_10;
-    reg signed [9:0] cos_correction_10;
-    reg signed [15:0] sin_correction;
-    reg signed [15:0] cos_correction;
+    reg signed [31:0] rounded;
+    reg signed [9:0] correction_10;
+    reg signed [15:0] correction;
 
     // Sub module instances
-    gyro_interface__modulation_nco__sincos__rom rom(
+    gyro_interface__modulation_nco__sine__rom rom(
         .clock(rom$clock),
-        .addr_a(rom$addr_a),
-        .addr_b(rom$addr_b),
-        .value_a(rom$value_a),
-        .slope_a(rom$slope_a),
-        .value_b(rom$value_b),
-        .slope_b(rom$slope_b)
+        .addr(rom$addr),
+        .value(rom$value),
+        .slope(rom$slope)
     );
-    gyro_interface__modulation_nco__sincos__sin_slope_product sin_slope_product(
-        .clock(sin_slope_product$clock),
-        .a(sin_slope_product$a),
-        .b(sin_slope_product$b),
-        .p(sin_slope_product$p)
+    gyro_interface__modulation_nco__sine__slope_product slope_product(
+        .clock(slope_product$clock),
+        .a(slope_product$a),
+        .b(slope_product$b),
+        .p(slope_product$p)
     );
-    gyro_interface__modulation_nco__sincos__cos_slope_product cos_slope_product(
-        .clock(cos_slope_product$clock),
-        .a(cos_slope_product$a),
-        .b(cos_slope_product$b),
-        .p(cos_slope_product$p)
+    gyro_interface__modulation_nco__sine__index_1 index_1(
+        .d(index_1$d),
+        .q(index_1$q),
+        .clock(index_1$clock)
     );
-    gyro_interface__modulation_nco__sincos__quadrant_1 quadrant_1(
+    gyro_interface__modulation_nco__sine__quadrant_1 quadrant_1(
         .d(quadrant_1$d),
         .q(quadrant_1$q),
         .clock(quadrant_1$clock)
     );
-    gyro_interface__modulation_nco__sincos__offset_1 offset_1(
+    gyro_interface__modulation_nco__sine__offset_1 offset_1(
         .d(offset_1$d),
         .q(offset_1$q),
         .clock(offset_1$clock)
     );
-    gyro_interface__modulation_nco__sincos__quadrant_read quadrant_read(
-        .d(quadrant_read$d),
-        .q(quadrant_read$q),
-        .clock(quadrant_read$clock)
-    );
-    gyro_interface__modulation_nco__sincos__offset_read offset_read(
-        .d(offset_read$d),
-        .q(offset_read$q),
-        .clock(offset_read$clock)
-    );
-    gyro_interface__modulation_nco__sincos__sin_value_read sin_value_read(
-        .d(sin_value_read$d),
-        .q(sin_value_read$q),
-        .clock(sin_value_read$clock)
-    );
-    gyro_interface__modulation_nco__sincos__cos_value_read cos_value_read(
-        .d(cos_value_read$d),
-        .q(cos_value_read$q),
-        .clock(cos_value_read$clock)
-    );
-    gyro_interface__modulation_nco__sincos__sin_slope_read sin_slope_read(
-        .d(sin_slope_read$d),
-        .q(sin_slope_read$q),
-        .clock(sin_slope_read$clock)
-    );
-    gyro_interface__modulation_nco__sincos__cos_slope_read cos_slope_read(
-        .d(cos_slope_read$d),
-        .q(cos_slope_read$q),
-        .clock(cos_slope_read$clock)
-    );
-    gyro_interface__modulation_nco__sincos__quadrant_2 quadrant_2(
+    gyro_interface__modulation_nco__sine__quadrant_2 quadrant_2(
         .d(quadrant_2$d),
         .q(quadrant_2$q),
         .clock(quadrant_2$clock)
     );
-    gyro_interface__modulation_nco__sincos__sin_sample_2 sin_sample_2(
-        .d(sin_sample_2$d),
-        .q(sin_sample_2$q),
-        .clock(sin_sample_2$clock)
+    gyro_interface__modulation_nco__sine__offset_2 offset_2(
+        .d(offset_2$d),
+        .q(offset_2$q),
+        .clock(offset_2$clock)
     );
-    gyro_interface__modulation_nco__sincos__cos_sample_2 cos_sample_2(
-        .d(cos_sample_2$d),
-        .q(cos_sample_2$q),
-        .clock(cos_sample_2$clock)
+    gyro_interface__modulation_nco__sine__quadrant_read quadrant_read(
+        .d(quadrant_read$d),
+        .q(quadrant_read$q),
+        .clock(quadrant_read$clock)
     );
-    gyro_interface__modulation_nco__sincos__quadrant_3 quadrant_3(
-        .d(quadrant_3$d),
-        .q(quadrant_3$q),
-        .clock(quadrant_3$clock)
+    gyro_interface__modulation_nco__sine__offset_read offset_read(
+        .d(offset_read$d),
+        .q(offset_read$q),
+        .clock(offset_read$clock)
     );
-    gyro_interface__modulation_nco__sincos__sin_first_3 sin_first_3(
-        .d(sin_first_3$d),
-        .q(sin_first_3$q),
-        .clock(sin_first_3$clock)
+    gyro_interface__modulation_nco__sine__value_read value_read(
+        .d(value_read$d),
+        .q(value_read$q),
+        .clock(value_read$clock)
     );
-    gyro_interface__modulation_nco__sincos__cos_first_3 cos_first_3(
-        .d(cos_first_3$d),
-        .q(cos_first_3$q),
-        .clock(cos_first_3$clock)
+    gyro_interface__modulation_nco__sine__slope_read slope_read(
+        .d(slope_read$d),
+        .q(slope_read$q),
+        .clock(slope_read$clock)
     );
-    gyro_interface__modulation_nco__sincos__sin_out sin_out(
+    gyro_interface__modulation_nco__sine__quadrant_4 quadrant_4(
+        .d(quadrant_4$d),
+        .q(quadrant_4$q),
+        .clock(quadrant_4$clock)
+    );
+    gyro_interface__modulation_nco__sine__signed_sample_4 signed_sample_4(
+        .d(signed_sample_4$d),
+        .q(signed_sample_4$q),
+        .clock(signed_sample_4$clock)
+    );
+    gyro_interface__modulation_nco__sine__sin_out sin_out(
         .d(sin_out$d),
         .q(sin_out$q),
         .clock(sin_out$clock)
-    );
-    gyro_interface__modulation_nco__sincos__cos_out cos_out(
-        .d(cos_out$d),
-        .q(cos_out$q),
-        .clock(cos_out$clock)
     );
 
     // Update code
     always @(*) begin
         rom$clock = clock;
-        sin_slope_product$clock = clock;
-        cos_slope_product$clock = clock;
+        slope_product$clock = clock;
+        index_1$clock = clock;
         quadrant_1$clock = clock;
         offset_1$clock = clock;
+        quadrant_2$clock = clock;
+        offset_2$clock = clock;
         quadrant_read$clock = clock;
         offset_read$clock = clock;
-        sin_value_read$clock = clock;
-        cos_value_read$clock = clock;
-        sin_slope_read$clock = clock;
-        cos_slope_read$clock = clock;
-        quadrant_2$clock = clock;
-        sin_sample_2$clock = clock;
-        cos_sample_2$clock = clock;
-        quadrant_3$clock = clock;
-        sin_first_3$clock = clock;
-        cos_first_3$clock = clock;
+        value_read$clock = clock;
+        slope_read$clock = clock;
+        quadrant_4$clock = clock;
+        signed_sample_4$clock = clock;
         sin_out$clock = clock;
-        cos_out$clock = clock;
+        index_1$d = index_1$q;
         quadrant_1$d = quadrant_1$q;
         offset_1$d = offset_1$q;
+        quadrant_2$d = quadrant_2$q;
+        offset_2$d = offset_2$q;
         quadrant_read$d = quadrant_read$q;
         offset_read$d = offset_read$q;
-        sin_value_read$d = sin_value_read$q;
-        cos_value_read$d = cos_value_read$q;
-        sin_slope_read$d = sin_slope_read$q;
-        cos_slope_read$d = cos_slope_read$q;
-        quadrant_2$d = quadrant_2$q;
-        sin_sample_2$d = sin_sample_2$q;
-        cos_sample_2$d = cos_sample_2$q;
-        quadrant_3$d = quadrant_3$q;
-        sin_first_3$d = sin_first_3$q;
-        cos_first_3$d = cos_first_3$q;
+        value_read$d = value_read$q;
+        slope_read$d = slope_read$q;
+        quadrant_4$d = quadrant_4$q;
+        signed_sample_4$d = signed_sample_4$q;
         sin_out$d = sin_out$q;
-        cos_out$d = cos_out$q;
-        rom$addr_a = phase[(32'h16)+:(8)];
-        rom$addr_b = ~(phase[(32'h16)+:(8)]);
-        quadrant_1$d = phase[(32'h1e)+:(2)];
+        quadrant = phase[(32'h1e)+:(2)] + advance;
+        index_1$d = phase[(32'h16)+:(8)];
+        if (quadrant[32'h0]) begin
+            index_1$d = ~(phase[(32'h16)+:(8)]);
+        end
+        quadrant_1$d = quadrant;
         fraction = ((phase[(32'h7)+:(15)]) & 16'hffff);
         offset_1$d = $signed(fraction - half_step);
-        quadrant_read$d = quadrant_1$q;
-        offset_read$d = offset_1$q;
-        sin_value_read$d = rom$value_a;
-        cos_value_read$d = rom$value_b;
-        sin_slope_read$d = rom$slope_a;
-        cos_slope_read$d = rom$slope_b;
-        sin_slope_product$a = offset_read$q;
-        sin_slope_product$b = sin_slope_read$q;
-        cos_slope_product$a = offset_read$q;
-        cos_slope_product$b = cos_slope_read$q;
-        quadrant_2$d = quadrant_read$q;
-        sin_sample_2$d = sin_value_read$q;
-        cos_sample_2$d = cos_value_read$q;
-        sin_rounded = sin_slope_product$p + rounding;
-        cos_rounded = cos_slope_product$p + rounding;
-        sin_correction_10 = sin_rounded[(32'h16)+:(10)];
-        cos_correction_10 = cos_rounded[(32'h16)+:(10)];
-        sin_correction = $signed(sin_correction_10);
-        cos_correction = $signed(cos_correction_10);
-        sin_first_3$d = sin_sample_2$q + sin_correction;
-        cos_first_3$d = cos_sample_2$q - cos_correction;
-        quadrant_3$d = quadrant_2$q;
-        sin_out$d = sin_first_3$q;
-        cos_out$d = cos_first_3$q;
-        if (quadrant_3$q == 32'h1) begin
-            sin_out$d = cos_first_3$q;
-            cos_out$d = -sin_first_3$q;
+        rom$addr = index_1$q;
+        quadrant_2$d = quadrant_1$q;
+        offset_2$d = offset_1$q;
+        quadrant_read$d = quadrant_2$q;
+        offset_read$d = offset_2$q;
+        value_read$d = rom$value;
+        slope_read$d = rom$slope;
+        slope_product$a = offset_read$q;
+        slope_product$b = slope_read$q;
+        quadrant_4$d = quadrant_read$q;
+        signed_sample_4$d = value_read$q;
+        if (quadrant_read$q[32'h1]) begin
+            signed_sample_4$d = -value_read$q;
         end
-        if (quadrant_3$q == 32'h2) begin
-            sin_out$d = -sin_first_3$q;
-            cos_out$d = -cos_first_3$q;
-        end
-        if (quadrant_3$q == 32'h3) begin
-            sin_out$d = -cos_first_3$q;
-            cos_out$d = sin_first_3$q;
+        rounded = slope_product$p + rounding;
+        correction_10 = rounded[(32'h16)+:(10)];
+        correction = $signed(correction_10);
+        sin_out$d = signed_sample_4$q + correction;
+        if (quadrant_4$q[32'h0] ^ quadrant_4$q[32'h1]) begin
+            sin_out$d = signed_sample_4$q - correction;
         end
         sin = sin_out$q;
-        cos = cos_out$q;
     end
 
-endmodule // gyro_interface__modulation_nco__sincos
+endmodule // gyro_interface__modulation_nco__sine
 
 
-module gyro_interface__modulation_nco__sincos__cos_first_3(d,q,clock);
+module gyro_interface__modulation_nco__sine__index_1(d,q,clock);
+
+    // Module arguments
+    input wire  [7:0] d;
+    output reg  [7:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 8'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__modulation_nco__sine__index_1
+
+
+module gyro_interface__modulation_nco__sine__offset_1(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -5523,29 +6647,10 @@ module gyro_interface__modulation_nco__sincos__cos_first_3(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__modulation_nco__sincos__cos_first_3
+endmodule // gyro_interface__modulation_nco__sine__offset_1
 
 
-module gyro_interface__modulation_nco__sincos__cos_out(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__modulation_nco__sincos__cos_out
-
-
-module gyro_interface__modulation_nco__sincos__cos_sample_2(d,q,clock);
+module gyro_interface__modulation_nco__sine__offset_2(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -5561,27 +6666,10 @@ module gyro_interface__modulation_nco__sincos__cos_sample_2(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__modulation_nco__sincos__cos_sample_2
+endmodule // gyro_interface__modulation_nco__sine__offset_2
 
 
-module gyro_interface__modulation_nco__sincos__cos_slope_product(clock,a,b,p);
-
-    // Module arguments
-    input wire  clock;
-    input wire signed [15:0] a;
-    input wire signed [15:0] b;
-    output reg signed [31:0] p;
-
-    // Update code (custom)
-    initial p = 0;
-
-    always @(posedge clock) begin
-       p <= a * b;
-    end
-endmodule // gyro_interface__modulation_nco__sincos__cos_slope_product
-
-
-module gyro_interface__modulation_nco__sincos__cos_slope_read(d,q,clock);
+module gyro_interface__modulation_nco__sine__offset_read(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -5597,67 +6685,10 @@ module gyro_interface__modulation_nco__sincos__cos_slope_read(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__modulation_nco__sincos__cos_slope_read
+endmodule // gyro_interface__modulation_nco__sine__offset_read
 
 
-module gyro_interface__modulation_nco__sincos__cos_value_read(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__modulation_nco__sincos__cos_value_read
-
-
-module gyro_interface__modulation_nco__sincos__offset_1(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__modulation_nco__sincos__offset_1
-
-
-module gyro_interface__modulation_nco__sincos__offset_read(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__modulation_nco__sincos__offset_read
-
-
-module gyro_interface__modulation_nco__sincos__quadrant_1(d,q,clock);
+module gyro_interface__modulation_nco__sine__quadrant_1(d,q,clock);
 
     // Module arguments
     input wire  [1:0] d;
@@ -5673,29 +6704,10 @@ module gyro_interface__modulation_nco__sincos__quadrant_1(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__modulation_nco__sincos__quadrant_1
+endmodule // gyro_interface__modulation_nco__sine__quadrant_1
 
 
-module gyro_interface__modulation_nco__sincos__quadrant_2(d,q,clock);
-
-    // Module arguments
-    input wire  [1:0] d;
-    output reg  [1:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 2'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__modulation_nco__sincos__quadrant_2
-
-
-module gyro_interface__modulation_nco__sincos__quadrant_3(d,q,clock);
+module gyro_interface__modulation_nco__sine__quadrant_2(d,q,clock);
 
     // Module arguments
     input wire  [1:0] d;
@@ -5711,10 +6723,10 @@ module gyro_interface__modulation_nco__sincos__quadrant_3(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__modulation_nco__sincos__quadrant_3
+endmodule // gyro_interface__modulation_nco__sine__quadrant_2
 
 
-module gyro_interface__modulation_nco__sincos__quadrant_read(d,q,clock);
+module gyro_interface__modulation_nco__sine__quadrant_4(d,q,clock);
 
     // Module arguments
     input wire  [1:0] d;
@@ -5730,19 +6742,35 @@ module gyro_interface__modulation_nco__sincos__quadrant_read(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__modulation_nco__sincos__quadrant_read
+endmodule // gyro_interface__modulation_nco__sine__quadrant_4
 
 
-module gyro_interface__modulation_nco__sincos__rom(clock,addr_a,addr_b,value_a,slope_a,value_b,slope_b);
+module gyro_interface__modulation_nco__sine__quadrant_read(d,q,clock);
+
+    // Module arguments
+    input wire  [1:0] d;
+    output reg  [1:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 2'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__modulation_nco__sine__quadrant_read
+
+
+module gyro_interface__modulation_nco__sine__rom(clock,addr,value,slope);
 
     // Module arguments
     input wire  clock;
-    input wire  [7:0] addr_a;
-    input wire  [7:0] addr_b;
-    output reg signed [15:0] value_a;
-    output reg signed [15:0] slope_a;
-    output reg signed [15:0] value_b;
-    output reg signed [15:0] slope_b;
+    input wire  [7:0] addr;
+    output reg signed [15:0] value;
+    output reg signed [15:0] slope;
 
     // Update code (custom)
     reg signed [15:0] value_rom [0:255];
@@ -6005,22 +7033,18 @@ module gyro_interface__modulation_nco__sincos__rom(clock,addr_a,addr_b,value_a,s
        value_rom[253] = 16'sd32763; slope_rom[253] = 16'sd395;
        value_rom[254] = 16'sd32766; slope_rom[254] = 16'sd237;
        value_rom[255] = 16'sd32767; slope_rom[255] = 16'sd79;
-       value_a = 0;
-       slope_a = 0;
-       value_b = 0;
-       slope_b = 0;
+       value = 0;
+       slope = 0;
     end
 
     always @(posedge clock) begin
-       value_a <= value_rom[addr_a];
-       slope_a <= slope_rom[addr_a];
-       value_b <= value_rom[addr_b];
-       slope_b <= slope_rom[addr_b];
+       value <= value_rom[addr];
+       slope <= slope_rom[addr];
     end
-endmodule // gyro_interface__modulation_nco__sincos__rom
+endmodule // gyro_interface__modulation_nco__sine__rom
 
 
-module gyro_interface__modulation_nco__sincos__sin_first_3(d,q,clock);
+module gyro_interface__modulation_nco__sine__signed_sample_4(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -6036,29 +7060,10 @@ module gyro_interface__modulation_nco__sincos__sin_first_3(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__modulation_nco__sincos__sin_first_3
+endmodule // gyro_interface__modulation_nco__sine__signed_sample_4
 
 
-module gyro_interface__modulation_nco__sincos__sin_out(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__modulation_nco__sincos__sin_out
-
-
-module gyro_interface__modulation_nco__sincos__sin_sample_2(d,q,clock);
+module gyro_interface__modulation_nco__sine__sin_out(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -6074,10 +7079,10 @@ module gyro_interface__modulation_nco__sincos__sin_sample_2(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__modulation_nco__sincos__sin_sample_2
+endmodule // gyro_interface__modulation_nco__sine__sin_out
 
 
-module gyro_interface__modulation_nco__sincos__sin_slope_product(clock,a,b,p);
+module gyro_interface__modulation_nco__sine__slope_product(clock,a,b,p);
 
     // Module arguments
     input wire  clock;
@@ -6091,29 +7096,10 @@ module gyro_interface__modulation_nco__sincos__sin_slope_product(clock,a,b,p);
     always @(posedge clock) begin
        p <= a * b;
     end
-endmodule // gyro_interface__modulation_nco__sincos__sin_slope_product
+endmodule // gyro_interface__modulation_nco__sine__slope_product
 
 
-module gyro_interface__modulation_nco__sincos__sin_slope_read(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__modulation_nco__sincos__sin_slope_read
-
-
-module gyro_interface__modulation_nco__sincos__sin_value_read(d,q,clock);
+module gyro_interface__modulation_nco__sine__slope_read(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -6129,7 +7115,45 @@ module gyro_interface__modulation_nco__sincos__sin_value_read(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__modulation_nco__sincos__sin_value_read
+endmodule // gyro_interface__modulation_nco__sine__slope_read
+
+
+module gyro_interface__modulation_nco__sine__value_read(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__modulation_nco__sine__value_read
+
+
+module gyro_interface__modulation_nco__turn(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__modulation_nco__turn
 
 
 module gyro_interface__reference_alignment(clock,ref1,ref2,delay,aligned1,aligned2);

@@ -1,12 +1,11 @@
 //! AM mixers: the two drive signals and their reference copies.
 //!
 //! ```text
-//!  amp1 (F1) ─┐                   ┌─► x drive_cos ──► dac1  = F1 A1 cos(wt)
-//!  am1  (A1) ─┴─ x ──► fa1 ───────┤
-//!                                 └─► x ref_cos   ──► ref1  = F1 A1 cos(wt + offset)
-//!  amp2 (F2) ─┐                   ┌─► x drive_sin ──► dac2  = F2 A2 sin(wt)
-//!  am2  (A2) ─┴─ x ──► fa2 ───────┤
-//!                                 └─► x ref_sin   ──► ref2  = F2 A2 sin(wt + offset)
+//!  turn 0: F1, A1 ─┐                              ┌─► x drive_cos ──► dac1 = F1 A1 cos(wt)
+//!  turn 1: F2, A2 ─┴─ x ──► fa1 (held, turn 0) ───┤
+//!       (one envelope      └► fa2 (held, turn 1) ─┼─► x ref_cos   ──► ref1 = F1 A1 cos(wt + offset)
+//!        multiplier)                              ├─► x drive_sin ──► dac2 = F2 A2 sin(wt)
+//!                                                 └─► x ref_sin   ──► ref2 = F2 A2 sin(wt + offset)
 //! ```
 //!
 //! Every product is a `Q15Multiplier`: Q1.15 factors, rounded half up to
@@ -17,19 +16,36 @@
 //! dac1 = round(round(F1 A1 / 2^15) cos / 2^15), a full-scale drive being
 //! F1 = 32767 with A1 = 32767.
 //!
+//! The envelopes F A move only with a bus write or the modulation (f_cal,
+//! hertz against a clock of tens of megahertz), so one multiplier serves
+//! both channels on alternate clocks: a `turn` bit (power-up 0, toggled
+//! every clock) picks channel 1 on turn 0 and channel 2 on turn 1, and the
+//! product is held in fa1 or fa2 when it comes out `LATENCY` clocks later.
+//! Each envelope is therefore refreshed every other clock, from the F and A
+//! of that clock; the modulation advances by 2 pi f_cal / f_clk per clock
+//! (1.3e-6 rad at 10 Hz and 50 MHz), which is all a one-clock hold can
+//! shift it.
+//!
 //! The reference words are the drive words computed from the reference
 //! carrier: in readout they equal the drives up to the phase offset, in
 //! calibration they carry the same modulation. Latency: carriers to outputs
-//! 3 clocks, amplitudes to outputs 6 clocks (`q15_multiplier::LATENCY` per
-//! product), the same for drives and references.
+//! 3 clocks (`q15_multiplier::LATENCY`), amplitudes to outputs 7 or 8
+//! clocks (product, hold, product, and a clock's wait when the other
+//! channel has the multiplier), the same for drives and references.
+//! Resources: 5 16x16 multipliers.
 
 use crate::q15_multiplier::Q15Multiplier;
 use rust_hdl::prelude::*;
 
 /// Clock cycles from the carrier inputs to the drive and reference outputs.
 pub const CARRIER_LATENCY: usize = crate::q15_multiplier::LATENCY;
-/// Clock cycles from the amplitudes and modulation factors to the outputs.
-pub const AMPLITUDE_LATENCY: usize = 2 * crate::q15_multiplier::LATENCY;
+/// Clock cycles from the amplitudes and modulation factors to the outputs,
+/// at most: two products, the hold register, and one clock's wait for the
+/// shared envelope multiplier.
+pub const AMPLITUDE_LATENCY: usize = 2 * crate::q15_multiplier::LATENCY + 2;
+/// The `turn` during which the envelope product of channel 1 leaves the
+/// multiplier: it entered on turn 0, `LATENCY` toggles earlier.
+const CHANNEL1_OUT_TURN: bool = crate::q15_multiplier::LATENCY % 2 == 1;
 
 /// Two AM drive channels with reference copies.
 #[derive(LogicBlock)]
@@ -60,8 +76,11 @@ pub struct AmMixer {
     pub ref1: Signal<Out, Signed<16>>,
     /// Reference copy of drive 2, from the reference carrier.
     pub ref2: Signal<Out, Signed<16>>,
-    envelope1: Q15Multiplier,
-    envelope2: Q15Multiplier,
+    envelope: Q15Multiplier,
+    turn: DFF<Bit>,
+    fa1: DFF<Signed<16>>,
+    fa2: DFF<Signed<16>>,
+    channel1_out_turn: Constant<Bit>,
     drive1: Q15Multiplier,
     drive2: Q15Multiplier,
     reference1: Q15Multiplier,
@@ -85,8 +104,11 @@ impl AmMixer {
             dac2: Default::default(),
             ref1: Default::default(),
             ref2: Default::default(),
-            envelope1: Q15Multiplier::new(),
-            envelope2: Q15Multiplier::new(),
+            envelope: Q15Multiplier::new(),
+            turn: Default::default(),
+            fa1: Default::default(),
+            fa2: Default::default(),
+            channel1_out_turn: Constant::new(CHANNEL1_OUT_TURN),
             drive1: Q15Multiplier::new(),
             drive2: Q15Multiplier::new(),
             reference1: Q15Multiplier::new(),
@@ -104,23 +126,32 @@ impl Default for AmMixer {
 impl Logic for AmMixer {
     #[hdl_gen]
     fn update(&mut self) {
-        self.envelope1.clock.next = self.clock.val();
-        self.envelope2.clock.next = self.clock.val();
+        dff_setup!(self, clock, turn, fa1, fa2);
+        self.envelope.clock.next = self.clock.val();
         self.drive1.clock.next = self.clock.val();
         self.drive2.clock.next = self.clock.val();
         self.reference1.clock.next = self.clock.val();
         self.reference2.clock.next = self.clock.val();
-        self.envelope1.a.next = self.amp1.val();
-        self.envelope1.b.next = self.am1.val();
-        self.envelope2.a.next = self.amp2.val();
-        self.envelope2.b.next = self.am2.val();
-        self.drive1.a.next = self.envelope1.y.val();
+        // One envelope multiplier, channel 1 on turn 0, channel 2 on turn 1.
+        self.turn.d.next = !self.turn.q.val();
+        self.envelope.a.next = self.amp1.val();
+        self.envelope.b.next = self.am1.val();
+        if self.turn.q.val() {
+            self.envelope.a.next = self.amp2.val();
+            self.envelope.b.next = self.am2.val();
+        }
+        if self.turn.q.val() == self.channel1_out_turn.val() {
+            self.fa1.d.next = self.envelope.y.val();
+        } else {
+            self.fa2.d.next = self.envelope.y.val();
+        }
+        self.drive1.a.next = self.fa1.q.val();
         self.drive1.b.next = self.drive_cos.val();
-        self.drive2.a.next = self.envelope2.y.val();
+        self.drive2.a.next = self.fa2.q.val();
         self.drive2.b.next = self.drive_sin.val();
-        self.reference1.a.next = self.envelope1.y.val();
+        self.reference1.a.next = self.fa1.q.val();
         self.reference1.b.next = self.ref_cos.val();
-        self.reference2.a.next = self.envelope2.y.val();
+        self.reference2.a.next = self.fa2.q.val();
         self.reference2.b.next = self.ref_sin.val();
         self.dac1.next = self.drive1.y.val();
         self.dac2.next = self.drive2.y.val();

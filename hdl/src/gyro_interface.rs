@@ -18,7 +18,7 @@
 //!  iir_k0, iir_k1, iir_k2, iir_alpha ──────────►  IirLowpass (both channels) ──► z1, z2, z_valid
 //! ```
 //!
-//! Follow a sample in file order: `carrier_nco` (with `sincos`,
+//! Follow a sample in file order: `carrier_nco` (with `sincos`, `sine`,
 //! `sine_table`), `modulation_nco`, `am_mixer` (with `q15_multiplier`), the
 //! DACs and the gyroscope (in the simulator), `reference_alignment`,
 //! `demod_mux`, `cic_integrators`, `cic_decimator`, `iir_lowpass`.

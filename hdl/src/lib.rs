@@ -20,6 +20,7 @@ pub mod reference_alignment;
 pub mod rtl;
 pub mod settings;
 pub mod sincos;
+pub mod sine;
 pub mod sine_table;
 #[cfg(test)]
 pub(crate) mod test_util;

@@ -1,27 +1,42 @@
 //! Modulation NCO: the "rotating" excitation A1 = cos(Om t), A2 = sin(Om t).
 //!
 //! ```text
-//!            ┌──────────────┐ phase[47:16]          select
-//!  step ────►│ acc += step  ├────────────► SinCos ──►  1 ? cos : 32767 ──► am1
-//!            └──────────────┘                     └─►  1 ? sin : 32767 ──► am2
+//!            ┌──────────────┐ phase[47:16]
+//!  step ────►│ acc += step  ├────────────► Sine ──► turn 0's output: select ? cos : 32767 ──► am1
+//!            └──────────────┘   advance: │          turn 1's output: select ? sin : 32767 ──► am2
+//!                       turn 0: cos (1), turn 1: sin (0)
 //! ```
 //!
 //! In calibration (`select` = 1) the two carriers are amplitude modulated by
 //! the quadrature pair of a slow NCO, which makes the excitation rotate at
 //! Om = 2 pi f_cal in the plane of the two modes (paper eq. 3). In readout
 //! (`select` = 0) both outputs are the constant 32767, exactly the peak of
-//! the cos/sin outputs, so "A = 1" in readout has the same full scale as the
+//! the sine generator, so "A = 1" in readout has the same full scale as the
 //! crest of the modulation: the calibration excitation amplitude equals the
 //! readout one, as in the paper's measurement.
 //!
 //! The accumulator has 48 bits: f_cal = step * f_clk / 2^48, resolution
 //! 0.18 uHz at 50 MHz (a 32-bit NCO would be off by up to 0.06% at 10 Hz).
-//! The top 32 bits address the sine generator. Latency from the phase
-//! register to `am1`/`am2`: 6 clocks (5 in `SinCos`, 1 for the select
-//! register); `select` itself acts after 1 clock.
+//! The top 32 bits address the sine generator.
+//!
+//! One `crate::sine::Sine` serves both outputs on alternate clocks: a
+//! `turn` bit (power-up 0, toggled every clock) asks for the cosine (A1) on
+//! turn 0 and the sine (A2) on turn 1, and each answer is held in its
+//! output register when it leaves the pipeline `sine::LATENCY` clocks
+//! later. So each output is refreshed every other clock, from the phase of
+//! its own clock: A1 and A2 are sampled one clock apart, a phase skew of
+//! 2 pi f_cal / f_clk (1.3e-6 rad at 10 Hz and 50 MHz). Latency from the
+//! phase register to `am1`/`am2`: 6 clocks (5 in `Sine`, 1 for the output
+//! register). `select` acts after 1 clock on the output whose answer is
+//! due, after 2 on the other (which holds its previous word for one clock).
+//! Resources: one table port, one 16x16 multiplier.
 
-use crate::sincos::SinCos;
+use crate::sine::Sine;
 use rust_hdl::prelude::*;
+
+/// The `turn` during which the cosine (A1) leaves the sine generator: it
+/// was asked for on turn 0, `sine::LATENCY` toggles earlier.
+const COSINE_OUT_TURN: bool = crate::sine::LATENCY % 2 == 1;
 
 /// 48-bit modulation NCO with the readout/calibration amplitude select.
 #[derive(LogicBlock)]
@@ -37,10 +52,14 @@ pub struct ModulationNco {
     /// Amplitude factor A2 for drive 2, 16-bit, full scale 32767.
     pub am2: Signal<Out, Signed<16>>,
     phase: DFF<Bits<48>>,
-    sincos: SinCos,
+    sine: Sine,
+    turn: DFF<Bit>,
     am1_out: DFF<Signed<16>>,
     am2_out: DFF<Signed<16>>,
     full_scale: Constant<Signed<16>>,
+    cosine_advance: Constant<Bits<2>>,
+    sine_advance: Constant<Bits<2>>,
+    cosine_out_turn: Constant<Bit>,
 }
 
 impl ModulationNco {
@@ -53,10 +72,14 @@ impl ModulationNco {
             am1: Default::default(),
             am2: Default::default(),
             phase: Default::default(),
-            sincos: SinCos::new(),
+            sine: Sine::new(),
+            turn: Default::default(),
             am1_out: Default::default(),
             am2_out: Default::default(),
             full_scale: Constant::new((crate::sine_table::PEAK as i64).into()),
+            cosine_advance: Constant::new(1.into()),
+            sine_advance: Constant::new(0.into()),
+            cosine_out_turn: Constant::new(COSINE_OUT_TURN),
         }
     }
 }
@@ -70,15 +93,24 @@ impl Default for ModulationNco {
 impl Logic for ModulationNco {
     #[hdl_gen]
     fn update(&mut self) {
-        dff_setup!(self, clock, phase, am1_out, am2_out);
-        self.sincos.clock.next = self.clock.val();
+        dff_setup!(self, clock, phase, turn, am1_out, am2_out);
+        self.sine.clock.next = self.clock.val();
         self.phase.d.next = self.phase.q.val() + self.step.val();
-        self.sincos.phase.next = self.phase.q.val().get_bits::<32>(16);
-        self.am1_out.d.next = self.full_scale.val();
-        self.am2_out.d.next = self.full_scale.val();
+        self.turn.d.next = !self.turn.q.val();
+        self.sine.phase.next = self.phase.q.val().get_bits::<32>(16);
+        self.sine.advance.next = self.cosine_advance.val();
+        if self.turn.q.val() {
+            self.sine.advance.next = self.sine_advance.val();
+        }
         if self.select.val() {
-            self.am1_out.d.next = self.sincos.cos.val();
-            self.am2_out.d.next = self.sincos.sin.val();
+            if self.turn.q.val() == self.cosine_out_turn.val() {
+                self.am1_out.d.next = self.sine.sin.val();
+            } else {
+                self.am2_out.d.next = self.sine.sin.val();
+            }
+        } else {
+            self.am1_out.d.next = self.full_scale.val();
+            self.am2_out.d.next = self.full_scale.val();
         }
         self.am1.next = self.am1_out.q.val();
         self.am2.next = self.am2_out.q.val();

@@ -1,6 +1,7 @@
 //! Bit-true model of `crate::modulation_nco::ModulationNco`.
 
-use super::sincos::SinCos;
+use super::sincos::Sine;
+use crate::sine::LATENCY;
 use crate::sine_table::PEAK;
 
 const PHASE_MASK: u64 = (1 << 48) - 1;
@@ -9,7 +10,9 @@ const PHASE_MASK: u64 = (1 << 48) - 1;
 #[derive(Clone, Debug, Default)]
 pub struct ModulationNco {
     phase: u64,
-    sincos: SinCos,
+    /// false: the sine generator is asked for the cosine (A1); true: the sine (A2).
+    turn: bool,
+    sine: Sine,
     am: (i16, i16),
 }
 
@@ -23,13 +26,17 @@ impl ModulationNco {
     /// One clock; returns `(am1, am2)` after the edge.
     #[inline(always)]
     pub fn step(&mut self, step: u64, select: bool) -> (i16, i16) {
-        let (sin, cos) = self.sincos.output();
-        self.am = if select {
-            (cos, sin)
+        if !select {
+            self.am = (PEAK as i16, PEAK as i16);
+        } else if self.turn == (LATENCY % 2 == 1) {
+            // The cosine asked for LATENCY toggles ago leaves the pipeline.
+            self.am.0 = self.sine.output();
         } else {
-            (PEAK as i16, PEAK as i16)
-        };
-        self.sincos.step((self.phase >> 16) as u32);
+            self.am.1 = self.sine.output();
+        }
+        let advance = if self.turn { 0 } else { 1 };
+        self.sine.step((self.phase >> 16) as u32, advance);
+        self.turn = !self.turn;
         self.phase = (self.phase + step) & PHASE_MASK;
         self.am
     }

@@ -1,12 +1,12 @@
-//! Bit-true model of `crate::sincos::SinCos`.
+//! Bit-true models of `crate::sine::Sine` and `crate::sincos::SinCos`.
 //!
-//! `evaluate` is the arithmetic of the four pipeline stages collapsed into
-//! one function; `SinCos` delays it by the block's latency with zero
-//! power-up values, which is exactly what the registers do: an all-zero
-//! pipeline produces zero outputs (offset 0 times slope 0, sample 0,
-//! quadrant 0), so the first `LATENCY` outputs are 0.
+//! `sine` is the arithmetic of the pipeline stages collapsed into one
+//! function; `Sine` and `SinCos` delay it by the block's latency, starting
+//! from what the power-up registers give (`crate::sine`'s header): 0 during
+//! cycles 0..=3, then `power_up_word()`, table entry 0 read through the
+//! all-zero index register with a zero offset, during cycle 4.
 
-use crate::sincos::LATENCY;
+use crate::sine::LATENCY;
 use crate::sine_table;
 use std::sync::OnceLock;
 
@@ -39,7 +39,29 @@ fn first_quadrant_with(table: &Table, phase: u32) -> (i32, i32) {
     )
 }
 
-/// `(sin, cos)` of a 32-bit phase, as the hardware computes it.
+/// `32767 sin` of a 32-bit phase plus `advance` quarter turns, as
+/// `crate::sine::Sine` computes it.
+#[inline(always)]
+pub fn sine(phase: u32, advance: u8) -> i16 {
+    sine_with(table(), phase, advance)
+}
+
+#[inline(always)]
+fn sine_with(table: &Table, phase: u32, advance: u8) -> i16 {
+    let q = ((phase >> 30) + u32::from(advance)) & 3;
+    let i = ((phase >> 22) & 0xff) as usize;
+    let [sample, slope] = table[if q & 1 == 0 { i } else { 0xff - i }];
+    let offset = ((phase >> 7) & 0x7fff) as i32 - 0x4000;
+    let correction = (offset * slope + (1 << 21)) >> 22;
+    let first = if q & 1 == 0 {
+        sample + correction
+    } else {
+        sample - correction
+    };
+    (if q >= 2 { -first } else { first }) as i16
+}
+
+/// `(sin, cos)` of a 32-bit phase, as `crate::sincos::SinCos` computes it.
 #[inline(always)]
 pub fn evaluate(phase: u32) -> (i16, i16) {
     evaluate_with(table(), phase)
@@ -47,17 +69,59 @@ pub fn evaluate(phase: u32) -> (i16, i16) {
 
 #[inline(always)]
 fn evaluate_with(table: &Table, phase: u32) -> (i16, i16) {
-    let (s, c) = first_quadrant_with(table, phase);
-    // Quadrant mirror without branches: odd quadrants swap sine and
-    // cosine; the sine is negated in quadrants 2 and 3, the cosine in 1 and 2.
-    let q = phase >> 30;
-    let (a, b) = if q & 1 == 0 { (s, c) } else { (c, s) };
-    let sin = if q >= 2 { -a } else { a };
-    let cos = if q == 1 || q == 2 { -b } else { b };
-    (sin as i16, cos as i16)
+    (sine_with(table, phase, 0), sine_with(table, phase, 1))
 }
 
-/// Cycle-true model of the pipeline.
+/// The output during cycle `LATENCY - 1` after power-up: the entry the
+/// all-zero index register reads, with a zero correction, quadrant 0.
+pub fn power_up_word() -> i16 {
+    sine_table::value(0) as i16
+}
+
+/// The pipeline's contents at power-up, output slot first.
+fn power_up_pipe<T: Copy + Default>(word: T) -> [T; LATENCY] {
+    let mut pipe = [T::default(); LATENCY];
+    pipe[LATENCY - 1] = word;
+    pipe
+}
+
+/// Cycle-true model of one `crate::sine::Sine`.
+#[derive(Clone, Debug)]
+pub struct Sine {
+    /// Values in flight; `pipe[head]` is the current output.
+    pipe: [i16; LATENCY],
+    head: usize,
+    table: &'static Table,
+}
+
+impl Default for Sine {
+    fn default() -> Self {
+        Self {
+            pipe: power_up_pipe(power_up_word()),
+            head: 0,
+            table: table(),
+        }
+    }
+}
+
+impl Sine {
+    /// The output during the current cycle.
+    #[inline(always)]
+    pub fn output(&self) -> i16 {
+        self.pipe[self.head]
+    }
+
+    /// Present `phase` and `advance` for one clock; returns the output
+    /// after the edge.
+    #[inline(always)]
+    pub fn step(&mut self, phase: u32, advance: u8) -> i16 {
+        self.pipe[self.head] = sine_with(self.table, phase, advance);
+        self.head = (self.head + 1) % LATENCY;
+        self.pipe[self.head]
+    }
+}
+
+/// Cycle-true model of the two-sine pipeline.
 #[derive(Clone, Debug)]
 pub struct SinCos {
     /// Values in flight; `pipe[head]` is the current output.
@@ -68,8 +132,9 @@ pub struct SinCos {
 
 impl Default for SinCos {
     fn default() -> Self {
+        let word = power_up_word();
         Self {
-            pipe: Default::default(),
+            pipe: power_up_pipe((word, word)),
             head: 0,
             table: table(),
         }
@@ -108,6 +173,32 @@ mod tests {
             let (s, c) = first_quadrant(code << 7);
             assert!((0..=sine_table::PEAK).contains(&s), "sin {s} at {code:#x}");
             assert!((0..=sine_table::PEAK).contains(&c), "cos {c} at {code:#x}");
+        }
+    }
+
+    /// The former dual-output arithmetic: one table index for both, the
+    /// quadrant mirror swapping and negating the pair.
+    fn dual_output_reference(phase: u32) -> (i16, i16) {
+        let (s, c) = first_quadrant(phase);
+        let q = phase >> 30;
+        let (a, b) = if q & 1 == 0 { (s, c) } else { (c, s) };
+        let sin = if q >= 2 { -a } else { a };
+        let cos = if q == 1 || q == 2 { -b } else { b };
+        (sin as i16, cos as i16)
+    }
+
+    #[test]
+    fn two_sines_equal_the_dual_output_generator_for_every_phase() {
+        // Exhaustive over phase bits 31:7 (bits 6:0 are ignored): the
+        // quadrant-advanced sine reproduces the pair the earlier SinCos
+        // computed from one table index, word for word.
+        for code in 0u32..(1 << 25) {
+            let phase = code << 7;
+            assert_eq!(
+                evaluate(phase),
+                dual_output_reference(phase),
+                "phase {phase:#x}"
+            );
         }
     }
 

@@ -1,15 +1,16 @@
-//! Dual-read synchronous ROM holding the quarter-wave sine table.
+//! Synchronous ROM holding the quarter-wave sine table.
 //!
 //! ```text
-//!   addr_a[8] ──► [value, slope ROM] ──► [reg] ──► value_a, slope_a  (16-bit signed)
-//!   addr_b[8] ──► [value, slope ROM] ──► [reg] ──► value_b, slope_b
+//!   addr[8] ──► [value, slope ROM] ──► [reg] ──► value, slope  (16-bit signed)
 //! ```
 //!
-//! Two registered read ports of the 256 x (16 + 16)-bit table of
-//! `crate::sine_table`. Port a reads the sine sample of an interval and port
-//! b the mirrored entry, which is its cosine. The Verilog is a plain memory
-//! with an `initial` image and registered reads, which Yosys and vendor tools
-//! map to block RAM (two copies on iCE40, whose EBRs have a single read port).
+//! One registered read port of the 256 x (16 + 16)-bit table of
+//! `crate::sine_table`: the sample at the centre of an interval and the
+//! derivative there. Drive `addr` from a register: where a tool builds the
+//! ROM from LUTs (Yosys `synth_xilinx`), logic before the address would be
+//! folded into the ROM's (an address mirrored by a ninth input doubles it). The Verilog is a plain memory with an `initial` image
+//! and a registered read, which Yosys and vendor tools map to block RAM (two
+//! iCE40 `SB_RAM40_4K`, 16 bits wide each; one ECP5 `DP16KD`).
 //! Unlike rust-hdl's `SyncROM`, the output registers have a power-up value
 //! (0), so the design simulates from time zero without X.
 //!
@@ -20,23 +21,17 @@ use super::convert::i128_to_signed;
 use crate::sine_table;
 use rust_hdl::prelude::*;
 
-/// Quarter-wave sine and slope table, two registered read ports.
+/// Quarter-wave sine and slope table, one registered read port.
 #[derive(Clone, Debug, LogicBlock)]
 pub struct QuarterSineRom {
     /// The clock.
     pub clock: Signal<In, Clock>,
-    /// Address of read port a.
-    pub addr_a: Signal<In, Bits<8>>,
-    /// Address of read port b.
-    pub addr_b: Signal<In, Bits<8>>,
-    /// `value[addr_a]` as of the previous rising edge.
-    pub value_a: Signal<Out, Signed<16>>,
-    /// `slope[addr_a]` as of the previous rising edge.
-    pub slope_a: Signal<Out, Signed<16>>,
-    /// `value[addr_b]` as of the previous rising edge.
-    pub value_b: Signal<Out, Signed<16>>,
-    /// `slope[addr_b]` as of the previous rising edge.
-    pub slope_b: Signal<Out, Signed<16>>,
+    /// Table index: the interval of the quadrant.
+    pub addr: Signal<In, Bits<8>>,
+    /// `value[addr]` as of the previous rising edge.
+    pub value: Signal<Out, Signed<16>>,
+    /// `slope[addr]` as of the previous rising edge.
+    pub slope: Signal<Out, Signed<16>>,
     _value: Vec<Signed<16>>,
     _slope: Vec<Signed<16>>,
 }
@@ -49,12 +44,9 @@ impl QuarterSineRom {
         let to_words = |v: Vec<i32>| v.into_iter().map(|x| i128_to_signed(x as i128)).collect();
         Self {
             clock: Default::default(),
-            addr_a: Default::default(),
-            addr_b: Default::default(),
-            value_a: Signal::new_with_default(Signed::default()),
-            slope_a: Signal::new_with_default(Signed::default()),
-            value_b: Signal::new_with_default(Signed::default()),
-            slope_b: Signal::new_with_default(Signed::default()),
+            addr: Default::default(),
+            value: Signal::new_with_default(Signed::default()),
+            slope: Signal::new_with_default(Signed::default()),
             _value: to_words(value),
             _slope: to_words(slope),
         }
@@ -70,20 +62,15 @@ impl Default for QuarterSineRom {
 impl Logic for QuarterSineRom {
     fn update(&mut self) {
         if self.clock.pos_edge() {
-            let a = self.addr_a.val().to_u64() as usize;
-            let b = self.addr_b.val().to_u64() as usize;
-            self.value_a.next = self._value[a];
-            self.slope_a.next = self._slope[a];
-            self.value_b.next = self._value[b];
-            self.slope_b.next = self._slope[b];
+            let a = self.addr.val().to_u64() as usize;
+            self.value.next = self._value[a];
+            self.slope.next = self._slope[a];
         }
     }
 
     fn connect(&mut self) {
-        self.value_a.connect();
-        self.slope_a.connect();
-        self.value_b.connect();
-        self.slope_b.connect();
+        self.value.connect();
+        self.slope.connect();
     }
 
     fn hdl(&self) -> Verilog {
@@ -100,17 +87,13 @@ reg signed [15:0] value_rom [0:255];
 reg signed [15:0] slope_rom [0:255];
 
 initial begin
-{init}   value_a = 0;
-   slope_a = 0;
-   value_b = 0;
-   slope_b = 0;
+{init}   value = 0;
+   slope = 0;
 end
 
 always @(posedge clock) begin
-   value_a <= value_rom[addr_a];
-   slope_a <= slope_rom[addr_a];
-   value_b <= value_rom[addr_b];
-   slope_b <= slope_rom[addr_b];
+   value <= value_rom[addr];
+   slope <= slope_rom[addr];
 end"
         ))
     }
@@ -119,13 +102,8 @@ end"
         vec![TimingInfo {
             name: "quarter_sine_rom".into(),
             clock: "clock".into(),
-            inputs: vec!["addr_a".into(), "addr_b".into()],
-            outputs: vec![
-                "value_a".into(),
-                "slope_a".into(),
-                "value_b".into(),
-                "slope_b".into(),
-            ],
+            inputs: vec!["addr".into()],
+            outputs: vec!["value".into(), "slope".into()],
         }]
     }
 }
