@@ -7066,20 +7066,35 @@ module gyro_interface_axi__core__iir__ram(clock,read_address,q,write_address,wri
     input wire  write_enable;
 
     // Update code (custom)
-    reg signed [15:0] words [0:127];
+    (* no_rw_check *) reg signed [15:0] words_low [0:63];
+    (* no_rw_check *) reg signed [15:0] words_high [0:63];
+    reg signed [15:0] q_low;
+    reg signed [15:0] q_high;
+    reg high_read;
     integer init_index;
 
     initial begin
-       for (init_index = 0; init_index < 128; init_index = init_index + 1)
-          words[init_index] = 0;
-       q = 0;
+       for (init_index = 0; init_index < 64; init_index = init_index + 1) begin
+          words_low[init_index] = 0;
+          words_high[init_index] = 0;
+       end
+       q_low = 0;
+       q_high = 0;
+       high_read = 0;
     end
 
     always @(posedge clock) begin
-       q <= words[read_address];
-       if (write_enable)
-          words[write_address] <= write_data;
+       q_low <= words_low[read_address[5:0]];
+       q_high <= words_high[read_address[5:0]];
+       high_read <= read_address[6];
+       if (write_enable && !write_address[6])
+          words_low[write_address[5:0]] <= write_data;
+       if (write_enable && write_address[6])
+          words_high[write_address[5:0]] <= write_data;
     end
+
+    always @(*)
+       q = high_read ? q_high : q_low;
 endmodule // gyro_interface_axi__core__iir__ram
 
 
@@ -8451,7 +8466,7 @@ module gyro_interface_axi__core__reference_alignment__line1(clock,d,delay,q);
     output reg signed [15:0] q;
 
     // Update code (custom)
-    reg signed [15:0] words [0:63];
+    (* no_rw_check *) reg signed [15:0] words [0:63];
     reg [5:0] write_address;
     // An A-bit wire, so the address wraps modulo 2^A in every simulator.
     wire [5:0] read_address = write_address - delay;
@@ -8490,7 +8505,7 @@ module gyro_interface_axi__core__reference_alignment__line2(clock,d,delay,q);
     output reg signed [15:0] q;
 
     // Update code (custom)
-    reg signed [15:0] words [0:63];
+    (* no_rw_check *) reg signed [15:0] words [0:63];
     reg [5:0] write_address;
     // An A-bit wire, so the address wraps modulo 2^A in every simulator.
     wire [5:0] read_address = write_address - delay;

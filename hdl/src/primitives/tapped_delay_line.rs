@@ -13,9 +13,11 @@
 //! a bypass register instead. So during cycle n + 1, `q = d(n - delay(n))`:
 //! for a constant delay, `q = d(m - 1 - delay)` during cycle m, as a shift
 //! register with a combinational tap would give, and a new delay acts one
-//! clock later than with such a tap. Read and write addresses never meet
-//! (delay >= 1 reads an older word), so the RAM's read-during-write mode
-//! does not matter. Every word powers up at 0.
+//! clock later than with such a tap. Read and write addresses meet only at
+//! delay 0, whose RAM word the bypass replaces, so the RAM's
+//! read-during-write mode does not matter: the memory carries Yosys's
+//! `no_rw_check` attribute, and Yosys adds no collision logic. Every word
+//! powers up at 0.
 //!
 //! The RAM read goes straight into a register, so Yosys maps the words to
 //! one block RAM per line (iCE40 `SB_RAM40_4K`, ECP5 `DP16KD` or LUT RAM)
@@ -91,7 +93,7 @@ impl<const W: usize, const A: usize> Logic for TappedDelayLine<W, A> {
         let amsb = A - 1;
         Verilog::Custom(format!(
             "\
-reg signed [{msb}:0] words [0:{last}];
+(* no_rw_check *) reg signed [{msb}:0] words [0:{last}];
 reg [{amsb}:0] write_address;
 // An A-bit wire, so the address wraps modulo 2^A in every simulator.
 wire [{amsb}:0] read_address = write_address - delay;
