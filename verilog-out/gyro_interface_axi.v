@@ -8548,56 +8548,50 @@ module gyro_interface_axi__fifo(clock,reset,push,push_data,tready,tvalid,tdata,d
     output reg  dropped;
 
     // Constant declarations
-    localparam  full_count = 3'b100;
+    localparam  full_count = 9'b100000000;
 
     // Stub signals
-    reg  [95:0] slots$0$d;
-    wire  [95:0] slots$0$q;
-    reg  slots$0$clock;
-    reg  [95:0] slots$1$d;
-    wire  [95:0] slots$1$q;
-    reg  slots$1$clock;
-    reg  [95:0] slots$2$d;
-    wire  [95:0] slots$2$q;
-    reg  slots$2$clock;
-    reg  [95:0] slots$3$d;
-    wire  [95:0] slots$3$q;
-    reg  slots$3$clock;
-    reg  [1:0] write_ptr$d;
-    wire  [1:0] write_ptr$q;
+    reg  memory$clock;
+    reg  memory$write_enable;
+    reg  [7:0] memory$write_address;
+    reg signed [95:0] memory$write_data;
+    reg  [7:0] memory$read_address;
+    wire signed [95:0] memory$q;
+    reg  [7:0] write_ptr$d;
+    wire  [7:0] write_ptr$q;
     reg  write_ptr$clock;
-    reg  [1:0] read_ptr$d;
-    wire  [1:0] read_ptr$q;
+    reg  [7:0] read_ptr$d;
+    wire  [7:0] read_ptr$q;
     reg  read_ptr$clock;
-    reg  [2:0] count$d;
-    wire  [2:0] count$q;
+    reg  [8:0] count$d;
+    wire  [8:0] count$q;
     reg  count$clock;
+    reg  fetching$d;
+    wire  fetching$q;
+    reg  fetching$clock;
+    reg  out_valid$d;
+    wire  out_valid$q;
+    reg  out_valid$clock;
+    reg  [95:0] out_data$d;
+    wire  [95:0] out_data$q;
+    reg  out_data$clock;
 
     // Local signals
     reg  full;
     reg  accept;
     reg  pop;
+    reg  busy;
+    reg  stored;
+    reg  issue;
 
     // Sub module instances
-    gyro_interface_axi__fifo__slots__0 slots$0(
-        .d(slots$0$d),
-        .q(slots$0$q),
-        .clock(slots$0$clock)
-    );
-    gyro_interface_axi__fifo__slots__1 slots$1(
-        .d(slots$1$d),
-        .q(slots$1$q),
-        .clock(slots$1$clock)
-    );
-    gyro_interface_axi__fifo__slots__2 slots$2(
-        .d(slots$2$d),
-        .q(slots$2$q),
-        .clock(slots$2$clock)
-    );
-    gyro_interface_axi__fifo__slots__3 slots$3(
-        .d(slots$3$d),
-        .q(slots$3$q),
-        .clock(slots$3$clock)
+    gyro_interface_axi__fifo__memory memory(
+        .clock(memory$clock),
+        .write_enable(memory$write_enable),
+        .write_address(memory$write_address),
+        .write_data(memory$write_data),
+        .read_address(memory$read_address),
+        .q(memory$q)
     );
     gyro_interface_axi__fifo__write_ptr write_ptr(
         .d(write_ptr$d),
@@ -8614,58 +8608,62 @@ module gyro_interface_axi__fifo(clock,reset,push,push_data,tready,tvalid,tdata,d
         .q(count$q),
         .clock(count$clock)
     );
+    gyro_interface_axi__fifo__fetching fetching(
+        .d(fetching$d),
+        .q(fetching$q),
+        .clock(fetching$clock)
+    );
+    gyro_interface_axi__fifo__out_valid out_valid(
+        .d(out_valid$d),
+        .q(out_valid$q),
+        .clock(out_valid$clock)
+    );
+    gyro_interface_axi__fifo__out_data out_data(
+        .d(out_data$d),
+        .q(out_data$q),
+        .clock(out_data$clock)
+    );
 
     // Update code
     always @(*) begin
         write_ptr$clock = clock;
         read_ptr$clock = clock;
         count$clock = clock;
+        fetching$clock = clock;
+        out_valid$clock = clock;
+        out_data$clock = clock;
         write_ptr$d = write_ptr$q;
         read_ptr$d = read_ptr$q;
         count$d = count$q;
-        slots$0$clock = clock;
-        slots$0$d = slots$0$q;
-        slots$1$clock = clock;
-        slots$1$d = slots$1$q;
-        slots$2$clock = clock;
-        slots$2$d = slots$2$q;
-        slots$3$clock = clock;
-        slots$3$d = slots$3$q;
+        fetching$d = fetching$q;
+        out_valid$d = out_valid$q;
+        out_data$d = out_data$q;
+        memory$clock = clock;
         full = count$q == full_count;
-        tvalid = |count$q;
-        pop = |count$q & tready;
         accept = push & (~full);
         dropped = push & full;
-        tdata = slots$0$q;
-        if (read_ptr$q == 0) begin
-            tdata = slots$0$q;
-        end
-        if (accept & (write_ptr$q == 0)) begin
-            slots$0$d = push_data;
-        end
-        if (read_ptr$q == 1) begin
-            tdata = slots$1$q;
-        end
-        if (accept & (write_ptr$q == 1)) begin
-            slots$1$d = push_data;
-        end
-        if (read_ptr$q == 2) begin
-            tdata = slots$2$q;
-        end
-        if (accept & (write_ptr$q == 2)) begin
-            slots$2$d = push_data;
-        end
-        if (read_ptr$q == 3) begin
-            tdata = slots$3$q;
-        end
-        if (accept & (write_ptr$q == 3)) begin
-            slots$3$d = push_data;
+        pop = out_valid$q & tready;
+        busy = out_valid$q | fetching$q;
+        stored = (count$q > 32'h1) | ((count$q == 32'h1) & (~busy));
+        issue = stored & (~fetching$q) & ((~out_valid$q) | pop);
+        memory$write_enable = accept;
+        memory$write_address = write_ptr$q;
+        memory$write_data = $signed(push_data);
+        memory$read_address = read_ptr$q - 32'h1;
+        if (issue) begin
+            memory$read_address = read_ptr$q;
+            read_ptr$d = read_ptr$q + 32'h1;
         end
         if (accept) begin
             write_ptr$d = write_ptr$q + 32'h1;
         end
+        fetching$d = issue;
         if (pop) begin
-            read_ptr$d = read_ptr$q + 32'h1;
+            out_valid$d = 1'b0;
+        end
+        if (fetching$q) begin
+            out_valid$d = 1'b1;
+            out_data$d = $unsigned(memory$q);
         end
         if (accept & (~pop)) begin
             count$d = count$q + 32'h1;
@@ -8677,11 +8675,12 @@ module gyro_interface_axi__fifo(clock,reset,push,push_data,tready,tvalid,tdata,d
             write_ptr$d = 32'h0;
             read_ptr$d = 32'h0;
             count$d = 32'h0;
-            slots$0$d = 32'h0;
-            slots$1$d = 32'h0;
-            slots$2$d = 32'h0;
-            slots$3$d = 32'h0;
+            fetching$d = 1'b0;
+            out_valid$d = 1'b0;
+            out_data$d = 32'h0;
         end
+        tvalid = out_valid$q;
+        tdata = out_data$q;
     end
 
 endmodule // gyro_interface_axi__fifo
@@ -8690,13 +8689,13 @@ endmodule // gyro_interface_axi__fifo
 module gyro_interface_axi__fifo__count(d,q,clock);
 
     // Module arguments
-    input wire  [2:0] d;
-    output reg  [2:0] q;
+    input wire  [8:0] d;
+    output reg  [8:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 3'h0;
+       q = 9'h0;
     end
 
     always @(posedge clock) begin
@@ -8706,16 +8705,101 @@ module gyro_interface_axi__fifo__count(d,q,clock);
 endmodule // gyro_interface_axi__fifo__count
 
 
-module gyro_interface_axi__fifo__read_ptr(d,q,clock);
+module gyro_interface_axi__fifo__fetching(d,q,clock);
 
     // Module arguments
-    input wire  [1:0] d;
-    output reg  [1:0] q;
+    input wire  d;
+    output reg  q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 2'h0;
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__fifo__fetching
+
+
+module gyro_interface_axi__fifo__memory(clock,write_enable,write_address,write_data,read_address,q);
+
+    // Module arguments
+    input wire  clock;
+    input wire  write_enable;
+    input wire  [7:0] write_address;
+    input wire signed [95:0] write_data;
+    input wire  [7:0] read_address;
+    output reg signed [95:0] q;
+
+    // Update code (custom)
+    (* no_rw_check *)
+    reg signed [95:0] words [0:255];
+    integer init_index;
+
+    initial begin
+       for (init_index = 0; init_index < 256; init_index = init_index + 1)
+          words[init_index] = 0;
+    end
+
+    always @(posedge clock) begin
+       if (write_enable)
+          words[write_address] <= write_data;
+       q <= words[read_address];
+    end
+endmodule // gyro_interface_axi__fifo__memory
+
+
+module gyro_interface_axi__fifo__out_data(d,q,clock);
+
+    // Module arguments
+    input wire  [95:0] d;
+    output reg  [95:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 96'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__fifo__out_data
+
+
+module gyro_interface_axi__fifo__out_valid(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__fifo__out_valid
+
+
+module gyro_interface_axi__fifo__read_ptr(d,q,clock);
+
+    // Module arguments
+    input wire  [7:0] d;
+    output reg  [7:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 8'h0;
     end
 
     always @(posedge clock) begin
@@ -8725,92 +8809,16 @@ module gyro_interface_axi__fifo__read_ptr(d,q,clock);
 endmodule // gyro_interface_axi__fifo__read_ptr
 
 
-module gyro_interface_axi__fifo__slots__0(d,q,clock);
-
-    // Module arguments
-    input wire  [95:0] d;
-    output reg  [95:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 96'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__fifo__slots__0
-
-
-module gyro_interface_axi__fifo__slots__1(d,q,clock);
-
-    // Module arguments
-    input wire  [95:0] d;
-    output reg  [95:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 96'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__fifo__slots__1
-
-
-module gyro_interface_axi__fifo__slots__2(d,q,clock);
-
-    // Module arguments
-    input wire  [95:0] d;
-    output reg  [95:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 96'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__fifo__slots__2
-
-
-module gyro_interface_axi__fifo__slots__3(d,q,clock);
-
-    // Module arguments
-    input wire  [95:0] d;
-    output reg  [95:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 96'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__fifo__slots__3
-
-
 module gyro_interface_axi__fifo__write_ptr(d,q,clock);
 
     // Module arguments
-    input wire  [1:0] d;
-    output reg  [1:0] q;
+    input wire  [7:0] d;
+    output reg  [7:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 2'h0;
+       q = 8'h0;
     end
 
     always @(posedge clock) begin

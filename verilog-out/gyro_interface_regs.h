@@ -7,6 +7,8 @@
 
 #define GYRO_ID_VALUE 0x4759524fu
 #define GYRO_VERSION_VALUE 0x00010000u
+/* Samples the AXI4-Stream FIFO holds before it drops one. */
+#define GYRO_STREAM_FIFO_DEPTH 256u
 
 /* ID: read-only, 32 bits. Identification: 0x4759524f, ASCII "GYRO". */
 #define GYRO_ID_OFFSET 0x00u

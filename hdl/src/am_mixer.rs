@@ -21,10 +21,13 @@
 //! both channels on alternate clocks: a `turn` bit (power-up 0, toggled
 //! every clock) picks channel 1 on turn 0 and channel 2 on turn 1, and the
 //! product is held in fa1 or fa2 when it comes out `LATENCY` clocks later.
-//! Each envelope is therefore refreshed every other clock, from the F and A
-//! of that clock; the modulation advances by 2 pi f_cal / f_clk per clock
-//! (1.3e-6 rad at 10 Hz and 50 MHz), which is all a one-clock hold can
-//! shift it.
+//! Each envelope is therefore a two-clock hold of its products, the two
+//! channels' on alternate clocks. The modulation NCO staggers A1 and A2 the
+//! same way, so each channel's multiplier takes its A one clock after the
+//! NCO refreshed it: both envelopes lag their modulation phase by the same
+//! number of clocks, and both holds add the same mean delay. Drive and
+//! reference of one channel share the held word, so the alignment of the
+//! references to the drives (`crate::settings`) is untouched.
 //!
 //! The reference words are the drive words computed from the reference
 //! carrier: in readout they equal the drives up to the phase offset, in

@@ -34,7 +34,8 @@ pub fn tick<B: Clocked>(uut: &mut B) {
     settle(uut);
 }
 
-fn settle<B: Block>(uut: &mut B) {
+/// Settle the combinational logic for inputs just set, without a clock edge.
+pub fn settle<B: Block>(uut: &mut B) {
     assert!(
         simulate(uut, MAX_SETTLE_PASSES),
         "design did not settle within {MAX_SETTLE_PASSES} passes"

@@ -23,9 +23,11 @@
 //! `turn` bit (power-up 0, toggled every clock) asks for the cosine (A1) on
 //! turn 0 and the sine (A2) on turn 1, and each answer is held in its
 //! output register when it leaves the pipeline `sine::LATENCY` clocks
-//! later. So each output is refreshed every other clock, from the phase of
-//! its own clock: A1 and A2 are sampled one clock apart, a phase skew of
-//! 2 pi f_cal / f_clk (1.3e-6 rad at 10 Hz and 50 MHz). Latency from the
+//! later. So each output is a two-clock hold of samples taken on its own
+//! clocks, A1 on the even ones and A2 on the odd ones: the skew between
+//! them alternates between +1 and -1 clock (2 pi f_cal / f_clk = 1.3e-6
+//! rad at 10 Hz and 50 MHz) and is zero on average, and both holds add the
+//! same mean delay, half a clock. Latency from the
 //! phase register to `am1`/`am2`: 6 clocks (5 in `Sine`, 1 for the output
 //! register). `select` acts after 1 clock on the output whose answer is
 //! due, after 2 on the other (which holds its previous word for one clock).

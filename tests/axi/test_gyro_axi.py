@@ -46,6 +46,15 @@ def load_map():
 REGS = load_map()
 
 
+def fifo_depth():
+    """The stream FIFO's depth, from the same C header."""
+    with open(os.environ["GYRO_HEADER"]) as f:
+        return int(re.search(r"#define GYRO_STREAM_FIFO_DEPTH (\d+)u", f.read()).group(1))
+
+
+FIFO_DEPTH = fifo_depth()
+
+
 def extend(reg, field):
     """The word a read returns for a field value."""
     field &= reg["mask"]
@@ -319,9 +328,10 @@ async def stream_backpressure_and_overflow(dut):
     assert await write(axil, "STREAM_ENABLE", 1) == AxiResp.OKAY
     r = (await read(axil, "CIC_DECIMATION"))[0]
     await ClockCycles(dut.aclk, 40 * r)
-    # A long stall: the 4-deep FIFO fills and later samples are dropped.
+    # A long stall of FIFO_DEPTH + 15 samples: the FIFO fills and the last
+    # ~15 samples are dropped.
     stall["on"] = True
-    await ClockCycles(dut.aclk, 20 * r)
+    await ClockCycles(dut.aclk, (FIFO_DEPTH + 15) * r)
     stall["on"] = False
     await ClockCycles(dut.aclk, 20 * r)
     assert await write(axil, "STREAM_ENABLE", 0) == AxiResp.OKAY
@@ -333,7 +343,7 @@ async def stream_backpressure_and_overflow(dut):
     gaps = sum((b - a - 1) & 0xFFFF for a, b in zip(seqs, seqs[1:]))
     overflow, _ = await read(axil, "STREAM_OVERFLOW")
     assert stable["stalls"] > 20, stable
-    assert 10 <= overflow <= 20, f"overflow {overflow}: a 20 R stall minus the FIFO depth"
+    assert 10 <= overflow <= 20, f"overflow {overflow}: a FIFO_DEPTH + 15 R stall minus the depth"
     assert gaps == overflow, f"missing sequence numbers {gaps} != STREAM_OVERFLOW {overflow}"
 
 

@@ -5,7 +5,7 @@
 //!  s_axil_* ─┤ AXI4-Lite slave ─► SettingRegister x15 ──► settings ports ─► GyroInterface ├─ dac1, dac2
 //!            │        ▲          StatusWord x8 ◄─ ID, VERSION, counters,   (the core)    ├◄ adc1, adc2
 //!            │        └──────────────────────── z snapshot ◄── z1, z2, z_valid ──┘       │
-//!  m_axis_* ◄┤ SampleFifo (4 x 96 bit) ◄── {count[15:0], z2, z1} when STREAM_ENABLE      │
+//!  m_axis_* ◄┤ SampleFifo (256 x 96 bit) ◄── {count[15:0], z2, z1} when STREAM_ENABLE      │
 //!            └────────────────────────────────────────────────────────────────────────────┘
 //! ```
 //!

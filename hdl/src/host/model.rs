@@ -11,6 +11,7 @@ use super::register_map::{
 use super::sample_fifo::FIFO_DEPTH;
 use super::{OKAY, SLVERR, Z_BITS};
 use crate::model::gyro_interface::{GyroInterface, Outputs};
+use std::collections::VecDeque;
 
 /// The input ports of `gyro_interface_axi` during one cycle.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -109,30 +110,44 @@ struct Wrapper {
     sample_count: u32,
     overflow_count: u32,
     snapshot: (u64, u64),
-    fifo: Fifo,
 }
 
-/// The stream FIFO's registers (`super::sample_fifo`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-struct Fifo {
-    slots: [u128; FIFO_DEPTH],
-    write_ptr: usize,
-    read_ptr: usize,
+/// The stream FIFO's registers (`super::sample_fifo`): the words stored
+/// in its RAM, the RAM's read register, and the output register.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub(crate) struct Fifo {
+    stored: VecDeque<u128>,
     count: usize,
+    fetching: bool,
+    read_word: u128,
+    out_valid: bool,
+    out_data: u128,
 }
 
 impl Fifo {
+    /// `(tvalid, tdata)` during the current cycle.
+    pub(crate) fn output(&self) -> (bool, u128) {
+        (self.out_valid, self.out_data)
+    }
+
     /// One edge; returns true when the push was dropped.
-    fn step(&mut self, push: Option<u128>, tready: bool) -> bool {
+    pub(crate) fn step(&mut self, push: Option<u128>, tready: bool) -> bool {
         let full = self.count == FIFO_DEPTH;
-        let pop = self.count > 0 && tready;
         let accept = push.is_some() && !full;
-        if let (true, Some(sample)) = (accept, push) {
-            self.slots[self.write_ptr] = sample;
-            self.write_ptr = (self.write_ptr + 1) % FIFO_DEPTH;
+        let pop = self.out_valid && tready;
+        let issue = !self.stored.is_empty() && !self.fetching && (!self.out_valid || pop);
+        if self.fetching {
+            self.out_valid = true;
+            self.out_data = self.read_word;
+        } else if pop {
+            self.out_valid = false;
         }
-        if pop {
-            self.read_ptr = (self.read_ptr + 1) % FIFO_DEPTH;
+        self.fetching = issue;
+        if issue {
+            self.read_word = self.stored.pop_front().expect("issue needs a stored word");
+        }
+        if let (true, Some(sample)) = (accept, push) {
+            self.stored.push_back(sample);
         }
         self.count = self.count + accept as usize - pop as usize;
         push.is_some() && full
@@ -160,7 +175,6 @@ impl Wrapper {
             sample_count: 0,
             overflow_count: 0,
             snapshot: (0, 0),
-            fifo: Fifo::default(),
         }
     }
 
@@ -191,6 +205,9 @@ impl Wrapper {
 pub struct GyroInterfaceAxi {
     core: GyroInterface,
     bus: Wrapper,
+    /// Apart from `bus`, which is copied every clock: the FIFO's step reads
+    /// only its own state.
+    fifo: Fifo,
 }
 
 impl Default for GyroInterfaceAxi {
@@ -209,6 +226,7 @@ impl GyroInterfaceAxi {
         Self {
             core: GyroInterface::new(),
             bus: Wrapper::power_up(),
+            fifo: Fifo::default(),
         }
     }
 
@@ -225,8 +243,8 @@ impl GyroInterfaceAxi {
             rvalid: b.r_valid,
             rdata: b.r_data,
             rresp: b.r_resp,
-            tvalid: b.fifo.count > 0,
-            tdata: b.fifo.slots[b.fifo.read_ptr],
+            tvalid: self.fifo.output().0,
+            tdata: self.fifo.output().1,
             tlast: true,
         }
     }
@@ -290,11 +308,12 @@ impl GyroInterfaceAxi {
         next.sample_count = count_now;
         let push =
             (core.z_valid && now.bank.stream_enabled()).then(|| sample_word(core, count_now));
-        if next.fifo.step(push, i.tready) {
+        if self.fifo.step(push, i.tready) {
             next.overflow_count = now.overflow_count.wrapping_add(1);
         }
         if !i.aresetn {
             *next = Wrapper::power_up();
+            self.fifo = Fifo::default();
         }
         self.core.step(i.adc, &regs);
         self.outputs()

@@ -31,6 +31,7 @@
 //! assert_eq!(bank.read(register_map::AMP1.offset), Ok(-5i32 as u32));
 //! ```
 
+use super::sample_fifo::FIFO_DEPTH;
 use crate::model::gyro_interface::Registers;
 use crate::model::iir_lowpass::Coefficients;
 
@@ -559,8 +560,14 @@ pub fn markdown() -> String {
             r.offset, r.name, r.bits, r.doc
         ));
     }
-    md.push_str(COHERENCE_NOTES);
+    md.push_str(&coherence_notes());
     md
+}
+
+/// The access rules after the register table (the FIFO depth from
+/// `super::sample_fifo`).
+fn coherence_notes() -> String {
+    COHERENCE_NOTES.replace("{fifo_depth}", &FIFO_DEPTH.to_string())
 }
 
 const COHERENCE_NOTES: &str = r#"
@@ -572,10 +579,11 @@ const COHERENCE_NOTES: &str = r#"
   mixes two samples. z = (HI << 32 | LO) / 256 in mixer LSBs.
 - **mod_step.** Write `MOD_STEP_LO`, then `MOD_STEP_HI`: the 48-bit step reaches the
   datapath at once when `MOD_STEP_HI` is written, never half-updated.
-- **Stream.** With `STREAM_ENABLE` = 1 every z sample enters a 4-deep FIFO feeding the
-  AXI4-Stream master (`tdata` 96 bits: z1 in 39..0, z2 in 79..40, SAMPLE_COUNT's low 16
-  bits in 95..80; `tlast` = 1, one sample per packet). A sample arriving while the FIFO
-  is full is dropped and counted in `STREAM_OVERFLOW`.
+- **Stream.** With `STREAM_ENABLE` = 1 every z sample enters a FIFO of {fifo_depth} samples
+  (`GYRO_STREAM_FIFO_DEPTH`, block RAM) feeding the AXI4-Stream master (`tdata` 96 bits:
+  z1 in 39..0, z2 in 79..40, SAMPLE_COUNT's low 16 bits in 95..80; `tlast` = 1, one
+  sample per packet), offered 3 clocks after it is computed. A sample arriving while the
+  FIFO is full is dropped and counted in `STREAM_OVERFLOW`.
 - **Reset.** `aresetn` low (synchronous) returns every register above to its power-up
   value and empties the FIFO; the datapath core itself has no reset.
 "#;
@@ -591,7 +599,11 @@ pub fn c_header() -> String {
     );
     h.push_str(&format!("#define GYRO_ID_VALUE 0x{ID_WORD:08x}u\n"));
     h.push_str(&format!(
-        "#define GYRO_VERSION_VALUE 0x{VERSION_WORD:08x}u\n\n"
+        "#define GYRO_VERSION_VALUE 0x{VERSION_WORD:08x}u\n"
+    ));
+    h.push_str(&format!(
+        "/* Samples the AXI4-Stream FIFO holds before it drops one. */\n\
+         #define GYRO_STREAM_FIFO_DEPTH {FIFO_DEPTH}u\n\n"
     ));
     for r in &REGISTERS {
         let access = match r.access {
