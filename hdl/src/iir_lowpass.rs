@@ -73,10 +73,12 @@
 //! runs is dropped. z1 and z2 change only at `publish`.
 //!
 //! Gain: the filter's DC gain, 4 k0 / -(k1 + k2). Resources (Yosys 0.23,
-//! `synth_ice40 -dsp -noflatten`, this module and its children): 1
-//! `SB_MAC16`, 3 `SB_RAM40_4K` (the digit RAM, and the 256 x 30-bit program
-//! in two), 402 flip-flops, 737 `SB_LUT4`; the 60 x 32 design before it took
-//! 8 `SB_MAC16`, 1870 flip-flops and 3379 `SB_LUT4`.
+//! `synth_ice40 -dsp -top gyro_interface__iir` on the exported Verilog): 1
+//! `SB_MAC16`, 4 `SB_RAM40_4K` (the digit RAM's two halves, and the 256 x
+//! 30-bit program in two), 329 flip-flops, 375 `SB_LUT4`; with the digit RAM
+//! in one piece and Yosys's collision logic it was 3 block RAMs, 369
+//! flip-flops and 385 LUT4. The 60 x 32 design before it took 8 `SB_MAC16`,
+//! 1870 flip-flops and 3379 `SB_LUT4` (`-noflatten`).
 
 use crate::iir_program::{
     ACCUMULATOR_BITS as COLUMN_BITS, OPERAND_BITS as DIGIT_OPERAND_BITS, PC_BITS,
