@@ -33,8 +33,10 @@
 //! Latencies (clocks): carrier phase to DAC word 8 (the sum of
 //! `carrier_nco::LATENCY` and `am_mixer::CARRIER_LATENCY`), ADC word to
 //! mixer output 2, mixer output to CIC output R + 13 at most
-//! (`cic_decimator::SAMPLE_TO_OUTPUT`), CIC output to z 17
-//! (`crate::iir_lowpass::LATENCY`).
+//! (`cic_decimator::SAMPLE_TO_OUTPUT`), CIC output to z 168
+//! (`crate::iir_lowpass::LATENCY`); `amp1`/`amp2` or the modulation factors to
+//! DAC word 7 or 8 (`am_mixer::AMPLITUDE_LATENCY`, the shared envelope
+//! multiplier's turn).
 
 use crate::am_mixer::AmMixer;
 use crate::carrier_nco::CarrierNco;
