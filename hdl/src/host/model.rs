@@ -113,11 +113,11 @@ struct Wrapper {
 }
 
 /// The stream FIFO's registers (`super::sample_fifo`): the words stored
-/// in its RAM, the RAM's read register, and the output register.
+/// in its RAM, the RAM's read register, and the output register. The
+/// hardware's fill count is every sample held: `held()`.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub(crate) struct Fifo {
     stored: VecDeque<u128>,
-    count: usize,
     fetching: bool,
     read_word: u128,
     out_valid: bool,
@@ -130,10 +130,14 @@ impl Fifo {
         (self.out_valid, self.out_data)
     }
 
+    /// Samples held: in the RAM, in flight from it, in the output register.
+    fn held(&self) -> usize {
+        self.stored.len() + usize::from(self.fetching) + usize::from(self.out_valid)
+    }
+
     /// One edge; returns true when the push was dropped.
     pub(crate) fn step(&mut self, push: Option<u128>, tready: bool) -> bool {
-        let full = self.count == FIFO_DEPTH;
-        let accept = push.is_some() && !full;
+        let full = self.held() == FIFO_DEPTH;
         let pop = self.out_valid && tready;
         let issue = !self.stored.is_empty() && !self.fetching && (!self.out_valid || pop);
         if self.fetching {
@@ -146,10 +150,10 @@ impl Fifo {
         if issue {
             self.read_word = self.stored.pop_front().expect("issue needs a stored word");
         }
-        if let (true, Some(sample)) = (accept, push) {
-            self.stored.push_back(sample);
+        match push {
+            Some(sample) if !full => self.stored.push_back(sample),
+            _ => {}
         }
-        self.count = self.count + accept as usize - pop as usize;
         push.is_some() && full
     }
 }

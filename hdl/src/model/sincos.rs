@@ -19,26 +19,6 @@ pub fn table() -> &'static Table {
     TABLE.get_or_init(|| std::array::from_fn(|i| [sine_table::value(i), sine_table::slope(i)]))
 }
 
-/// First-quadrant sine and cosine of the interval and offset encoded in
-/// phase bits 29:7, before the quadrant mirror.
-#[inline(always)]
-pub fn first_quadrant(phase: u32) -> (i32, i32) {
-    first_quadrant_with(table(), phase)
-}
-
-#[inline(always)]
-fn first_quadrant_with(table: &Table, phase: u32) -> (i32, i32) {
-    let i = ((phase >> 22) & 0xff) as usize;
-    let [sin_sample, sin_slope] = table[i];
-    let [cos_sample, cos_slope] = table[0xff - i];
-    let offset = ((phase >> 7) & 0x7fff) as i32 - 0x4000;
-    let round = |p: i32| (p + (1 << 21)) >> 22;
-    (
-        sin_sample + round(offset * sin_slope),
-        cos_sample - round(offset * cos_slope),
-    )
-}
-
 /// `32767 sin` of a 32-bit phase plus `advance` quarter turns, as
 /// `crate::sine::Sine` computes it.
 #[inline(always)]
@@ -64,25 +44,13 @@ fn sine_with(table: &Table, phase: u32, advance: u8) -> i16 {
 /// `(sin, cos)` of a 32-bit phase, as `crate::sincos::SinCos` computes it.
 #[inline(always)]
 pub fn evaluate(phase: u32) -> (i16, i16) {
-    evaluate_with(table(), phase)
-}
-
-#[inline(always)]
-fn evaluate_with(table: &Table, phase: u32) -> (i16, i16) {
-    (sine_with(table, phase, 0), sine_with(table, phase, 1))
+    (sine(phase, 0), sine(phase, 1))
 }
 
 /// The output during cycle `LATENCY - 1` after power-up: the entry the
 /// all-zero index register reads, with a zero correction, quadrant 0.
 pub fn power_up_word() -> i16 {
     sine_table::value(0) as i16
-}
-
-/// The pipeline's contents at power-up, output slot first.
-fn power_up_pipe<T: Copy + Default>(word: T) -> [T; LATENCY] {
-    let mut pipe = [T::default(); LATENCY];
-    pipe[LATENCY - 1] = word;
-    pipe
 }
 
 /// Cycle-true model of one `crate::sine::Sine`.
@@ -96,8 +64,12 @@ pub struct Sine {
 
 impl Default for Sine {
     fn default() -> Self {
+        // Zero in every slot but the one that comes out during cycle
+        // LATENCY - 1.
+        let mut pipe = [0; LATENCY];
+        pipe[LATENCY - 1] = power_up_word();
         Self {
-            pipe: power_up_pipe(power_up_word()),
+            pipe,
             head: 0,
             table: table(),
         }
@@ -121,47 +93,46 @@ impl Sine {
     }
 }
 
-/// Cycle-true model of the two-sine pipeline.
-#[derive(Clone, Debug)]
+/// Cycle-true model of `crate::sincos::SinCos`: two `Sine`s, the second a
+/// quarter turn ahead, as in the hardware.
+#[derive(Clone, Debug, Default)]
 pub struct SinCos {
-    /// Values in flight; `pipe[head]` is the current output.
-    pipe: [(i16, i16); LATENCY],
-    head: usize,
-    table: &'static Table,
-}
-
-impl Default for SinCos {
-    fn default() -> Self {
-        let word = power_up_word();
-        Self {
-            pipe: power_up_pipe((word, word)),
-            head: 0,
-            table: table(),
-        }
-    }
+    sine: Sine,
+    cosine: Sine,
 }
 
 impl SinCos {
     /// `(sin, cos)` during the current cycle.
     #[inline(always)]
     pub fn output(&self) -> (i16, i16) {
-        self.pipe[self.head]
+        (self.sine.output(), self.cosine.output())
     }
 
     /// Present `phase` for one clock; returns `(sin, cos)` after the edge.
     #[inline(always)]
     pub fn step(&mut self, phase: u32) -> (i16, i16) {
-        // The slot of the current output is reused for the newest value,
-        // which comes out LATENCY edges later.
-        self.pipe[self.head] = evaluate_with(self.table, phase);
-        self.head = (self.head + 1) % LATENCY;
-        self.pipe[self.head]
+        (self.sine.step(phase, 0), self.cosine.step(phase, 1))
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// First-quadrant sine and cosine of the interval and offset encoded in
+    /// phase bits 29:7, before the quadrant mirror: the arithmetic of the
+    /// former dual-output generator, one table index for both.
+    fn first_quadrant(phase: u32) -> (i32, i32) {
+        let i = ((phase >> 22) & 0xff) as usize;
+        let [sin_sample, sin_slope] = table()[i];
+        let [cos_sample, cos_slope] = table()[0xff - i];
+        let offset = ((phase >> 7) & 0x7fff) as i32 - 0x4000;
+        let round = |p: i32| (p + (1 << 21)) >> 22;
+        (
+            sin_sample + round(offset * sin_slope),
+            cos_sample - round(offset * cos_slope),
+        )
+    }
 
     #[test]
     fn first_quadrant_stays_within_the_peak_for_every_phase() {
