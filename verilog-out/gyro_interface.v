@@ -35,6 +35,9 @@ module gyro_interface(clock,adc1,adc2,dac1,dac2,z1,z2,z_valid,select,carrier_ste
     reg  carrier_nco$clock;
     reg  [31:0] carrier_nco$step;
     reg  [31:0] carrier_nco$ref_offset;
+    reg signed [15:0] carrier_nco$fill_word;
+    wire  carrier_nco$filling;
+    wire  [31:0] carrier_nco$fill_phase;
     wire signed [15:0] carrier_nco$drive_cos;
     wire signed [15:0] carrier_nco$drive_sin;
     wire signed [15:0] carrier_nco$ref_cos;
@@ -42,6 +45,9 @@ module gyro_interface(clock,adc1,adc2,dac1,dac2,z1,z2,z_valid,select,carrier_ste
     reg  modulation_nco$clock;
     reg  [47:0] modulation_nco$step;
     reg  modulation_nco$select;
+    reg  modulation_nco$filling;
+    reg  [31:0] modulation_nco$fill_phase;
+    wire signed [15:0] modulation_nco$fill_word;
     wire signed [15:0] modulation_nco$am1;
     wire signed [15:0] modulation_nco$am2;
     reg  am_mixer$clock;
@@ -96,6 +102,9 @@ module gyro_interface(clock,adc1,adc2,dac1,dac2,z1,z2,z_valid,select,carrier_ste
         .clock(carrier_nco$clock),
         .step(carrier_nco$step),
         .ref_offset(carrier_nco$ref_offset),
+        .fill_word(carrier_nco$fill_word),
+        .filling(carrier_nco$filling),
+        .fill_phase(carrier_nco$fill_phase),
         .drive_cos(carrier_nco$drive_cos),
         .drive_sin(carrier_nco$drive_sin),
         .ref_cos(carrier_nco$ref_cos),
@@ -105,6 +114,9 @@ module gyro_interface(clock,adc1,adc2,dac1,dac2,z1,z2,z_valid,select,carrier_ste
         .clock(modulation_nco$clock),
         .step(modulation_nco$step),
         .select(modulation_nco$select),
+        .filling(modulation_nco$filling),
+        .fill_phase(modulation_nco$fill_phase),
+        .fill_word(modulation_nco$fill_word),
         .am1(modulation_nco$am1),
         .am2(modulation_nco$am2)
     );
@@ -178,6 +190,9 @@ module gyro_interface(clock,adc1,adc2,dac1,dac2,z1,z2,z_valid,select,carrier_ste
         carrier_nco$ref_offset = ref_phase;
         modulation_nco$step = mod_step;
         modulation_nco$select = select;
+        modulation_nco$filling = carrier_nco$filling;
+        modulation_nco$fill_phase = carrier_nco$fill_phase;
+        carrier_nco$fill_word = modulation_nco$fill_word;
         am_mixer$amp1 = amp1;
         am_mixer$amp2 = amp2;
         am_mixer$am1 = modulation_nco$am1;
@@ -1148,29 +1163,69 @@ module gyro_interface__am_mixer__turn(d,q,clock);
 endmodule // gyro_interface__am_mixer__turn
 
 
-module gyro_interface__carrier_nco(clock,step,ref_offset,drive_cos,drive_sin,ref_cos,ref_sin);
+module gyro_interface__carrier_nco(clock,step,ref_offset,fill_word,filling,fill_phase,drive_cos,drive_sin,ref_cos,ref_sin);
 
     // Module arguments
     input wire  clock;
     input wire  [31:0] step;
     input wire  [31:0] ref_offset;
+    input wire signed [15:0] fill_word;
+    output reg  filling;
+    output reg  [31:0] fill_phase;
     output reg signed [15:0] drive_cos;
     output reg signed [15:0] drive_sin;
     output reg signed [15:0] ref_cos;
     output reg signed [15:0] ref_sin;
 
+    // Constant declarations
+    localparam  cosine_advance = 2'b1;
+    localparam  sine_advance = 2'b0;
+
     // Stub signals
     reg  [31:0] phase$d;
     wire  [31:0] phase$q;
     reg  phase$clock;
-    reg  drive$clock;
-    reg  [31:0] drive$phase;
-    wire signed [15:0] drive$sin;
-    wire signed [15:0] drive$cos;
-    reg  reference$clock;
-    reg  [31:0] reference$phase;
-    wire signed [15:0] reference$sin;
-    wire signed [15:0] reference$cos;
+    reg  fill$clock;
+    wire  fill$busy;
+    wire  [31:0] fill$phase;
+    wire  fill$write;
+    wire  [12:0] fill$address;
+    wire  fill$ready;
+    reg  drive_cosine$clock;
+    reg  [31:0] drive_cosine$phase;
+    reg  [1:0] drive_cosine$advance;
+    reg  drive_cosine$fill_write;
+    reg  [12:0] drive_cosine$fill_address;
+    reg signed [15:0] drive_cosine$fill_word;
+    reg  drive_cosine$ready;
+    wire signed [15:0] drive_cosine$sin;
+    reg  drive_sine$clock;
+    reg  [31:0] drive_sine$phase;
+    reg  [1:0] drive_sine$advance;
+    reg  drive_sine$fill_write;
+    reg  [12:0] drive_sine$fill_address;
+    reg signed [15:0] drive_sine$fill_word;
+    reg  drive_sine$ready;
+    wire signed [15:0] drive_sine$sin;
+    reg  ref_cosine$clock;
+    reg  [31:0] ref_cosine$phase;
+    reg  [1:0] ref_cosine$advance;
+    reg  ref_cosine$fill_write;
+    reg  [12:0] ref_cosine$fill_address;
+    reg signed [15:0] ref_cosine$fill_word;
+    reg  ref_cosine$ready;
+    wire signed [15:0] ref_cosine$sin;
+    reg  ref_sine$clock;
+    reg  [31:0] ref_sine$phase;
+    reg  [1:0] ref_sine$advance;
+    reg  ref_sine$fill_write;
+    reg  [12:0] ref_sine$fill_address;
+    reg signed [15:0] ref_sine$fill_word;
+    reg  ref_sine$ready;
+    wire signed [15:0] ref_sine$sin;
+
+    // Local signals
+    reg  [31:0] ref_phase;
 
     // Sub module instances
     gyro_interface__carrier_nco__phase phase(
@@ -1178,222 +1233,218 @@ module gyro_interface__carrier_nco(clock,step,ref_offset,drive_cos,drive_sin,ref
         .q(phase$q),
         .clock(phase$clock)
     );
-    gyro_interface__carrier_nco__drive drive(
-        .clock(drive$clock),
-        .phase(drive$phase),
-        .sin(drive$sin),
-        .cos(drive$cos)
+    gyro_interface__carrier_nco__fill fill(
+        .clock(fill$clock),
+        .busy(fill$busy),
+        .phase(fill$phase),
+        .write(fill$write),
+        .address(fill$address),
+        .ready(fill$ready)
     );
-    gyro_interface__carrier_nco__reference reference(
-        .clock(reference$clock),
-        .phase(reference$phase),
-        .sin(reference$sin),
-        .cos(reference$cos)
+    gyro_interface__carrier_nco__drive_cosine drive_cosine(
+        .clock(drive_cosine$clock),
+        .phase(drive_cosine$phase),
+        .advance(drive_cosine$advance),
+        .fill_write(drive_cosine$fill_write),
+        .fill_address(drive_cosine$fill_address),
+        .fill_word(drive_cosine$fill_word),
+        .ready(drive_cosine$ready),
+        .sin(drive_cosine$sin)
+    );
+    gyro_interface__carrier_nco__drive_sine drive_sine(
+        .clock(drive_sine$clock),
+        .phase(drive_sine$phase),
+        .advance(drive_sine$advance),
+        .fill_write(drive_sine$fill_write),
+        .fill_address(drive_sine$fill_address),
+        .fill_word(drive_sine$fill_word),
+        .ready(drive_sine$ready),
+        .sin(drive_sine$sin)
+    );
+    gyro_interface__carrier_nco__ref_cosine ref_cosine(
+        .clock(ref_cosine$clock),
+        .phase(ref_cosine$phase),
+        .advance(ref_cosine$advance),
+        .fill_write(ref_cosine$fill_write),
+        .fill_address(ref_cosine$fill_address),
+        .fill_word(ref_cosine$fill_word),
+        .ready(ref_cosine$ready),
+        .sin(ref_cosine$sin)
+    );
+    gyro_interface__carrier_nco__ref_sine ref_sine(
+        .clock(ref_sine$clock),
+        .phase(ref_sine$phase),
+        .advance(ref_sine$advance),
+        .fill_write(ref_sine$fill_write),
+        .fill_address(ref_sine$fill_address),
+        .fill_word(ref_sine$fill_word),
+        .ready(ref_sine$ready),
+        .sin(ref_sine$sin)
     );
 
     // Update code
     always @(*) begin
         phase$clock = clock;
         phase$d = phase$q;
-        drive$clock = clock;
-        reference$clock = clock;
+        fill$clock = clock;
+        drive_cosine$clock = clock;
+        drive_sine$clock = clock;
+        ref_cosine$clock = clock;
+        ref_sine$clock = clock;
         phase$d = phase$q + step;
-        drive$phase = phase$q;
-        reference$phase = phase$q + ref_offset;
-        drive_cos = drive$cos;
-        drive_sin = drive$sin;
-        ref_cos = reference$cos;
-        ref_sin = reference$sin;
+        ref_phase = phase$q + ref_offset;
+        filling = fill$busy;
+        fill_phase = fill$phase;
+        drive_cosine$fill_write = fill$write;
+        drive_cosine$fill_address = fill$address;
+        drive_cosine$fill_word = fill_word;
+        drive_cosine$ready = fill$ready;
+        drive_sine$fill_write = fill$write;
+        drive_sine$fill_address = fill$address;
+        drive_sine$fill_word = fill_word;
+        drive_sine$ready = fill$ready;
+        ref_cosine$fill_write = fill$write;
+        ref_cosine$fill_address = fill$address;
+        ref_cosine$fill_word = fill_word;
+        ref_cosine$ready = fill$ready;
+        ref_sine$fill_write = fill$write;
+        ref_sine$fill_address = fill$address;
+        ref_sine$fill_word = fill_word;
+        ref_sine$ready = fill$ready;
+        drive_cosine$phase = phase$q;
+        drive_cosine$advance = cosine_advance;
+        drive_sine$phase = phase$q;
+        drive_sine$advance = sine_advance;
+        ref_cosine$phase = ref_phase;
+        ref_cosine$advance = cosine_advance;
+        ref_sine$phase = ref_phase;
+        ref_sine$advance = sine_advance;
+        drive_cos = drive_cosine$sin;
+        drive_sin = drive_sine$sin;
+        ref_cos = ref_cosine$sin;
+        ref_sin = ref_sine$sin;
     end
 
 endmodule // gyro_interface__carrier_nco
 
 
-module gyro_interface__carrier_nco__drive(clock,phase,sin,cos);
-
-    // Module arguments
-    input wire  clock;
-    input wire  [31:0] phase;
-    output reg signed [15:0] sin;
-    output reg signed [15:0] cos;
-
-    // Constant declarations
-    localparam  no_turn = 2'b0;
-    localparam  quarter_turn = 2'b1;
-
-    // Stub signals
-    reg  sine$clock;
-    reg  [31:0] sine$phase;
-    reg  [1:0] sine$advance;
-    wire signed [15:0] sine$sin;
-    reg  cosine$clock;
-    reg  [31:0] cosine$phase;
-    reg  [1:0] cosine$advance;
-    wire signed [15:0] cosine$sin;
-
-    // Sub module instances
-    gyro_interface__carrier_nco__drive__sine sine(
-        .clock(sine$clock),
-        .phase(sine$phase),
-        .advance(sine$advance),
-        .sin(sine$sin)
-    );
-    gyro_interface__carrier_nco__drive__cosine cosine(
-        .clock(cosine$clock),
-        .phase(cosine$phase),
-        .advance(cosine$advance),
-        .sin(cosine$sin)
-    );
-
-    // Update code
-    always @(*) begin
-        sine$clock = clock;
-        cosine$clock = clock;
-        sine$phase = phase;
-        cosine$phase = phase;
-        sine$advance = no_turn;
-        cosine$advance = quarter_turn;
-        sin = sine$sin;
-        cos = cosine$sin;
-    end
-
-endmodule // gyro_interface__carrier_nco__drive
-
-
-module gyro_interface__carrier_nco__drive__cosine(clock,phase,advance,sin);
+module gyro_interface__carrier_nco__drive_cosine(clock,phase,advance,fill_write,fill_address,fill_word,ready,sin);
 
     // Module arguments
     input wire  clock;
     input wire  [31:0] phase;
     input wire  [1:0] advance;
+    input wire  fill_write;
+    input wire  [12:0] fill_address;
+    input wire signed [15:0] fill_word;
+    input wire  ready;
     output reg signed [15:0] sin;
 
     // Constant declarations
-    localparam  half_step = 16'h4000;
-    localparam signed rounding = 32'h200000;
+    localparam signed zero = 16'h0;
 
     // Stub signals
-    reg  rom$clock;
-    reg  [7:0] rom$addr;
-    wire signed [15:0] rom$value;
-    wire signed [15:0] rom$slope;
-    reg  slope_product$clock;
-    reg signed [15:0] slope_product$a;
-    reg signed [15:0] slope_product$b;
-    wire signed [31:0] slope_product$p;
-    reg  [7:0] index_1$d;
-    wire  [7:0] index_1$q;
+    reg  ram$clock;
+    reg  ram$write_enable;
+    reg  [12:0] ram$address;
+    reg signed [15:0] ram$write_data;
+    wire signed [15:0] ram$q;
+    reg  [12:0] index_1$d;
+    wire  [12:0] index_1$q;
     reg  index_1$clock;
     reg  [1:0] quadrant_1$d;
     wire  [1:0] quadrant_1$q;
     reg  quadrant_1$clock;
-    reg signed [15:0] offset_1$d;
-    wire signed [15:0] offset_1$q;
-    reg  offset_1$clock;
+    reg  live_1$d;
+    wire  live_1$q;
+    reg  live_1$clock;
     reg  [1:0] quadrant_2$d;
     wire  [1:0] quadrant_2$q;
     reg  quadrant_2$clock;
-    reg signed [15:0] offset_2$d;
-    wire signed [15:0] offset_2$q;
-    reg  offset_2$clock;
-    reg  [1:0] quadrant_read$d;
-    wire  [1:0] quadrant_read$q;
-    reg  quadrant_read$clock;
-    reg signed [15:0] offset_read$d;
-    wire signed [15:0] offset_read$q;
-    reg  offset_read$clock;
-    reg signed [15:0] value_read$d;
-    wire signed [15:0] value_read$q;
-    reg  value_read$clock;
-    reg signed [15:0] slope_read$d;
-    wire signed [15:0] slope_read$q;
-    reg  slope_read$clock;
-    reg  [1:0] quadrant_4$d;
-    wire  [1:0] quadrant_4$q;
-    reg  quadrant_4$clock;
-    reg signed [15:0] signed_sample_4$d;
-    wire signed [15:0] signed_sample_4$q;
-    reg  signed_sample_4$clock;
+    reg  live_2$d;
+    wire  live_2$q;
+    reg  live_2$clock;
+    reg  [1:0] quadrant_3$d;
+    wire  [1:0] quadrant_3$q;
+    reg  quadrant_3$clock;
+    reg  live_3$d;
+    wire  live_3$q;
+    reg  live_3$clock;
+    reg signed [15:0] value_3$d;
+    wire signed [15:0] value_3$q;
+    reg  value_3$clock;
+    reg  live_4$d;
+    wire  live_4$q;
+    reg  live_4$clock;
+    reg signed [15:0] signed_4$d;
+    wire signed [15:0] signed_4$q;
+    reg  signed_4$clock;
     reg signed [15:0] sin_out$d;
     wire signed [15:0] sin_out$q;
     reg  sin_out$clock;
 
     // Local signals
     reg  [1:0] quadrant;
-    reg  [15:0] fraction;
-    reg signed [31:0] rounded;
-    reg signed [9:0] correction_10;
-    reg signed [15:0] correction;
 
     // Sub module instances
-    gyro_interface__carrier_nco__drive__cosine__rom rom(
-        .clock(rom$clock),
-        .addr(rom$addr),
-        .value(rom$value),
-        .slope(rom$slope)
+    gyro_interface__carrier_nco__drive_cosine__ram ram(
+        .clock(ram$clock),
+        .write_enable(ram$write_enable),
+        .address(ram$address),
+        .write_data(ram$write_data),
+        .q(ram$q)
     );
-    gyro_interface__carrier_nco__drive__cosine__slope_product slope_product(
-        .clock(slope_product$clock),
-        .a(slope_product$a),
-        .b(slope_product$b),
-        .p(slope_product$p)
-    );
-    gyro_interface__carrier_nco__drive__cosine__index_1 index_1(
+    gyro_interface__carrier_nco__drive_cosine__index_1 index_1(
         .d(index_1$d),
         .q(index_1$q),
         .clock(index_1$clock)
     );
-    gyro_interface__carrier_nco__drive__cosine__quadrant_1 quadrant_1(
+    gyro_interface__carrier_nco__drive_cosine__quadrant_1 quadrant_1(
         .d(quadrant_1$d),
         .q(quadrant_1$q),
         .clock(quadrant_1$clock)
     );
-    gyro_interface__carrier_nco__drive__cosine__offset_1 offset_1(
-        .d(offset_1$d),
-        .q(offset_1$q),
-        .clock(offset_1$clock)
+    gyro_interface__carrier_nco__drive_cosine__live_1 live_1(
+        .d(live_1$d),
+        .q(live_1$q),
+        .clock(live_1$clock)
     );
-    gyro_interface__carrier_nco__drive__cosine__quadrant_2 quadrant_2(
+    gyro_interface__carrier_nco__drive_cosine__quadrant_2 quadrant_2(
         .d(quadrant_2$d),
         .q(quadrant_2$q),
         .clock(quadrant_2$clock)
     );
-    gyro_interface__carrier_nco__drive__cosine__offset_2 offset_2(
-        .d(offset_2$d),
-        .q(offset_2$q),
-        .clock(offset_2$clock)
+    gyro_interface__carrier_nco__drive_cosine__live_2 live_2(
+        .d(live_2$d),
+        .q(live_2$q),
+        .clock(live_2$clock)
     );
-    gyro_interface__carrier_nco__drive__cosine__quadrant_read quadrant_read(
-        .d(quadrant_read$d),
-        .q(quadrant_read$q),
-        .clock(quadrant_read$clock)
+    gyro_interface__carrier_nco__drive_cosine__quadrant_3 quadrant_3(
+        .d(quadrant_3$d),
+        .q(quadrant_3$q),
+        .clock(quadrant_3$clock)
     );
-    gyro_interface__carrier_nco__drive__cosine__offset_read offset_read(
-        .d(offset_read$d),
-        .q(offset_read$q),
-        .clock(offset_read$clock)
+    gyro_interface__carrier_nco__drive_cosine__live_3 live_3(
+        .d(live_3$d),
+        .q(live_3$q),
+        .clock(live_3$clock)
     );
-    gyro_interface__carrier_nco__drive__cosine__value_read value_read(
-        .d(value_read$d),
-        .q(value_read$q),
-        .clock(value_read$clock)
+    gyro_interface__carrier_nco__drive_cosine__value_3 value_3(
+        .d(value_3$d),
+        .q(value_3$q),
+        .clock(value_3$clock)
     );
-    gyro_interface__carrier_nco__drive__cosine__slope_read slope_read(
-        .d(slope_read$d),
-        .q(slope_read$q),
-        .clock(slope_read$clock)
+    gyro_interface__carrier_nco__drive_cosine__live_4 live_4(
+        .d(live_4$d),
+        .q(live_4$q),
+        .clock(live_4$clock)
     );
-    gyro_interface__carrier_nco__drive__cosine__quadrant_4 quadrant_4(
-        .d(quadrant_4$d),
-        .q(quadrant_4$q),
-        .clock(quadrant_4$clock)
+    gyro_interface__carrier_nco__drive_cosine__signed_4 signed_4(
+        .d(signed_4$d),
+        .q(signed_4$q),
+        .clock(signed_4$clock)
     );
-    gyro_interface__carrier_nco__drive__cosine__signed_sample_4 signed_sample_4(
-        .d(signed_sample_4$d),
-        .q(signed_sample_4$q),
-        .clock(signed_sample_4$clock)
-    );
-    gyro_interface__carrier_nco__drive__cosine__sin_out sin_out(
+    gyro_interface__carrier_nco__drive_cosine__sin_out sin_out(
         .d(sin_out$d),
         .q(sin_out$q),
         .clock(sin_out$clock)
@@ -1401,144 +1452,158 @@ module gyro_interface__carrier_nco__drive__cosine(clock,phase,advance,sin);
 
     // Update code
     always @(*) begin
-        rom$clock = clock;
-        slope_product$clock = clock;
+        ram$clock = clock;
         index_1$clock = clock;
         quadrant_1$clock = clock;
-        offset_1$clock = clock;
+        live_1$clock = clock;
         quadrant_2$clock = clock;
-        offset_2$clock = clock;
-        quadrant_read$clock = clock;
-        offset_read$clock = clock;
-        value_read$clock = clock;
-        slope_read$clock = clock;
-        quadrant_4$clock = clock;
-        signed_sample_4$clock = clock;
+        live_2$clock = clock;
+        quadrant_3$clock = clock;
+        live_3$clock = clock;
+        value_3$clock = clock;
+        live_4$clock = clock;
+        signed_4$clock = clock;
         sin_out$clock = clock;
         index_1$d = index_1$q;
         quadrant_1$d = quadrant_1$q;
-        offset_1$d = offset_1$q;
+        live_1$d = live_1$q;
         quadrant_2$d = quadrant_2$q;
-        offset_2$d = offset_2$q;
-        quadrant_read$d = quadrant_read$q;
-        offset_read$d = offset_read$q;
-        value_read$d = value_read$q;
-        slope_read$d = slope_read$q;
-        quadrant_4$d = quadrant_4$q;
-        signed_sample_4$d = signed_sample_4$q;
+        live_2$d = live_2$q;
+        quadrant_3$d = quadrant_3$q;
+        live_3$d = live_3$q;
+        value_3$d = value_3$q;
+        live_4$d = live_4$q;
+        signed_4$d = signed_4$q;
         sin_out$d = sin_out$q;
         quadrant = phase[(32'h1e)+:(2)] + advance;
-        index_1$d = phase[(32'h16)+:(8)];
+        index_1$d = phase[(32'h11)+:(13)];
         if (quadrant[32'h0]) begin
-            index_1$d = ~(phase[(32'h16)+:(8)]);
+            index_1$d = ~(phase[(32'h11)+:(13)]);
         end
         quadrant_1$d = quadrant;
-        fraction = ((phase[(32'h7)+:(15)]) & 16'hffff);
-        offset_1$d = $signed(fraction - half_step);
-        rom$addr = index_1$q;
-        quadrant_2$d = quadrant_1$q;
-        offset_2$d = offset_1$q;
-        quadrant_read$d = quadrant_2$q;
-        offset_read$d = offset_2$q;
-        value_read$d = rom$value;
-        slope_read$d = rom$slope;
-        slope_product$a = offset_read$q;
-        slope_product$b = slope_read$q;
-        quadrant_4$d = quadrant_read$q;
-        signed_sample_4$d = value_read$q;
-        if (quadrant_read$q[32'h1]) begin
-            signed_sample_4$d = -value_read$q;
+        live_1$d = ready;
+        ram$write_enable = fill_write;
+        ram$address = index_1$q;
+        if (fill_write) begin
+            ram$address = fill_address;
         end
-        rounded = slope_product$p + rounding;
-        correction_10 = rounded[(32'h16)+:(10)];
-        correction = $signed(correction_10);
-        sin_out$d = signed_sample_4$q + correction;
-        if (quadrant_4$q[32'h0] ^ quadrant_4$q[32'h1]) begin
-            sin_out$d = signed_sample_4$q - correction;
+        ram$write_data = fill_word;
+        quadrant_2$d = quadrant_1$q;
+        live_2$d = live_1$q;
+        quadrant_3$d = quadrant_2$q;
+        live_3$d = live_2$q;
+        value_3$d = ram$q;
+        live_4$d = live_3$q;
+        signed_4$d = value_3$q;
+        if (quadrant_3$q[32'h1]) begin
+            signed_4$d = -value_3$q;
+        end
+        sin_out$d = zero;
+        if (live_4$q) begin
+            sin_out$d = signed_4$q;
         end
         sin = sin_out$q;
     end
 
-endmodule // gyro_interface__carrier_nco__drive__cosine
+endmodule // gyro_interface__carrier_nco__drive_cosine
 
 
-module gyro_interface__carrier_nco__drive__cosine__index_1(d,q,clock);
+module gyro_interface__carrier_nco__drive_cosine__index_1(d,q,clock);
 
     // Module arguments
-    input wire  [7:0] d;
-    output reg  [7:0] q;
+    input wire  [12:0] d;
+    output reg  [12:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 8'h0;
+       q = 13'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive__cosine__index_1
+endmodule // gyro_interface__carrier_nco__drive_cosine__index_1
 
 
-module gyro_interface__carrier_nco__drive__cosine__offset_1(d,q,clock);
+module gyro_interface__carrier_nco__drive_cosine__live_1(d,q,clock);
 
     // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
+    input wire  d;
+    output reg  q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 16'h0;
+       q = 1'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive__cosine__offset_1
+endmodule // gyro_interface__carrier_nco__drive_cosine__live_1
 
 
-module gyro_interface__carrier_nco__drive__cosine__offset_2(d,q,clock);
+module gyro_interface__carrier_nco__drive_cosine__live_2(d,q,clock);
 
     // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
+    input wire  d;
+    output reg  q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 16'h0;
+       q = 1'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive__cosine__offset_2
+endmodule // gyro_interface__carrier_nco__drive_cosine__live_2
 
 
-module gyro_interface__carrier_nco__drive__cosine__offset_read(d,q,clock);
+module gyro_interface__carrier_nco__drive_cosine__live_3(d,q,clock);
 
     // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
+    input wire  d;
+    output reg  q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 16'h0;
+       q = 1'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive__cosine__offset_read
+endmodule // gyro_interface__carrier_nco__drive_cosine__live_3
 
 
-module gyro_interface__carrier_nco__drive__cosine__quadrant_1(d,q,clock);
+module gyro_interface__carrier_nco__drive_cosine__live_4(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive_cosine__live_4
+
+
+module gyro_interface__carrier_nco__drive_cosine__quadrant_1(d,q,clock);
 
     // Module arguments
     input wire  [1:0] d;
@@ -1554,29 +1619,10 @@ module gyro_interface__carrier_nco__drive__cosine__quadrant_1(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive__cosine__quadrant_1
+endmodule // gyro_interface__carrier_nco__drive_cosine__quadrant_1
 
 
-module gyro_interface__carrier_nco__drive__cosine__quadrant_2(d,q,clock);
-
-    // Module arguments
-    input wire  [1:0] d;
-    output reg  [1:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 2'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__drive__cosine__quadrant_2
-
-
-module gyro_interface__carrier_nco__drive__cosine__quadrant_4(d,q,clock);
+module gyro_interface__carrier_nco__drive_cosine__quadrant_2(d,q,clock);
 
     // Module arguments
     input wire  [1:0] d;
@@ -1592,10 +1638,10 @@ module gyro_interface__carrier_nco__drive__cosine__quadrant_4(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive__cosine__quadrant_4
+endmodule // gyro_interface__carrier_nco__drive_cosine__quadrant_2
 
 
-module gyro_interface__carrier_nco__drive__cosine__quadrant_read(d,q,clock);
+module gyro_interface__carrier_nco__drive_cosine__quadrant_3(d,q,clock);
 
     // Module arguments
     input wire  [1:0] d;
@@ -1611,290 +1657,31 @@ module gyro_interface__carrier_nco__drive__cosine__quadrant_read(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive__cosine__quadrant_read
+endmodule // gyro_interface__carrier_nco__drive_cosine__quadrant_3
 
 
-module gyro_interface__carrier_nco__drive__cosine__rom(clock,addr,value,slope);
+module gyro_interface__carrier_nco__drive_cosine__ram(clock,write_enable,address,write_data,q);
 
     // Module arguments
     input wire  clock;
-    input wire  [7:0] addr;
-    output reg signed [15:0] value;
-    output reg signed [15:0] slope;
+    input wire  write_enable;
+    input wire  [12:0] address;
+    input wire signed [15:0] write_data;
+    output reg signed [15:0] q;
 
     // Update code (custom)
-    reg signed [15:0] value_rom [0:255];
-    reg signed [15:0] slope_rom [0:255];
-
-    initial begin
-       value_rom[0] = 16'sd101; slope_rom[0] = 16'sd25735;
-       value_rom[1] = 16'sd302; slope_rom[1] = 16'sd25734;
-       value_rom[2] = 16'sd503; slope_rom[2] = 16'sd25732;
-       value_rom[3] = 16'sd704; slope_rom[3] = 16'sd25729;
-       value_rom[4] = 16'sd905; slope_rom[4] = 16'sd25725;
-       value_rom[5] = 16'sd1106; slope_rom[5] = 16'sd25720;
-       value_rom[6] = 16'sd1307; slope_rom[6] = 16'sd25715;
-       value_rom[7] = 16'sd1507; slope_rom[7] = 16'sd25708;
-       value_rom[8] = 16'sd1708; slope_rom[8] = 16'sd25700;
-       value_rom[9] = 16'sd1909; slope_rom[9] = 16'sd25691;
-       value_rom[10] = 16'sd2110; slope_rom[10] = 16'sd25682;
-       value_rom[11] = 16'sd2310; slope_rom[11] = 16'sd25671;
-       value_rom[12] = 16'sd2511; slope_rom[12] = 16'sd25659;
-       value_rom[13] = 16'sd2711; slope_rom[13] = 16'sd25647;
-       value_rom[14] = 16'sd2911; slope_rom[14] = 16'sd25633;
-       value_rom[15] = 16'sd3112; slope_rom[15] = 16'sd25619;
-       value_rom[16] = 16'sd3312; slope_rom[16] = 16'sd25603;
-       value_rom[17] = 16'sd3512; slope_rom[17] = 16'sd25587;
-       value_rom[18] = 16'sd3712; slope_rom[18] = 16'sd25570;
-       value_rom[19] = 16'sd3911; slope_rom[19] = 16'sd25551;
-       value_rom[20] = 16'sd4111; slope_rom[20] = 16'sd25532;
-       value_rom[21] = 16'sd4310; slope_rom[21] = 16'sd25512;
-       value_rom[22] = 16'sd4509; slope_rom[22] = 16'sd25490;
-       value_rom[23] = 16'sd4708; slope_rom[23] = 16'sd25468;
-       value_rom[24] = 16'sd4907; slope_rom[24] = 16'sd25445;
-       value_rom[25] = 16'sd5106; slope_rom[25] = 16'sd25421;
-       value_rom[26] = 16'sd5305; slope_rom[26] = 16'sd25396;
-       value_rom[27] = 16'sd5503; slope_rom[27] = 16'sd25370;
-       value_rom[28] = 16'sd5701; slope_rom[28] = 16'sd25343;
-       value_rom[29] = 16'sd5899; slope_rom[29] = 16'sd25315;
-       value_rom[30] = 16'sd6096; slope_rom[30] = 16'sd25286;
-       value_rom[31] = 16'sd6294; slope_rom[31] = 16'sd25256;
-       value_rom[32] = 16'sd6491; slope_rom[32] = 16'sd25225;
-       value_rom[33] = 16'sd6688; slope_rom[33] = 16'sd25193;
-       value_rom[34] = 16'sd6885; slope_rom[34] = 16'sd25161;
-       value_rom[35] = 16'sd7081; slope_rom[35] = 16'sd25127;
-       value_rom[36] = 16'sd7277; slope_rom[36] = 16'sd25092;
-       value_rom[37] = 16'sd7473; slope_rom[37] = 16'sd25057;
-       value_rom[38] = 16'sd7669; slope_rom[38] = 16'sd25020;
-       value_rom[39] = 16'sd7864; slope_rom[39] = 16'sd24983;
-       value_rom[40] = 16'sd8059; slope_rom[40] = 16'sd24945;
-       value_rom[41] = 16'sd8254; slope_rom[41] = 16'sd24905;
-       value_rom[42] = 16'sd8448; slope_rom[42] = 16'sd24865;
-       value_rom[43] = 16'sd8642; slope_rom[43] = 16'sd24824;
-       value_rom[44] = 16'sd8836; slope_rom[44] = 16'sd24782;
-       value_rom[45] = 16'sd9030; slope_rom[45] = 16'sd24739;
-       value_rom[46] = 16'sd9223; slope_rom[46] = 16'sd24695;
-       value_rom[47] = 16'sd9416; slope_rom[47] = 16'sd24650;
-       value_rom[48] = 16'sd9608; slope_rom[48] = 16'sd24604;
-       value_rom[49] = 16'sd9800; slope_rom[49] = 16'sd24557;
-       value_rom[50] = 16'sd9992; slope_rom[50] = 16'sd24510;
-       value_rom[51] = 16'sd10183; slope_rom[51] = 16'sd24461;
-       value_rom[52] = 16'sd10374; slope_rom[52] = 16'sd24411;
-       value_rom[53] = 16'sd10564; slope_rom[53] = 16'sd24361;
-       value_rom[54] = 16'sd10754; slope_rom[54] = 16'sd24310;
-       value_rom[55] = 16'sd10944; slope_rom[55] = 16'sd24257;
-       value_rom[56] = 16'sd11133; slope_rom[56] = 16'sd24204;
-       value_rom[57] = 16'sd11322; slope_rom[57] = 16'sd24150;
-       value_rom[58] = 16'sd11511; slope_rom[58] = 16'sd24095;
-       value_rom[59] = 16'sd11699; slope_rom[59] = 16'sd24039;
-       value_rom[60] = 16'sd11886; slope_rom[60] = 16'sd23982;
-       value_rom[61] = 16'sd12074; slope_rom[61] = 16'sd23924;
-       value_rom[62] = 16'sd12260; slope_rom[62] = 16'sd23866;
-       value_rom[63] = 16'sd12446; slope_rom[63] = 16'sd23806;
-       value_rom[64] = 16'sd12632; slope_rom[64] = 16'sd23746;
-       value_rom[65] = 16'sd12817; slope_rom[65] = 16'sd23685;
-       value_rom[66] = 16'sd13002; slope_rom[66] = 16'sd23622;
-       value_rom[67] = 16'sd13187; slope_rom[67] = 16'sd23559;
-       value_rom[68] = 16'sd13370; slope_rom[68] = 16'sd23495;
-       value_rom[69] = 16'sd13554; slope_rom[69] = 16'sd23430;
-       value_rom[70] = 16'sd13736; slope_rom[70] = 16'sd23365;
-       value_rom[71] = 16'sd13919; slope_rom[71] = 16'sd23298;
-       value_rom[72] = 16'sd14101; slope_rom[72] = 16'sd23230;
-       value_rom[73] = 16'sd14282; slope_rom[73] = 16'sd23162;
-       value_rom[74] = 16'sd14462; slope_rom[74] = 16'sd23093;
-       value_rom[75] = 16'sd14643; slope_rom[75] = 16'sd23023;
-       value_rom[76] = 16'sd14822; slope_rom[76] = 16'sd22952;
-       value_rom[77] = 16'sd15001; slope_rom[77] = 16'sd22880;
-       value_rom[78] = 16'sd15180; slope_rom[78] = 16'sd22807;
-       value_rom[79] = 16'sd15358; slope_rom[79] = 16'sd22733;
-       value_rom[80] = 16'sd15535; slope_rom[80] = 16'sd22659;
-       value_rom[81] = 16'sd15712; slope_rom[81] = 16'sd22584;
-       value_rom[82] = 16'sd15888; slope_rom[82] = 16'sd22508;
-       value_rom[83] = 16'sd16063; slope_rom[83] = 16'sd22431;
-       value_rom[84] = 16'sd16238; slope_rom[84] = 16'sd22353;
-       value_rom[85] = 16'sd16413; slope_rom[85] = 16'sd22274;
-       value_rom[86] = 16'sd16586; slope_rom[86] = 16'sd22195;
-       value_rom[87] = 16'sd16759; slope_rom[87] = 16'sd22114;
-       value_rom[88] = 16'sd16932; slope_rom[88] = 16'sd22033;
-       value_rom[89] = 16'sd17104; slope_rom[89] = 16'sd21951;
-       value_rom[90] = 16'sd17275; slope_rom[90] = 16'sd21868;
-       value_rom[91] = 16'sd17445; slope_rom[91] = 16'sd21785;
-       value_rom[92] = 16'sd17615; slope_rom[92] = 16'sd21700;
-       value_rom[93] = 16'sd17784; slope_rom[93] = 16'sd21615;
-       value_rom[94] = 16'sd17953; slope_rom[94] = 16'sd21529;
-       value_rom[95] = 16'sd18121; slope_rom[95] = 16'sd21442;
-       value_rom[96] = 16'sd18288; slope_rom[96] = 16'sd21354;
-       value_rom[97] = 16'sd18454; slope_rom[97] = 16'sd21265;
-       value_rom[98] = 16'sd18620; slope_rom[98] = 16'sd21176;
-       value_rom[99] = 16'sd18785; slope_rom[99] = 16'sd21086;
-       value_rom[100] = 16'sd18950; slope_rom[100] = 16'sd20995;
-       value_rom[101] = 16'sd19113; slope_rom[101] = 16'sd20903;
-       value_rom[102] = 16'sd19276; slope_rom[102] = 16'sd20811;
-       value_rom[103] = 16'sd19438; slope_rom[103] = 16'sd20718;
-       value_rom[104] = 16'sd19600; slope_rom[104] = 16'sd20624;
-       value_rom[105] = 16'sd19761; slope_rom[105] = 16'sd20529;
-       value_rom[106] = 16'sd19921; slope_rom[106] = 16'sd20433;
-       value_rom[107] = 16'sd20080; slope_rom[107] = 16'sd20337;
-       value_rom[108] = 16'sd20238; slope_rom[108] = 16'sd20240;
-       value_rom[109] = 16'sd20396; slope_rom[109] = 16'sd20142;
-       value_rom[110] = 16'sd20553; slope_rom[110] = 16'sd20043;
-       value_rom[111] = 16'sd20709; slope_rom[111] = 16'sd19944;
-       value_rom[112] = 16'sd20865; slope_rom[112] = 16'sd19843;
-       value_rom[113] = 16'sd21019; slope_rom[113] = 16'sd19742;
-       value_rom[114] = 16'sd21173; slope_rom[114] = 16'sd19641;
-       value_rom[115] = 16'sd21326; slope_rom[115] = 16'sd19538;
-       value_rom[116] = 16'sd21479; slope_rom[116] = 16'sd19435;
-       value_rom[117] = 16'sd21630; slope_rom[117] = 16'sd19331;
-       value_rom[118] = 16'sd21781; slope_rom[118] = 16'sd19227;
-       value_rom[119] = 16'sd21930; slope_rom[119] = 16'sd19121;
-       value_rom[120] = 16'sd22079; slope_rom[120] = 16'sd19015;
-       value_rom[121] = 16'sd22227; slope_rom[121] = 16'sd18909;
-       value_rom[122] = 16'sd22375; slope_rom[122] = 16'sd18801;
-       value_rom[123] = 16'sd22521; slope_rom[123] = 16'sd18693;
-       value_rom[124] = 16'sd22667; slope_rom[124] = 16'sd18584;
-       value_rom[125] = 16'sd22812; slope_rom[125] = 16'sd18474;
-       value_rom[126] = 16'sd22956; slope_rom[126] = 16'sd18364;
-       value_rom[127] = 16'sd23099; slope_rom[127] = 16'sd18253;
-       value_rom[128] = 16'sd23241; slope_rom[128] = 16'sd18142;
-       value_rom[129] = 16'sd23382; slope_rom[129] = 16'sd18029;
-       value_rom[130] = 16'sd23522; slope_rom[130] = 16'sd17916;
-       value_rom[131] = 16'sd23662; slope_rom[131] = 16'sd17803;
-       value_rom[132] = 16'sd23801; slope_rom[132] = 16'sd17688;
-       value_rom[133] = 16'sd23938; slope_rom[133] = 16'sd17573;
-       value_rom[134] = 16'sd24075; slope_rom[134] = 16'sd17457;
-       value_rom[135] = 16'sd24211; slope_rom[135] = 16'sd17341;
-       value_rom[136] = 16'sd24346; slope_rom[136] = 16'sd17224;
-       value_rom[137] = 16'sd24480; slope_rom[137] = 16'sd17106;
-       value_rom[138] = 16'sd24613; slope_rom[138] = 16'sd16988;
-       value_rom[139] = 16'sd24746; slope_rom[139] = 16'sd16869;
-       value_rom[140] = 16'sd24877; slope_rom[140] = 16'sd16750;
-       value_rom[141] = 16'sd25007; slope_rom[141] = 16'sd16629;
-       value_rom[142] = 16'sd25137; slope_rom[142] = 16'sd16509;
-       value_rom[143] = 16'sd25265; slope_rom[143] = 16'sd16387;
-       value_rom[144] = 16'sd25393; slope_rom[144] = 16'sd16265;
-       value_rom[145] = 16'sd25519; slope_rom[145] = 16'sd16142;
-       value_rom[146] = 16'sd25645; slope_rom[146] = 16'sd16019;
-       value_rom[147] = 16'sd25770; slope_rom[147] = 16'sd15895;
-       value_rom[148] = 16'sd25893; slope_rom[148] = 16'sd15771;
-       value_rom[149] = 16'sd26016; slope_rom[149] = 16'sd15646;
-       value_rom[150] = 16'sd26138; slope_rom[150] = 16'sd15520;
-       value_rom[151] = 16'sd26259; slope_rom[151] = 16'sd15394;
-       value_rom[152] = 16'sd26378; slope_rom[152] = 16'sd15267;
-       value_rom[153] = 16'sd26497; slope_rom[153] = 16'sd15140;
-       value_rom[154] = 16'sd26615; slope_rom[154] = 16'sd15012;
-       value_rom[155] = 16'sd26732; slope_rom[155] = 16'sd14883;
-       value_rom[156] = 16'sd26848; slope_rom[156] = 16'sd14754;
-       value_rom[157] = 16'sd26962; slope_rom[157] = 16'sd14624;
-       value_rom[158] = 16'sd27076; slope_rom[158] = 16'sd14494;
-       value_rom[159] = 16'sd27189; slope_rom[159] = 16'sd14363;
-       value_rom[160] = 16'sd27300; slope_rom[160] = 16'sd14232;
-       value_rom[161] = 16'sd27411; slope_rom[161] = 16'sd14100;
-       value_rom[162] = 16'sd27521; slope_rom[162] = 16'sd13968;
-       value_rom[163] = 16'sd27629; slope_rom[163] = 16'sd13835;
-       value_rom[164] = 16'sd27737; slope_rom[164] = 16'sd13701;
-       value_rom[165] = 16'sd27843; slope_rom[165] = 16'sd13568;
-       value_rom[166] = 16'sd27949; slope_rom[166] = 16'sd13433;
-       value_rom[167] = 16'sd28053; slope_rom[167] = 16'sd13298;
-       value_rom[168] = 16'sd28157; slope_rom[168] = 16'sd13163;
-       value_rom[169] = 16'sd28259; slope_rom[169] = 16'sd13027;
-       value_rom[170] = 16'sd28360; slope_rom[170] = 16'sd12890;
-       value_rom[171] = 16'sd28460; slope_rom[171] = 16'sd12753;
-       value_rom[172] = 16'sd28560; slope_rom[172] = 16'sd12616;
-       value_rom[173] = 16'sd28658; slope_rom[173] = 16'sd12478;
-       value_rom[174] = 16'sd28755; slope_rom[174] = 16'sd12340;
-       value_rom[175] = 16'sd28850; slope_rom[175] = 16'sd12201;
-       value_rom[176] = 16'sd28945; slope_rom[176] = 16'sd12062;
-       value_rom[177] = 16'sd29039; slope_rom[177] = 16'sd11922;
-       value_rom[178] = 16'sd29131; slope_rom[178] = 16'sd11782;
-       value_rom[179] = 16'sd29223; slope_rom[179] = 16'sd11641;
-       value_rom[180] = 16'sd29313; slope_rom[180] = 16'sd11500;
-       value_rom[181] = 16'sd29403; slope_rom[181] = 16'sd11359;
-       value_rom[182] = 16'sd29491; slope_rom[182] = 16'sd11217;
-       value_rom[183] = 16'sd29578; slope_rom[183] = 16'sd11075;
-       value_rom[184] = 16'sd29664; slope_rom[184] = 16'sd10932;
-       value_rom[185] = 16'sd29749; slope_rom[185] = 16'sd10789;
-       value_rom[186] = 16'sd29832; slope_rom[186] = 16'sd10645;
-       value_rom[187] = 16'sd29915; slope_rom[187] = 16'sd10501;
-       value_rom[188] = 16'sd29997; slope_rom[188] = 16'sd10357;
-       value_rom[189] = 16'sd30077; slope_rom[189] = 16'sd10212;
-       value_rom[190] = 16'sd30156; slope_rom[190] = 16'sd10067;
-       value_rom[191] = 16'sd30234; slope_rom[191] = 16'sd9921;
-       value_rom[192] = 16'sd30311; slope_rom[192] = 16'sd9775;
-       value_rom[193] = 16'sd30387; slope_rom[193] = 16'sd9629;
-       value_rom[194] = 16'sd30462; slope_rom[194] = 16'sd9483;
-       value_rom[195] = 16'sd30535; slope_rom[195] = 16'sd9336;
-       value_rom[196] = 16'sd30607; slope_rom[196] = 16'sd9188;
-       value_rom[197] = 16'sd30679; slope_rom[197] = 16'sd9041;
-       value_rom[198] = 16'sd30749; slope_rom[198] = 16'sd8893;
-       value_rom[199] = 16'sd30818; slope_rom[199] = 16'sd8744;
-       value_rom[200] = 16'sd30885; slope_rom[200] = 16'sd8596;
-       value_rom[201] = 16'sd30952; slope_rom[201] = 16'sd8447;
-       value_rom[202] = 16'sd31017; slope_rom[202] = 16'sd8297;
-       value_rom[203] = 16'sd31082; slope_rom[203] = 16'sd8148;
-       value_rom[204] = 16'sd31145; slope_rom[204] = 16'sd7998;
-       value_rom[205] = 16'sd31206; slope_rom[205] = 16'sd7847;
-       value_rom[206] = 16'sd31267; slope_rom[206] = 16'sd7697;
-       value_rom[207] = 16'sd31327; slope_rom[207] = 16'sd7546;
-       value_rom[208] = 16'sd31385; slope_rom[208] = 16'sd7395;
-       value_rom[209] = 16'sd31442; slope_rom[209] = 16'sd7244;
-       value_rom[210] = 16'sd31498; slope_rom[210] = 16'sd7092;
-       value_rom[211] = 16'sd31553; slope_rom[211] = 16'sd6940;
-       value_rom[212] = 16'sd31607; slope_rom[212] = 16'sd6788;
-       value_rom[213] = 16'sd31659; slope_rom[213] = 16'sd6635;
-       value_rom[214] = 16'sd31710; slope_rom[214] = 16'sd6483;
-       value_rom[215] = 16'sd31760; slope_rom[215] = 16'sd6330;
-       value_rom[216] = 16'sd31809; slope_rom[216] = 16'sd6177;
-       value_rom[217] = 16'sd31857; slope_rom[217] = 16'sd6023;
-       value_rom[218] = 16'sd31903; slope_rom[218] = 16'sd5869;
-       value_rom[219] = 16'sd31949; slope_rom[219] = 16'sd5716;
-       value_rom[220] = 16'sd31993; slope_rom[220] = 16'sd5562;
-       value_rom[221] = 16'sd32036; slope_rom[221] = 16'sd5407;
-       value_rom[222] = 16'sd32077; slope_rom[222] = 16'sd5253;
-       value_rom[223] = 16'sd32118; slope_rom[223] = 16'sd5098;
-       value_rom[224] = 16'sd32157; slope_rom[224] = 16'sd4943;
-       value_rom[225] = 16'sd32195; slope_rom[225] = 16'sd4788;
-       value_rom[226] = 16'sd32232; slope_rom[226] = 16'sd4633;
-       value_rom[227] = 16'sd32267; slope_rom[227] = 16'sd4477;
-       value_rom[228] = 16'sd32302; slope_rom[228] = 16'sd4322;
-       value_rom[229] = 16'sd32335; slope_rom[229] = 16'sd4166;
-       value_rom[230] = 16'sd32367; slope_rom[230] = 16'sd4010;
-       value_rom[231] = 16'sd32397; slope_rom[231] = 16'sd3854;
-       value_rom[232] = 16'sd32427; slope_rom[232] = 16'sd3698;
-       value_rom[233] = 16'sd32455; slope_rom[233] = 16'sd3542;
-       value_rom[234] = 16'sd32482; slope_rom[234] = 16'sd3385;
-       value_rom[235] = 16'sd32508; slope_rom[235] = 16'sd3229;
-       value_rom[236] = 16'sd32533; slope_rom[236] = 16'sd3072;
-       value_rom[237] = 16'sd32556; slope_rom[237] = 16'sd2915;
-       value_rom[238] = 16'sd32578; slope_rom[238] = 16'sd2758;
-       value_rom[239] = 16'sd32599; slope_rom[239] = 16'sd2601;
-       value_rom[240] = 16'sd32619; slope_rom[240] = 16'sd2444;
-       value_rom[241] = 16'sd32637; slope_rom[241] = 16'sd2287;
-       value_rom[242] = 16'sd32655; slope_rom[242] = 16'sd2129;
-       value_rom[243] = 16'sd32671; slope_rom[243] = 16'sd1972;
-       value_rom[244] = 16'sd32685; slope_rom[244] = 16'sd1814;
-       value_rom[245] = 16'sd32699; slope_rom[245] = 16'sd1657;
-       value_rom[246] = 16'sd32711; slope_rom[246] = 16'sd1499;
-       value_rom[247] = 16'sd32722; slope_rom[247] = 16'sd1342;
-       value_rom[248] = 16'sd32732; slope_rom[248] = 16'sd1184;
-       value_rom[249] = 16'sd32741; slope_rom[249] = 16'sd1026;
-       value_rom[250] = 16'sd32748; slope_rom[250] = 16'sd868;
-       value_rom[251] = 16'sd32755; slope_rom[251] = 16'sd710;
-       value_rom[252] = 16'sd32759; slope_rom[252] = 16'sd553;
-       value_rom[253] = 16'sd32763; slope_rom[253] = 16'sd395;
-       value_rom[254] = 16'sd32766; slope_rom[254] = 16'sd237;
-       value_rom[255] = 16'sd32767; slope_rom[255] = 16'sd79;
-       value = 0;
-       slope = 0;
-    end
+    reg signed [15:0] words [0:8191];
 
     always @(posedge clock) begin
-       value <= value_rom[addr];
-       slope <= slope_rom[addr];
+       if (write_enable)
+          words[address] <= write_data;
+       else
+          q <= words[address];
     end
-endmodule // gyro_interface__carrier_nco__drive__cosine__rom
+endmodule // gyro_interface__carrier_nco__drive_cosine__ram
 
 
-module gyro_interface__carrier_nco__drive__cosine__signed_sample_4(d,q,clock);
+module gyro_interface__carrier_nco__drive_cosine__signed_4(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -1910,46 +1697,10 @@ module gyro_interface__carrier_nco__drive__cosine__signed_sample_4(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive__cosine__signed_sample_4
+endmodule // gyro_interface__carrier_nco__drive_cosine__signed_4
 
 
-module gyro_interface__carrier_nco__drive__cosine__sin_out(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__drive__cosine__sin_out
-
-
-module gyro_interface__carrier_nco__drive__cosine__slope_product(clock,a,b,p);
-
-    // Module arguments
-    input wire  clock;
-    input wire signed [15:0] a;
-    input wire signed [15:0] b;
-    output reg signed [31:0] p;
-
-    // Update code (custom)
-    initial p = 0;
-
-    always @(posedge clock) begin
-       p <= a * b;
-    end
-endmodule // gyro_interface__carrier_nco__drive__cosine__slope_product
-
-
-module gyro_interface__carrier_nco__drive__cosine__slope_read(d,q,clock);
+module gyro_interface__carrier_nco__drive_cosine__sin_out(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -1965,10 +1716,10 @@ module gyro_interface__carrier_nco__drive__cosine__slope_read(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive__cosine__slope_read
+endmodule // gyro_interface__carrier_nco__drive_cosine__sin_out
 
 
-module gyro_interface__carrier_nco__drive__cosine__value_read(d,q,clock);
+module gyro_interface__carrier_nco__drive_cosine__value_3(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -1984,143 +1735,126 @@ module gyro_interface__carrier_nco__drive__cosine__value_read(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive__cosine__value_read
+endmodule // gyro_interface__carrier_nco__drive_cosine__value_3
 
 
-module gyro_interface__carrier_nco__drive__sine(clock,phase,advance,sin);
+module gyro_interface__carrier_nco__drive_sine(clock,phase,advance,fill_write,fill_address,fill_word,ready,sin);
 
     // Module arguments
     input wire  clock;
     input wire  [31:0] phase;
     input wire  [1:0] advance;
+    input wire  fill_write;
+    input wire  [12:0] fill_address;
+    input wire signed [15:0] fill_word;
+    input wire  ready;
     output reg signed [15:0] sin;
 
     // Constant declarations
-    localparam  half_step = 16'h4000;
-    localparam signed rounding = 32'h200000;
+    localparam signed zero = 16'h0;
 
     // Stub signals
-    reg  rom$clock;
-    reg  [7:0] rom$addr;
-    wire signed [15:0] rom$value;
-    wire signed [15:0] rom$slope;
-    reg  slope_product$clock;
-    reg signed [15:0] slope_product$a;
-    reg signed [15:0] slope_product$b;
-    wire signed [31:0] slope_product$p;
-    reg  [7:0] index_1$d;
-    wire  [7:0] index_1$q;
+    reg  ram$clock;
+    reg  ram$write_enable;
+    reg  [12:0] ram$address;
+    reg signed [15:0] ram$write_data;
+    wire signed [15:0] ram$q;
+    reg  [12:0] index_1$d;
+    wire  [12:0] index_1$q;
     reg  index_1$clock;
     reg  [1:0] quadrant_1$d;
     wire  [1:0] quadrant_1$q;
     reg  quadrant_1$clock;
-    reg signed [15:0] offset_1$d;
-    wire signed [15:0] offset_1$q;
-    reg  offset_1$clock;
+    reg  live_1$d;
+    wire  live_1$q;
+    reg  live_1$clock;
     reg  [1:0] quadrant_2$d;
     wire  [1:0] quadrant_2$q;
     reg  quadrant_2$clock;
-    reg signed [15:0] offset_2$d;
-    wire signed [15:0] offset_2$q;
-    reg  offset_2$clock;
-    reg  [1:0] quadrant_read$d;
-    wire  [1:0] quadrant_read$q;
-    reg  quadrant_read$clock;
-    reg signed [15:0] offset_read$d;
-    wire signed [15:0] offset_read$q;
-    reg  offset_read$clock;
-    reg signed [15:0] value_read$d;
-    wire signed [15:0] value_read$q;
-    reg  value_read$clock;
-    reg signed [15:0] slope_read$d;
-    wire signed [15:0] slope_read$q;
-    reg  slope_read$clock;
-    reg  [1:0] quadrant_4$d;
-    wire  [1:0] quadrant_4$q;
-    reg  quadrant_4$clock;
-    reg signed [15:0] signed_sample_4$d;
-    wire signed [15:0] signed_sample_4$q;
-    reg  signed_sample_4$clock;
+    reg  live_2$d;
+    wire  live_2$q;
+    reg  live_2$clock;
+    reg  [1:0] quadrant_3$d;
+    wire  [1:0] quadrant_3$q;
+    reg  quadrant_3$clock;
+    reg  live_3$d;
+    wire  live_3$q;
+    reg  live_3$clock;
+    reg signed [15:0] value_3$d;
+    wire signed [15:0] value_3$q;
+    reg  value_3$clock;
+    reg  live_4$d;
+    wire  live_4$q;
+    reg  live_4$clock;
+    reg signed [15:0] signed_4$d;
+    wire signed [15:0] signed_4$q;
+    reg  signed_4$clock;
     reg signed [15:0] sin_out$d;
     wire signed [15:0] sin_out$q;
     reg  sin_out$clock;
 
     // Local signals
     reg  [1:0] quadrant;
-    reg  [15:0] fraction;
-    reg signed [31:0] rounded;
-    reg signed [9:0] correction_10;
-    reg signed [15:0] correction;
 
     // Sub module instances
-    gyro_interface__carrier_nco__drive__sine__rom rom(
-        .clock(rom$clock),
-        .addr(rom$addr),
-        .value(rom$value),
-        .slope(rom$slope)
+    gyro_interface__carrier_nco__drive_sine__ram ram(
+        .clock(ram$clock),
+        .write_enable(ram$write_enable),
+        .address(ram$address),
+        .write_data(ram$write_data),
+        .q(ram$q)
     );
-    gyro_interface__carrier_nco__drive__sine__slope_product slope_product(
-        .clock(slope_product$clock),
-        .a(slope_product$a),
-        .b(slope_product$b),
-        .p(slope_product$p)
-    );
-    gyro_interface__carrier_nco__drive__sine__index_1 index_1(
+    gyro_interface__carrier_nco__drive_sine__index_1 index_1(
         .d(index_1$d),
         .q(index_1$q),
         .clock(index_1$clock)
     );
-    gyro_interface__carrier_nco__drive__sine__quadrant_1 quadrant_1(
+    gyro_interface__carrier_nco__drive_sine__quadrant_1 quadrant_1(
         .d(quadrant_1$d),
         .q(quadrant_1$q),
         .clock(quadrant_1$clock)
     );
-    gyro_interface__carrier_nco__drive__sine__offset_1 offset_1(
-        .d(offset_1$d),
-        .q(offset_1$q),
-        .clock(offset_1$clock)
+    gyro_interface__carrier_nco__drive_sine__live_1 live_1(
+        .d(live_1$d),
+        .q(live_1$q),
+        .clock(live_1$clock)
     );
-    gyro_interface__carrier_nco__drive__sine__quadrant_2 quadrant_2(
+    gyro_interface__carrier_nco__drive_sine__quadrant_2 quadrant_2(
         .d(quadrant_2$d),
         .q(quadrant_2$q),
         .clock(quadrant_2$clock)
     );
-    gyro_interface__carrier_nco__drive__sine__offset_2 offset_2(
-        .d(offset_2$d),
-        .q(offset_2$q),
-        .clock(offset_2$clock)
+    gyro_interface__carrier_nco__drive_sine__live_2 live_2(
+        .d(live_2$d),
+        .q(live_2$q),
+        .clock(live_2$clock)
     );
-    gyro_interface__carrier_nco__drive__sine__quadrant_read quadrant_read(
-        .d(quadrant_read$d),
-        .q(quadrant_read$q),
-        .clock(quadrant_read$clock)
+    gyro_interface__carrier_nco__drive_sine__quadrant_3 quadrant_3(
+        .d(quadrant_3$d),
+        .q(quadrant_3$q),
+        .clock(quadrant_3$clock)
     );
-    gyro_interface__carrier_nco__drive__sine__offset_read offset_read(
-        .d(offset_read$d),
-        .q(offset_read$q),
-        .clock(offset_read$clock)
+    gyro_interface__carrier_nco__drive_sine__live_3 live_3(
+        .d(live_3$d),
+        .q(live_3$q),
+        .clock(live_3$clock)
     );
-    gyro_interface__carrier_nco__drive__sine__value_read value_read(
-        .d(value_read$d),
-        .q(value_read$q),
-        .clock(value_read$clock)
+    gyro_interface__carrier_nco__drive_sine__value_3 value_3(
+        .d(value_3$d),
+        .q(value_3$q),
+        .clock(value_3$clock)
     );
-    gyro_interface__carrier_nco__drive__sine__slope_read slope_read(
-        .d(slope_read$d),
-        .q(slope_read$q),
-        .clock(slope_read$clock)
+    gyro_interface__carrier_nco__drive_sine__live_4 live_4(
+        .d(live_4$d),
+        .q(live_4$q),
+        .clock(live_4$clock)
     );
-    gyro_interface__carrier_nco__drive__sine__quadrant_4 quadrant_4(
-        .d(quadrant_4$d),
-        .q(quadrant_4$q),
-        .clock(quadrant_4$clock)
+    gyro_interface__carrier_nco__drive_sine__signed_4 signed_4(
+        .d(signed_4$d),
+        .q(signed_4$q),
+        .clock(signed_4$clock)
     );
-    gyro_interface__carrier_nco__drive__sine__signed_sample_4 signed_sample_4(
-        .d(signed_sample_4$d),
-        .q(signed_sample_4$q),
-        .clock(signed_sample_4$clock)
-    );
-    gyro_interface__carrier_nco__drive__sine__sin_out sin_out(
+    gyro_interface__carrier_nco__drive_sine__sin_out sin_out(
         .d(sin_out$d),
         .q(sin_out$q),
         .clock(sin_out$clock)
@@ -2128,144 +1862,158 @@ module gyro_interface__carrier_nco__drive__sine(clock,phase,advance,sin);
 
     // Update code
     always @(*) begin
-        rom$clock = clock;
-        slope_product$clock = clock;
+        ram$clock = clock;
         index_1$clock = clock;
         quadrant_1$clock = clock;
-        offset_1$clock = clock;
+        live_1$clock = clock;
         quadrant_2$clock = clock;
-        offset_2$clock = clock;
-        quadrant_read$clock = clock;
-        offset_read$clock = clock;
-        value_read$clock = clock;
-        slope_read$clock = clock;
-        quadrant_4$clock = clock;
-        signed_sample_4$clock = clock;
+        live_2$clock = clock;
+        quadrant_3$clock = clock;
+        live_3$clock = clock;
+        value_3$clock = clock;
+        live_4$clock = clock;
+        signed_4$clock = clock;
         sin_out$clock = clock;
         index_1$d = index_1$q;
         quadrant_1$d = quadrant_1$q;
-        offset_1$d = offset_1$q;
+        live_1$d = live_1$q;
         quadrant_2$d = quadrant_2$q;
-        offset_2$d = offset_2$q;
-        quadrant_read$d = quadrant_read$q;
-        offset_read$d = offset_read$q;
-        value_read$d = value_read$q;
-        slope_read$d = slope_read$q;
-        quadrant_4$d = quadrant_4$q;
-        signed_sample_4$d = signed_sample_4$q;
+        live_2$d = live_2$q;
+        quadrant_3$d = quadrant_3$q;
+        live_3$d = live_3$q;
+        value_3$d = value_3$q;
+        live_4$d = live_4$q;
+        signed_4$d = signed_4$q;
         sin_out$d = sin_out$q;
         quadrant = phase[(32'h1e)+:(2)] + advance;
-        index_1$d = phase[(32'h16)+:(8)];
+        index_1$d = phase[(32'h11)+:(13)];
         if (quadrant[32'h0]) begin
-            index_1$d = ~(phase[(32'h16)+:(8)]);
+            index_1$d = ~(phase[(32'h11)+:(13)]);
         end
         quadrant_1$d = quadrant;
-        fraction = ((phase[(32'h7)+:(15)]) & 16'hffff);
-        offset_1$d = $signed(fraction - half_step);
-        rom$addr = index_1$q;
-        quadrant_2$d = quadrant_1$q;
-        offset_2$d = offset_1$q;
-        quadrant_read$d = quadrant_2$q;
-        offset_read$d = offset_2$q;
-        value_read$d = rom$value;
-        slope_read$d = rom$slope;
-        slope_product$a = offset_read$q;
-        slope_product$b = slope_read$q;
-        quadrant_4$d = quadrant_read$q;
-        signed_sample_4$d = value_read$q;
-        if (quadrant_read$q[32'h1]) begin
-            signed_sample_4$d = -value_read$q;
+        live_1$d = ready;
+        ram$write_enable = fill_write;
+        ram$address = index_1$q;
+        if (fill_write) begin
+            ram$address = fill_address;
         end
-        rounded = slope_product$p + rounding;
-        correction_10 = rounded[(32'h16)+:(10)];
-        correction = $signed(correction_10);
-        sin_out$d = signed_sample_4$q + correction;
-        if (quadrant_4$q[32'h0] ^ quadrant_4$q[32'h1]) begin
-            sin_out$d = signed_sample_4$q - correction;
+        ram$write_data = fill_word;
+        quadrant_2$d = quadrant_1$q;
+        live_2$d = live_1$q;
+        quadrant_3$d = quadrant_2$q;
+        live_3$d = live_2$q;
+        value_3$d = ram$q;
+        live_4$d = live_3$q;
+        signed_4$d = value_3$q;
+        if (quadrant_3$q[32'h1]) begin
+            signed_4$d = -value_3$q;
+        end
+        sin_out$d = zero;
+        if (live_4$q) begin
+            sin_out$d = signed_4$q;
         end
         sin = sin_out$q;
     end
 
-endmodule // gyro_interface__carrier_nco__drive__sine
+endmodule // gyro_interface__carrier_nco__drive_sine
 
 
-module gyro_interface__carrier_nco__drive__sine__index_1(d,q,clock);
+module gyro_interface__carrier_nco__drive_sine__index_1(d,q,clock);
 
     // Module arguments
-    input wire  [7:0] d;
-    output reg  [7:0] q;
+    input wire  [12:0] d;
+    output reg  [12:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 8'h0;
+       q = 13'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive__sine__index_1
+endmodule // gyro_interface__carrier_nco__drive_sine__index_1
 
 
-module gyro_interface__carrier_nco__drive__sine__offset_1(d,q,clock);
+module gyro_interface__carrier_nco__drive_sine__live_1(d,q,clock);
 
     // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
+    input wire  d;
+    output reg  q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 16'h0;
+       q = 1'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive__sine__offset_1
+endmodule // gyro_interface__carrier_nco__drive_sine__live_1
 
 
-module gyro_interface__carrier_nco__drive__sine__offset_2(d,q,clock);
+module gyro_interface__carrier_nco__drive_sine__live_2(d,q,clock);
 
     // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
+    input wire  d;
+    output reg  q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 16'h0;
+       q = 1'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive__sine__offset_2
+endmodule // gyro_interface__carrier_nco__drive_sine__live_2
 
 
-module gyro_interface__carrier_nco__drive__sine__offset_read(d,q,clock);
+module gyro_interface__carrier_nco__drive_sine__live_3(d,q,clock);
 
     // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
+    input wire  d;
+    output reg  q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 16'h0;
+       q = 1'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive__sine__offset_read
+endmodule // gyro_interface__carrier_nco__drive_sine__live_3
 
 
-module gyro_interface__carrier_nco__drive__sine__quadrant_1(d,q,clock);
+module gyro_interface__carrier_nco__drive_sine__live_4(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive_sine__live_4
+
+
+module gyro_interface__carrier_nco__drive_sine__quadrant_1(d,q,clock);
 
     // Module arguments
     input wire  [1:0] d;
@@ -2281,29 +2029,10 @@ module gyro_interface__carrier_nco__drive__sine__quadrant_1(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive__sine__quadrant_1
+endmodule // gyro_interface__carrier_nco__drive_sine__quadrant_1
 
 
-module gyro_interface__carrier_nco__drive__sine__quadrant_2(d,q,clock);
-
-    // Module arguments
-    input wire  [1:0] d;
-    output reg  [1:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 2'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__drive__sine__quadrant_2
-
-
-module gyro_interface__carrier_nco__drive__sine__quadrant_4(d,q,clock);
+module gyro_interface__carrier_nco__drive_sine__quadrant_2(d,q,clock);
 
     // Module arguments
     input wire  [1:0] d;
@@ -2319,10 +2048,10 @@ module gyro_interface__carrier_nco__drive__sine__quadrant_4(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive__sine__quadrant_4
+endmodule // gyro_interface__carrier_nco__drive_sine__quadrant_2
 
 
-module gyro_interface__carrier_nco__drive__sine__quadrant_read(d,q,clock);
+module gyro_interface__carrier_nco__drive_sine__quadrant_3(d,q,clock);
 
     // Module arguments
     input wire  [1:0] d;
@@ -2338,290 +2067,31 @@ module gyro_interface__carrier_nco__drive__sine__quadrant_read(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive__sine__quadrant_read
+endmodule // gyro_interface__carrier_nco__drive_sine__quadrant_3
 
 
-module gyro_interface__carrier_nco__drive__sine__rom(clock,addr,value,slope);
+module gyro_interface__carrier_nco__drive_sine__ram(clock,write_enable,address,write_data,q);
 
     // Module arguments
     input wire  clock;
-    input wire  [7:0] addr;
-    output reg signed [15:0] value;
-    output reg signed [15:0] slope;
+    input wire  write_enable;
+    input wire  [12:0] address;
+    input wire signed [15:0] write_data;
+    output reg signed [15:0] q;
 
     // Update code (custom)
-    reg signed [15:0] value_rom [0:255];
-    reg signed [15:0] slope_rom [0:255];
-
-    initial begin
-       value_rom[0] = 16'sd101; slope_rom[0] = 16'sd25735;
-       value_rom[1] = 16'sd302; slope_rom[1] = 16'sd25734;
-       value_rom[2] = 16'sd503; slope_rom[2] = 16'sd25732;
-       value_rom[3] = 16'sd704; slope_rom[3] = 16'sd25729;
-       value_rom[4] = 16'sd905; slope_rom[4] = 16'sd25725;
-       value_rom[5] = 16'sd1106; slope_rom[5] = 16'sd25720;
-       value_rom[6] = 16'sd1307; slope_rom[6] = 16'sd25715;
-       value_rom[7] = 16'sd1507; slope_rom[7] = 16'sd25708;
-       value_rom[8] = 16'sd1708; slope_rom[8] = 16'sd25700;
-       value_rom[9] = 16'sd1909; slope_rom[9] = 16'sd25691;
-       value_rom[10] = 16'sd2110; slope_rom[10] = 16'sd25682;
-       value_rom[11] = 16'sd2310; slope_rom[11] = 16'sd25671;
-       value_rom[12] = 16'sd2511; slope_rom[12] = 16'sd25659;
-       value_rom[13] = 16'sd2711; slope_rom[13] = 16'sd25647;
-       value_rom[14] = 16'sd2911; slope_rom[14] = 16'sd25633;
-       value_rom[15] = 16'sd3112; slope_rom[15] = 16'sd25619;
-       value_rom[16] = 16'sd3312; slope_rom[16] = 16'sd25603;
-       value_rom[17] = 16'sd3512; slope_rom[17] = 16'sd25587;
-       value_rom[18] = 16'sd3712; slope_rom[18] = 16'sd25570;
-       value_rom[19] = 16'sd3911; slope_rom[19] = 16'sd25551;
-       value_rom[20] = 16'sd4111; slope_rom[20] = 16'sd25532;
-       value_rom[21] = 16'sd4310; slope_rom[21] = 16'sd25512;
-       value_rom[22] = 16'sd4509; slope_rom[22] = 16'sd25490;
-       value_rom[23] = 16'sd4708; slope_rom[23] = 16'sd25468;
-       value_rom[24] = 16'sd4907; slope_rom[24] = 16'sd25445;
-       value_rom[25] = 16'sd5106; slope_rom[25] = 16'sd25421;
-       value_rom[26] = 16'sd5305; slope_rom[26] = 16'sd25396;
-       value_rom[27] = 16'sd5503; slope_rom[27] = 16'sd25370;
-       value_rom[28] = 16'sd5701; slope_rom[28] = 16'sd25343;
-       value_rom[29] = 16'sd5899; slope_rom[29] = 16'sd25315;
-       value_rom[30] = 16'sd6096; slope_rom[30] = 16'sd25286;
-       value_rom[31] = 16'sd6294; slope_rom[31] = 16'sd25256;
-       value_rom[32] = 16'sd6491; slope_rom[32] = 16'sd25225;
-       value_rom[33] = 16'sd6688; slope_rom[33] = 16'sd25193;
-       value_rom[34] = 16'sd6885; slope_rom[34] = 16'sd25161;
-       value_rom[35] = 16'sd7081; slope_rom[35] = 16'sd25127;
-       value_rom[36] = 16'sd7277; slope_rom[36] = 16'sd25092;
-       value_rom[37] = 16'sd7473; slope_rom[37] = 16'sd25057;
-       value_rom[38] = 16'sd7669; slope_rom[38] = 16'sd25020;
-       value_rom[39] = 16'sd7864; slope_rom[39] = 16'sd24983;
-       value_rom[40] = 16'sd8059; slope_rom[40] = 16'sd24945;
-       value_rom[41] = 16'sd8254; slope_rom[41] = 16'sd24905;
-       value_rom[42] = 16'sd8448; slope_rom[42] = 16'sd24865;
-       value_rom[43] = 16'sd8642; slope_rom[43] = 16'sd24824;
-       value_rom[44] = 16'sd8836; slope_rom[44] = 16'sd24782;
-       value_rom[45] = 16'sd9030; slope_rom[45] = 16'sd24739;
-       value_rom[46] = 16'sd9223; slope_rom[46] = 16'sd24695;
-       value_rom[47] = 16'sd9416; slope_rom[47] = 16'sd24650;
-       value_rom[48] = 16'sd9608; slope_rom[48] = 16'sd24604;
-       value_rom[49] = 16'sd9800; slope_rom[49] = 16'sd24557;
-       value_rom[50] = 16'sd9992; slope_rom[50] = 16'sd24510;
-       value_rom[51] = 16'sd10183; slope_rom[51] = 16'sd24461;
-       value_rom[52] = 16'sd10374; slope_rom[52] = 16'sd24411;
-       value_rom[53] = 16'sd10564; slope_rom[53] = 16'sd24361;
-       value_rom[54] = 16'sd10754; slope_rom[54] = 16'sd24310;
-       value_rom[55] = 16'sd10944; slope_rom[55] = 16'sd24257;
-       value_rom[56] = 16'sd11133; slope_rom[56] = 16'sd24204;
-       value_rom[57] = 16'sd11322; slope_rom[57] = 16'sd24150;
-       value_rom[58] = 16'sd11511; slope_rom[58] = 16'sd24095;
-       value_rom[59] = 16'sd11699; slope_rom[59] = 16'sd24039;
-       value_rom[60] = 16'sd11886; slope_rom[60] = 16'sd23982;
-       value_rom[61] = 16'sd12074; slope_rom[61] = 16'sd23924;
-       value_rom[62] = 16'sd12260; slope_rom[62] = 16'sd23866;
-       value_rom[63] = 16'sd12446; slope_rom[63] = 16'sd23806;
-       value_rom[64] = 16'sd12632; slope_rom[64] = 16'sd23746;
-       value_rom[65] = 16'sd12817; slope_rom[65] = 16'sd23685;
-       value_rom[66] = 16'sd13002; slope_rom[66] = 16'sd23622;
-       value_rom[67] = 16'sd13187; slope_rom[67] = 16'sd23559;
-       value_rom[68] = 16'sd13370; slope_rom[68] = 16'sd23495;
-       value_rom[69] = 16'sd13554; slope_rom[69] = 16'sd23430;
-       value_rom[70] = 16'sd13736; slope_rom[70] = 16'sd23365;
-       value_rom[71] = 16'sd13919; slope_rom[71] = 16'sd23298;
-       value_rom[72] = 16'sd14101; slope_rom[72] = 16'sd23230;
-       value_rom[73] = 16'sd14282; slope_rom[73] = 16'sd23162;
-       value_rom[74] = 16'sd14462; slope_rom[74] = 16'sd23093;
-       value_rom[75] = 16'sd14643; slope_rom[75] = 16'sd23023;
-       value_rom[76] = 16'sd14822; slope_rom[76] = 16'sd22952;
-       value_rom[77] = 16'sd15001; slope_rom[77] = 16'sd22880;
-       value_rom[78] = 16'sd15180; slope_rom[78] = 16'sd22807;
-       value_rom[79] = 16'sd15358; slope_rom[79] = 16'sd22733;
-       value_rom[80] = 16'sd15535; slope_rom[80] = 16'sd22659;
-       value_rom[81] = 16'sd15712; slope_rom[81] = 16'sd22584;
-       value_rom[82] = 16'sd15888; slope_rom[82] = 16'sd22508;
-       value_rom[83] = 16'sd16063; slope_rom[83] = 16'sd22431;
-       value_rom[84] = 16'sd16238; slope_rom[84] = 16'sd22353;
-       value_rom[85] = 16'sd16413; slope_rom[85] = 16'sd22274;
-       value_rom[86] = 16'sd16586; slope_rom[86] = 16'sd22195;
-       value_rom[87] = 16'sd16759; slope_rom[87] = 16'sd22114;
-       value_rom[88] = 16'sd16932; slope_rom[88] = 16'sd22033;
-       value_rom[89] = 16'sd17104; slope_rom[89] = 16'sd21951;
-       value_rom[90] = 16'sd17275; slope_rom[90] = 16'sd21868;
-       value_rom[91] = 16'sd17445; slope_rom[91] = 16'sd21785;
-       value_rom[92] = 16'sd17615; slope_rom[92] = 16'sd21700;
-       value_rom[93] = 16'sd17784; slope_rom[93] = 16'sd21615;
-       value_rom[94] = 16'sd17953; slope_rom[94] = 16'sd21529;
-       value_rom[95] = 16'sd18121; slope_rom[95] = 16'sd21442;
-       value_rom[96] = 16'sd18288; slope_rom[96] = 16'sd21354;
-       value_rom[97] = 16'sd18454; slope_rom[97] = 16'sd21265;
-       value_rom[98] = 16'sd18620; slope_rom[98] = 16'sd21176;
-       value_rom[99] = 16'sd18785; slope_rom[99] = 16'sd21086;
-       value_rom[100] = 16'sd18950; slope_rom[100] = 16'sd20995;
-       value_rom[101] = 16'sd19113; slope_rom[101] = 16'sd20903;
-       value_rom[102] = 16'sd19276; slope_rom[102] = 16'sd20811;
-       value_rom[103] = 16'sd19438; slope_rom[103] = 16'sd20718;
-       value_rom[104] = 16'sd19600; slope_rom[104] = 16'sd20624;
-       value_rom[105] = 16'sd19761; slope_rom[105] = 16'sd20529;
-       value_rom[106] = 16'sd19921; slope_rom[106] = 16'sd20433;
-       value_rom[107] = 16'sd20080; slope_rom[107] = 16'sd20337;
-       value_rom[108] = 16'sd20238; slope_rom[108] = 16'sd20240;
-       value_rom[109] = 16'sd20396; slope_rom[109] = 16'sd20142;
-       value_rom[110] = 16'sd20553; slope_rom[110] = 16'sd20043;
-       value_rom[111] = 16'sd20709; slope_rom[111] = 16'sd19944;
-       value_rom[112] = 16'sd20865; slope_rom[112] = 16'sd19843;
-       value_rom[113] = 16'sd21019; slope_rom[113] = 16'sd19742;
-       value_rom[114] = 16'sd21173; slope_rom[114] = 16'sd19641;
-       value_rom[115] = 16'sd21326; slope_rom[115] = 16'sd19538;
-       value_rom[116] = 16'sd21479; slope_rom[116] = 16'sd19435;
-       value_rom[117] = 16'sd21630; slope_rom[117] = 16'sd19331;
-       value_rom[118] = 16'sd21781; slope_rom[118] = 16'sd19227;
-       value_rom[119] = 16'sd21930; slope_rom[119] = 16'sd19121;
-       value_rom[120] = 16'sd22079; slope_rom[120] = 16'sd19015;
-       value_rom[121] = 16'sd22227; slope_rom[121] = 16'sd18909;
-       value_rom[122] = 16'sd22375; slope_rom[122] = 16'sd18801;
-       value_rom[123] = 16'sd22521; slope_rom[123] = 16'sd18693;
-       value_rom[124] = 16'sd22667; slope_rom[124] = 16'sd18584;
-       value_rom[125] = 16'sd22812; slope_rom[125] = 16'sd18474;
-       value_rom[126] = 16'sd22956; slope_rom[126] = 16'sd18364;
-       value_rom[127] = 16'sd23099; slope_rom[127] = 16'sd18253;
-       value_rom[128] = 16'sd23241; slope_rom[128] = 16'sd18142;
-       value_rom[129] = 16'sd23382; slope_rom[129] = 16'sd18029;
-       value_rom[130] = 16'sd23522; slope_rom[130] = 16'sd17916;
-       value_rom[131] = 16'sd23662; slope_rom[131] = 16'sd17803;
-       value_rom[132] = 16'sd23801; slope_rom[132] = 16'sd17688;
-       value_rom[133] = 16'sd23938; slope_rom[133] = 16'sd17573;
-       value_rom[134] = 16'sd24075; slope_rom[134] = 16'sd17457;
-       value_rom[135] = 16'sd24211; slope_rom[135] = 16'sd17341;
-       value_rom[136] = 16'sd24346; slope_rom[136] = 16'sd17224;
-       value_rom[137] = 16'sd24480; slope_rom[137] = 16'sd17106;
-       value_rom[138] = 16'sd24613; slope_rom[138] = 16'sd16988;
-       value_rom[139] = 16'sd24746; slope_rom[139] = 16'sd16869;
-       value_rom[140] = 16'sd24877; slope_rom[140] = 16'sd16750;
-       value_rom[141] = 16'sd25007; slope_rom[141] = 16'sd16629;
-       value_rom[142] = 16'sd25137; slope_rom[142] = 16'sd16509;
-       value_rom[143] = 16'sd25265; slope_rom[143] = 16'sd16387;
-       value_rom[144] = 16'sd25393; slope_rom[144] = 16'sd16265;
-       value_rom[145] = 16'sd25519; slope_rom[145] = 16'sd16142;
-       value_rom[146] = 16'sd25645; slope_rom[146] = 16'sd16019;
-       value_rom[147] = 16'sd25770; slope_rom[147] = 16'sd15895;
-       value_rom[148] = 16'sd25893; slope_rom[148] = 16'sd15771;
-       value_rom[149] = 16'sd26016; slope_rom[149] = 16'sd15646;
-       value_rom[150] = 16'sd26138; slope_rom[150] = 16'sd15520;
-       value_rom[151] = 16'sd26259; slope_rom[151] = 16'sd15394;
-       value_rom[152] = 16'sd26378; slope_rom[152] = 16'sd15267;
-       value_rom[153] = 16'sd26497; slope_rom[153] = 16'sd15140;
-       value_rom[154] = 16'sd26615; slope_rom[154] = 16'sd15012;
-       value_rom[155] = 16'sd26732; slope_rom[155] = 16'sd14883;
-       value_rom[156] = 16'sd26848; slope_rom[156] = 16'sd14754;
-       value_rom[157] = 16'sd26962; slope_rom[157] = 16'sd14624;
-       value_rom[158] = 16'sd27076; slope_rom[158] = 16'sd14494;
-       value_rom[159] = 16'sd27189; slope_rom[159] = 16'sd14363;
-       value_rom[160] = 16'sd27300; slope_rom[160] = 16'sd14232;
-       value_rom[161] = 16'sd27411; slope_rom[161] = 16'sd14100;
-       value_rom[162] = 16'sd27521; slope_rom[162] = 16'sd13968;
-       value_rom[163] = 16'sd27629; slope_rom[163] = 16'sd13835;
-       value_rom[164] = 16'sd27737; slope_rom[164] = 16'sd13701;
-       value_rom[165] = 16'sd27843; slope_rom[165] = 16'sd13568;
-       value_rom[166] = 16'sd27949; slope_rom[166] = 16'sd13433;
-       value_rom[167] = 16'sd28053; slope_rom[167] = 16'sd13298;
-       value_rom[168] = 16'sd28157; slope_rom[168] = 16'sd13163;
-       value_rom[169] = 16'sd28259; slope_rom[169] = 16'sd13027;
-       value_rom[170] = 16'sd28360; slope_rom[170] = 16'sd12890;
-       value_rom[171] = 16'sd28460; slope_rom[171] = 16'sd12753;
-       value_rom[172] = 16'sd28560; slope_rom[172] = 16'sd12616;
-       value_rom[173] = 16'sd28658; slope_rom[173] = 16'sd12478;
-       value_rom[174] = 16'sd28755; slope_rom[174] = 16'sd12340;
-       value_rom[175] = 16'sd28850; slope_rom[175] = 16'sd12201;
-       value_rom[176] = 16'sd28945; slope_rom[176] = 16'sd12062;
-       value_rom[177] = 16'sd29039; slope_rom[177] = 16'sd11922;
-       value_rom[178] = 16'sd29131; slope_rom[178] = 16'sd11782;
-       value_rom[179] = 16'sd29223; slope_rom[179] = 16'sd11641;
-       value_rom[180] = 16'sd29313; slope_rom[180] = 16'sd11500;
-       value_rom[181] = 16'sd29403; slope_rom[181] = 16'sd11359;
-       value_rom[182] = 16'sd29491; slope_rom[182] = 16'sd11217;
-       value_rom[183] = 16'sd29578; slope_rom[183] = 16'sd11075;
-       value_rom[184] = 16'sd29664; slope_rom[184] = 16'sd10932;
-       value_rom[185] = 16'sd29749; slope_rom[185] = 16'sd10789;
-       value_rom[186] = 16'sd29832; slope_rom[186] = 16'sd10645;
-       value_rom[187] = 16'sd29915; slope_rom[187] = 16'sd10501;
-       value_rom[188] = 16'sd29997; slope_rom[188] = 16'sd10357;
-       value_rom[189] = 16'sd30077; slope_rom[189] = 16'sd10212;
-       value_rom[190] = 16'sd30156; slope_rom[190] = 16'sd10067;
-       value_rom[191] = 16'sd30234; slope_rom[191] = 16'sd9921;
-       value_rom[192] = 16'sd30311; slope_rom[192] = 16'sd9775;
-       value_rom[193] = 16'sd30387; slope_rom[193] = 16'sd9629;
-       value_rom[194] = 16'sd30462; slope_rom[194] = 16'sd9483;
-       value_rom[195] = 16'sd30535; slope_rom[195] = 16'sd9336;
-       value_rom[196] = 16'sd30607; slope_rom[196] = 16'sd9188;
-       value_rom[197] = 16'sd30679; slope_rom[197] = 16'sd9041;
-       value_rom[198] = 16'sd30749; slope_rom[198] = 16'sd8893;
-       value_rom[199] = 16'sd30818; slope_rom[199] = 16'sd8744;
-       value_rom[200] = 16'sd30885; slope_rom[200] = 16'sd8596;
-       value_rom[201] = 16'sd30952; slope_rom[201] = 16'sd8447;
-       value_rom[202] = 16'sd31017; slope_rom[202] = 16'sd8297;
-       value_rom[203] = 16'sd31082; slope_rom[203] = 16'sd8148;
-       value_rom[204] = 16'sd31145; slope_rom[204] = 16'sd7998;
-       value_rom[205] = 16'sd31206; slope_rom[205] = 16'sd7847;
-       value_rom[206] = 16'sd31267; slope_rom[206] = 16'sd7697;
-       value_rom[207] = 16'sd31327; slope_rom[207] = 16'sd7546;
-       value_rom[208] = 16'sd31385; slope_rom[208] = 16'sd7395;
-       value_rom[209] = 16'sd31442; slope_rom[209] = 16'sd7244;
-       value_rom[210] = 16'sd31498; slope_rom[210] = 16'sd7092;
-       value_rom[211] = 16'sd31553; slope_rom[211] = 16'sd6940;
-       value_rom[212] = 16'sd31607; slope_rom[212] = 16'sd6788;
-       value_rom[213] = 16'sd31659; slope_rom[213] = 16'sd6635;
-       value_rom[214] = 16'sd31710; slope_rom[214] = 16'sd6483;
-       value_rom[215] = 16'sd31760; slope_rom[215] = 16'sd6330;
-       value_rom[216] = 16'sd31809; slope_rom[216] = 16'sd6177;
-       value_rom[217] = 16'sd31857; slope_rom[217] = 16'sd6023;
-       value_rom[218] = 16'sd31903; slope_rom[218] = 16'sd5869;
-       value_rom[219] = 16'sd31949; slope_rom[219] = 16'sd5716;
-       value_rom[220] = 16'sd31993; slope_rom[220] = 16'sd5562;
-       value_rom[221] = 16'sd32036; slope_rom[221] = 16'sd5407;
-       value_rom[222] = 16'sd32077; slope_rom[222] = 16'sd5253;
-       value_rom[223] = 16'sd32118; slope_rom[223] = 16'sd5098;
-       value_rom[224] = 16'sd32157; slope_rom[224] = 16'sd4943;
-       value_rom[225] = 16'sd32195; slope_rom[225] = 16'sd4788;
-       value_rom[226] = 16'sd32232; slope_rom[226] = 16'sd4633;
-       value_rom[227] = 16'sd32267; slope_rom[227] = 16'sd4477;
-       value_rom[228] = 16'sd32302; slope_rom[228] = 16'sd4322;
-       value_rom[229] = 16'sd32335; slope_rom[229] = 16'sd4166;
-       value_rom[230] = 16'sd32367; slope_rom[230] = 16'sd4010;
-       value_rom[231] = 16'sd32397; slope_rom[231] = 16'sd3854;
-       value_rom[232] = 16'sd32427; slope_rom[232] = 16'sd3698;
-       value_rom[233] = 16'sd32455; slope_rom[233] = 16'sd3542;
-       value_rom[234] = 16'sd32482; slope_rom[234] = 16'sd3385;
-       value_rom[235] = 16'sd32508; slope_rom[235] = 16'sd3229;
-       value_rom[236] = 16'sd32533; slope_rom[236] = 16'sd3072;
-       value_rom[237] = 16'sd32556; slope_rom[237] = 16'sd2915;
-       value_rom[238] = 16'sd32578; slope_rom[238] = 16'sd2758;
-       value_rom[239] = 16'sd32599; slope_rom[239] = 16'sd2601;
-       value_rom[240] = 16'sd32619; slope_rom[240] = 16'sd2444;
-       value_rom[241] = 16'sd32637; slope_rom[241] = 16'sd2287;
-       value_rom[242] = 16'sd32655; slope_rom[242] = 16'sd2129;
-       value_rom[243] = 16'sd32671; slope_rom[243] = 16'sd1972;
-       value_rom[244] = 16'sd32685; slope_rom[244] = 16'sd1814;
-       value_rom[245] = 16'sd32699; slope_rom[245] = 16'sd1657;
-       value_rom[246] = 16'sd32711; slope_rom[246] = 16'sd1499;
-       value_rom[247] = 16'sd32722; slope_rom[247] = 16'sd1342;
-       value_rom[248] = 16'sd32732; slope_rom[248] = 16'sd1184;
-       value_rom[249] = 16'sd32741; slope_rom[249] = 16'sd1026;
-       value_rom[250] = 16'sd32748; slope_rom[250] = 16'sd868;
-       value_rom[251] = 16'sd32755; slope_rom[251] = 16'sd710;
-       value_rom[252] = 16'sd32759; slope_rom[252] = 16'sd553;
-       value_rom[253] = 16'sd32763; slope_rom[253] = 16'sd395;
-       value_rom[254] = 16'sd32766; slope_rom[254] = 16'sd237;
-       value_rom[255] = 16'sd32767; slope_rom[255] = 16'sd79;
-       value = 0;
-       slope = 0;
-    end
+    reg signed [15:0] words [0:8191];
 
     always @(posedge clock) begin
-       value <= value_rom[addr];
-       slope <= slope_rom[addr];
+       if (write_enable)
+          words[address] <= write_data;
+       else
+          q <= words[address];
     end
-endmodule // gyro_interface__carrier_nco__drive__sine__rom
+endmodule // gyro_interface__carrier_nco__drive_sine__ram
 
 
-module gyro_interface__carrier_nco__drive__sine__signed_sample_4(d,q,clock);
+module gyro_interface__carrier_nco__drive_sine__signed_4(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -2637,46 +2107,10 @@ module gyro_interface__carrier_nco__drive__sine__signed_sample_4(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive__sine__signed_sample_4
+endmodule // gyro_interface__carrier_nco__drive_sine__signed_4
 
 
-module gyro_interface__carrier_nco__drive__sine__sin_out(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__drive__sine__sin_out
-
-
-module gyro_interface__carrier_nco__drive__sine__slope_product(clock,a,b,p);
-
-    // Module arguments
-    input wire  clock;
-    input wire signed [15:0] a;
-    input wire signed [15:0] b;
-    output reg signed [31:0] p;
-
-    // Update code (custom)
-    initial p = 0;
-
-    always @(posedge clock) begin
-       p <= a * b;
-    end
-endmodule // gyro_interface__carrier_nco__drive__sine__slope_product
-
-
-module gyro_interface__carrier_nco__drive__sine__slope_read(d,q,clock);
+module gyro_interface__carrier_nco__drive_sine__sin_out(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -2692,10 +2126,10 @@ module gyro_interface__carrier_nco__drive__sine__slope_read(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive__sine__slope_read
+endmodule // gyro_interface__carrier_nco__drive_sine__sin_out
 
 
-module gyro_interface__carrier_nco__drive__sine__value_read(d,q,clock);
+module gyro_interface__carrier_nco__drive_sine__value_3(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -2711,7 +2145,137 @@ module gyro_interface__carrier_nco__drive__sine__value_read(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive__sine__value_read
+endmodule // gyro_interface__carrier_nco__drive_sine__value_3
+
+
+module gyro_interface__carrier_nco__fill(clock,busy,phase,write,address,ready);
+
+    // Module arguments
+    input wire  clock;
+    output reg  busy;
+    output reg  [31:0] phase;
+    output reg  write;
+    output reg  [12:0] address;
+    output reg  ready;
+
+    // Constant declarations
+    localparam  last = 14'b10000000010000;
+    localparam  entries = 14'b10000000000000;
+    localparam  centre = 32'h10000;
+    localparam  index_shift = 32'h11;
+
+    // Stub signals
+    reg  [13:0] count$d;
+    wire  [13:0] count$q;
+    reg  count$clock;
+    reg  [4:0] pending$d;
+    wire  [4:0] pending$q;
+    reg  pending$clock;
+    reg  [12:0] write_address$d;
+    wire  [12:0] write_address$q;
+    reg  write_address$clock;
+
+    // Local signals
+    reg  counting;
+
+    // Sub module instances
+    gyro_interface__carrier_nco__fill__count count(
+        .d(count$d),
+        .q(count$q),
+        .clock(count$clock)
+    );
+    gyro_interface__carrier_nco__fill__pending pending(
+        .d(pending$d),
+        .q(pending$q),
+        .clock(pending$clock)
+    );
+    gyro_interface__carrier_nco__fill__write_address write_address(
+        .d(write_address$d),
+        .q(write_address$q),
+        .clock(write_address$clock)
+    );
+
+    // Update code
+    always @(*) begin
+        count$clock = clock;
+        pending$clock = clock;
+        write_address$clock = clock;
+        count$d = count$q;
+        pending$d = pending$q;
+        write_address$d = write_address$q;
+        counting = count$q != last;
+        if (counting) begin
+            count$d = count$q + 32'h1;
+        end
+        busy = count$q < entries;
+        phase = (((count$q[(32'h0)+:(13)]) & 32'hffffffff) << index_shift) | centre;
+        pending$d = (pending$q << 32'h1) | ((busy) & 5'h1f);
+        write = pending$q[32'h4];
+        if (pending$q[32'h4]) begin
+            write_address$d = write_address$q + 32'h1;
+        end
+        address = write_address$q;
+        ready = ~counting;
+    end
+
+endmodule // gyro_interface__carrier_nco__fill
+
+
+module gyro_interface__carrier_nco__fill__count(d,q,clock);
+
+    // Module arguments
+    input wire  [13:0] d;
+    output reg  [13:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 14'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__fill__count
+
+
+module gyro_interface__carrier_nco__fill__pending(d,q,clock);
+
+    // Module arguments
+    input wire  [4:0] d;
+    output reg  [4:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 5'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__fill__pending
+
+
+module gyro_interface__carrier_nco__fill__write_address(d,q,clock);
+
+    // Module arguments
+    input wire  [12:0] d;
+    output reg  [12:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 13'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__fill__write_address
 
 
 module gyro_interface__carrier_nco__phase(d,q,clock);
@@ -2733,191 +2297,123 @@ module gyro_interface__carrier_nco__phase(d,q,clock);
 endmodule // gyro_interface__carrier_nco__phase
 
 
-module gyro_interface__carrier_nco__reference(clock,phase,sin,cos);
-
-    // Module arguments
-    input wire  clock;
-    input wire  [31:0] phase;
-    output reg signed [15:0] sin;
-    output reg signed [15:0] cos;
-
-    // Constant declarations
-    localparam  no_turn = 2'b0;
-    localparam  quarter_turn = 2'b1;
-
-    // Stub signals
-    reg  sine$clock;
-    reg  [31:0] sine$phase;
-    reg  [1:0] sine$advance;
-    wire signed [15:0] sine$sin;
-    reg  cosine$clock;
-    reg  [31:0] cosine$phase;
-    reg  [1:0] cosine$advance;
-    wire signed [15:0] cosine$sin;
-
-    // Sub module instances
-    gyro_interface__carrier_nco__reference__sine sine(
-        .clock(sine$clock),
-        .phase(sine$phase),
-        .advance(sine$advance),
-        .sin(sine$sin)
-    );
-    gyro_interface__carrier_nco__reference__cosine cosine(
-        .clock(cosine$clock),
-        .phase(cosine$phase),
-        .advance(cosine$advance),
-        .sin(cosine$sin)
-    );
-
-    // Update code
-    always @(*) begin
-        sine$clock = clock;
-        cosine$clock = clock;
-        sine$phase = phase;
-        cosine$phase = phase;
-        sine$advance = no_turn;
-        cosine$advance = quarter_turn;
-        sin = sine$sin;
-        cos = cosine$sin;
-    end
-
-endmodule // gyro_interface__carrier_nco__reference
-
-
-module gyro_interface__carrier_nco__reference__cosine(clock,phase,advance,sin);
+module gyro_interface__carrier_nco__ref_cosine(clock,phase,advance,fill_write,fill_address,fill_word,ready,sin);
 
     // Module arguments
     input wire  clock;
     input wire  [31:0] phase;
     input wire  [1:0] advance;
+    input wire  fill_write;
+    input wire  [12:0] fill_address;
+    input wire signed [15:0] fill_word;
+    input wire  ready;
     output reg signed [15:0] sin;
 
     // Constant declarations
-    localparam  half_step = 16'h4000;
-    localparam signed rounding = 32'h200000;
+    localparam signed zero = 16'h0;
 
     // Stub signals
-    reg  rom$clock;
-    reg  [7:0] rom$addr;
-    wire signed [15:0] rom$value;
-    wire signed [15:0] rom$slope;
-    reg  slope_product$clock;
-    reg signed [15:0] slope_product$a;
-    reg signed [15:0] slope_product$b;
-    wire signed [31:0] slope_product$p;
-    reg  [7:0] index_1$d;
-    wire  [7:0] index_1$q;
+    reg  ram$clock;
+    reg  ram$write_enable;
+    reg  [12:0] ram$address;
+    reg signed [15:0] ram$write_data;
+    wire signed [15:0] ram$q;
+    reg  [12:0] index_1$d;
+    wire  [12:0] index_1$q;
     reg  index_1$clock;
     reg  [1:0] quadrant_1$d;
     wire  [1:0] quadrant_1$q;
     reg  quadrant_1$clock;
-    reg signed [15:0] offset_1$d;
-    wire signed [15:0] offset_1$q;
-    reg  offset_1$clock;
+    reg  live_1$d;
+    wire  live_1$q;
+    reg  live_1$clock;
     reg  [1:0] quadrant_2$d;
     wire  [1:0] quadrant_2$q;
     reg  quadrant_2$clock;
-    reg signed [15:0] offset_2$d;
-    wire signed [15:0] offset_2$q;
-    reg  offset_2$clock;
-    reg  [1:0] quadrant_read$d;
-    wire  [1:0] quadrant_read$q;
-    reg  quadrant_read$clock;
-    reg signed [15:0] offset_read$d;
-    wire signed [15:0] offset_read$q;
-    reg  offset_read$clock;
-    reg signed [15:0] value_read$d;
-    wire signed [15:0] value_read$q;
-    reg  value_read$clock;
-    reg signed [15:0] slope_read$d;
-    wire signed [15:0] slope_read$q;
-    reg  slope_read$clock;
-    reg  [1:0] quadrant_4$d;
-    wire  [1:0] quadrant_4$q;
-    reg  quadrant_4$clock;
-    reg signed [15:0] signed_sample_4$d;
-    wire signed [15:0] signed_sample_4$q;
-    reg  signed_sample_4$clock;
+    reg  live_2$d;
+    wire  live_2$q;
+    reg  live_2$clock;
+    reg  [1:0] quadrant_3$d;
+    wire  [1:0] quadrant_3$q;
+    reg  quadrant_3$clock;
+    reg  live_3$d;
+    wire  live_3$q;
+    reg  live_3$clock;
+    reg signed [15:0] value_3$d;
+    wire signed [15:0] value_3$q;
+    reg  value_3$clock;
+    reg  live_4$d;
+    wire  live_4$q;
+    reg  live_4$clock;
+    reg signed [15:0] signed_4$d;
+    wire signed [15:0] signed_4$q;
+    reg  signed_4$clock;
     reg signed [15:0] sin_out$d;
     wire signed [15:0] sin_out$q;
     reg  sin_out$clock;
 
     // Local signals
     reg  [1:0] quadrant;
-    reg  [15:0] fraction;
-    reg signed [31:0] rounded;
-    reg signed [9:0] correction_10;
-    reg signed [15:0] correction;
 
     // Sub module instances
-    gyro_interface__carrier_nco__reference__cosine__rom rom(
-        .clock(rom$clock),
-        .addr(rom$addr),
-        .value(rom$value),
-        .slope(rom$slope)
+    gyro_interface__carrier_nco__ref_cosine__ram ram(
+        .clock(ram$clock),
+        .write_enable(ram$write_enable),
+        .address(ram$address),
+        .write_data(ram$write_data),
+        .q(ram$q)
     );
-    gyro_interface__carrier_nco__reference__cosine__slope_product slope_product(
-        .clock(slope_product$clock),
-        .a(slope_product$a),
-        .b(slope_product$b),
-        .p(slope_product$p)
-    );
-    gyro_interface__carrier_nco__reference__cosine__index_1 index_1(
+    gyro_interface__carrier_nco__ref_cosine__index_1 index_1(
         .d(index_1$d),
         .q(index_1$q),
         .clock(index_1$clock)
     );
-    gyro_interface__carrier_nco__reference__cosine__quadrant_1 quadrant_1(
+    gyro_interface__carrier_nco__ref_cosine__quadrant_1 quadrant_1(
         .d(quadrant_1$d),
         .q(quadrant_1$q),
         .clock(quadrant_1$clock)
     );
-    gyro_interface__carrier_nco__reference__cosine__offset_1 offset_1(
-        .d(offset_1$d),
-        .q(offset_1$q),
-        .clock(offset_1$clock)
+    gyro_interface__carrier_nco__ref_cosine__live_1 live_1(
+        .d(live_1$d),
+        .q(live_1$q),
+        .clock(live_1$clock)
     );
-    gyro_interface__carrier_nco__reference__cosine__quadrant_2 quadrant_2(
+    gyro_interface__carrier_nco__ref_cosine__quadrant_2 quadrant_2(
         .d(quadrant_2$d),
         .q(quadrant_2$q),
         .clock(quadrant_2$clock)
     );
-    gyro_interface__carrier_nco__reference__cosine__offset_2 offset_2(
-        .d(offset_2$d),
-        .q(offset_2$q),
-        .clock(offset_2$clock)
+    gyro_interface__carrier_nco__ref_cosine__live_2 live_2(
+        .d(live_2$d),
+        .q(live_2$q),
+        .clock(live_2$clock)
     );
-    gyro_interface__carrier_nco__reference__cosine__quadrant_read quadrant_read(
-        .d(quadrant_read$d),
-        .q(quadrant_read$q),
-        .clock(quadrant_read$clock)
+    gyro_interface__carrier_nco__ref_cosine__quadrant_3 quadrant_3(
+        .d(quadrant_3$d),
+        .q(quadrant_3$q),
+        .clock(quadrant_3$clock)
     );
-    gyro_interface__carrier_nco__reference__cosine__offset_read offset_read(
-        .d(offset_read$d),
-        .q(offset_read$q),
-        .clock(offset_read$clock)
+    gyro_interface__carrier_nco__ref_cosine__live_3 live_3(
+        .d(live_3$d),
+        .q(live_3$q),
+        .clock(live_3$clock)
     );
-    gyro_interface__carrier_nco__reference__cosine__value_read value_read(
-        .d(value_read$d),
-        .q(value_read$q),
-        .clock(value_read$clock)
+    gyro_interface__carrier_nco__ref_cosine__value_3 value_3(
+        .d(value_3$d),
+        .q(value_3$q),
+        .clock(value_3$clock)
     );
-    gyro_interface__carrier_nco__reference__cosine__slope_read slope_read(
-        .d(slope_read$d),
-        .q(slope_read$q),
-        .clock(slope_read$clock)
+    gyro_interface__carrier_nco__ref_cosine__live_4 live_4(
+        .d(live_4$d),
+        .q(live_4$q),
+        .clock(live_4$clock)
     );
-    gyro_interface__carrier_nco__reference__cosine__quadrant_4 quadrant_4(
-        .d(quadrant_4$d),
-        .q(quadrant_4$q),
-        .clock(quadrant_4$clock)
+    gyro_interface__carrier_nco__ref_cosine__signed_4 signed_4(
+        .d(signed_4$d),
+        .q(signed_4$q),
+        .clock(signed_4$clock)
     );
-    gyro_interface__carrier_nco__reference__cosine__signed_sample_4 signed_sample_4(
-        .d(signed_sample_4$d),
-        .q(signed_sample_4$q),
-        .clock(signed_sample_4$clock)
-    );
-    gyro_interface__carrier_nco__reference__cosine__sin_out sin_out(
+    gyro_interface__carrier_nco__ref_cosine__sin_out sin_out(
         .d(sin_out$d),
         .q(sin_out$q),
         .clock(sin_out$clock)
@@ -2925,144 +2421,158 @@ module gyro_interface__carrier_nco__reference__cosine(clock,phase,advance,sin);
 
     // Update code
     always @(*) begin
-        rom$clock = clock;
-        slope_product$clock = clock;
+        ram$clock = clock;
         index_1$clock = clock;
         quadrant_1$clock = clock;
-        offset_1$clock = clock;
+        live_1$clock = clock;
         quadrant_2$clock = clock;
-        offset_2$clock = clock;
-        quadrant_read$clock = clock;
-        offset_read$clock = clock;
-        value_read$clock = clock;
-        slope_read$clock = clock;
-        quadrant_4$clock = clock;
-        signed_sample_4$clock = clock;
+        live_2$clock = clock;
+        quadrant_3$clock = clock;
+        live_3$clock = clock;
+        value_3$clock = clock;
+        live_4$clock = clock;
+        signed_4$clock = clock;
         sin_out$clock = clock;
         index_1$d = index_1$q;
         quadrant_1$d = quadrant_1$q;
-        offset_1$d = offset_1$q;
+        live_1$d = live_1$q;
         quadrant_2$d = quadrant_2$q;
-        offset_2$d = offset_2$q;
-        quadrant_read$d = quadrant_read$q;
-        offset_read$d = offset_read$q;
-        value_read$d = value_read$q;
-        slope_read$d = slope_read$q;
-        quadrant_4$d = quadrant_4$q;
-        signed_sample_4$d = signed_sample_4$q;
+        live_2$d = live_2$q;
+        quadrant_3$d = quadrant_3$q;
+        live_3$d = live_3$q;
+        value_3$d = value_3$q;
+        live_4$d = live_4$q;
+        signed_4$d = signed_4$q;
         sin_out$d = sin_out$q;
         quadrant = phase[(32'h1e)+:(2)] + advance;
-        index_1$d = phase[(32'h16)+:(8)];
+        index_1$d = phase[(32'h11)+:(13)];
         if (quadrant[32'h0]) begin
-            index_1$d = ~(phase[(32'h16)+:(8)]);
+            index_1$d = ~(phase[(32'h11)+:(13)]);
         end
         quadrant_1$d = quadrant;
-        fraction = ((phase[(32'h7)+:(15)]) & 16'hffff);
-        offset_1$d = $signed(fraction - half_step);
-        rom$addr = index_1$q;
-        quadrant_2$d = quadrant_1$q;
-        offset_2$d = offset_1$q;
-        quadrant_read$d = quadrant_2$q;
-        offset_read$d = offset_2$q;
-        value_read$d = rom$value;
-        slope_read$d = rom$slope;
-        slope_product$a = offset_read$q;
-        slope_product$b = slope_read$q;
-        quadrant_4$d = quadrant_read$q;
-        signed_sample_4$d = value_read$q;
-        if (quadrant_read$q[32'h1]) begin
-            signed_sample_4$d = -value_read$q;
+        live_1$d = ready;
+        ram$write_enable = fill_write;
+        ram$address = index_1$q;
+        if (fill_write) begin
+            ram$address = fill_address;
         end
-        rounded = slope_product$p + rounding;
-        correction_10 = rounded[(32'h16)+:(10)];
-        correction = $signed(correction_10);
-        sin_out$d = signed_sample_4$q + correction;
-        if (quadrant_4$q[32'h0] ^ quadrant_4$q[32'h1]) begin
-            sin_out$d = signed_sample_4$q - correction;
+        ram$write_data = fill_word;
+        quadrant_2$d = quadrant_1$q;
+        live_2$d = live_1$q;
+        quadrant_3$d = quadrant_2$q;
+        live_3$d = live_2$q;
+        value_3$d = ram$q;
+        live_4$d = live_3$q;
+        signed_4$d = value_3$q;
+        if (quadrant_3$q[32'h1]) begin
+            signed_4$d = -value_3$q;
+        end
+        sin_out$d = zero;
+        if (live_4$q) begin
+            sin_out$d = signed_4$q;
         end
         sin = sin_out$q;
     end
 
-endmodule // gyro_interface__carrier_nco__reference__cosine
+endmodule // gyro_interface__carrier_nco__ref_cosine
 
 
-module gyro_interface__carrier_nco__reference__cosine__index_1(d,q,clock);
+module gyro_interface__carrier_nco__ref_cosine__index_1(d,q,clock);
 
     // Module arguments
-    input wire  [7:0] d;
-    output reg  [7:0] q;
+    input wire  [12:0] d;
+    output reg  [12:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 8'h0;
+       q = 13'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__reference__cosine__index_1
+endmodule // gyro_interface__carrier_nco__ref_cosine__index_1
 
 
-module gyro_interface__carrier_nco__reference__cosine__offset_1(d,q,clock);
+module gyro_interface__carrier_nco__ref_cosine__live_1(d,q,clock);
 
     // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
+    input wire  d;
+    output reg  q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 16'h0;
+       q = 1'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__reference__cosine__offset_1
+endmodule // gyro_interface__carrier_nco__ref_cosine__live_1
 
 
-module gyro_interface__carrier_nco__reference__cosine__offset_2(d,q,clock);
+module gyro_interface__carrier_nco__ref_cosine__live_2(d,q,clock);
 
     // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
+    input wire  d;
+    output reg  q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 16'h0;
+       q = 1'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__reference__cosine__offset_2
+endmodule // gyro_interface__carrier_nco__ref_cosine__live_2
 
 
-module gyro_interface__carrier_nco__reference__cosine__offset_read(d,q,clock);
+module gyro_interface__carrier_nco__ref_cosine__live_3(d,q,clock);
 
     // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
+    input wire  d;
+    output reg  q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 16'h0;
+       q = 1'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__reference__cosine__offset_read
+endmodule // gyro_interface__carrier_nco__ref_cosine__live_3
 
 
-module gyro_interface__carrier_nco__reference__cosine__quadrant_1(d,q,clock);
+module gyro_interface__carrier_nco__ref_cosine__live_4(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__ref_cosine__live_4
+
+
+module gyro_interface__carrier_nco__ref_cosine__quadrant_1(d,q,clock);
 
     // Module arguments
     input wire  [1:0] d;
@@ -3078,29 +2588,10 @@ module gyro_interface__carrier_nco__reference__cosine__quadrant_1(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__reference__cosine__quadrant_1
+endmodule // gyro_interface__carrier_nco__ref_cosine__quadrant_1
 
 
-module gyro_interface__carrier_nco__reference__cosine__quadrant_2(d,q,clock);
-
-    // Module arguments
-    input wire  [1:0] d;
-    output reg  [1:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 2'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__reference__cosine__quadrant_2
-
-
-module gyro_interface__carrier_nco__reference__cosine__quadrant_4(d,q,clock);
+module gyro_interface__carrier_nco__ref_cosine__quadrant_2(d,q,clock);
 
     // Module arguments
     input wire  [1:0] d;
@@ -3116,10 +2607,10 @@ module gyro_interface__carrier_nco__reference__cosine__quadrant_4(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__reference__cosine__quadrant_4
+endmodule // gyro_interface__carrier_nco__ref_cosine__quadrant_2
 
 
-module gyro_interface__carrier_nco__reference__cosine__quadrant_read(d,q,clock);
+module gyro_interface__carrier_nco__ref_cosine__quadrant_3(d,q,clock);
 
     // Module arguments
     input wire  [1:0] d;
@@ -3135,290 +2626,31 @@ module gyro_interface__carrier_nco__reference__cosine__quadrant_read(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__reference__cosine__quadrant_read
+endmodule // gyro_interface__carrier_nco__ref_cosine__quadrant_3
 
 
-module gyro_interface__carrier_nco__reference__cosine__rom(clock,addr,value,slope);
+module gyro_interface__carrier_nco__ref_cosine__ram(clock,write_enable,address,write_data,q);
 
     // Module arguments
     input wire  clock;
-    input wire  [7:0] addr;
-    output reg signed [15:0] value;
-    output reg signed [15:0] slope;
+    input wire  write_enable;
+    input wire  [12:0] address;
+    input wire signed [15:0] write_data;
+    output reg signed [15:0] q;
 
     // Update code (custom)
-    reg signed [15:0] value_rom [0:255];
-    reg signed [15:0] slope_rom [0:255];
-
-    initial begin
-       value_rom[0] = 16'sd101; slope_rom[0] = 16'sd25735;
-       value_rom[1] = 16'sd302; slope_rom[1] = 16'sd25734;
-       value_rom[2] = 16'sd503; slope_rom[2] = 16'sd25732;
-       value_rom[3] = 16'sd704; slope_rom[3] = 16'sd25729;
-       value_rom[4] = 16'sd905; slope_rom[4] = 16'sd25725;
-       value_rom[5] = 16'sd1106; slope_rom[5] = 16'sd25720;
-       value_rom[6] = 16'sd1307; slope_rom[6] = 16'sd25715;
-       value_rom[7] = 16'sd1507; slope_rom[7] = 16'sd25708;
-       value_rom[8] = 16'sd1708; slope_rom[8] = 16'sd25700;
-       value_rom[9] = 16'sd1909; slope_rom[9] = 16'sd25691;
-       value_rom[10] = 16'sd2110; slope_rom[10] = 16'sd25682;
-       value_rom[11] = 16'sd2310; slope_rom[11] = 16'sd25671;
-       value_rom[12] = 16'sd2511; slope_rom[12] = 16'sd25659;
-       value_rom[13] = 16'sd2711; slope_rom[13] = 16'sd25647;
-       value_rom[14] = 16'sd2911; slope_rom[14] = 16'sd25633;
-       value_rom[15] = 16'sd3112; slope_rom[15] = 16'sd25619;
-       value_rom[16] = 16'sd3312; slope_rom[16] = 16'sd25603;
-       value_rom[17] = 16'sd3512; slope_rom[17] = 16'sd25587;
-       value_rom[18] = 16'sd3712; slope_rom[18] = 16'sd25570;
-       value_rom[19] = 16'sd3911; slope_rom[19] = 16'sd25551;
-       value_rom[20] = 16'sd4111; slope_rom[20] = 16'sd25532;
-       value_rom[21] = 16'sd4310; slope_rom[21] = 16'sd25512;
-       value_rom[22] = 16'sd4509; slope_rom[22] = 16'sd25490;
-       value_rom[23] = 16'sd4708; slope_rom[23] = 16'sd25468;
-       value_rom[24] = 16'sd4907; slope_rom[24] = 16'sd25445;
-       value_rom[25] = 16'sd5106; slope_rom[25] = 16'sd25421;
-       value_rom[26] = 16'sd5305; slope_rom[26] = 16'sd25396;
-       value_rom[27] = 16'sd5503; slope_rom[27] = 16'sd25370;
-       value_rom[28] = 16'sd5701; slope_rom[28] = 16'sd25343;
-       value_rom[29] = 16'sd5899; slope_rom[29] = 16'sd25315;
-       value_rom[30] = 16'sd6096; slope_rom[30] = 16'sd25286;
-       value_rom[31] = 16'sd6294; slope_rom[31] = 16'sd25256;
-       value_rom[32] = 16'sd6491; slope_rom[32] = 16'sd25225;
-       value_rom[33] = 16'sd6688; slope_rom[33] = 16'sd25193;
-       value_rom[34] = 16'sd6885; slope_rom[34] = 16'sd25161;
-       value_rom[35] = 16'sd7081; slope_rom[35] = 16'sd25127;
-       value_rom[36] = 16'sd7277; slope_rom[36] = 16'sd25092;
-       value_rom[37] = 16'sd7473; slope_rom[37] = 16'sd25057;
-       value_rom[38] = 16'sd7669; slope_rom[38] = 16'sd25020;
-       value_rom[39] = 16'sd7864; slope_rom[39] = 16'sd24983;
-       value_rom[40] = 16'sd8059; slope_rom[40] = 16'sd24945;
-       value_rom[41] = 16'sd8254; slope_rom[41] = 16'sd24905;
-       value_rom[42] = 16'sd8448; slope_rom[42] = 16'sd24865;
-       value_rom[43] = 16'sd8642; slope_rom[43] = 16'sd24824;
-       value_rom[44] = 16'sd8836; slope_rom[44] = 16'sd24782;
-       value_rom[45] = 16'sd9030; slope_rom[45] = 16'sd24739;
-       value_rom[46] = 16'sd9223; slope_rom[46] = 16'sd24695;
-       value_rom[47] = 16'sd9416; slope_rom[47] = 16'sd24650;
-       value_rom[48] = 16'sd9608; slope_rom[48] = 16'sd24604;
-       value_rom[49] = 16'sd9800; slope_rom[49] = 16'sd24557;
-       value_rom[50] = 16'sd9992; slope_rom[50] = 16'sd24510;
-       value_rom[51] = 16'sd10183; slope_rom[51] = 16'sd24461;
-       value_rom[52] = 16'sd10374; slope_rom[52] = 16'sd24411;
-       value_rom[53] = 16'sd10564; slope_rom[53] = 16'sd24361;
-       value_rom[54] = 16'sd10754; slope_rom[54] = 16'sd24310;
-       value_rom[55] = 16'sd10944; slope_rom[55] = 16'sd24257;
-       value_rom[56] = 16'sd11133; slope_rom[56] = 16'sd24204;
-       value_rom[57] = 16'sd11322; slope_rom[57] = 16'sd24150;
-       value_rom[58] = 16'sd11511; slope_rom[58] = 16'sd24095;
-       value_rom[59] = 16'sd11699; slope_rom[59] = 16'sd24039;
-       value_rom[60] = 16'sd11886; slope_rom[60] = 16'sd23982;
-       value_rom[61] = 16'sd12074; slope_rom[61] = 16'sd23924;
-       value_rom[62] = 16'sd12260; slope_rom[62] = 16'sd23866;
-       value_rom[63] = 16'sd12446; slope_rom[63] = 16'sd23806;
-       value_rom[64] = 16'sd12632; slope_rom[64] = 16'sd23746;
-       value_rom[65] = 16'sd12817; slope_rom[65] = 16'sd23685;
-       value_rom[66] = 16'sd13002; slope_rom[66] = 16'sd23622;
-       value_rom[67] = 16'sd13187; slope_rom[67] = 16'sd23559;
-       value_rom[68] = 16'sd13370; slope_rom[68] = 16'sd23495;
-       value_rom[69] = 16'sd13554; slope_rom[69] = 16'sd23430;
-       value_rom[70] = 16'sd13736; slope_rom[70] = 16'sd23365;
-       value_rom[71] = 16'sd13919; slope_rom[71] = 16'sd23298;
-       value_rom[72] = 16'sd14101; slope_rom[72] = 16'sd23230;
-       value_rom[73] = 16'sd14282; slope_rom[73] = 16'sd23162;
-       value_rom[74] = 16'sd14462; slope_rom[74] = 16'sd23093;
-       value_rom[75] = 16'sd14643; slope_rom[75] = 16'sd23023;
-       value_rom[76] = 16'sd14822; slope_rom[76] = 16'sd22952;
-       value_rom[77] = 16'sd15001; slope_rom[77] = 16'sd22880;
-       value_rom[78] = 16'sd15180; slope_rom[78] = 16'sd22807;
-       value_rom[79] = 16'sd15358; slope_rom[79] = 16'sd22733;
-       value_rom[80] = 16'sd15535; slope_rom[80] = 16'sd22659;
-       value_rom[81] = 16'sd15712; slope_rom[81] = 16'sd22584;
-       value_rom[82] = 16'sd15888; slope_rom[82] = 16'sd22508;
-       value_rom[83] = 16'sd16063; slope_rom[83] = 16'sd22431;
-       value_rom[84] = 16'sd16238; slope_rom[84] = 16'sd22353;
-       value_rom[85] = 16'sd16413; slope_rom[85] = 16'sd22274;
-       value_rom[86] = 16'sd16586; slope_rom[86] = 16'sd22195;
-       value_rom[87] = 16'sd16759; slope_rom[87] = 16'sd22114;
-       value_rom[88] = 16'sd16932; slope_rom[88] = 16'sd22033;
-       value_rom[89] = 16'sd17104; slope_rom[89] = 16'sd21951;
-       value_rom[90] = 16'sd17275; slope_rom[90] = 16'sd21868;
-       value_rom[91] = 16'sd17445; slope_rom[91] = 16'sd21785;
-       value_rom[92] = 16'sd17615; slope_rom[92] = 16'sd21700;
-       value_rom[93] = 16'sd17784; slope_rom[93] = 16'sd21615;
-       value_rom[94] = 16'sd17953; slope_rom[94] = 16'sd21529;
-       value_rom[95] = 16'sd18121; slope_rom[95] = 16'sd21442;
-       value_rom[96] = 16'sd18288; slope_rom[96] = 16'sd21354;
-       value_rom[97] = 16'sd18454; slope_rom[97] = 16'sd21265;
-       value_rom[98] = 16'sd18620; slope_rom[98] = 16'sd21176;
-       value_rom[99] = 16'sd18785; slope_rom[99] = 16'sd21086;
-       value_rom[100] = 16'sd18950; slope_rom[100] = 16'sd20995;
-       value_rom[101] = 16'sd19113; slope_rom[101] = 16'sd20903;
-       value_rom[102] = 16'sd19276; slope_rom[102] = 16'sd20811;
-       value_rom[103] = 16'sd19438; slope_rom[103] = 16'sd20718;
-       value_rom[104] = 16'sd19600; slope_rom[104] = 16'sd20624;
-       value_rom[105] = 16'sd19761; slope_rom[105] = 16'sd20529;
-       value_rom[106] = 16'sd19921; slope_rom[106] = 16'sd20433;
-       value_rom[107] = 16'sd20080; slope_rom[107] = 16'sd20337;
-       value_rom[108] = 16'sd20238; slope_rom[108] = 16'sd20240;
-       value_rom[109] = 16'sd20396; slope_rom[109] = 16'sd20142;
-       value_rom[110] = 16'sd20553; slope_rom[110] = 16'sd20043;
-       value_rom[111] = 16'sd20709; slope_rom[111] = 16'sd19944;
-       value_rom[112] = 16'sd20865; slope_rom[112] = 16'sd19843;
-       value_rom[113] = 16'sd21019; slope_rom[113] = 16'sd19742;
-       value_rom[114] = 16'sd21173; slope_rom[114] = 16'sd19641;
-       value_rom[115] = 16'sd21326; slope_rom[115] = 16'sd19538;
-       value_rom[116] = 16'sd21479; slope_rom[116] = 16'sd19435;
-       value_rom[117] = 16'sd21630; slope_rom[117] = 16'sd19331;
-       value_rom[118] = 16'sd21781; slope_rom[118] = 16'sd19227;
-       value_rom[119] = 16'sd21930; slope_rom[119] = 16'sd19121;
-       value_rom[120] = 16'sd22079; slope_rom[120] = 16'sd19015;
-       value_rom[121] = 16'sd22227; slope_rom[121] = 16'sd18909;
-       value_rom[122] = 16'sd22375; slope_rom[122] = 16'sd18801;
-       value_rom[123] = 16'sd22521; slope_rom[123] = 16'sd18693;
-       value_rom[124] = 16'sd22667; slope_rom[124] = 16'sd18584;
-       value_rom[125] = 16'sd22812; slope_rom[125] = 16'sd18474;
-       value_rom[126] = 16'sd22956; slope_rom[126] = 16'sd18364;
-       value_rom[127] = 16'sd23099; slope_rom[127] = 16'sd18253;
-       value_rom[128] = 16'sd23241; slope_rom[128] = 16'sd18142;
-       value_rom[129] = 16'sd23382; slope_rom[129] = 16'sd18029;
-       value_rom[130] = 16'sd23522; slope_rom[130] = 16'sd17916;
-       value_rom[131] = 16'sd23662; slope_rom[131] = 16'sd17803;
-       value_rom[132] = 16'sd23801; slope_rom[132] = 16'sd17688;
-       value_rom[133] = 16'sd23938; slope_rom[133] = 16'sd17573;
-       value_rom[134] = 16'sd24075; slope_rom[134] = 16'sd17457;
-       value_rom[135] = 16'sd24211; slope_rom[135] = 16'sd17341;
-       value_rom[136] = 16'sd24346; slope_rom[136] = 16'sd17224;
-       value_rom[137] = 16'sd24480; slope_rom[137] = 16'sd17106;
-       value_rom[138] = 16'sd24613; slope_rom[138] = 16'sd16988;
-       value_rom[139] = 16'sd24746; slope_rom[139] = 16'sd16869;
-       value_rom[140] = 16'sd24877; slope_rom[140] = 16'sd16750;
-       value_rom[141] = 16'sd25007; slope_rom[141] = 16'sd16629;
-       value_rom[142] = 16'sd25137; slope_rom[142] = 16'sd16509;
-       value_rom[143] = 16'sd25265; slope_rom[143] = 16'sd16387;
-       value_rom[144] = 16'sd25393; slope_rom[144] = 16'sd16265;
-       value_rom[145] = 16'sd25519; slope_rom[145] = 16'sd16142;
-       value_rom[146] = 16'sd25645; slope_rom[146] = 16'sd16019;
-       value_rom[147] = 16'sd25770; slope_rom[147] = 16'sd15895;
-       value_rom[148] = 16'sd25893; slope_rom[148] = 16'sd15771;
-       value_rom[149] = 16'sd26016; slope_rom[149] = 16'sd15646;
-       value_rom[150] = 16'sd26138; slope_rom[150] = 16'sd15520;
-       value_rom[151] = 16'sd26259; slope_rom[151] = 16'sd15394;
-       value_rom[152] = 16'sd26378; slope_rom[152] = 16'sd15267;
-       value_rom[153] = 16'sd26497; slope_rom[153] = 16'sd15140;
-       value_rom[154] = 16'sd26615; slope_rom[154] = 16'sd15012;
-       value_rom[155] = 16'sd26732; slope_rom[155] = 16'sd14883;
-       value_rom[156] = 16'sd26848; slope_rom[156] = 16'sd14754;
-       value_rom[157] = 16'sd26962; slope_rom[157] = 16'sd14624;
-       value_rom[158] = 16'sd27076; slope_rom[158] = 16'sd14494;
-       value_rom[159] = 16'sd27189; slope_rom[159] = 16'sd14363;
-       value_rom[160] = 16'sd27300; slope_rom[160] = 16'sd14232;
-       value_rom[161] = 16'sd27411; slope_rom[161] = 16'sd14100;
-       value_rom[162] = 16'sd27521; slope_rom[162] = 16'sd13968;
-       value_rom[163] = 16'sd27629; slope_rom[163] = 16'sd13835;
-       value_rom[164] = 16'sd27737; slope_rom[164] = 16'sd13701;
-       value_rom[165] = 16'sd27843; slope_rom[165] = 16'sd13568;
-       value_rom[166] = 16'sd27949; slope_rom[166] = 16'sd13433;
-       value_rom[167] = 16'sd28053; slope_rom[167] = 16'sd13298;
-       value_rom[168] = 16'sd28157; slope_rom[168] = 16'sd13163;
-       value_rom[169] = 16'sd28259; slope_rom[169] = 16'sd13027;
-       value_rom[170] = 16'sd28360; slope_rom[170] = 16'sd12890;
-       value_rom[171] = 16'sd28460; slope_rom[171] = 16'sd12753;
-       value_rom[172] = 16'sd28560; slope_rom[172] = 16'sd12616;
-       value_rom[173] = 16'sd28658; slope_rom[173] = 16'sd12478;
-       value_rom[174] = 16'sd28755; slope_rom[174] = 16'sd12340;
-       value_rom[175] = 16'sd28850; slope_rom[175] = 16'sd12201;
-       value_rom[176] = 16'sd28945; slope_rom[176] = 16'sd12062;
-       value_rom[177] = 16'sd29039; slope_rom[177] = 16'sd11922;
-       value_rom[178] = 16'sd29131; slope_rom[178] = 16'sd11782;
-       value_rom[179] = 16'sd29223; slope_rom[179] = 16'sd11641;
-       value_rom[180] = 16'sd29313; slope_rom[180] = 16'sd11500;
-       value_rom[181] = 16'sd29403; slope_rom[181] = 16'sd11359;
-       value_rom[182] = 16'sd29491; slope_rom[182] = 16'sd11217;
-       value_rom[183] = 16'sd29578; slope_rom[183] = 16'sd11075;
-       value_rom[184] = 16'sd29664; slope_rom[184] = 16'sd10932;
-       value_rom[185] = 16'sd29749; slope_rom[185] = 16'sd10789;
-       value_rom[186] = 16'sd29832; slope_rom[186] = 16'sd10645;
-       value_rom[187] = 16'sd29915; slope_rom[187] = 16'sd10501;
-       value_rom[188] = 16'sd29997; slope_rom[188] = 16'sd10357;
-       value_rom[189] = 16'sd30077; slope_rom[189] = 16'sd10212;
-       value_rom[190] = 16'sd30156; slope_rom[190] = 16'sd10067;
-       value_rom[191] = 16'sd30234; slope_rom[191] = 16'sd9921;
-       value_rom[192] = 16'sd30311; slope_rom[192] = 16'sd9775;
-       value_rom[193] = 16'sd30387; slope_rom[193] = 16'sd9629;
-       value_rom[194] = 16'sd30462; slope_rom[194] = 16'sd9483;
-       value_rom[195] = 16'sd30535; slope_rom[195] = 16'sd9336;
-       value_rom[196] = 16'sd30607; slope_rom[196] = 16'sd9188;
-       value_rom[197] = 16'sd30679; slope_rom[197] = 16'sd9041;
-       value_rom[198] = 16'sd30749; slope_rom[198] = 16'sd8893;
-       value_rom[199] = 16'sd30818; slope_rom[199] = 16'sd8744;
-       value_rom[200] = 16'sd30885; slope_rom[200] = 16'sd8596;
-       value_rom[201] = 16'sd30952; slope_rom[201] = 16'sd8447;
-       value_rom[202] = 16'sd31017; slope_rom[202] = 16'sd8297;
-       value_rom[203] = 16'sd31082; slope_rom[203] = 16'sd8148;
-       value_rom[204] = 16'sd31145; slope_rom[204] = 16'sd7998;
-       value_rom[205] = 16'sd31206; slope_rom[205] = 16'sd7847;
-       value_rom[206] = 16'sd31267; slope_rom[206] = 16'sd7697;
-       value_rom[207] = 16'sd31327; slope_rom[207] = 16'sd7546;
-       value_rom[208] = 16'sd31385; slope_rom[208] = 16'sd7395;
-       value_rom[209] = 16'sd31442; slope_rom[209] = 16'sd7244;
-       value_rom[210] = 16'sd31498; slope_rom[210] = 16'sd7092;
-       value_rom[211] = 16'sd31553; slope_rom[211] = 16'sd6940;
-       value_rom[212] = 16'sd31607; slope_rom[212] = 16'sd6788;
-       value_rom[213] = 16'sd31659; slope_rom[213] = 16'sd6635;
-       value_rom[214] = 16'sd31710; slope_rom[214] = 16'sd6483;
-       value_rom[215] = 16'sd31760; slope_rom[215] = 16'sd6330;
-       value_rom[216] = 16'sd31809; slope_rom[216] = 16'sd6177;
-       value_rom[217] = 16'sd31857; slope_rom[217] = 16'sd6023;
-       value_rom[218] = 16'sd31903; slope_rom[218] = 16'sd5869;
-       value_rom[219] = 16'sd31949; slope_rom[219] = 16'sd5716;
-       value_rom[220] = 16'sd31993; slope_rom[220] = 16'sd5562;
-       value_rom[221] = 16'sd32036; slope_rom[221] = 16'sd5407;
-       value_rom[222] = 16'sd32077; slope_rom[222] = 16'sd5253;
-       value_rom[223] = 16'sd32118; slope_rom[223] = 16'sd5098;
-       value_rom[224] = 16'sd32157; slope_rom[224] = 16'sd4943;
-       value_rom[225] = 16'sd32195; slope_rom[225] = 16'sd4788;
-       value_rom[226] = 16'sd32232; slope_rom[226] = 16'sd4633;
-       value_rom[227] = 16'sd32267; slope_rom[227] = 16'sd4477;
-       value_rom[228] = 16'sd32302; slope_rom[228] = 16'sd4322;
-       value_rom[229] = 16'sd32335; slope_rom[229] = 16'sd4166;
-       value_rom[230] = 16'sd32367; slope_rom[230] = 16'sd4010;
-       value_rom[231] = 16'sd32397; slope_rom[231] = 16'sd3854;
-       value_rom[232] = 16'sd32427; slope_rom[232] = 16'sd3698;
-       value_rom[233] = 16'sd32455; slope_rom[233] = 16'sd3542;
-       value_rom[234] = 16'sd32482; slope_rom[234] = 16'sd3385;
-       value_rom[235] = 16'sd32508; slope_rom[235] = 16'sd3229;
-       value_rom[236] = 16'sd32533; slope_rom[236] = 16'sd3072;
-       value_rom[237] = 16'sd32556; slope_rom[237] = 16'sd2915;
-       value_rom[238] = 16'sd32578; slope_rom[238] = 16'sd2758;
-       value_rom[239] = 16'sd32599; slope_rom[239] = 16'sd2601;
-       value_rom[240] = 16'sd32619; slope_rom[240] = 16'sd2444;
-       value_rom[241] = 16'sd32637; slope_rom[241] = 16'sd2287;
-       value_rom[242] = 16'sd32655; slope_rom[242] = 16'sd2129;
-       value_rom[243] = 16'sd32671; slope_rom[243] = 16'sd1972;
-       value_rom[244] = 16'sd32685; slope_rom[244] = 16'sd1814;
-       value_rom[245] = 16'sd32699; slope_rom[245] = 16'sd1657;
-       value_rom[246] = 16'sd32711; slope_rom[246] = 16'sd1499;
-       value_rom[247] = 16'sd32722; slope_rom[247] = 16'sd1342;
-       value_rom[248] = 16'sd32732; slope_rom[248] = 16'sd1184;
-       value_rom[249] = 16'sd32741; slope_rom[249] = 16'sd1026;
-       value_rom[250] = 16'sd32748; slope_rom[250] = 16'sd868;
-       value_rom[251] = 16'sd32755; slope_rom[251] = 16'sd710;
-       value_rom[252] = 16'sd32759; slope_rom[252] = 16'sd553;
-       value_rom[253] = 16'sd32763; slope_rom[253] = 16'sd395;
-       value_rom[254] = 16'sd32766; slope_rom[254] = 16'sd237;
-       value_rom[255] = 16'sd32767; slope_rom[255] = 16'sd79;
-       value = 0;
-       slope = 0;
-    end
+    reg signed [15:0] words [0:8191];
 
     always @(posedge clock) begin
-       value <= value_rom[addr];
-       slope <= slope_rom[addr];
+       if (write_enable)
+          words[address] <= write_data;
+       else
+          q <= words[address];
     end
-endmodule // gyro_interface__carrier_nco__reference__cosine__rom
+endmodule // gyro_interface__carrier_nco__ref_cosine__ram
 
 
-module gyro_interface__carrier_nco__reference__cosine__signed_sample_4(d,q,clock);
+module gyro_interface__carrier_nco__ref_cosine__signed_4(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -3434,46 +2666,10 @@ module gyro_interface__carrier_nco__reference__cosine__signed_sample_4(d,q,clock
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__reference__cosine__signed_sample_4
+endmodule // gyro_interface__carrier_nco__ref_cosine__signed_4
 
 
-module gyro_interface__carrier_nco__reference__cosine__sin_out(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__reference__cosine__sin_out
-
-
-module gyro_interface__carrier_nco__reference__cosine__slope_product(clock,a,b,p);
-
-    // Module arguments
-    input wire  clock;
-    input wire signed [15:0] a;
-    input wire signed [15:0] b;
-    output reg signed [31:0] p;
-
-    // Update code (custom)
-    initial p = 0;
-
-    always @(posedge clock) begin
-       p <= a * b;
-    end
-endmodule // gyro_interface__carrier_nco__reference__cosine__slope_product
-
-
-module gyro_interface__carrier_nco__reference__cosine__slope_read(d,q,clock);
+module gyro_interface__carrier_nco__ref_cosine__sin_out(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -3489,10 +2685,10 @@ module gyro_interface__carrier_nco__reference__cosine__slope_read(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__reference__cosine__slope_read
+endmodule // gyro_interface__carrier_nco__ref_cosine__sin_out
 
 
-module gyro_interface__carrier_nco__reference__cosine__value_read(d,q,clock);
+module gyro_interface__carrier_nco__ref_cosine__value_3(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -3508,143 +2704,126 @@ module gyro_interface__carrier_nco__reference__cosine__value_read(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__reference__cosine__value_read
+endmodule // gyro_interface__carrier_nco__ref_cosine__value_3
 
 
-module gyro_interface__carrier_nco__reference__sine(clock,phase,advance,sin);
+module gyro_interface__carrier_nco__ref_sine(clock,phase,advance,fill_write,fill_address,fill_word,ready,sin);
 
     // Module arguments
     input wire  clock;
     input wire  [31:0] phase;
     input wire  [1:0] advance;
+    input wire  fill_write;
+    input wire  [12:0] fill_address;
+    input wire signed [15:0] fill_word;
+    input wire  ready;
     output reg signed [15:0] sin;
 
     // Constant declarations
-    localparam  half_step = 16'h4000;
-    localparam signed rounding = 32'h200000;
+    localparam signed zero = 16'h0;
 
     // Stub signals
-    reg  rom$clock;
-    reg  [7:0] rom$addr;
-    wire signed [15:0] rom$value;
-    wire signed [15:0] rom$slope;
-    reg  slope_product$clock;
-    reg signed [15:0] slope_product$a;
-    reg signed [15:0] slope_product$b;
-    wire signed [31:0] slope_product$p;
-    reg  [7:0] index_1$d;
-    wire  [7:0] index_1$q;
+    reg  ram$clock;
+    reg  ram$write_enable;
+    reg  [12:0] ram$address;
+    reg signed [15:0] ram$write_data;
+    wire signed [15:0] ram$q;
+    reg  [12:0] index_1$d;
+    wire  [12:0] index_1$q;
     reg  index_1$clock;
     reg  [1:0] quadrant_1$d;
     wire  [1:0] quadrant_1$q;
     reg  quadrant_1$clock;
-    reg signed [15:0] offset_1$d;
-    wire signed [15:0] offset_1$q;
-    reg  offset_1$clock;
+    reg  live_1$d;
+    wire  live_1$q;
+    reg  live_1$clock;
     reg  [1:0] quadrant_2$d;
     wire  [1:0] quadrant_2$q;
     reg  quadrant_2$clock;
-    reg signed [15:0] offset_2$d;
-    wire signed [15:0] offset_2$q;
-    reg  offset_2$clock;
-    reg  [1:0] quadrant_read$d;
-    wire  [1:0] quadrant_read$q;
-    reg  quadrant_read$clock;
-    reg signed [15:0] offset_read$d;
-    wire signed [15:0] offset_read$q;
-    reg  offset_read$clock;
-    reg signed [15:0] value_read$d;
-    wire signed [15:0] value_read$q;
-    reg  value_read$clock;
-    reg signed [15:0] slope_read$d;
-    wire signed [15:0] slope_read$q;
-    reg  slope_read$clock;
-    reg  [1:0] quadrant_4$d;
-    wire  [1:0] quadrant_4$q;
-    reg  quadrant_4$clock;
-    reg signed [15:0] signed_sample_4$d;
-    wire signed [15:0] signed_sample_4$q;
-    reg  signed_sample_4$clock;
+    reg  live_2$d;
+    wire  live_2$q;
+    reg  live_2$clock;
+    reg  [1:0] quadrant_3$d;
+    wire  [1:0] quadrant_3$q;
+    reg  quadrant_3$clock;
+    reg  live_3$d;
+    wire  live_3$q;
+    reg  live_3$clock;
+    reg signed [15:0] value_3$d;
+    wire signed [15:0] value_3$q;
+    reg  value_3$clock;
+    reg  live_4$d;
+    wire  live_4$q;
+    reg  live_4$clock;
+    reg signed [15:0] signed_4$d;
+    wire signed [15:0] signed_4$q;
+    reg  signed_4$clock;
     reg signed [15:0] sin_out$d;
     wire signed [15:0] sin_out$q;
     reg  sin_out$clock;
 
     // Local signals
     reg  [1:0] quadrant;
-    reg  [15:0] fraction;
-    reg signed [31:0] rounded;
-    reg signed [9:0] correction_10;
-    reg signed [15:0] correction;
 
     // Sub module instances
-    gyro_interface__carrier_nco__reference__sine__rom rom(
-        .clock(rom$clock),
-        .addr(rom$addr),
-        .value(rom$value),
-        .slope(rom$slope)
+    gyro_interface__carrier_nco__ref_sine__ram ram(
+        .clock(ram$clock),
+        .write_enable(ram$write_enable),
+        .address(ram$address),
+        .write_data(ram$write_data),
+        .q(ram$q)
     );
-    gyro_interface__carrier_nco__reference__sine__slope_product slope_product(
-        .clock(slope_product$clock),
-        .a(slope_product$a),
-        .b(slope_product$b),
-        .p(slope_product$p)
-    );
-    gyro_interface__carrier_nco__reference__sine__index_1 index_1(
+    gyro_interface__carrier_nco__ref_sine__index_1 index_1(
         .d(index_1$d),
         .q(index_1$q),
         .clock(index_1$clock)
     );
-    gyro_interface__carrier_nco__reference__sine__quadrant_1 quadrant_1(
+    gyro_interface__carrier_nco__ref_sine__quadrant_1 quadrant_1(
         .d(quadrant_1$d),
         .q(quadrant_1$q),
         .clock(quadrant_1$clock)
     );
-    gyro_interface__carrier_nco__reference__sine__offset_1 offset_1(
-        .d(offset_1$d),
-        .q(offset_1$q),
-        .clock(offset_1$clock)
+    gyro_interface__carrier_nco__ref_sine__live_1 live_1(
+        .d(live_1$d),
+        .q(live_1$q),
+        .clock(live_1$clock)
     );
-    gyro_interface__carrier_nco__reference__sine__quadrant_2 quadrant_2(
+    gyro_interface__carrier_nco__ref_sine__quadrant_2 quadrant_2(
         .d(quadrant_2$d),
         .q(quadrant_2$q),
         .clock(quadrant_2$clock)
     );
-    gyro_interface__carrier_nco__reference__sine__offset_2 offset_2(
-        .d(offset_2$d),
-        .q(offset_2$q),
-        .clock(offset_2$clock)
+    gyro_interface__carrier_nco__ref_sine__live_2 live_2(
+        .d(live_2$d),
+        .q(live_2$q),
+        .clock(live_2$clock)
     );
-    gyro_interface__carrier_nco__reference__sine__quadrant_read quadrant_read(
-        .d(quadrant_read$d),
-        .q(quadrant_read$q),
-        .clock(quadrant_read$clock)
+    gyro_interface__carrier_nco__ref_sine__quadrant_3 quadrant_3(
+        .d(quadrant_3$d),
+        .q(quadrant_3$q),
+        .clock(quadrant_3$clock)
     );
-    gyro_interface__carrier_nco__reference__sine__offset_read offset_read(
-        .d(offset_read$d),
-        .q(offset_read$q),
-        .clock(offset_read$clock)
+    gyro_interface__carrier_nco__ref_sine__live_3 live_3(
+        .d(live_3$d),
+        .q(live_3$q),
+        .clock(live_3$clock)
     );
-    gyro_interface__carrier_nco__reference__sine__value_read value_read(
-        .d(value_read$d),
-        .q(value_read$q),
-        .clock(value_read$clock)
+    gyro_interface__carrier_nco__ref_sine__value_3 value_3(
+        .d(value_3$d),
+        .q(value_3$q),
+        .clock(value_3$clock)
     );
-    gyro_interface__carrier_nco__reference__sine__slope_read slope_read(
-        .d(slope_read$d),
-        .q(slope_read$q),
-        .clock(slope_read$clock)
+    gyro_interface__carrier_nco__ref_sine__live_4 live_4(
+        .d(live_4$d),
+        .q(live_4$q),
+        .clock(live_4$clock)
     );
-    gyro_interface__carrier_nco__reference__sine__quadrant_4 quadrant_4(
-        .d(quadrant_4$d),
-        .q(quadrant_4$q),
-        .clock(quadrant_4$clock)
+    gyro_interface__carrier_nco__ref_sine__signed_4 signed_4(
+        .d(signed_4$d),
+        .q(signed_4$q),
+        .clock(signed_4$clock)
     );
-    gyro_interface__carrier_nco__reference__sine__signed_sample_4 signed_sample_4(
-        .d(signed_sample_4$d),
-        .q(signed_sample_4$q),
-        .clock(signed_sample_4$clock)
-    );
-    gyro_interface__carrier_nco__reference__sine__sin_out sin_out(
+    gyro_interface__carrier_nco__ref_sine__sin_out sin_out(
         .d(sin_out$d),
         .q(sin_out$q),
         .clock(sin_out$clock)
@@ -3652,144 +2831,158 @@ module gyro_interface__carrier_nco__reference__sine(clock,phase,advance,sin);
 
     // Update code
     always @(*) begin
-        rom$clock = clock;
-        slope_product$clock = clock;
+        ram$clock = clock;
         index_1$clock = clock;
         quadrant_1$clock = clock;
-        offset_1$clock = clock;
+        live_1$clock = clock;
         quadrant_2$clock = clock;
-        offset_2$clock = clock;
-        quadrant_read$clock = clock;
-        offset_read$clock = clock;
-        value_read$clock = clock;
-        slope_read$clock = clock;
-        quadrant_4$clock = clock;
-        signed_sample_4$clock = clock;
+        live_2$clock = clock;
+        quadrant_3$clock = clock;
+        live_3$clock = clock;
+        value_3$clock = clock;
+        live_4$clock = clock;
+        signed_4$clock = clock;
         sin_out$clock = clock;
         index_1$d = index_1$q;
         quadrant_1$d = quadrant_1$q;
-        offset_1$d = offset_1$q;
+        live_1$d = live_1$q;
         quadrant_2$d = quadrant_2$q;
-        offset_2$d = offset_2$q;
-        quadrant_read$d = quadrant_read$q;
-        offset_read$d = offset_read$q;
-        value_read$d = value_read$q;
-        slope_read$d = slope_read$q;
-        quadrant_4$d = quadrant_4$q;
-        signed_sample_4$d = signed_sample_4$q;
+        live_2$d = live_2$q;
+        quadrant_3$d = quadrant_3$q;
+        live_3$d = live_3$q;
+        value_3$d = value_3$q;
+        live_4$d = live_4$q;
+        signed_4$d = signed_4$q;
         sin_out$d = sin_out$q;
         quadrant = phase[(32'h1e)+:(2)] + advance;
-        index_1$d = phase[(32'h16)+:(8)];
+        index_1$d = phase[(32'h11)+:(13)];
         if (quadrant[32'h0]) begin
-            index_1$d = ~(phase[(32'h16)+:(8)]);
+            index_1$d = ~(phase[(32'h11)+:(13)]);
         end
         quadrant_1$d = quadrant;
-        fraction = ((phase[(32'h7)+:(15)]) & 16'hffff);
-        offset_1$d = $signed(fraction - half_step);
-        rom$addr = index_1$q;
-        quadrant_2$d = quadrant_1$q;
-        offset_2$d = offset_1$q;
-        quadrant_read$d = quadrant_2$q;
-        offset_read$d = offset_2$q;
-        value_read$d = rom$value;
-        slope_read$d = rom$slope;
-        slope_product$a = offset_read$q;
-        slope_product$b = slope_read$q;
-        quadrant_4$d = quadrant_read$q;
-        signed_sample_4$d = value_read$q;
-        if (quadrant_read$q[32'h1]) begin
-            signed_sample_4$d = -value_read$q;
+        live_1$d = ready;
+        ram$write_enable = fill_write;
+        ram$address = index_1$q;
+        if (fill_write) begin
+            ram$address = fill_address;
         end
-        rounded = slope_product$p + rounding;
-        correction_10 = rounded[(32'h16)+:(10)];
-        correction = $signed(correction_10);
-        sin_out$d = signed_sample_4$q + correction;
-        if (quadrant_4$q[32'h0] ^ quadrant_4$q[32'h1]) begin
-            sin_out$d = signed_sample_4$q - correction;
+        ram$write_data = fill_word;
+        quadrant_2$d = quadrant_1$q;
+        live_2$d = live_1$q;
+        quadrant_3$d = quadrant_2$q;
+        live_3$d = live_2$q;
+        value_3$d = ram$q;
+        live_4$d = live_3$q;
+        signed_4$d = value_3$q;
+        if (quadrant_3$q[32'h1]) begin
+            signed_4$d = -value_3$q;
+        end
+        sin_out$d = zero;
+        if (live_4$q) begin
+            sin_out$d = signed_4$q;
         end
         sin = sin_out$q;
     end
 
-endmodule // gyro_interface__carrier_nco__reference__sine
+endmodule // gyro_interface__carrier_nco__ref_sine
 
 
-module gyro_interface__carrier_nco__reference__sine__index_1(d,q,clock);
+module gyro_interface__carrier_nco__ref_sine__index_1(d,q,clock);
 
     // Module arguments
-    input wire  [7:0] d;
-    output reg  [7:0] q;
+    input wire  [12:0] d;
+    output reg  [12:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 8'h0;
+       q = 13'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__reference__sine__index_1
+endmodule // gyro_interface__carrier_nco__ref_sine__index_1
 
 
-module gyro_interface__carrier_nco__reference__sine__offset_1(d,q,clock);
+module gyro_interface__carrier_nco__ref_sine__live_1(d,q,clock);
 
     // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
+    input wire  d;
+    output reg  q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 16'h0;
+       q = 1'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__reference__sine__offset_1
+endmodule // gyro_interface__carrier_nco__ref_sine__live_1
 
 
-module gyro_interface__carrier_nco__reference__sine__offset_2(d,q,clock);
+module gyro_interface__carrier_nco__ref_sine__live_2(d,q,clock);
 
     // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
+    input wire  d;
+    output reg  q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 16'h0;
+       q = 1'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__reference__sine__offset_2
+endmodule // gyro_interface__carrier_nco__ref_sine__live_2
 
 
-module gyro_interface__carrier_nco__reference__sine__offset_read(d,q,clock);
+module gyro_interface__carrier_nco__ref_sine__live_3(d,q,clock);
 
     // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
+    input wire  d;
+    output reg  q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 16'h0;
+       q = 1'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__reference__sine__offset_read
+endmodule // gyro_interface__carrier_nco__ref_sine__live_3
 
 
-module gyro_interface__carrier_nco__reference__sine__quadrant_1(d,q,clock);
+module gyro_interface__carrier_nco__ref_sine__live_4(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__ref_sine__live_4
+
+
+module gyro_interface__carrier_nco__ref_sine__quadrant_1(d,q,clock);
 
     // Module arguments
     input wire  [1:0] d;
@@ -3805,29 +2998,10 @@ module gyro_interface__carrier_nco__reference__sine__quadrant_1(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__reference__sine__quadrant_1
+endmodule // gyro_interface__carrier_nco__ref_sine__quadrant_1
 
 
-module gyro_interface__carrier_nco__reference__sine__quadrant_2(d,q,clock);
-
-    // Module arguments
-    input wire  [1:0] d;
-    output reg  [1:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 2'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__reference__sine__quadrant_2
-
-
-module gyro_interface__carrier_nco__reference__sine__quadrant_4(d,q,clock);
+module gyro_interface__carrier_nco__ref_sine__quadrant_2(d,q,clock);
 
     // Module arguments
     input wire  [1:0] d;
@@ -3843,10 +3017,10 @@ module gyro_interface__carrier_nco__reference__sine__quadrant_4(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__reference__sine__quadrant_4
+endmodule // gyro_interface__carrier_nco__ref_sine__quadrant_2
 
 
-module gyro_interface__carrier_nco__reference__sine__quadrant_read(d,q,clock);
+module gyro_interface__carrier_nco__ref_sine__quadrant_3(d,q,clock);
 
     // Module arguments
     input wire  [1:0] d;
@@ -3862,290 +3036,31 @@ module gyro_interface__carrier_nco__reference__sine__quadrant_read(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__reference__sine__quadrant_read
+endmodule // gyro_interface__carrier_nco__ref_sine__quadrant_3
 
 
-module gyro_interface__carrier_nco__reference__sine__rom(clock,addr,value,slope);
+module gyro_interface__carrier_nco__ref_sine__ram(clock,write_enable,address,write_data,q);
 
     // Module arguments
     input wire  clock;
-    input wire  [7:0] addr;
-    output reg signed [15:0] value;
-    output reg signed [15:0] slope;
+    input wire  write_enable;
+    input wire  [12:0] address;
+    input wire signed [15:0] write_data;
+    output reg signed [15:0] q;
 
     // Update code (custom)
-    reg signed [15:0] value_rom [0:255];
-    reg signed [15:0] slope_rom [0:255];
-
-    initial begin
-       value_rom[0] = 16'sd101; slope_rom[0] = 16'sd25735;
-       value_rom[1] = 16'sd302; slope_rom[1] = 16'sd25734;
-       value_rom[2] = 16'sd503; slope_rom[2] = 16'sd25732;
-       value_rom[3] = 16'sd704; slope_rom[3] = 16'sd25729;
-       value_rom[4] = 16'sd905; slope_rom[4] = 16'sd25725;
-       value_rom[5] = 16'sd1106; slope_rom[5] = 16'sd25720;
-       value_rom[6] = 16'sd1307; slope_rom[6] = 16'sd25715;
-       value_rom[7] = 16'sd1507; slope_rom[7] = 16'sd25708;
-       value_rom[8] = 16'sd1708; slope_rom[8] = 16'sd25700;
-       value_rom[9] = 16'sd1909; slope_rom[9] = 16'sd25691;
-       value_rom[10] = 16'sd2110; slope_rom[10] = 16'sd25682;
-       value_rom[11] = 16'sd2310; slope_rom[11] = 16'sd25671;
-       value_rom[12] = 16'sd2511; slope_rom[12] = 16'sd25659;
-       value_rom[13] = 16'sd2711; slope_rom[13] = 16'sd25647;
-       value_rom[14] = 16'sd2911; slope_rom[14] = 16'sd25633;
-       value_rom[15] = 16'sd3112; slope_rom[15] = 16'sd25619;
-       value_rom[16] = 16'sd3312; slope_rom[16] = 16'sd25603;
-       value_rom[17] = 16'sd3512; slope_rom[17] = 16'sd25587;
-       value_rom[18] = 16'sd3712; slope_rom[18] = 16'sd25570;
-       value_rom[19] = 16'sd3911; slope_rom[19] = 16'sd25551;
-       value_rom[20] = 16'sd4111; slope_rom[20] = 16'sd25532;
-       value_rom[21] = 16'sd4310; slope_rom[21] = 16'sd25512;
-       value_rom[22] = 16'sd4509; slope_rom[22] = 16'sd25490;
-       value_rom[23] = 16'sd4708; slope_rom[23] = 16'sd25468;
-       value_rom[24] = 16'sd4907; slope_rom[24] = 16'sd25445;
-       value_rom[25] = 16'sd5106; slope_rom[25] = 16'sd25421;
-       value_rom[26] = 16'sd5305; slope_rom[26] = 16'sd25396;
-       value_rom[27] = 16'sd5503; slope_rom[27] = 16'sd25370;
-       value_rom[28] = 16'sd5701; slope_rom[28] = 16'sd25343;
-       value_rom[29] = 16'sd5899; slope_rom[29] = 16'sd25315;
-       value_rom[30] = 16'sd6096; slope_rom[30] = 16'sd25286;
-       value_rom[31] = 16'sd6294; slope_rom[31] = 16'sd25256;
-       value_rom[32] = 16'sd6491; slope_rom[32] = 16'sd25225;
-       value_rom[33] = 16'sd6688; slope_rom[33] = 16'sd25193;
-       value_rom[34] = 16'sd6885; slope_rom[34] = 16'sd25161;
-       value_rom[35] = 16'sd7081; slope_rom[35] = 16'sd25127;
-       value_rom[36] = 16'sd7277; slope_rom[36] = 16'sd25092;
-       value_rom[37] = 16'sd7473; slope_rom[37] = 16'sd25057;
-       value_rom[38] = 16'sd7669; slope_rom[38] = 16'sd25020;
-       value_rom[39] = 16'sd7864; slope_rom[39] = 16'sd24983;
-       value_rom[40] = 16'sd8059; slope_rom[40] = 16'sd24945;
-       value_rom[41] = 16'sd8254; slope_rom[41] = 16'sd24905;
-       value_rom[42] = 16'sd8448; slope_rom[42] = 16'sd24865;
-       value_rom[43] = 16'sd8642; slope_rom[43] = 16'sd24824;
-       value_rom[44] = 16'sd8836; slope_rom[44] = 16'sd24782;
-       value_rom[45] = 16'sd9030; slope_rom[45] = 16'sd24739;
-       value_rom[46] = 16'sd9223; slope_rom[46] = 16'sd24695;
-       value_rom[47] = 16'sd9416; slope_rom[47] = 16'sd24650;
-       value_rom[48] = 16'sd9608; slope_rom[48] = 16'sd24604;
-       value_rom[49] = 16'sd9800; slope_rom[49] = 16'sd24557;
-       value_rom[50] = 16'sd9992; slope_rom[50] = 16'sd24510;
-       value_rom[51] = 16'sd10183; slope_rom[51] = 16'sd24461;
-       value_rom[52] = 16'sd10374; slope_rom[52] = 16'sd24411;
-       value_rom[53] = 16'sd10564; slope_rom[53] = 16'sd24361;
-       value_rom[54] = 16'sd10754; slope_rom[54] = 16'sd24310;
-       value_rom[55] = 16'sd10944; slope_rom[55] = 16'sd24257;
-       value_rom[56] = 16'sd11133; slope_rom[56] = 16'sd24204;
-       value_rom[57] = 16'sd11322; slope_rom[57] = 16'sd24150;
-       value_rom[58] = 16'sd11511; slope_rom[58] = 16'sd24095;
-       value_rom[59] = 16'sd11699; slope_rom[59] = 16'sd24039;
-       value_rom[60] = 16'sd11886; slope_rom[60] = 16'sd23982;
-       value_rom[61] = 16'sd12074; slope_rom[61] = 16'sd23924;
-       value_rom[62] = 16'sd12260; slope_rom[62] = 16'sd23866;
-       value_rom[63] = 16'sd12446; slope_rom[63] = 16'sd23806;
-       value_rom[64] = 16'sd12632; slope_rom[64] = 16'sd23746;
-       value_rom[65] = 16'sd12817; slope_rom[65] = 16'sd23685;
-       value_rom[66] = 16'sd13002; slope_rom[66] = 16'sd23622;
-       value_rom[67] = 16'sd13187; slope_rom[67] = 16'sd23559;
-       value_rom[68] = 16'sd13370; slope_rom[68] = 16'sd23495;
-       value_rom[69] = 16'sd13554; slope_rom[69] = 16'sd23430;
-       value_rom[70] = 16'sd13736; slope_rom[70] = 16'sd23365;
-       value_rom[71] = 16'sd13919; slope_rom[71] = 16'sd23298;
-       value_rom[72] = 16'sd14101; slope_rom[72] = 16'sd23230;
-       value_rom[73] = 16'sd14282; slope_rom[73] = 16'sd23162;
-       value_rom[74] = 16'sd14462; slope_rom[74] = 16'sd23093;
-       value_rom[75] = 16'sd14643; slope_rom[75] = 16'sd23023;
-       value_rom[76] = 16'sd14822; slope_rom[76] = 16'sd22952;
-       value_rom[77] = 16'sd15001; slope_rom[77] = 16'sd22880;
-       value_rom[78] = 16'sd15180; slope_rom[78] = 16'sd22807;
-       value_rom[79] = 16'sd15358; slope_rom[79] = 16'sd22733;
-       value_rom[80] = 16'sd15535; slope_rom[80] = 16'sd22659;
-       value_rom[81] = 16'sd15712; slope_rom[81] = 16'sd22584;
-       value_rom[82] = 16'sd15888; slope_rom[82] = 16'sd22508;
-       value_rom[83] = 16'sd16063; slope_rom[83] = 16'sd22431;
-       value_rom[84] = 16'sd16238; slope_rom[84] = 16'sd22353;
-       value_rom[85] = 16'sd16413; slope_rom[85] = 16'sd22274;
-       value_rom[86] = 16'sd16586; slope_rom[86] = 16'sd22195;
-       value_rom[87] = 16'sd16759; slope_rom[87] = 16'sd22114;
-       value_rom[88] = 16'sd16932; slope_rom[88] = 16'sd22033;
-       value_rom[89] = 16'sd17104; slope_rom[89] = 16'sd21951;
-       value_rom[90] = 16'sd17275; slope_rom[90] = 16'sd21868;
-       value_rom[91] = 16'sd17445; slope_rom[91] = 16'sd21785;
-       value_rom[92] = 16'sd17615; slope_rom[92] = 16'sd21700;
-       value_rom[93] = 16'sd17784; slope_rom[93] = 16'sd21615;
-       value_rom[94] = 16'sd17953; slope_rom[94] = 16'sd21529;
-       value_rom[95] = 16'sd18121; slope_rom[95] = 16'sd21442;
-       value_rom[96] = 16'sd18288; slope_rom[96] = 16'sd21354;
-       value_rom[97] = 16'sd18454; slope_rom[97] = 16'sd21265;
-       value_rom[98] = 16'sd18620; slope_rom[98] = 16'sd21176;
-       value_rom[99] = 16'sd18785; slope_rom[99] = 16'sd21086;
-       value_rom[100] = 16'sd18950; slope_rom[100] = 16'sd20995;
-       value_rom[101] = 16'sd19113; slope_rom[101] = 16'sd20903;
-       value_rom[102] = 16'sd19276; slope_rom[102] = 16'sd20811;
-       value_rom[103] = 16'sd19438; slope_rom[103] = 16'sd20718;
-       value_rom[104] = 16'sd19600; slope_rom[104] = 16'sd20624;
-       value_rom[105] = 16'sd19761; slope_rom[105] = 16'sd20529;
-       value_rom[106] = 16'sd19921; slope_rom[106] = 16'sd20433;
-       value_rom[107] = 16'sd20080; slope_rom[107] = 16'sd20337;
-       value_rom[108] = 16'sd20238; slope_rom[108] = 16'sd20240;
-       value_rom[109] = 16'sd20396; slope_rom[109] = 16'sd20142;
-       value_rom[110] = 16'sd20553; slope_rom[110] = 16'sd20043;
-       value_rom[111] = 16'sd20709; slope_rom[111] = 16'sd19944;
-       value_rom[112] = 16'sd20865; slope_rom[112] = 16'sd19843;
-       value_rom[113] = 16'sd21019; slope_rom[113] = 16'sd19742;
-       value_rom[114] = 16'sd21173; slope_rom[114] = 16'sd19641;
-       value_rom[115] = 16'sd21326; slope_rom[115] = 16'sd19538;
-       value_rom[116] = 16'sd21479; slope_rom[116] = 16'sd19435;
-       value_rom[117] = 16'sd21630; slope_rom[117] = 16'sd19331;
-       value_rom[118] = 16'sd21781; slope_rom[118] = 16'sd19227;
-       value_rom[119] = 16'sd21930; slope_rom[119] = 16'sd19121;
-       value_rom[120] = 16'sd22079; slope_rom[120] = 16'sd19015;
-       value_rom[121] = 16'sd22227; slope_rom[121] = 16'sd18909;
-       value_rom[122] = 16'sd22375; slope_rom[122] = 16'sd18801;
-       value_rom[123] = 16'sd22521; slope_rom[123] = 16'sd18693;
-       value_rom[124] = 16'sd22667; slope_rom[124] = 16'sd18584;
-       value_rom[125] = 16'sd22812; slope_rom[125] = 16'sd18474;
-       value_rom[126] = 16'sd22956; slope_rom[126] = 16'sd18364;
-       value_rom[127] = 16'sd23099; slope_rom[127] = 16'sd18253;
-       value_rom[128] = 16'sd23241; slope_rom[128] = 16'sd18142;
-       value_rom[129] = 16'sd23382; slope_rom[129] = 16'sd18029;
-       value_rom[130] = 16'sd23522; slope_rom[130] = 16'sd17916;
-       value_rom[131] = 16'sd23662; slope_rom[131] = 16'sd17803;
-       value_rom[132] = 16'sd23801; slope_rom[132] = 16'sd17688;
-       value_rom[133] = 16'sd23938; slope_rom[133] = 16'sd17573;
-       value_rom[134] = 16'sd24075; slope_rom[134] = 16'sd17457;
-       value_rom[135] = 16'sd24211; slope_rom[135] = 16'sd17341;
-       value_rom[136] = 16'sd24346; slope_rom[136] = 16'sd17224;
-       value_rom[137] = 16'sd24480; slope_rom[137] = 16'sd17106;
-       value_rom[138] = 16'sd24613; slope_rom[138] = 16'sd16988;
-       value_rom[139] = 16'sd24746; slope_rom[139] = 16'sd16869;
-       value_rom[140] = 16'sd24877; slope_rom[140] = 16'sd16750;
-       value_rom[141] = 16'sd25007; slope_rom[141] = 16'sd16629;
-       value_rom[142] = 16'sd25137; slope_rom[142] = 16'sd16509;
-       value_rom[143] = 16'sd25265; slope_rom[143] = 16'sd16387;
-       value_rom[144] = 16'sd25393; slope_rom[144] = 16'sd16265;
-       value_rom[145] = 16'sd25519; slope_rom[145] = 16'sd16142;
-       value_rom[146] = 16'sd25645; slope_rom[146] = 16'sd16019;
-       value_rom[147] = 16'sd25770; slope_rom[147] = 16'sd15895;
-       value_rom[148] = 16'sd25893; slope_rom[148] = 16'sd15771;
-       value_rom[149] = 16'sd26016; slope_rom[149] = 16'sd15646;
-       value_rom[150] = 16'sd26138; slope_rom[150] = 16'sd15520;
-       value_rom[151] = 16'sd26259; slope_rom[151] = 16'sd15394;
-       value_rom[152] = 16'sd26378; slope_rom[152] = 16'sd15267;
-       value_rom[153] = 16'sd26497; slope_rom[153] = 16'sd15140;
-       value_rom[154] = 16'sd26615; slope_rom[154] = 16'sd15012;
-       value_rom[155] = 16'sd26732; slope_rom[155] = 16'sd14883;
-       value_rom[156] = 16'sd26848; slope_rom[156] = 16'sd14754;
-       value_rom[157] = 16'sd26962; slope_rom[157] = 16'sd14624;
-       value_rom[158] = 16'sd27076; slope_rom[158] = 16'sd14494;
-       value_rom[159] = 16'sd27189; slope_rom[159] = 16'sd14363;
-       value_rom[160] = 16'sd27300; slope_rom[160] = 16'sd14232;
-       value_rom[161] = 16'sd27411; slope_rom[161] = 16'sd14100;
-       value_rom[162] = 16'sd27521; slope_rom[162] = 16'sd13968;
-       value_rom[163] = 16'sd27629; slope_rom[163] = 16'sd13835;
-       value_rom[164] = 16'sd27737; slope_rom[164] = 16'sd13701;
-       value_rom[165] = 16'sd27843; slope_rom[165] = 16'sd13568;
-       value_rom[166] = 16'sd27949; slope_rom[166] = 16'sd13433;
-       value_rom[167] = 16'sd28053; slope_rom[167] = 16'sd13298;
-       value_rom[168] = 16'sd28157; slope_rom[168] = 16'sd13163;
-       value_rom[169] = 16'sd28259; slope_rom[169] = 16'sd13027;
-       value_rom[170] = 16'sd28360; slope_rom[170] = 16'sd12890;
-       value_rom[171] = 16'sd28460; slope_rom[171] = 16'sd12753;
-       value_rom[172] = 16'sd28560; slope_rom[172] = 16'sd12616;
-       value_rom[173] = 16'sd28658; slope_rom[173] = 16'sd12478;
-       value_rom[174] = 16'sd28755; slope_rom[174] = 16'sd12340;
-       value_rom[175] = 16'sd28850; slope_rom[175] = 16'sd12201;
-       value_rom[176] = 16'sd28945; slope_rom[176] = 16'sd12062;
-       value_rom[177] = 16'sd29039; slope_rom[177] = 16'sd11922;
-       value_rom[178] = 16'sd29131; slope_rom[178] = 16'sd11782;
-       value_rom[179] = 16'sd29223; slope_rom[179] = 16'sd11641;
-       value_rom[180] = 16'sd29313; slope_rom[180] = 16'sd11500;
-       value_rom[181] = 16'sd29403; slope_rom[181] = 16'sd11359;
-       value_rom[182] = 16'sd29491; slope_rom[182] = 16'sd11217;
-       value_rom[183] = 16'sd29578; slope_rom[183] = 16'sd11075;
-       value_rom[184] = 16'sd29664; slope_rom[184] = 16'sd10932;
-       value_rom[185] = 16'sd29749; slope_rom[185] = 16'sd10789;
-       value_rom[186] = 16'sd29832; slope_rom[186] = 16'sd10645;
-       value_rom[187] = 16'sd29915; slope_rom[187] = 16'sd10501;
-       value_rom[188] = 16'sd29997; slope_rom[188] = 16'sd10357;
-       value_rom[189] = 16'sd30077; slope_rom[189] = 16'sd10212;
-       value_rom[190] = 16'sd30156; slope_rom[190] = 16'sd10067;
-       value_rom[191] = 16'sd30234; slope_rom[191] = 16'sd9921;
-       value_rom[192] = 16'sd30311; slope_rom[192] = 16'sd9775;
-       value_rom[193] = 16'sd30387; slope_rom[193] = 16'sd9629;
-       value_rom[194] = 16'sd30462; slope_rom[194] = 16'sd9483;
-       value_rom[195] = 16'sd30535; slope_rom[195] = 16'sd9336;
-       value_rom[196] = 16'sd30607; slope_rom[196] = 16'sd9188;
-       value_rom[197] = 16'sd30679; slope_rom[197] = 16'sd9041;
-       value_rom[198] = 16'sd30749; slope_rom[198] = 16'sd8893;
-       value_rom[199] = 16'sd30818; slope_rom[199] = 16'sd8744;
-       value_rom[200] = 16'sd30885; slope_rom[200] = 16'sd8596;
-       value_rom[201] = 16'sd30952; slope_rom[201] = 16'sd8447;
-       value_rom[202] = 16'sd31017; slope_rom[202] = 16'sd8297;
-       value_rom[203] = 16'sd31082; slope_rom[203] = 16'sd8148;
-       value_rom[204] = 16'sd31145; slope_rom[204] = 16'sd7998;
-       value_rom[205] = 16'sd31206; slope_rom[205] = 16'sd7847;
-       value_rom[206] = 16'sd31267; slope_rom[206] = 16'sd7697;
-       value_rom[207] = 16'sd31327; slope_rom[207] = 16'sd7546;
-       value_rom[208] = 16'sd31385; slope_rom[208] = 16'sd7395;
-       value_rom[209] = 16'sd31442; slope_rom[209] = 16'sd7244;
-       value_rom[210] = 16'sd31498; slope_rom[210] = 16'sd7092;
-       value_rom[211] = 16'sd31553; slope_rom[211] = 16'sd6940;
-       value_rom[212] = 16'sd31607; slope_rom[212] = 16'sd6788;
-       value_rom[213] = 16'sd31659; slope_rom[213] = 16'sd6635;
-       value_rom[214] = 16'sd31710; slope_rom[214] = 16'sd6483;
-       value_rom[215] = 16'sd31760; slope_rom[215] = 16'sd6330;
-       value_rom[216] = 16'sd31809; slope_rom[216] = 16'sd6177;
-       value_rom[217] = 16'sd31857; slope_rom[217] = 16'sd6023;
-       value_rom[218] = 16'sd31903; slope_rom[218] = 16'sd5869;
-       value_rom[219] = 16'sd31949; slope_rom[219] = 16'sd5716;
-       value_rom[220] = 16'sd31993; slope_rom[220] = 16'sd5562;
-       value_rom[221] = 16'sd32036; slope_rom[221] = 16'sd5407;
-       value_rom[222] = 16'sd32077; slope_rom[222] = 16'sd5253;
-       value_rom[223] = 16'sd32118; slope_rom[223] = 16'sd5098;
-       value_rom[224] = 16'sd32157; slope_rom[224] = 16'sd4943;
-       value_rom[225] = 16'sd32195; slope_rom[225] = 16'sd4788;
-       value_rom[226] = 16'sd32232; slope_rom[226] = 16'sd4633;
-       value_rom[227] = 16'sd32267; slope_rom[227] = 16'sd4477;
-       value_rom[228] = 16'sd32302; slope_rom[228] = 16'sd4322;
-       value_rom[229] = 16'sd32335; slope_rom[229] = 16'sd4166;
-       value_rom[230] = 16'sd32367; slope_rom[230] = 16'sd4010;
-       value_rom[231] = 16'sd32397; slope_rom[231] = 16'sd3854;
-       value_rom[232] = 16'sd32427; slope_rom[232] = 16'sd3698;
-       value_rom[233] = 16'sd32455; slope_rom[233] = 16'sd3542;
-       value_rom[234] = 16'sd32482; slope_rom[234] = 16'sd3385;
-       value_rom[235] = 16'sd32508; slope_rom[235] = 16'sd3229;
-       value_rom[236] = 16'sd32533; slope_rom[236] = 16'sd3072;
-       value_rom[237] = 16'sd32556; slope_rom[237] = 16'sd2915;
-       value_rom[238] = 16'sd32578; slope_rom[238] = 16'sd2758;
-       value_rom[239] = 16'sd32599; slope_rom[239] = 16'sd2601;
-       value_rom[240] = 16'sd32619; slope_rom[240] = 16'sd2444;
-       value_rom[241] = 16'sd32637; slope_rom[241] = 16'sd2287;
-       value_rom[242] = 16'sd32655; slope_rom[242] = 16'sd2129;
-       value_rom[243] = 16'sd32671; slope_rom[243] = 16'sd1972;
-       value_rom[244] = 16'sd32685; slope_rom[244] = 16'sd1814;
-       value_rom[245] = 16'sd32699; slope_rom[245] = 16'sd1657;
-       value_rom[246] = 16'sd32711; slope_rom[246] = 16'sd1499;
-       value_rom[247] = 16'sd32722; slope_rom[247] = 16'sd1342;
-       value_rom[248] = 16'sd32732; slope_rom[248] = 16'sd1184;
-       value_rom[249] = 16'sd32741; slope_rom[249] = 16'sd1026;
-       value_rom[250] = 16'sd32748; slope_rom[250] = 16'sd868;
-       value_rom[251] = 16'sd32755; slope_rom[251] = 16'sd710;
-       value_rom[252] = 16'sd32759; slope_rom[252] = 16'sd553;
-       value_rom[253] = 16'sd32763; slope_rom[253] = 16'sd395;
-       value_rom[254] = 16'sd32766; slope_rom[254] = 16'sd237;
-       value_rom[255] = 16'sd32767; slope_rom[255] = 16'sd79;
-       value = 0;
-       slope = 0;
-    end
+    reg signed [15:0] words [0:8191];
 
     always @(posedge clock) begin
-       value <= value_rom[addr];
-       slope <= slope_rom[addr];
+       if (write_enable)
+          words[address] <= write_data;
+       else
+          q <= words[address];
     end
-endmodule // gyro_interface__carrier_nco__reference__sine__rom
+endmodule // gyro_interface__carrier_nco__ref_sine__ram
 
 
-module gyro_interface__carrier_nco__reference__sine__signed_sample_4(d,q,clock);
+module gyro_interface__carrier_nco__ref_sine__signed_4(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -4161,46 +3076,10 @@ module gyro_interface__carrier_nco__reference__sine__signed_sample_4(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__reference__sine__signed_sample_4
+endmodule // gyro_interface__carrier_nco__ref_sine__signed_4
 
 
-module gyro_interface__carrier_nco__reference__sine__sin_out(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__reference__sine__sin_out
-
-
-module gyro_interface__carrier_nco__reference__sine__slope_product(clock,a,b,p);
-
-    // Module arguments
-    input wire  clock;
-    input wire signed [15:0] a;
-    input wire signed [15:0] b;
-    output reg signed [31:0] p;
-
-    // Update code (custom)
-    initial p = 0;
-
-    always @(posedge clock) begin
-       p <= a * b;
-    end
-endmodule // gyro_interface__carrier_nco__reference__sine__slope_product
-
-
-module gyro_interface__carrier_nco__reference__sine__slope_read(d,q,clock);
+module gyro_interface__carrier_nco__ref_sine__sin_out(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -4216,10 +3095,10 @@ module gyro_interface__carrier_nco__reference__sine__slope_read(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__reference__sine__slope_read
+endmodule // gyro_interface__carrier_nco__ref_sine__sin_out
 
 
-module gyro_interface__carrier_nco__reference__sine__value_read(d,q,clock);
+module gyro_interface__carrier_nco__ref_sine__value_3(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -4235,7 +3114,7 @@ module gyro_interface__carrier_nco__reference__sine__value_read(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__reference__sine__value_read
+endmodule // gyro_interface__carrier_nco__ref_sine__value_3
 
 
 module gyro_interface__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
@@ -6270,12 +5149,15 @@ module gyro_interface__iir__z_valid_out(d,q,clock);
 endmodule // gyro_interface__iir__z_valid_out
 
 
-module gyro_interface__modulation_nco(clock,step,select,am1,am2);
+module gyro_interface__modulation_nco(clock,step,select,filling,fill_phase,fill_word,am1,am2);
 
     // Module arguments
     input wire  clock;
     input wire  [47:0] step;
     input wire  select;
+    input wire  filling;
+    input wire  [31:0] fill_phase;
+    output reg signed [15:0] fill_word;
     output reg signed [15:0] am1;
     output reg signed [15:0] am2;
 
@@ -6349,6 +5231,11 @@ module gyro_interface__modulation_nco(clock,step,select,am1,am2);
         if (turn$q) begin
             sine$advance = sine_advance;
         end
+        if (filling) begin
+            sine$phase = fill_phase;
+            sine$advance = sine_advance;
+        end
+        fill_word = sine$sin;
         if (select) begin
             if (turn$q == cosine_out_turn) begin
                 am1_out$d = sine$sin;

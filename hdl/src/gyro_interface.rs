@@ -158,6 +158,9 @@ impl Logic for GyroInterface {
         self.carrier_nco.ref_offset.next = self.ref_phase.val();
         self.modulation_nco.step.next = self.mod_step.val();
         self.modulation_nco.select.next = self.select.val();
+        self.modulation_nco.filling.next = self.carrier_nco.filling.val();
+        self.modulation_nco.fill_phase.next = self.carrier_nco.fill_phase.val();
+        self.carrier_nco.fill_word.next = self.modulation_nco.fill_word.val();
         self.am_mixer.amp1.next = self.amp1.val();
         self.am_mixer.amp2.next = self.amp2.val();
         self.am_mixer.am1.next = self.modulation_nco.am1.val();
@@ -205,8 +208,11 @@ crate::impl_clocked!(GyroInterface);
 pub enum Mutation {
     /// The drive 1 rounding adds 2^13 instead of 2^14.
     DriveRounding,
-    /// The sine correction rounding adds 1.5 half-LSBs.
+    /// The modulation sine's correction rounding adds 1.5 half-LSBs (it
+    /// also computes the carrier tables).
     SineRounding,
+    /// The carrier table is sampled at each interval's start, not its centre.
+    TableCentre,
     /// The readout amplitude is 32766 instead of 32767.
     ModulationFullScale,
 }
@@ -214,9 +220,10 @@ pub enum Mutation {
 #[cfg(test)]
 impl Mutation {
     /// Every mutation.
-    pub const ALL: [Mutation; 3] = [
+    pub const ALL: [Mutation; 4] = [
         Mutation::DriveRounding,
         Mutation::SineRounding,
+        Mutation::TableCentre,
         Mutation::ModulationFullScale,
     ];
 }
@@ -227,7 +234,8 @@ impl GyroInterface {
     pub fn mutate(&mut self, mutation: Mutation) {
         match mutation {
             Mutation::DriveRounding => self.am_mixer.mutate_drive_rounding(),
-            Mutation::SineRounding => self.carrier_nco.mutate_sine_rounding(),
+            Mutation::SineRounding => self.modulation_nco.mutate_sine_rounding(),
+            Mutation::TableCentre => self.carrier_nco.mutate_table_centre(),
             Mutation::ModulationFullScale => self.modulation_nco.mutate_full_scale(),
         }
     }

@@ -2,6 +2,7 @@
 
 pub mod am_mixer;
 pub mod carrier_nco;
+pub mod carrier_table_fill;
 pub mod cic_decimator;
 pub mod cic_integrators;
 pub mod demod_mux;
@@ -19,8 +20,8 @@ pub mod q15_multiplier;
 pub mod reference_alignment;
 pub mod rtl;
 pub mod settings;
-pub mod sincos;
 pub mod sine;
 pub mod sine_table;
+pub mod table_sine;
 #[cfg(test)]
 pub(crate) mod test_util;

@@ -49,6 +49,13 @@ pub struct ModulationNco {
     pub step: Signal<In, Bits<48>>,
     /// 0: readout (am1 = am2 = 32767); 1: calibration (am1, am2 = cos, sin).
     pub select: Signal<In, Bit>,
+    /// Carrier table fill: the sine generator evaluates `fill_phase` instead.
+    pub filling: Signal<In, Bit>,
+    /// Carrier table fill: the phase asked for while `filling`.
+    pub fill_phase: Signal<In, Bits<32>>,
+    /// The sine generator's output, `sine::LATENCY` clocks after its phase
+    /// (the carrier tables' words during the fill).
+    pub fill_word: Signal<Out, Signed<16>>,
     /// Amplitude factor A1 for drive 1, 16-bit, full scale 32767.
     pub am1: Signal<Out, Signed<16>>,
     /// Amplitude factor A2 for drive 2, 16-bit, full scale 32767.
@@ -71,6 +78,9 @@ impl ModulationNco {
             clock: Default::default(),
             step: Default::default(),
             select: Default::default(),
+            filling: Default::default(),
+            fill_phase: Default::default(),
+            fill_word: Default::default(),
             am1: Default::default(),
             am2: Default::default(),
             phase: Default::default(),
@@ -104,6 +114,11 @@ impl Logic for ModulationNco {
         if self.turn.q.val() {
             self.sine.advance.next = self.sine_advance.val();
         }
+        if self.filling.val() {
+            self.sine.phase.next = self.fill_phase.val();
+            self.sine.advance.next = self.sine_advance.val();
+        }
+        self.fill_word.next = self.sine.sin.val();
         if self.select.val() {
             if self.turn.q.val() == self.cosine_out_turn.val() {
                 self.am1_out.d.next = self.sine.sin.val();
@@ -128,6 +143,11 @@ impl ModulationNco {
     pub fn mutate_full_scale(&mut self) {
         self.full_scale = Constant::new(((crate::sine_table::PEAK - 1) as i64).into());
     }
+
+    #[doc(hidden)]
+    pub fn mutate_sine_rounding(&mut self) {
+        self.sine.mutate_rounding();
+    }
 }
 
 #[cfg(test)]
@@ -143,20 +163,28 @@ mod tests {
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(8))]
         #[test]
-        fn rtl_matches_model_across_select_changes(
-            // Large steps (up to 2^48 / 2^4) so the sine moves within the test.
-            settings in segments((0u64..(1 << 44), any::<bool>()), 2..8, 30..150),
+        fn rtl_matches_model_across_select_changes_and_fill_requests(
+            // Large steps (up to 2^48 / 2^4) so the sine moves within the test;
+            // some segments take the sine generator for the carrier tables.
+            settings in segments(
+                (0u64..(1 << 44), any::<bool>(), prop::option::of(any::<u32>())),
+                2..8,
+                30..150,
+            ),
         ) {
             let mut uut = ModulationNco::new();
             prepare(&mut uut);
             let mut model = Model::default();
-            for (n, &(step, select)) in settings.iter().enumerate() {
+            for (n, &(step, select, fill)) in settings.iter().enumerate() {
                 uut.step.next = u128_to_bits(step as u128);
                 uut.select.next = select;
+                uut.filling.next = fill.is_some();
+                uut.fill_phase.next = u128_to_bits(fill.unwrap_or(0) as u128);
                 tick(&mut uut);
                 let v = |x: Signed<16>| signed_to_i128(x) as i16;
                 let hw = (v(uut.am1.val()), v(uut.am2.val()));
-                prop_assert_eq!(hw, model.step(step, select), "cycle {}", n);
+                prop_assert_eq!(hw, model.step(step, select, fill), "cycle {}", n);
+                prop_assert_eq!(v(uut.fill_word.val()), model.fill_word(), "cycle {}", n);
             }
         }
     }
@@ -167,15 +195,15 @@ mod tests {
         let mut model = Model::default();
         let mut crest = 0;
         for n in 0..(1 << 20) {
-            let (c, s) = model.step(1 << 28, true);
+            let (c, s) = model.step(1 << 28, true, None);
             if n > 8 {
                 crest = crest.max(c).max(s);
             }
         }
         assert_eq!(crest as i32, PEAK);
         for _ in 0..3 {
-            model.step(1 << 28, false);
+            model.step(1 << 28, false, None);
         }
-        assert_eq!(model.step(1 << 28, false), (PEAK as i16, PEAK as i16));
+        assert_eq!(model.step(1 << 28, false, None), (PEAK as i16, PEAK as i16));
     }
 }

@@ -137,6 +137,9 @@ mod tests {
     use crate::settings::{FrequencyPlan, registers};
     use crate::test_util::Rng;
 
+    /// The carrier table fill, then 3000 clocks of carriers.
+    const CYCLES: usize = crate::carrier_table_fill::FILL_CLOCKS + 3000;
+
     /// Valid registers and stimulus the mutations below must disturb.
     fn stimulus(cycles: usize, calibration: bool) -> (Vec<(i16, i16)>, Vec<Registers>) {
         let plan = FrequencyPlan {
@@ -161,7 +164,7 @@ mod tests {
     #[test]
     fn the_unmodified_design_matches_the_model() {
         for calibration in [false, true] {
-            let (adc, regs) = stimulus(3000, calibration);
+            let (adc, regs) = stimulus(CYCLES, calibration);
             assert_eq!(
                 first_mismatch(&mut RtlGyroInterface::new(), &adc, &regs),
                 None
@@ -173,9 +176,10 @@ mod tests {
     fn a_hardware_change_not_mirrored_in_the_model_is_caught() {
         // Negative control for every rtl-vs-model comparison: each of these
         // one-constant changes to the hardware (not to the model) must make
-        // the comparison fail within a few thousand cycles.
+        // the comparison fail within a few thousand cycles of the carrier
+        // tables' fill.
         for mutation in Mutation::ALL {
-            let (adc, regs) = stimulus(3000, false);
+            let (adc, regs) = stimulus(CYCLES, false);
             let mut design = GyroInterface::new();
             design.mutate(mutation);
             let found = first_mismatch(&mut RtlGyroInterface::from_design(design), &adc, &regs);

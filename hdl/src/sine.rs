@@ -215,7 +215,7 @@ impl Sine {
 mod tests {
     use super::*;
     use crate::drive::{prepare, tick};
-    use crate::model::sincos::{Sine as Model, sine};
+    use crate::model::sine::{Sine as Model, sine};
     use crate::primitives::convert::{signed_to_i128, u128_to_bits};
     use proptest::prelude::*;
 

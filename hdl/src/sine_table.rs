@@ -1,4 +1,6 @@
-//! The quarter-wave sine table shared by every sine/cosine generator.
+//! The quarter-wave sine table of the modulation NCO's sine generator
+//! (`crate::sine`), which also computes the carriers' 8192-word tables at
+//! power-up (`crate::carrier_table_fill`).
 //!
 //! 256 entries cover the first quadrant, sampled at the centre of each
 //! interval (the "half-LSB offset" table):
@@ -12,7 +14,7 @@
 //! at entry 255 - i, which is `!i` in 8 bits, with no special case at the
 //! quadrant edges. `slope` is the derivative of `value` per table step, scaled
 //! by 2^7 so it keeps 7 more bits than the 16-bit samples; the first-order
-//! Taylor correction in `sincos` uses it to interpolate between entries, which
+//! Taylor correction in `crate::sine` uses it to interpolate between entries, which
 //! takes the spur level from about -72 dBc (plain 256-entry table) to below
 //! -100 dBc. Both columns are positive and below 2^15 (value <= 32767,
 //! slope <= 25735), so they are stored as 16-bit signed words.

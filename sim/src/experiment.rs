@@ -313,7 +313,7 @@ fn sine_table_gain() -> f64 {
     let sum: f64 = (0..PHASES)
         .map(|i| {
             let phase = ((i << 32) / PHASES) as u32 + (1 << 15);
-            let sin = gyrocal_hdl::model::sincos::sine(phase, 0);
+            let sin = gyrocal_hdl::model::sine::sine(phase, 0);
             f64::from(sin) * (f64::from(phase) * TAU / 2f64.powi(32)).sin()
         })
         .sum();

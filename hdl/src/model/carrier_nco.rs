@@ -1,6 +1,38 @@
-//! Bit-true model of `crate::carrier_nco::CarrierNco`.
+//! Bit-true model of `crate::carrier_nco::CarrierNco`, with its table fill
+//! (`crate::carrier_table_fill`) and table sines (`crate::table_sine`).
+//!
+//! The table the hardware writes at power-up is built here once per
+//! process from the sine generator's model (`super::sine::sine` at each
+//! entry's centre phase): the hardware computes it with the modulation
+//! NCO's sine generator, so a fill that wrote other words, or wrote them
+//! elsewhere, shows as a carrier mismatch. The model tracks only the fill's
+//! progress (`fill_request` for the modulation NCO, and when the lookups
+//! go live).
 
-use super::sincos::SinCos;
+use super::sine::sine;
+use crate::carrier_table_fill::{FILL_CLOCKS, PHASE_BELOW_INDEX, TABLE_ENTRIES, entry_phase};
+use crate::table_sine::LATENCY;
+use std::sync::OnceLock;
+
+/// The carriers' quarter-wave table: entry i is the sine generator's
+/// output for the centre of interval i.
+pub type Table = [i16; TABLE_ENTRIES];
+
+/// The table the power-up fill writes, built once per process.
+pub fn table() -> &'static Table {
+    static TABLE: OnceLock<Box<Table>> = OnceLock::new();
+    TABLE.get_or_init(|| Box::new(std::array::from_fn(|i| sine(entry_phase(i), 0))))
+}
+
+/// `32767 sin` of a 32-bit phase plus `advance` quarter turns, as
+/// `crate::table_sine::TableSine` looks it up in `table`.
+#[inline(always)]
+pub fn table_sine(table: &Table, phase: u32, advance: u8) -> i16 {
+    let q = ((phase >> 30) + u32::from(advance)) & 3;
+    let i = (phase >> PHASE_BELOW_INDEX) as usize & (TABLE_ENTRIES - 1);
+    let v = table[if q & 1 == 0 { i } else { TABLE_ENTRIES - 1 - i }];
+    if q >= 2 { -v } else { v }
+}
 
 /// Outputs of the carrier NCO during one cycle.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -16,33 +48,106 @@ pub struct Carriers {
 }
 
 /// Cycle-true model of the carrier NCO.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct CarrierNco {
     phase: u32,
-    drive: SinCos,
-    reference: SinCos,
+    /// The fill counter: cycles since power-up, stopped at `FILL_CLOCKS`.
+    count: u16,
+    /// Outputs in flight; `pipe[head]` is the current output.
+    pipe: [Carriers; LATENCY],
+    head: usize,
+    table: &'static Table,
+}
+
+impl Default for CarrierNco {
+    fn default() -> Self {
+        Self {
+            phase: 0,
+            count: 0,
+            pipe: [Carriers::default(); LATENCY],
+            head: 0,
+            table: table(),
+        }
+    }
 }
 
 impl CarrierNco {
     /// The outputs during the current cycle.
     #[inline(always)]
     pub fn output(&self) -> Carriers {
-        let (drive_sin, drive_cos) = self.drive.output();
-        let (ref_sin, ref_cos) = self.reference.output();
-        Carriers {
-            drive_cos,
-            drive_sin,
-            ref_cos,
-            ref_sin,
-        }
+        self.pipe[self.head]
+    }
+
+    /// The phase the fill asks the modulation NCO's sine generator for
+    /// during the current cycle, while it needs it.
+    #[inline(always)]
+    pub fn fill_request(&self) -> Option<u32> {
+        let entry = self.count as usize;
+        (entry < TABLE_ENTRIES).then(|| entry_phase(entry))
     }
 
     /// One clock with the given step and reference offset; outputs after the edge.
     #[inline(always)]
     pub fn step(&mut self, step: u32, ref_offset: u32) -> Carriers {
-        self.drive.step(self.phase);
-        self.reference.step(self.phase.wrapping_add(ref_offset));
+        let live = self.count as usize == FILL_CLOCKS;
+        self.pipe[self.head] = if live {
+            let t = self.table;
+            let reference = self.phase.wrapping_add(ref_offset);
+            Carriers {
+                drive_cos: table_sine(t, self.phase, 1),
+                drive_sin: table_sine(t, self.phase, 0),
+                ref_cos: table_sine(t, reference, 1),
+                ref_sin: table_sine(t, reference, 0),
+            }
+        } else {
+            self.count += 1;
+            Carriers::default()
+        };
+        self.head = (self.head + 1) % LATENCY;
         self.phase = self.phase.wrapping_add(step);
         self.output()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sine_table::PEAK;
+
+    #[test]
+    fn table_words_lie_in_the_first_quadrant_range() {
+        // The negation in quadrants 2 and 3 cannot overflow.
+        assert!(table().iter().all(|&v| (0..=PEAK as i16).contains(&v)));
+    }
+
+    #[test]
+    fn error_against_the_exact_sine_is_at_most_4_4_lsb() {
+        // The phase is rounded to an interval centre, at most half an
+        // interval (pi / 2^15 rad) away: 32767 pi / 2^15 = 3.14 LSB; the
+        // table words carry the sine generator's 1.16 LSB (model::sine).
+        let t = table();
+        let mut worst = 0.0f64;
+        for k in 0u32..(1 << 20) {
+            let phase = k.wrapping_mul(0x9e37_79b9);
+            let angle = phase as f64 / 2f64.powi(32) * std::f64::consts::TAU;
+            worst = worst.max((table_sine(t, phase, 0) as f64 - 32767.0 * angle.sin()).abs());
+            worst = worst.max((table_sine(t, phase, 1) as f64 - 32767.0 * angle.cos()).abs());
+        }
+        assert!(worst <= 3.15 + 1.16, "worst error {worst} LSB");
+    }
+
+    #[test]
+    fn outputs_are_zero_until_the_fill_is_over_then_lag_the_phase_by_5() {
+        let mut nco = CarrierNco::default();
+        let step = 0x1234_5679;
+        // `step` returns the outputs of the next cycle: cycles 1..FILL_CLOCKS + 4.
+        for n in 1..FILL_CLOCKS + LATENCY {
+            assert_eq!(nco.step(step, 0), Carriers::default(), "cycle {n}");
+        }
+        // Cycle FILL_CLOCKS + 5: the phase of cycle FILL_CLOCKS.
+        let phase = step.wrapping_mul(FILL_CLOCKS as u32);
+        let first = nco.step(step, 0);
+        assert_eq!(first.drive_sin, table_sine(table(), phase, 0));
+        assert_eq!(first.drive_cos, table_sine(table(), phase, 1));
     }
 }

@@ -140,8 +140,9 @@ impl GyroInterface {
         let w = self.demod_mux.output();
         let (cic, cic_valid) = self.cic.output();
 
+        let fill = self.carrier_nco.fill_request();
         self.carrier_nco.step(regs.carrier_step, regs.ref_phase);
-        self.modulation_nco.step(regs.mod_step, regs.select);
+        self.modulation_nco.step(regs.mod_step, regs.select, fill);
         self.am_mixer.step(regs.amp, am, carriers);
         self.reference_alignment
             .step(drives.ref1, drives.ref2, regs.ref_delay);

@@ -16,4 +16,4 @@ pub mod iir_lowpass;
 pub mod modulation_nco;
 pub mod q15_multiplier;
 pub mod reference_alignment;
-pub mod sincos;
+pub mod sine;

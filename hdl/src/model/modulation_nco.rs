@@ -1,6 +1,6 @@
 //! Bit-true model of `crate::modulation_nco::ModulationNco`.
 
-use super::sincos::Sine;
+use super::sine::Sine;
 use crate::sine::LATENCY;
 use crate::sine_table::PEAK;
 
@@ -23,9 +23,18 @@ impl ModulationNco {
         self.am
     }
 
-    /// One clock; returns `(am1, am2)` after the edge.
+    /// The sine generator's output during the current cycle (the carrier
+    /// tables' word during the fill).
     #[inline(always)]
-    pub fn step(&mut self, step: u64, select: bool) -> (i16, i16) {
+    pub fn fill_word(&self) -> i16 {
+        self.sine.output()
+    }
+
+    /// One clock; `fill` is the carrier table fill's request for the sine
+    /// generator (`CarrierNco::fill_request`). Returns `(am1, am2)` after
+    /// the edge.
+    #[inline(always)]
+    pub fn step(&mut self, step: u64, select: bool, fill: Option<u32>) -> (i16, i16) {
         if !select {
             self.am = (PEAK as i16, PEAK as i16);
         } else if self.turn == (LATENCY % 2 == 1) {
@@ -34,8 +43,12 @@ impl ModulationNco {
         } else {
             self.am.1 = self.sine.output();
         }
-        let advance = if self.turn { 0 } else { 1 };
-        self.sine.step((self.phase >> 16) as u32, advance);
+        match fill {
+            Some(phase) => self.sine.step(phase, 0),
+            None => self
+                .sine
+                .step((self.phase >> 16) as u32, if self.turn { 0 } else { 1 }),
+        };
         self.turn = !self.turn;
         self.phase = (self.phase + step) & PHASE_MASK;
         self.am

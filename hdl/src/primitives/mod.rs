@@ -10,6 +10,7 @@ mod microcode_rom;
 pub mod pipelined_multiplier;
 mod quarter_sine_rom;
 mod registered_multiplier;
+mod single_port_ram;
 mod tapped_delay_line;
 mod word_ram;
 
@@ -18,5 +19,6 @@ pub use microcode_rom::MicrocodeRom;
 pub use pipelined_multiplier::PipelinedMultiplier;
 pub use quarter_sine_rom::QuarterSineRom;
 pub use registered_multiplier::RegisteredMultiplier;
+pub use single_port_ram::SinglePortRam;
 pub use tapped_delay_line::TappedDelayLine;
 pub use word_ram::WordRam;

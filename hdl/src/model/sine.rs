@@ -1,7 +1,7 @@
-//! Bit-true models of `crate::sine::Sine` and `crate::sincos::SinCos`.
+//! Bit-true model of `crate::sine::Sine`.
 //!
 //! `sine` is the arithmetic of the pipeline stages collapsed into one
-//! function; `Sine` and `SinCos` delay it by the block's latency, starting
+//! function; `Sine` delays it by the block's latency, starting
 //! from what the power-up registers give (`crate::sine`'s header): 0 during
 //! cycles 0..=3, then `power_up_word()`, table entry 0 read through the
 //! all-zero index register with a zero offset, during cycle 4.
@@ -39,12 +39,6 @@ fn sine_with(table: &Table, phase: u32, advance: u8) -> i16 {
         sample - correction
     };
     (if q >= 2 { -first } else { first }) as i16
-}
-
-/// `(sin, cos)` of a 32-bit phase, as `crate::sincos::SinCos` computes it.
-#[inline(always)]
-pub fn evaluate(phase: u32) -> (i16, i16) {
-    (sine(phase, 0), sine(phase, 1))
 }
 
 /// The output during cycle `LATENCY - 1` after power-up: the entry the
@@ -93,31 +87,15 @@ impl Sine {
     }
 }
 
-/// Cycle-true model of `crate::sincos::SinCos`: two `Sine`s, the second a
-/// quarter turn ahead, as in the hardware.
-#[derive(Clone, Debug, Default)]
-pub struct SinCos {
-    sine: Sine,
-    cosine: Sine,
-}
-
-impl SinCos {
-    /// `(sin, cos)` during the current cycle.
-    #[inline(always)]
-    pub fn output(&self) -> (i16, i16) {
-        (self.sine.output(), self.cosine.output())
-    }
-
-    /// Present `phase` for one clock; returns `(sin, cos)` after the edge.
-    #[inline(always)]
-    pub fn step(&mut self, phase: u32) -> (i16, i16) {
-        (self.sine.step(phase, 0), self.cosine.step(phase, 1))
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `(sin, cos)` of a 32-bit phase: the sine with no advance and with a
+    /// quarter turn (the modulation NCO's A2 and A1).
+    fn evaluate(phase: u32) -> (i16, i16) {
+        (sine(phase, 0), sine(phase, 1))
+    }
 
     /// First-quadrant sine and cosine of the interval and offset encoded in
     /// phase bits 29:7, before the quadrant mirror: the arithmetic of the

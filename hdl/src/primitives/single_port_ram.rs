@@ -1,0 +1,116 @@
+//! Single-port RAM with a registered read: one address, a write or a read
+//! at each edge, no initial contents.
+//!
+//! ```text
+//!  write_enable, address, write_data ──► words[2^A] of W bits
+//!                              address ──► words[address] ──► [q]   (when not writing)
+//! ```
+//!
+//! At a rising edge with `write_enable` high, `write_data` goes into the
+//! word at `address` and `q` keeps its value; with `write_enable` low, `q`
+//! takes the word at `address`. Latency: 1 clock from an address to `q`.
+//! This is the port of the iCE40 UltraPlus `SB_SPRAM256KA` (16K x 16, read
+//! and write on one address, the output unchanged while writing), so Yosys
+//! `synth_ice40 -spram` maps an 8192 x 16 instance to one SPRAM (half of
+//! it used); ECP5 maps it to eight `DP16KD` in no-change write mode.
+//!
+//! The words have no power-up value: an SPRAM cannot be initialized by the
+//! bitstream, so the Verilog has no `initial` block and an unwritten word
+//! reads as X in Icarus. The caller writes every word before it uses what
+//! it reads (`crate::carrier_table_fill`). The Rust model starts every word
+//! and `q` at 0; whatever is read before the words are written must not
+//! reach an output, and the top-level replay in Icarus (where it would be
+//! X) checks that.
+//!
+//! Leaf block with hand-written Verilog (not single-source): the top-level
+//! golden-vector replay in Icarus and Verilator covers it.
+
+use super::convert::i128_to_signed;
+use rust_hdl::prelude::*;
+
+/// `2^A` words of `W` bits, one write or one registered read per clock.
+#[derive(Clone, Debug, LogicBlock)]
+pub struct SinglePortRam<const W: usize, const A: usize> {
+    /// The clock.
+    pub clock: Signal<In, Clock>,
+    /// Write `write_data` at `address` at this edge (no read).
+    pub write_enable: Signal<In, Bit>,
+    /// The word written or read.
+    pub address: Signal<In, Bits<A>>,
+    /// The word written.
+    pub write_data: Signal<In, Signed<W>>,
+    /// The word at `address` at the last edge without a write.
+    pub q: Signal<Out, Signed<W>>,
+    _words: Vec<Signed<W>>,
+}
+
+impl<const W: usize, const A: usize> SinglePortRam<W, A> {
+    /// A RAM of `2^A` words of `W` bits; `A` must be between 1 and 14 (the
+    /// depth of one SPRAM) and `W` between 1 and 16 (its width).
+    pub fn new() -> Self {
+        assert!(
+            (1..=14).contains(&A),
+            "SinglePortRam depth must be 2..16384 words"
+        );
+        assert!(
+            (1..=16).contains(&W),
+            "SinglePortRam width must be 1..16 bits"
+        );
+        Self {
+            clock: Default::default(),
+            write_enable: Default::default(),
+            address: Default::default(),
+            write_data: Default::default(),
+            q: Signal::new_with_default(i128_to_signed(0)),
+            _words: vec![i128_to_signed(0); 1 << A],
+        }
+    }
+}
+
+impl<const W: usize, const A: usize> Default for SinglePortRam<W, A> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const W: usize, const A: usize> Logic for SinglePortRam<W, A> {
+    fn update(&mut self) {
+        if self.clock.pos_edge() {
+            let address = self.address.val().index();
+            if self.write_enable.val() {
+                self._words[address] = self.write_data.val();
+            } else {
+                self.q.next = self._words[address];
+            }
+        }
+    }
+
+    fn connect(&mut self) {
+        self.q.connect();
+    }
+
+    fn hdl(&self) -> Verilog {
+        Verilog::Custom(format!(
+            "\
+reg signed [{msb}:0] words [0:{last}];
+
+always @(posedge clock) begin
+   if (write_enable)
+      words[address] <= write_data;
+   else
+      q <= words[address];
+end",
+            msb = W - 1,
+            last = (1usize << A) - 1
+        ))
+    }
+
+    fn timing(&self) -> Vec<TimingInfo> {
+        vec![TimingInfo {
+            name: "single_port_ram".into(),
+            clock: "clock".into(),
+            inputs: vec!["write_enable".into(), "address".into(), "write_data".into()],
+            outputs: vec!["q".into()],
+        }]
+    }
+}
