@@ -49,7 +49,11 @@ fn main() {
         "verilated_threads.o",
     ]));
     let include = Path::new(root.trim()).join("include");
-    cc::Build::new()
+    let mut build = cc::Build::new();
+    for object in verilated_objects(&out) {
+        build.object(object);
+    }
+    build
         .cpp(true)
         .std("c++17")
         .opt_level(2)
@@ -58,7 +62,6 @@ fn main() {
         .include(&include)
         .include(include.join("vltstd"))
         .file(&wrapper)
-        .object(out.join("Vgyro_interface__ALL.o"))
         .object(out.join("verilated.o"))
         .object(out.join("verilated_threads.o"))
         .compile("gyrocal_verilator");
@@ -80,4 +83,24 @@ fn run(cmd: &mut Command) {
         .status()
         .unwrap_or_else(|e| panic!("cannot run {:?}: {e} (the `verilator` feature needs the Debian packages `verilator` and `make`)", cmd.get_program()));
     assert!(status.success(), "{cmd:?} failed");
+}
+
+/// The model's object files: Verilator compiles a small design into one
+/// `Vgyro_interface__ALL.o`, and a larger one (split output, parallel
+/// build) into one object per C++ file, archived as `__ALL.a`.
+fn verilated_objects(out: &Path) -> Vec<PathBuf> {
+    let all = out.join("Vgyro_interface__ALL.o");
+    if all.exists() {
+        return vec![all];
+    }
+    let mut objects: Vec<PathBuf> = std::fs::read_dir(out)
+        .expect("the Verilator output directory")
+        .filter_map(|entry| entry.ok().map(|e| e.path()))
+        .filter(|path| {
+            let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+            name.starts_with("Vgyro_interface") && name.ends_with(".o")
+        })
+        .collect();
+    objects.sort();
+    objects
 }

@@ -1,5 +1,5 @@
 //! Yosys synthesis of the committed `verilog-out/gyro_interface.v` for iCE40
-//! (`synth_ice40 -dsp`) and Xilinx 7-series (`synth_xilinx -flatten`): no
+//! (`synth_ice40 -dsp -spram`) and Xilinx 7-series (`synth_xilinx -flatten`): no
 //! latches, a clean `check`, and `verilog-out/RESOURCES.md` starting with
 //! what Yosys reports now (its place-and-route section is checked by
 //! `tests/verilog_pnr.rs`).

@@ -1188,8 +1188,10 @@ module gyro_interface__carrier_nco(clock,step,ref_offset,fill_word,filling,fill_
     reg  fill$clock;
     wire  fill$busy;
     wire  [31:0] fill$phase;
+    reg signed [15:0] fill$sine;
     wire  fill$write;
     wire  [12:0] fill$address;
+    wire signed [15:0] fill$word;
     wire  fill$ready;
     reg  drive_cosine$clock;
     reg  [31:0] drive_cosine$phase;
@@ -1237,8 +1239,10 @@ module gyro_interface__carrier_nco(clock,step,ref_offset,fill_word,filling,fill_
         .clock(fill$clock),
         .busy(fill$busy),
         .phase(fill$phase),
+        .sine(fill$sine),
         .write(fill$write),
         .address(fill$address),
+        .word(fill$word),
         .ready(fill$ready)
     );
     gyro_interface__carrier_nco__drive_cosine drive_cosine(
@@ -1295,21 +1299,22 @@ module gyro_interface__carrier_nco(clock,step,ref_offset,fill_word,filling,fill_
         ref_phase = phase$q + ref_offset;
         filling = fill$busy;
         fill_phase = fill$phase;
+        fill$sine = fill_word;
         drive_cosine$fill_write = fill$write;
         drive_cosine$fill_address = fill$address;
-        drive_cosine$fill_word = fill_word;
+        drive_cosine$fill_word = fill$word;
         drive_cosine$ready = fill$ready;
         drive_sine$fill_write = fill$write;
         drive_sine$fill_address = fill$address;
-        drive_sine$fill_word = fill_word;
+        drive_sine$fill_word = fill$word;
         drive_sine$ready = fill$ready;
         ref_cosine$fill_write = fill$write;
         ref_cosine$fill_address = fill$address;
-        ref_cosine$fill_word = fill_word;
+        ref_cosine$fill_word = fill$word;
         ref_cosine$ready = fill$ready;
         ref_sine$fill_write = fill$write;
         ref_sine$fill_address = fill$address;
-        ref_sine$fill_word = fill_word;
+        ref_sine$fill_word = fill$word;
         ref_sine$ready = fill$ready;
         drive_cosine$phase = phase$q;
         drive_cosine$advance = cosine_advance;
@@ -1340,15 +1345,73 @@ module gyro_interface__carrier_nco__drive_cosine(clock,phase,advance,fill_write,
     input wire  ready;
     output reg signed [15:0] sin;
 
-    // Constant declarations
-    localparam signed zero = 16'h0;
-
     // Stub signals
+    reg  lookup$clock;
+    reg  [31:0] lookup$phase;
+    reg  [1:0] lookup$advance;
+    reg  lookup$live;
+    wire  [12:0] lookup$index;
+    reg signed [15:0] lookup$word;
+    wire signed [15:0] lookup$sin;
     reg  ram$clock;
     reg  ram$write_enable;
     reg  [12:0] ram$address;
     reg signed [15:0] ram$write_data;
     wire signed [15:0] ram$q;
+
+    // Sub module instances
+    gyro_interface__carrier_nco__drive_cosine__lookup lookup(
+        .clock(lookup$clock),
+        .phase(lookup$phase),
+        .advance(lookup$advance),
+        .live(lookup$live),
+        .index(lookup$index),
+        .word(lookup$word),
+        .sin(lookup$sin)
+    );
+    gyro_interface__carrier_nco__drive_cosine__ram ram(
+        .clock(ram$clock),
+        .write_enable(ram$write_enable),
+        .address(ram$address),
+        .write_data(ram$write_data),
+        .q(ram$q)
+    );
+
+    // Update code
+    always @(*) begin
+        lookup$clock = clock;
+        ram$clock = clock;
+        lookup$phase = phase;
+        lookup$advance = advance;
+        lookup$live = ready;
+        ram$write_enable = fill_write;
+        ram$address = lookup$index;
+        if (fill_write) begin
+            ram$address = fill_address;
+        end
+        ram$write_data = fill_word;
+        lookup$word = ram$q;
+        sin = lookup$sin;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive_cosine
+
+
+module gyro_interface__carrier_nco__drive_cosine__lookup(clock,phase,advance,live,index,word,sin);
+
+    // Module arguments
+    input wire  clock;
+    input wire  [31:0] phase;
+    input wire  [1:0] advance;
+    input wire  live;
+    output reg  [12:0] index;
+    input wire signed [15:0] word;
+    output reg signed [15:0] sin;
+
+    // Constant declarations
+    localparam signed zero = 16'h0;
+
+    // Stub signals
     reg  [12:0] index_1$d;
     wire  [12:0] index_1$q;
     reg  index_1$clock;
@@ -1387,64 +1450,57 @@ module gyro_interface__carrier_nco__drive_cosine(clock,phase,advance,fill_write,
     reg  [1:0] quadrant;
 
     // Sub module instances
-    gyro_interface__carrier_nco__drive_cosine__ram ram(
-        .clock(ram$clock),
-        .write_enable(ram$write_enable),
-        .address(ram$address),
-        .write_data(ram$write_data),
-        .q(ram$q)
-    );
-    gyro_interface__carrier_nco__drive_cosine__index_1 index_1(
+    gyro_interface__carrier_nco__drive_cosine__lookup__index_1 index_1(
         .d(index_1$d),
         .q(index_1$q),
         .clock(index_1$clock)
     );
-    gyro_interface__carrier_nco__drive_cosine__quadrant_1 quadrant_1(
+    gyro_interface__carrier_nco__drive_cosine__lookup__quadrant_1 quadrant_1(
         .d(quadrant_1$d),
         .q(quadrant_1$q),
         .clock(quadrant_1$clock)
     );
-    gyro_interface__carrier_nco__drive_cosine__live_1 live_1(
+    gyro_interface__carrier_nco__drive_cosine__lookup__live_1 live_1(
         .d(live_1$d),
         .q(live_1$q),
         .clock(live_1$clock)
     );
-    gyro_interface__carrier_nco__drive_cosine__quadrant_2 quadrant_2(
+    gyro_interface__carrier_nco__drive_cosine__lookup__quadrant_2 quadrant_2(
         .d(quadrant_2$d),
         .q(quadrant_2$q),
         .clock(quadrant_2$clock)
     );
-    gyro_interface__carrier_nco__drive_cosine__live_2 live_2(
+    gyro_interface__carrier_nco__drive_cosine__lookup__live_2 live_2(
         .d(live_2$d),
         .q(live_2$q),
         .clock(live_2$clock)
     );
-    gyro_interface__carrier_nco__drive_cosine__quadrant_3 quadrant_3(
+    gyro_interface__carrier_nco__drive_cosine__lookup__quadrant_3 quadrant_3(
         .d(quadrant_3$d),
         .q(quadrant_3$q),
         .clock(quadrant_3$clock)
     );
-    gyro_interface__carrier_nco__drive_cosine__live_3 live_3(
+    gyro_interface__carrier_nco__drive_cosine__lookup__live_3 live_3(
         .d(live_3$d),
         .q(live_3$q),
         .clock(live_3$clock)
     );
-    gyro_interface__carrier_nco__drive_cosine__value_3 value_3(
+    gyro_interface__carrier_nco__drive_cosine__lookup__value_3 value_3(
         .d(value_3$d),
         .q(value_3$q),
         .clock(value_3$clock)
     );
-    gyro_interface__carrier_nco__drive_cosine__live_4 live_4(
+    gyro_interface__carrier_nco__drive_cosine__lookup__live_4 live_4(
         .d(live_4$d),
         .q(live_4$q),
         .clock(live_4$clock)
     );
-    gyro_interface__carrier_nco__drive_cosine__signed_4 signed_4(
+    gyro_interface__carrier_nco__drive_cosine__lookup__signed_4 signed_4(
         .d(signed_4$d),
         .q(signed_4$q),
         .clock(signed_4$clock)
     );
-    gyro_interface__carrier_nco__drive_cosine__sin_out sin_out(
+    gyro_interface__carrier_nco__drive_cosine__lookup__sin_out sin_out(
         .d(sin_out$d),
         .q(sin_out$q),
         .clock(sin_out$clock)
@@ -1452,7 +1508,6 @@ module gyro_interface__carrier_nco__drive_cosine(clock,phase,advance,fill_write,
 
     // Update code
     always @(*) begin
-        ram$clock = clock;
         index_1$clock = clock;
         quadrant_1$clock = clock;
         live_1$clock = clock;
@@ -1481,18 +1536,13 @@ module gyro_interface__carrier_nco__drive_cosine(clock,phase,advance,fill_write,
             index_1$d = ~(phase[(32'h11)+:(13)]);
         end
         quadrant_1$d = quadrant;
-        live_1$d = ready;
-        ram$write_enable = fill_write;
-        ram$address = index_1$q;
-        if (fill_write) begin
-            ram$address = fill_address;
-        end
-        ram$write_data = fill_word;
+        live_1$d = live;
+        index = index_1$q;
         quadrant_2$d = quadrant_1$q;
         live_2$d = live_1$q;
         quadrant_3$d = quadrant_2$q;
         live_3$d = live_2$q;
-        value_3$d = ram$q;
+        value_3$d = word;
         live_4$d = live_3$q;
         signed_4$d = value_3$q;
         if (quadrant_3$q[32'h1]) begin
@@ -1505,10 +1555,10 @@ module gyro_interface__carrier_nco__drive_cosine(clock,phase,advance,fill_write,
         sin = sin_out$q;
     end
 
-endmodule // gyro_interface__carrier_nco__drive_cosine
+endmodule // gyro_interface__carrier_nco__drive_cosine__lookup
 
 
-module gyro_interface__carrier_nco__drive_cosine__index_1(d,q,clock);
+module gyro_interface__carrier_nco__drive_cosine__lookup__index_1(d,q,clock);
 
     // Module arguments
     input wire  [12:0] d;
@@ -1524,29 +1574,10 @@ module gyro_interface__carrier_nco__drive_cosine__index_1(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive_cosine__index_1
+endmodule // gyro_interface__carrier_nco__drive_cosine__lookup__index_1
 
 
-module gyro_interface__carrier_nco__drive_cosine__live_1(d,q,clock);
-
-    // Module arguments
-    input wire  d;
-    output reg  q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 1'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__drive_cosine__live_1
-
-
-module gyro_interface__carrier_nco__drive_cosine__live_2(d,q,clock);
+module gyro_interface__carrier_nco__drive_cosine__lookup__live_1(d,q,clock);
 
     // Module arguments
     input wire  d;
@@ -1562,29 +1593,10 @@ module gyro_interface__carrier_nco__drive_cosine__live_2(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive_cosine__live_2
+endmodule // gyro_interface__carrier_nco__drive_cosine__lookup__live_1
 
 
-module gyro_interface__carrier_nco__drive_cosine__live_3(d,q,clock);
-
-    // Module arguments
-    input wire  d;
-    output reg  q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 1'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__drive_cosine__live_3
-
-
-module gyro_interface__carrier_nco__drive_cosine__live_4(d,q,clock);
+module gyro_interface__carrier_nco__drive_cosine__lookup__live_2(d,q,clock);
 
     // Module arguments
     input wire  d;
@@ -1600,10 +1612,48 @@ module gyro_interface__carrier_nco__drive_cosine__live_4(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive_cosine__live_4
+endmodule // gyro_interface__carrier_nco__drive_cosine__lookup__live_2
 
 
-module gyro_interface__carrier_nco__drive_cosine__quadrant_1(d,q,clock);
+module gyro_interface__carrier_nco__drive_cosine__lookup__live_3(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive_cosine__lookup__live_3
+
+
+module gyro_interface__carrier_nco__drive_cosine__lookup__live_4(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive_cosine__lookup__live_4
+
+
+module gyro_interface__carrier_nco__drive_cosine__lookup__quadrant_1(d,q,clock);
 
     // Module arguments
     input wire  [1:0] d;
@@ -1619,29 +1669,10 @@ module gyro_interface__carrier_nco__drive_cosine__quadrant_1(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive_cosine__quadrant_1
+endmodule // gyro_interface__carrier_nco__drive_cosine__lookup__quadrant_1
 
 
-module gyro_interface__carrier_nco__drive_cosine__quadrant_2(d,q,clock);
-
-    // Module arguments
-    input wire  [1:0] d;
-    output reg  [1:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 2'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__drive_cosine__quadrant_2
-
-
-module gyro_interface__carrier_nco__drive_cosine__quadrant_3(d,q,clock);
+module gyro_interface__carrier_nco__drive_cosine__lookup__quadrant_2(d,q,clock);
 
     // Module arguments
     input wire  [1:0] d;
@@ -1657,7 +1688,83 @@ module gyro_interface__carrier_nco__drive_cosine__quadrant_3(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive_cosine__quadrant_3
+endmodule // gyro_interface__carrier_nco__drive_cosine__lookup__quadrant_2
+
+
+module gyro_interface__carrier_nco__drive_cosine__lookup__quadrant_3(d,q,clock);
+
+    // Module arguments
+    input wire  [1:0] d;
+    output reg  [1:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 2'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive_cosine__lookup__quadrant_3
+
+
+module gyro_interface__carrier_nco__drive_cosine__lookup__signed_4(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive_cosine__lookup__signed_4
+
+
+module gyro_interface__carrier_nco__drive_cosine__lookup__sin_out(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive_cosine__lookup__sin_out
+
+
+module gyro_interface__carrier_nco__drive_cosine__lookup__value_3(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive_cosine__lookup__value_3
 
 
 module gyro_interface__carrier_nco__drive_cosine__ram(clock,write_enable,address,write_data,q);
@@ -1681,63 +1788,6 @@ module gyro_interface__carrier_nco__drive_cosine__ram(clock,write_enable,address
 endmodule // gyro_interface__carrier_nco__drive_cosine__ram
 
 
-module gyro_interface__carrier_nco__drive_cosine__signed_4(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__drive_cosine__signed_4
-
-
-module gyro_interface__carrier_nco__drive_cosine__sin_out(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__drive_cosine__sin_out
-
-
-module gyro_interface__carrier_nco__drive_cosine__value_3(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__drive_cosine__value_3
-
-
 module gyro_interface__carrier_nco__drive_sine(clock,phase,advance,fill_write,fill_address,fill_word,ready,sin);
 
     // Module arguments
@@ -1750,15 +1800,73 @@ module gyro_interface__carrier_nco__drive_sine(clock,phase,advance,fill_write,fi
     input wire  ready;
     output reg signed [15:0] sin;
 
-    // Constant declarations
-    localparam signed zero = 16'h0;
-
     // Stub signals
+    reg  lookup$clock;
+    reg  [31:0] lookup$phase;
+    reg  [1:0] lookup$advance;
+    reg  lookup$live;
+    wire  [12:0] lookup$index;
+    reg signed [15:0] lookup$word;
+    wire signed [15:0] lookup$sin;
     reg  ram$clock;
     reg  ram$write_enable;
     reg  [12:0] ram$address;
     reg signed [15:0] ram$write_data;
     wire signed [15:0] ram$q;
+
+    // Sub module instances
+    gyro_interface__carrier_nco__drive_sine__lookup lookup(
+        .clock(lookup$clock),
+        .phase(lookup$phase),
+        .advance(lookup$advance),
+        .live(lookup$live),
+        .index(lookup$index),
+        .word(lookup$word),
+        .sin(lookup$sin)
+    );
+    gyro_interface__carrier_nco__drive_sine__ram ram(
+        .clock(ram$clock),
+        .write_enable(ram$write_enable),
+        .address(ram$address),
+        .write_data(ram$write_data),
+        .q(ram$q)
+    );
+
+    // Update code
+    always @(*) begin
+        lookup$clock = clock;
+        ram$clock = clock;
+        lookup$phase = phase;
+        lookup$advance = advance;
+        lookup$live = ready;
+        ram$write_enable = fill_write;
+        ram$address = lookup$index;
+        if (fill_write) begin
+            ram$address = fill_address;
+        end
+        ram$write_data = fill_word;
+        lookup$word = ram$q;
+        sin = lookup$sin;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive_sine
+
+
+module gyro_interface__carrier_nco__drive_sine__lookup(clock,phase,advance,live,index,word,sin);
+
+    // Module arguments
+    input wire  clock;
+    input wire  [31:0] phase;
+    input wire  [1:0] advance;
+    input wire  live;
+    output reg  [12:0] index;
+    input wire signed [15:0] word;
+    output reg signed [15:0] sin;
+
+    // Constant declarations
+    localparam signed zero = 16'h0;
+
+    // Stub signals
     reg  [12:0] index_1$d;
     wire  [12:0] index_1$q;
     reg  index_1$clock;
@@ -1797,64 +1905,57 @@ module gyro_interface__carrier_nco__drive_sine(clock,phase,advance,fill_write,fi
     reg  [1:0] quadrant;
 
     // Sub module instances
-    gyro_interface__carrier_nco__drive_sine__ram ram(
-        .clock(ram$clock),
-        .write_enable(ram$write_enable),
-        .address(ram$address),
-        .write_data(ram$write_data),
-        .q(ram$q)
-    );
-    gyro_interface__carrier_nco__drive_sine__index_1 index_1(
+    gyro_interface__carrier_nco__drive_sine__lookup__index_1 index_1(
         .d(index_1$d),
         .q(index_1$q),
         .clock(index_1$clock)
     );
-    gyro_interface__carrier_nco__drive_sine__quadrant_1 quadrant_1(
+    gyro_interface__carrier_nco__drive_sine__lookup__quadrant_1 quadrant_1(
         .d(quadrant_1$d),
         .q(quadrant_1$q),
         .clock(quadrant_1$clock)
     );
-    gyro_interface__carrier_nco__drive_sine__live_1 live_1(
+    gyro_interface__carrier_nco__drive_sine__lookup__live_1 live_1(
         .d(live_1$d),
         .q(live_1$q),
         .clock(live_1$clock)
     );
-    gyro_interface__carrier_nco__drive_sine__quadrant_2 quadrant_2(
+    gyro_interface__carrier_nco__drive_sine__lookup__quadrant_2 quadrant_2(
         .d(quadrant_2$d),
         .q(quadrant_2$q),
         .clock(quadrant_2$clock)
     );
-    gyro_interface__carrier_nco__drive_sine__live_2 live_2(
+    gyro_interface__carrier_nco__drive_sine__lookup__live_2 live_2(
         .d(live_2$d),
         .q(live_2$q),
         .clock(live_2$clock)
     );
-    gyro_interface__carrier_nco__drive_sine__quadrant_3 quadrant_3(
+    gyro_interface__carrier_nco__drive_sine__lookup__quadrant_3 quadrant_3(
         .d(quadrant_3$d),
         .q(quadrant_3$q),
         .clock(quadrant_3$clock)
     );
-    gyro_interface__carrier_nco__drive_sine__live_3 live_3(
+    gyro_interface__carrier_nco__drive_sine__lookup__live_3 live_3(
         .d(live_3$d),
         .q(live_3$q),
         .clock(live_3$clock)
     );
-    gyro_interface__carrier_nco__drive_sine__value_3 value_3(
+    gyro_interface__carrier_nco__drive_sine__lookup__value_3 value_3(
         .d(value_3$d),
         .q(value_3$q),
         .clock(value_3$clock)
     );
-    gyro_interface__carrier_nco__drive_sine__live_4 live_4(
+    gyro_interface__carrier_nco__drive_sine__lookup__live_4 live_4(
         .d(live_4$d),
         .q(live_4$q),
         .clock(live_4$clock)
     );
-    gyro_interface__carrier_nco__drive_sine__signed_4 signed_4(
+    gyro_interface__carrier_nco__drive_sine__lookup__signed_4 signed_4(
         .d(signed_4$d),
         .q(signed_4$q),
         .clock(signed_4$clock)
     );
-    gyro_interface__carrier_nco__drive_sine__sin_out sin_out(
+    gyro_interface__carrier_nco__drive_sine__lookup__sin_out sin_out(
         .d(sin_out$d),
         .q(sin_out$q),
         .clock(sin_out$clock)
@@ -1862,7 +1963,6 @@ module gyro_interface__carrier_nco__drive_sine(clock,phase,advance,fill_write,fi
 
     // Update code
     always @(*) begin
-        ram$clock = clock;
         index_1$clock = clock;
         quadrant_1$clock = clock;
         live_1$clock = clock;
@@ -1891,18 +1991,13 @@ module gyro_interface__carrier_nco__drive_sine(clock,phase,advance,fill_write,fi
             index_1$d = ~(phase[(32'h11)+:(13)]);
         end
         quadrant_1$d = quadrant;
-        live_1$d = ready;
-        ram$write_enable = fill_write;
-        ram$address = index_1$q;
-        if (fill_write) begin
-            ram$address = fill_address;
-        end
-        ram$write_data = fill_word;
+        live_1$d = live;
+        index = index_1$q;
         quadrant_2$d = quadrant_1$q;
         live_2$d = live_1$q;
         quadrant_3$d = quadrant_2$q;
         live_3$d = live_2$q;
-        value_3$d = ram$q;
+        value_3$d = word;
         live_4$d = live_3$q;
         signed_4$d = value_3$q;
         if (quadrant_3$q[32'h1]) begin
@@ -1915,10 +2010,10 @@ module gyro_interface__carrier_nco__drive_sine(clock,phase,advance,fill_write,fi
         sin = sin_out$q;
     end
 
-endmodule // gyro_interface__carrier_nco__drive_sine
+endmodule // gyro_interface__carrier_nco__drive_sine__lookup
 
 
-module gyro_interface__carrier_nco__drive_sine__index_1(d,q,clock);
+module gyro_interface__carrier_nco__drive_sine__lookup__index_1(d,q,clock);
 
     // Module arguments
     input wire  [12:0] d;
@@ -1934,29 +2029,10 @@ module gyro_interface__carrier_nco__drive_sine__index_1(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive_sine__index_1
+endmodule // gyro_interface__carrier_nco__drive_sine__lookup__index_1
 
 
-module gyro_interface__carrier_nco__drive_sine__live_1(d,q,clock);
-
-    // Module arguments
-    input wire  d;
-    output reg  q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 1'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__drive_sine__live_1
-
-
-module gyro_interface__carrier_nco__drive_sine__live_2(d,q,clock);
+module gyro_interface__carrier_nco__drive_sine__lookup__live_1(d,q,clock);
 
     // Module arguments
     input wire  d;
@@ -1972,29 +2048,10 @@ module gyro_interface__carrier_nco__drive_sine__live_2(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive_sine__live_2
+endmodule // gyro_interface__carrier_nco__drive_sine__lookup__live_1
 
 
-module gyro_interface__carrier_nco__drive_sine__live_3(d,q,clock);
-
-    // Module arguments
-    input wire  d;
-    output reg  q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 1'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__drive_sine__live_3
-
-
-module gyro_interface__carrier_nco__drive_sine__live_4(d,q,clock);
+module gyro_interface__carrier_nco__drive_sine__lookup__live_2(d,q,clock);
 
     // Module arguments
     input wire  d;
@@ -2010,10 +2067,48 @@ module gyro_interface__carrier_nco__drive_sine__live_4(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive_sine__live_4
+endmodule // gyro_interface__carrier_nco__drive_sine__lookup__live_2
 
 
-module gyro_interface__carrier_nco__drive_sine__quadrant_1(d,q,clock);
+module gyro_interface__carrier_nco__drive_sine__lookup__live_3(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive_sine__lookup__live_3
+
+
+module gyro_interface__carrier_nco__drive_sine__lookup__live_4(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive_sine__lookup__live_4
+
+
+module gyro_interface__carrier_nco__drive_sine__lookup__quadrant_1(d,q,clock);
 
     // Module arguments
     input wire  [1:0] d;
@@ -2029,29 +2124,10 @@ module gyro_interface__carrier_nco__drive_sine__quadrant_1(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive_sine__quadrant_1
+endmodule // gyro_interface__carrier_nco__drive_sine__lookup__quadrant_1
 
 
-module gyro_interface__carrier_nco__drive_sine__quadrant_2(d,q,clock);
-
-    // Module arguments
-    input wire  [1:0] d;
-    output reg  [1:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 2'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__drive_sine__quadrant_2
-
-
-module gyro_interface__carrier_nco__drive_sine__quadrant_3(d,q,clock);
+module gyro_interface__carrier_nco__drive_sine__lookup__quadrant_2(d,q,clock);
 
     // Module arguments
     input wire  [1:0] d;
@@ -2067,7 +2143,83 @@ module gyro_interface__carrier_nco__drive_sine__quadrant_3(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive_sine__quadrant_3
+endmodule // gyro_interface__carrier_nco__drive_sine__lookup__quadrant_2
+
+
+module gyro_interface__carrier_nco__drive_sine__lookup__quadrant_3(d,q,clock);
+
+    // Module arguments
+    input wire  [1:0] d;
+    output reg  [1:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 2'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive_sine__lookup__quadrant_3
+
+
+module gyro_interface__carrier_nco__drive_sine__lookup__signed_4(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive_sine__lookup__signed_4
+
+
+module gyro_interface__carrier_nco__drive_sine__lookup__sin_out(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive_sine__lookup__sin_out
+
+
+module gyro_interface__carrier_nco__drive_sine__lookup__value_3(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive_sine__lookup__value_3
 
 
 module gyro_interface__carrier_nco__drive_sine__ram(clock,write_enable,address,write_data,q);
@@ -2091,92 +2243,56 @@ module gyro_interface__carrier_nco__drive_sine__ram(clock,write_enable,address,w
 endmodule // gyro_interface__carrier_nco__drive_sine__ram
 
 
-module gyro_interface__carrier_nco__drive_sine__signed_4(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__drive_sine__signed_4
-
-
-module gyro_interface__carrier_nco__drive_sine__sin_out(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__drive_sine__sin_out
-
-
-module gyro_interface__carrier_nco__drive_sine__value_3(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__drive_sine__value_3
-
-
-module gyro_interface__carrier_nco__fill(clock,busy,phase,write,address,ready);
+module gyro_interface__carrier_nco__fill(clock,busy,phase,sine,write,address,word,ready);
 
     // Module arguments
     input wire  clock;
     output reg  busy;
     output reg  [31:0] phase;
+    input wire signed [15:0] sine;
     output reg  write;
     output reg  [12:0] address;
+    output reg signed [15:0] word;
     output reg  ready;
 
     // Constant declarations
-    localparam  last = 14'b10000000010000;
-    localparam  entries = 14'b10000000000000;
-    localparam  centre = 32'h10000;
-    localparam  index_shift = 32'h11;
+    localparam  last = 14'b10000000100000;
+    localparam  requests = 14'b10000000000011;
+    localparam  first_written = 14'b11;
+    localparam  entry_shift = 32'h12;
+    localparam  half_rom_step = 32'h20000;
+    localparam signed round_down = 18'b1;
+    localparam signed round_up = 18'b10;
+    localparam  one = 6'b1;
 
     // Stub signals
     reg  [13:0] count$d;
     wire  [13:0] count$q;
     reg  count$clock;
-    reg  [4:0] pending$d;
-    wire  [4:0] pending$q;
+    reg  [5:0] pending$d;
+    wire  [5:0] pending$q;
     reg  pending$clock;
     reg  [12:0] write_address$d;
     wire  [12:0] write_address$q;
     reg  write_address$clock;
+    reg signed [15:0] previous_1$d;
+    wire signed [15:0] previous_1$q;
+    reg  previous_1$clock;
+    reg signed [15:0] previous_2$d;
+    wire signed [15:0] previous_2$q;
+    reg  previous_2$clock;
+    reg signed [15:0] entry$d;
+    wire signed [15:0] entry$q;
+    reg  entry$clock;
 
     // Local signals
     reg  counting;
+    reg  wanted;
+    reg signed [17:0] near;
+    reg signed [17:0] far;
+    reg signed [17:0] sum;
+    reg signed [17:0] rounded;
+    reg signed [15:0] quotient;
 
     // Sub module instances
     gyro_interface__carrier_nco__fill__count count(
@@ -2194,27 +2310,68 @@ module gyro_interface__carrier_nco__fill(clock,busy,phase,write,address,ready);
         .q(write_address$q),
         .clock(write_address$clock)
     );
+    gyro_interface__carrier_nco__fill__previous_1 previous_1(
+        .d(previous_1$d),
+        .q(previous_1$q),
+        .clock(previous_1$clock)
+    );
+    gyro_interface__carrier_nco__fill__previous_2 previous_2(
+        .d(previous_2$d),
+        .q(previous_2$q),
+        .clock(previous_2$clock)
+    );
+    gyro_interface__carrier_nco__fill__entry entry(
+        .d(entry$d),
+        .q(entry$q),
+        .clock(entry$clock)
+    );
 
     // Update code
     always @(*) begin
         count$clock = clock;
         pending$clock = clock;
         write_address$clock = clock;
+        previous_1$clock = clock;
+        previous_2$clock = clock;
+        entry$clock = clock;
         count$d = count$q;
         pending$d = pending$q;
         write_address$d = write_address$q;
+        previous_1$d = previous_1$q;
+        previous_2$d = previous_2$q;
+        entry$d = entry$q;
         counting = count$q != last;
         if (counting) begin
             count$d = count$q + 32'h1;
         end
-        busy = count$q < entries;
-        phase = (((count$q[(32'h0)+:(13)]) & 32'hffffffff) << index_shift) | centre;
-        pending$d = (pending$q << 32'h1) | ((busy) & 5'h1f);
-        write = pending$q[32'h4];
-        if (pending$q[32'h4]) begin
+        busy = count$q < requests;
+        phase = (((count$q[(32'h1)+:(13)]) & 32'hffffffff) << entry_shift) - half_rom_step;
+        wanted = busy & (count$q >= first_written);
+        previous_1$d = sine;
+        previous_2$d = previous_1$q;
+        near = $signed(sine);
+        far = $signed(previous_2$q);
+        if (count$q[32'h0]) begin
+            near = $signed(previous_2$q);
+            far = $signed(sine);
+        end
+        sum = far + near + near + near;
+        rounded = sum + round_down;
+        if (sum[32'h2]) begin
+            rounded = sum + round_up;
+        end
+        quotient = rounded[(32'h2)+:(16)];
+        entry$d = quotient;
+        pending$d = pending$q << 32'h1;
+        if (wanted) begin
+            pending$d = (pending$q << 32'h1) | one;
+        end
+        write = pending$q[32'h5];
+        if (pending$q[32'h5]) begin
             write_address$d = write_address$q + 32'h1;
         end
         address = write_address$q;
+        word = entry$q;
         ready = ~counting;
     end
 
@@ -2240,16 +2397,35 @@ module gyro_interface__carrier_nco__fill__count(d,q,clock);
 endmodule // gyro_interface__carrier_nco__fill__count
 
 
-module gyro_interface__carrier_nco__fill__pending(d,q,clock);
+module gyro_interface__carrier_nco__fill__entry(d,q,clock);
 
     // Module arguments
-    input wire  [4:0] d;
-    output reg  [4:0] q;
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 5'h0;
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__fill__entry
+
+
+module gyro_interface__carrier_nco__fill__pending(d,q,clock);
+
+    // Module arguments
+    input wire  [5:0] d;
+    output reg  [5:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 6'h0;
     end
 
     always @(posedge clock) begin
@@ -2257,6 +2433,44 @@ module gyro_interface__carrier_nco__fill__pending(d,q,clock);
     end
 
 endmodule // gyro_interface__carrier_nco__fill__pending
+
+
+module gyro_interface__carrier_nco__fill__previous_1(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__fill__previous_1
+
+
+module gyro_interface__carrier_nco__fill__previous_2(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__fill__previous_2
 
 
 module gyro_interface__carrier_nco__fill__write_address(d,q,clock);
@@ -2309,15 +2523,73 @@ module gyro_interface__carrier_nco__ref_cosine(clock,phase,advance,fill_write,fi
     input wire  ready;
     output reg signed [15:0] sin;
 
-    // Constant declarations
-    localparam signed zero = 16'h0;
-
     // Stub signals
+    reg  lookup$clock;
+    reg  [31:0] lookup$phase;
+    reg  [1:0] lookup$advance;
+    reg  lookup$live;
+    wire  [12:0] lookup$index;
+    reg signed [15:0] lookup$word;
+    wire signed [15:0] lookup$sin;
     reg  ram$clock;
     reg  ram$write_enable;
     reg  [12:0] ram$address;
     reg signed [15:0] ram$write_data;
     wire signed [15:0] ram$q;
+
+    // Sub module instances
+    gyro_interface__carrier_nco__ref_cosine__lookup lookup(
+        .clock(lookup$clock),
+        .phase(lookup$phase),
+        .advance(lookup$advance),
+        .live(lookup$live),
+        .index(lookup$index),
+        .word(lookup$word),
+        .sin(lookup$sin)
+    );
+    gyro_interface__carrier_nco__ref_cosine__ram ram(
+        .clock(ram$clock),
+        .write_enable(ram$write_enable),
+        .address(ram$address),
+        .write_data(ram$write_data),
+        .q(ram$q)
+    );
+
+    // Update code
+    always @(*) begin
+        lookup$clock = clock;
+        ram$clock = clock;
+        lookup$phase = phase;
+        lookup$advance = advance;
+        lookup$live = ready;
+        ram$write_enable = fill_write;
+        ram$address = lookup$index;
+        if (fill_write) begin
+            ram$address = fill_address;
+        end
+        ram$write_data = fill_word;
+        lookup$word = ram$q;
+        sin = lookup$sin;
+    end
+
+endmodule // gyro_interface__carrier_nco__ref_cosine
+
+
+module gyro_interface__carrier_nco__ref_cosine__lookup(clock,phase,advance,live,index,word,sin);
+
+    // Module arguments
+    input wire  clock;
+    input wire  [31:0] phase;
+    input wire  [1:0] advance;
+    input wire  live;
+    output reg  [12:0] index;
+    input wire signed [15:0] word;
+    output reg signed [15:0] sin;
+
+    // Constant declarations
+    localparam signed zero = 16'h0;
+
+    // Stub signals
     reg  [12:0] index_1$d;
     wire  [12:0] index_1$q;
     reg  index_1$clock;
@@ -2356,64 +2628,57 @@ module gyro_interface__carrier_nco__ref_cosine(clock,phase,advance,fill_write,fi
     reg  [1:0] quadrant;
 
     // Sub module instances
-    gyro_interface__carrier_nco__ref_cosine__ram ram(
-        .clock(ram$clock),
-        .write_enable(ram$write_enable),
-        .address(ram$address),
-        .write_data(ram$write_data),
-        .q(ram$q)
-    );
-    gyro_interface__carrier_nco__ref_cosine__index_1 index_1(
+    gyro_interface__carrier_nco__ref_cosine__lookup__index_1 index_1(
         .d(index_1$d),
         .q(index_1$q),
         .clock(index_1$clock)
     );
-    gyro_interface__carrier_nco__ref_cosine__quadrant_1 quadrant_1(
+    gyro_interface__carrier_nco__ref_cosine__lookup__quadrant_1 quadrant_1(
         .d(quadrant_1$d),
         .q(quadrant_1$q),
         .clock(quadrant_1$clock)
     );
-    gyro_interface__carrier_nco__ref_cosine__live_1 live_1(
+    gyro_interface__carrier_nco__ref_cosine__lookup__live_1 live_1(
         .d(live_1$d),
         .q(live_1$q),
         .clock(live_1$clock)
     );
-    gyro_interface__carrier_nco__ref_cosine__quadrant_2 quadrant_2(
+    gyro_interface__carrier_nco__ref_cosine__lookup__quadrant_2 quadrant_2(
         .d(quadrant_2$d),
         .q(quadrant_2$q),
         .clock(quadrant_2$clock)
     );
-    gyro_interface__carrier_nco__ref_cosine__live_2 live_2(
+    gyro_interface__carrier_nco__ref_cosine__lookup__live_2 live_2(
         .d(live_2$d),
         .q(live_2$q),
         .clock(live_2$clock)
     );
-    gyro_interface__carrier_nco__ref_cosine__quadrant_3 quadrant_3(
+    gyro_interface__carrier_nco__ref_cosine__lookup__quadrant_3 quadrant_3(
         .d(quadrant_3$d),
         .q(quadrant_3$q),
         .clock(quadrant_3$clock)
     );
-    gyro_interface__carrier_nco__ref_cosine__live_3 live_3(
+    gyro_interface__carrier_nco__ref_cosine__lookup__live_3 live_3(
         .d(live_3$d),
         .q(live_3$q),
         .clock(live_3$clock)
     );
-    gyro_interface__carrier_nco__ref_cosine__value_3 value_3(
+    gyro_interface__carrier_nco__ref_cosine__lookup__value_3 value_3(
         .d(value_3$d),
         .q(value_3$q),
         .clock(value_3$clock)
     );
-    gyro_interface__carrier_nco__ref_cosine__live_4 live_4(
+    gyro_interface__carrier_nco__ref_cosine__lookup__live_4 live_4(
         .d(live_4$d),
         .q(live_4$q),
         .clock(live_4$clock)
     );
-    gyro_interface__carrier_nco__ref_cosine__signed_4 signed_4(
+    gyro_interface__carrier_nco__ref_cosine__lookup__signed_4 signed_4(
         .d(signed_4$d),
         .q(signed_4$q),
         .clock(signed_4$clock)
     );
-    gyro_interface__carrier_nco__ref_cosine__sin_out sin_out(
+    gyro_interface__carrier_nco__ref_cosine__lookup__sin_out sin_out(
         .d(sin_out$d),
         .q(sin_out$q),
         .clock(sin_out$clock)
@@ -2421,7 +2686,6 @@ module gyro_interface__carrier_nco__ref_cosine(clock,phase,advance,fill_write,fi
 
     // Update code
     always @(*) begin
-        ram$clock = clock;
         index_1$clock = clock;
         quadrant_1$clock = clock;
         live_1$clock = clock;
@@ -2450,18 +2714,13 @@ module gyro_interface__carrier_nco__ref_cosine(clock,phase,advance,fill_write,fi
             index_1$d = ~(phase[(32'h11)+:(13)]);
         end
         quadrant_1$d = quadrant;
-        live_1$d = ready;
-        ram$write_enable = fill_write;
-        ram$address = index_1$q;
-        if (fill_write) begin
-            ram$address = fill_address;
-        end
-        ram$write_data = fill_word;
+        live_1$d = live;
+        index = index_1$q;
         quadrant_2$d = quadrant_1$q;
         live_2$d = live_1$q;
         quadrant_3$d = quadrant_2$q;
         live_3$d = live_2$q;
-        value_3$d = ram$q;
+        value_3$d = word;
         live_4$d = live_3$q;
         signed_4$d = value_3$q;
         if (quadrant_3$q[32'h1]) begin
@@ -2474,10 +2733,10 @@ module gyro_interface__carrier_nco__ref_cosine(clock,phase,advance,fill_write,fi
         sin = sin_out$q;
     end
 
-endmodule // gyro_interface__carrier_nco__ref_cosine
+endmodule // gyro_interface__carrier_nco__ref_cosine__lookup
 
 
-module gyro_interface__carrier_nco__ref_cosine__index_1(d,q,clock);
+module gyro_interface__carrier_nco__ref_cosine__lookup__index_1(d,q,clock);
 
     // Module arguments
     input wire  [12:0] d;
@@ -2493,29 +2752,10 @@ module gyro_interface__carrier_nco__ref_cosine__index_1(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__ref_cosine__index_1
+endmodule // gyro_interface__carrier_nco__ref_cosine__lookup__index_1
 
 
-module gyro_interface__carrier_nco__ref_cosine__live_1(d,q,clock);
-
-    // Module arguments
-    input wire  d;
-    output reg  q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 1'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__ref_cosine__live_1
-
-
-module gyro_interface__carrier_nco__ref_cosine__live_2(d,q,clock);
+module gyro_interface__carrier_nco__ref_cosine__lookup__live_1(d,q,clock);
 
     // Module arguments
     input wire  d;
@@ -2531,29 +2771,10 @@ module gyro_interface__carrier_nco__ref_cosine__live_2(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__ref_cosine__live_2
+endmodule // gyro_interface__carrier_nco__ref_cosine__lookup__live_1
 
 
-module gyro_interface__carrier_nco__ref_cosine__live_3(d,q,clock);
-
-    // Module arguments
-    input wire  d;
-    output reg  q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 1'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__ref_cosine__live_3
-
-
-module gyro_interface__carrier_nco__ref_cosine__live_4(d,q,clock);
+module gyro_interface__carrier_nco__ref_cosine__lookup__live_2(d,q,clock);
 
     // Module arguments
     input wire  d;
@@ -2569,10 +2790,48 @@ module gyro_interface__carrier_nco__ref_cosine__live_4(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__ref_cosine__live_4
+endmodule // gyro_interface__carrier_nco__ref_cosine__lookup__live_2
 
 
-module gyro_interface__carrier_nco__ref_cosine__quadrant_1(d,q,clock);
+module gyro_interface__carrier_nco__ref_cosine__lookup__live_3(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__ref_cosine__lookup__live_3
+
+
+module gyro_interface__carrier_nco__ref_cosine__lookup__live_4(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__ref_cosine__lookup__live_4
+
+
+module gyro_interface__carrier_nco__ref_cosine__lookup__quadrant_1(d,q,clock);
 
     // Module arguments
     input wire  [1:0] d;
@@ -2588,29 +2847,10 @@ module gyro_interface__carrier_nco__ref_cosine__quadrant_1(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__ref_cosine__quadrant_1
+endmodule // gyro_interface__carrier_nco__ref_cosine__lookup__quadrant_1
 
 
-module gyro_interface__carrier_nco__ref_cosine__quadrant_2(d,q,clock);
-
-    // Module arguments
-    input wire  [1:0] d;
-    output reg  [1:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 2'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__ref_cosine__quadrant_2
-
-
-module gyro_interface__carrier_nco__ref_cosine__quadrant_3(d,q,clock);
+module gyro_interface__carrier_nco__ref_cosine__lookup__quadrant_2(d,q,clock);
 
     // Module arguments
     input wire  [1:0] d;
@@ -2626,7 +2866,83 @@ module gyro_interface__carrier_nco__ref_cosine__quadrant_3(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__ref_cosine__quadrant_3
+endmodule // gyro_interface__carrier_nco__ref_cosine__lookup__quadrant_2
+
+
+module gyro_interface__carrier_nco__ref_cosine__lookup__quadrant_3(d,q,clock);
+
+    // Module arguments
+    input wire  [1:0] d;
+    output reg  [1:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 2'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__ref_cosine__lookup__quadrant_3
+
+
+module gyro_interface__carrier_nco__ref_cosine__lookup__signed_4(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__ref_cosine__lookup__signed_4
+
+
+module gyro_interface__carrier_nco__ref_cosine__lookup__sin_out(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__ref_cosine__lookup__sin_out
+
+
+module gyro_interface__carrier_nco__ref_cosine__lookup__value_3(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__ref_cosine__lookup__value_3
 
 
 module gyro_interface__carrier_nco__ref_cosine__ram(clock,write_enable,address,write_data,q);
@@ -2650,63 +2966,6 @@ module gyro_interface__carrier_nco__ref_cosine__ram(clock,write_enable,address,w
 endmodule // gyro_interface__carrier_nco__ref_cosine__ram
 
 
-module gyro_interface__carrier_nco__ref_cosine__signed_4(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__ref_cosine__signed_4
-
-
-module gyro_interface__carrier_nco__ref_cosine__sin_out(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__ref_cosine__sin_out
-
-
-module gyro_interface__carrier_nco__ref_cosine__value_3(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__ref_cosine__value_3
-
-
 module gyro_interface__carrier_nco__ref_sine(clock,phase,advance,fill_write,fill_address,fill_word,ready,sin);
 
     // Module arguments
@@ -2719,15 +2978,73 @@ module gyro_interface__carrier_nco__ref_sine(clock,phase,advance,fill_write,fill
     input wire  ready;
     output reg signed [15:0] sin;
 
-    // Constant declarations
-    localparam signed zero = 16'h0;
-
     // Stub signals
+    reg  lookup$clock;
+    reg  [31:0] lookup$phase;
+    reg  [1:0] lookup$advance;
+    reg  lookup$live;
+    wire  [12:0] lookup$index;
+    reg signed [15:0] lookup$word;
+    wire signed [15:0] lookup$sin;
     reg  ram$clock;
     reg  ram$write_enable;
     reg  [12:0] ram$address;
     reg signed [15:0] ram$write_data;
     wire signed [15:0] ram$q;
+
+    // Sub module instances
+    gyro_interface__carrier_nco__ref_sine__lookup lookup(
+        .clock(lookup$clock),
+        .phase(lookup$phase),
+        .advance(lookup$advance),
+        .live(lookup$live),
+        .index(lookup$index),
+        .word(lookup$word),
+        .sin(lookup$sin)
+    );
+    gyro_interface__carrier_nco__ref_sine__ram ram(
+        .clock(ram$clock),
+        .write_enable(ram$write_enable),
+        .address(ram$address),
+        .write_data(ram$write_data),
+        .q(ram$q)
+    );
+
+    // Update code
+    always @(*) begin
+        lookup$clock = clock;
+        ram$clock = clock;
+        lookup$phase = phase;
+        lookup$advance = advance;
+        lookup$live = ready;
+        ram$write_enable = fill_write;
+        ram$address = lookup$index;
+        if (fill_write) begin
+            ram$address = fill_address;
+        end
+        ram$write_data = fill_word;
+        lookup$word = ram$q;
+        sin = lookup$sin;
+    end
+
+endmodule // gyro_interface__carrier_nco__ref_sine
+
+
+module gyro_interface__carrier_nco__ref_sine__lookup(clock,phase,advance,live,index,word,sin);
+
+    // Module arguments
+    input wire  clock;
+    input wire  [31:0] phase;
+    input wire  [1:0] advance;
+    input wire  live;
+    output reg  [12:0] index;
+    input wire signed [15:0] word;
+    output reg signed [15:0] sin;
+
+    // Constant declarations
+    localparam signed zero = 16'h0;
+
+    // Stub signals
     reg  [12:0] index_1$d;
     wire  [12:0] index_1$q;
     reg  index_1$clock;
@@ -2766,64 +3083,57 @@ module gyro_interface__carrier_nco__ref_sine(clock,phase,advance,fill_write,fill
     reg  [1:0] quadrant;
 
     // Sub module instances
-    gyro_interface__carrier_nco__ref_sine__ram ram(
-        .clock(ram$clock),
-        .write_enable(ram$write_enable),
-        .address(ram$address),
-        .write_data(ram$write_data),
-        .q(ram$q)
-    );
-    gyro_interface__carrier_nco__ref_sine__index_1 index_1(
+    gyro_interface__carrier_nco__ref_sine__lookup__index_1 index_1(
         .d(index_1$d),
         .q(index_1$q),
         .clock(index_1$clock)
     );
-    gyro_interface__carrier_nco__ref_sine__quadrant_1 quadrant_1(
+    gyro_interface__carrier_nco__ref_sine__lookup__quadrant_1 quadrant_1(
         .d(quadrant_1$d),
         .q(quadrant_1$q),
         .clock(quadrant_1$clock)
     );
-    gyro_interface__carrier_nco__ref_sine__live_1 live_1(
+    gyro_interface__carrier_nco__ref_sine__lookup__live_1 live_1(
         .d(live_1$d),
         .q(live_1$q),
         .clock(live_1$clock)
     );
-    gyro_interface__carrier_nco__ref_sine__quadrant_2 quadrant_2(
+    gyro_interface__carrier_nco__ref_sine__lookup__quadrant_2 quadrant_2(
         .d(quadrant_2$d),
         .q(quadrant_2$q),
         .clock(quadrant_2$clock)
     );
-    gyro_interface__carrier_nco__ref_sine__live_2 live_2(
+    gyro_interface__carrier_nco__ref_sine__lookup__live_2 live_2(
         .d(live_2$d),
         .q(live_2$q),
         .clock(live_2$clock)
     );
-    gyro_interface__carrier_nco__ref_sine__quadrant_3 quadrant_3(
+    gyro_interface__carrier_nco__ref_sine__lookup__quadrant_3 quadrant_3(
         .d(quadrant_3$d),
         .q(quadrant_3$q),
         .clock(quadrant_3$clock)
     );
-    gyro_interface__carrier_nco__ref_sine__live_3 live_3(
+    gyro_interface__carrier_nco__ref_sine__lookup__live_3 live_3(
         .d(live_3$d),
         .q(live_3$q),
         .clock(live_3$clock)
     );
-    gyro_interface__carrier_nco__ref_sine__value_3 value_3(
+    gyro_interface__carrier_nco__ref_sine__lookup__value_3 value_3(
         .d(value_3$d),
         .q(value_3$q),
         .clock(value_3$clock)
     );
-    gyro_interface__carrier_nco__ref_sine__live_4 live_4(
+    gyro_interface__carrier_nco__ref_sine__lookup__live_4 live_4(
         .d(live_4$d),
         .q(live_4$q),
         .clock(live_4$clock)
     );
-    gyro_interface__carrier_nco__ref_sine__signed_4 signed_4(
+    gyro_interface__carrier_nco__ref_sine__lookup__signed_4 signed_4(
         .d(signed_4$d),
         .q(signed_4$q),
         .clock(signed_4$clock)
     );
-    gyro_interface__carrier_nco__ref_sine__sin_out sin_out(
+    gyro_interface__carrier_nco__ref_sine__lookup__sin_out sin_out(
         .d(sin_out$d),
         .q(sin_out$q),
         .clock(sin_out$clock)
@@ -2831,7 +3141,6 @@ module gyro_interface__carrier_nco__ref_sine(clock,phase,advance,fill_write,fill
 
     // Update code
     always @(*) begin
-        ram$clock = clock;
         index_1$clock = clock;
         quadrant_1$clock = clock;
         live_1$clock = clock;
@@ -2860,18 +3169,13 @@ module gyro_interface__carrier_nco__ref_sine(clock,phase,advance,fill_write,fill
             index_1$d = ~(phase[(32'h11)+:(13)]);
         end
         quadrant_1$d = quadrant;
-        live_1$d = ready;
-        ram$write_enable = fill_write;
-        ram$address = index_1$q;
-        if (fill_write) begin
-            ram$address = fill_address;
-        end
-        ram$write_data = fill_word;
+        live_1$d = live;
+        index = index_1$q;
         quadrant_2$d = quadrant_1$q;
         live_2$d = live_1$q;
         quadrant_3$d = quadrant_2$q;
         live_3$d = live_2$q;
-        value_3$d = ram$q;
+        value_3$d = word;
         live_4$d = live_3$q;
         signed_4$d = value_3$q;
         if (quadrant_3$q[32'h1]) begin
@@ -2884,10 +3188,10 @@ module gyro_interface__carrier_nco__ref_sine(clock,phase,advance,fill_write,fill
         sin = sin_out$q;
     end
 
-endmodule // gyro_interface__carrier_nco__ref_sine
+endmodule // gyro_interface__carrier_nco__ref_sine__lookup
 
 
-module gyro_interface__carrier_nco__ref_sine__index_1(d,q,clock);
+module gyro_interface__carrier_nco__ref_sine__lookup__index_1(d,q,clock);
 
     // Module arguments
     input wire  [12:0] d;
@@ -2903,29 +3207,10 @@ module gyro_interface__carrier_nco__ref_sine__index_1(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__ref_sine__index_1
+endmodule // gyro_interface__carrier_nco__ref_sine__lookup__index_1
 
 
-module gyro_interface__carrier_nco__ref_sine__live_1(d,q,clock);
-
-    // Module arguments
-    input wire  d;
-    output reg  q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 1'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__ref_sine__live_1
-
-
-module gyro_interface__carrier_nco__ref_sine__live_2(d,q,clock);
+module gyro_interface__carrier_nco__ref_sine__lookup__live_1(d,q,clock);
 
     // Module arguments
     input wire  d;
@@ -2941,29 +3226,10 @@ module gyro_interface__carrier_nco__ref_sine__live_2(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__ref_sine__live_2
+endmodule // gyro_interface__carrier_nco__ref_sine__lookup__live_1
 
 
-module gyro_interface__carrier_nco__ref_sine__live_3(d,q,clock);
-
-    // Module arguments
-    input wire  d;
-    output reg  q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 1'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__ref_sine__live_3
-
-
-module gyro_interface__carrier_nco__ref_sine__live_4(d,q,clock);
+module gyro_interface__carrier_nco__ref_sine__lookup__live_2(d,q,clock);
 
     // Module arguments
     input wire  d;
@@ -2979,10 +3245,48 @@ module gyro_interface__carrier_nco__ref_sine__live_4(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__ref_sine__live_4
+endmodule // gyro_interface__carrier_nco__ref_sine__lookup__live_2
 
 
-module gyro_interface__carrier_nco__ref_sine__quadrant_1(d,q,clock);
+module gyro_interface__carrier_nco__ref_sine__lookup__live_3(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__ref_sine__lookup__live_3
+
+
+module gyro_interface__carrier_nco__ref_sine__lookup__live_4(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__ref_sine__lookup__live_4
+
+
+module gyro_interface__carrier_nco__ref_sine__lookup__quadrant_1(d,q,clock);
 
     // Module arguments
     input wire  [1:0] d;
@@ -2998,29 +3302,10 @@ module gyro_interface__carrier_nco__ref_sine__quadrant_1(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__ref_sine__quadrant_1
+endmodule // gyro_interface__carrier_nco__ref_sine__lookup__quadrant_1
 
 
-module gyro_interface__carrier_nco__ref_sine__quadrant_2(d,q,clock);
-
-    // Module arguments
-    input wire  [1:0] d;
-    output reg  [1:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 2'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__ref_sine__quadrant_2
-
-
-module gyro_interface__carrier_nco__ref_sine__quadrant_3(d,q,clock);
+module gyro_interface__carrier_nco__ref_sine__lookup__quadrant_2(d,q,clock);
 
     // Module arguments
     input wire  [1:0] d;
@@ -3036,7 +3321,83 @@ module gyro_interface__carrier_nco__ref_sine__quadrant_3(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__ref_sine__quadrant_3
+endmodule // gyro_interface__carrier_nco__ref_sine__lookup__quadrant_2
+
+
+module gyro_interface__carrier_nco__ref_sine__lookup__quadrant_3(d,q,clock);
+
+    // Module arguments
+    input wire  [1:0] d;
+    output reg  [1:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 2'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__ref_sine__lookup__quadrant_3
+
+
+module gyro_interface__carrier_nco__ref_sine__lookup__signed_4(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__ref_sine__lookup__signed_4
+
+
+module gyro_interface__carrier_nco__ref_sine__lookup__sin_out(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__ref_sine__lookup__sin_out
+
+
+module gyro_interface__carrier_nco__ref_sine__lookup__value_3(d,q,clock);
+
+    // Module arguments
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__carrier_nco__ref_sine__lookup__value_3
 
 
 module gyro_interface__carrier_nco__ref_sine__ram(clock,write_enable,address,write_data,q);
@@ -3060,63 +3421,6 @@ module gyro_interface__carrier_nco__ref_sine__ram(clock,write_enable,address,wri
 endmodule // gyro_interface__carrier_nco__ref_sine__ram
 
 
-module gyro_interface__carrier_nco__ref_sine__signed_4(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__ref_sine__signed_4
-
-
-module gyro_interface__carrier_nco__ref_sine__sin_out(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__ref_sine__sin_out
-
-
-module gyro_interface__carrier_nco__ref_sine__value_3(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__carrier_nco__ref_sine__value_3
-
-
 module gyro_interface__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
 
     // Module arguments
@@ -3134,21 +3438,30 @@ module gyro_interface__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
     localparam  coarse_shift_mask = 6'b111000;
     localparam  fine_shift_mask = 6'b111;
     localparam  next_address = 3'b1;
+    localparam  half_shift = 8'h28;
 
     // Enums
     localparam CicStep$Idle = 0;
-    localparam CicStep$FirstComb1 = 1;
-    localparam CicStep$FirstComb2 = 2;
-    localparam CicStep$FirstComb3 = 3;
-    localparam CicStep$FirstComb4 = 4;
-    localparam CicStep$SecondLoad = 5;
-    localparam CicStep$SecondComb1 = 6;
-    localparam CicStep$SecondComb2 = 7;
-    localparam CicStep$SecondComb3 = 8;
-    localparam CicStep$SecondComb4 = 9;
-    localparam CicStep$SecondCoarse = 10;
-    localparam CicStep$SecondFine = 11;
-    localparam CicStep$SecondRound = 12;
+    localparam CicStep$FirstLow1 = 1;
+    localparam CicStep$FirstHigh1 = 2;
+    localparam CicStep$FirstLow2 = 3;
+    localparam CicStep$FirstHigh2 = 4;
+    localparam CicStep$FirstLow3 = 5;
+    localparam CicStep$FirstHigh3 = 6;
+    localparam CicStep$FirstLow4 = 7;
+    localparam CicStep$FirstHigh4 = 8;
+    localparam CicStep$SecondLoad = 9;
+    localparam CicStep$SecondLow1 = 10;
+    localparam CicStep$SecondHigh1 = 11;
+    localparam CicStep$SecondLow2 = 12;
+    localparam CicStep$SecondHigh2 = 13;
+    localparam CicStep$SecondLow3 = 14;
+    localparam CicStep$SecondHigh3 = 15;
+    localparam CicStep$SecondLow4 = 16;
+    localparam CicStep$SecondHigh4 = 17;
+    localparam CicStep$SecondCoarse = 18;
+    localparam CicStep$SecondFine = 19;
+    localparam CicStep$SecondRound = 20;
 
     // Stub signals
     reg  integrators1$clock;
@@ -3160,8 +3473,8 @@ module gyro_interface__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
     reg  [12:0] count$d;
     wire  [12:0] count$q;
     reg  count$clock;
-    reg  [3:0] step$d;
-    wire  [3:0] step$q;
+    reg  [4:0] step$d;
+    wire  [4:0] step$q;
     reg  step$clock;
     reg signed [79:0] acc$d;
     wire signed [79:0] acc$q;
@@ -3181,6 +3494,12 @@ module gyro_interface__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
     reg  [2:0] delay_address$d;
     wire  [2:0] delay_address$q;
     reg  delay_address$clock;
+    reg  borrow$d;
+    wire  borrow$q;
+    reg  borrow$clock;
+    reg  [39:0] delay_high$d;
+    wire  [39:0] delay_high$q;
+    reg  delay_high$clock;
     reg  [47:0] coarse$d;
     wire  [47:0] coarse$q;
     reg  coarse$clock;
@@ -3201,7 +3520,15 @@ module gyro_interface__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
     reg  valid_out$clock;
 
     // Local signals
-    reg  combing;
+    reg  comb_low;
+    reg  comb_high;
+    reg  [79:0] acc_bits;
+    reg  [79:0] delay_bits;
+    reg  [39:0] acc_low;
+    reg  [39:0] acc_high;
+    reg  [39:0] delay_low;
+    reg  [40:0] low_difference;
+    reg  [40:0] high_difference;
     reg signed [103:0] extended;
     reg  [103:0] doubled;
     reg  [5:0] coarse_shift;
@@ -3260,6 +3587,16 @@ module gyro_interface__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
         .q(delay_address$q),
         .clock(delay_address$clock)
     );
+    gyro_interface__cic__borrow borrow(
+        .d(borrow$d),
+        .q(borrow$q),
+        .clock(borrow$clock)
+    );
+    gyro_interface__cic__delay_high delay_high(
+        .d(delay_high$d),
+        .q(delay_high$q),
+        .clock(delay_high$clock)
+    );
     gyro_interface__cic__coarse coarse(
         .d(coarse$d),
         .q(coarse$q),
@@ -3299,6 +3636,8 @@ module gyro_interface__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
         sample2$clock = clock;
         held_shift$clock = clock;
         delay_address$clock = clock;
+        borrow$clock = clock;
+        delay_high$clock = clock;
         coarse$clock = clock;
         fine$clock = clock;
         y_first$clock = clock;
@@ -3311,6 +3650,8 @@ module gyro_interface__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
         sample2$d = sample2$q;
         held_shift$d = held_shift$q;
         delay_address$d = delay_address$q;
+        borrow$d = borrow$q;
+        delay_high$d = delay_high$q;
         coarse$d = coarse$q;
         fine$d = fine$q;
         y_first$d = y_first$q;
@@ -3338,7 +3679,8 @@ module gyro_interface__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
         fine$d = fine_shifted[(32'h0)+:(41)];
         rounded_half = (fine$q + one) >> 32'h1;
         rounded = $signed(rounded_half[(32'h0)+:(40)]);
-        combing = 1'b0;
+        comb_low = 1'b0;
+        comb_high = 1'b0;
         valid_out$d = 1'b0;
         case (step$q)
             CicStep$Idle:
@@ -3347,53 +3689,93 @@ module gyro_interface__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
                         acc$d = integrators1$integral;
                         sample2$d = integrators2$integral;
                         held_shift$d = shift;
-                        step$d = CicStep$FirstComb1;
+                        step$d = CicStep$FirstLow1;
                     end
                 end
-            CicStep$FirstComb1:
+            CicStep$FirstLow1:
                 begin
-                    combing = 1'b1;
-                    step$d = CicStep$FirstComb2;
+                    comb_low = 1'b1;
+                    step$d = CicStep$FirstHigh1;
                 end
-            CicStep$FirstComb2:
+            CicStep$FirstHigh1:
                 begin
-                    combing = 1'b1;
-                    step$d = CicStep$FirstComb3;
+                    comb_high = 1'b1;
+                    step$d = CicStep$FirstLow2;
                 end
-            CicStep$FirstComb3:
+            CicStep$FirstLow2:
                 begin
-                    combing = 1'b1;
-                    step$d = CicStep$FirstComb4;
+                    comb_low = 1'b1;
+                    step$d = CicStep$FirstHigh2;
                 end
-            CicStep$FirstComb4:
+            CicStep$FirstHigh2:
                 begin
-                    combing = 1'b1;
+                    comb_high = 1'b1;
+                    step$d = CicStep$FirstLow3;
+                end
+            CicStep$FirstLow3:
+                begin
+                    comb_low = 1'b1;
+                    step$d = CicStep$FirstHigh3;
+                end
+            CicStep$FirstHigh3:
+                begin
+                    comb_high = 1'b1;
+                    step$d = CicStep$FirstLow4;
+                end
+            CicStep$FirstLow4:
+                begin
+                    comb_low = 1'b1;
+                    step$d = CicStep$FirstHigh4;
+                end
+            CicStep$FirstHigh4:
+                begin
+                    comb_high = 1'b1;
                     step$d = CicStep$SecondLoad;
                 end
             CicStep$SecondLoad:
                 begin
                     acc$d = sample2$q;
-                    step$d = CicStep$SecondComb1;
+                    step$d = CicStep$SecondLow1;
                 end
-            CicStep$SecondComb1:
+            CicStep$SecondLow1:
                 begin
-                    combing = 1'b1;
-                    step$d = CicStep$SecondComb2;
+                    comb_low = 1'b1;
+                    step$d = CicStep$SecondHigh1;
                 end
-            CicStep$SecondComb2:
+            CicStep$SecondHigh1:
                 begin
-                    combing = 1'b1;
+                    comb_high = 1'b1;
                     y_first$d = rounded;
-                    step$d = CicStep$SecondComb3;
+                    step$d = CicStep$SecondLow2;
                 end
-            CicStep$SecondComb3:
+            CicStep$SecondLow2:
                 begin
-                    combing = 1'b1;
-                    step$d = CicStep$SecondComb4;
+                    comb_low = 1'b1;
+                    step$d = CicStep$SecondHigh2;
                 end
-            CicStep$SecondComb4:
+            CicStep$SecondHigh2:
                 begin
-                    combing = 1'b1;
+                    comb_high = 1'b1;
+                    step$d = CicStep$SecondLow3;
+                end
+            CicStep$SecondLow3:
+                begin
+                    comb_low = 1'b1;
+                    step$d = CicStep$SecondHigh3;
+                end
+            CicStep$SecondHigh3:
+                begin
+                    comb_high = 1'b1;
+                    step$d = CicStep$SecondLow4;
+                end
+            CicStep$SecondLow4:
+                begin
+                    comb_low = 1'b1;
+                    step$d = CicStep$SecondHigh4;
+                end
+            CicStep$SecondHigh4:
+                begin
+                    comb_high = 1'b1;
                     step$d = CicStep$SecondCoarse;
                 end
             CicStep$SecondCoarse:
@@ -3412,12 +3794,25 @@ module gyro_interface__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
                     step$d = CicStep$Idle;
                 end
         endcase
-        delays$write_enable = combing;
+        acc_bits = $unsigned(acc$q);
+        delay_bits = $unsigned(delays$q);
+        acc_low = acc_bits[(32'h0)+:(40)];
+        acc_high = acc_bits[(32'h28)+:(40)];
+        delay_low = delay_bits[(32'h0)+:(40)];
+        low_difference = ((acc_low) & 41'h1ffffffffff) - ((delay_low) & 41'h1ffffffffff);
+        high_difference = (((acc_high) & 41'h1ffffffffff) << 32'h1) - ((((delay_high$q) & 41'h1ffffffffff) << 32'h1) | ((borrow$q) & 41'h1ffffffffff));
+        delays$write_enable = comb_low;
         delays$write_address = delay_address$q;
         delays$write_data = acc$q;
         delays$read_address = delay_address$q;
-        if (combing) begin
-            acc$d = acc$q - delays$q;
+        if (comb_low) begin
+            acc$d = $signed((((acc_high) & 80'hffffffffffffffffffff) << half_shift) | ((low_difference[(32'h0)+:(40)]) & 80'hffffffffffffffffffff));
+            borrow$d = low_difference[(32'h28)+:(1)];
+            delay_high$d = delay_bits[(32'h28)+:(40)];
+            delays$read_address = delay_address$q + next_address;
+        end
+        if (comb_high) begin
+            acc$d = $signed((((high_difference[(32'h1)+:(40)]) & 80'hffffffffffffffffffff) << half_shift) | ((acc_low) & 80'hffffffffffffffffffff));
             delay_address$d = delay_address$q + next_address;
             delays$read_address = delay_address$q + next_address;
         end
@@ -3446,6 +3841,25 @@ module gyro_interface__cic__acc(d,q,clock);
     end
 
 endmodule // gyro_interface__cic__acc
+
+
+module gyro_interface__cic__borrow(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__cic__borrow
 
 
 module gyro_interface__cic__coarse(d,q,clock);
@@ -3503,6 +3917,25 @@ module gyro_interface__cic__delay_address(d,q,clock);
     end
 
 endmodule // gyro_interface__cic__delay_address
+
+
+module gyro_interface__cic__delay_high(d,q,clock);
+
+    // Module arguments
+    input wire  [39:0] d;
+    output reg  [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__cic__delay_high
 
 
 module gyro_interface__cic__delays(clock,write_enable,write_address,write_data,read_address,q);
@@ -3879,24 +4312,32 @@ endmodule // gyro_interface__cic__sample2
 module gyro_interface__cic__step(d,q,clock);
 
     // Module arguments
-    input wire  [3:0] d;
-    output reg  [3:0] q;
+    input wire  [4:0] d;
+    output reg  [4:0] q;
     input wire  clock;
 
     // Enums
     localparam CicStep$Idle = 0;
-    localparam CicStep$FirstComb1 = 1;
-    localparam CicStep$FirstComb2 = 2;
-    localparam CicStep$FirstComb3 = 3;
-    localparam CicStep$FirstComb4 = 4;
-    localparam CicStep$SecondLoad = 5;
-    localparam CicStep$SecondComb1 = 6;
-    localparam CicStep$SecondComb2 = 7;
-    localparam CicStep$SecondComb3 = 8;
-    localparam CicStep$SecondComb4 = 9;
-    localparam CicStep$SecondCoarse = 10;
-    localparam CicStep$SecondFine = 11;
-    localparam CicStep$SecondRound = 12;
+    localparam CicStep$FirstLow1 = 1;
+    localparam CicStep$FirstHigh1 = 2;
+    localparam CicStep$FirstLow2 = 3;
+    localparam CicStep$FirstHigh2 = 4;
+    localparam CicStep$FirstLow3 = 5;
+    localparam CicStep$FirstHigh3 = 6;
+    localparam CicStep$FirstLow4 = 7;
+    localparam CicStep$FirstHigh4 = 8;
+    localparam CicStep$SecondLoad = 9;
+    localparam CicStep$SecondLow1 = 10;
+    localparam CicStep$SecondHigh1 = 11;
+    localparam CicStep$SecondLow2 = 12;
+    localparam CicStep$SecondHigh2 = 13;
+    localparam CicStep$SecondLow3 = 14;
+    localparam CicStep$SecondHigh3 = 15;
+    localparam CicStep$SecondLow4 = 16;
+    localparam CicStep$SecondHigh4 = 17;
+    localparam CicStep$SecondCoarse = 18;
+    localparam CicStep$SecondFine = 19;
+    localparam CicStep$SecondRound = 20;
 
     // Update code (custom)
     initial begin
@@ -5321,131 +5762,155 @@ module gyro_interface__modulation_nco__sine(clock,phase,advance,sin);
     output reg signed [15:0] sin;
 
     // Constant declarations
-    localparam  half_step = 16'h4000;
-    localparam signed rounding = 32'h200000;
+    localparam  rom_ready = 1'b1;
 
     // Stub signals
+    reg  lookup$clock;
+    reg  [31:0] lookup$phase;
+    reg  [1:0] lookup$advance;
+    reg  lookup$live;
+    wire  [12:0] lookup$index;
+    reg signed [15:0] lookup$word;
+    wire signed [15:0] lookup$sin;
     reg  rom$clock;
-    reg  [7:0] rom$addr;
+    reg  [12:0] rom$addr;
     wire signed [15:0] rom$value;
-    wire signed [15:0] rom$slope;
-    reg  slope_product$clock;
-    reg signed [15:0] slope_product$a;
-    reg signed [15:0] slope_product$b;
-    wire signed [31:0] slope_product$p;
-    reg  [7:0] index_1$d;
-    wire  [7:0] index_1$q;
+
+    // Sub module instances
+    gyro_interface__modulation_nco__sine__lookup lookup(
+        .clock(lookup$clock),
+        .phase(lookup$phase),
+        .advance(lookup$advance),
+        .live(lookup$live),
+        .index(lookup$index),
+        .word(lookup$word),
+        .sin(lookup$sin)
+    );
+    gyro_interface__modulation_nco__sine__rom rom(
+        .clock(rom$clock),
+        .addr(rom$addr),
+        .value(rom$value)
+    );
+
+    // Update code
+    always @(*) begin
+        lookup$clock = clock;
+        rom$clock = clock;
+        lookup$phase = phase;
+        lookup$advance = advance;
+        lookup$live = rom_ready;
+        rom$addr = lookup$index;
+        lookup$word = rom$value;
+        sin = lookup$sin;
+    end
+
+endmodule // gyro_interface__modulation_nco__sine
+
+
+module gyro_interface__modulation_nco__sine__lookup(clock,phase,advance,live,index,word,sin);
+
+    // Module arguments
+    input wire  clock;
+    input wire  [31:0] phase;
+    input wire  [1:0] advance;
+    input wire  live;
+    output reg  [12:0] index;
+    input wire signed [15:0] word;
+    output reg signed [15:0] sin;
+
+    // Constant declarations
+    localparam signed zero = 16'h0;
+
+    // Stub signals
+    reg  [12:0] index_1$d;
+    wire  [12:0] index_1$q;
     reg  index_1$clock;
     reg  [1:0] quadrant_1$d;
     wire  [1:0] quadrant_1$q;
     reg  quadrant_1$clock;
-    reg signed [15:0] offset_1$d;
-    wire signed [15:0] offset_1$q;
-    reg  offset_1$clock;
+    reg  live_1$d;
+    wire  live_1$q;
+    reg  live_1$clock;
     reg  [1:0] quadrant_2$d;
     wire  [1:0] quadrant_2$q;
     reg  quadrant_2$clock;
-    reg signed [15:0] offset_2$d;
-    wire signed [15:0] offset_2$q;
-    reg  offset_2$clock;
-    reg  [1:0] quadrant_read$d;
-    wire  [1:0] quadrant_read$q;
-    reg  quadrant_read$clock;
-    reg signed [15:0] offset_read$d;
-    wire signed [15:0] offset_read$q;
-    reg  offset_read$clock;
-    reg signed [15:0] value_read$d;
-    wire signed [15:0] value_read$q;
-    reg  value_read$clock;
-    reg signed [15:0] slope_read$d;
-    wire signed [15:0] slope_read$q;
-    reg  slope_read$clock;
-    reg  [1:0] quadrant_4$d;
-    wire  [1:0] quadrant_4$q;
-    reg  quadrant_4$clock;
-    reg signed [15:0] signed_sample_4$d;
-    wire signed [15:0] signed_sample_4$q;
-    reg  signed_sample_4$clock;
+    reg  live_2$d;
+    wire  live_2$q;
+    reg  live_2$clock;
+    reg  [1:0] quadrant_3$d;
+    wire  [1:0] quadrant_3$q;
+    reg  quadrant_3$clock;
+    reg  live_3$d;
+    wire  live_3$q;
+    reg  live_3$clock;
+    reg signed [15:0] value_3$d;
+    wire signed [15:0] value_3$q;
+    reg  value_3$clock;
+    reg  live_4$d;
+    wire  live_4$q;
+    reg  live_4$clock;
+    reg signed [15:0] signed_4$d;
+    wire signed [15:0] signed_4$q;
+    reg  signed_4$clock;
     reg signed [15:0] sin_out$d;
     wire signed [15:0] sin_out$q;
     reg  sin_out$clock;
 
     // Local signals
     reg  [1:0] quadrant;
-    reg  [15:0] fraction;
-    reg signed [31:0] rounded;
-    reg signed [9:0] correction_10;
-    reg signed [15:0] correction;
 
     // Sub module instances
-    gyro_interface__modulation_nco__sine__rom rom(
-        .clock(rom$clock),
-        .addr(rom$addr),
-        .value(rom$value),
-        .slope(rom$slope)
-    );
-    gyro_interface__modulation_nco__sine__slope_product slope_product(
-        .clock(slope_product$clock),
-        .a(slope_product$a),
-        .b(slope_product$b),
-        .p(slope_product$p)
-    );
-    gyro_interface__modulation_nco__sine__index_1 index_1(
+    gyro_interface__modulation_nco__sine__lookup__index_1 index_1(
         .d(index_1$d),
         .q(index_1$q),
         .clock(index_1$clock)
     );
-    gyro_interface__modulation_nco__sine__quadrant_1 quadrant_1(
+    gyro_interface__modulation_nco__sine__lookup__quadrant_1 quadrant_1(
         .d(quadrant_1$d),
         .q(quadrant_1$q),
         .clock(quadrant_1$clock)
     );
-    gyro_interface__modulation_nco__sine__offset_1 offset_1(
-        .d(offset_1$d),
-        .q(offset_1$q),
-        .clock(offset_1$clock)
+    gyro_interface__modulation_nco__sine__lookup__live_1 live_1(
+        .d(live_1$d),
+        .q(live_1$q),
+        .clock(live_1$clock)
     );
-    gyro_interface__modulation_nco__sine__quadrant_2 quadrant_2(
+    gyro_interface__modulation_nco__sine__lookup__quadrant_2 quadrant_2(
         .d(quadrant_2$d),
         .q(quadrant_2$q),
         .clock(quadrant_2$clock)
     );
-    gyro_interface__modulation_nco__sine__offset_2 offset_2(
-        .d(offset_2$d),
-        .q(offset_2$q),
-        .clock(offset_2$clock)
+    gyro_interface__modulation_nco__sine__lookup__live_2 live_2(
+        .d(live_2$d),
+        .q(live_2$q),
+        .clock(live_2$clock)
     );
-    gyro_interface__modulation_nco__sine__quadrant_read quadrant_read(
-        .d(quadrant_read$d),
-        .q(quadrant_read$q),
-        .clock(quadrant_read$clock)
+    gyro_interface__modulation_nco__sine__lookup__quadrant_3 quadrant_3(
+        .d(quadrant_3$d),
+        .q(quadrant_3$q),
+        .clock(quadrant_3$clock)
     );
-    gyro_interface__modulation_nco__sine__offset_read offset_read(
-        .d(offset_read$d),
-        .q(offset_read$q),
-        .clock(offset_read$clock)
+    gyro_interface__modulation_nco__sine__lookup__live_3 live_3(
+        .d(live_3$d),
+        .q(live_3$q),
+        .clock(live_3$clock)
     );
-    gyro_interface__modulation_nco__sine__value_read value_read(
-        .d(value_read$d),
-        .q(value_read$q),
-        .clock(value_read$clock)
+    gyro_interface__modulation_nco__sine__lookup__value_3 value_3(
+        .d(value_3$d),
+        .q(value_3$q),
+        .clock(value_3$clock)
     );
-    gyro_interface__modulation_nco__sine__slope_read slope_read(
-        .d(slope_read$d),
-        .q(slope_read$q),
-        .clock(slope_read$clock)
+    gyro_interface__modulation_nco__sine__lookup__live_4 live_4(
+        .d(live_4$d),
+        .q(live_4$q),
+        .clock(live_4$clock)
     );
-    gyro_interface__modulation_nco__sine__quadrant_4 quadrant_4(
-        .d(quadrant_4$d),
-        .q(quadrant_4$q),
-        .clock(quadrant_4$clock)
+    gyro_interface__modulation_nco__sine__lookup__signed_4 signed_4(
+        .d(signed_4$d),
+        .q(signed_4$q),
+        .clock(signed_4$clock)
     );
-    gyro_interface__modulation_nco__sine__signed_sample_4 signed_sample_4(
-        .d(signed_sample_4$d),
-        .q(signed_sample_4$q),
-        .clock(signed_sample_4$clock)
-    );
-    gyro_interface__modulation_nco__sine__sin_out sin_out(
+    gyro_interface__modulation_nco__sine__lookup__sin_out sin_out(
         .d(sin_out$d),
         .q(sin_out$q),
         .clock(sin_out$clock)
@@ -5453,87 +5918,209 @@ module gyro_interface__modulation_nco__sine(clock,phase,advance,sin);
 
     // Update code
     always @(*) begin
-        rom$clock = clock;
-        slope_product$clock = clock;
         index_1$clock = clock;
         quadrant_1$clock = clock;
-        offset_1$clock = clock;
+        live_1$clock = clock;
         quadrant_2$clock = clock;
-        offset_2$clock = clock;
-        quadrant_read$clock = clock;
-        offset_read$clock = clock;
-        value_read$clock = clock;
-        slope_read$clock = clock;
-        quadrant_4$clock = clock;
-        signed_sample_4$clock = clock;
+        live_2$clock = clock;
+        quadrant_3$clock = clock;
+        live_3$clock = clock;
+        value_3$clock = clock;
+        live_4$clock = clock;
+        signed_4$clock = clock;
         sin_out$clock = clock;
         index_1$d = index_1$q;
         quadrant_1$d = quadrant_1$q;
-        offset_1$d = offset_1$q;
+        live_1$d = live_1$q;
         quadrant_2$d = quadrant_2$q;
-        offset_2$d = offset_2$q;
-        quadrant_read$d = quadrant_read$q;
-        offset_read$d = offset_read$q;
-        value_read$d = value_read$q;
-        slope_read$d = slope_read$q;
-        quadrant_4$d = quadrant_4$q;
-        signed_sample_4$d = signed_sample_4$q;
+        live_2$d = live_2$q;
+        quadrant_3$d = quadrant_3$q;
+        live_3$d = live_3$q;
+        value_3$d = value_3$q;
+        live_4$d = live_4$q;
+        signed_4$d = signed_4$q;
         sin_out$d = sin_out$q;
         quadrant = phase[(32'h1e)+:(2)] + advance;
-        index_1$d = phase[(32'h16)+:(8)];
+        index_1$d = phase[(32'h11)+:(13)];
         if (quadrant[32'h0]) begin
-            index_1$d = ~(phase[(32'h16)+:(8)]);
+            index_1$d = ~(phase[(32'h11)+:(13)]);
         end
         quadrant_1$d = quadrant;
-        fraction = ((phase[(32'h7)+:(15)]) & 16'hffff);
-        offset_1$d = $signed(fraction - half_step);
-        rom$addr = index_1$q;
+        live_1$d = live;
+        index = index_1$q;
         quadrant_2$d = quadrant_1$q;
-        offset_2$d = offset_1$q;
-        quadrant_read$d = quadrant_2$q;
-        offset_read$d = offset_2$q;
-        value_read$d = rom$value;
-        slope_read$d = rom$slope;
-        slope_product$a = offset_read$q;
-        slope_product$b = slope_read$q;
-        quadrant_4$d = quadrant_read$q;
-        signed_sample_4$d = value_read$q;
-        if (quadrant_read$q[32'h1]) begin
-            signed_sample_4$d = -value_read$q;
+        live_2$d = live_1$q;
+        quadrant_3$d = quadrant_2$q;
+        live_3$d = live_2$q;
+        value_3$d = word;
+        live_4$d = live_3$q;
+        signed_4$d = value_3$q;
+        if (quadrant_3$q[32'h1]) begin
+            signed_4$d = -value_3$q;
         end
-        rounded = slope_product$p + rounding;
-        correction_10 = rounded[(32'h16)+:(10)];
-        correction = $signed(correction_10);
-        sin_out$d = signed_sample_4$q + correction;
-        if (quadrant_4$q[32'h0] ^ quadrant_4$q[32'h1]) begin
-            sin_out$d = signed_sample_4$q - correction;
+        sin_out$d = zero;
+        if (live_4$q) begin
+            sin_out$d = signed_4$q;
         end
         sin = sin_out$q;
     end
 
-endmodule // gyro_interface__modulation_nco__sine
+endmodule // gyro_interface__modulation_nco__sine__lookup
 
 
-module gyro_interface__modulation_nco__sine__index_1(d,q,clock);
+module gyro_interface__modulation_nco__sine__lookup__index_1(d,q,clock);
 
     // Module arguments
-    input wire  [7:0] d;
-    output reg  [7:0] q;
+    input wire  [12:0] d;
+    output reg  [12:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 8'h0;
+       q = 13'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface__modulation_nco__sine__index_1
+endmodule // gyro_interface__modulation_nco__sine__lookup__index_1
 
 
-module gyro_interface__modulation_nco__sine__offset_1(d,q,clock);
+module gyro_interface__modulation_nco__sine__lookup__live_1(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__modulation_nco__sine__lookup__live_1
+
+
+module gyro_interface__modulation_nco__sine__lookup__live_2(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__modulation_nco__sine__lookup__live_2
+
+
+module gyro_interface__modulation_nco__sine__lookup__live_3(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__modulation_nco__sine__lookup__live_3
+
+
+module gyro_interface__modulation_nco__sine__lookup__live_4(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__modulation_nco__sine__lookup__live_4
+
+
+module gyro_interface__modulation_nco__sine__lookup__quadrant_1(d,q,clock);
+
+    // Module arguments
+    input wire  [1:0] d;
+    output reg  [1:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 2'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__modulation_nco__sine__lookup__quadrant_1
+
+
+module gyro_interface__modulation_nco__sine__lookup__quadrant_2(d,q,clock);
+
+    // Module arguments
+    input wire  [1:0] d;
+    output reg  [1:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 2'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__modulation_nco__sine__lookup__quadrant_2
+
+
+module gyro_interface__modulation_nco__sine__lookup__quadrant_3(d,q,clock);
+
+    // Module arguments
+    input wire  [1:0] d;
+    output reg  [1:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 2'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface__modulation_nco__sine__lookup__quadrant_3
+
+
+module gyro_interface__modulation_nco__sine__lookup__signed_4(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -5549,29 +6136,10 @@ module gyro_interface__modulation_nco__sine__offset_1(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__modulation_nco__sine__offset_1
+endmodule // gyro_interface__modulation_nco__sine__lookup__signed_4
 
 
-module gyro_interface__modulation_nco__sine__offset_2(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__modulation_nco__sine__offset_2
-
-
-module gyro_interface__modulation_nco__sine__offset_read(d,q,clock);
+module gyro_interface__modulation_nco__sine__lookup__sin_out(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -5587,456 +6155,4405 @@ module gyro_interface__modulation_nco__sine__offset_read(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__modulation_nco__sine__offset_read
+endmodule // gyro_interface__modulation_nco__sine__lookup__sin_out
 
 
-module gyro_interface__modulation_nco__sine__quadrant_1(d,q,clock);
+module gyro_interface__modulation_nco__sine__lookup__value_3(d,q,clock);
 
     // Module arguments
-    input wire  [1:0] d;
-    output reg  [1:0] q;
+    input wire signed [15:0] d;
+    output reg signed [15:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 2'h0;
+       q = 16'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface__modulation_nco__sine__quadrant_1
+endmodule // gyro_interface__modulation_nco__sine__lookup__value_3
 
 
-module gyro_interface__modulation_nco__sine__quadrant_2(d,q,clock);
-
-    // Module arguments
-    input wire  [1:0] d;
-    output reg  [1:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 2'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__modulation_nco__sine__quadrant_2
-
-
-module gyro_interface__modulation_nco__sine__quadrant_4(d,q,clock);
-
-    // Module arguments
-    input wire  [1:0] d;
-    output reg  [1:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 2'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__modulation_nco__sine__quadrant_4
-
-
-module gyro_interface__modulation_nco__sine__quadrant_read(d,q,clock);
-
-    // Module arguments
-    input wire  [1:0] d;
-    output reg  [1:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 2'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__modulation_nco__sine__quadrant_read
-
-
-module gyro_interface__modulation_nco__sine__rom(clock,addr,value,slope);
+module gyro_interface__modulation_nco__sine__rom(clock,addr,value);
 
     // Module arguments
     input wire  clock;
-    input wire  [7:0] addr;
+    input wire  [12:0] addr;
     output reg signed [15:0] value;
-    output reg signed [15:0] slope;
 
     // Update code (custom)
-    reg signed [15:0] value_rom [0:255];
-    reg signed [15:0] slope_rom [0:255];
+    reg signed [15:0] coarse_rom [0:255];
+    reg [7:0] fine_rom [0:4095];
+    reg signed [15:0] coarse_q;
+    reg [7:0] fine_q;
 
     initial begin
-       value_rom[0] = 16'sd101; slope_rom[0] = 16'sd25735;
-       value_rom[1] = 16'sd302; slope_rom[1] = 16'sd25734;
-       value_rom[2] = 16'sd503; slope_rom[2] = 16'sd25732;
-       value_rom[3] = 16'sd704; slope_rom[3] = 16'sd25729;
-       value_rom[4] = 16'sd905; slope_rom[4] = 16'sd25725;
-       value_rom[5] = 16'sd1106; slope_rom[5] = 16'sd25720;
-       value_rom[6] = 16'sd1307; slope_rom[6] = 16'sd25715;
-       value_rom[7] = 16'sd1507; slope_rom[7] = 16'sd25708;
-       value_rom[8] = 16'sd1708; slope_rom[8] = 16'sd25700;
-       value_rom[9] = 16'sd1909; slope_rom[9] = 16'sd25691;
-       value_rom[10] = 16'sd2110; slope_rom[10] = 16'sd25682;
-       value_rom[11] = 16'sd2310; slope_rom[11] = 16'sd25671;
-       value_rom[12] = 16'sd2511; slope_rom[12] = 16'sd25659;
-       value_rom[13] = 16'sd2711; slope_rom[13] = 16'sd25647;
-       value_rom[14] = 16'sd2911; slope_rom[14] = 16'sd25633;
-       value_rom[15] = 16'sd3112; slope_rom[15] = 16'sd25619;
-       value_rom[16] = 16'sd3312; slope_rom[16] = 16'sd25603;
-       value_rom[17] = 16'sd3512; slope_rom[17] = 16'sd25587;
-       value_rom[18] = 16'sd3712; slope_rom[18] = 16'sd25570;
-       value_rom[19] = 16'sd3911; slope_rom[19] = 16'sd25551;
-       value_rom[20] = 16'sd4111; slope_rom[20] = 16'sd25532;
-       value_rom[21] = 16'sd4310; slope_rom[21] = 16'sd25512;
-       value_rom[22] = 16'sd4509; slope_rom[22] = 16'sd25490;
-       value_rom[23] = 16'sd4708; slope_rom[23] = 16'sd25468;
-       value_rom[24] = 16'sd4907; slope_rom[24] = 16'sd25445;
-       value_rom[25] = 16'sd5106; slope_rom[25] = 16'sd25421;
-       value_rom[26] = 16'sd5305; slope_rom[26] = 16'sd25396;
-       value_rom[27] = 16'sd5503; slope_rom[27] = 16'sd25370;
-       value_rom[28] = 16'sd5701; slope_rom[28] = 16'sd25343;
-       value_rom[29] = 16'sd5899; slope_rom[29] = 16'sd25315;
-       value_rom[30] = 16'sd6096; slope_rom[30] = 16'sd25286;
-       value_rom[31] = 16'sd6294; slope_rom[31] = 16'sd25256;
-       value_rom[32] = 16'sd6491; slope_rom[32] = 16'sd25225;
-       value_rom[33] = 16'sd6688; slope_rom[33] = 16'sd25193;
-       value_rom[34] = 16'sd6885; slope_rom[34] = 16'sd25161;
-       value_rom[35] = 16'sd7081; slope_rom[35] = 16'sd25127;
-       value_rom[36] = 16'sd7277; slope_rom[36] = 16'sd25092;
-       value_rom[37] = 16'sd7473; slope_rom[37] = 16'sd25057;
-       value_rom[38] = 16'sd7669; slope_rom[38] = 16'sd25020;
-       value_rom[39] = 16'sd7864; slope_rom[39] = 16'sd24983;
-       value_rom[40] = 16'sd8059; slope_rom[40] = 16'sd24945;
-       value_rom[41] = 16'sd8254; slope_rom[41] = 16'sd24905;
-       value_rom[42] = 16'sd8448; slope_rom[42] = 16'sd24865;
-       value_rom[43] = 16'sd8642; slope_rom[43] = 16'sd24824;
-       value_rom[44] = 16'sd8836; slope_rom[44] = 16'sd24782;
-       value_rom[45] = 16'sd9030; slope_rom[45] = 16'sd24739;
-       value_rom[46] = 16'sd9223; slope_rom[46] = 16'sd24695;
-       value_rom[47] = 16'sd9416; slope_rom[47] = 16'sd24650;
-       value_rom[48] = 16'sd9608; slope_rom[48] = 16'sd24604;
-       value_rom[49] = 16'sd9800; slope_rom[49] = 16'sd24557;
-       value_rom[50] = 16'sd9992; slope_rom[50] = 16'sd24510;
-       value_rom[51] = 16'sd10183; slope_rom[51] = 16'sd24461;
-       value_rom[52] = 16'sd10374; slope_rom[52] = 16'sd24411;
-       value_rom[53] = 16'sd10564; slope_rom[53] = 16'sd24361;
-       value_rom[54] = 16'sd10754; slope_rom[54] = 16'sd24310;
-       value_rom[55] = 16'sd10944; slope_rom[55] = 16'sd24257;
-       value_rom[56] = 16'sd11133; slope_rom[56] = 16'sd24204;
-       value_rom[57] = 16'sd11322; slope_rom[57] = 16'sd24150;
-       value_rom[58] = 16'sd11511; slope_rom[58] = 16'sd24095;
-       value_rom[59] = 16'sd11699; slope_rom[59] = 16'sd24039;
-       value_rom[60] = 16'sd11886; slope_rom[60] = 16'sd23982;
-       value_rom[61] = 16'sd12074; slope_rom[61] = 16'sd23924;
-       value_rom[62] = 16'sd12260; slope_rom[62] = 16'sd23866;
-       value_rom[63] = 16'sd12446; slope_rom[63] = 16'sd23806;
-       value_rom[64] = 16'sd12632; slope_rom[64] = 16'sd23746;
-       value_rom[65] = 16'sd12817; slope_rom[65] = 16'sd23685;
-       value_rom[66] = 16'sd13002; slope_rom[66] = 16'sd23622;
-       value_rom[67] = 16'sd13187; slope_rom[67] = 16'sd23559;
-       value_rom[68] = 16'sd13370; slope_rom[68] = 16'sd23495;
-       value_rom[69] = 16'sd13554; slope_rom[69] = 16'sd23430;
-       value_rom[70] = 16'sd13736; slope_rom[70] = 16'sd23365;
-       value_rom[71] = 16'sd13919; slope_rom[71] = 16'sd23298;
-       value_rom[72] = 16'sd14101; slope_rom[72] = 16'sd23230;
-       value_rom[73] = 16'sd14282; slope_rom[73] = 16'sd23162;
-       value_rom[74] = 16'sd14462; slope_rom[74] = 16'sd23093;
-       value_rom[75] = 16'sd14643; slope_rom[75] = 16'sd23023;
-       value_rom[76] = 16'sd14822; slope_rom[76] = 16'sd22952;
-       value_rom[77] = 16'sd15001; slope_rom[77] = 16'sd22880;
-       value_rom[78] = 16'sd15180; slope_rom[78] = 16'sd22807;
-       value_rom[79] = 16'sd15358; slope_rom[79] = 16'sd22733;
-       value_rom[80] = 16'sd15535; slope_rom[80] = 16'sd22659;
-       value_rom[81] = 16'sd15712; slope_rom[81] = 16'sd22584;
-       value_rom[82] = 16'sd15888; slope_rom[82] = 16'sd22508;
-       value_rom[83] = 16'sd16063; slope_rom[83] = 16'sd22431;
-       value_rom[84] = 16'sd16238; slope_rom[84] = 16'sd22353;
-       value_rom[85] = 16'sd16413; slope_rom[85] = 16'sd22274;
-       value_rom[86] = 16'sd16586; slope_rom[86] = 16'sd22195;
-       value_rom[87] = 16'sd16759; slope_rom[87] = 16'sd22114;
-       value_rom[88] = 16'sd16932; slope_rom[88] = 16'sd22033;
-       value_rom[89] = 16'sd17104; slope_rom[89] = 16'sd21951;
-       value_rom[90] = 16'sd17275; slope_rom[90] = 16'sd21868;
-       value_rom[91] = 16'sd17445; slope_rom[91] = 16'sd21785;
-       value_rom[92] = 16'sd17615; slope_rom[92] = 16'sd21700;
-       value_rom[93] = 16'sd17784; slope_rom[93] = 16'sd21615;
-       value_rom[94] = 16'sd17953; slope_rom[94] = 16'sd21529;
-       value_rom[95] = 16'sd18121; slope_rom[95] = 16'sd21442;
-       value_rom[96] = 16'sd18288; slope_rom[96] = 16'sd21354;
-       value_rom[97] = 16'sd18454; slope_rom[97] = 16'sd21265;
-       value_rom[98] = 16'sd18620; slope_rom[98] = 16'sd21176;
-       value_rom[99] = 16'sd18785; slope_rom[99] = 16'sd21086;
-       value_rom[100] = 16'sd18950; slope_rom[100] = 16'sd20995;
-       value_rom[101] = 16'sd19113; slope_rom[101] = 16'sd20903;
-       value_rom[102] = 16'sd19276; slope_rom[102] = 16'sd20811;
-       value_rom[103] = 16'sd19438; slope_rom[103] = 16'sd20718;
-       value_rom[104] = 16'sd19600; slope_rom[104] = 16'sd20624;
-       value_rom[105] = 16'sd19761; slope_rom[105] = 16'sd20529;
-       value_rom[106] = 16'sd19921; slope_rom[106] = 16'sd20433;
-       value_rom[107] = 16'sd20080; slope_rom[107] = 16'sd20337;
-       value_rom[108] = 16'sd20238; slope_rom[108] = 16'sd20240;
-       value_rom[109] = 16'sd20396; slope_rom[109] = 16'sd20142;
-       value_rom[110] = 16'sd20553; slope_rom[110] = 16'sd20043;
-       value_rom[111] = 16'sd20709; slope_rom[111] = 16'sd19944;
-       value_rom[112] = 16'sd20865; slope_rom[112] = 16'sd19843;
-       value_rom[113] = 16'sd21019; slope_rom[113] = 16'sd19742;
-       value_rom[114] = 16'sd21173; slope_rom[114] = 16'sd19641;
-       value_rom[115] = 16'sd21326; slope_rom[115] = 16'sd19538;
-       value_rom[116] = 16'sd21479; slope_rom[116] = 16'sd19435;
-       value_rom[117] = 16'sd21630; slope_rom[117] = 16'sd19331;
-       value_rom[118] = 16'sd21781; slope_rom[118] = 16'sd19227;
-       value_rom[119] = 16'sd21930; slope_rom[119] = 16'sd19121;
-       value_rom[120] = 16'sd22079; slope_rom[120] = 16'sd19015;
-       value_rom[121] = 16'sd22227; slope_rom[121] = 16'sd18909;
-       value_rom[122] = 16'sd22375; slope_rom[122] = 16'sd18801;
-       value_rom[123] = 16'sd22521; slope_rom[123] = 16'sd18693;
-       value_rom[124] = 16'sd22667; slope_rom[124] = 16'sd18584;
-       value_rom[125] = 16'sd22812; slope_rom[125] = 16'sd18474;
-       value_rom[126] = 16'sd22956; slope_rom[126] = 16'sd18364;
-       value_rom[127] = 16'sd23099; slope_rom[127] = 16'sd18253;
-       value_rom[128] = 16'sd23241; slope_rom[128] = 16'sd18142;
-       value_rom[129] = 16'sd23382; slope_rom[129] = 16'sd18029;
-       value_rom[130] = 16'sd23522; slope_rom[130] = 16'sd17916;
-       value_rom[131] = 16'sd23662; slope_rom[131] = 16'sd17803;
-       value_rom[132] = 16'sd23801; slope_rom[132] = 16'sd17688;
-       value_rom[133] = 16'sd23938; slope_rom[133] = 16'sd17573;
-       value_rom[134] = 16'sd24075; slope_rom[134] = 16'sd17457;
-       value_rom[135] = 16'sd24211; slope_rom[135] = 16'sd17341;
-       value_rom[136] = 16'sd24346; slope_rom[136] = 16'sd17224;
-       value_rom[137] = 16'sd24480; slope_rom[137] = 16'sd17106;
-       value_rom[138] = 16'sd24613; slope_rom[138] = 16'sd16988;
-       value_rom[139] = 16'sd24746; slope_rom[139] = 16'sd16869;
-       value_rom[140] = 16'sd24877; slope_rom[140] = 16'sd16750;
-       value_rom[141] = 16'sd25007; slope_rom[141] = 16'sd16629;
-       value_rom[142] = 16'sd25137; slope_rom[142] = 16'sd16509;
-       value_rom[143] = 16'sd25265; slope_rom[143] = 16'sd16387;
-       value_rom[144] = 16'sd25393; slope_rom[144] = 16'sd16265;
-       value_rom[145] = 16'sd25519; slope_rom[145] = 16'sd16142;
-       value_rom[146] = 16'sd25645; slope_rom[146] = 16'sd16019;
-       value_rom[147] = 16'sd25770; slope_rom[147] = 16'sd15895;
-       value_rom[148] = 16'sd25893; slope_rom[148] = 16'sd15771;
-       value_rom[149] = 16'sd26016; slope_rom[149] = 16'sd15646;
-       value_rom[150] = 16'sd26138; slope_rom[150] = 16'sd15520;
-       value_rom[151] = 16'sd26259; slope_rom[151] = 16'sd15394;
-       value_rom[152] = 16'sd26378; slope_rom[152] = 16'sd15267;
-       value_rom[153] = 16'sd26497; slope_rom[153] = 16'sd15140;
-       value_rom[154] = 16'sd26615; slope_rom[154] = 16'sd15012;
-       value_rom[155] = 16'sd26732; slope_rom[155] = 16'sd14883;
-       value_rom[156] = 16'sd26848; slope_rom[156] = 16'sd14754;
-       value_rom[157] = 16'sd26962; slope_rom[157] = 16'sd14624;
-       value_rom[158] = 16'sd27076; slope_rom[158] = 16'sd14494;
-       value_rom[159] = 16'sd27189; slope_rom[159] = 16'sd14363;
-       value_rom[160] = 16'sd27300; slope_rom[160] = 16'sd14232;
-       value_rom[161] = 16'sd27411; slope_rom[161] = 16'sd14100;
-       value_rom[162] = 16'sd27521; slope_rom[162] = 16'sd13968;
-       value_rom[163] = 16'sd27629; slope_rom[163] = 16'sd13835;
-       value_rom[164] = 16'sd27737; slope_rom[164] = 16'sd13701;
-       value_rom[165] = 16'sd27843; slope_rom[165] = 16'sd13568;
-       value_rom[166] = 16'sd27949; slope_rom[166] = 16'sd13433;
-       value_rom[167] = 16'sd28053; slope_rom[167] = 16'sd13298;
-       value_rom[168] = 16'sd28157; slope_rom[168] = 16'sd13163;
-       value_rom[169] = 16'sd28259; slope_rom[169] = 16'sd13027;
-       value_rom[170] = 16'sd28360; slope_rom[170] = 16'sd12890;
-       value_rom[171] = 16'sd28460; slope_rom[171] = 16'sd12753;
-       value_rom[172] = 16'sd28560; slope_rom[172] = 16'sd12616;
-       value_rom[173] = 16'sd28658; slope_rom[173] = 16'sd12478;
-       value_rom[174] = 16'sd28755; slope_rom[174] = 16'sd12340;
-       value_rom[175] = 16'sd28850; slope_rom[175] = 16'sd12201;
-       value_rom[176] = 16'sd28945; slope_rom[176] = 16'sd12062;
-       value_rom[177] = 16'sd29039; slope_rom[177] = 16'sd11922;
-       value_rom[178] = 16'sd29131; slope_rom[178] = 16'sd11782;
-       value_rom[179] = 16'sd29223; slope_rom[179] = 16'sd11641;
-       value_rom[180] = 16'sd29313; slope_rom[180] = 16'sd11500;
-       value_rom[181] = 16'sd29403; slope_rom[181] = 16'sd11359;
-       value_rom[182] = 16'sd29491; slope_rom[182] = 16'sd11217;
-       value_rom[183] = 16'sd29578; slope_rom[183] = 16'sd11075;
-       value_rom[184] = 16'sd29664; slope_rom[184] = 16'sd10932;
-       value_rom[185] = 16'sd29749; slope_rom[185] = 16'sd10789;
-       value_rom[186] = 16'sd29832; slope_rom[186] = 16'sd10645;
-       value_rom[187] = 16'sd29915; slope_rom[187] = 16'sd10501;
-       value_rom[188] = 16'sd29997; slope_rom[188] = 16'sd10357;
-       value_rom[189] = 16'sd30077; slope_rom[189] = 16'sd10212;
-       value_rom[190] = 16'sd30156; slope_rom[190] = 16'sd10067;
-       value_rom[191] = 16'sd30234; slope_rom[191] = 16'sd9921;
-       value_rom[192] = 16'sd30311; slope_rom[192] = 16'sd9775;
-       value_rom[193] = 16'sd30387; slope_rom[193] = 16'sd9629;
-       value_rom[194] = 16'sd30462; slope_rom[194] = 16'sd9483;
-       value_rom[195] = 16'sd30535; slope_rom[195] = 16'sd9336;
-       value_rom[196] = 16'sd30607; slope_rom[196] = 16'sd9188;
-       value_rom[197] = 16'sd30679; slope_rom[197] = 16'sd9041;
-       value_rom[198] = 16'sd30749; slope_rom[198] = 16'sd8893;
-       value_rom[199] = 16'sd30818; slope_rom[199] = 16'sd8744;
-       value_rom[200] = 16'sd30885; slope_rom[200] = 16'sd8596;
-       value_rom[201] = 16'sd30952; slope_rom[201] = 16'sd8447;
-       value_rom[202] = 16'sd31017; slope_rom[202] = 16'sd8297;
-       value_rom[203] = 16'sd31082; slope_rom[203] = 16'sd8148;
-       value_rom[204] = 16'sd31145; slope_rom[204] = 16'sd7998;
-       value_rom[205] = 16'sd31206; slope_rom[205] = 16'sd7847;
-       value_rom[206] = 16'sd31267; slope_rom[206] = 16'sd7697;
-       value_rom[207] = 16'sd31327; slope_rom[207] = 16'sd7546;
-       value_rom[208] = 16'sd31385; slope_rom[208] = 16'sd7395;
-       value_rom[209] = 16'sd31442; slope_rom[209] = 16'sd7244;
-       value_rom[210] = 16'sd31498; slope_rom[210] = 16'sd7092;
-       value_rom[211] = 16'sd31553; slope_rom[211] = 16'sd6940;
-       value_rom[212] = 16'sd31607; slope_rom[212] = 16'sd6788;
-       value_rom[213] = 16'sd31659; slope_rom[213] = 16'sd6635;
-       value_rom[214] = 16'sd31710; slope_rom[214] = 16'sd6483;
-       value_rom[215] = 16'sd31760; slope_rom[215] = 16'sd6330;
-       value_rom[216] = 16'sd31809; slope_rom[216] = 16'sd6177;
-       value_rom[217] = 16'sd31857; slope_rom[217] = 16'sd6023;
-       value_rom[218] = 16'sd31903; slope_rom[218] = 16'sd5869;
-       value_rom[219] = 16'sd31949; slope_rom[219] = 16'sd5716;
-       value_rom[220] = 16'sd31993; slope_rom[220] = 16'sd5562;
-       value_rom[221] = 16'sd32036; slope_rom[221] = 16'sd5407;
-       value_rom[222] = 16'sd32077; slope_rom[222] = 16'sd5253;
-       value_rom[223] = 16'sd32118; slope_rom[223] = 16'sd5098;
-       value_rom[224] = 16'sd32157; slope_rom[224] = 16'sd4943;
-       value_rom[225] = 16'sd32195; slope_rom[225] = 16'sd4788;
-       value_rom[226] = 16'sd32232; slope_rom[226] = 16'sd4633;
-       value_rom[227] = 16'sd32267; slope_rom[227] = 16'sd4477;
-       value_rom[228] = 16'sd32302; slope_rom[228] = 16'sd4322;
-       value_rom[229] = 16'sd32335; slope_rom[229] = 16'sd4166;
-       value_rom[230] = 16'sd32367; slope_rom[230] = 16'sd4010;
-       value_rom[231] = 16'sd32397; slope_rom[231] = 16'sd3854;
-       value_rom[232] = 16'sd32427; slope_rom[232] = 16'sd3698;
-       value_rom[233] = 16'sd32455; slope_rom[233] = 16'sd3542;
-       value_rom[234] = 16'sd32482; slope_rom[234] = 16'sd3385;
-       value_rom[235] = 16'sd32508; slope_rom[235] = 16'sd3229;
-       value_rom[236] = 16'sd32533; slope_rom[236] = 16'sd3072;
-       value_rom[237] = 16'sd32556; slope_rom[237] = 16'sd2915;
-       value_rom[238] = 16'sd32578; slope_rom[238] = 16'sd2758;
-       value_rom[239] = 16'sd32599; slope_rom[239] = 16'sd2601;
-       value_rom[240] = 16'sd32619; slope_rom[240] = 16'sd2444;
-       value_rom[241] = 16'sd32637; slope_rom[241] = 16'sd2287;
-       value_rom[242] = 16'sd32655; slope_rom[242] = 16'sd2129;
-       value_rom[243] = 16'sd32671; slope_rom[243] = 16'sd1972;
-       value_rom[244] = 16'sd32685; slope_rom[244] = 16'sd1814;
-       value_rom[245] = 16'sd32699; slope_rom[245] = 16'sd1657;
-       value_rom[246] = 16'sd32711; slope_rom[246] = 16'sd1499;
-       value_rom[247] = 16'sd32722; slope_rom[247] = 16'sd1342;
-       value_rom[248] = 16'sd32732; slope_rom[248] = 16'sd1184;
-       value_rom[249] = 16'sd32741; slope_rom[249] = 16'sd1026;
-       value_rom[250] = 16'sd32748; slope_rom[250] = 16'sd868;
-       value_rom[251] = 16'sd32755; slope_rom[251] = 16'sd710;
-       value_rom[252] = 16'sd32759; slope_rom[252] = 16'sd553;
-       value_rom[253] = 16'sd32763; slope_rom[253] = 16'sd395;
-       value_rom[254] = 16'sd32766; slope_rom[254] = 16'sd237;
-       value_rom[255] = 16'sd32767; slope_rom[255] = 16'sd79;
-       value = 0;
-       slope = 0;
+       coarse_rom[0] = 16'sd6;
+       coarse_rom[1] = 16'sd207;
+       coarse_rom[2] = 16'sd408;
+       coarse_rom[3] = 16'sd609;
+       coarse_rom[4] = 16'sd810;
+       coarse_rom[5] = 16'sd1011;
+       coarse_rom[6] = 16'sd1212;
+       coarse_rom[7] = 16'sd1413;
+       coarse_rom[8] = 16'sd1614;
+       coarse_rom[9] = 16'sd1815;
+       coarse_rom[10] = 16'sd2016;
+       coarse_rom[11] = 16'sd2216;
+       coarse_rom[12] = 16'sd2417;
+       coarse_rom[13] = 16'sd2617;
+       coarse_rom[14] = 16'sd2818;
+       coarse_rom[15] = 16'sd3018;
+       coarse_rom[16] = 16'sd3218;
+       coarse_rom[17] = 16'sd3418;
+       coarse_rom[18] = 16'sd3618;
+       coarse_rom[19] = 16'sd3818;
+       coarse_rom[20] = 16'sd4017;
+       coarse_rom[21] = 16'sd4217;
+       coarse_rom[22] = 16'sd4416;
+       coarse_rom[23] = 16'sd4615;
+       coarse_rom[24] = 16'sd4814;
+       coarse_rom[25] = 16'sd5013;
+       coarse_rom[26] = 16'sd5212;
+       coarse_rom[27] = 16'sd5410;
+       coarse_rom[28] = 16'sd5608;
+       coarse_rom[29] = 16'sd5806;
+       coarse_rom[30] = 16'sd6004;
+       coarse_rom[31] = 16'sd6201;
+       coarse_rom[32] = 16'sd6399;
+       coarse_rom[33] = 16'sd6596;
+       coarse_rom[34] = 16'sd6793;
+       coarse_rom[35] = 16'sd6989;
+       coarse_rom[36] = 16'sd7185;
+       coarse_rom[37] = 16'sd7381;
+       coarse_rom[38] = 16'sd7577;
+       coarse_rom[39] = 16'sd7773;
+       coarse_rom[40] = 16'sd7968;
+       coarse_rom[41] = 16'sd8163;
+       coarse_rom[42] = 16'sd8357;
+       coarse_rom[43] = 16'sd8552;
+       coarse_rom[44] = 16'sd8745;
+       coarse_rom[45] = 16'sd8939;
+       coarse_rom[46] = 16'sd9132;
+       coarse_rom[47] = 16'sd9325;
+       coarse_rom[48] = 16'sd9518;
+       coarse_rom[49] = 16'sd9710;
+       coarse_rom[50] = 16'sd9902;
+       coarse_rom[51] = 16'sd10093;
+       coarse_rom[52] = 16'sd10284;
+       coarse_rom[53] = 16'sd10475;
+       coarse_rom[54] = 16'sd10665;
+       coarse_rom[55] = 16'sd10855;
+       coarse_rom[56] = 16'sd11045;
+       coarse_rom[57] = 16'sd11234;
+       coarse_rom[58] = 16'sd11423;
+       coarse_rom[59] = 16'sd11611;
+       coarse_rom[60] = 16'sd11799;
+       coarse_rom[61] = 16'sd11986;
+       coarse_rom[62] = 16'sd12173;
+       coarse_rom[63] = 16'sd12359;
+       coarse_rom[64] = 16'sd12545;
+       coarse_rom[65] = 16'sd12731;
+       coarse_rom[66] = 16'sd12916;
+       coarse_rom[67] = 16'sd13100;
+       coarse_rom[68] = 16'sd13284;
+       coarse_rom[69] = 16'sd13468;
+       coarse_rom[70] = 16'sd13651;
+       coarse_rom[71] = 16'sd13833;
+       coarse_rom[72] = 16'sd14015;
+       coarse_rom[73] = 16'sd14197;
+       coarse_rom[74] = 16'sd14378;
+       coarse_rom[75] = 16'sd14558;
+       coarse_rom[76] = 16'sd14738;
+       coarse_rom[77] = 16'sd14917;
+       coarse_rom[78] = 16'sd15096;
+       coarse_rom[79] = 16'sd15274;
+       coarse_rom[80] = 16'sd15452;
+       coarse_rom[81] = 16'sd15629;
+       coarse_rom[82] = 16'sd15805;
+       coarse_rom[83] = 16'sd15981;
+       coarse_rom[84] = 16'sd16156;
+       coarse_rom[85] = 16'sd16331;
+       coarse_rom[86] = 16'sd16505;
+       coarse_rom[87] = 16'sd16678;
+       coarse_rom[88] = 16'sd16851;
+       coarse_rom[89] = 16'sd17023;
+       coarse_rom[90] = 16'sd17195;
+       coarse_rom[91] = 16'sd17365;
+       coarse_rom[92] = 16'sd17536;
+       coarse_rom[93] = 16'sd17705;
+       coarse_rom[94] = 16'sd17874;
+       coarse_rom[95] = 16'sd18042;
+       coarse_rom[96] = 16'sd18210;
+       coarse_rom[97] = 16'sd18376;
+       coarse_rom[98] = 16'sd18543;
+       coarse_rom[99] = 16'sd18708;
+       coarse_rom[100] = 16'sd18873;
+       coarse_rom[101] = 16'sd19037;
+       coarse_rom[102] = 16'sd19200;
+       coarse_rom[103] = 16'sd19362;
+       coarse_rom[104] = 16'sd19524;
+       coarse_rom[105] = 16'sd19685;
+       coarse_rom[106] = 16'sd19846;
+       coarse_rom[107] = 16'sd20005;
+       coarse_rom[108] = 16'sd20164;
+       coarse_rom[109] = 16'sd20322;
+       coarse_rom[110] = 16'sd20480;
+       coarse_rom[111] = 16'sd20636;
+       coarse_rom[112] = 16'sd20792;
+       coarse_rom[113] = 16'sd20947;
+       coarse_rom[114] = 16'sd21101;
+       coarse_rom[115] = 16'sd21255;
+       coarse_rom[116] = 16'sd21407;
+       coarse_rom[117] = 16'sd21559;
+       coarse_rom[118] = 16'sd21710;
+       coarse_rom[119] = 16'sd21860;
+       coarse_rom[120] = 16'sd22010;
+       coarse_rom[121] = 16'sd22158;
+       coarse_rom[122] = 16'sd22306;
+       coarse_rom[123] = 16'sd22453;
+       coarse_rom[124] = 16'sd22599;
+       coarse_rom[125] = 16'sd22744;
+       coarse_rom[126] = 16'sd22888;
+       coarse_rom[127] = 16'sd23032;
+       coarse_rom[128] = 16'sd23174;
+       coarse_rom[129] = 16'sd23316;
+       coarse_rom[130] = 16'sd23457;
+       coarse_rom[131] = 16'sd23597;
+       coarse_rom[132] = 16'sd23736;
+       coarse_rom[133] = 16'sd23874;
+       coarse_rom[134] = 16'sd24011;
+       coarse_rom[135] = 16'sd24148;
+       coarse_rom[136] = 16'sd24283;
+       coarse_rom[137] = 16'sd24417;
+       coarse_rom[138] = 16'sd24551;
+       coarse_rom[139] = 16'sd24684;
+       coarse_rom[140] = 16'sd24816;
+       coarse_rom[141] = 16'sd24946;
+       coarse_rom[142] = 16'sd25076;
+       coarse_rom[143] = 16'sd25205;
+       coarse_rom[144] = 16'sd25333;
+       coarse_rom[145] = 16'sd25460;
+       coarse_rom[146] = 16'sd25586;
+       coarse_rom[147] = 16'sd25711;
+       coarse_rom[148] = 16'sd25836;
+       coarse_rom[149] = 16'sd25959;
+       coarse_rom[150] = 16'sd26081;
+       coarse_rom[151] = 16'sd26202;
+       coarse_rom[152] = 16'sd26322;
+       coarse_rom[153] = 16'sd26442;
+       coarse_rom[154] = 16'sd26560;
+       coarse_rom[155] = 16'sd26677;
+       coarse_rom[156] = 16'sd26793;
+       coarse_rom[157] = 16'sd26909;
+       coarse_rom[158] = 16'sd27023;
+       coarse_rom[159] = 16'sd27136;
+       coarse_rom[160] = 16'sd27248;
+       coarse_rom[161] = 16'sd27359;
+       coarse_rom[162] = 16'sd27470;
+       coarse_rom[163] = 16'sd27579;
+       coarse_rom[164] = 16'sd27687;
+       coarse_rom[165] = 16'sd27794;
+       coarse_rom[166] = 16'sd27900;
+       coarse_rom[167] = 16'sd28005;
+       coarse_rom[168] = 16'sd28108;
+       coarse_rom[169] = 16'sd28211;
+       coarse_rom[170] = 16'sd28313;
+       coarse_rom[171] = 16'sd28414;
+       coarse_rom[172] = 16'sd28513;
+       coarse_rom[173] = 16'sd28612;
+       coarse_rom[174] = 16'sd28709;
+       coarse_rom[175] = 16'sd28806;
+       coarse_rom[176] = 16'sd28901;
+       coarse_rom[177] = 16'sd28995;
+       coarse_rom[178] = 16'sd29088;
+       coarse_rom[179] = 16'sd29180;
+       coarse_rom[180] = 16'sd29271;
+       coarse_rom[181] = 16'sd29361;
+       coarse_rom[182] = 16'sd29450;
+       coarse_rom[183] = 16'sd29537;
+       coarse_rom[184] = 16'sd29624;
+       coarse_rom[185] = 16'sd29709;
+       coarse_rom[186] = 16'sd29793;
+       coarse_rom[187] = 16'sd29876;
+       coarse_rom[188] = 16'sd29958;
+       coarse_rom[189] = 16'sd30039;
+       coarse_rom[190] = 16'sd30119;
+       coarse_rom[191] = 16'sd30198;
+       coarse_rom[192] = 16'sd30275;
+       coarse_rom[193] = 16'sd30351;
+       coarse_rom[194] = 16'sd30427;
+       coarse_rom[195] = 16'sd30501;
+       coarse_rom[196] = 16'sd30574;
+       coarse_rom[197] = 16'sd30645;
+       coarse_rom[198] = 16'sd30716;
+       coarse_rom[199] = 16'sd30785;
+       coarse_rom[200] = 16'sd30854;
+       coarse_rom[201] = 16'sd30921;
+       coarse_rom[202] = 16'sd30987;
+       coarse_rom[203] = 16'sd31052;
+       coarse_rom[204] = 16'sd31115;
+       coarse_rom[205] = 16'sd31178;
+       coarse_rom[206] = 16'sd31239;
+       coarse_rom[207] = 16'sd31299;
+       coarse_rom[208] = 16'sd31358;
+       coarse_rom[209] = 16'sd31416;
+       coarse_rom[210] = 16'sd31472;
+       coarse_rom[211] = 16'sd31528;
+       coarse_rom[212] = 16'sd31582;
+       coarse_rom[213] = 16'sd31635;
+       coarse_rom[214] = 16'sd31687;
+       coarse_rom[215] = 16'sd31737;
+       coarse_rom[216] = 16'sd31787;
+       coarse_rom[217] = 16'sd31835;
+       coarse_rom[218] = 16'sd31882;
+       coarse_rom[219] = 16'sd31928;
+       coarse_rom[220] = 16'sd31972;
+       coarse_rom[221] = 16'sd32016;
+       coarse_rom[222] = 16'sd32058;
+       coarse_rom[223] = 16'sd32099;
+       coarse_rom[224] = 16'sd32139;
+       coarse_rom[225] = 16'sd32177;
+       coarse_rom[226] = 16'sd32215;
+       coarse_rom[227] = 16'sd32251;
+       coarse_rom[228] = 16'sd32286;
+       coarse_rom[229] = 16'sd32319;
+       coarse_rom[230] = 16'sd32352;
+       coarse_rom[231] = 16'sd32383;
+       coarse_rom[232] = 16'sd32413;
+       coarse_rom[233] = 16'sd32442;
+       coarse_rom[234] = 16'sd32470;
+       coarse_rom[235] = 16'sd32496;
+       coarse_rom[236] = 16'sd32521;
+       coarse_rom[237] = 16'sd32545;
+       coarse_rom[238] = 16'sd32568;
+       coarse_rom[239] = 16'sd32590;
+       coarse_rom[240] = 16'sd32610;
+       coarse_rom[241] = 16'sd32629;
+       coarse_rom[242] = 16'sd32647;
+       coarse_rom[243] = 16'sd32663;
+       coarse_rom[244] = 16'sd32679;
+       coarse_rom[245] = 16'sd32693;
+       coarse_rom[246] = 16'sd32706;
+       coarse_rom[247] = 16'sd32717;
+       coarse_rom[248] = 16'sd32728;
+       coarse_rom[249] = 16'sd32737;
+       coarse_rom[250] = 16'sd32745;
+       coarse_rom[251] = 16'sd32752;
+       coarse_rom[252] = 16'sd32757;
+       coarse_rom[253] = 16'sd32762;
+       coarse_rom[254] = 16'sd32765;
+       coarse_rom[255] = 16'sd32766;
+       fine_rom[0] = 8'd0;
+       fine_rom[1] = 8'd13;
+       fine_rom[2] = 8'd25;
+       fine_rom[3] = 8'd38;
+       fine_rom[4] = 8'd51;
+       fine_rom[5] = 8'd63;
+       fine_rom[6] = 8'd76;
+       fine_rom[7] = 8'd88;
+       fine_rom[8] = 8'd101;
+       fine_rom[9] = 8'd113;
+       fine_rom[10] = 8'd126;
+       fine_rom[11] = 8'd139;
+       fine_rom[12] = 8'd151;
+       fine_rom[13] = 8'd164;
+       fine_rom[14] = 8'd176;
+       fine_rom[15] = 8'd189;
+       fine_rom[16] = 8'd0;
+       fine_rom[17] = 8'd13;
+       fine_rom[18] = 8'd25;
+       fine_rom[19] = 8'd38;
+       fine_rom[20] = 8'd51;
+       fine_rom[21] = 8'd63;
+       fine_rom[22] = 8'd76;
+       fine_rom[23] = 8'd88;
+       fine_rom[24] = 8'd101;
+       fine_rom[25] = 8'd113;
+       fine_rom[26] = 8'd126;
+       fine_rom[27] = 8'd139;
+       fine_rom[28] = 8'd151;
+       fine_rom[29] = 8'd164;
+       fine_rom[30] = 8'd176;
+       fine_rom[31] = 8'd189;
+       fine_rom[32] = 8'd0;
+       fine_rom[33] = 8'd13;
+       fine_rom[34] = 8'd26;
+       fine_rom[35] = 8'd38;
+       fine_rom[36] = 8'd51;
+       fine_rom[37] = 8'd63;
+       fine_rom[38] = 8'd76;
+       fine_rom[39] = 8'd88;
+       fine_rom[40] = 8'd101;
+       fine_rom[41] = 8'd113;
+       fine_rom[42] = 8'd126;
+       fine_rom[43] = 8'd139;
+       fine_rom[44] = 8'd151;
+       fine_rom[45] = 8'd164;
+       fine_rom[46] = 8'd176;
+       fine_rom[47] = 8'd189;
+       fine_rom[48] = 8'd0;
+       fine_rom[49] = 8'd13;
+       fine_rom[50] = 8'd26;
+       fine_rom[51] = 8'd38;
+       fine_rom[52] = 8'd51;
+       fine_rom[53] = 8'd63;
+       fine_rom[54] = 8'd76;
+       fine_rom[55] = 8'd88;
+       fine_rom[56] = 8'd101;
+       fine_rom[57] = 8'd113;
+       fine_rom[58] = 8'd126;
+       fine_rom[59] = 8'd139;
+       fine_rom[60] = 8'd151;
+       fine_rom[61] = 8'd164;
+       fine_rom[62] = 8'd176;
+       fine_rom[63] = 8'd189;
+       fine_rom[64] = 8'd0;
+       fine_rom[65] = 8'd13;
+       fine_rom[66] = 8'd26;
+       fine_rom[67] = 8'd38;
+       fine_rom[68] = 8'd51;
+       fine_rom[69] = 8'd63;
+       fine_rom[70] = 8'd76;
+       fine_rom[71] = 8'd88;
+       fine_rom[72] = 8'd101;
+       fine_rom[73] = 8'd113;
+       fine_rom[74] = 8'd126;
+       fine_rom[75] = 8'd139;
+       fine_rom[76] = 8'd151;
+       fine_rom[77] = 8'd164;
+       fine_rom[78] = 8'd176;
+       fine_rom[79] = 8'd189;
+       fine_rom[80] = 8'd0;
+       fine_rom[81] = 8'd13;
+       fine_rom[82] = 8'd26;
+       fine_rom[83] = 8'd38;
+       fine_rom[84] = 8'd51;
+       fine_rom[85] = 8'd63;
+       fine_rom[86] = 8'd76;
+       fine_rom[87] = 8'd88;
+       fine_rom[88] = 8'd101;
+       fine_rom[89] = 8'd113;
+       fine_rom[90] = 8'd126;
+       fine_rom[91] = 8'd139;
+       fine_rom[92] = 8'd151;
+       fine_rom[93] = 8'd164;
+       fine_rom[94] = 8'd176;
+       fine_rom[95] = 8'd189;
+       fine_rom[96] = 8'd0;
+       fine_rom[97] = 8'd13;
+       fine_rom[98] = 8'd25;
+       fine_rom[99] = 8'd38;
+       fine_rom[100] = 8'd51;
+       fine_rom[101] = 8'd63;
+       fine_rom[102] = 8'd76;
+       fine_rom[103] = 8'd88;
+       fine_rom[104] = 8'd101;
+       fine_rom[105] = 8'd113;
+       fine_rom[106] = 8'd126;
+       fine_rom[107] = 8'd138;
+       fine_rom[108] = 8'd151;
+       fine_rom[109] = 8'd164;
+       fine_rom[110] = 8'd176;
+       fine_rom[111] = 8'd189;
+       fine_rom[112] = 8'd0;
+       fine_rom[113] = 8'd13;
+       fine_rom[114] = 8'd25;
+       fine_rom[115] = 8'd38;
+       fine_rom[116] = 8'd50;
+       fine_rom[117] = 8'd63;
+       fine_rom[118] = 8'd76;
+       fine_rom[119] = 8'd88;
+       fine_rom[120] = 8'd101;
+       fine_rom[121] = 8'd113;
+       fine_rom[122] = 8'd126;
+       fine_rom[123] = 8'd138;
+       fine_rom[124] = 8'd151;
+       fine_rom[125] = 8'd163;
+       fine_rom[126] = 8'd176;
+       fine_rom[127] = 8'd189;
+       fine_rom[128] = 8'd0;
+       fine_rom[129] = 8'd13;
+       fine_rom[130] = 8'd25;
+       fine_rom[131] = 8'd38;
+       fine_rom[132] = 8'd50;
+       fine_rom[133] = 8'd63;
+       fine_rom[134] = 8'd75;
+       fine_rom[135] = 8'd88;
+       fine_rom[136] = 8'd100;
+       fine_rom[137] = 8'd113;
+       fine_rom[138] = 8'd126;
+       fine_rom[139] = 8'd138;
+       fine_rom[140] = 8'd151;
+       fine_rom[141] = 8'd163;
+       fine_rom[142] = 8'd176;
+       fine_rom[143] = 8'd188;
+       fine_rom[144] = 8'd0;
+       fine_rom[145] = 8'd12;
+       fine_rom[146] = 8'd25;
+       fine_rom[147] = 8'd37;
+       fine_rom[148] = 8'd50;
+       fine_rom[149] = 8'd63;
+       fine_rom[150] = 8'd75;
+       fine_rom[151] = 8'd88;
+       fine_rom[152] = 8'd100;
+       fine_rom[153] = 8'd113;
+       fine_rom[154] = 8'd125;
+       fine_rom[155] = 8'd138;
+       fine_rom[156] = 8'd150;
+       fine_rom[157] = 8'd163;
+       fine_rom[158] = 8'd175;
+       fine_rom[159] = 8'd188;
+       fine_rom[160] = 8'd0;
+       fine_rom[161] = 8'd12;
+       fine_rom[162] = 8'd25;
+       fine_rom[163] = 8'd37;
+       fine_rom[164] = 8'd50;
+       fine_rom[165] = 8'd62;
+       fine_rom[166] = 8'd75;
+       fine_rom[167] = 8'd87;
+       fine_rom[168] = 8'd100;
+       fine_rom[169] = 8'd112;
+       fine_rom[170] = 8'd125;
+       fine_rom[171] = 8'd138;
+       fine_rom[172] = 8'd150;
+       fine_rom[173] = 8'd163;
+       fine_rom[174] = 8'd175;
+       fine_rom[175] = 8'd188;
+       fine_rom[176] = 8'd0;
+       fine_rom[177] = 8'd13;
+       fine_rom[178] = 8'd25;
+       fine_rom[179] = 8'd38;
+       fine_rom[180] = 8'd50;
+       fine_rom[181] = 8'd63;
+       fine_rom[182] = 8'd75;
+       fine_rom[183] = 8'd88;
+       fine_rom[184] = 8'd100;
+       fine_rom[185] = 8'd113;
+       fine_rom[186] = 8'd126;
+       fine_rom[187] = 8'd138;
+       fine_rom[188] = 8'd151;
+       fine_rom[189] = 8'd163;
+       fine_rom[190] = 8'd176;
+       fine_rom[191] = 8'd188;
+       fine_rom[192] = 8'd0;
+       fine_rom[193] = 8'd12;
+       fine_rom[194] = 8'd25;
+       fine_rom[195] = 8'd37;
+       fine_rom[196] = 8'd50;
+       fine_rom[197] = 8'd62;
+       fine_rom[198] = 8'd75;
+       fine_rom[199] = 8'd87;
+       fine_rom[200] = 8'd100;
+       fine_rom[201] = 8'd113;
+       fine_rom[202] = 8'd125;
+       fine_rom[203] = 8'd138;
+       fine_rom[204] = 8'd150;
+       fine_rom[205] = 8'd163;
+       fine_rom[206] = 8'd175;
+       fine_rom[207] = 8'd188;
+       fine_rom[208] = 8'd0;
+       fine_rom[209] = 8'd13;
+       fine_rom[210] = 8'd25;
+       fine_rom[211] = 8'd38;
+       fine_rom[212] = 8'd50;
+       fine_rom[213] = 8'd63;
+       fine_rom[214] = 8'd75;
+       fine_rom[215] = 8'd88;
+       fine_rom[216] = 8'd100;
+       fine_rom[217] = 8'd113;
+       fine_rom[218] = 8'd125;
+       fine_rom[219] = 8'd138;
+       fine_rom[220] = 8'd150;
+       fine_rom[221] = 8'd163;
+       fine_rom[222] = 8'd176;
+       fine_rom[223] = 8'd188;
+       fine_rom[224] = 8'd0;
+       fine_rom[225] = 8'd12;
+       fine_rom[226] = 8'd25;
+       fine_rom[227] = 8'd37;
+       fine_rom[228] = 8'd50;
+       fine_rom[229] = 8'd62;
+       fine_rom[230] = 8'd75;
+       fine_rom[231] = 8'd87;
+       fine_rom[232] = 8'd100;
+       fine_rom[233] = 8'd112;
+       fine_rom[234] = 8'd125;
+       fine_rom[235] = 8'd137;
+       fine_rom[236] = 8'd150;
+       fine_rom[237] = 8'd162;
+       fine_rom[238] = 8'd175;
+       fine_rom[239] = 8'd187;
+       fine_rom[240] = 8'd0;
+       fine_rom[241] = 8'd12;
+       fine_rom[242] = 8'd25;
+       fine_rom[243] = 8'd37;
+       fine_rom[244] = 8'd50;
+       fine_rom[245] = 8'd62;
+       fine_rom[246] = 8'd75;
+       fine_rom[247] = 8'd87;
+       fine_rom[248] = 8'd100;
+       fine_rom[249] = 8'd112;
+       fine_rom[250] = 8'd125;
+       fine_rom[251] = 8'd137;
+       fine_rom[252] = 8'd150;
+       fine_rom[253] = 8'd162;
+       fine_rom[254] = 8'd175;
+       fine_rom[255] = 8'd187;
+       fine_rom[256] = 8'd0;
+       fine_rom[257] = 8'd12;
+       fine_rom[258] = 8'd25;
+       fine_rom[259] = 8'd37;
+       fine_rom[260] = 8'd50;
+       fine_rom[261] = 8'd63;
+       fine_rom[262] = 8'd75;
+       fine_rom[263] = 8'd88;
+       fine_rom[264] = 8'd100;
+       fine_rom[265] = 8'd113;
+       fine_rom[266] = 8'd125;
+       fine_rom[267] = 8'd138;
+       fine_rom[268] = 8'd150;
+       fine_rom[269] = 8'd163;
+       fine_rom[270] = 8'd175;
+       fine_rom[271] = 8'd188;
+       fine_rom[272] = 8'd0;
+       fine_rom[273] = 8'd12;
+       fine_rom[274] = 8'd25;
+       fine_rom[275] = 8'd37;
+       fine_rom[276] = 8'd50;
+       fine_rom[277] = 8'd62;
+       fine_rom[278] = 8'd75;
+       fine_rom[279] = 8'd87;
+       fine_rom[280] = 8'd100;
+       fine_rom[281] = 8'd112;
+       fine_rom[282] = 8'd125;
+       fine_rom[283] = 8'd137;
+       fine_rom[284] = 8'd150;
+       fine_rom[285] = 8'd162;
+       fine_rom[286] = 8'd175;
+       fine_rom[287] = 8'd187;
+       fine_rom[288] = 8'd0;
+       fine_rom[289] = 8'd12;
+       fine_rom[290] = 8'd25;
+       fine_rom[291] = 8'd37;
+       fine_rom[292] = 8'd50;
+       fine_rom[293] = 8'd62;
+       fine_rom[294] = 8'd75;
+       fine_rom[295] = 8'd87;
+       fine_rom[296] = 8'd100;
+       fine_rom[297] = 8'd112;
+       fine_rom[298] = 8'd125;
+       fine_rom[299] = 8'd137;
+       fine_rom[300] = 8'd150;
+       fine_rom[301] = 8'd162;
+       fine_rom[302] = 8'd175;
+       fine_rom[303] = 8'd187;
+       fine_rom[304] = 8'd0;
+       fine_rom[305] = 8'd12;
+       fine_rom[306] = 8'd25;
+       fine_rom[307] = 8'd37;
+       fine_rom[308] = 8'd50;
+       fine_rom[309] = 8'd62;
+       fine_rom[310] = 8'd75;
+       fine_rom[311] = 8'd87;
+       fine_rom[312] = 8'd99;
+       fine_rom[313] = 8'd112;
+       fine_rom[314] = 8'd124;
+       fine_rom[315] = 8'd137;
+       fine_rom[316] = 8'd149;
+       fine_rom[317] = 8'd162;
+       fine_rom[318] = 8'd174;
+       fine_rom[319] = 8'd187;
+       fine_rom[320] = 8'd0;
+       fine_rom[321] = 8'd13;
+       fine_rom[322] = 8'd25;
+       fine_rom[323] = 8'd38;
+       fine_rom[324] = 8'd50;
+       fine_rom[325] = 8'd63;
+       fine_rom[326] = 8'd75;
+       fine_rom[327] = 8'd88;
+       fine_rom[328] = 8'd100;
+       fine_rom[329] = 8'd112;
+       fine_rom[330] = 8'd125;
+       fine_rom[331] = 8'd137;
+       fine_rom[332] = 8'd150;
+       fine_rom[333] = 8'd162;
+       fine_rom[334] = 8'd175;
+       fine_rom[335] = 8'd187;
+       fine_rom[336] = 8'd0;
+       fine_rom[337] = 8'd12;
+       fine_rom[338] = 8'd25;
+       fine_rom[339] = 8'd37;
+       fine_rom[340] = 8'd50;
+       fine_rom[341] = 8'd62;
+       fine_rom[342] = 8'd74;
+       fine_rom[343] = 8'd87;
+       fine_rom[344] = 8'd99;
+       fine_rom[345] = 8'd112;
+       fine_rom[346] = 8'd124;
+       fine_rom[347] = 8'd137;
+       fine_rom[348] = 8'd149;
+       fine_rom[349] = 8'd162;
+       fine_rom[350] = 8'd174;
+       fine_rom[351] = 8'd187;
+       fine_rom[352] = 8'd0;
+       fine_rom[353] = 8'd12;
+       fine_rom[354] = 8'd25;
+       fine_rom[355] = 8'd37;
+       fine_rom[356] = 8'd50;
+       fine_rom[357] = 8'd62;
+       fine_rom[358] = 8'd75;
+       fine_rom[359] = 8'd87;
+       fine_rom[360] = 8'd100;
+       fine_rom[361] = 8'd112;
+       fine_rom[362] = 8'd125;
+       fine_rom[363] = 8'd137;
+       fine_rom[364] = 8'd149;
+       fine_rom[365] = 8'd162;
+       fine_rom[366] = 8'd174;
+       fine_rom[367] = 8'd187;
+       fine_rom[368] = 8'd0;
+       fine_rom[369] = 8'd13;
+       fine_rom[370] = 8'd25;
+       fine_rom[371] = 8'd37;
+       fine_rom[372] = 8'd50;
+       fine_rom[373] = 8'd62;
+       fine_rom[374] = 8'd75;
+       fine_rom[375] = 8'd87;
+       fine_rom[376] = 8'd100;
+       fine_rom[377] = 8'd112;
+       fine_rom[378] = 8'd125;
+       fine_rom[379] = 8'd137;
+       fine_rom[380] = 8'd149;
+       fine_rom[381] = 8'd162;
+       fine_rom[382] = 8'd174;
+       fine_rom[383] = 8'd187;
+       fine_rom[384] = 8'd0;
+       fine_rom[385] = 8'd13;
+       fine_rom[386] = 8'd25;
+       fine_rom[387] = 8'd37;
+       fine_rom[388] = 8'd50;
+       fine_rom[389] = 8'd62;
+       fine_rom[390] = 8'd75;
+       fine_rom[391] = 8'd87;
+       fine_rom[392] = 8'd100;
+       fine_rom[393] = 8'd112;
+       fine_rom[394] = 8'd124;
+       fine_rom[395] = 8'd137;
+       fine_rom[396] = 8'd149;
+       fine_rom[397] = 8'd162;
+       fine_rom[398] = 8'd174;
+       fine_rom[399] = 8'd186;
+       fine_rom[400] = 8'd0;
+       fine_rom[401] = 8'd12;
+       fine_rom[402] = 8'd25;
+       fine_rom[403] = 8'd37;
+       fine_rom[404] = 8'd50;
+       fine_rom[405] = 8'd62;
+       fine_rom[406] = 8'd74;
+       fine_rom[407] = 8'd87;
+       fine_rom[408] = 8'd99;
+       fine_rom[409] = 8'd112;
+       fine_rom[410] = 8'd124;
+       fine_rom[411] = 8'd136;
+       fine_rom[412] = 8'd149;
+       fine_rom[413] = 8'd161;
+       fine_rom[414] = 8'd174;
+       fine_rom[415] = 8'd186;
+       fine_rom[416] = 8'd0;
+       fine_rom[417] = 8'd12;
+       fine_rom[418] = 8'd24;
+       fine_rom[419] = 8'd37;
+       fine_rom[420] = 8'd49;
+       fine_rom[421] = 8'd62;
+       fine_rom[422] = 8'd74;
+       fine_rom[423] = 8'd86;
+       fine_rom[424] = 8'd99;
+       fine_rom[425] = 8'd111;
+       fine_rom[426] = 8'd124;
+       fine_rom[427] = 8'd136;
+       fine_rom[428] = 8'd148;
+       fine_rom[429] = 8'd161;
+       fine_rom[430] = 8'd173;
+       fine_rom[431] = 8'd186;
+       fine_rom[432] = 8'd0;
+       fine_rom[433] = 8'd12;
+       fine_rom[434] = 8'd25;
+       fine_rom[435] = 8'd37;
+       fine_rom[436] = 8'd49;
+       fine_rom[437] = 8'd62;
+       fine_rom[438] = 8'd74;
+       fine_rom[439] = 8'd87;
+       fine_rom[440] = 8'd99;
+       fine_rom[441] = 8'd111;
+       fine_rom[442] = 8'd124;
+       fine_rom[443] = 8'd136;
+       fine_rom[444] = 8'd149;
+       fine_rom[445] = 8'd161;
+       fine_rom[446] = 8'd173;
+       fine_rom[447] = 8'd186;
+       fine_rom[448] = 8'd0;
+       fine_rom[449] = 8'd12;
+       fine_rom[450] = 8'd25;
+       fine_rom[451] = 8'd37;
+       fine_rom[452] = 8'd50;
+       fine_rom[453] = 8'd62;
+       fine_rom[454] = 8'd74;
+       fine_rom[455] = 8'd87;
+       fine_rom[456] = 8'd99;
+       fine_rom[457] = 8'd111;
+       fine_rom[458] = 8'd124;
+       fine_rom[459] = 8'd136;
+       fine_rom[460] = 8'd149;
+       fine_rom[461] = 8'd161;
+       fine_rom[462] = 8'd173;
+       fine_rom[463] = 8'd186;
+       fine_rom[464] = 8'd0;
+       fine_rom[465] = 8'd12;
+       fine_rom[466] = 8'd25;
+       fine_rom[467] = 8'd37;
+       fine_rom[468] = 8'd50;
+       fine_rom[469] = 8'd62;
+       fine_rom[470] = 8'd74;
+       fine_rom[471] = 8'd87;
+       fine_rom[472] = 8'd99;
+       fine_rom[473] = 8'd111;
+       fine_rom[474] = 8'd124;
+       fine_rom[475] = 8'd136;
+       fine_rom[476] = 8'd148;
+       fine_rom[477] = 8'd161;
+       fine_rom[478] = 8'd173;
+       fine_rom[479] = 8'd185;
+       fine_rom[480] = 8'd0;
+       fine_rom[481] = 8'd12;
+       fine_rom[482] = 8'd25;
+       fine_rom[483] = 8'd37;
+       fine_rom[484] = 8'd49;
+       fine_rom[485] = 8'd62;
+       fine_rom[486] = 8'd74;
+       fine_rom[487] = 8'd86;
+       fine_rom[488] = 8'd99;
+       fine_rom[489] = 8'd111;
+       fine_rom[490] = 8'd123;
+       fine_rom[491] = 8'd136;
+       fine_rom[492] = 8'd148;
+       fine_rom[493] = 8'd160;
+       fine_rom[494] = 8'd173;
+       fine_rom[495] = 8'd185;
+       fine_rom[496] = 8'd0;
+       fine_rom[497] = 8'd13;
+       fine_rom[498] = 8'd25;
+       fine_rom[499] = 8'd37;
+       fine_rom[500] = 8'd50;
+       fine_rom[501] = 8'd62;
+       fine_rom[502] = 8'd74;
+       fine_rom[503] = 8'd87;
+       fine_rom[504] = 8'd99;
+       fine_rom[505] = 8'd111;
+       fine_rom[506] = 8'd124;
+       fine_rom[507] = 8'd136;
+       fine_rom[508] = 8'd148;
+       fine_rom[509] = 8'd161;
+       fine_rom[510] = 8'd173;
+       fine_rom[511] = 8'd185;
+       fine_rom[512] = 8'd0;
+       fine_rom[513] = 8'd12;
+       fine_rom[514] = 8'd24;
+       fine_rom[515] = 8'd37;
+       fine_rom[516] = 8'd49;
+       fine_rom[517] = 8'd61;
+       fine_rom[518] = 8'd74;
+       fine_rom[519] = 8'd86;
+       fine_rom[520] = 8'd98;
+       fine_rom[521] = 8'd111;
+       fine_rom[522] = 8'd123;
+       fine_rom[523] = 8'd135;
+       fine_rom[524] = 8'd148;
+       fine_rom[525] = 8'd160;
+       fine_rom[526] = 8'd172;
+       fine_rom[527] = 8'd184;
+       fine_rom[528] = 8'd0;
+       fine_rom[529] = 8'd12;
+       fine_rom[530] = 8'd24;
+       fine_rom[531] = 8'd37;
+       fine_rom[532] = 8'd49;
+       fine_rom[533] = 8'd61;
+       fine_rom[534] = 8'd74;
+       fine_rom[535] = 8'd86;
+       fine_rom[536] = 8'd98;
+       fine_rom[537] = 8'd110;
+       fine_rom[538] = 8'd123;
+       fine_rom[539] = 8'd135;
+       fine_rom[540] = 8'd147;
+       fine_rom[541] = 8'd160;
+       fine_rom[542] = 8'd172;
+       fine_rom[543] = 8'd184;
+       fine_rom[544] = 8'd0;
+       fine_rom[545] = 8'd12;
+       fine_rom[546] = 8'd24;
+       fine_rom[547] = 8'd36;
+       fine_rom[548] = 8'd49;
+       fine_rom[549] = 8'd61;
+       fine_rom[550] = 8'd73;
+       fine_rom[551] = 8'd86;
+       fine_rom[552] = 8'd98;
+       fine_rom[553] = 8'd110;
+       fine_rom[554] = 8'd122;
+       fine_rom[555] = 8'd135;
+       fine_rom[556] = 8'd147;
+       fine_rom[557] = 8'd159;
+       fine_rom[558] = 8'd172;
+       fine_rom[559] = 8'd184;
+       fine_rom[560] = 8'd0;
+       fine_rom[561] = 8'd12;
+       fine_rom[562] = 8'd25;
+       fine_rom[563] = 8'd37;
+       fine_rom[564] = 8'd49;
+       fine_rom[565] = 8'd61;
+       fine_rom[566] = 8'd74;
+       fine_rom[567] = 8'd86;
+       fine_rom[568] = 8'd98;
+       fine_rom[569] = 8'd111;
+       fine_rom[570] = 8'd123;
+       fine_rom[571] = 8'd135;
+       fine_rom[572] = 8'd147;
+       fine_rom[573] = 8'd160;
+       fine_rom[574] = 8'd172;
+       fine_rom[575] = 8'd184;
+       fine_rom[576] = 8'd0;
+       fine_rom[577] = 8'd13;
+       fine_rom[578] = 8'd25;
+       fine_rom[579] = 8'd37;
+       fine_rom[580] = 8'd49;
+       fine_rom[581] = 8'd62;
+       fine_rom[582] = 8'd74;
+       fine_rom[583] = 8'd86;
+       fine_rom[584] = 8'd98;
+       fine_rom[585] = 8'd111;
+       fine_rom[586] = 8'd123;
+       fine_rom[587] = 8'd135;
+       fine_rom[588] = 8'd147;
+       fine_rom[589] = 8'd160;
+       fine_rom[590] = 8'd172;
+       fine_rom[591] = 8'd184;
+       fine_rom[592] = 8'd0;
+       fine_rom[593] = 8'd13;
+       fine_rom[594] = 8'd25;
+       fine_rom[595] = 8'd37;
+       fine_rom[596] = 8'd49;
+       fine_rom[597] = 8'd62;
+       fine_rom[598] = 8'd74;
+       fine_rom[599] = 8'd86;
+       fine_rom[600] = 8'd98;
+       fine_rom[601] = 8'd111;
+       fine_rom[602] = 8'd123;
+       fine_rom[603] = 8'd135;
+       fine_rom[604] = 8'd147;
+       fine_rom[605] = 8'd160;
+       fine_rom[606] = 8'd172;
+       fine_rom[607] = 8'd184;
+       fine_rom[608] = 8'd0;
+       fine_rom[609] = 8'd12;
+       fine_rom[610] = 8'd25;
+       fine_rom[611] = 8'd37;
+       fine_rom[612] = 8'd49;
+       fine_rom[613] = 8'd61;
+       fine_rom[614] = 8'd74;
+       fine_rom[615] = 8'd86;
+       fine_rom[616] = 8'd98;
+       fine_rom[617] = 8'd110;
+       fine_rom[618] = 8'd122;
+       fine_rom[619] = 8'd135;
+       fine_rom[620] = 8'd147;
+       fine_rom[621] = 8'd159;
+       fine_rom[622] = 8'd171;
+       fine_rom[623] = 8'd183;
+       fine_rom[624] = 8'd0;
+       fine_rom[625] = 8'd12;
+       fine_rom[626] = 8'd24;
+       fine_rom[627] = 8'd36;
+       fine_rom[628] = 8'd48;
+       fine_rom[629] = 8'd61;
+       fine_rom[630] = 8'd73;
+       fine_rom[631] = 8'd85;
+       fine_rom[632] = 8'd97;
+       fine_rom[633] = 8'd109;
+       fine_rom[634] = 8'd122;
+       fine_rom[635] = 8'd134;
+       fine_rom[636] = 8'd146;
+       fine_rom[637] = 8'd158;
+       fine_rom[638] = 8'd170;
+       fine_rom[639] = 8'd183;
+       fine_rom[640] = 8'd0;
+       fine_rom[641] = 8'd12;
+       fine_rom[642] = 8'd24;
+       fine_rom[643] = 8'd36;
+       fine_rom[644] = 8'd49;
+       fine_rom[645] = 8'd61;
+       fine_rom[646] = 8'd73;
+       fine_rom[647] = 8'd85;
+       fine_rom[648] = 8'd97;
+       fine_rom[649] = 8'd109;
+       fine_rom[650] = 8'd122;
+       fine_rom[651] = 8'd134;
+       fine_rom[652] = 8'd146;
+       fine_rom[653] = 8'd158;
+       fine_rom[654] = 8'd170;
+       fine_rom[655] = 8'd183;
+       fine_rom[656] = 8'd0;
+       fine_rom[657] = 8'd12;
+       fine_rom[658] = 8'd24;
+       fine_rom[659] = 8'd36;
+       fine_rom[660] = 8'd48;
+       fine_rom[661] = 8'd61;
+       fine_rom[662] = 8'd73;
+       fine_rom[663] = 8'd85;
+       fine_rom[664] = 8'd97;
+       fine_rom[665] = 8'd109;
+       fine_rom[666] = 8'd121;
+       fine_rom[667] = 8'd133;
+       fine_rom[668] = 8'd146;
+       fine_rom[669] = 8'd158;
+       fine_rom[670] = 8'd170;
+       fine_rom[671] = 8'd182;
+       fine_rom[672] = 8'd0;
+       fine_rom[673] = 8'd12;
+       fine_rom[674] = 8'd25;
+       fine_rom[675] = 8'd37;
+       fine_rom[676] = 8'd49;
+       fine_rom[677] = 8'd61;
+       fine_rom[678] = 8'd73;
+       fine_rom[679] = 8'd85;
+       fine_rom[680] = 8'd97;
+       fine_rom[681] = 8'd110;
+       fine_rom[682] = 8'd122;
+       fine_rom[683] = 8'd134;
+       fine_rom[684] = 8'd146;
+       fine_rom[685] = 8'd158;
+       fine_rom[686] = 8'd170;
+       fine_rom[687] = 8'd182;
+       fine_rom[688] = 8'd0;
+       fine_rom[689] = 8'd12;
+       fine_rom[690] = 8'd24;
+       fine_rom[691] = 8'd36;
+       fine_rom[692] = 8'd48;
+       fine_rom[693] = 8'd60;
+       fine_rom[694] = 8'd72;
+       fine_rom[695] = 8'd84;
+       fine_rom[696] = 8'd97;
+       fine_rom[697] = 8'd109;
+       fine_rom[698] = 8'd121;
+       fine_rom[699] = 8'd133;
+       fine_rom[700] = 8'd145;
+       fine_rom[701] = 8'd157;
+       fine_rom[702] = 8'd169;
+       fine_rom[703] = 8'd181;
+       fine_rom[704] = 8'd0;
+       fine_rom[705] = 8'd13;
+       fine_rom[706] = 8'd25;
+       fine_rom[707] = 8'd37;
+       fine_rom[708] = 8'd49;
+       fine_rom[709] = 8'd61;
+       fine_rom[710] = 8'd73;
+       fine_rom[711] = 8'd85;
+       fine_rom[712] = 8'd97;
+       fine_rom[713] = 8'd109;
+       fine_rom[714] = 8'd121;
+       fine_rom[715] = 8'd134;
+       fine_rom[716] = 8'd146;
+       fine_rom[717] = 8'd158;
+       fine_rom[718] = 8'd170;
+       fine_rom[719] = 8'd182;
+       fine_rom[720] = 8'd0;
+       fine_rom[721] = 8'd12;
+       fine_rom[722] = 8'd24;
+       fine_rom[723] = 8'd36;
+       fine_rom[724] = 8'd48;
+       fine_rom[725] = 8'd60;
+       fine_rom[726] = 8'd73;
+       fine_rom[727] = 8'd85;
+       fine_rom[728] = 8'd97;
+       fine_rom[729] = 8'd109;
+       fine_rom[730] = 8'd121;
+       fine_rom[731] = 8'd133;
+       fine_rom[732] = 8'd145;
+       fine_rom[733] = 8'd157;
+       fine_rom[734] = 8'd169;
+       fine_rom[735] = 8'd181;
+       fine_rom[736] = 8'd0;
+       fine_rom[737] = 8'd12;
+       fine_rom[738] = 8'd24;
+       fine_rom[739] = 8'd36;
+       fine_rom[740] = 8'd49;
+       fine_rom[741] = 8'd61;
+       fine_rom[742] = 8'd73;
+       fine_rom[743] = 8'd85;
+       fine_rom[744] = 8'd97;
+       fine_rom[745] = 8'd109;
+       fine_rom[746] = 8'd121;
+       fine_rom[747] = 8'd133;
+       fine_rom[748] = 8'd145;
+       fine_rom[749] = 8'd157;
+       fine_rom[750] = 8'd169;
+       fine_rom[751] = 8'd181;
+       fine_rom[752] = 8'd0;
+       fine_rom[753] = 8'd12;
+       fine_rom[754] = 8'd24;
+       fine_rom[755] = 8'd36;
+       fine_rom[756] = 8'd48;
+       fine_rom[757] = 8'd60;
+       fine_rom[758] = 8'd72;
+       fine_rom[759] = 8'd84;
+       fine_rom[760] = 8'd97;
+       fine_rom[761] = 8'd109;
+       fine_rom[762] = 8'd121;
+       fine_rom[763] = 8'd133;
+       fine_rom[764] = 8'd145;
+       fine_rom[765] = 8'd157;
+       fine_rom[766] = 8'd169;
+       fine_rom[767] = 8'd181;
+       fine_rom[768] = 8'd0;
+       fine_rom[769] = 8'd12;
+       fine_rom[770] = 8'd24;
+       fine_rom[771] = 8'd36;
+       fine_rom[772] = 8'd48;
+       fine_rom[773] = 8'd60;
+       fine_rom[774] = 8'd72;
+       fine_rom[775] = 8'd84;
+       fine_rom[776] = 8'd96;
+       fine_rom[777] = 8'd108;
+       fine_rom[778] = 8'd120;
+       fine_rom[779] = 8'd132;
+       fine_rom[780] = 8'd144;
+       fine_rom[781] = 8'd156;
+       fine_rom[782] = 8'd168;
+       fine_rom[783] = 8'd180;
+       fine_rom[784] = 8'd0;
+       fine_rom[785] = 8'd12;
+       fine_rom[786] = 8'd24;
+       fine_rom[787] = 8'd36;
+       fine_rom[788] = 8'd48;
+       fine_rom[789] = 8'd60;
+       fine_rom[790] = 8'd72;
+       fine_rom[791] = 8'd84;
+       fine_rom[792] = 8'd96;
+       fine_rom[793] = 8'd108;
+       fine_rom[794] = 8'd120;
+       fine_rom[795] = 8'd132;
+       fine_rom[796] = 8'd144;
+       fine_rom[797] = 8'd156;
+       fine_rom[798] = 8'd168;
+       fine_rom[799] = 8'd180;
+       fine_rom[800] = 8'd0;
+       fine_rom[801] = 8'd12;
+       fine_rom[802] = 8'd24;
+       fine_rom[803] = 8'd36;
+       fine_rom[804] = 8'd48;
+       fine_rom[805] = 8'd60;
+       fine_rom[806] = 8'd72;
+       fine_rom[807] = 8'd84;
+       fine_rom[808] = 8'd96;
+       fine_rom[809] = 8'd108;
+       fine_rom[810] = 8'd120;
+       fine_rom[811] = 8'd131;
+       fine_rom[812] = 8'd143;
+       fine_rom[813] = 8'd155;
+       fine_rom[814] = 8'd167;
+       fine_rom[815] = 8'd179;
+       fine_rom[816] = 8'd0;
+       fine_rom[817] = 8'd12;
+       fine_rom[818] = 8'd24;
+       fine_rom[819] = 8'd36;
+       fine_rom[820] = 8'd48;
+       fine_rom[821] = 8'd60;
+       fine_rom[822] = 8'd72;
+       fine_rom[823] = 8'd84;
+       fine_rom[824] = 8'd96;
+       fine_rom[825] = 8'd108;
+       fine_rom[826] = 8'd120;
+       fine_rom[827] = 8'd132;
+       fine_rom[828] = 8'd144;
+       fine_rom[829] = 8'd156;
+       fine_rom[830] = 8'd168;
+       fine_rom[831] = 8'd179;
+       fine_rom[832] = 8'd0;
+       fine_rom[833] = 8'd12;
+       fine_rom[834] = 8'd24;
+       fine_rom[835] = 8'd36;
+       fine_rom[836] = 8'd48;
+       fine_rom[837] = 8'd60;
+       fine_rom[838] = 8'd72;
+       fine_rom[839] = 8'd84;
+       fine_rom[840] = 8'd96;
+       fine_rom[841] = 8'd108;
+       fine_rom[842] = 8'd120;
+       fine_rom[843] = 8'd132;
+       fine_rom[844] = 8'd143;
+       fine_rom[845] = 8'd155;
+       fine_rom[846] = 8'd167;
+       fine_rom[847] = 8'd179;
+       fine_rom[848] = 8'd0;
+       fine_rom[849] = 8'd12;
+       fine_rom[850] = 8'd24;
+       fine_rom[851] = 8'd36;
+       fine_rom[852] = 8'd48;
+       fine_rom[853] = 8'd60;
+       fine_rom[854] = 8'd71;
+       fine_rom[855] = 8'd83;
+       fine_rom[856] = 8'd95;
+       fine_rom[857] = 8'd107;
+       fine_rom[858] = 8'd119;
+       fine_rom[859] = 8'd131;
+       fine_rom[860] = 8'd143;
+       fine_rom[861] = 8'd155;
+       fine_rom[862] = 8'd167;
+       fine_rom[863] = 8'd179;
+       fine_rom[864] = 8'd0;
+       fine_rom[865] = 8'd12;
+       fine_rom[866] = 8'd24;
+       fine_rom[867] = 8'd36;
+       fine_rom[868] = 8'd48;
+       fine_rom[869] = 8'd60;
+       fine_rom[870] = 8'd72;
+       fine_rom[871] = 8'd84;
+       fine_rom[872] = 8'd95;
+       fine_rom[873] = 8'd107;
+       fine_rom[874] = 8'd119;
+       fine_rom[875] = 8'd131;
+       fine_rom[876] = 8'd143;
+       fine_rom[877] = 8'd155;
+       fine_rom[878] = 8'd167;
+       fine_rom[879] = 8'd178;
+       fine_rom[880] = 8'd0;
+       fine_rom[881] = 8'd12;
+       fine_rom[882] = 8'd24;
+       fine_rom[883] = 8'd36;
+       fine_rom[884] = 8'd48;
+       fine_rom[885] = 8'd60;
+       fine_rom[886] = 8'd71;
+       fine_rom[887] = 8'd83;
+       fine_rom[888] = 8'd95;
+       fine_rom[889] = 8'd107;
+       fine_rom[890] = 8'd119;
+       fine_rom[891] = 8'd131;
+       fine_rom[892] = 8'd142;
+       fine_rom[893] = 8'd154;
+       fine_rom[894] = 8'd166;
+       fine_rom[895] = 8'd178;
+       fine_rom[896] = 8'd0;
+       fine_rom[897] = 8'd12;
+       fine_rom[898] = 8'd23;
+       fine_rom[899] = 8'd35;
+       fine_rom[900] = 8'd47;
+       fine_rom[901] = 8'd59;
+       fine_rom[902] = 8'd71;
+       fine_rom[903] = 8'd83;
+       fine_rom[904] = 8'd94;
+       fine_rom[905] = 8'd106;
+       fine_rom[906] = 8'd118;
+       fine_rom[907] = 8'd130;
+       fine_rom[908] = 8'd142;
+       fine_rom[909] = 8'd153;
+       fine_rom[910] = 8'd165;
+       fine_rom[911] = 8'd177;
+       fine_rom[912] = 8'd0;
+       fine_rom[913] = 8'd12;
+       fine_rom[914] = 8'd23;
+       fine_rom[915] = 8'd35;
+       fine_rom[916] = 8'd47;
+       fine_rom[917] = 8'd59;
+       fine_rom[918] = 8'd71;
+       fine_rom[919] = 8'd82;
+       fine_rom[920] = 8'd94;
+       fine_rom[921] = 8'd106;
+       fine_rom[922] = 8'd118;
+       fine_rom[923] = 8'd130;
+       fine_rom[924] = 8'd141;
+       fine_rom[925] = 8'd153;
+       fine_rom[926] = 8'd165;
+       fine_rom[927] = 8'd177;
+       fine_rom[928] = 8'd0;
+       fine_rom[929] = 8'd11;
+       fine_rom[930] = 8'd23;
+       fine_rom[931] = 8'd35;
+       fine_rom[932] = 8'd47;
+       fine_rom[933] = 8'd58;
+       fine_rom[934] = 8'd70;
+       fine_rom[935] = 8'd82;
+       fine_rom[936] = 8'd94;
+       fine_rom[937] = 8'd105;
+       fine_rom[938] = 8'd117;
+       fine_rom[939] = 8'd129;
+       fine_rom[940] = 8'd141;
+       fine_rom[941] = 8'd152;
+       fine_rom[942] = 8'd164;
+       fine_rom[943] = 8'd176;
+       fine_rom[944] = 8'd0;
+       fine_rom[945] = 8'd12;
+       fine_rom[946] = 8'd23;
+       fine_rom[947] = 8'd35;
+       fine_rom[948] = 8'd47;
+       fine_rom[949] = 8'd58;
+       fine_rom[950] = 8'd70;
+       fine_rom[951] = 8'd82;
+       fine_rom[952] = 8'd94;
+       fine_rom[953] = 8'd105;
+       fine_rom[954] = 8'd117;
+       fine_rom[955] = 8'd129;
+       fine_rom[956] = 8'd141;
+       fine_rom[957] = 8'd152;
+       fine_rom[958] = 8'd164;
+       fine_rom[959] = 8'd176;
+       fine_rom[960] = 8'd0;
+       fine_rom[961] = 8'd11;
+       fine_rom[962] = 8'd23;
+       fine_rom[963] = 8'd35;
+       fine_rom[964] = 8'd46;
+       fine_rom[965] = 8'd58;
+       fine_rom[966] = 8'd70;
+       fine_rom[967] = 8'd82;
+       fine_rom[968] = 8'd93;
+       fine_rom[969] = 8'd105;
+       fine_rom[970] = 8'd117;
+       fine_rom[971] = 8'd128;
+       fine_rom[972] = 8'd140;
+       fine_rom[973] = 8'd152;
+       fine_rom[974] = 8'd163;
+       fine_rom[975] = 8'd175;
+       fine_rom[976] = 8'd0;
+       fine_rom[977] = 8'd12;
+       fine_rom[978] = 8'd23;
+       fine_rom[979] = 8'd35;
+       fine_rom[980] = 8'd47;
+       fine_rom[981] = 8'd58;
+       fine_rom[982] = 8'd70;
+       fine_rom[983] = 8'd82;
+       fine_rom[984] = 8'd93;
+       fine_rom[985] = 8'd105;
+       fine_rom[986] = 8'd117;
+       fine_rom[987] = 8'd128;
+       fine_rom[988] = 8'd140;
+       fine_rom[989] = 8'd152;
+       fine_rom[990] = 8'd163;
+       fine_rom[991] = 8'd175;
+       fine_rom[992] = 8'd0;
+       fine_rom[993] = 8'd11;
+       fine_rom[994] = 8'd23;
+       fine_rom[995] = 8'd35;
+       fine_rom[996] = 8'd46;
+       fine_rom[997] = 8'd58;
+       fine_rom[998] = 8'd70;
+       fine_rom[999] = 8'd81;
+       fine_rom[1000] = 8'd93;
+       fine_rom[1001] = 8'd105;
+       fine_rom[1002] = 8'd116;
+       fine_rom[1003] = 8'd128;
+       fine_rom[1004] = 8'd140;
+       fine_rom[1005] = 8'd151;
+       fine_rom[1006] = 8'd163;
+       fine_rom[1007] = 8'd175;
+       fine_rom[1008] = 8'd0;
+       fine_rom[1009] = 8'd12;
+       fine_rom[1010] = 8'd23;
+       fine_rom[1011] = 8'd35;
+       fine_rom[1012] = 8'd47;
+       fine_rom[1013] = 8'd58;
+       fine_rom[1014] = 8'd70;
+       fine_rom[1015] = 8'd82;
+       fine_rom[1016] = 8'd93;
+       fine_rom[1017] = 8'd105;
+       fine_rom[1018] = 8'd117;
+       fine_rom[1019] = 8'd128;
+       fine_rom[1020] = 8'd140;
+       fine_rom[1021] = 8'd151;
+       fine_rom[1022] = 8'd163;
+       fine_rom[1023] = 8'd175;
+       fine_rom[1024] = 8'd0;
+       fine_rom[1025] = 8'd12;
+       fine_rom[1026] = 8'd23;
+       fine_rom[1027] = 8'd35;
+       fine_rom[1028] = 8'd47;
+       fine_rom[1029] = 8'd58;
+       fine_rom[1030] = 8'd70;
+       fine_rom[1031] = 8'd81;
+       fine_rom[1032] = 8'd93;
+       fine_rom[1033] = 8'd105;
+       fine_rom[1034] = 8'd116;
+       fine_rom[1035] = 8'd128;
+       fine_rom[1036] = 8'd139;
+       fine_rom[1037] = 8'd151;
+       fine_rom[1038] = 8'd163;
+       fine_rom[1039] = 8'd174;
+       fine_rom[1040] = 8'd0;
+       fine_rom[1041] = 8'd11;
+       fine_rom[1042] = 8'd23;
+       fine_rom[1043] = 8'd34;
+       fine_rom[1044] = 8'd46;
+       fine_rom[1045] = 8'd58;
+       fine_rom[1046] = 8'd69;
+       fine_rom[1047] = 8'd81;
+       fine_rom[1048] = 8'd92;
+       fine_rom[1049] = 8'd104;
+       fine_rom[1050] = 8'd115;
+       fine_rom[1051] = 8'd127;
+       fine_rom[1052] = 8'd139;
+       fine_rom[1053] = 8'd150;
+       fine_rom[1054] = 8'd162;
+       fine_rom[1055] = 8'd173;
+       fine_rom[1056] = 8'd0;
+       fine_rom[1057] = 8'd11;
+       fine_rom[1058] = 8'd23;
+       fine_rom[1059] = 8'd34;
+       fine_rom[1060] = 8'd46;
+       fine_rom[1061] = 8'd57;
+       fine_rom[1062] = 8'd69;
+       fine_rom[1063] = 8'd81;
+       fine_rom[1064] = 8'd92;
+       fine_rom[1065] = 8'd104;
+       fine_rom[1066] = 8'd115;
+       fine_rom[1067] = 8'd127;
+       fine_rom[1068] = 8'd138;
+       fine_rom[1069] = 8'd150;
+       fine_rom[1070] = 8'd161;
+       fine_rom[1071] = 8'd173;
+       fine_rom[1072] = 8'd0;
+       fine_rom[1073] = 8'd12;
+       fine_rom[1074] = 8'd23;
+       fine_rom[1075] = 8'd35;
+       fine_rom[1076] = 8'd46;
+       fine_rom[1077] = 8'd58;
+       fine_rom[1078] = 8'd69;
+       fine_rom[1079] = 8'd81;
+       fine_rom[1080] = 8'd92;
+       fine_rom[1081] = 8'd104;
+       fine_rom[1082] = 8'd115;
+       fine_rom[1083] = 8'd127;
+       fine_rom[1084] = 8'd138;
+       fine_rom[1085] = 8'd150;
+       fine_rom[1086] = 8'd161;
+       fine_rom[1087] = 8'd173;
+       fine_rom[1088] = 8'd0;
+       fine_rom[1089] = 8'd12;
+       fine_rom[1090] = 8'd23;
+       fine_rom[1091] = 8'd35;
+       fine_rom[1092] = 8'd46;
+       fine_rom[1093] = 8'd58;
+       fine_rom[1094] = 8'd69;
+       fine_rom[1095] = 8'd81;
+       fine_rom[1096] = 8'd92;
+       fine_rom[1097] = 8'd104;
+       fine_rom[1098] = 8'd115;
+       fine_rom[1099] = 8'd127;
+       fine_rom[1100] = 8'd138;
+       fine_rom[1101] = 8'd149;
+       fine_rom[1102] = 8'd161;
+       fine_rom[1103] = 8'd172;
+       fine_rom[1104] = 8'd0;
+       fine_rom[1105] = 8'd11;
+       fine_rom[1106] = 8'd23;
+       fine_rom[1107] = 8'd34;
+       fine_rom[1108] = 8'd46;
+       fine_rom[1109] = 8'd57;
+       fine_rom[1110] = 8'd69;
+       fine_rom[1111] = 8'd80;
+       fine_rom[1112] = 8'd91;
+       fine_rom[1113] = 8'd103;
+       fine_rom[1114] = 8'd114;
+       fine_rom[1115] = 8'd126;
+       fine_rom[1116] = 8'd137;
+       fine_rom[1117] = 8'd149;
+       fine_rom[1118] = 8'd160;
+       fine_rom[1119] = 8'd171;
+       fine_rom[1120] = 8'd0;
+       fine_rom[1121] = 8'd11;
+       fine_rom[1122] = 8'd23;
+       fine_rom[1123] = 8'd34;
+       fine_rom[1124] = 8'd46;
+       fine_rom[1125] = 8'd57;
+       fine_rom[1126] = 8'd68;
+       fine_rom[1127] = 8'd80;
+       fine_rom[1128] = 8'd91;
+       fine_rom[1129] = 8'd103;
+       fine_rom[1130] = 8'd114;
+       fine_rom[1131] = 8'd125;
+       fine_rom[1132] = 8'd137;
+       fine_rom[1133] = 8'd148;
+       fine_rom[1134] = 8'd160;
+       fine_rom[1135] = 8'd171;
+       fine_rom[1136] = 8'd0;
+       fine_rom[1137] = 8'd12;
+       fine_rom[1138] = 8'd23;
+       fine_rom[1139] = 8'd35;
+       fine_rom[1140] = 8'd46;
+       fine_rom[1141] = 8'd57;
+       fine_rom[1142] = 8'd69;
+       fine_rom[1143] = 8'd80;
+       fine_rom[1144] = 8'd91;
+       fine_rom[1145] = 8'd103;
+       fine_rom[1146] = 8'd114;
+       fine_rom[1147] = 8'd126;
+       fine_rom[1148] = 8'd137;
+       fine_rom[1149] = 8'd148;
+       fine_rom[1150] = 8'd160;
+       fine_rom[1151] = 8'd171;
+       fine_rom[1152] = 8'd0;
+       fine_rom[1153] = 8'd12;
+       fine_rom[1154] = 8'd23;
+       fine_rom[1155] = 8'd34;
+       fine_rom[1156] = 8'd46;
+       fine_rom[1157] = 8'd57;
+       fine_rom[1158] = 8'd68;
+       fine_rom[1159] = 8'd80;
+       fine_rom[1160] = 8'd91;
+       fine_rom[1161] = 8'd103;
+       fine_rom[1162] = 8'd114;
+       fine_rom[1163] = 8'd125;
+       fine_rom[1164] = 8'd137;
+       fine_rom[1165] = 8'd148;
+       fine_rom[1166] = 8'd159;
+       fine_rom[1167] = 8'd171;
+       fine_rom[1168] = 8'd0;
+       fine_rom[1169] = 8'd11;
+       fine_rom[1170] = 8'd22;
+       fine_rom[1171] = 8'd34;
+       fine_rom[1172] = 8'd45;
+       fine_rom[1173] = 8'd56;
+       fine_rom[1174] = 8'd68;
+       fine_rom[1175] = 8'd79;
+       fine_rom[1176] = 8'd90;
+       fine_rom[1177] = 8'd102;
+       fine_rom[1178] = 8'd113;
+       fine_rom[1179] = 8'd124;
+       fine_rom[1180] = 8'd136;
+       fine_rom[1181] = 8'd147;
+       fine_rom[1182] = 8'd158;
+       fine_rom[1183] = 8'd169;
+       fine_rom[1184] = 8'd0;
+       fine_rom[1185] = 8'd11;
+       fine_rom[1186] = 8'd22;
+       fine_rom[1187] = 8'd34;
+       fine_rom[1188] = 8'd45;
+       fine_rom[1189] = 8'd56;
+       fine_rom[1190] = 8'd67;
+       fine_rom[1191] = 8'd79;
+       fine_rom[1192] = 8'd90;
+       fine_rom[1193] = 8'd101;
+       fine_rom[1194] = 8'd113;
+       fine_rom[1195] = 8'd124;
+       fine_rom[1196] = 8'd135;
+       fine_rom[1197] = 8'd146;
+       fine_rom[1198] = 8'd158;
+       fine_rom[1199] = 8'd169;
+       fine_rom[1200] = 8'd0;
+       fine_rom[1201] = 8'd11;
+       fine_rom[1202] = 8'd23;
+       fine_rom[1203] = 8'd34;
+       fine_rom[1204] = 8'd45;
+       fine_rom[1205] = 8'd56;
+       fine_rom[1206] = 8'd68;
+       fine_rom[1207] = 8'd79;
+       fine_rom[1208] = 8'd90;
+       fine_rom[1209] = 8'd101;
+       fine_rom[1210] = 8'd113;
+       fine_rom[1211] = 8'd124;
+       fine_rom[1212] = 8'd135;
+       fine_rom[1213] = 8'd146;
+       fine_rom[1214] = 8'd158;
+       fine_rom[1215] = 8'd169;
+       fine_rom[1216] = 8'd0;
+       fine_rom[1217] = 8'd11;
+       fine_rom[1218] = 8'd22;
+       fine_rom[1219] = 8'd34;
+       fine_rom[1220] = 8'd45;
+       fine_rom[1221] = 8'd56;
+       fine_rom[1222] = 8'd67;
+       fine_rom[1223] = 8'd79;
+       fine_rom[1224] = 8'd90;
+       fine_rom[1225] = 8'd101;
+       fine_rom[1226] = 8'd112;
+       fine_rom[1227] = 8'd123;
+       fine_rom[1228] = 8'd135;
+       fine_rom[1229] = 8'd146;
+       fine_rom[1230] = 8'd157;
+       fine_rom[1231] = 8'd168;
+       fine_rom[1232] = 8'd0;
+       fine_rom[1233] = 8'd12;
+       fine_rom[1234] = 8'd23;
+       fine_rom[1235] = 8'd34;
+       fine_rom[1236] = 8'd45;
+       fine_rom[1237] = 8'd56;
+       fine_rom[1238] = 8'd67;
+       fine_rom[1239] = 8'd79;
+       fine_rom[1240] = 8'd90;
+       fine_rom[1241] = 8'd101;
+       fine_rom[1242] = 8'd112;
+       fine_rom[1243] = 8'd123;
+       fine_rom[1244] = 8'd134;
+       fine_rom[1245] = 8'd146;
+       fine_rom[1246] = 8'd157;
+       fine_rom[1247] = 8'd168;
+       fine_rom[1248] = 8'd0;
+       fine_rom[1249] = 8'd11;
+       fine_rom[1250] = 8'd22;
+       fine_rom[1251] = 8'd33;
+       fine_rom[1252] = 8'd45;
+       fine_rom[1253] = 8'd56;
+       fine_rom[1254] = 8'd67;
+       fine_rom[1255] = 8'd78;
+       fine_rom[1256] = 8'd89;
+       fine_rom[1257] = 8'd100;
+       fine_rom[1258] = 8'd111;
+       fine_rom[1259] = 8'd123;
+       fine_rom[1260] = 8'd134;
+       fine_rom[1261] = 8'd145;
+       fine_rom[1262] = 8'd156;
+       fine_rom[1263] = 8'd167;
+       fine_rom[1264] = 8'd0;
+       fine_rom[1265] = 8'd11;
+       fine_rom[1266] = 8'd22;
+       fine_rom[1267] = 8'd34;
+       fine_rom[1268] = 8'd45;
+       fine_rom[1269] = 8'd56;
+       fine_rom[1270] = 8'd67;
+       fine_rom[1271] = 8'd78;
+       fine_rom[1272] = 8'd89;
+       fine_rom[1273] = 8'd100;
+       fine_rom[1274] = 8'd111;
+       fine_rom[1275] = 8'd122;
+       fine_rom[1276] = 8'd133;
+       fine_rom[1277] = 8'd145;
+       fine_rom[1278] = 8'd156;
+       fine_rom[1279] = 8'd167;
+       fine_rom[1280] = 8'd0;
+       fine_rom[1281] = 8'd11;
+       fine_rom[1282] = 8'd22;
+       fine_rom[1283] = 8'd33;
+       fine_rom[1284] = 8'd44;
+       fine_rom[1285] = 8'd55;
+       fine_rom[1286] = 8'd66;
+       fine_rom[1287] = 8'd77;
+       fine_rom[1288] = 8'd88;
+       fine_rom[1289] = 8'd99;
+       fine_rom[1290] = 8'd110;
+       fine_rom[1291] = 8'd122;
+       fine_rom[1292] = 8'd133;
+       fine_rom[1293] = 8'd144;
+       fine_rom[1294] = 8'd155;
+       fine_rom[1295] = 8'd166;
+       fine_rom[1296] = 8'd0;
+       fine_rom[1297] = 8'd11;
+       fine_rom[1298] = 8'd22;
+       fine_rom[1299] = 8'd33;
+       fine_rom[1300] = 8'd44;
+       fine_rom[1301] = 8'd55;
+       fine_rom[1302] = 8'd66;
+       fine_rom[1303] = 8'd77;
+       fine_rom[1304] = 8'd88;
+       fine_rom[1305] = 8'd99;
+       fine_rom[1306] = 8'd110;
+       fine_rom[1307] = 8'd121;
+       fine_rom[1308] = 8'd132;
+       fine_rom[1309] = 8'd143;
+       fine_rom[1310] = 8'd154;
+       fine_rom[1311] = 8'd165;
+       fine_rom[1312] = 8'd0;
+       fine_rom[1313] = 8'd11;
+       fine_rom[1314] = 8'd22;
+       fine_rom[1315] = 8'd33;
+       fine_rom[1316] = 8'd44;
+       fine_rom[1317] = 8'd55;
+       fine_rom[1318] = 8'd66;
+       fine_rom[1319] = 8'd77;
+       fine_rom[1320] = 8'd88;
+       fine_rom[1321] = 8'd99;
+       fine_rom[1322] = 8'd110;
+       fine_rom[1323] = 8'd121;
+       fine_rom[1324] = 8'd132;
+       fine_rom[1325] = 8'd143;
+       fine_rom[1326] = 8'd154;
+       fine_rom[1327] = 8'd165;
+       fine_rom[1328] = 8'd0;
+       fine_rom[1329] = 8'd11;
+       fine_rom[1330] = 8'd22;
+       fine_rom[1331] = 8'd33;
+       fine_rom[1332] = 8'd44;
+       fine_rom[1333] = 8'd55;
+       fine_rom[1334] = 8'd66;
+       fine_rom[1335] = 8'd77;
+       fine_rom[1336] = 8'd88;
+       fine_rom[1337] = 8'd99;
+       fine_rom[1338] = 8'd110;
+       fine_rom[1339] = 8'd121;
+       fine_rom[1340] = 8'd132;
+       fine_rom[1341] = 8'd142;
+       fine_rom[1342] = 8'd153;
+       fine_rom[1343] = 8'd164;
+       fine_rom[1344] = 8'd0;
+       fine_rom[1345] = 8'd11;
+       fine_rom[1346] = 8'd22;
+       fine_rom[1347] = 8'd33;
+       fine_rom[1348] = 8'd44;
+       fine_rom[1349] = 8'd55;
+       fine_rom[1350] = 8'd66;
+       fine_rom[1351] = 8'd77;
+       fine_rom[1352] = 8'd88;
+       fine_rom[1353] = 8'd99;
+       fine_rom[1354] = 8'd109;
+       fine_rom[1355] = 8'd120;
+       fine_rom[1356] = 8'd131;
+       fine_rom[1357] = 8'd142;
+       fine_rom[1358] = 8'd153;
+       fine_rom[1359] = 8'd164;
+       fine_rom[1360] = 8'd0;
+       fine_rom[1361] = 8'd11;
+       fine_rom[1362] = 8'd22;
+       fine_rom[1363] = 8'd33;
+       fine_rom[1364] = 8'd43;
+       fine_rom[1365] = 8'd54;
+       fine_rom[1366] = 8'd65;
+       fine_rom[1367] = 8'd76;
+       fine_rom[1368] = 8'd87;
+       fine_rom[1369] = 8'd98;
+       fine_rom[1370] = 8'd109;
+       fine_rom[1371] = 8'd120;
+       fine_rom[1372] = 8'd130;
+       fine_rom[1373] = 8'd141;
+       fine_rom[1374] = 8'd152;
+       fine_rom[1375] = 8'd163;
+       fine_rom[1376] = 8'd0;
+       fine_rom[1377] = 8'd11;
+       fine_rom[1378] = 8'd22;
+       fine_rom[1379] = 8'd32;
+       fine_rom[1380] = 8'd43;
+       fine_rom[1381] = 8'd54;
+       fine_rom[1382] = 8'd65;
+       fine_rom[1383] = 8'd76;
+       fine_rom[1384] = 8'd87;
+       fine_rom[1385] = 8'd97;
+       fine_rom[1386] = 8'd108;
+       fine_rom[1387] = 8'd119;
+       fine_rom[1388] = 8'd130;
+       fine_rom[1389] = 8'd141;
+       fine_rom[1390] = 8'd152;
+       fine_rom[1391] = 8'd162;
+       fine_rom[1392] = 8'd0;
+       fine_rom[1393] = 8'd11;
+       fine_rom[1394] = 8'd22;
+       fine_rom[1395] = 8'd33;
+       fine_rom[1396] = 8'd43;
+       fine_rom[1397] = 8'd54;
+       fine_rom[1398] = 8'd65;
+       fine_rom[1399] = 8'd76;
+       fine_rom[1400] = 8'd87;
+       fine_rom[1401] = 8'd97;
+       fine_rom[1402] = 8'd108;
+       fine_rom[1403] = 8'd119;
+       fine_rom[1404] = 8'd130;
+       fine_rom[1405] = 8'd141;
+       fine_rom[1406] = 8'd151;
+       fine_rom[1407] = 8'd162;
+       fine_rom[1408] = 8'd0;
+       fine_rom[1409] = 8'd11;
+       fine_rom[1410] = 8'd22;
+       fine_rom[1411] = 8'd32;
+       fine_rom[1412] = 8'd43;
+       fine_rom[1413] = 8'd54;
+       fine_rom[1414] = 8'd65;
+       fine_rom[1415] = 8'd75;
+       fine_rom[1416] = 8'd86;
+       fine_rom[1417] = 8'd97;
+       fine_rom[1418] = 8'd108;
+       fine_rom[1419] = 8'd118;
+       fine_rom[1420] = 8'd129;
+       fine_rom[1421] = 8'd140;
+       fine_rom[1422] = 8'd151;
+       fine_rom[1423] = 8'd161;
+       fine_rom[1424] = 8'd0;
+       fine_rom[1425] = 8'd11;
+       fine_rom[1426] = 8'd22;
+       fine_rom[1427] = 8'd32;
+       fine_rom[1428] = 8'd43;
+       fine_rom[1429] = 8'd54;
+       fine_rom[1430] = 8'd64;
+       fine_rom[1431] = 8'd75;
+       fine_rom[1432] = 8'd86;
+       fine_rom[1433] = 8'd97;
+       fine_rom[1434] = 8'd107;
+       fine_rom[1435] = 8'd118;
+       fine_rom[1436] = 8'd129;
+       fine_rom[1437] = 8'd139;
+       fine_rom[1438] = 8'd150;
+       fine_rom[1439] = 8'd161;
+       fine_rom[1440] = 8'd0;
+       fine_rom[1441] = 8'd10;
+       fine_rom[1442] = 8'd21;
+       fine_rom[1443] = 8'd32;
+       fine_rom[1444] = 8'd42;
+       fine_rom[1445] = 8'd53;
+       fine_rom[1446] = 8'd64;
+       fine_rom[1447] = 8'd74;
+       fine_rom[1448] = 8'd85;
+       fine_rom[1449] = 8'd96;
+       fine_rom[1450] = 8'd106;
+       fine_rom[1451] = 8'd117;
+       fine_rom[1452] = 8'd128;
+       fine_rom[1453] = 8'd138;
+       fine_rom[1454] = 8'd149;
+       fine_rom[1455] = 8'd160;
+       fine_rom[1456] = 8'd0;
+       fine_rom[1457] = 8'd11;
+       fine_rom[1458] = 8'd22;
+       fine_rom[1459] = 8'd32;
+       fine_rom[1460] = 8'd43;
+       fine_rom[1461] = 8'd54;
+       fine_rom[1462] = 8'd64;
+       fine_rom[1463] = 8'd75;
+       fine_rom[1464] = 8'd86;
+       fine_rom[1465] = 8'd96;
+       fine_rom[1466] = 8'd107;
+       fine_rom[1467] = 8'd117;
+       fine_rom[1468] = 8'd128;
+       fine_rom[1469] = 8'd139;
+       fine_rom[1470] = 8'd149;
+       fine_rom[1471] = 8'd160;
+       fine_rom[1472] = 8'd0;
+       fine_rom[1473] = 8'd10;
+       fine_rom[1474] = 8'd21;
+       fine_rom[1475] = 8'd31;
+       fine_rom[1476] = 8'd42;
+       fine_rom[1477] = 8'd53;
+       fine_rom[1478] = 8'd63;
+       fine_rom[1479] = 8'd74;
+       fine_rom[1480] = 8'd84;
+       fine_rom[1481] = 8'd95;
+       fine_rom[1482] = 8'd106;
+       fine_rom[1483] = 8'd116;
+       fine_rom[1484] = 8'd127;
+       fine_rom[1485] = 8'd137;
+       fine_rom[1486] = 8'd148;
+       fine_rom[1487] = 8'd159;
+       fine_rom[1488] = 8'd0;
+       fine_rom[1489] = 8'd11;
+       fine_rom[1490] = 8'd21;
+       fine_rom[1491] = 8'd32;
+       fine_rom[1492] = 8'd42;
+       fine_rom[1493] = 8'd53;
+       fine_rom[1494] = 8'd63;
+       fine_rom[1495] = 8'd74;
+       fine_rom[1496] = 8'd85;
+       fine_rom[1497] = 8'd95;
+       fine_rom[1498] = 8'd106;
+       fine_rom[1499] = 8'd116;
+       fine_rom[1500] = 8'd127;
+       fine_rom[1501] = 8'd137;
+       fine_rom[1502] = 8'd148;
+       fine_rom[1503] = 8'd158;
+       fine_rom[1504] = 8'd0;
+       fine_rom[1505] = 8'd10;
+       fine_rom[1506] = 8'd21;
+       fine_rom[1507] = 8'd32;
+       fine_rom[1508] = 8'd42;
+       fine_rom[1509] = 8'd53;
+       fine_rom[1510] = 8'd63;
+       fine_rom[1511] = 8'd74;
+       fine_rom[1512] = 8'd84;
+       fine_rom[1513] = 8'd95;
+       fine_rom[1514] = 8'd105;
+       fine_rom[1515] = 8'd116;
+       fine_rom[1516] = 8'd126;
+       fine_rom[1517] = 8'd137;
+       fine_rom[1518] = 8'd147;
+       fine_rom[1519] = 8'd158;
+       fine_rom[1520] = 8'd0;
+       fine_rom[1521] = 8'd11;
+       fine_rom[1522] = 8'd21;
+       fine_rom[1523] = 8'd32;
+       fine_rom[1524] = 8'd42;
+       fine_rom[1525] = 8'd53;
+       fine_rom[1526] = 8'd63;
+       fine_rom[1527] = 8'd73;
+       fine_rom[1528] = 8'd84;
+       fine_rom[1529] = 8'd94;
+       fine_rom[1530] = 8'd105;
+       fine_rom[1531] = 8'd115;
+       fine_rom[1532] = 8'd126;
+       fine_rom[1533] = 8'd136;
+       fine_rom[1534] = 8'd147;
+       fine_rom[1535] = 8'd157;
+       fine_rom[1536] = 8'd0;
+       fine_rom[1537] = 8'd10;
+       fine_rom[1538] = 8'd20;
+       fine_rom[1539] = 8'd31;
+       fine_rom[1540] = 8'd41;
+       fine_rom[1541] = 8'd52;
+       fine_rom[1542] = 8'd62;
+       fine_rom[1543] = 8'd73;
+       fine_rom[1544] = 8'd83;
+       fine_rom[1545] = 8'd94;
+       fine_rom[1546] = 8'd104;
+       fine_rom[1547] = 8'd114;
+       fine_rom[1548] = 8'd125;
+       fine_rom[1549] = 8'd135;
+       fine_rom[1550] = 8'd146;
+       fine_rom[1551] = 8'd156;
+       fine_rom[1552] = 8'd0;
+       fine_rom[1553] = 8'd11;
+       fine_rom[1554] = 8'd21;
+       fine_rom[1555] = 8'd32;
+       fine_rom[1556] = 8'd42;
+       fine_rom[1557] = 8'd52;
+       fine_rom[1558] = 8'd63;
+       fine_rom[1559] = 8'd73;
+       fine_rom[1560] = 8'd84;
+       fine_rom[1561] = 8'd94;
+       fine_rom[1562] = 8'd104;
+       fine_rom[1563] = 8'd115;
+       fine_rom[1564] = 8'd125;
+       fine_rom[1565] = 8'd135;
+       fine_rom[1566] = 8'd146;
+       fine_rom[1567] = 8'd156;
+       fine_rom[1568] = 8'd0;
+       fine_rom[1569] = 8'd10;
+       fine_rom[1570] = 8'd20;
+       fine_rom[1571] = 8'd31;
+       fine_rom[1572] = 8'd41;
+       fine_rom[1573] = 8'd51;
+       fine_rom[1574] = 8'd62;
+       fine_rom[1575] = 8'd72;
+       fine_rom[1576] = 8'd82;
+       fine_rom[1577] = 8'd93;
+       fine_rom[1578] = 8'd103;
+       fine_rom[1579] = 8'd113;
+       fine_rom[1580] = 8'd124;
+       fine_rom[1581] = 8'd134;
+       fine_rom[1582] = 8'd144;
+       fine_rom[1583] = 8'd155;
+       fine_rom[1584] = 8'd0;
+       fine_rom[1585] = 8'd10;
+       fine_rom[1586] = 8'd21;
+       fine_rom[1587] = 8'd31;
+       fine_rom[1588] = 8'd41;
+       fine_rom[1589] = 8'd51;
+       fine_rom[1590] = 8'd62;
+       fine_rom[1591] = 8'd72;
+       fine_rom[1592] = 8'd82;
+       fine_rom[1593] = 8'd93;
+       fine_rom[1594] = 8'd103;
+       fine_rom[1595] = 8'd113;
+       fine_rom[1596] = 8'd124;
+       fine_rom[1597] = 8'd134;
+       fine_rom[1598] = 8'd144;
+       fine_rom[1599] = 8'd154;
+       fine_rom[1600] = 8'd0;
+       fine_rom[1601] = 8'd10;
+       fine_rom[1602] = 8'd20;
+       fine_rom[1603] = 8'd30;
+       fine_rom[1604] = 8'd41;
+       fine_rom[1605] = 8'd51;
+       fine_rom[1606] = 8'd61;
+       fine_rom[1607] = 8'd71;
+       fine_rom[1608] = 8'd82;
+       fine_rom[1609] = 8'd92;
+       fine_rom[1610] = 8'd102;
+       fine_rom[1611] = 8'd112;
+       fine_rom[1612] = 8'd123;
+       fine_rom[1613] = 8'd133;
+       fine_rom[1614] = 8'd143;
+       fine_rom[1615] = 8'd153;
+       fine_rom[1616] = 8'd0;
+       fine_rom[1617] = 8'd10;
+       fine_rom[1618] = 8'd20;
+       fine_rom[1619] = 8'd30;
+       fine_rom[1620] = 8'd41;
+       fine_rom[1621] = 8'd51;
+       fine_rom[1622] = 8'd61;
+       fine_rom[1623] = 8'd71;
+       fine_rom[1624] = 8'd81;
+       fine_rom[1625] = 8'd92;
+       fine_rom[1626] = 8'd102;
+       fine_rom[1627] = 8'd112;
+       fine_rom[1628] = 8'd122;
+       fine_rom[1629] = 8'd132;
+       fine_rom[1630] = 8'd143;
+       fine_rom[1631] = 8'd153;
+       fine_rom[1632] = 8'd0;
+       fine_rom[1633] = 8'd10;
+       fine_rom[1634] = 8'd20;
+       fine_rom[1635] = 8'd30;
+       fine_rom[1636] = 8'd41;
+       fine_rom[1637] = 8'd51;
+       fine_rom[1638] = 8'd61;
+       fine_rom[1639] = 8'd71;
+       fine_rom[1640] = 8'd81;
+       fine_rom[1641] = 8'd91;
+       fine_rom[1642] = 8'd102;
+       fine_rom[1643] = 8'd112;
+       fine_rom[1644] = 8'd122;
+       fine_rom[1645] = 8'd132;
+       fine_rom[1646] = 8'd142;
+       fine_rom[1647] = 8'd152;
+       fine_rom[1648] = 8'd0;
+       fine_rom[1649] = 8'd11;
+       fine_rom[1650] = 8'd21;
+       fine_rom[1651] = 8'd31;
+       fine_rom[1652] = 8'd41;
+       fine_rom[1653] = 8'd51;
+       fine_rom[1654] = 8'd61;
+       fine_rom[1655] = 8'd71;
+       fine_rom[1656] = 8'd82;
+       fine_rom[1657] = 8'd92;
+       fine_rom[1658] = 8'd102;
+       fine_rom[1659] = 8'd112;
+       fine_rom[1660] = 8'd122;
+       fine_rom[1661] = 8'd132;
+       fine_rom[1662] = 8'd142;
+       fine_rom[1663] = 8'd152;
+       fine_rom[1664] = 8'd0;
+       fine_rom[1665] = 8'd10;
+       fine_rom[1666] = 8'd21;
+       fine_rom[1667] = 8'd31;
+       fine_rom[1668] = 8'd41;
+       fine_rom[1669] = 8'd51;
+       fine_rom[1670] = 8'd61;
+       fine_rom[1671] = 8'd71;
+       fine_rom[1672] = 8'd81;
+       fine_rom[1673] = 8'd91;
+       fine_rom[1674] = 8'd101;
+       fine_rom[1675] = 8'd111;
+       fine_rom[1676] = 8'd121;
+       fine_rom[1677] = 8'd131;
+       fine_rom[1678] = 8'd141;
+       fine_rom[1679] = 8'd151;
+       fine_rom[1680] = 8'd0;
+       fine_rom[1681] = 8'd10;
+       fine_rom[1682] = 8'd21;
+       fine_rom[1683] = 8'd31;
+       fine_rom[1684] = 8'd41;
+       fine_rom[1685] = 8'd51;
+       fine_rom[1686] = 8'd61;
+       fine_rom[1687] = 8'd71;
+       fine_rom[1688] = 8'd81;
+       fine_rom[1689] = 8'd91;
+       fine_rom[1690] = 8'd101;
+       fine_rom[1691] = 8'd111;
+       fine_rom[1692] = 8'd121;
+       fine_rom[1693] = 8'd131;
+       fine_rom[1694] = 8'd141;
+       fine_rom[1695] = 8'd151;
+       fine_rom[1696] = 8'd0;
+       fine_rom[1697] = 8'd10;
+       fine_rom[1698] = 8'd20;
+       fine_rom[1699] = 8'd30;
+       fine_rom[1700] = 8'd40;
+       fine_rom[1701] = 8'd50;
+       fine_rom[1702] = 8'd60;
+       fine_rom[1703] = 8'd70;
+       fine_rom[1704] = 8'd80;
+       fine_rom[1705] = 8'd90;
+       fine_rom[1706] = 8'd100;
+       fine_rom[1707] = 8'd110;
+       fine_rom[1708] = 8'd120;
+       fine_rom[1709] = 8'd130;
+       fine_rom[1710] = 8'd139;
+       fine_rom[1711] = 8'd149;
+       fine_rom[1712] = 8'd0;
+       fine_rom[1713] = 8'd10;
+       fine_rom[1714] = 8'd20;
+       fine_rom[1715] = 8'd30;
+       fine_rom[1716] = 8'd40;
+       fine_rom[1717] = 8'd50;
+       fine_rom[1718] = 8'd60;
+       fine_rom[1719] = 8'd70;
+       fine_rom[1720] = 8'd80;
+       fine_rom[1721] = 8'd90;
+       fine_rom[1722] = 8'd100;
+       fine_rom[1723] = 8'd110;
+       fine_rom[1724] = 8'd120;
+       fine_rom[1725] = 8'd130;
+       fine_rom[1726] = 8'd139;
+       fine_rom[1727] = 8'd149;
+       fine_rom[1728] = 8'd0;
+       fine_rom[1729] = 8'd10;
+       fine_rom[1730] = 8'd20;
+       fine_rom[1731] = 8'd30;
+       fine_rom[1732] = 8'd40;
+       fine_rom[1733] = 8'd50;
+       fine_rom[1734] = 8'd60;
+       fine_rom[1735] = 8'd70;
+       fine_rom[1736] = 8'd79;
+       fine_rom[1737] = 8'd89;
+       fine_rom[1738] = 8'd99;
+       fine_rom[1739] = 8'd109;
+       fine_rom[1740] = 8'd119;
+       fine_rom[1741] = 8'd129;
+       fine_rom[1742] = 8'd139;
+       fine_rom[1743] = 8'd148;
+       fine_rom[1744] = 8'd0;
+       fine_rom[1745] = 8'd10;
+       fine_rom[1746] = 8'd20;
+       fine_rom[1747] = 8'd30;
+       fine_rom[1748] = 8'd40;
+       fine_rom[1749] = 8'd50;
+       fine_rom[1750] = 8'd59;
+       fine_rom[1751] = 8'd69;
+       fine_rom[1752] = 8'd79;
+       fine_rom[1753] = 8'd89;
+       fine_rom[1754] = 8'd99;
+       fine_rom[1755] = 8'd109;
+       fine_rom[1756] = 8'd118;
+       fine_rom[1757] = 8'd128;
+       fine_rom[1758] = 8'd138;
+       fine_rom[1759] = 8'd148;
+       fine_rom[1760] = 8'd0;
+       fine_rom[1761] = 8'd9;
+       fine_rom[1762] = 8'd19;
+       fine_rom[1763] = 8'd29;
+       fine_rom[1764] = 8'd39;
+       fine_rom[1765] = 8'd49;
+       fine_rom[1766] = 8'd58;
+       fine_rom[1767] = 8'd68;
+       fine_rom[1768] = 8'd78;
+       fine_rom[1769] = 8'd88;
+       fine_rom[1770] = 8'd98;
+       fine_rom[1771] = 8'd107;
+       fine_rom[1772] = 8'd117;
+       fine_rom[1773] = 8'd127;
+       fine_rom[1774] = 8'd137;
+       fine_rom[1775] = 8'd146;
+       fine_rom[1776] = 8'd0;
+       fine_rom[1777] = 8'd10;
+       fine_rom[1778] = 8'd20;
+       fine_rom[1779] = 8'd30;
+       fine_rom[1780] = 8'd39;
+       fine_rom[1781] = 8'd49;
+       fine_rom[1782] = 8'd59;
+       fine_rom[1783] = 8'd68;
+       fine_rom[1784] = 8'd78;
+       fine_rom[1785] = 8'd88;
+       fine_rom[1786] = 8'd98;
+       fine_rom[1787] = 8'd107;
+       fine_rom[1788] = 8'd117;
+       fine_rom[1789] = 8'd127;
+       fine_rom[1790] = 8'd137;
+       fine_rom[1791] = 8'd146;
+       fine_rom[1792] = 8'd0;
+       fine_rom[1793] = 8'd10;
+       fine_rom[1794] = 8'd19;
+       fine_rom[1795] = 8'd29;
+       fine_rom[1796] = 8'd39;
+       fine_rom[1797] = 8'd49;
+       fine_rom[1798] = 8'd58;
+       fine_rom[1799] = 8'd68;
+       fine_rom[1800] = 8'd78;
+       fine_rom[1801] = 8'd87;
+       fine_rom[1802] = 8'd97;
+       fine_rom[1803] = 8'd107;
+       fine_rom[1804] = 8'd116;
+       fine_rom[1805] = 8'd126;
+       fine_rom[1806] = 8'd136;
+       fine_rom[1807] = 8'd145;
+       fine_rom[1808] = 8'd0;
+       fine_rom[1809] = 8'd10;
+       fine_rom[1810] = 8'd19;
+       fine_rom[1811] = 8'd29;
+       fine_rom[1812] = 8'd39;
+       fine_rom[1813] = 8'd48;
+       fine_rom[1814] = 8'd58;
+       fine_rom[1815] = 8'd68;
+       fine_rom[1816] = 8'd77;
+       fine_rom[1817] = 8'd87;
+       fine_rom[1818] = 8'd96;
+       fine_rom[1819] = 8'd106;
+       fine_rom[1820] = 8'd116;
+       fine_rom[1821] = 8'd125;
+       fine_rom[1822] = 8'd135;
+       fine_rom[1823] = 8'd145;
+       fine_rom[1824] = 8'd0;
+       fine_rom[1825] = 8'd10;
+       fine_rom[1826] = 8'd19;
+       fine_rom[1827] = 8'd29;
+       fine_rom[1828] = 8'd39;
+       fine_rom[1829] = 8'd48;
+       fine_rom[1830] = 8'd58;
+       fine_rom[1831] = 8'd67;
+       fine_rom[1832] = 8'd77;
+       fine_rom[1833] = 8'd87;
+       fine_rom[1834] = 8'd96;
+       fine_rom[1835] = 8'd106;
+       fine_rom[1836] = 8'd115;
+       fine_rom[1837] = 8'd125;
+       fine_rom[1838] = 8'd135;
+       fine_rom[1839] = 8'd144;
+       fine_rom[1840] = 8'd0;
+       fine_rom[1841] = 8'd9;
+       fine_rom[1842] = 8'd19;
+       fine_rom[1843] = 8'd28;
+       fine_rom[1844] = 8'd38;
+       fine_rom[1845] = 8'd47;
+       fine_rom[1846] = 8'd57;
+       fine_rom[1847] = 8'd67;
+       fine_rom[1848] = 8'd76;
+       fine_rom[1849] = 8'd86;
+       fine_rom[1850] = 8'd95;
+       fine_rom[1851] = 8'd105;
+       fine_rom[1852] = 8'd114;
+       fine_rom[1853] = 8'd124;
+       fine_rom[1854] = 8'd133;
+       fine_rom[1855] = 8'd143;
+       fine_rom[1856] = 8'd0;
+       fine_rom[1857] = 8'd10;
+       fine_rom[1858] = 8'd19;
+       fine_rom[1859] = 8'd29;
+       fine_rom[1860] = 8'd38;
+       fine_rom[1861] = 8'd48;
+       fine_rom[1862] = 8'd57;
+       fine_rom[1863] = 8'd67;
+       fine_rom[1864] = 8'd76;
+       fine_rom[1865] = 8'd86;
+       fine_rom[1866] = 8'd95;
+       fine_rom[1867] = 8'd105;
+       fine_rom[1868] = 8'd114;
+       fine_rom[1869] = 8'd124;
+       fine_rom[1870] = 8'd133;
+       fine_rom[1871] = 8'd143;
+       fine_rom[1872] = 8'd0;
+       fine_rom[1873] = 8'd10;
+       fine_rom[1874] = 8'd19;
+       fine_rom[1875] = 8'd28;
+       fine_rom[1876] = 8'd38;
+       fine_rom[1877] = 8'd47;
+       fine_rom[1878] = 8'd57;
+       fine_rom[1879] = 8'd66;
+       fine_rom[1880] = 8'd76;
+       fine_rom[1881] = 8'd85;
+       fine_rom[1882] = 8'd95;
+       fine_rom[1883] = 8'd104;
+       fine_rom[1884] = 8'd113;
+       fine_rom[1885] = 8'd123;
+       fine_rom[1886] = 8'd132;
+       fine_rom[1887] = 8'd142;
+       fine_rom[1888] = 8'd0;
+       fine_rom[1889] = 8'd9;
+       fine_rom[1890] = 8'd19;
+       fine_rom[1891] = 8'd28;
+       fine_rom[1892] = 8'd38;
+       fine_rom[1893] = 8'd47;
+       fine_rom[1894] = 8'd56;
+       fine_rom[1895] = 8'd66;
+       fine_rom[1896] = 8'd75;
+       fine_rom[1897] = 8'd85;
+       fine_rom[1898] = 8'd94;
+       fine_rom[1899] = 8'd103;
+       fine_rom[1900] = 8'd113;
+       fine_rom[1901] = 8'd122;
+       fine_rom[1902] = 8'd132;
+       fine_rom[1903] = 8'd141;
+       fine_rom[1904] = 8'd0;
+       fine_rom[1905] = 8'd10;
+       fine_rom[1906] = 8'd19;
+       fine_rom[1907] = 8'd28;
+       fine_rom[1908] = 8'd38;
+       fine_rom[1909] = 8'd47;
+       fine_rom[1910] = 8'd56;
+       fine_rom[1911] = 8'd66;
+       fine_rom[1912] = 8'd75;
+       fine_rom[1913] = 8'd84;
+       fine_rom[1914] = 8'd94;
+       fine_rom[1915] = 8'd103;
+       fine_rom[1916] = 8'd112;
+       fine_rom[1917] = 8'd122;
+       fine_rom[1918] = 8'd131;
+       fine_rom[1919] = 8'd140;
+       fine_rom[1920] = 8'd0;
+       fine_rom[1921] = 8'd9;
+       fine_rom[1922] = 8'd18;
+       fine_rom[1923] = 8'd28;
+       fine_rom[1924] = 8'd37;
+       fine_rom[1925] = 8'd46;
+       fine_rom[1926] = 8'd55;
+       fine_rom[1927] = 8'd65;
+       fine_rom[1928] = 8'd74;
+       fine_rom[1929] = 8'd83;
+       fine_rom[1930] = 8'd93;
+       fine_rom[1931] = 8'd102;
+       fine_rom[1932] = 8'd111;
+       fine_rom[1933] = 8'd120;
+       fine_rom[1934] = 8'd130;
+       fine_rom[1935] = 8'd139;
+       fine_rom[1936] = 8'd0;
+       fine_rom[1937] = 8'd9;
+       fine_rom[1938] = 8'd19;
+       fine_rom[1939] = 8'd28;
+       fine_rom[1940] = 8'd37;
+       fine_rom[1941] = 8'd46;
+       fine_rom[1942] = 8'd56;
+       fine_rom[1943] = 8'd65;
+       fine_rom[1944] = 8'd74;
+       fine_rom[1945] = 8'd83;
+       fine_rom[1946] = 8'd93;
+       fine_rom[1947] = 8'd102;
+       fine_rom[1948] = 8'd111;
+       fine_rom[1949] = 8'd120;
+       fine_rom[1950] = 8'd129;
+       fine_rom[1951] = 8'd139;
+       fine_rom[1952] = 8'd0;
+       fine_rom[1953] = 8'd9;
+       fine_rom[1954] = 8'd18;
+       fine_rom[1955] = 8'd27;
+       fine_rom[1956] = 8'd37;
+       fine_rom[1957] = 8'd46;
+       fine_rom[1958] = 8'd55;
+       fine_rom[1959] = 8'd64;
+       fine_rom[1960] = 8'd73;
+       fine_rom[1961] = 8'd83;
+       fine_rom[1962] = 8'd92;
+       fine_rom[1963] = 8'd101;
+       fine_rom[1964] = 8'd110;
+       fine_rom[1965] = 8'd119;
+       fine_rom[1966] = 8'd128;
+       fine_rom[1967] = 8'd138;
+       fine_rom[1968] = 8'd0;
+       fine_rom[1969] = 8'd9;
+       fine_rom[1970] = 8'd18;
+       fine_rom[1971] = 8'd27;
+       fine_rom[1972] = 8'd36;
+       fine_rom[1973] = 8'd45;
+       fine_rom[1974] = 8'd55;
+       fine_rom[1975] = 8'd64;
+       fine_rom[1976] = 8'd73;
+       fine_rom[1977] = 8'd82;
+       fine_rom[1978] = 8'd91;
+       fine_rom[1979] = 8'd100;
+       fine_rom[1980] = 8'd109;
+       fine_rom[1981] = 8'd118;
+       fine_rom[1982] = 8'd128;
+       fine_rom[1983] = 8'd137;
+       fine_rom[1984] = 8'd0;
+       fine_rom[1985] = 8'd9;
+       fine_rom[1986] = 8'd18;
+       fine_rom[1987] = 8'd27;
+       fine_rom[1988] = 8'd36;
+       fine_rom[1989] = 8'd45;
+       fine_rom[1990] = 8'd54;
+       fine_rom[1991] = 8'd63;
+       fine_rom[1992] = 8'd72;
+       fine_rom[1993] = 8'd81;
+       fine_rom[1994] = 8'd91;
+       fine_rom[1995] = 8'd100;
+       fine_rom[1996] = 8'd109;
+       fine_rom[1997] = 8'd118;
+       fine_rom[1998] = 8'd127;
+       fine_rom[1999] = 8'd136;
+       fine_rom[2000] = 8'd0;
+       fine_rom[2001] = 8'd9;
+       fine_rom[2002] = 8'd18;
+       fine_rom[2003] = 8'd27;
+       fine_rom[2004] = 8'd36;
+       fine_rom[2005] = 8'd45;
+       fine_rom[2006] = 8'd54;
+       fine_rom[2007] = 8'd63;
+       fine_rom[2008] = 8'd72;
+       fine_rom[2009] = 8'd81;
+       fine_rom[2010] = 8'd90;
+       fine_rom[2011] = 8'd99;
+       fine_rom[2012] = 8'd108;
+       fine_rom[2013] = 8'd117;
+       fine_rom[2014] = 8'd126;
+       fine_rom[2015] = 8'd135;
+       fine_rom[2016] = 8'd0;
+       fine_rom[2017] = 8'd9;
+       fine_rom[2018] = 8'd18;
+       fine_rom[2019] = 8'd27;
+       fine_rom[2020] = 8'd36;
+       fine_rom[2021] = 8'd45;
+       fine_rom[2022] = 8'd54;
+       fine_rom[2023] = 8'd63;
+       fine_rom[2024] = 8'd72;
+       fine_rom[2025] = 8'd81;
+       fine_rom[2026] = 8'd90;
+       fine_rom[2027] = 8'd99;
+       fine_rom[2028] = 8'd108;
+       fine_rom[2029] = 8'd117;
+       fine_rom[2030] = 8'd126;
+       fine_rom[2031] = 8'd135;
+       fine_rom[2032] = 8'd0;
+       fine_rom[2033] = 8'd9;
+       fine_rom[2034] = 8'd18;
+       fine_rom[2035] = 8'd26;
+       fine_rom[2036] = 8'd35;
+       fine_rom[2037] = 8'd44;
+       fine_rom[2038] = 8'd53;
+       fine_rom[2039] = 8'd62;
+       fine_rom[2040] = 8'd71;
+       fine_rom[2041] = 8'd80;
+       fine_rom[2042] = 8'd89;
+       fine_rom[2043] = 8'd98;
+       fine_rom[2044] = 8'd107;
+       fine_rom[2045] = 8'd116;
+       fine_rom[2046] = 8'd124;
+       fine_rom[2047] = 8'd133;
+       fine_rom[2048] = 8'd0;
+       fine_rom[2049] = 8'd9;
+       fine_rom[2050] = 8'd18;
+       fine_rom[2051] = 8'd27;
+       fine_rom[2052] = 8'd36;
+       fine_rom[2053] = 8'd45;
+       fine_rom[2054] = 8'd53;
+       fine_rom[2055] = 8'd62;
+       fine_rom[2056] = 8'd71;
+       fine_rom[2057] = 8'd80;
+       fine_rom[2058] = 8'd89;
+       fine_rom[2059] = 8'd98;
+       fine_rom[2060] = 8'd107;
+       fine_rom[2061] = 8'd115;
+       fine_rom[2062] = 8'd124;
+       fine_rom[2063] = 8'd133;
+       fine_rom[2064] = 8'd0;
+       fine_rom[2065] = 8'd9;
+       fine_rom[2066] = 8'd18;
+       fine_rom[2067] = 8'd26;
+       fine_rom[2068] = 8'd35;
+       fine_rom[2069] = 8'd44;
+       fine_rom[2070] = 8'd53;
+       fine_rom[2071] = 8'd62;
+       fine_rom[2072] = 8'd70;
+       fine_rom[2073] = 8'd79;
+       fine_rom[2074] = 8'd88;
+       fine_rom[2075] = 8'd97;
+       fine_rom[2076] = 8'd106;
+       fine_rom[2077] = 8'd114;
+       fine_rom[2078] = 8'd123;
+       fine_rom[2079] = 8'd132;
+       fine_rom[2080] = 8'd0;
+       fine_rom[2081] = 8'd9;
+       fine_rom[2082] = 8'd17;
+       fine_rom[2083] = 8'd26;
+       fine_rom[2084] = 8'd35;
+       fine_rom[2085] = 8'd44;
+       fine_rom[2086] = 8'd52;
+       fine_rom[2087] = 8'd61;
+       fine_rom[2088] = 8'd70;
+       fine_rom[2089] = 8'd79;
+       fine_rom[2090] = 8'd87;
+       fine_rom[2091] = 8'd96;
+       fine_rom[2092] = 8'd105;
+       fine_rom[2093] = 8'd114;
+       fine_rom[2094] = 8'd122;
+       fine_rom[2095] = 8'd131;
+       fine_rom[2096] = 8'd0;
+       fine_rom[2097] = 8'd8;
+       fine_rom[2098] = 8'd17;
+       fine_rom[2099] = 8'd26;
+       fine_rom[2100] = 8'd35;
+       fine_rom[2101] = 8'd43;
+       fine_rom[2102] = 8'd52;
+       fine_rom[2103] = 8'd61;
+       fine_rom[2104] = 8'd69;
+       fine_rom[2105] = 8'd78;
+       fine_rom[2106] = 8'd87;
+       fine_rom[2107] = 8'd95;
+       fine_rom[2108] = 8'd104;
+       fine_rom[2109] = 8'd113;
+       fine_rom[2110] = 8'd121;
+       fine_rom[2111] = 8'd130;
+       fine_rom[2112] = 8'd0;
+       fine_rom[2113] = 8'd8;
+       fine_rom[2114] = 8'd17;
+       fine_rom[2115] = 8'd26;
+       fine_rom[2116] = 8'd34;
+       fine_rom[2117] = 8'd43;
+       fine_rom[2118] = 8'd52;
+       fine_rom[2119] = 8'd60;
+       fine_rom[2120] = 8'd69;
+       fine_rom[2121] = 8'd78;
+       fine_rom[2122] = 8'd86;
+       fine_rom[2123] = 8'd95;
+       fine_rom[2124] = 8'd103;
+       fine_rom[2125] = 8'd112;
+       fine_rom[2126] = 8'd121;
+       fine_rom[2127] = 8'd129;
+       fine_rom[2128] = 8'd0;
+       fine_rom[2129] = 8'd9;
+       fine_rom[2130] = 8'd17;
+       fine_rom[2131] = 8'd26;
+       fine_rom[2132] = 8'd34;
+       fine_rom[2133] = 8'd43;
+       fine_rom[2134] = 8'd51;
+       fine_rom[2135] = 8'd60;
+       fine_rom[2136] = 8'd69;
+       fine_rom[2137] = 8'd77;
+       fine_rom[2138] = 8'd86;
+       fine_rom[2139] = 8'd94;
+       fine_rom[2140] = 8'd103;
+       fine_rom[2141] = 8'd111;
+       fine_rom[2142] = 8'd120;
+       fine_rom[2143] = 8'd129;
+       fine_rom[2144] = 8'd0;
+       fine_rom[2145] = 8'd9;
+       fine_rom[2146] = 8'd17;
+       fine_rom[2147] = 8'd26;
+       fine_rom[2148] = 8'd34;
+       fine_rom[2149] = 8'd43;
+       fine_rom[2150] = 8'd51;
+       fine_rom[2151] = 8'd60;
+       fine_rom[2152] = 8'd68;
+       fine_rom[2153] = 8'd77;
+       fine_rom[2154] = 8'd85;
+       fine_rom[2155] = 8'd94;
+       fine_rom[2156] = 8'd103;
+       fine_rom[2157] = 8'd111;
+       fine_rom[2158] = 8'd120;
+       fine_rom[2159] = 8'd128;
+       fine_rom[2160] = 8'd0;
+       fine_rom[2161] = 8'd8;
+       fine_rom[2162] = 8'd16;
+       fine_rom[2163] = 8'd25;
+       fine_rom[2164] = 8'd33;
+       fine_rom[2165] = 8'd42;
+       fine_rom[2166] = 8'd50;
+       fine_rom[2167] = 8'd59;
+       fine_rom[2168] = 8'd67;
+       fine_rom[2169] = 8'd76;
+       fine_rom[2170] = 8'd84;
+       fine_rom[2171] = 8'd93;
+       fine_rom[2172] = 8'd101;
+       fine_rom[2173] = 8'd110;
+       fine_rom[2174] = 8'd118;
+       fine_rom[2175] = 8'd127;
+       fine_rom[2176] = 8'd0;
+       fine_rom[2177] = 8'd8;
+       fine_rom[2178] = 8'd17;
+       fine_rom[2179] = 8'd25;
+       fine_rom[2180] = 8'd34;
+       fine_rom[2181] = 8'd42;
+       fine_rom[2182] = 8'd51;
+       fine_rom[2183] = 8'd59;
+       fine_rom[2184] = 8'd67;
+       fine_rom[2185] = 8'd76;
+       fine_rom[2186] = 8'd84;
+       fine_rom[2187] = 8'd93;
+       fine_rom[2188] = 8'd101;
+       fine_rom[2189] = 8'd109;
+       fine_rom[2190] = 8'd118;
+       fine_rom[2191] = 8'd126;
+       fine_rom[2192] = 8'd0;
+       fine_rom[2193] = 8'd9;
+       fine_rom[2194] = 8'd17;
+       fine_rom[2195] = 8'd26;
+       fine_rom[2196] = 8'd34;
+       fine_rom[2197] = 8'd42;
+       fine_rom[2198] = 8'd51;
+       fine_rom[2199] = 8'd59;
+       fine_rom[2200] = 8'd67;
+       fine_rom[2201] = 8'd76;
+       fine_rom[2202] = 8'd84;
+       fine_rom[2203] = 8'd92;
+       fine_rom[2204] = 8'd101;
+       fine_rom[2205] = 8'd109;
+       fine_rom[2206] = 8'd117;
+       fine_rom[2207] = 8'd126;
+       fine_rom[2208] = 8'd0;
+       fine_rom[2209] = 8'd8;
+       fine_rom[2210] = 8'd17;
+       fine_rom[2211] = 8'd25;
+       fine_rom[2212] = 8'd33;
+       fine_rom[2213] = 8'd42;
+       fine_rom[2214] = 8'd50;
+       fine_rom[2215] = 8'd58;
+       fine_rom[2216] = 8'd67;
+       fine_rom[2217] = 8'd75;
+       fine_rom[2218] = 8'd83;
+       fine_rom[2219] = 8'd91;
+       fine_rom[2220] = 8'd100;
+       fine_rom[2221] = 8'd108;
+       fine_rom[2222] = 8'd116;
+       fine_rom[2223] = 8'd125;
+       fine_rom[2224] = 8'd0;
+       fine_rom[2225] = 8'd8;
+       fine_rom[2226] = 8'd16;
+       fine_rom[2227] = 8'd25;
+       fine_rom[2228] = 8'd33;
+       fine_rom[2229] = 8'd41;
+       fine_rom[2230] = 8'd49;
+       fine_rom[2231] = 8'd58;
+       fine_rom[2232] = 8'd66;
+       fine_rom[2233] = 8'd74;
+       fine_rom[2234] = 8'd82;
+       fine_rom[2235] = 8'd90;
+       fine_rom[2236] = 8'd99;
+       fine_rom[2237] = 8'd107;
+       fine_rom[2238] = 8'd115;
+       fine_rom[2239] = 8'd123;
+       fine_rom[2240] = 8'd0;
+       fine_rom[2241] = 8'd8;
+       fine_rom[2242] = 8'd16;
+       fine_rom[2243] = 8'd24;
+       fine_rom[2244] = 8'd32;
+       fine_rom[2245] = 8'd41;
+       fine_rom[2246] = 8'd49;
+       fine_rom[2247] = 8'd57;
+       fine_rom[2248] = 8'd65;
+       fine_rom[2249] = 8'd73;
+       fine_rom[2250] = 8'd81;
+       fine_rom[2251] = 8'd90;
+       fine_rom[2252] = 8'd98;
+       fine_rom[2253] = 8'd106;
+       fine_rom[2254] = 8'd114;
+       fine_rom[2255] = 8'd122;
+       fine_rom[2256] = 8'd0;
+       fine_rom[2257] = 8'd9;
+       fine_rom[2258] = 8'd17;
+       fine_rom[2259] = 8'd25;
+       fine_rom[2260] = 8'd33;
+       fine_rom[2261] = 8'd41;
+       fine_rom[2262] = 8'd49;
+       fine_rom[2263] = 8'd57;
+       fine_rom[2264] = 8'd65;
+       fine_rom[2265] = 8'd74;
+       fine_rom[2266] = 8'd82;
+       fine_rom[2267] = 8'd90;
+       fine_rom[2268] = 8'd98;
+       fine_rom[2269] = 8'd106;
+       fine_rom[2270] = 8'd114;
+       fine_rom[2271] = 8'd122;
+       fine_rom[2272] = 8'd0;
+       fine_rom[2273] = 8'd8;
+       fine_rom[2274] = 8'd16;
+       fine_rom[2275] = 8'd25;
+       fine_rom[2276] = 8'd33;
+       fine_rom[2277] = 8'd41;
+       fine_rom[2278] = 8'd49;
+       fine_rom[2279] = 8'd57;
+       fine_rom[2280] = 8'd65;
+       fine_rom[2281] = 8'd73;
+       fine_rom[2282] = 8'd81;
+       fine_rom[2283] = 8'd89;
+       fine_rom[2284] = 8'd97;
+       fine_rom[2285] = 8'd105;
+       fine_rom[2286] = 8'd113;
+       fine_rom[2287] = 8'd121;
+       fine_rom[2288] = 8'd0;
+       fine_rom[2289] = 8'd8;
+       fine_rom[2290] = 8'd16;
+       fine_rom[2291] = 8'd24;
+       fine_rom[2292] = 8'd32;
+       fine_rom[2293] = 8'd40;
+       fine_rom[2294] = 8'd48;
+       fine_rom[2295] = 8'd56;
+       fine_rom[2296] = 8'd64;
+       fine_rom[2297] = 8'd72;
+       fine_rom[2298] = 8'd80;
+       fine_rom[2299] = 8'd88;
+       fine_rom[2300] = 8'd96;
+       fine_rom[2301] = 8'd104;
+       fine_rom[2302] = 8'd112;
+       fine_rom[2303] = 8'd120;
+       fine_rom[2304] = 8'd0;
+       fine_rom[2305] = 8'd8;
+       fine_rom[2306] = 8'd16;
+       fine_rom[2307] = 8'd24;
+       fine_rom[2308] = 8'd32;
+       fine_rom[2309] = 8'd40;
+       fine_rom[2310] = 8'd48;
+       fine_rom[2311] = 8'd56;
+       fine_rom[2312] = 8'd64;
+       fine_rom[2313] = 8'd72;
+       fine_rom[2314] = 8'd80;
+       fine_rom[2315] = 8'd88;
+       fine_rom[2316] = 8'd96;
+       fine_rom[2317] = 8'd104;
+       fine_rom[2318] = 8'd111;
+       fine_rom[2319] = 8'd119;
+       fine_rom[2320] = 8'd0;
+       fine_rom[2321] = 8'd8;
+       fine_rom[2322] = 8'd16;
+       fine_rom[2323] = 8'd24;
+       fine_rom[2324] = 8'd32;
+       fine_rom[2325] = 8'd40;
+       fine_rom[2326] = 8'd48;
+       fine_rom[2327] = 8'd56;
+       fine_rom[2328] = 8'd63;
+       fine_rom[2329] = 8'd71;
+       fine_rom[2330] = 8'd79;
+       fine_rom[2331] = 8'd87;
+       fine_rom[2332] = 8'd95;
+       fine_rom[2333] = 8'd103;
+       fine_rom[2334] = 8'd111;
+       fine_rom[2335] = 8'd118;
+       fine_rom[2336] = 8'd0;
+       fine_rom[2337] = 8'd8;
+       fine_rom[2338] = 8'd16;
+       fine_rom[2339] = 8'd24;
+       fine_rom[2340] = 8'd32;
+       fine_rom[2341] = 8'd40;
+       fine_rom[2342] = 8'd47;
+       fine_rom[2343] = 8'd55;
+       fine_rom[2344] = 8'd63;
+       fine_rom[2345] = 8'd71;
+       fine_rom[2346] = 8'd79;
+       fine_rom[2347] = 8'd86;
+       fine_rom[2348] = 8'd94;
+       fine_rom[2349] = 8'd102;
+       fine_rom[2350] = 8'd110;
+       fine_rom[2351] = 8'd118;
+       fine_rom[2352] = 8'd0;
+       fine_rom[2353] = 8'd8;
+       fine_rom[2354] = 8'd16;
+       fine_rom[2355] = 8'd24;
+       fine_rom[2356] = 8'd32;
+       fine_rom[2357] = 8'd39;
+       fine_rom[2358] = 8'd47;
+       fine_rom[2359] = 8'd55;
+       fine_rom[2360] = 8'd63;
+       fine_rom[2361] = 8'd70;
+       fine_rom[2362] = 8'd78;
+       fine_rom[2363] = 8'd86;
+       fine_rom[2364] = 8'd94;
+       fine_rom[2365] = 8'd101;
+       fine_rom[2366] = 8'd109;
+       fine_rom[2367] = 8'd117;
+       fine_rom[2368] = 8'd0;
+       fine_rom[2369] = 8'd7;
+       fine_rom[2370] = 8'd15;
+       fine_rom[2371] = 8'd23;
+       fine_rom[2372] = 8'd30;
+       fine_rom[2373] = 8'd38;
+       fine_rom[2374] = 8'd46;
+       fine_rom[2375] = 8'd54;
+       fine_rom[2376] = 8'd61;
+       fine_rom[2377] = 8'd69;
+       fine_rom[2378] = 8'd77;
+       fine_rom[2379] = 8'd84;
+       fine_rom[2380] = 8'd92;
+       fine_rom[2381] = 8'd100;
+       fine_rom[2382] = 8'd107;
+       fine_rom[2383] = 8'd115;
+       fine_rom[2384] = 8'd0;
+       fine_rom[2385] = 8'd7;
+       fine_rom[2386] = 8'd15;
+       fine_rom[2387] = 8'd23;
+       fine_rom[2388] = 8'd30;
+       fine_rom[2389] = 8'd38;
+       fine_rom[2390] = 8'd46;
+       fine_rom[2391] = 8'd53;
+       fine_rom[2392] = 8'd61;
+       fine_rom[2393] = 8'd69;
+       fine_rom[2394] = 8'd76;
+       fine_rom[2395] = 8'd84;
+       fine_rom[2396] = 8'd92;
+       fine_rom[2397] = 8'd99;
+       fine_rom[2398] = 8'd107;
+       fine_rom[2399] = 8'd114;
+       fine_rom[2400] = 8'd0;
+       fine_rom[2401] = 8'd8;
+       fine_rom[2402] = 8'd15;
+       fine_rom[2403] = 8'd23;
+       fine_rom[2404] = 8'd30;
+       fine_rom[2405] = 8'd38;
+       fine_rom[2406] = 8'd46;
+       fine_rom[2407] = 8'd53;
+       fine_rom[2408] = 8'd61;
+       fine_rom[2409] = 8'd68;
+       fine_rom[2410] = 8'd76;
+       fine_rom[2411] = 8'd83;
+       fine_rom[2412] = 8'd91;
+       fine_rom[2413] = 8'd99;
+       fine_rom[2414] = 8'd106;
+       fine_rom[2415] = 8'd114;
+       fine_rom[2416] = 8'd0;
+       fine_rom[2417] = 8'd8;
+       fine_rom[2418] = 8'd15;
+       fine_rom[2419] = 8'd23;
+       fine_rom[2420] = 8'd30;
+       fine_rom[2421] = 8'd38;
+       fine_rom[2422] = 8'd45;
+       fine_rom[2423] = 8'd53;
+       fine_rom[2424] = 8'd60;
+       fine_rom[2425] = 8'd68;
+       fine_rom[2426] = 8'd75;
+       fine_rom[2427] = 8'd83;
+       fine_rom[2428] = 8'd90;
+       fine_rom[2429] = 8'd98;
+       fine_rom[2430] = 8'd105;
+       fine_rom[2431] = 8'd113;
+       fine_rom[2432] = 8'd0;
+       fine_rom[2433] = 8'd8;
+       fine_rom[2434] = 8'd15;
+       fine_rom[2435] = 8'd23;
+       fine_rom[2436] = 8'd30;
+       fine_rom[2437] = 8'd38;
+       fine_rom[2438] = 8'd45;
+       fine_rom[2439] = 8'd53;
+       fine_rom[2440] = 8'd60;
+       fine_rom[2441] = 8'd68;
+       fine_rom[2442] = 8'd75;
+       fine_rom[2443] = 8'd83;
+       fine_rom[2444] = 8'd90;
+       fine_rom[2445] = 8'd97;
+       fine_rom[2446] = 8'd105;
+       fine_rom[2447] = 8'd112;
+       fine_rom[2448] = 8'd0;
+       fine_rom[2449] = 8'd7;
+       fine_rom[2450] = 8'd15;
+       fine_rom[2451] = 8'd22;
+       fine_rom[2452] = 8'd29;
+       fine_rom[2453] = 8'd37;
+       fine_rom[2454] = 8'd44;
+       fine_rom[2455] = 8'd52;
+       fine_rom[2456] = 8'd59;
+       fine_rom[2457] = 8'd66;
+       fine_rom[2458] = 8'd74;
+       fine_rom[2459] = 8'd81;
+       fine_rom[2460] = 8'd88;
+       fine_rom[2461] = 8'd96;
+       fine_rom[2462] = 8'd103;
+       fine_rom[2463] = 8'd111;
+       fine_rom[2464] = 8'd0;
+       fine_rom[2465] = 8'd7;
+       fine_rom[2466] = 8'd15;
+       fine_rom[2467] = 8'd22;
+       fine_rom[2468] = 8'd29;
+       fine_rom[2469] = 8'd37;
+       fine_rom[2470] = 8'd44;
+       fine_rom[2471] = 8'd51;
+       fine_rom[2472] = 8'd59;
+       fine_rom[2473] = 8'd66;
+       fine_rom[2474] = 8'd73;
+       fine_rom[2475] = 8'd81;
+       fine_rom[2476] = 8'd88;
+       fine_rom[2477] = 8'd95;
+       fine_rom[2478] = 8'd103;
+       fine_rom[2479] = 8'd110;
+       fine_rom[2480] = 8'd0;
+       fine_rom[2481] = 8'd7;
+       fine_rom[2482] = 8'd15;
+       fine_rom[2483] = 8'd22;
+       fine_rom[2484] = 8'd29;
+       fine_rom[2485] = 8'd37;
+       fine_rom[2486] = 8'd44;
+       fine_rom[2487] = 8'd51;
+       fine_rom[2488] = 8'd58;
+       fine_rom[2489] = 8'd66;
+       fine_rom[2490] = 8'd73;
+       fine_rom[2491] = 8'd80;
+       fine_rom[2492] = 8'd87;
+       fine_rom[2493] = 8'd95;
+       fine_rom[2494] = 8'd102;
+       fine_rom[2495] = 8'd109;
+       fine_rom[2496] = 8'd0;
+       fine_rom[2497] = 8'd8;
+       fine_rom[2498] = 8'd15;
+       fine_rom[2499] = 8'd22;
+       fine_rom[2500] = 8'd29;
+       fine_rom[2501] = 8'd37;
+       fine_rom[2502] = 8'd44;
+       fine_rom[2503] = 8'd51;
+       fine_rom[2504] = 8'd58;
+       fine_rom[2505] = 8'd65;
+       fine_rom[2506] = 8'd73;
+       fine_rom[2507] = 8'd80;
+       fine_rom[2508] = 8'd87;
+       fine_rom[2509] = 8'd94;
+       fine_rom[2510] = 8'd101;
+       fine_rom[2511] = 8'd108;
+       fine_rom[2512] = 8'd0;
+       fine_rom[2513] = 8'd7;
+       fine_rom[2514] = 8'd14;
+       fine_rom[2515] = 8'd21;
+       fine_rom[2516] = 8'd28;
+       fine_rom[2517] = 8'd35;
+       fine_rom[2518] = 8'd43;
+       fine_rom[2519] = 8'd50;
+       fine_rom[2520] = 8'd57;
+       fine_rom[2521] = 8'd64;
+       fine_rom[2522] = 8'd71;
+       fine_rom[2523] = 8'd78;
+       fine_rom[2524] = 8'd85;
+       fine_rom[2525] = 8'd93;
+       fine_rom[2526] = 8'd100;
+       fine_rom[2527] = 8'd107;
+       fine_rom[2528] = 8'd0;
+       fine_rom[2529] = 8'd7;
+       fine_rom[2530] = 8'd14;
+       fine_rom[2531] = 8'd21;
+       fine_rom[2532] = 8'd28;
+       fine_rom[2533] = 8'd35;
+       fine_rom[2534] = 8'd42;
+       fine_rom[2535] = 8'd50;
+       fine_rom[2536] = 8'd57;
+       fine_rom[2537] = 8'd64;
+       fine_rom[2538] = 8'd71;
+       fine_rom[2539] = 8'd78;
+       fine_rom[2540] = 8'd85;
+       fine_rom[2541] = 8'd92;
+       fine_rom[2542] = 8'd99;
+       fine_rom[2543] = 8'd106;
+       fine_rom[2544] = 8'd0;
+       fine_rom[2545] = 8'd7;
+       fine_rom[2546] = 8'd14;
+       fine_rom[2547] = 8'd21;
+       fine_rom[2548] = 8'd28;
+       fine_rom[2549] = 8'd35;
+       fine_rom[2550] = 8'd42;
+       fine_rom[2551] = 8'd49;
+       fine_rom[2552] = 8'd56;
+       fine_rom[2553] = 8'd63;
+       fine_rom[2554] = 8'd70;
+       fine_rom[2555] = 8'd77;
+       fine_rom[2556] = 8'd84;
+       fine_rom[2557] = 8'd91;
+       fine_rom[2558] = 8'd98;
+       fine_rom[2559] = 8'd105;
+       fine_rom[2560] = 8'd0;
+       fine_rom[2561] = 8'd7;
+       fine_rom[2562] = 8'd14;
+       fine_rom[2563] = 8'd21;
+       fine_rom[2564] = 8'd28;
+       fine_rom[2565] = 8'd35;
+       fine_rom[2566] = 8'd42;
+       fine_rom[2567] = 8'd49;
+       fine_rom[2568] = 8'd56;
+       fine_rom[2569] = 8'd63;
+       fine_rom[2570] = 8'd70;
+       fine_rom[2571] = 8'd77;
+       fine_rom[2572] = 8'd84;
+       fine_rom[2573] = 8'd91;
+       fine_rom[2574] = 8'd98;
+       fine_rom[2575] = 8'd104;
+       fine_rom[2576] = 8'd0;
+       fine_rom[2577] = 8'd7;
+       fine_rom[2578] = 8'd14;
+       fine_rom[2579] = 8'd21;
+       fine_rom[2580] = 8'd28;
+       fine_rom[2581] = 8'd35;
+       fine_rom[2582] = 8'd42;
+       fine_rom[2583] = 8'd49;
+       fine_rom[2584] = 8'd56;
+       fine_rom[2585] = 8'd62;
+       fine_rom[2586] = 8'd69;
+       fine_rom[2587] = 8'd76;
+       fine_rom[2588] = 8'd83;
+       fine_rom[2589] = 8'd90;
+       fine_rom[2590] = 8'd97;
+       fine_rom[2591] = 8'd104;
+       fine_rom[2592] = 8'd0;
+       fine_rom[2593] = 8'd6;
+       fine_rom[2594] = 8'd13;
+       fine_rom[2595] = 8'd20;
+       fine_rom[2596] = 8'd27;
+       fine_rom[2597] = 8'd34;
+       fine_rom[2598] = 8'd41;
+       fine_rom[2599] = 8'd47;
+       fine_rom[2600] = 8'd54;
+       fine_rom[2601] = 8'd61;
+       fine_rom[2602] = 8'd68;
+       fine_rom[2603] = 8'd75;
+       fine_rom[2604] = 8'd81;
+       fine_rom[2605] = 8'd88;
+       fine_rom[2606] = 8'd95;
+       fine_rom[2607] = 8'd102;
+       fine_rom[2608] = 8'd0;
+       fine_rom[2609] = 8'd6;
+       fine_rom[2610] = 8'd13;
+       fine_rom[2611] = 8'd20;
+       fine_rom[2612] = 8'd27;
+       fine_rom[2613] = 8'd34;
+       fine_rom[2614] = 8'd40;
+       fine_rom[2615] = 8'd47;
+       fine_rom[2616] = 8'd54;
+       fine_rom[2617] = 8'd61;
+       fine_rom[2618] = 8'd67;
+       fine_rom[2619] = 8'd74;
+       fine_rom[2620] = 8'd81;
+       fine_rom[2621] = 8'd87;
+       fine_rom[2622] = 8'd94;
+       fine_rom[2623] = 8'd101;
+       fine_rom[2624] = 8'd0;
+       fine_rom[2625] = 8'd6;
+       fine_rom[2626] = 8'd13;
+       fine_rom[2627] = 8'd20;
+       fine_rom[2628] = 8'd27;
+       fine_rom[2629] = 8'd33;
+       fine_rom[2630] = 8'd40;
+       fine_rom[2631] = 8'd47;
+       fine_rom[2632] = 8'd53;
+       fine_rom[2633] = 8'd60;
+       fine_rom[2634] = 8'd67;
+       fine_rom[2635] = 8'd73;
+       fine_rom[2636] = 8'd80;
+       fine_rom[2637] = 8'd87;
+       fine_rom[2638] = 8'd93;
+       fine_rom[2639] = 8'd100;
+       fine_rom[2640] = 8'd0;
+       fine_rom[2641] = 8'd6;
+       fine_rom[2642] = 8'd13;
+       fine_rom[2643] = 8'd20;
+       fine_rom[2644] = 8'd26;
+       fine_rom[2645] = 8'd33;
+       fine_rom[2646] = 8'd40;
+       fine_rom[2647] = 8'd46;
+       fine_rom[2648] = 8'd53;
+       fine_rom[2649] = 8'd59;
+       fine_rom[2650] = 8'd66;
+       fine_rom[2651] = 8'd73;
+       fine_rom[2652] = 8'd79;
+       fine_rom[2653] = 8'd86;
+       fine_rom[2654] = 8'd92;
+       fine_rom[2655] = 8'd99;
+       fine_rom[2656] = 8'd0;
+       fine_rom[2657] = 8'd6;
+       fine_rom[2658] = 8'd13;
+       fine_rom[2659] = 8'd19;
+       fine_rom[2660] = 8'd26;
+       fine_rom[2661] = 8'd33;
+       fine_rom[2662] = 8'd39;
+       fine_rom[2663] = 8'd46;
+       fine_rom[2664] = 8'd52;
+       fine_rom[2665] = 8'd59;
+       fine_rom[2666] = 8'd65;
+       fine_rom[2667] = 8'd72;
+       fine_rom[2668] = 8'd78;
+       fine_rom[2669] = 8'd85;
+       fine_rom[2670] = 8'd92;
+       fine_rom[2671] = 8'd98;
+       fine_rom[2672] = 8'd0;
+       fine_rom[2673] = 8'd6;
+       fine_rom[2674] = 8'd13;
+       fine_rom[2675] = 8'd19;
+       fine_rom[2676] = 8'd26;
+       fine_rom[2677] = 8'd32;
+       fine_rom[2678] = 8'd39;
+       fine_rom[2679] = 8'd45;
+       fine_rom[2680] = 8'd52;
+       fine_rom[2681] = 8'd58;
+       fine_rom[2682] = 8'd65;
+       fine_rom[2683] = 8'd71;
+       fine_rom[2684] = 8'd78;
+       fine_rom[2685] = 8'd84;
+       fine_rom[2686] = 8'd90;
+       fine_rom[2687] = 8'd97;
+       fine_rom[2688] = 8'd0;
+       fine_rom[2689] = 8'd7;
+       fine_rom[2690] = 8'd13;
+       fine_rom[2691] = 8'd20;
+       fine_rom[2692] = 8'd26;
+       fine_rom[2693] = 8'd33;
+       fine_rom[2694] = 8'd39;
+       fine_rom[2695] = 8'd46;
+       fine_rom[2696] = 8'd52;
+       fine_rom[2697] = 8'd58;
+       fine_rom[2698] = 8'd65;
+       fine_rom[2699] = 8'd71;
+       fine_rom[2700] = 8'd78;
+       fine_rom[2701] = 8'd84;
+       fine_rom[2702] = 8'd90;
+       fine_rom[2703] = 8'd97;
+       fine_rom[2704] = 8'd0;
+       fine_rom[2705] = 8'd7;
+       fine_rom[2706] = 8'd13;
+       fine_rom[2707] = 8'd19;
+       fine_rom[2708] = 8'd26;
+       fine_rom[2709] = 8'd32;
+       fine_rom[2710] = 8'd38;
+       fine_rom[2711] = 8'd45;
+       fine_rom[2712] = 8'd51;
+       fine_rom[2713] = 8'd58;
+       fine_rom[2714] = 8'd64;
+       fine_rom[2715] = 8'd70;
+       fine_rom[2716] = 8'd77;
+       fine_rom[2717] = 8'd83;
+       fine_rom[2718] = 8'd89;
+       fine_rom[2719] = 8'd96;
+       fine_rom[2720] = 8'd0;
+       fine_rom[2721] = 8'd6;
+       fine_rom[2722] = 8'd13;
+       fine_rom[2723] = 8'd19;
+       fine_rom[2724] = 8'd25;
+       fine_rom[2725] = 8'd32;
+       fine_rom[2726] = 8'd38;
+       fine_rom[2727] = 8'd44;
+       fine_rom[2728] = 8'd50;
+       fine_rom[2729] = 8'd57;
+       fine_rom[2730] = 8'd63;
+       fine_rom[2731] = 8'd69;
+       fine_rom[2732] = 8'd76;
+       fine_rom[2733] = 8'd82;
+       fine_rom[2734] = 8'd88;
+       fine_rom[2735] = 8'd94;
+       fine_rom[2736] = 8'd0;
+       fine_rom[2737] = 8'd6;
+       fine_rom[2738] = 8'd12;
+       fine_rom[2739] = 8'd18;
+       fine_rom[2740] = 8'd25;
+       fine_rom[2741] = 8'd31;
+       fine_rom[2742] = 8'd37;
+       fine_rom[2743] = 8'd43;
+       fine_rom[2744] = 8'd50;
+       fine_rom[2745] = 8'd56;
+       fine_rom[2746] = 8'd62;
+       fine_rom[2747] = 8'd68;
+       fine_rom[2748] = 8'd74;
+       fine_rom[2749] = 8'd81;
+       fine_rom[2750] = 8'd87;
+       fine_rom[2751] = 8'd93;
+       fine_rom[2752] = 8'd0;
+       fine_rom[2753] = 8'd6;
+       fine_rom[2754] = 8'd13;
+       fine_rom[2755] = 8'd19;
+       fine_rom[2756] = 8'd25;
+       fine_rom[2757] = 8'd31;
+       fine_rom[2758] = 8'd37;
+       fine_rom[2759] = 8'd43;
+       fine_rom[2760] = 8'd50;
+       fine_rom[2761] = 8'd56;
+       fine_rom[2762] = 8'd62;
+       fine_rom[2763] = 8'd68;
+       fine_rom[2764] = 8'd74;
+       fine_rom[2765] = 8'd80;
+       fine_rom[2766] = 8'd87;
+       fine_rom[2767] = 8'd93;
+       fine_rom[2768] = 8'd0;
+       fine_rom[2769] = 8'd6;
+       fine_rom[2770] = 8'd12;
+       fine_rom[2771] = 8'd18;
+       fine_rom[2772] = 8'd24;
+       fine_rom[2773] = 8'd30;
+       fine_rom[2774] = 8'd36;
+       fine_rom[2775] = 8'd43;
+       fine_rom[2776] = 8'd49;
+       fine_rom[2777] = 8'd55;
+       fine_rom[2778] = 8'd61;
+       fine_rom[2779] = 8'd67;
+       fine_rom[2780] = 8'd73;
+       fine_rom[2781] = 8'd79;
+       fine_rom[2782] = 8'd85;
+       fine_rom[2783] = 8'd91;
+       fine_rom[2784] = 8'd0;
+       fine_rom[2785] = 8'd6;
+       fine_rom[2786] = 8'd12;
+       fine_rom[2787] = 8'd18;
+       fine_rom[2788] = 8'd24;
+       fine_rom[2789] = 8'd30;
+       fine_rom[2790] = 8'd36;
+       fine_rom[2791] = 8'd43;
+       fine_rom[2792] = 8'd49;
+       fine_rom[2793] = 8'd55;
+       fine_rom[2794] = 8'd61;
+       fine_rom[2795] = 8'd67;
+       fine_rom[2796] = 8'd73;
+       fine_rom[2797] = 8'd79;
+       fine_rom[2798] = 8'd85;
+       fine_rom[2799] = 8'd91;
+       fine_rom[2800] = 8'd0;
+       fine_rom[2801] = 8'd6;
+       fine_rom[2802] = 8'd12;
+       fine_rom[2803] = 8'd18;
+       fine_rom[2804] = 8'd24;
+       fine_rom[2805] = 8'd29;
+       fine_rom[2806] = 8'd35;
+       fine_rom[2807] = 8'd41;
+       fine_rom[2808] = 8'd47;
+       fine_rom[2809] = 8'd53;
+       fine_rom[2810] = 8'd59;
+       fine_rom[2811] = 8'd65;
+       fine_rom[2812] = 8'd71;
+       fine_rom[2813] = 8'd77;
+       fine_rom[2814] = 8'd83;
+       fine_rom[2815] = 8'd89;
+       fine_rom[2816] = 8'd0;
+       fine_rom[2817] = 8'd6;
+       fine_rom[2818] = 8'd12;
+       fine_rom[2819] = 8'd18;
+       fine_rom[2820] = 8'd24;
+       fine_rom[2821] = 8'd29;
+       fine_rom[2822] = 8'd35;
+       fine_rom[2823] = 8'd41;
+       fine_rom[2824] = 8'd47;
+       fine_rom[2825] = 8'd53;
+       fine_rom[2826] = 8'd59;
+       fine_rom[2827] = 8'd65;
+       fine_rom[2828] = 8'd71;
+       fine_rom[2829] = 8'd76;
+       fine_rom[2830] = 8'd82;
+       fine_rom[2831] = 8'd88;
+       fine_rom[2832] = 8'd0;
+       fine_rom[2833] = 8'd6;
+       fine_rom[2834] = 8'd12;
+       fine_rom[2835] = 8'd18;
+       fine_rom[2836] = 8'd23;
+       fine_rom[2837] = 8'd29;
+       fine_rom[2838] = 8'd35;
+       fine_rom[2839] = 8'd41;
+       fine_rom[2840] = 8'd47;
+       fine_rom[2841] = 8'd53;
+       fine_rom[2842] = 8'd58;
+       fine_rom[2843] = 8'd64;
+       fine_rom[2844] = 8'd70;
+       fine_rom[2845] = 8'd76;
+       fine_rom[2846] = 8'd82;
+       fine_rom[2847] = 8'd87;
+       fine_rom[2848] = 8'd0;
+       fine_rom[2849] = 8'd6;
+       fine_rom[2850] = 8'd12;
+       fine_rom[2851] = 8'd18;
+       fine_rom[2852] = 8'd23;
+       fine_rom[2853] = 8'd29;
+       fine_rom[2854] = 8'd35;
+       fine_rom[2855] = 8'd41;
+       fine_rom[2856] = 8'd46;
+       fine_rom[2857] = 8'd52;
+       fine_rom[2858] = 8'd58;
+       fine_rom[2859] = 8'd64;
+       fine_rom[2860] = 8'd69;
+       fine_rom[2861] = 8'd75;
+       fine_rom[2862] = 8'd81;
+       fine_rom[2863] = 8'd86;
+       fine_rom[2864] = 8'd0;
+       fine_rom[2865] = 8'd6;
+       fine_rom[2866] = 8'd12;
+       fine_rom[2867] = 8'd17;
+       fine_rom[2868] = 8'd23;
+       fine_rom[2869] = 8'd29;
+       fine_rom[2870] = 8'd34;
+       fine_rom[2871] = 8'd40;
+       fine_rom[2872] = 8'd46;
+       fine_rom[2873] = 8'd51;
+       fine_rom[2874] = 8'd57;
+       fine_rom[2875] = 8'd63;
+       fine_rom[2876] = 8'd68;
+       fine_rom[2877] = 8'd74;
+       fine_rom[2878] = 8'd80;
+       fine_rom[2879] = 8'd85;
+       fine_rom[2880] = 8'd0;
+       fine_rom[2881] = 8'd6;
+       fine_rom[2882] = 8'd11;
+       fine_rom[2883] = 8'd17;
+       fine_rom[2884] = 8'd23;
+       fine_rom[2885] = 8'd28;
+       fine_rom[2886] = 8'd34;
+       fine_rom[2887] = 8'd40;
+       fine_rom[2888] = 8'd45;
+       fine_rom[2889] = 8'd51;
+       fine_rom[2890] = 8'd56;
+       fine_rom[2891] = 8'd62;
+       fine_rom[2892] = 8'd68;
+       fine_rom[2893] = 8'd73;
+       fine_rom[2894] = 8'd79;
+       fine_rom[2895] = 8'd84;
+       fine_rom[2896] = 8'd0;
+       fine_rom[2897] = 8'd5;
+       fine_rom[2898] = 8'd11;
+       fine_rom[2899] = 8'd17;
+       fine_rom[2900] = 8'd22;
+       fine_rom[2901] = 8'd28;
+       fine_rom[2902] = 8'd33;
+       fine_rom[2903] = 8'd39;
+       fine_rom[2904] = 8'd44;
+       fine_rom[2905] = 8'd50;
+       fine_rom[2906] = 8'd55;
+       fine_rom[2907] = 8'd61;
+       fine_rom[2908] = 8'd67;
+       fine_rom[2909] = 8'd72;
+       fine_rom[2910] = 8'd78;
+       fine_rom[2911] = 8'd83;
+       fine_rom[2912] = 8'd0;
+       fine_rom[2913] = 8'd5;
+       fine_rom[2914] = 8'd11;
+       fine_rom[2915] = 8'd16;
+       fine_rom[2916] = 8'd22;
+       fine_rom[2917] = 8'd27;
+       fine_rom[2918] = 8'd33;
+       fine_rom[2919] = 8'd38;
+       fine_rom[2920] = 8'd44;
+       fine_rom[2921] = 8'd49;
+       fine_rom[2922] = 8'd54;
+       fine_rom[2923] = 8'd60;
+       fine_rom[2924] = 8'd65;
+       fine_rom[2925] = 8'd71;
+       fine_rom[2926] = 8'd76;
+       fine_rom[2927] = 8'd82;
+       fine_rom[2928] = 8'd0;
+       fine_rom[2929] = 8'd6;
+       fine_rom[2930] = 8'd11;
+       fine_rom[2931] = 8'd17;
+       fine_rom[2932] = 8'd22;
+       fine_rom[2933] = 8'd27;
+       fine_rom[2934] = 8'd33;
+       fine_rom[2935] = 8'd38;
+       fine_rom[2936] = 8'd44;
+       fine_rom[2937] = 8'd49;
+       fine_rom[2938] = 8'd54;
+       fine_rom[2939] = 8'd60;
+       fine_rom[2940] = 8'd65;
+       fine_rom[2941] = 8'd71;
+       fine_rom[2942] = 8'd76;
+       fine_rom[2943] = 8'd81;
+       fine_rom[2944] = 8'd0;
+       fine_rom[2945] = 8'd5;
+       fine_rom[2946] = 8'd10;
+       fine_rom[2947] = 8'd16;
+       fine_rom[2948] = 8'd21;
+       fine_rom[2949] = 8'd27;
+       fine_rom[2950] = 8'd32;
+       fine_rom[2951] = 8'd37;
+       fine_rom[2952] = 8'd43;
+       fine_rom[2953] = 8'd48;
+       fine_rom[2954] = 8'd53;
+       fine_rom[2955] = 8'd59;
+       fine_rom[2956] = 8'd64;
+       fine_rom[2957] = 8'd69;
+       fine_rom[2958] = 8'd74;
+       fine_rom[2959] = 8'd80;
+       fine_rom[2960] = 8'd0;
+       fine_rom[2961] = 8'd5;
+       fine_rom[2962] = 8'd11;
+       fine_rom[2963] = 8'd16;
+       fine_rom[2964] = 8'd21;
+       fine_rom[2965] = 8'd27;
+       fine_rom[2966] = 8'd32;
+       fine_rom[2967] = 8'd37;
+       fine_rom[2968] = 8'd42;
+       fine_rom[2969] = 8'd48;
+       fine_rom[2970] = 8'd53;
+       fine_rom[2971] = 8'd58;
+       fine_rom[2972] = 8'd63;
+       fine_rom[2973] = 8'd69;
+       fine_rom[2974] = 8'd74;
+       fine_rom[2975] = 8'd79;
+       fine_rom[2976] = 8'd0;
+       fine_rom[2977] = 8'd6;
+       fine_rom[2978] = 8'd11;
+       fine_rom[2979] = 8'd16;
+       fine_rom[2980] = 8'd21;
+       fine_rom[2981] = 8'd26;
+       fine_rom[2982] = 8'd32;
+       fine_rom[2983] = 8'd37;
+       fine_rom[2984] = 8'd42;
+       fine_rom[2985] = 8'd47;
+       fine_rom[2986] = 8'd52;
+       fine_rom[2987] = 8'd58;
+       fine_rom[2988] = 8'd63;
+       fine_rom[2989] = 8'd68;
+       fine_rom[2990] = 8'd73;
+       fine_rom[2991] = 8'd78;
+       fine_rom[2992] = 8'd0;
+       fine_rom[2993] = 8'd6;
+       fine_rom[2994] = 8'd11;
+       fine_rom[2995] = 8'd16;
+       fine_rom[2996] = 8'd21;
+       fine_rom[2997] = 8'd26;
+       fine_rom[2998] = 8'd31;
+       fine_rom[2999] = 8'd36;
+       fine_rom[3000] = 8'd42;
+       fine_rom[3001] = 8'd47;
+       fine_rom[3002] = 8'd52;
+       fine_rom[3003] = 8'd57;
+       fine_rom[3004] = 8'd62;
+       fine_rom[3005] = 8'd67;
+       fine_rom[3006] = 8'd72;
+       fine_rom[3007] = 8'd77;
+       fine_rom[3008] = 8'd0;
+       fine_rom[3009] = 8'd6;
+       fine_rom[3010] = 8'd11;
+       fine_rom[3011] = 8'd16;
+       fine_rom[3012] = 8'd21;
+       fine_rom[3013] = 8'd26;
+       fine_rom[3014] = 8'd31;
+       fine_rom[3015] = 8'd36;
+       fine_rom[3016] = 8'd41;
+       fine_rom[3017] = 8'd46;
+       fine_rom[3018] = 8'd51;
+       fine_rom[3019] = 8'd56;
+       fine_rom[3020] = 8'd61;
+       fine_rom[3021] = 8'd66;
+       fine_rom[3022] = 8'd71;
+       fine_rom[3023] = 8'd76;
+       fine_rom[3024] = 8'd0;
+       fine_rom[3025] = 8'd5;
+       fine_rom[3026] = 8'd10;
+       fine_rom[3027] = 8'd15;
+       fine_rom[3028] = 8'd20;
+       fine_rom[3029] = 8'd25;
+       fine_rom[3030] = 8'd30;
+       fine_rom[3031] = 8'd35;
+       fine_rom[3032] = 8'd40;
+       fine_rom[3033] = 8'd45;
+       fine_rom[3034] = 8'd50;
+       fine_rom[3035] = 8'd55;
+       fine_rom[3036] = 8'd60;
+       fine_rom[3037] = 8'd65;
+       fine_rom[3038] = 8'd70;
+       fine_rom[3039] = 8'd75;
+       fine_rom[3040] = 8'd0;
+       fine_rom[3041] = 8'd5;
+       fine_rom[3042] = 8'd10;
+       fine_rom[3043] = 8'd15;
+       fine_rom[3044] = 8'd20;
+       fine_rom[3045] = 8'd25;
+       fine_rom[3046] = 8'd30;
+       fine_rom[3047] = 8'd35;
+       fine_rom[3048] = 8'd40;
+       fine_rom[3049] = 8'd44;
+       fine_rom[3050] = 8'd49;
+       fine_rom[3051] = 8'd54;
+       fine_rom[3052] = 8'd59;
+       fine_rom[3053] = 8'd64;
+       fine_rom[3054] = 8'd69;
+       fine_rom[3055] = 8'd74;
+       fine_rom[3056] = 8'd0;
+       fine_rom[3057] = 8'd5;
+       fine_rom[3058] = 8'd9;
+       fine_rom[3059] = 8'd14;
+       fine_rom[3060] = 8'd19;
+       fine_rom[3061] = 8'd24;
+       fine_rom[3062] = 8'd29;
+       fine_rom[3063] = 8'd34;
+       fine_rom[3064] = 8'd39;
+       fine_rom[3065] = 8'd43;
+       fine_rom[3066] = 8'd48;
+       fine_rom[3067] = 8'd53;
+       fine_rom[3068] = 8'd58;
+       fine_rom[3069] = 8'd63;
+       fine_rom[3070] = 8'd68;
+       fine_rom[3071] = 8'd72;
+       fine_rom[3072] = 8'd0;
+       fine_rom[3073] = 8'd5;
+       fine_rom[3074] = 8'd10;
+       fine_rom[3075] = 8'd15;
+       fine_rom[3076] = 8'd19;
+       fine_rom[3077] = 8'd24;
+       fine_rom[3078] = 8'd29;
+       fine_rom[3079] = 8'd34;
+       fine_rom[3080] = 8'd38;
+       fine_rom[3081] = 8'd43;
+       fine_rom[3082] = 8'd48;
+       fine_rom[3083] = 8'd53;
+       fine_rom[3084] = 8'd58;
+       fine_rom[3085] = 8'd62;
+       fine_rom[3086] = 8'd67;
+       fine_rom[3087] = 8'd72;
+       fine_rom[3088] = 8'd0;
+       fine_rom[3089] = 8'd5;
+       fine_rom[3090] = 8'd10;
+       fine_rom[3091] = 8'd15;
+       fine_rom[3092] = 8'd19;
+       fine_rom[3093] = 8'd24;
+       fine_rom[3094] = 8'd29;
+       fine_rom[3095] = 8'd34;
+       fine_rom[3096] = 8'd38;
+       fine_rom[3097] = 8'd43;
+       fine_rom[3098] = 8'd48;
+       fine_rom[3099] = 8'd52;
+       fine_rom[3100] = 8'd57;
+       fine_rom[3101] = 8'd62;
+       fine_rom[3102] = 8'd66;
+       fine_rom[3103] = 8'd71;
+       fine_rom[3104] = 8'd0;
+       fine_rom[3105] = 8'd4;
+       fine_rom[3106] = 8'd9;
+       fine_rom[3107] = 8'd14;
+       fine_rom[3108] = 8'd18;
+       fine_rom[3109] = 8'd23;
+       fine_rom[3110] = 8'd28;
+       fine_rom[3111] = 8'd32;
+       fine_rom[3112] = 8'd37;
+       fine_rom[3113] = 8'd41;
+       fine_rom[3114] = 8'd46;
+       fine_rom[3115] = 8'd51;
+       fine_rom[3116] = 8'd55;
+       fine_rom[3117] = 8'd60;
+       fine_rom[3118] = 8'd65;
+       fine_rom[3119] = 8'd69;
+       fine_rom[3120] = 8'd0;
+       fine_rom[3121] = 8'd4;
+       fine_rom[3122] = 8'd9;
+       fine_rom[3123] = 8'd13;
+       fine_rom[3124] = 8'd18;
+       fine_rom[3125] = 8'd23;
+       fine_rom[3126] = 8'd27;
+       fine_rom[3127] = 8'd32;
+       fine_rom[3128] = 8'd36;
+       fine_rom[3129] = 8'd41;
+       fine_rom[3130] = 8'd45;
+       fine_rom[3131] = 8'd50;
+       fine_rom[3132] = 8'd55;
+       fine_rom[3133] = 8'd59;
+       fine_rom[3134] = 8'd64;
+       fine_rom[3135] = 8'd68;
+       fine_rom[3136] = 8'd0;
+       fine_rom[3137] = 8'd4;
+       fine_rom[3138] = 8'd9;
+       fine_rom[3139] = 8'd13;
+       fine_rom[3140] = 8'd18;
+       fine_rom[3141] = 8'd22;
+       fine_rom[3142] = 8'd27;
+       fine_rom[3143] = 8'd31;
+       fine_rom[3144] = 8'd36;
+       fine_rom[3145] = 8'd40;
+       fine_rom[3146] = 8'd45;
+       fine_rom[3147] = 8'd49;
+       fine_rom[3148] = 8'd54;
+       fine_rom[3149] = 8'd58;
+       fine_rom[3150] = 8'd62;
+       fine_rom[3151] = 8'd67;
+       fine_rom[3152] = 8'd0;
+       fine_rom[3153] = 8'd5;
+       fine_rom[3154] = 8'd9;
+       fine_rom[3155] = 8'd14;
+       fine_rom[3156] = 8'd18;
+       fine_rom[3157] = 8'd23;
+       fine_rom[3158] = 8'd27;
+       fine_rom[3159] = 8'd31;
+       fine_rom[3160] = 8'd36;
+       fine_rom[3161] = 8'd40;
+       fine_rom[3162] = 8'd45;
+       fine_rom[3163] = 8'd49;
+       fine_rom[3164] = 8'd53;
+       fine_rom[3165] = 8'd58;
+       fine_rom[3166] = 8'd62;
+       fine_rom[3167] = 8'd67;
+       fine_rom[3168] = 8'd0;
+       fine_rom[3169] = 8'd4;
+       fine_rom[3170] = 8'd9;
+       fine_rom[3171] = 8'd13;
+       fine_rom[3172] = 8'd17;
+       fine_rom[3173] = 8'd22;
+       fine_rom[3174] = 8'd26;
+       fine_rom[3175] = 8'd30;
+       fine_rom[3176] = 8'd35;
+       fine_rom[3177] = 8'd39;
+       fine_rom[3178] = 8'd44;
+       fine_rom[3179] = 8'd48;
+       fine_rom[3180] = 8'd52;
+       fine_rom[3181] = 8'd56;
+       fine_rom[3182] = 8'd61;
+       fine_rom[3183] = 8'd65;
+       fine_rom[3184] = 8'd0;
+       fine_rom[3185] = 8'd5;
+       fine_rom[3186] = 8'd9;
+       fine_rom[3187] = 8'd13;
+       fine_rom[3188] = 8'd18;
+       fine_rom[3189] = 8'd22;
+       fine_rom[3190] = 8'd26;
+       fine_rom[3191] = 8'd30;
+       fine_rom[3192] = 8'd35;
+       fine_rom[3193] = 8'd39;
+       fine_rom[3194] = 8'd43;
+       fine_rom[3195] = 8'd47;
+       fine_rom[3196] = 8'd52;
+       fine_rom[3197] = 8'd56;
+       fine_rom[3198] = 8'd60;
+       fine_rom[3199] = 8'd64;
+       fine_rom[3200] = 8'd0;
+       fine_rom[3201] = 8'd4;
+       fine_rom[3202] = 8'd8;
+       fine_rom[3203] = 8'd12;
+       fine_rom[3204] = 8'd17;
+       fine_rom[3205] = 8'd21;
+       fine_rom[3206] = 8'd25;
+       fine_rom[3207] = 8'd29;
+       fine_rom[3208] = 8'd33;
+       fine_rom[3209] = 8'd38;
+       fine_rom[3210] = 8'd42;
+       fine_rom[3211] = 8'd46;
+       fine_rom[3212] = 8'd50;
+       fine_rom[3213] = 8'd54;
+       fine_rom[3214] = 8'd58;
+       fine_rom[3215] = 8'd63;
+       fine_rom[3216] = 8'd0;
+       fine_rom[3217] = 8'd4;
+       fine_rom[3218] = 8'd8;
+       fine_rom[3219] = 8'd12;
+       fine_rom[3220] = 8'd16;
+       fine_rom[3221] = 8'd21;
+       fine_rom[3222] = 8'd25;
+       fine_rom[3223] = 8'd29;
+       fine_rom[3224] = 8'd33;
+       fine_rom[3225] = 8'd37;
+       fine_rom[3226] = 8'd41;
+       fine_rom[3227] = 8'd45;
+       fine_rom[3228] = 8'd49;
+       fine_rom[3229] = 8'd53;
+       fine_rom[3230] = 8'd58;
+       fine_rom[3231] = 8'd62;
+       fine_rom[3232] = 8'd0;
+       fine_rom[3233] = 8'd4;
+       fine_rom[3234] = 8'd8;
+       fine_rom[3235] = 8'd12;
+       fine_rom[3236] = 8'd16;
+       fine_rom[3237] = 8'd20;
+       fine_rom[3238] = 8'd24;
+       fine_rom[3239] = 8'd28;
+       fine_rom[3240] = 8'd32;
+       fine_rom[3241] = 8'd36;
+       fine_rom[3242] = 8'd40;
+       fine_rom[3243] = 8'd44;
+       fine_rom[3244] = 8'd48;
+       fine_rom[3245] = 8'd52;
+       fine_rom[3246] = 8'd57;
+       fine_rom[3247] = 8'd61;
+       fine_rom[3248] = 8'd0;
+       fine_rom[3249] = 8'd4;
+       fine_rom[3250] = 8'd8;
+       fine_rom[3251] = 8'd12;
+       fine_rom[3252] = 8'd16;
+       fine_rom[3253] = 8'd20;
+       fine_rom[3254] = 8'd24;
+       fine_rom[3255] = 8'd28;
+       fine_rom[3256] = 8'd31;
+       fine_rom[3257] = 8'd35;
+       fine_rom[3258] = 8'd39;
+       fine_rom[3259] = 8'd43;
+       fine_rom[3260] = 8'd47;
+       fine_rom[3261] = 8'd51;
+       fine_rom[3262] = 8'd55;
+       fine_rom[3263] = 8'd59;
+       fine_rom[3264] = 8'd0;
+       fine_rom[3265] = 8'd4;
+       fine_rom[3266] = 8'd8;
+       fine_rom[3267] = 8'd12;
+       fine_rom[3268] = 8'd16;
+       fine_rom[3269] = 8'd20;
+       fine_rom[3270] = 8'd24;
+       fine_rom[3271] = 8'd28;
+       fine_rom[3272] = 8'd32;
+       fine_rom[3273] = 8'd35;
+       fine_rom[3274] = 8'd39;
+       fine_rom[3275] = 8'd43;
+       fine_rom[3276] = 8'd47;
+       fine_rom[3277] = 8'd51;
+       fine_rom[3278] = 8'd55;
+       fine_rom[3279] = 8'd59;
+       fine_rom[3280] = 8'd0;
+       fine_rom[3281] = 8'd3;
+       fine_rom[3282] = 8'd7;
+       fine_rom[3283] = 8'd11;
+       fine_rom[3284] = 8'd15;
+       fine_rom[3285] = 8'd19;
+       fine_rom[3286] = 8'd23;
+       fine_rom[3287] = 8'd27;
+       fine_rom[3288] = 8'd30;
+       fine_rom[3289] = 8'd34;
+       fine_rom[3290] = 8'd38;
+       fine_rom[3291] = 8'd42;
+       fine_rom[3292] = 8'd46;
+       fine_rom[3293] = 8'd49;
+       fine_rom[3294] = 8'd53;
+       fine_rom[3295] = 8'd57;
+       fine_rom[3296] = 8'd0;
+       fine_rom[3297] = 8'd4;
+       fine_rom[3298] = 8'd7;
+       fine_rom[3299] = 8'd11;
+       fine_rom[3300] = 8'd15;
+       fine_rom[3301] = 8'd19;
+       fine_rom[3302] = 8'd23;
+       fine_rom[3303] = 8'd26;
+       fine_rom[3304] = 8'd30;
+       fine_rom[3305] = 8'd34;
+       fine_rom[3306] = 8'd38;
+       fine_rom[3307] = 8'd41;
+       fine_rom[3308] = 8'd45;
+       fine_rom[3309] = 8'd49;
+       fine_rom[3310] = 8'd53;
+       fine_rom[3311] = 8'd56;
+       fine_rom[3312] = 8'd0;
+       fine_rom[3313] = 8'd4;
+       fine_rom[3314] = 8'd7;
+       fine_rom[3315] = 8'd11;
+       fine_rom[3316] = 8'd15;
+       fine_rom[3317] = 8'd19;
+       fine_rom[3318] = 8'd22;
+       fine_rom[3319] = 8'd26;
+       fine_rom[3320] = 8'd30;
+       fine_rom[3321] = 8'd33;
+       fine_rom[3322] = 8'd37;
+       fine_rom[3323] = 8'd41;
+       fine_rom[3324] = 8'd44;
+       fine_rom[3325] = 8'd48;
+       fine_rom[3326] = 8'd52;
+       fine_rom[3327] = 8'd55;
+       fine_rom[3328] = 8'd0;
+       fine_rom[3329] = 8'd4;
+       fine_rom[3330] = 8'd7;
+       fine_rom[3331] = 8'd11;
+       fine_rom[3332] = 8'd14;
+       fine_rom[3333] = 8'd18;
+       fine_rom[3334] = 8'd22;
+       fine_rom[3335] = 8'd25;
+       fine_rom[3336] = 8'd29;
+       fine_rom[3337] = 8'd33;
+       fine_rom[3338] = 8'd36;
+       fine_rom[3339] = 8'd40;
+       fine_rom[3340] = 8'd43;
+       fine_rom[3341] = 8'd47;
+       fine_rom[3342] = 8'd50;
+       fine_rom[3343] = 8'd54;
+       fine_rom[3344] = 8'd0;
+       fine_rom[3345] = 8'd3;
+       fine_rom[3346] = 8'd7;
+       fine_rom[3347] = 8'd10;
+       fine_rom[3348] = 8'd14;
+       fine_rom[3349] = 8'd17;
+       fine_rom[3350] = 8'd21;
+       fine_rom[3351] = 8'd25;
+       fine_rom[3352] = 8'd28;
+       fine_rom[3353] = 8'd32;
+       fine_rom[3354] = 8'd35;
+       fine_rom[3355] = 8'd39;
+       fine_rom[3356] = 8'd42;
+       fine_rom[3357] = 8'd46;
+       fine_rom[3358] = 8'd49;
+       fine_rom[3359] = 8'd53;
+       fine_rom[3360] = 8'd0;
+       fine_rom[3361] = 8'd4;
+       fine_rom[3362] = 8'd7;
+       fine_rom[3363] = 8'd11;
+       fine_rom[3364] = 8'd14;
+       fine_rom[3365] = 8'd18;
+       fine_rom[3366] = 8'd21;
+       fine_rom[3367] = 8'd25;
+       fine_rom[3368] = 8'd28;
+       fine_rom[3369] = 8'd31;
+       fine_rom[3370] = 8'd35;
+       fine_rom[3371] = 8'd38;
+       fine_rom[3372] = 8'd42;
+       fine_rom[3373] = 8'd45;
+       fine_rom[3374] = 8'd49;
+       fine_rom[3375] = 8'd52;
+       fine_rom[3376] = 8'd0;
+       fine_rom[3377] = 8'd3;
+       fine_rom[3378] = 8'd6;
+       fine_rom[3379] = 8'd10;
+       fine_rom[3380] = 8'd13;
+       fine_rom[3381] = 8'd17;
+       fine_rom[3382] = 8'd20;
+       fine_rom[3383] = 8'd23;
+       fine_rom[3384] = 8'd27;
+       fine_rom[3385] = 8'd30;
+       fine_rom[3386] = 8'd34;
+       fine_rom[3387] = 8'd37;
+       fine_rom[3388] = 8'd40;
+       fine_rom[3389] = 8'd44;
+       fine_rom[3390] = 8'd47;
+       fine_rom[3391] = 8'd50;
+       fine_rom[3392] = 8'd0;
+       fine_rom[3393] = 8'd3;
+       fine_rom[3394] = 8'd6;
+       fine_rom[3395] = 8'd10;
+       fine_rom[3396] = 8'd13;
+       fine_rom[3397] = 8'd16;
+       fine_rom[3398] = 8'd20;
+       fine_rom[3399] = 8'd23;
+       fine_rom[3400] = 8'd26;
+       fine_rom[3401] = 8'd30;
+       fine_rom[3402] = 8'd33;
+       fine_rom[3403] = 8'd36;
+       fine_rom[3404] = 8'd40;
+       fine_rom[3405] = 8'd43;
+       fine_rom[3406] = 8'd46;
+       fine_rom[3407] = 8'd49;
+       fine_rom[3408] = 8'd0;
+       fine_rom[3409] = 8'd3;
+       fine_rom[3410] = 8'd6;
+       fine_rom[3411] = 8'd10;
+       fine_rom[3412] = 8'd13;
+       fine_rom[3413] = 8'd16;
+       fine_rom[3414] = 8'd19;
+       fine_rom[3415] = 8'd23;
+       fine_rom[3416] = 8'd26;
+       fine_rom[3417] = 8'd29;
+       fine_rom[3418] = 8'd32;
+       fine_rom[3419] = 8'd35;
+       fine_rom[3420] = 8'd39;
+       fine_rom[3421] = 8'd42;
+       fine_rom[3422] = 8'd45;
+       fine_rom[3423] = 8'd48;
+       fine_rom[3424] = 8'd0;
+       fine_rom[3425] = 8'd3;
+       fine_rom[3426] = 8'd6;
+       fine_rom[3427] = 8'd9;
+       fine_rom[3428] = 8'd12;
+       fine_rom[3429] = 8'd15;
+       fine_rom[3430] = 8'd19;
+       fine_rom[3431] = 8'd22;
+       fine_rom[3432] = 8'd25;
+       fine_rom[3433] = 8'd28;
+       fine_rom[3434] = 8'd31;
+       fine_rom[3435] = 8'd34;
+       fine_rom[3436] = 8'd38;
+       fine_rom[3437] = 8'd41;
+       fine_rom[3438] = 8'd44;
+       fine_rom[3439] = 8'd47;
+       fine_rom[3440] = 8'd0;
+       fine_rom[3441] = 8'd3;
+       fine_rom[3442] = 8'd6;
+       fine_rom[3443] = 8'd9;
+       fine_rom[3444] = 8'd13;
+       fine_rom[3445] = 8'd16;
+       fine_rom[3446] = 8'd19;
+       fine_rom[3447] = 8'd22;
+       fine_rom[3448] = 8'd25;
+       fine_rom[3449] = 8'd28;
+       fine_rom[3450] = 8'd31;
+       fine_rom[3451] = 8'd34;
+       fine_rom[3452] = 8'd37;
+       fine_rom[3453] = 8'd40;
+       fine_rom[3454] = 8'd43;
+       fine_rom[3455] = 8'd46;
+       fine_rom[3456] = 8'd0;
+       fine_rom[3457] = 8'd3;
+       fine_rom[3458] = 8'd6;
+       fine_rom[3459] = 8'd9;
+       fine_rom[3460] = 8'd12;
+       fine_rom[3461] = 8'd15;
+       fine_rom[3462] = 8'd18;
+       fine_rom[3463] = 8'd21;
+       fine_rom[3464] = 8'd24;
+       fine_rom[3465] = 8'd27;
+       fine_rom[3466] = 8'd30;
+       fine_rom[3467] = 8'd33;
+       fine_rom[3468] = 8'd36;
+       fine_rom[3469] = 8'd39;
+       fine_rom[3470] = 8'd42;
+       fine_rom[3471] = 8'd45;
+       fine_rom[3472] = 8'd0;
+       fine_rom[3473] = 8'd3;
+       fine_rom[3474] = 8'd6;
+       fine_rom[3475] = 8'd9;
+       fine_rom[3476] = 8'd12;
+       fine_rom[3477] = 8'd15;
+       fine_rom[3478] = 8'd18;
+       fine_rom[3479] = 8'd20;
+       fine_rom[3480] = 8'd23;
+       fine_rom[3481] = 8'd26;
+       fine_rom[3482] = 8'd29;
+       fine_rom[3483] = 8'd32;
+       fine_rom[3484] = 8'd35;
+       fine_rom[3485] = 8'd38;
+       fine_rom[3486] = 8'd41;
+       fine_rom[3487] = 8'd44;
+       fine_rom[3488] = 8'd0;
+       fine_rom[3489] = 8'd3;
+       fine_rom[3490] = 8'd6;
+       fine_rom[3491] = 8'd8;
+       fine_rom[3492] = 8'd11;
+       fine_rom[3493] = 8'd14;
+       fine_rom[3494] = 8'd17;
+       fine_rom[3495] = 8'd20;
+       fine_rom[3496] = 8'd23;
+       fine_rom[3497] = 8'd26;
+       fine_rom[3498] = 8'd29;
+       fine_rom[3499] = 8'd31;
+       fine_rom[3500] = 8'd34;
+       fine_rom[3501] = 8'd37;
+       fine_rom[3502] = 8'd40;
+       fine_rom[3503] = 8'd43;
+       fine_rom[3504] = 8'd0;
+       fine_rom[3505] = 8'd2;
+       fine_rom[3506] = 8'd5;
+       fine_rom[3507] = 8'd8;
+       fine_rom[3508] = 8'd11;
+       fine_rom[3509] = 8'd14;
+       fine_rom[3510] = 8'd16;
+       fine_rom[3511] = 8'd19;
+       fine_rom[3512] = 8'd22;
+       fine_rom[3513] = 8'd25;
+       fine_rom[3514] = 8'd28;
+       fine_rom[3515] = 8'd30;
+       fine_rom[3516] = 8'd33;
+       fine_rom[3517] = 8'd36;
+       fine_rom[3518] = 8'd39;
+       fine_rom[3519] = 8'd41;
+       fine_rom[3520] = 8'd0;
+       fine_rom[3521] = 8'd3;
+       fine_rom[3522] = 8'd6;
+       fine_rom[3523] = 8'd8;
+       fine_rom[3524] = 8'd11;
+       fine_rom[3525] = 8'd14;
+       fine_rom[3526] = 8'd17;
+       fine_rom[3527] = 8'd19;
+       fine_rom[3528] = 8'd22;
+       fine_rom[3529] = 8'd25;
+       fine_rom[3530] = 8'd27;
+       fine_rom[3531] = 8'd30;
+       fine_rom[3532] = 8'd33;
+       fine_rom[3533] = 8'd36;
+       fine_rom[3534] = 8'd38;
+       fine_rom[3535] = 8'd41;
+       fine_rom[3536] = 8'd0;
+       fine_rom[3537] = 8'd2;
+       fine_rom[3538] = 8'd5;
+       fine_rom[3539] = 8'd8;
+       fine_rom[3540] = 8'd10;
+       fine_rom[3541] = 8'd13;
+       fine_rom[3542] = 8'd16;
+       fine_rom[3543] = 8'd18;
+       fine_rom[3544] = 8'd21;
+       fine_rom[3545] = 8'd24;
+       fine_rom[3546] = 8'd26;
+       fine_rom[3547] = 8'd29;
+       fine_rom[3548] = 8'd31;
+       fine_rom[3549] = 8'd34;
+       fine_rom[3550] = 8'd37;
+       fine_rom[3551] = 8'd39;
+       fine_rom[3552] = 8'd0;
+       fine_rom[3553] = 8'd2;
+       fine_rom[3554] = 8'd5;
+       fine_rom[3555] = 8'd8;
+       fine_rom[3556] = 8'd10;
+       fine_rom[3557] = 8'd13;
+       fine_rom[3558] = 8'd15;
+       fine_rom[3559] = 8'd18;
+       fine_rom[3560] = 8'd20;
+       fine_rom[3561] = 8'd23;
+       fine_rom[3562] = 8'd26;
+       fine_rom[3563] = 8'd28;
+       fine_rom[3564] = 8'd31;
+       fine_rom[3565] = 8'd33;
+       fine_rom[3566] = 8'd36;
+       fine_rom[3567] = 8'd38;
+       fine_rom[3568] = 8'd0;
+       fine_rom[3569] = 8'd2;
+       fine_rom[3570] = 8'd5;
+       fine_rom[3571] = 8'd7;
+       fine_rom[3572] = 8'd10;
+       fine_rom[3573] = 8'd12;
+       fine_rom[3574] = 8'd15;
+       fine_rom[3575] = 8'd17;
+       fine_rom[3576] = 8'd20;
+       fine_rom[3577] = 8'd22;
+       fine_rom[3578] = 8'd25;
+       fine_rom[3579] = 8'd27;
+       fine_rom[3580] = 8'd30;
+       fine_rom[3581] = 8'd32;
+       fine_rom[3582] = 8'd35;
+       fine_rom[3583] = 8'd37;
+       fine_rom[3584] = 8'd0;
+       fine_rom[3585] = 8'd2;
+       fine_rom[3586] = 8'd5;
+       fine_rom[3587] = 8'd7;
+       fine_rom[3588] = 8'd9;
+       fine_rom[3589] = 8'd12;
+       fine_rom[3590] = 8'd14;
+       fine_rom[3591] = 8'd17;
+       fine_rom[3592] = 8'd19;
+       fine_rom[3593] = 8'd21;
+       fine_rom[3594] = 8'd24;
+       fine_rom[3595] = 8'd26;
+       fine_rom[3596] = 8'd29;
+       fine_rom[3597] = 8'd31;
+       fine_rom[3598] = 8'd33;
+       fine_rom[3599] = 8'd36;
+       fine_rom[3600] = 8'd0;
+       fine_rom[3601] = 8'd3;
+       fine_rom[3602] = 8'd5;
+       fine_rom[3603] = 8'd7;
+       fine_rom[3604] = 8'd10;
+       fine_rom[3605] = 8'd12;
+       fine_rom[3606] = 8'd14;
+       fine_rom[3607] = 8'd17;
+       fine_rom[3608] = 8'd19;
+       fine_rom[3609] = 8'd21;
+       fine_rom[3610] = 8'd24;
+       fine_rom[3611] = 8'd26;
+       fine_rom[3612] = 8'd28;
+       fine_rom[3613] = 8'd31;
+       fine_rom[3614] = 8'd33;
+       fine_rom[3615] = 8'd35;
+       fine_rom[3616] = 8'd0;
+       fine_rom[3617] = 8'd2;
+       fine_rom[3618] = 8'd4;
+       fine_rom[3619] = 8'd6;
+       fine_rom[3620] = 8'd9;
+       fine_rom[3621] = 8'd11;
+       fine_rom[3622] = 8'd13;
+       fine_rom[3623] = 8'd16;
+       fine_rom[3624] = 8'd18;
+       fine_rom[3625] = 8'd20;
+       fine_rom[3626] = 8'd22;
+       fine_rom[3627] = 8'd25;
+       fine_rom[3628] = 8'd27;
+       fine_rom[3629] = 8'd29;
+       fine_rom[3630] = 8'd31;
+       fine_rom[3631] = 8'd33;
+       fine_rom[3632] = 8'd0;
+       fine_rom[3633] = 8'd2;
+       fine_rom[3634] = 8'd4;
+       fine_rom[3635] = 8'd6;
+       fine_rom[3636] = 8'd9;
+       fine_rom[3637] = 8'd11;
+       fine_rom[3638] = 8'd13;
+       fine_rom[3639] = 8'd15;
+       fine_rom[3640] = 8'd17;
+       fine_rom[3641] = 8'd20;
+       fine_rom[3642] = 8'd22;
+       fine_rom[3643] = 8'd24;
+       fine_rom[3644] = 8'd26;
+       fine_rom[3645] = 8'd28;
+       fine_rom[3646] = 8'd30;
+       fine_rom[3647] = 8'd33;
+       fine_rom[3648] = 8'd0;
+       fine_rom[3649] = 8'd2;
+       fine_rom[3650] = 8'd4;
+       fine_rom[3651] = 8'd6;
+       fine_rom[3652] = 8'd8;
+       fine_rom[3653] = 8'd10;
+       fine_rom[3654] = 8'd12;
+       fine_rom[3655] = 8'd15;
+       fine_rom[3656] = 8'd17;
+       fine_rom[3657] = 8'd19;
+       fine_rom[3658] = 8'd21;
+       fine_rom[3659] = 8'd23;
+       fine_rom[3660] = 8'd25;
+       fine_rom[3661] = 8'd27;
+       fine_rom[3662] = 8'd29;
+       fine_rom[3663] = 8'd31;
+       fine_rom[3664] = 8'd0;
+       fine_rom[3665] = 8'd2;
+       fine_rom[3666] = 8'd5;
+       fine_rom[3667] = 8'd7;
+       fine_rom[3668] = 8'd9;
+       fine_rom[3669] = 8'd11;
+       fine_rom[3670] = 8'd13;
+       fine_rom[3671] = 8'd15;
+       fine_rom[3672] = 8'd17;
+       fine_rom[3673] = 8'd19;
+       fine_rom[3674] = 8'd21;
+       fine_rom[3675] = 8'd23;
+       fine_rom[3676] = 8'd25;
+       fine_rom[3677] = 8'd27;
+       fine_rom[3678] = 8'd29;
+       fine_rom[3679] = 8'd31;
+       fine_rom[3680] = 8'd0;
+       fine_rom[3681] = 8'd2;
+       fine_rom[3682] = 8'd4;
+       fine_rom[3683] = 8'd6;
+       fine_rom[3684] = 8'd8;
+       fine_rom[3685] = 8'd10;
+       fine_rom[3686] = 8'd12;
+       fine_rom[3687] = 8'd14;
+       fine_rom[3688] = 8'd16;
+       fine_rom[3689] = 8'd18;
+       fine_rom[3690] = 8'd20;
+       fine_rom[3691] = 8'd22;
+       fine_rom[3692] = 8'd23;
+       fine_rom[3693] = 8'd25;
+       fine_rom[3694] = 8'd27;
+       fine_rom[3695] = 8'd29;
+       fine_rom[3696] = 8'd0;
+       fine_rom[3697] = 8'd2;
+       fine_rom[3698] = 8'd4;
+       fine_rom[3699] = 8'd6;
+       fine_rom[3700] = 8'd8;
+       fine_rom[3701] = 8'd10;
+       fine_rom[3702] = 8'd12;
+       fine_rom[3703] = 8'd14;
+       fine_rom[3704] = 8'd15;
+       fine_rom[3705] = 8'd17;
+       fine_rom[3706] = 8'd19;
+       fine_rom[3707] = 8'd21;
+       fine_rom[3708] = 8'd23;
+       fine_rom[3709] = 8'd25;
+       fine_rom[3710] = 8'd27;
+       fine_rom[3711] = 8'd28;
+       fine_rom[3712] = 8'd0;
+       fine_rom[3713] = 8'd2;
+       fine_rom[3714] = 8'd4;
+       fine_rom[3715] = 8'd6;
+       fine_rom[3716] = 8'd8;
+       fine_rom[3717] = 8'd9;
+       fine_rom[3718] = 8'd11;
+       fine_rom[3719] = 8'd13;
+       fine_rom[3720] = 8'd15;
+       fine_rom[3721] = 8'd17;
+       fine_rom[3722] = 8'd18;
+       fine_rom[3723] = 8'd20;
+       fine_rom[3724] = 8'd22;
+       fine_rom[3725] = 8'd24;
+       fine_rom[3726] = 8'd26;
+       fine_rom[3727] = 8'd27;
+       fine_rom[3728] = 8'd0;
+       fine_rom[3729] = 8'd2;
+       fine_rom[3730] = 8'd4;
+       fine_rom[3731] = 8'd5;
+       fine_rom[3732] = 8'd7;
+       fine_rom[3733] = 8'd9;
+       fine_rom[3734] = 8'd11;
+       fine_rom[3735] = 8'd12;
+       fine_rom[3736] = 8'd14;
+       fine_rom[3737] = 8'd16;
+       fine_rom[3738] = 8'd18;
+       fine_rom[3739] = 8'd19;
+       fine_rom[3740] = 8'd21;
+       fine_rom[3741] = 8'd23;
+       fine_rom[3742] = 8'd24;
+       fine_rom[3743] = 8'd26;
+       fine_rom[3744] = 8'd0;
+       fine_rom[3745] = 8'd1;
+       fine_rom[3746] = 8'd3;
+       fine_rom[3747] = 8'd5;
+       fine_rom[3748] = 8'd6;
+       fine_rom[3749] = 8'd8;
+       fine_rom[3750] = 8'd10;
+       fine_rom[3751] = 8'd11;
+       fine_rom[3752] = 8'd13;
+       fine_rom[3753] = 8'd15;
+       fine_rom[3754] = 8'd16;
+       fine_rom[3755] = 8'd18;
+       fine_rom[3756] = 8'd20;
+       fine_rom[3757] = 8'd21;
+       fine_rom[3758] = 8'd23;
+       fine_rom[3759] = 8'd25;
+       fine_rom[3760] = 8'd0;
+       fine_rom[3761] = 8'd2;
+       fine_rom[3762] = 8'd3;
+       fine_rom[3763] = 8'd5;
+       fine_rom[3764] = 8'd7;
+       fine_rom[3765] = 8'd8;
+       fine_rom[3766] = 8'd10;
+       fine_rom[3767] = 8'd11;
+       fine_rom[3768] = 8'd13;
+       fine_rom[3769] = 8'd14;
+       fine_rom[3770] = 8'd16;
+       fine_rom[3771] = 8'd18;
+       fine_rom[3772] = 8'd19;
+       fine_rom[3773] = 8'd21;
+       fine_rom[3774] = 8'd22;
+       fine_rom[3775] = 8'd24;
+       fine_rom[3776] = 8'd0;
+       fine_rom[3777] = 8'd2;
+       fine_rom[3778] = 8'd3;
+       fine_rom[3779] = 8'd5;
+       fine_rom[3780] = 8'd6;
+       fine_rom[3781] = 8'd8;
+       fine_rom[3782] = 8'd9;
+       fine_rom[3783] = 8'd11;
+       fine_rom[3784] = 8'd12;
+       fine_rom[3785] = 8'd14;
+       fine_rom[3786] = 8'd15;
+       fine_rom[3787] = 8'd17;
+       fine_rom[3788] = 8'd18;
+       fine_rom[3789] = 8'd20;
+       fine_rom[3790] = 8'd21;
+       fine_rom[3791] = 8'd23;
+       fine_rom[3792] = 8'd0;
+       fine_rom[3793] = 8'd2;
+       fine_rom[3794] = 8'd3;
+       fine_rom[3795] = 8'd5;
+       fine_rom[3796] = 8'd6;
+       fine_rom[3797] = 8'd8;
+       fine_rom[3798] = 8'd9;
+       fine_rom[3799] = 8'd10;
+       fine_rom[3800] = 8'd12;
+       fine_rom[3801] = 8'd13;
+       fine_rom[3802] = 8'd15;
+       fine_rom[3803] = 8'd16;
+       fine_rom[3804] = 8'd17;
+       fine_rom[3805] = 8'd19;
+       fine_rom[3806] = 8'd20;
+       fine_rom[3807] = 8'd22;
+       fine_rom[3808] = 8'd0;
+       fine_rom[3809] = 8'd1;
+       fine_rom[3810] = 8'd3;
+       fine_rom[3811] = 8'd4;
+       fine_rom[3812] = 8'd6;
+       fine_rom[3813] = 8'd7;
+       fine_rom[3814] = 8'd8;
+       fine_rom[3815] = 8'd10;
+       fine_rom[3816] = 8'd11;
+       fine_rom[3817] = 8'd12;
+       fine_rom[3818] = 8'd14;
+       fine_rom[3819] = 8'd15;
+       fine_rom[3820] = 8'd16;
+       fine_rom[3821] = 8'd18;
+       fine_rom[3822] = 8'd19;
+       fine_rom[3823] = 8'd20;
+       fine_rom[3824] = 8'd0;
+       fine_rom[3825] = 8'd1;
+       fine_rom[3826] = 8'd2;
+       fine_rom[3827] = 8'd3;
+       fine_rom[3828] = 8'd5;
+       fine_rom[3829] = 8'd6;
+       fine_rom[3830] = 8'd7;
+       fine_rom[3831] = 8'd9;
+       fine_rom[3832] = 8'd10;
+       fine_rom[3833] = 8'd11;
+       fine_rom[3834] = 8'd12;
+       fine_rom[3835] = 8'd14;
+       fine_rom[3836] = 8'd15;
+       fine_rom[3837] = 8'd16;
+       fine_rom[3838] = 8'd17;
+       fine_rom[3839] = 8'd19;
+       fine_rom[3840] = 8'd0;
+       fine_rom[3841] = 8'd1;
+       fine_rom[3842] = 8'd2;
+       fine_rom[3843] = 8'd3;
+       fine_rom[3844] = 8'd5;
+       fine_rom[3845] = 8'd6;
+       fine_rom[3846] = 8'd7;
+       fine_rom[3847] = 8'd8;
+       fine_rom[3848] = 8'd10;
+       fine_rom[3849] = 8'd11;
+       fine_rom[3850] = 8'd12;
+       fine_rom[3851] = 8'd13;
+       fine_rom[3852] = 8'd14;
+       fine_rom[3853] = 8'd15;
+       fine_rom[3854] = 8'd17;
+       fine_rom[3855] = 8'd18;
+       fine_rom[3856] = 8'd0;
+       fine_rom[3857] = 8'd1;
+       fine_rom[3858] = 8'd2;
+       fine_rom[3859] = 8'd3;
+       fine_rom[3860] = 8'd4;
+       fine_rom[3861] = 8'd6;
+       fine_rom[3862] = 8'd7;
+       fine_rom[3863] = 8'd8;
+       fine_rom[3864] = 8'd9;
+       fine_rom[3865] = 8'd10;
+       fine_rom[3866] = 8'd11;
+       fine_rom[3867] = 8'd12;
+       fine_rom[3868] = 8'd13;
+       fine_rom[3869] = 8'd14;
+       fine_rom[3870] = 8'd16;
+       fine_rom[3871] = 8'd17;
+       fine_rom[3872] = 8'd0;
+       fine_rom[3873] = 8'd1;
+       fine_rom[3874] = 8'd2;
+       fine_rom[3875] = 8'd3;
+       fine_rom[3876] = 8'd4;
+       fine_rom[3877] = 8'd5;
+       fine_rom[3878] = 8'd6;
+       fine_rom[3879] = 8'd7;
+       fine_rom[3880] = 8'd8;
+       fine_rom[3881] = 8'd9;
+       fine_rom[3882] = 8'd10;
+       fine_rom[3883] = 8'd11;
+       fine_rom[3884] = 8'd12;
+       fine_rom[3885] = 8'd13;
+       fine_rom[3886] = 8'd14;
+       fine_rom[3887] = 8'd15;
+       fine_rom[3888] = 8'd0;
+       fine_rom[3889] = 8'd1;
+       fine_rom[3890] = 8'd2;
+       fine_rom[3891] = 8'd3;
+       fine_rom[3892] = 8'd4;
+       fine_rom[3893] = 8'd5;
+       fine_rom[3894] = 8'd6;
+       fine_rom[3895] = 8'd7;
+       fine_rom[3896] = 8'd8;
+       fine_rom[3897] = 8'd9;
+       fine_rom[3898] = 8'd10;
+       fine_rom[3899] = 8'd11;
+       fine_rom[3900] = 8'd12;
+       fine_rom[3901] = 8'd13;
+       fine_rom[3902] = 8'd14;
+       fine_rom[3903] = 8'd15;
+       fine_rom[3904] = 8'd0;
+       fine_rom[3905] = 8'd1;
+       fine_rom[3906] = 8'd2;
+       fine_rom[3907] = 8'd2;
+       fine_rom[3908] = 8'd3;
+       fine_rom[3909] = 8'd4;
+       fine_rom[3910] = 8'd5;
+       fine_rom[3911] = 8'd6;
+       fine_rom[3912] = 8'd7;
+       fine_rom[3913] = 8'd8;
+       fine_rom[3914] = 8'd9;
+       fine_rom[3915] = 8'd10;
+       fine_rom[3916] = 8'd10;
+       fine_rom[3917] = 8'd11;
+       fine_rom[3918] = 8'd12;
+       fine_rom[3919] = 8'd13;
+       fine_rom[3920] = 8'd0;
+       fine_rom[3921] = 8'd1;
+       fine_rom[3922] = 8'd1;
+       fine_rom[3923] = 8'd2;
+       fine_rom[3924] = 8'd3;
+       fine_rom[3925] = 8'd4;
+       fine_rom[3926] = 8'd5;
+       fine_rom[3927] = 8'd6;
+       fine_rom[3928] = 8'd6;
+       fine_rom[3929] = 8'd7;
+       fine_rom[3930] = 8'd8;
+       fine_rom[3931] = 8'd9;
+       fine_rom[3932] = 8'd10;
+       fine_rom[3933] = 8'd10;
+       fine_rom[3934] = 8'd11;
+       fine_rom[3935] = 8'd12;
+       fine_rom[3936] = 8'd0;
+       fine_rom[3937] = 8'd0;
+       fine_rom[3938] = 8'd1;
+       fine_rom[3939] = 8'd2;
+       fine_rom[3940] = 8'd3;
+       fine_rom[3941] = 8'd4;
+       fine_rom[3942] = 8'd4;
+       fine_rom[3943] = 8'd5;
+       fine_rom[3944] = 8'd6;
+       fine_rom[3945] = 8'd6;
+       fine_rom[3946] = 8'd7;
+       fine_rom[3947] = 8'd8;
+       fine_rom[3948] = 8'd9;
+       fine_rom[3949] = 8'd9;
+       fine_rom[3950] = 8'd10;
+       fine_rom[3951] = 8'd11;
+       fine_rom[3952] = 8'd0;
+       fine_rom[3953] = 8'd1;
+       fine_rom[3954] = 8'd2;
+       fine_rom[3955] = 8'd2;
+       fine_rom[3956] = 8'd3;
+       fine_rom[3957] = 8'd4;
+       fine_rom[3958] = 8'd4;
+       fine_rom[3959] = 8'd5;
+       fine_rom[3960] = 8'd6;
+       fine_rom[3961] = 8'd6;
+       fine_rom[3962] = 8'd7;
+       fine_rom[3963] = 8'd8;
+       fine_rom[3964] = 8'd8;
+       fine_rom[3965] = 8'd9;
+       fine_rom[3966] = 8'd10;
+       fine_rom[3967] = 8'd10;
+       fine_rom[3968] = 8'd0;
+       fine_rom[3969] = 8'd0;
+       fine_rom[3970] = 8'd1;
+       fine_rom[3971] = 8'd2;
+       fine_rom[3972] = 8'd2;
+       fine_rom[3973] = 8'd3;
+       fine_rom[3974] = 8'd3;
+       fine_rom[3975] = 8'd4;
+       fine_rom[3976] = 8'd5;
+       fine_rom[3977] = 8'd5;
+       fine_rom[3978] = 8'd6;
+       fine_rom[3979] = 8'd6;
+       fine_rom[3980] = 8'd7;
+       fine_rom[3981] = 8'd7;
+       fine_rom[3982] = 8'd8;
+       fine_rom[3983] = 8'd9;
+       fine_rom[3984] = 8'd0;
+       fine_rom[3985] = 8'd1;
+       fine_rom[3986] = 8'd1;
+       fine_rom[3987] = 8'd2;
+       fine_rom[3988] = 8'd2;
+       fine_rom[3989] = 8'd3;
+       fine_rom[3990] = 8'd3;
+       fine_rom[3991] = 8'd4;
+       fine_rom[3992] = 8'd4;
+       fine_rom[3993] = 8'd5;
+       fine_rom[3994] = 8'd5;
+       fine_rom[3995] = 8'd6;
+       fine_rom[3996] = 8'd6;
+       fine_rom[3997] = 8'd7;
+       fine_rom[3998] = 8'd7;
+       fine_rom[3999] = 8'd8;
+       fine_rom[4000] = 8'd0;
+       fine_rom[4001] = 8'd0;
+       fine_rom[4002] = 8'd1;
+       fine_rom[4003] = 8'd1;
+       fine_rom[4004] = 8'd2;
+       fine_rom[4005] = 8'd2;
+       fine_rom[4006] = 8'd3;
+       fine_rom[4007] = 8'd3;
+       fine_rom[4008] = 8'd4;
+       fine_rom[4009] = 8'd4;
+       fine_rom[4010] = 8'd4;
+       fine_rom[4011] = 8'd5;
+       fine_rom[4012] = 8'd5;
+       fine_rom[4013] = 8'd6;
+       fine_rom[4014] = 8'd6;
+       fine_rom[4015] = 8'd6;
+       fine_rom[4016] = 8'd0;
+       fine_rom[4017] = 8'd0;
+       fine_rom[4018] = 8'd1;
+       fine_rom[4019] = 8'd1;
+       fine_rom[4020] = 8'd1;
+       fine_rom[4021] = 8'd2;
+       fine_rom[4022] = 8'd2;
+       fine_rom[4023] = 8'd2;
+       fine_rom[4024] = 8'd3;
+       fine_rom[4025] = 8'd3;
+       fine_rom[4026] = 8'd3;
+       fine_rom[4027] = 8'd4;
+       fine_rom[4028] = 8'd4;
+       fine_rom[4029] = 8'd4;
+       fine_rom[4030] = 8'd5;
+       fine_rom[4031] = 8'd5;
+       fine_rom[4032] = 8'd0;
+       fine_rom[4033] = 8'd1;
+       fine_rom[4034] = 8'd1;
+       fine_rom[4035] = 8'd1;
+       fine_rom[4036] = 8'd1;
+       fine_rom[4037] = 8'd2;
+       fine_rom[4038] = 8'd2;
+       fine_rom[4039] = 8'd2;
+       fine_rom[4040] = 8'd3;
+       fine_rom[4041] = 8'd3;
+       fine_rom[4042] = 8'd3;
+       fine_rom[4043] = 8'd3;
+       fine_rom[4044] = 8'd4;
+       fine_rom[4045] = 8'd4;
+       fine_rom[4046] = 8'd4;
+       fine_rom[4047] = 8'd4;
+       fine_rom[4048] = 8'd0;
+       fine_rom[4049] = 8'd0;
+       fine_rom[4050] = 8'd0;
+       fine_rom[4051] = 8'd0;
+       fine_rom[4052] = 8'd0;
+       fine_rom[4053] = 8'd1;
+       fine_rom[4054] = 8'd1;
+       fine_rom[4055] = 8'd1;
+       fine_rom[4056] = 8'd1;
+       fine_rom[4057] = 8'd1;
+       fine_rom[4058] = 8'd2;
+       fine_rom[4059] = 8'd2;
+       fine_rom[4060] = 8'd2;
+       fine_rom[4061] = 8'd2;
+       fine_rom[4062] = 8'd2;
+       fine_rom[4063] = 8'd2;
+       fine_rom[4064] = 8'd0;
+       fine_rom[4065] = 8'd0;
+       fine_rom[4066] = 8'd0;
+       fine_rom[4067] = 8'd0;
+       fine_rom[4068] = 8'd0;
+       fine_rom[4069] = 8'd0;
+       fine_rom[4070] = 8'd0;
+       fine_rom[4071] = 8'd1;
+       fine_rom[4072] = 8'd1;
+       fine_rom[4073] = 8'd1;
+       fine_rom[4074] = 8'd1;
+       fine_rom[4075] = 8'd1;
+       fine_rom[4076] = 8'd1;
+       fine_rom[4077] = 8'd1;
+       fine_rom[4078] = 8'd1;
+       fine_rom[4079] = 8'd1;
+       fine_rom[4080] = 8'd0;
+       fine_rom[4081] = 8'd0;
+       fine_rom[4082] = 8'd1;
+       fine_rom[4083] = 8'd1;
+       fine_rom[4084] = 8'd1;
+       fine_rom[4085] = 8'd1;
+       fine_rom[4086] = 8'd1;
+       fine_rom[4087] = 8'd1;
+       fine_rom[4088] = 8'd1;
+       fine_rom[4089] = 8'd1;
+       fine_rom[4090] = 8'd1;
+       fine_rom[4091] = 8'd1;
+       fine_rom[4092] = 8'd1;
+       fine_rom[4093] = 8'd1;
+       fine_rom[4094] = 8'd1;
+       fine_rom[4095] = 8'd1;
+       coarse_q = 0;
+       fine_q = 0;
     end
 
     always @(posedge clock) begin
-       value <= value_rom[addr];
-       slope <= slope_rom[addr];
+       coarse_q <= coarse_rom[addr[12:5]];
+       fine_q <= fine_rom[addr[12:1]];
     end
+
+    always @(*) value = coarse_q + $signed({8'd0, fine_q});
 endmodule // gyro_interface__modulation_nco__sine__rom
-
-
-module gyro_interface__modulation_nco__sine__signed_sample_4(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__modulation_nco__sine__signed_sample_4
-
-
-module gyro_interface__modulation_nco__sine__sin_out(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__modulation_nco__sine__sin_out
-
-
-module gyro_interface__modulation_nco__sine__slope_product(clock,a,b,p);
-
-    // Module arguments
-    input wire  clock;
-    input wire signed [15:0] a;
-    input wire signed [15:0] b;
-    output reg signed [31:0] p;
-
-    // Update code (custom)
-    initial p = 0;
-
-    always @(posedge clock) begin
-       p <= a * b;
-    end
-endmodule // gyro_interface__modulation_nco__sine__slope_product
-
-
-module gyro_interface__modulation_nco__sine__slope_read(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__modulation_nco__sine__slope_read
-
-
-module gyro_interface__modulation_nco__sine__value_read(d,q,clock);
-
-    // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface__modulation_nco__sine__value_read
 
 
 module gyro_interface__modulation_nco__turn(d,q,clock);

@@ -5,6 +5,7 @@
 //!  carrier_step ───────►│ CarrierNco ├──────────────►│          ├─────────────► to the DACs
 //!  ref_phase ──────────►│            ├──────────────►│ AmMixer  │ ref1, ref2
 //!                       └────────────┘ ref_cos/sin   │          ├──────┐
+//!     fill ▲▼  (carrier tables at power-up)          │          │      │
 //!  mod_step ──►┌───────────────┐ am1, am2            │          │      │
 //!  select ────►│ ModulationNco ├────────────────────►│          │      ▼
 //!              └───────────────┘       amp1, amp2 ──►└──────────┘ ┌────────────────────┐
@@ -18,21 +19,25 @@
 //!  iir_k0, iir_k1, iir_k2, iir_alpha ──────────►  IirLowpass (both channels) ──► z1, z2, z_valid
 //! ```
 //!
-//! Follow a sample in file order: `carrier_nco` (with `sincos`, `sine`,
-//! `sine_table`), `modulation_nco`, `am_mixer` (with `q15_multiplier`), the
+//! Follow a sample in file order: `carrier_nco` (with `carrier_table_fill`,
+//! `table_sine`, `quarter_wave`), `modulation_nco` (with `sine`,
+//! `sine_table`), `am_mixer` (with `q15_multiplier`), the
 //! DACs and the gyroscope (in the simulator), `reference_alignment`,
 //! `demod_mux`, `cic_integrators`, `cic_decimator`, `iir_lowpass`.
 //!
 //! Every input is sampled at the rising edge of `clock`; the run-time
 //! settings are meant to be driven from a register bank in the same clock
 //! domain. Every register has a power-up value (Verilog `initial`); there is
-//! no reset. `crate::settings::Settings` computes all the settings from
+//! no reset. The carriers' four table RAMs have no power-up contents (an
+//! iCE40 SPRAM cannot be initialized): they are filled during the first
+//! 8200 clocks (`crate::carrier_table_fill`), and the DAC words are 0 until
+//! cycle `FILL_CLOCKS` + 8 = 8232. `crate::settings::Settings` computes all the settings from
 //! frequencies in Hz; the port list with formats is in
 //! `verilog-out/PORTS.md`.
 //!
 //! Latencies (clocks): carrier phase to DAC word 8 (the sum of
 //! `carrier_nco::LATENCY` and `am_mixer::CARRIER_LATENCY`), ADC word to
-//! mixer output 2, mixer output to CIC output R + 13 at most
+//! mixer output 2, mixer output to CIC output R + 21 at most
 //! (`cic_decimator::SAMPLE_TO_OUTPUT`), CIC output to z 168
 //! (`crate::iir_lowpass::LATENCY`); `amp1`/`amp2` or the modulation factors to
 //! DAC word 7 or 8 (`am_mixer::AMPLITUDE_LATENCY`, the shared envelope
@@ -208,11 +213,8 @@ crate::impl_clocked!(GyroInterface);
 pub enum Mutation {
     /// The drive 1 rounding adds 2^13 instead of 2^14.
     DriveRounding,
-    /// The modulation sine's correction rounding adds 1.5 half-LSBs (it
-    /// also computes the carrier tables).
-    SineRounding,
-    /// The carrier table is sampled at each interval's start, not its centre.
-    TableCentre,
+    /// The carrier table's interpolation rounds with 1 instead of 2 quarter LSBs.
+    FillRounding,
     /// The readout amplitude is 32766 instead of 32767.
     ModulationFullScale,
 }
@@ -220,10 +222,9 @@ pub enum Mutation {
 #[cfg(test)]
 impl Mutation {
     /// Every mutation.
-    pub const ALL: [Mutation; 4] = [
+    pub const ALL: [Mutation; 3] = [
         Mutation::DriveRounding,
-        Mutation::SineRounding,
-        Mutation::TableCentre,
+        Mutation::FillRounding,
         Mutation::ModulationFullScale,
     ];
 }
@@ -234,8 +235,7 @@ impl GyroInterface {
     pub fn mutate(&mut self, mutation: Mutation) {
         match mutation {
             Mutation::DriveRounding => self.am_mixer.mutate_drive_rounding(),
-            Mutation::SineRounding => self.modulation_nco.mutate_sine_rounding(),
-            Mutation::TableCentre => self.carrier_nco.mutate_table_centre(),
+            Mutation::FillRounding => self.carrier_nco.mutate_fill_rounding(),
             Mutation::ModulationFullScale => self.modulation_nco.mutate_full_scale(),
         }
     }

@@ -17,6 +17,7 @@ pub mod model;
 pub mod modulation_nco;
 pub mod primitives;
 pub mod q15_multiplier;
+pub mod quarter_wave;
 pub mod reference_alignment;
 pub mod rtl;
 pub mod settings;

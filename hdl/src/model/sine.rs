@@ -1,22 +1,21 @@
 //! Bit-true model of `crate::sine::Sine`.
 //!
-//! `sine` is the arithmetic of the pipeline stages collapsed into one
-//! function; `Sine` delays it by the block's latency, starting
-//! from what the power-up registers give (`crate::sine`'s header): 0 during
-//! cycles 0..=3, then `power_up_word()`, table entry 0 read through the
-//! all-zero index register with a zero offset, during cycle 4.
+//! `sine` is the lookup the pipeline stages make, collapsed into one
+//! function; `Sine` delays it by the block's latency, starting from what
+//! the power-up registers give (`crate::quarter_wave`): 0 during cycles
+//! 0..=4.
 
-use crate::sine::LATENCY;
+use crate::quarter_wave::{LATENCY, PHASE_BELOW_INDEX, TABLE_ENTRIES};
 use crate::sine_table;
 use std::sync::OnceLock;
 
-/// The table columns interleaved as `[value, slope]`.
-pub type Table = [[i32; 2]; sine_table::ENTRIES];
+/// The ROM's words.
+pub type Table = [i16; sine_table::ENTRIES];
 
 /// The table, built once per process.
 pub fn table() -> &'static Table {
     static TABLE: OnceLock<Table> = OnceLock::new();
-    TABLE.get_or_init(|| std::array::from_fn(|i| [sine_table::value(i), sine_table::slope(i)]))
+    TABLE.get_or_init(|| std::array::from_fn(|i| sine_table::value(i) as i16))
 }
 
 /// `32767 sin` of a 32-bit phase plus `advance` quarter turns, as
@@ -29,22 +28,10 @@ pub fn sine(phase: u32, advance: u8) -> i16 {
 #[inline(always)]
 fn sine_with(table: &Table, phase: u32, advance: u8) -> i16 {
     let q = ((phase >> 30) + u32::from(advance)) & 3;
-    let i = ((phase >> 22) & 0xff) as usize;
-    let [sample, slope] = table[if q & 1 == 0 { i } else { 0xff - i }];
-    let offset = ((phase >> 7) & 0x7fff) as i32 - 0x4000;
-    let correction = (offset * slope + (1 << 21)) >> 22;
-    let first = if q & 1 == 0 {
-        sample + correction
-    } else {
-        sample - correction
-    };
-    (if q >= 2 { -first } else { first }) as i16
-}
-
-/// The output during cycle `LATENCY - 1` after power-up: the entry the
-/// all-zero index register reads, with a zero correction, quadrant 0.
-pub fn power_up_word() -> i16 {
-    sine_table::value(0) as i16
+    let i = (phase >> PHASE_BELOW_INDEX) as usize & (TABLE_ENTRIES - 1);
+    let index = if q & 1 == 0 { i } else { TABLE_ENTRIES - 1 - i };
+    let v = table[index >> 1];
+    if q >= 2 { -v } else { v }
 }
 
 /// Cycle-true model of one `crate::sine::Sine`.
@@ -58,12 +45,8 @@ pub struct Sine {
 
 impl Default for Sine {
     fn default() -> Self {
-        // Zero in every slot but the one that comes out during cycle
-        // LATENCY - 1.
-        let mut pipe = [0; LATENCY];
-        pipe[LATENCY - 1] = power_up_word();
         Self {
-            pipe,
+            pipe: [0; LATENCY],
             head: 0,
             table: table(),
         }
@@ -90,80 +73,45 @@ impl Sine {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// `(sin, cos)` of a 32-bit phase: the sine with no advance and with a
-    /// quarter turn (the modulation NCO's A2 and A1).
-    fn evaluate(phase: u32) -> (i16, i16) {
-        (sine(phase, 0), sine(phase, 1))
-    }
-
-    /// First-quadrant sine and cosine of the interval and offset encoded in
-    /// phase bits 29:7, before the quadrant mirror: the arithmetic of the
-    /// former dual-output generator, one table index for both.
-    fn first_quadrant(phase: u32) -> (i32, i32) {
-        let i = ((phase >> 22) & 0xff) as usize;
-        let [sin_sample, sin_slope] = table()[i];
-        let [cos_sample, cos_slope] = table()[0xff - i];
-        let offset = ((phase >> 7) & 0x7fff) as i32 - 0x4000;
-        let round = |p: i32| (p + (1 << 21)) >> 22;
-        (
-            sin_sample + round(offset * sin_slope),
-            cos_sample - round(offset * cos_slope),
-        )
-    }
+    use std::f64::consts::TAU;
 
     #[test]
-    fn first_quadrant_stays_within_the_peak_for_every_phase() {
-        // Exhaustive over the 2^23 interval/offset codes that matter (bits
-        // 29:7): the Taylor correction never pushes a first-quadrant value
-        // outside [0, 32767], so the quadrant mirror's negation is safe and
-        // -32768 never occurs.
-        for code in 0u32..(1 << 23) {
-            let (s, c) = first_quadrant(code << 7);
-            assert!((0..=sine_table::PEAK).contains(&s), "sin {s} at {code:#x}");
-            assert!((0..=sine_table::PEAK).contains(&c), "cos {c} at {code:#x}");
-        }
-    }
-
-    /// The former dual-output arithmetic: one table index for both, the
-    /// quadrant mirror swapping and negating the pair.
-    fn dual_output_reference(phase: u32) -> (i16, i16) {
-        let (s, c) = first_quadrant(phase);
-        let q = phase >> 30;
-        let (a, b) = if q & 1 == 0 { (s, c) } else { (c, s) };
-        let sin = if q >= 2 { -a } else { a };
-        let cos = if q == 1 || q == 2 { -b } else { b };
-        (sin as i16, cos as i16)
-    }
-
-    #[test]
-    fn two_sines_equal_the_dual_output_generator_for_every_phase() {
-        // Exhaustive over phase bits 31:7 (bits 6:0 are ignored): the
-        // quadrant-advanced sine reproduces the pair the earlier SinCos
-        // computed from one table index, word for word.
-        for code in 0u32..(1 << 25) {
-            let phase = code << 7;
-            assert_eq!(
-                evaluate(phase),
-                dual_output_reference(phase),
-                "phase {phase:#x}"
-            );
+    fn every_phase_gives_the_rounded_sine_of_its_interval_centre() {
+        // Exhaustive over the 2^14 intervals of a turn and the 4 advances:
+        // the quadrant mirror and negation reproduce, word for word, the
+        // rounded sine at the centre of the phase's interval (f64 rounds
+        // half away from zero, symmetric like the negated table).
+        for code in 0u32..(1 << 14) {
+            let phase = code << 18;
+            let centre = phase + (1 << 17);
+            for advance in 0u8..4 {
+                let angle = (centre as f64 / 2f64.powi(32) + f64::from(advance) / 4.0) * TAU;
+                let want = (32767.0 * angle.sin()).round() as i16;
+                assert_eq!(
+                    sine(phase, advance),
+                    want,
+                    "interval {code}, advance {advance}"
+                );
+                assert_eq!(
+                    sine(phase | 0x3ffff, advance),
+                    want,
+                    "end of interval {code}"
+                );
+            }
         }
     }
 
     #[test]
-    fn error_against_the_exact_sine_is_at_most_1_2_lsb() {
-        // Table rounding (0.5), correction rounding (0.5), the neglected
-        // second-order term (D^2/8 * 32767 = 0.15 LSB) and the 7 ignored
-        // phase bits (2 pi 2^-25 * 32767 = 0.006 LSB) add to at most 1.16.
+    fn error_against_the_exact_sine_is_at_most_6_8_lsb() {
+        // Half an interval of phase, 32767 pi / 2^14 = 6.28 LSB, plus the
+        // table's rounding, 0.5.
         let mut worst = 0.0f64;
         for k in 0u32..(1 << 20) {
             let phase = k.wrapping_mul(0x9e37_79b9);
-            let (s, c) = evaluate(phase);
-            let angle = phase as f64 / 2f64.powi(32) * std::f64::consts::TAU;
-            worst = worst.max((s as f64 - 32767.0 * angle.sin()).abs());
-            worst = worst.max((c as f64 - 32767.0 * angle.cos()).abs());
+            let angle = phase as f64 / 2f64.powi(32) * TAU;
+            worst = worst.max((sine(phase, 0) as f64 - 32767.0 * angle.sin()).abs());
+            worst = worst.max((sine(phase, 1) as f64 - 32767.0 * angle.cos()).abs());
         }
-        assert!(worst <= 1.16, "worst error {worst} LSB");
+        assert!(worst <= 6.79, "worst error {worst} LSB");
     }
 }

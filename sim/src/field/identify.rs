@@ -217,7 +217,7 @@ pub fn phase_word(deg: f64) -> u32 {
 /// Fundamental amplitude (LSB) of a readout drive word for a Q1.15
 /// amplitude `amp`: the envelope amp x PEAK / 2^15 rounded as the AM
 /// mixer rounds it, times the carrier table's amplitude PEAK / 2^15 (the
-/// table's own gain, 1 + 7e-7, is below anything this module resolves).
+/// table's own gain, 1 - 1.3e-7, is below anything this module resolves).
 pub fn readout_word(amp: i16) -> f64 {
     signed_readout_word(amp).abs()
 }
