@@ -5248,140 +5248,629 @@ module gyro_interface_axi__core__cic__integrators1(clock,x,integral);
     input wire signed [31:0] x;
     output reg signed [79:0] integral;
 
+    // Constant declarations
+    localparam  half_shift = 8'h28;
+
     // Stub signals
-    reg signed [79:0] integrator1$d;
-    wire signed [79:0] integrator1$q;
-    reg  integrator1$clock;
-    reg signed [79:0] integrator2$d;
-    wire signed [79:0] integrator2$q;
-    reg  integrator2$clock;
-    reg signed [79:0] integrator3$d;
-    wire signed [79:0] integrator3$q;
-    reg  integrator3$clock;
-    reg signed [79:0] integrator4$d;
-    wire signed [79:0] integrator4$q;
-    reg  integrator4$clock;
+    reg  [39:0] x_high$d;
+    wire  [39:0] x_high$q;
+    reg  x_high$clock;
+    reg  stage1$clock;
+    reg  [39:0] stage1$in_low;
+    reg  [39:0] stage1$in_high;
+    wire  [39:0] stage1$low;
+    wire  [39:0] stage1$high;
+    reg  stage2$clock;
+    reg  [39:0] stage2$in_low;
+    reg  [39:0] stage2$in_high;
+    wire  [39:0] stage2$low;
+    wire  [39:0] stage2$high;
+    reg  stage3$clock;
+    reg  [39:0] stage3$in_low;
+    reg  [39:0] stage3$in_high;
+    wire  [39:0] stage3$low;
+    wire  [39:0] stage3$high;
+    reg  stage4$clock;
+    reg  [39:0] stage4$in_low;
+    reg  [39:0] stage4$in_high;
+    wire  [39:0] stage4$low;
+    wire  [39:0] stage4$high;
+    reg  [39:0] low4$d;
+    wire  [39:0] low4$q;
+    reg  low4$clock;
 
     // Local signals
     reg signed [79:0] x_wide;
+    reg  [79:0] x_bits;
 
     // Sub module instances
-    gyro_interface_axi__core__cic__integrators1__integrator1 integrator1(
-        .d(integrator1$d),
-        .q(integrator1$q),
-        .clock(integrator1$clock)
+    gyro_interface_axi__core__cic__integrators1__x_high x_high(
+        .d(x_high$d),
+        .q(x_high$q),
+        .clock(x_high$clock)
     );
-    gyro_interface_axi__core__cic__integrators1__integrator2 integrator2(
-        .d(integrator2$d),
-        .q(integrator2$q),
-        .clock(integrator2$clock)
+    gyro_interface_axi__core__cic__integrators1__stage1 stage1(
+        .clock(stage1$clock),
+        .in_low(stage1$in_low),
+        .in_high(stage1$in_high),
+        .low(stage1$low),
+        .high(stage1$high)
     );
-    gyro_interface_axi__core__cic__integrators1__integrator3 integrator3(
-        .d(integrator3$d),
-        .q(integrator3$q),
-        .clock(integrator3$clock)
+    gyro_interface_axi__core__cic__integrators1__stage2 stage2(
+        .clock(stage2$clock),
+        .in_low(stage2$in_low),
+        .in_high(stage2$in_high),
+        .low(stage2$low),
+        .high(stage2$high)
     );
-    gyro_interface_axi__core__cic__integrators1__integrator4 integrator4(
-        .d(integrator4$d),
-        .q(integrator4$q),
-        .clock(integrator4$clock)
+    gyro_interface_axi__core__cic__integrators1__stage3 stage3(
+        .clock(stage3$clock),
+        .in_low(stage3$in_low),
+        .in_high(stage3$in_high),
+        .low(stage3$low),
+        .high(stage3$high)
+    );
+    gyro_interface_axi__core__cic__integrators1__stage4 stage4(
+        .clock(stage4$clock),
+        .in_low(stage4$in_low),
+        .in_high(stage4$in_high),
+        .low(stage4$low),
+        .high(stage4$high)
+    );
+    gyro_interface_axi__core__cic__integrators1__low4 low4(
+        .d(low4$d),
+        .q(low4$q),
+        .clock(low4$clock)
     );
 
     // Update code
     always @(*) begin
-        integrator1$clock = clock;
-        integrator2$clock = clock;
-        integrator3$clock = clock;
-        integrator4$clock = clock;
-        integrator1$d = integrator1$q;
-        integrator2$d = integrator2$q;
-        integrator3$d = integrator3$q;
-        integrator4$d = integrator4$q;
+        x_high$clock = clock;
+        low4$clock = clock;
+        x_high$d = x_high$q;
+        low4$d = low4$q;
+        stage1$clock = clock;
+        stage2$clock = clock;
+        stage3$clock = clock;
+        stage4$clock = clock;
         x_wide = $signed(x);
-        integrator1$d = integrator1$q + x_wide;
-        integrator2$d = integrator2$q + integrator1$q;
-        integrator3$d = integrator3$q + integrator2$q;
-        integrator4$d = integrator4$q + integrator3$q;
-        integral = integrator4$q;
+        x_bits = $unsigned(x_wide);
+        x_high$d = x_bits[(32'h28)+:(40)];
+        stage1$in_low = x_bits[(32'h0)+:(40)];
+        stage1$in_high = x_high$q;
+        stage2$in_low = stage1$low;
+        stage2$in_high = stage1$high;
+        stage3$in_low = stage2$low;
+        stage3$in_high = stage2$high;
+        stage4$in_low = stage3$low;
+        stage4$in_high = stage3$high;
+        low4$d = stage4$low;
+        integral = $signed((((stage4$high) & 80'hffffffffffffffffffff) << half_shift) | ((low4$q) & 80'hffffffffffffffffffff));
     end
 
 endmodule // gyro_interface_axi__core__cic__integrators1
 
 
-module gyro_interface_axi__core__cic__integrators1__integrator1(d,q,clock);
+module gyro_interface_axi__core__cic__integrators1__low4(d,q,clock);
 
     // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
+    input wire  [39:0] d;
+    output reg  [39:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 80'h0;
+       q = 40'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__cic__integrators1__integrator1
+endmodule // gyro_interface_axi__core__cic__integrators1__low4
 
 
-module gyro_interface_axi__core__cic__integrators1__integrator2(d,q,clock);
+module gyro_interface_axi__core__cic__integrators1__stage1(clock,in_low,in_high,low,high);
 
     // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
+    input wire  clock;
+    input wire  [39:0] in_low;
+    input wire  [39:0] in_high;
+    output reg  [39:0] low;
+    output reg  [39:0] high;
+
+    // Constant declarations
+    localparam  one = 41'h1;
+
+    // Stub signals
+    reg  [39:0] low_sum$d;
+    wire  [39:0] low_sum$q;
+    reg  low_sum$clock;
+    reg  carry$d;
+    wire  carry$q;
+    reg  carry$clock;
+    reg  [39:0] high_sum$d;
+    wire  [39:0] high_sum$q;
+    reg  high_sum$clock;
+
+    // Local signals
+    reg  [40:0] low_total;
+    reg  [40:0] high_total;
+
+    // Sub module instances
+    gyro_interface_axi__core__cic__integrators1__stage1__low_sum low_sum(
+        .d(low_sum$d),
+        .q(low_sum$q),
+        .clock(low_sum$clock)
+    );
+    gyro_interface_axi__core__cic__integrators1__stage1__carry carry(
+        .d(carry$d),
+        .q(carry$q),
+        .clock(carry$clock)
+    );
+    gyro_interface_axi__core__cic__integrators1__stage1__high_sum high_sum(
+        .d(high_sum$d),
+        .q(high_sum$q),
+        .clock(high_sum$clock)
+    );
+
+    // Update code
+    always @(*) begin
+        low_sum$clock = clock;
+        carry$clock = clock;
+        high_sum$clock = clock;
+        low_sum$d = low_sum$q;
+        carry$d = carry$q;
+        high_sum$d = high_sum$q;
+        low_total = ((low_sum$q) & 41'h1ffffffffff) + ((in_low) & 41'h1ffffffffff);
+        low_sum$d = low_total[(32'h0)+:(40)];
+        carry$d = low_total[(32'h28)+:(1)];
+        high_total = ((((high_sum$q) & 41'h1ffffffffff) << 32'h1) | one) + ((((in_high) & 41'h1ffffffffff) << 32'h1) | ((carry$q) & 41'h1ffffffffff));
+        high_sum$d = high_total[(32'h1)+:(40)];
+        low = low_sum$q;
+        high = high_sum$q;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators1__stage1
+
+
+module gyro_interface_axi__core__cic__integrators1__stage1__carry(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 80'h0;
+       q = 1'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__cic__integrators1__integrator2
+endmodule // gyro_interface_axi__core__cic__integrators1__stage1__carry
 
 
-module gyro_interface_axi__core__cic__integrators1__integrator3(d,q,clock);
+module gyro_interface_axi__core__cic__integrators1__stage1__high_sum(d,q,clock);
 
     // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
+    input wire  [39:0] d;
+    output reg  [39:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 80'h0;
+       q = 40'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__cic__integrators1__integrator3
+endmodule // gyro_interface_axi__core__cic__integrators1__stage1__high_sum
 
 
-module gyro_interface_axi__core__cic__integrators1__integrator4(d,q,clock);
+module gyro_interface_axi__core__cic__integrators1__stage1__low_sum(d,q,clock);
 
     // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
+    input wire  [39:0] d;
+    output reg  [39:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 80'h0;
+       q = 40'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__cic__integrators1__integrator4
+endmodule // gyro_interface_axi__core__cic__integrators1__stage1__low_sum
+
+
+module gyro_interface_axi__core__cic__integrators1__stage2(clock,in_low,in_high,low,high);
+
+    // Module arguments
+    input wire  clock;
+    input wire  [39:0] in_low;
+    input wire  [39:0] in_high;
+    output reg  [39:0] low;
+    output reg  [39:0] high;
+
+    // Constant declarations
+    localparam  one = 41'h1;
+
+    // Stub signals
+    reg  [39:0] low_sum$d;
+    wire  [39:0] low_sum$q;
+    reg  low_sum$clock;
+    reg  carry$d;
+    wire  carry$q;
+    reg  carry$clock;
+    reg  [39:0] high_sum$d;
+    wire  [39:0] high_sum$q;
+    reg  high_sum$clock;
+
+    // Local signals
+    reg  [40:0] low_total;
+    reg  [40:0] high_total;
+
+    // Sub module instances
+    gyro_interface_axi__core__cic__integrators1__stage2__low_sum low_sum(
+        .d(low_sum$d),
+        .q(low_sum$q),
+        .clock(low_sum$clock)
+    );
+    gyro_interface_axi__core__cic__integrators1__stage2__carry carry(
+        .d(carry$d),
+        .q(carry$q),
+        .clock(carry$clock)
+    );
+    gyro_interface_axi__core__cic__integrators1__stage2__high_sum high_sum(
+        .d(high_sum$d),
+        .q(high_sum$q),
+        .clock(high_sum$clock)
+    );
+
+    // Update code
+    always @(*) begin
+        low_sum$clock = clock;
+        carry$clock = clock;
+        high_sum$clock = clock;
+        low_sum$d = low_sum$q;
+        carry$d = carry$q;
+        high_sum$d = high_sum$q;
+        low_total = ((low_sum$q) & 41'h1ffffffffff) + ((in_low) & 41'h1ffffffffff);
+        low_sum$d = low_total[(32'h0)+:(40)];
+        carry$d = low_total[(32'h28)+:(1)];
+        high_total = ((((high_sum$q) & 41'h1ffffffffff) << 32'h1) | one) + ((((in_high) & 41'h1ffffffffff) << 32'h1) | ((carry$q) & 41'h1ffffffffff));
+        high_sum$d = high_total[(32'h1)+:(40)];
+        low = low_sum$q;
+        high = high_sum$q;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators1__stage2
+
+
+module gyro_interface_axi__core__cic__integrators1__stage2__carry(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators1__stage2__carry
+
+
+module gyro_interface_axi__core__cic__integrators1__stage2__high_sum(d,q,clock);
+
+    // Module arguments
+    input wire  [39:0] d;
+    output reg  [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators1__stage2__high_sum
+
+
+module gyro_interface_axi__core__cic__integrators1__stage2__low_sum(d,q,clock);
+
+    // Module arguments
+    input wire  [39:0] d;
+    output reg  [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators1__stage2__low_sum
+
+
+module gyro_interface_axi__core__cic__integrators1__stage3(clock,in_low,in_high,low,high);
+
+    // Module arguments
+    input wire  clock;
+    input wire  [39:0] in_low;
+    input wire  [39:0] in_high;
+    output reg  [39:0] low;
+    output reg  [39:0] high;
+
+    // Constant declarations
+    localparam  one = 41'h1;
+
+    // Stub signals
+    reg  [39:0] low_sum$d;
+    wire  [39:0] low_sum$q;
+    reg  low_sum$clock;
+    reg  carry$d;
+    wire  carry$q;
+    reg  carry$clock;
+    reg  [39:0] high_sum$d;
+    wire  [39:0] high_sum$q;
+    reg  high_sum$clock;
+
+    // Local signals
+    reg  [40:0] low_total;
+    reg  [40:0] high_total;
+
+    // Sub module instances
+    gyro_interface_axi__core__cic__integrators1__stage3__low_sum low_sum(
+        .d(low_sum$d),
+        .q(low_sum$q),
+        .clock(low_sum$clock)
+    );
+    gyro_interface_axi__core__cic__integrators1__stage3__carry carry(
+        .d(carry$d),
+        .q(carry$q),
+        .clock(carry$clock)
+    );
+    gyro_interface_axi__core__cic__integrators1__stage3__high_sum high_sum(
+        .d(high_sum$d),
+        .q(high_sum$q),
+        .clock(high_sum$clock)
+    );
+
+    // Update code
+    always @(*) begin
+        low_sum$clock = clock;
+        carry$clock = clock;
+        high_sum$clock = clock;
+        low_sum$d = low_sum$q;
+        carry$d = carry$q;
+        high_sum$d = high_sum$q;
+        low_total = ((low_sum$q) & 41'h1ffffffffff) + ((in_low) & 41'h1ffffffffff);
+        low_sum$d = low_total[(32'h0)+:(40)];
+        carry$d = low_total[(32'h28)+:(1)];
+        high_total = ((((high_sum$q) & 41'h1ffffffffff) << 32'h1) | one) + ((((in_high) & 41'h1ffffffffff) << 32'h1) | ((carry$q) & 41'h1ffffffffff));
+        high_sum$d = high_total[(32'h1)+:(40)];
+        low = low_sum$q;
+        high = high_sum$q;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators1__stage3
+
+
+module gyro_interface_axi__core__cic__integrators1__stage3__carry(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators1__stage3__carry
+
+
+module gyro_interface_axi__core__cic__integrators1__stage3__high_sum(d,q,clock);
+
+    // Module arguments
+    input wire  [39:0] d;
+    output reg  [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators1__stage3__high_sum
+
+
+module gyro_interface_axi__core__cic__integrators1__stage3__low_sum(d,q,clock);
+
+    // Module arguments
+    input wire  [39:0] d;
+    output reg  [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators1__stage3__low_sum
+
+
+module gyro_interface_axi__core__cic__integrators1__stage4(clock,in_low,in_high,low,high);
+
+    // Module arguments
+    input wire  clock;
+    input wire  [39:0] in_low;
+    input wire  [39:0] in_high;
+    output reg  [39:0] low;
+    output reg  [39:0] high;
+
+    // Constant declarations
+    localparam  one = 41'h1;
+
+    // Stub signals
+    reg  [39:0] low_sum$d;
+    wire  [39:0] low_sum$q;
+    reg  low_sum$clock;
+    reg  carry$d;
+    wire  carry$q;
+    reg  carry$clock;
+    reg  [39:0] high_sum$d;
+    wire  [39:0] high_sum$q;
+    reg  high_sum$clock;
+
+    // Local signals
+    reg  [40:0] low_total;
+    reg  [40:0] high_total;
+
+    // Sub module instances
+    gyro_interface_axi__core__cic__integrators1__stage4__low_sum low_sum(
+        .d(low_sum$d),
+        .q(low_sum$q),
+        .clock(low_sum$clock)
+    );
+    gyro_interface_axi__core__cic__integrators1__stage4__carry carry(
+        .d(carry$d),
+        .q(carry$q),
+        .clock(carry$clock)
+    );
+    gyro_interface_axi__core__cic__integrators1__stage4__high_sum high_sum(
+        .d(high_sum$d),
+        .q(high_sum$q),
+        .clock(high_sum$clock)
+    );
+
+    // Update code
+    always @(*) begin
+        low_sum$clock = clock;
+        carry$clock = clock;
+        high_sum$clock = clock;
+        low_sum$d = low_sum$q;
+        carry$d = carry$q;
+        high_sum$d = high_sum$q;
+        low_total = ((low_sum$q) & 41'h1ffffffffff) + ((in_low) & 41'h1ffffffffff);
+        low_sum$d = low_total[(32'h0)+:(40)];
+        carry$d = low_total[(32'h28)+:(1)];
+        high_total = ((((high_sum$q) & 41'h1ffffffffff) << 32'h1) | one) + ((((in_high) & 41'h1ffffffffff) << 32'h1) | ((carry$q) & 41'h1ffffffffff));
+        high_sum$d = high_total[(32'h1)+:(40)];
+        low = low_sum$q;
+        high = high_sum$q;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators1__stage4
+
+
+module gyro_interface_axi__core__cic__integrators1__stage4__carry(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators1__stage4__carry
+
+
+module gyro_interface_axi__core__cic__integrators1__stage4__high_sum(d,q,clock);
+
+    // Module arguments
+    input wire  [39:0] d;
+    output reg  [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators1__stage4__high_sum
+
+
+module gyro_interface_axi__core__cic__integrators1__stage4__low_sum(d,q,clock);
+
+    // Module arguments
+    input wire  [39:0] d;
+    output reg  [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators1__stage4__low_sum
+
+
+module gyro_interface_axi__core__cic__integrators1__x_high(d,q,clock);
+
+    // Module arguments
+    input wire  [39:0] d;
+    output reg  [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators1__x_high
 
 
 module gyro_interface_axi__core__cic__integrators2(clock,x,integral);
@@ -5391,140 +5880,629 @@ module gyro_interface_axi__core__cic__integrators2(clock,x,integral);
     input wire signed [31:0] x;
     output reg signed [79:0] integral;
 
+    // Constant declarations
+    localparam  half_shift = 8'h28;
+
     // Stub signals
-    reg signed [79:0] integrator1$d;
-    wire signed [79:0] integrator1$q;
-    reg  integrator1$clock;
-    reg signed [79:0] integrator2$d;
-    wire signed [79:0] integrator2$q;
-    reg  integrator2$clock;
-    reg signed [79:0] integrator3$d;
-    wire signed [79:0] integrator3$q;
-    reg  integrator3$clock;
-    reg signed [79:0] integrator4$d;
-    wire signed [79:0] integrator4$q;
-    reg  integrator4$clock;
+    reg  [39:0] x_high$d;
+    wire  [39:0] x_high$q;
+    reg  x_high$clock;
+    reg  stage1$clock;
+    reg  [39:0] stage1$in_low;
+    reg  [39:0] stage1$in_high;
+    wire  [39:0] stage1$low;
+    wire  [39:0] stage1$high;
+    reg  stage2$clock;
+    reg  [39:0] stage2$in_low;
+    reg  [39:0] stage2$in_high;
+    wire  [39:0] stage2$low;
+    wire  [39:0] stage2$high;
+    reg  stage3$clock;
+    reg  [39:0] stage3$in_low;
+    reg  [39:0] stage3$in_high;
+    wire  [39:0] stage3$low;
+    wire  [39:0] stage3$high;
+    reg  stage4$clock;
+    reg  [39:0] stage4$in_low;
+    reg  [39:0] stage4$in_high;
+    wire  [39:0] stage4$low;
+    wire  [39:0] stage4$high;
+    reg  [39:0] low4$d;
+    wire  [39:0] low4$q;
+    reg  low4$clock;
 
     // Local signals
     reg signed [79:0] x_wide;
+    reg  [79:0] x_bits;
 
     // Sub module instances
-    gyro_interface_axi__core__cic__integrators2__integrator1 integrator1(
-        .d(integrator1$d),
-        .q(integrator1$q),
-        .clock(integrator1$clock)
+    gyro_interface_axi__core__cic__integrators2__x_high x_high(
+        .d(x_high$d),
+        .q(x_high$q),
+        .clock(x_high$clock)
     );
-    gyro_interface_axi__core__cic__integrators2__integrator2 integrator2(
-        .d(integrator2$d),
-        .q(integrator2$q),
-        .clock(integrator2$clock)
+    gyro_interface_axi__core__cic__integrators2__stage1 stage1(
+        .clock(stage1$clock),
+        .in_low(stage1$in_low),
+        .in_high(stage1$in_high),
+        .low(stage1$low),
+        .high(stage1$high)
     );
-    gyro_interface_axi__core__cic__integrators2__integrator3 integrator3(
-        .d(integrator3$d),
-        .q(integrator3$q),
-        .clock(integrator3$clock)
+    gyro_interface_axi__core__cic__integrators2__stage2 stage2(
+        .clock(stage2$clock),
+        .in_low(stage2$in_low),
+        .in_high(stage2$in_high),
+        .low(stage2$low),
+        .high(stage2$high)
     );
-    gyro_interface_axi__core__cic__integrators2__integrator4 integrator4(
-        .d(integrator4$d),
-        .q(integrator4$q),
-        .clock(integrator4$clock)
+    gyro_interface_axi__core__cic__integrators2__stage3 stage3(
+        .clock(stage3$clock),
+        .in_low(stage3$in_low),
+        .in_high(stage3$in_high),
+        .low(stage3$low),
+        .high(stage3$high)
+    );
+    gyro_interface_axi__core__cic__integrators2__stage4 stage4(
+        .clock(stage4$clock),
+        .in_low(stage4$in_low),
+        .in_high(stage4$in_high),
+        .low(stage4$low),
+        .high(stage4$high)
+    );
+    gyro_interface_axi__core__cic__integrators2__low4 low4(
+        .d(low4$d),
+        .q(low4$q),
+        .clock(low4$clock)
     );
 
     // Update code
     always @(*) begin
-        integrator1$clock = clock;
-        integrator2$clock = clock;
-        integrator3$clock = clock;
-        integrator4$clock = clock;
-        integrator1$d = integrator1$q;
-        integrator2$d = integrator2$q;
-        integrator3$d = integrator3$q;
-        integrator4$d = integrator4$q;
+        x_high$clock = clock;
+        low4$clock = clock;
+        x_high$d = x_high$q;
+        low4$d = low4$q;
+        stage1$clock = clock;
+        stage2$clock = clock;
+        stage3$clock = clock;
+        stage4$clock = clock;
         x_wide = $signed(x);
-        integrator1$d = integrator1$q + x_wide;
-        integrator2$d = integrator2$q + integrator1$q;
-        integrator3$d = integrator3$q + integrator2$q;
-        integrator4$d = integrator4$q + integrator3$q;
-        integral = integrator4$q;
+        x_bits = $unsigned(x_wide);
+        x_high$d = x_bits[(32'h28)+:(40)];
+        stage1$in_low = x_bits[(32'h0)+:(40)];
+        stage1$in_high = x_high$q;
+        stage2$in_low = stage1$low;
+        stage2$in_high = stage1$high;
+        stage3$in_low = stage2$low;
+        stage3$in_high = stage2$high;
+        stage4$in_low = stage3$low;
+        stage4$in_high = stage3$high;
+        low4$d = stage4$low;
+        integral = $signed((((stage4$high) & 80'hffffffffffffffffffff) << half_shift) | ((low4$q) & 80'hffffffffffffffffffff));
     end
 
 endmodule // gyro_interface_axi__core__cic__integrators2
 
 
-module gyro_interface_axi__core__cic__integrators2__integrator1(d,q,clock);
+module gyro_interface_axi__core__cic__integrators2__low4(d,q,clock);
 
     // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
+    input wire  [39:0] d;
+    output reg  [39:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 80'h0;
+       q = 40'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__cic__integrators2__integrator1
+endmodule // gyro_interface_axi__core__cic__integrators2__low4
 
 
-module gyro_interface_axi__core__cic__integrators2__integrator2(d,q,clock);
+module gyro_interface_axi__core__cic__integrators2__stage1(clock,in_low,in_high,low,high);
 
     // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
+    input wire  clock;
+    input wire  [39:0] in_low;
+    input wire  [39:0] in_high;
+    output reg  [39:0] low;
+    output reg  [39:0] high;
+
+    // Constant declarations
+    localparam  one = 41'h1;
+
+    // Stub signals
+    reg  [39:0] low_sum$d;
+    wire  [39:0] low_sum$q;
+    reg  low_sum$clock;
+    reg  carry$d;
+    wire  carry$q;
+    reg  carry$clock;
+    reg  [39:0] high_sum$d;
+    wire  [39:0] high_sum$q;
+    reg  high_sum$clock;
+
+    // Local signals
+    reg  [40:0] low_total;
+    reg  [40:0] high_total;
+
+    // Sub module instances
+    gyro_interface_axi__core__cic__integrators2__stage1__low_sum low_sum(
+        .d(low_sum$d),
+        .q(low_sum$q),
+        .clock(low_sum$clock)
+    );
+    gyro_interface_axi__core__cic__integrators2__stage1__carry carry(
+        .d(carry$d),
+        .q(carry$q),
+        .clock(carry$clock)
+    );
+    gyro_interface_axi__core__cic__integrators2__stage1__high_sum high_sum(
+        .d(high_sum$d),
+        .q(high_sum$q),
+        .clock(high_sum$clock)
+    );
+
+    // Update code
+    always @(*) begin
+        low_sum$clock = clock;
+        carry$clock = clock;
+        high_sum$clock = clock;
+        low_sum$d = low_sum$q;
+        carry$d = carry$q;
+        high_sum$d = high_sum$q;
+        low_total = ((low_sum$q) & 41'h1ffffffffff) + ((in_low) & 41'h1ffffffffff);
+        low_sum$d = low_total[(32'h0)+:(40)];
+        carry$d = low_total[(32'h28)+:(1)];
+        high_total = ((((high_sum$q) & 41'h1ffffffffff) << 32'h1) | one) + ((((in_high) & 41'h1ffffffffff) << 32'h1) | ((carry$q) & 41'h1ffffffffff));
+        high_sum$d = high_total[(32'h1)+:(40)];
+        low = low_sum$q;
+        high = high_sum$q;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators2__stage1
+
+
+module gyro_interface_axi__core__cic__integrators2__stage1__carry(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 80'h0;
+       q = 1'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__cic__integrators2__integrator2
+endmodule // gyro_interface_axi__core__cic__integrators2__stage1__carry
 
 
-module gyro_interface_axi__core__cic__integrators2__integrator3(d,q,clock);
+module gyro_interface_axi__core__cic__integrators2__stage1__high_sum(d,q,clock);
 
     // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
+    input wire  [39:0] d;
+    output reg  [39:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 80'h0;
+       q = 40'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__cic__integrators2__integrator3
+endmodule // gyro_interface_axi__core__cic__integrators2__stage1__high_sum
 
 
-module gyro_interface_axi__core__cic__integrators2__integrator4(d,q,clock);
+module gyro_interface_axi__core__cic__integrators2__stage1__low_sum(d,q,clock);
 
     // Module arguments
-    input wire signed [79:0] d;
-    output reg signed [79:0] q;
+    input wire  [39:0] d;
+    output reg  [39:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 80'h0;
+       q = 40'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__cic__integrators2__integrator4
+endmodule // gyro_interface_axi__core__cic__integrators2__stage1__low_sum
+
+
+module gyro_interface_axi__core__cic__integrators2__stage2(clock,in_low,in_high,low,high);
+
+    // Module arguments
+    input wire  clock;
+    input wire  [39:0] in_low;
+    input wire  [39:0] in_high;
+    output reg  [39:0] low;
+    output reg  [39:0] high;
+
+    // Constant declarations
+    localparam  one = 41'h1;
+
+    // Stub signals
+    reg  [39:0] low_sum$d;
+    wire  [39:0] low_sum$q;
+    reg  low_sum$clock;
+    reg  carry$d;
+    wire  carry$q;
+    reg  carry$clock;
+    reg  [39:0] high_sum$d;
+    wire  [39:0] high_sum$q;
+    reg  high_sum$clock;
+
+    // Local signals
+    reg  [40:0] low_total;
+    reg  [40:0] high_total;
+
+    // Sub module instances
+    gyro_interface_axi__core__cic__integrators2__stage2__low_sum low_sum(
+        .d(low_sum$d),
+        .q(low_sum$q),
+        .clock(low_sum$clock)
+    );
+    gyro_interface_axi__core__cic__integrators2__stage2__carry carry(
+        .d(carry$d),
+        .q(carry$q),
+        .clock(carry$clock)
+    );
+    gyro_interface_axi__core__cic__integrators2__stage2__high_sum high_sum(
+        .d(high_sum$d),
+        .q(high_sum$q),
+        .clock(high_sum$clock)
+    );
+
+    // Update code
+    always @(*) begin
+        low_sum$clock = clock;
+        carry$clock = clock;
+        high_sum$clock = clock;
+        low_sum$d = low_sum$q;
+        carry$d = carry$q;
+        high_sum$d = high_sum$q;
+        low_total = ((low_sum$q) & 41'h1ffffffffff) + ((in_low) & 41'h1ffffffffff);
+        low_sum$d = low_total[(32'h0)+:(40)];
+        carry$d = low_total[(32'h28)+:(1)];
+        high_total = ((((high_sum$q) & 41'h1ffffffffff) << 32'h1) | one) + ((((in_high) & 41'h1ffffffffff) << 32'h1) | ((carry$q) & 41'h1ffffffffff));
+        high_sum$d = high_total[(32'h1)+:(40)];
+        low = low_sum$q;
+        high = high_sum$q;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators2__stage2
+
+
+module gyro_interface_axi__core__cic__integrators2__stage2__carry(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators2__stage2__carry
+
+
+module gyro_interface_axi__core__cic__integrators2__stage2__high_sum(d,q,clock);
+
+    // Module arguments
+    input wire  [39:0] d;
+    output reg  [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators2__stage2__high_sum
+
+
+module gyro_interface_axi__core__cic__integrators2__stage2__low_sum(d,q,clock);
+
+    // Module arguments
+    input wire  [39:0] d;
+    output reg  [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators2__stage2__low_sum
+
+
+module gyro_interface_axi__core__cic__integrators2__stage3(clock,in_low,in_high,low,high);
+
+    // Module arguments
+    input wire  clock;
+    input wire  [39:0] in_low;
+    input wire  [39:0] in_high;
+    output reg  [39:0] low;
+    output reg  [39:0] high;
+
+    // Constant declarations
+    localparam  one = 41'h1;
+
+    // Stub signals
+    reg  [39:0] low_sum$d;
+    wire  [39:0] low_sum$q;
+    reg  low_sum$clock;
+    reg  carry$d;
+    wire  carry$q;
+    reg  carry$clock;
+    reg  [39:0] high_sum$d;
+    wire  [39:0] high_sum$q;
+    reg  high_sum$clock;
+
+    // Local signals
+    reg  [40:0] low_total;
+    reg  [40:0] high_total;
+
+    // Sub module instances
+    gyro_interface_axi__core__cic__integrators2__stage3__low_sum low_sum(
+        .d(low_sum$d),
+        .q(low_sum$q),
+        .clock(low_sum$clock)
+    );
+    gyro_interface_axi__core__cic__integrators2__stage3__carry carry(
+        .d(carry$d),
+        .q(carry$q),
+        .clock(carry$clock)
+    );
+    gyro_interface_axi__core__cic__integrators2__stage3__high_sum high_sum(
+        .d(high_sum$d),
+        .q(high_sum$q),
+        .clock(high_sum$clock)
+    );
+
+    // Update code
+    always @(*) begin
+        low_sum$clock = clock;
+        carry$clock = clock;
+        high_sum$clock = clock;
+        low_sum$d = low_sum$q;
+        carry$d = carry$q;
+        high_sum$d = high_sum$q;
+        low_total = ((low_sum$q) & 41'h1ffffffffff) + ((in_low) & 41'h1ffffffffff);
+        low_sum$d = low_total[(32'h0)+:(40)];
+        carry$d = low_total[(32'h28)+:(1)];
+        high_total = ((((high_sum$q) & 41'h1ffffffffff) << 32'h1) | one) + ((((in_high) & 41'h1ffffffffff) << 32'h1) | ((carry$q) & 41'h1ffffffffff));
+        high_sum$d = high_total[(32'h1)+:(40)];
+        low = low_sum$q;
+        high = high_sum$q;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators2__stage3
+
+
+module gyro_interface_axi__core__cic__integrators2__stage3__carry(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators2__stage3__carry
+
+
+module gyro_interface_axi__core__cic__integrators2__stage3__high_sum(d,q,clock);
+
+    // Module arguments
+    input wire  [39:0] d;
+    output reg  [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators2__stage3__high_sum
+
+
+module gyro_interface_axi__core__cic__integrators2__stage3__low_sum(d,q,clock);
+
+    // Module arguments
+    input wire  [39:0] d;
+    output reg  [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators2__stage3__low_sum
+
+
+module gyro_interface_axi__core__cic__integrators2__stage4(clock,in_low,in_high,low,high);
+
+    // Module arguments
+    input wire  clock;
+    input wire  [39:0] in_low;
+    input wire  [39:0] in_high;
+    output reg  [39:0] low;
+    output reg  [39:0] high;
+
+    // Constant declarations
+    localparam  one = 41'h1;
+
+    // Stub signals
+    reg  [39:0] low_sum$d;
+    wire  [39:0] low_sum$q;
+    reg  low_sum$clock;
+    reg  carry$d;
+    wire  carry$q;
+    reg  carry$clock;
+    reg  [39:0] high_sum$d;
+    wire  [39:0] high_sum$q;
+    reg  high_sum$clock;
+
+    // Local signals
+    reg  [40:0] low_total;
+    reg  [40:0] high_total;
+
+    // Sub module instances
+    gyro_interface_axi__core__cic__integrators2__stage4__low_sum low_sum(
+        .d(low_sum$d),
+        .q(low_sum$q),
+        .clock(low_sum$clock)
+    );
+    gyro_interface_axi__core__cic__integrators2__stage4__carry carry(
+        .d(carry$d),
+        .q(carry$q),
+        .clock(carry$clock)
+    );
+    gyro_interface_axi__core__cic__integrators2__stage4__high_sum high_sum(
+        .d(high_sum$d),
+        .q(high_sum$q),
+        .clock(high_sum$clock)
+    );
+
+    // Update code
+    always @(*) begin
+        low_sum$clock = clock;
+        carry$clock = clock;
+        high_sum$clock = clock;
+        low_sum$d = low_sum$q;
+        carry$d = carry$q;
+        high_sum$d = high_sum$q;
+        low_total = ((low_sum$q) & 41'h1ffffffffff) + ((in_low) & 41'h1ffffffffff);
+        low_sum$d = low_total[(32'h0)+:(40)];
+        carry$d = low_total[(32'h28)+:(1)];
+        high_total = ((((high_sum$q) & 41'h1ffffffffff) << 32'h1) | one) + ((((in_high) & 41'h1ffffffffff) << 32'h1) | ((carry$q) & 41'h1ffffffffff));
+        high_sum$d = high_total[(32'h1)+:(40)];
+        low = low_sum$q;
+        high = high_sum$q;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators2__stage4
+
+
+module gyro_interface_axi__core__cic__integrators2__stage4__carry(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators2__stage4__carry
+
+
+module gyro_interface_axi__core__cic__integrators2__stage4__high_sum(d,q,clock);
+
+    // Module arguments
+    input wire  [39:0] d;
+    output reg  [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators2__stage4__high_sum
+
+
+module gyro_interface_axi__core__cic__integrators2__stage4__low_sum(d,q,clock);
+
+    // Module arguments
+    input wire  [39:0] d;
+    output reg  [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators2__stage4__low_sum
+
+
+module gyro_interface_axi__core__cic__integrators2__x_high(d,q,clock);
+
+    // Module arguments
+    input wire  [39:0] d;
+    output reg  [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__integrators2__x_high
 
 
 module gyro_interface_axi__core__cic__sample2(d,q,clock);

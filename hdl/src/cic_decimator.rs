@@ -594,20 +594,23 @@ mod tests {
     }
 
     /// The plain reference: exact i128 integrators, a strobe every R clocks
-    /// with R read at the strobe, four first differences of the sampled
-    /// fourth integrals (zero before the first), round half up by the shift
+    /// with R read at the strobe, four first differences of the fourth
+    /// integral as it was a clock before the strobe (the split integrators'
+    /// lag; zero before the first), round half up by the shift
     /// read at the strobe, low 40 bits. Returns (clock of the strobe,
     /// outputs of both channels).
     fn reference(settings: &[(u32, u32)], inputs: &[(i32, i32)]) -> Vec<(usize, (i64, i64))> {
         let channel = |c: usize| -> Vec<(usize, i64)> {
             let mut sums = [0i128; STAGES as usize];
+            let mut previous_fourth = 0i128;
             let mut deltas = [0i128; STAGES as usize];
             let mut next_strobe = 0;
             let mut out = Vec::new();
             for (n, (&(r, shift), x)) in settings.iter().zip(inputs).enumerate() {
                 if n == next_strobe {
-                    // During cycle n the integrals hold the inputs before n.
-                    let mut value = sums[STAGES as usize - 1];
+                    // During cycle n the sums hold the inputs before n; the
+                    // hardware samples the fourth as of cycle n - 1.
+                    let mut value = previous_fourth;
                     for d in &mut deltas {
                         let previous = std::mem::replace(d, value);
                         value -= previous;
@@ -621,6 +624,7 @@ mod tests {
                     next_strobe = n + r as usize;
                 }
                 let x = [x.0, x.1][c] as i128;
+                previous_fourth = sums[STAGES as usize - 1];
                 for k in (1..STAGES as usize).rev() {
                     sums[k] += sums[k - 1];
                 }

@@ -4,6 +4,7 @@ pub mod am_mixer;
 pub mod carrier_nco;
 pub mod carrier_table_fill;
 pub mod cic_decimator;
+pub mod cic_integrator_stage;
 pub mod cic_integrators;
 pub mod demod_mux;
 pub mod drive;

@@ -103,9 +103,13 @@ impl CicDecimator {
         scale_output(wrap(value), shift)
     }
 
-    /// Play the integrators' edges for the inputs still pending.
+    /// Play the integrators' edges for the inputs still pending but the
+    /// last: the hardware's `integral` is the unsplit cascade's value of
+    /// one clock earlier (`crate::cic_integrators`), so the newest input is
+    /// not in it yet and stays pending.
     #[inline(never)]
     fn integrate_pending(&mut self) {
+        let newest = self.pending.pop();
         let [
             [mut a1, mut a2, mut a3, mut a4],
             [mut b1, mut b2, mut b3, mut b4],
@@ -123,6 +127,7 @@ impl CicDecimator {
         }
         self.integrator = [[a1, a2, a3, a4], [b1, b2, b3, b4]];
         self.pending.clear();
+        self.pending.extend(newest);
     }
 }
 
