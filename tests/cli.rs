@@ -207,7 +207,7 @@ fn vcd_dump_reads_back_with_the_expected_signals_and_timing() {
         "--vcd-point",
         "4",
         "--vcd-cycles",
-        "1000:3000",
+        "9000:11000",
         "--vcd-signals",
         "ports,w1,cic1,x1_pm",
     ]);
@@ -264,8 +264,9 @@ fn vcd_dump_reads_back_with_the_expected_signals_and_timing() {
             _ => {}
         }
     }
-    // 2000 clocks of 100 ns at 10 MHz; z every R = 250 clocks.
-    assert_eq!(time, 2999 * 100_000);
+    // 2000 clocks of 100 ns at 10 MHz, after the drives start (cycle 8232);
+    // z every R = 250 clocks.
+    assert_eq!(time, 10999 * 100_000);
     assert_eq!(rising, 2000, "rising clock edges");
     assert!(
         strobes.len() >= 7 && strobes[1..].iter().all(|&d| d == 250 * 100_000),

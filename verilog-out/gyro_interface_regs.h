@@ -9,6 +9,9 @@
 #define GYRO_VERSION_VALUE 0x00010000u
 /* Samples the AXI4-Stream FIFO holds before it drops one. */
 #define GYRO_STREAM_FIFO_DEPTH 256u
+/* Clocks after configuration before the drives leave 0: the core fills its
+ * carrier tables first. */
+#define GYRO_DRIVE_START_CLOCKS 8232u
 
 /* ID: read-only, 32 bits. Identification: 0x4759524f, ASCII "GYRO". */
 #define GYRO_ID_OFFSET 0x00u

@@ -31,7 +31,7 @@
 //! no reset. The carriers' four table RAMs have no power-up contents (an
 //! iCE40 SPRAM cannot be initialized): they are filled during the first
 //! 8200 clocks (`crate::carrier_table_fill`), and the DAC words are 0 until
-//! cycle `FILL_CLOCKS` + 8 = 8232. `crate::settings::Settings` computes all the settings from
+//! cycle `DRIVE_START_CLOCKS` = 8232. `crate::settings::Settings` computes all the settings from
 //! frequencies in Hz; the port list with formats is in
 //! `verilog-out/PORTS.md`.
 //!
@@ -44,6 +44,13 @@
 //! multiplier's turn).
 
 use crate::am_mixer::AmMixer;
+
+/// Clocks from power-up until the DAC words can leave 0: the carrier table
+/// fill (`carrier_table_fill::FILL_CLOCKS`), the carrier lookup and the AM
+/// product.
+pub const DRIVE_START_CLOCKS: usize = crate::carrier_table_fill::FILL_CLOCKS
+    + crate::carrier_nco::LATENCY
+    + crate::am_mixer::CARRIER_LATENCY;
 use crate::carrier_nco::CarrierNco;
 use crate::cic_decimator::{CicDecimator, DECIMATION_BITS, OUTPUT_BITS, SHIFT_BITS};
 use crate::demod_mux::DemodMux;

@@ -79,6 +79,7 @@ use crate::gyro::GyroModel;
 use crate::theory::{self, Device};
 use gyrocal_hdl::cic_decimator::OUTPUT_FRACTION_BITS;
 use gyrocal_hdl::filter_design::FilterDesign;
+use gyrocal_hdl::gyro_interface::DRIVE_START_CLOCKS;
 use gyrocal_hdl::model::gyro_interface::{Outputs, Probes, Registers};
 use gyrocal_hdl::model::q15_multiplier::q15_product;
 use gyrocal_hdl::settings::{self, FrequencyPlan};
@@ -465,7 +466,9 @@ pub fn plan(exp: &Experiment) -> Result<Plan, String> {
             .map(|k| big[k] / (exp.points.tolerance * signal[k] / SETTLE_MARGIN))
             .fold(1.0f64, f64::max);
         let t = plan.tau_s * ratio.ln() + ratio.ln() / sigma + 5.0 * decimation as f64 / clock;
-        (t * clock).ceil() as u64
+        // Every point starts at power-up, and the drives start only once
+        // the core has filled its carrier tables.
+        (t * clock).ceil() as u64 + DRIVE_START_CLOCKS as u64
     };
 
     // Rate signal in ADC LSB of in-phase amplitude: mean(adc x ref) = A W / 2.

@@ -64,8 +64,10 @@ pub struct RunOptions {
     /// Point to dump (0-based: readout points first, then calibration).
     #[arg(long, default_value_t = 0)]
     pub vcd_point: usize,
-    /// Clock window of the dump, START:END (END exclusive).
-    #[arg(long, default_value = "0:4096")]
+    /// Clock window of the dump, START:END (END exclusive); the default
+    /// shows the drives starting at clock 8232, once the core has filled its
+    /// carrier tables.
+    #[arg(long, default_value = "8192:12288")]
     pub vcd_cycles: String,
     /// Signals to dump: names or groups (ports, internals, analog, all).
     #[arg(long, default_value = "all")]

@@ -55,6 +55,15 @@ def fifo_depth():
 FIFO_DEPTH = fifo_depth()
 
 
+def drive_start():
+    """Clocks before the drives (and the references) leave 0, from the C header."""
+    with open(os.environ["GYRO_HEADER"]) as f:
+        return int(re.search(r"#define GYRO_DRIVE_START_CLOCKS (\d+)u", f.read()).group(1))
+
+
+DRIVE_START = drive_start()
+
+
 def extend(reg, field):
     """The word a read returns for a field value."""
     field &= reg["mask"]
@@ -266,7 +275,8 @@ async def coherent_snapshot_while_z_updates(dut):
     await program_plan(axil)
     assert await write(axil, "STREAM_ENABLE", 1) == AxiResp.OKAY
     r = (await read(axil, "CIC_DECIMATION"))[0]
-    await ClockCycles(dut.aclk, 3 * r)
+    # The core fills its carrier tables first; until then z stays 0.
+    await ClockCycles(dut.aclk, DRIVE_START + 3 * r)
     streamed = {}
 
     async def collect():

@@ -567,7 +567,12 @@ pub fn markdown() -> String {
 /// The access rules after the register table (the FIFO depth from
 /// `super::sample_fifo`).
 fn coherence_notes() -> String {
-    COHERENCE_NOTES.replace("{fifo_depth}", &FIFO_DEPTH.to_string())
+    COHERENCE_NOTES
+        .replace("{fifo_depth}", &FIFO_DEPTH.to_string())
+        .replace(
+            "{drive_start}",
+            &crate::gyro_interface::DRIVE_START_CLOCKS.to_string(),
+        )
 }
 
 const COHERENCE_NOTES: &str = r#"
@@ -586,6 +591,9 @@ const COHERENCE_NOTES: &str = r#"
   FIFO is full is dropped and counted in `STREAM_OVERFLOW`.
 - **Reset.** `aresetn` low (synchronous) returns every register above to its power-up
   value and empties the FIFO; the datapath core itself has no reset.
+- **Power-up.** The core fills its carrier tables during its first clocks: the drives are
+  0 until clock {drive_start} after configuration (`GYRO_DRIVE_START_CLOCKS`), and so are
+  the references the demodulators use.
 "#;
 
 /// `verilog-out/gyro_interface_regs.h`: offsets, widths, power-up values.
@@ -603,7 +611,13 @@ pub fn c_header() -> String {
     ));
     h.push_str(&format!(
         "/* Samples the AXI4-Stream FIFO holds before it drops one. */\n\
-         #define GYRO_STREAM_FIFO_DEPTH {FIFO_DEPTH}u\n\n"
+         #define GYRO_STREAM_FIFO_DEPTH {FIFO_DEPTH}u\n"
+    ));
+    h.push_str(&format!(
+        "/* Clocks after configuration before the drives leave 0: the core fills its\n \
+         * carrier tables first. */\n\
+         #define GYRO_DRIVE_START_CLOCKS {}u\n\n",
+        crate::gyro_interface::DRIVE_START_CLOCKS
     ));
     for r in &REGISTERS {
         let access = match r.access {

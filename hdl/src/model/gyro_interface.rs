@@ -154,3 +154,30 @@ impl GyroInterface {
         self.outputs()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gyro_interface::DRIVE_START_CLOCKS;
+
+    #[test]
+    fn the_drives_leave_zero_at_drive_start_clocks() {
+        // Readout at full envelope: the DAC words are 0 while the carrier
+        // tables fill, and not during cycle DRIVE_START_CLOCKS.
+        let regs = Registers {
+            carrier_step: 0x1234_5679,
+            amp: (20000, -20000),
+            ..Default::default()
+        };
+        let mut m = GyroInterface::new();
+        // `step` returns the outputs of the next cycle.
+        for cycle in 1..DRIVE_START_CLOCKS {
+            assert_eq!(m.step((0, 0), &regs).dac, (0, 0), "cycle {cycle}");
+        }
+        let first = m.step((0, 0), &regs).dac;
+        assert!(
+            first.0 != 0 && first.1 != 0,
+            "cycle {DRIVE_START_CLOCKS}: {first:?}"
+        );
+    }
+}

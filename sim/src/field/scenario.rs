@@ -248,7 +248,11 @@ pub fn build(exp: &Experiment) -> Result<(FrontEnd, Knowns), String> {
 /// (off unless its temperature is set).
 pub fn board_at(exp: &Experiment, fe: &FrontEnd, at: &DeviceAt) -> Result<SimBoard, String> {
     let reference = 0.5 * (exp.gyro.f1_hz + exp.gyro.f2_hz);
-    SimBoard::new(at, fe, &exp.noise, exp.drive.clock_hz, reference)
+    let mut board = SimBoard::new(at, fe, &exp.noise, exp.drive.clock_hz, reference)?;
+    // As a host does: wait until the core has filled its carrier tables
+    // (GYRO_DRIVE_START_CLOCKS in the C header) before using it.
+    board.wait_clocks(gyrocal_hdl::gyro_interface::DRIVE_START_CLOCKS as u64);
+    Ok(board)
 }
 
 /// A fresh board at `at`, programmed in readout at `op` and settled
