@@ -11,7 +11,7 @@
 
 use super::sine::sine;
 use crate::carrier_table_fill::{FILL_CLOCKS, REQUESTS, rom_entry_phase};
-use crate::quarter_wave::{PHASE_BELOW_INDEX, TABLE_ENTRIES};
+use crate::quarter_wave::TABLE_ENTRIES;
 use crate::table_sine::LATENCY;
 use std::sync::OnceLock;
 
@@ -43,10 +43,7 @@ fn entry(i: usize) -> i16 {
 /// `crate::table_sine::TableSine` looks it up in `table`.
 #[inline(always)]
 pub fn table_sine(table: &Table, phase: u32, advance: u8) -> i16 {
-    let q = ((phase >> 30) + u32::from(advance)) & 3;
-    let i = (phase >> PHASE_BELOW_INDEX) as usize & (TABLE_ENTRIES - 1);
-    let v = table[if q & 1 == 0 { i } else { TABLE_ENTRIES - 1 - i }];
-    if q >= 2 { -v } else { v }
+    super::quarter_wave::lookup(phase, advance, |index| table[index])
 }
 
 /// Outputs of the carrier NCO during one cycle.

@@ -15,5 +15,6 @@ pub mod gyro_interface;
 pub mod iir_lowpass;
 pub mod modulation_nco;
 pub mod q15_multiplier;
+pub mod quarter_wave;
 pub mod reference_alignment;
 pub mod sine;

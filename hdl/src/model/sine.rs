@@ -5,7 +5,7 @@
 //! the power-up registers give (`crate::quarter_wave`): 0 during cycles
 //! 0..=4.
 
-use crate::quarter_wave::{LATENCY, PHASE_BELOW_INDEX, TABLE_ENTRIES};
+use crate::quarter_wave::LATENCY;
 use crate::sine_table;
 use std::sync::OnceLock;
 
@@ -25,13 +25,10 @@ pub fn sine(phase: u32, advance: u8) -> i16 {
     sine_with(table(), phase, advance)
 }
 
+/// The ROM ignores the index's lowest bit: one word per pair of intervals.
 #[inline(always)]
 fn sine_with(table: &Table, phase: u32, advance: u8) -> i16 {
-    let q = ((phase >> 30) + u32::from(advance)) & 3;
-    let i = (phase >> PHASE_BELOW_INDEX) as usize & (TABLE_ENTRIES - 1);
-    let index = if q & 1 == 0 { i } else { TABLE_ENTRIES - 1 - i };
-    let v = table[index >> 1];
-    if q >= 2 { -v } else { v }
+    super::quarter_wave::lookup(phase, advance, |index| table[index >> 1])
 }
 
 /// Cycle-true model of one `crate::sine::Sine`.
