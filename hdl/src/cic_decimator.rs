@@ -143,12 +143,13 @@ pub const OUTPUT_STAGES: usize = 3;
 pub const CHANNELS: usize = 2;
 /// Address bits of the comb delay RAM: `CHANNELS * STAGES` = 8 words.
 pub const DELAY_ADDRESS_BITS: usize = 3;
-/// Width of a comb half: the 80-bit subtraction runs as two 40-bit ones on
-/// consecutive clocks, so no clock carries an 80-bit carry chain (26 MHz
-/// on an iCE40 UP5K, with the RAM's clock-to-out in front).
-pub const COMB_HALF_BITS: usize = REGISTER_BITS / 2;
+/// Width of a register half: the combs' 80-bit subtraction runs as two
+/// 40-bit ones on consecutive clocks (26 MHz on an iCE40 UP5K with one
+/// 80-bit carry chain behind the RAM), and each integrator adds in two
+/// halves, the high one a clock late (`crate::cic_integrator_stage`).
+pub const REGISTER_HALF_BITS: usize = REGISTER_BITS / 2;
 /// A comb half with its borrow (low half) or its borrow-in (high half).
-const COMB_CARRY_BITS: usize = COMB_HALF_BITS + 1;
+const COMB_CARRY_BITS: usize = REGISTER_HALF_BITS + 1;
 /// Clocks per comb step: the low half, then the high half.
 pub const COMB_CLOCKS: usize = 2;
 /// Clocks from leaving `Idle` to being back in it: per channel one load
@@ -159,10 +160,11 @@ pub const SCHEDULE_CLOCKS: usize = CHANNELS * (1 + COMB_CLOCKS * STAGES as usize
 pub const SAMPLE_TO_OUTPUT: usize = SCHEDULE_CLOCKS;
 
 const _: () = assert!(CHANNELS * STAGES as usize == 1 << DELAY_ADDRESS_BITS);
-const _: () = assert!(2 * COMB_HALF_BITS == REGISTER_BITS);
+const _: () = assert!(2 * REGISTER_HALF_BITS == REGISTER_BITS);
 // `get_bits` offsets inside `update` are literals (rust-hdl prints a named
-// constant there verbatim into the Verilog): 40 is `COMB_HALF_BITS`.
-const _: () = assert!(COMB_HALF_BITS == 40);
+// constant there verbatim into the Verilog): 40 is `REGISTER_HALF_BITS`,
+// here and in `cic_integrators` and `cic_integrator_stage`.
+const _: () = assert!(REGISTER_HALF_BITS == 40);
 const _: () = assert!(DOUBLED_BITS > REGISTER_BITS);
 const _: () = assert!(SCHEDULE_CLOCKS as u32 <= crate::filter_design::MIN_DECIMATION);
 
@@ -245,12 +247,12 @@ pub struct CicDecimator {
     comb_low: Signal<Local, Bit>,
     comb_high: Signal<Local, Bit>,
     borrow: DFF<Bits<1>>,
-    delay_high: DFF<Bits<COMB_HALF_BITS>>,
+    delay_high: DFF<Bits<REGISTER_HALF_BITS>>,
     acc_bits: Signal<Local, Bits<REGISTER_BITS>>,
     delay_bits: Signal<Local, Bits<REGISTER_BITS>>,
-    acc_low: Signal<Local, Bits<COMB_HALF_BITS>>,
-    acc_high: Signal<Local, Bits<COMB_HALF_BITS>>,
-    delay_low: Signal<Local, Bits<COMB_HALF_BITS>>,
+    acc_low: Signal<Local, Bits<REGISTER_HALF_BITS>>,
+    acc_high: Signal<Local, Bits<REGISTER_HALF_BITS>>,
+    delay_low: Signal<Local, Bits<REGISTER_HALF_BITS>>,
     low_difference: Signal<Local, Bits<COMB_CARRY_BITS>>,
     high_difference: Signal<Local, Bits<COMB_CARRY_BITS>>,
     extended: Signal<Local, Signed<DOUBLED_BITS>>,
@@ -324,7 +326,7 @@ impl CicDecimator {
             coarse_shift_mask: Constant::new(COARSE_SHIFT_MASK.into()),
             fine_shift_mask: Constant::new(FINE_SHIFT_MASK.into()),
             next_address: Constant::new(1.into()),
-            half_shift: Constant::new((COMB_HALF_BITS as u64).into()),
+            half_shift: Constant::new((REGISTER_HALF_BITS as u64).into()),
         }
     }
 }
@@ -481,14 +483,15 @@ impl Logic for CicDecimator {
         // reads the next step's word one clock ahead of its low clock.
         self.acc_bits.next = unsigned_cast(self.acc.q.val());
         self.delay_bits.next = unsigned_cast(self.delays.q.val());
-        self.acc_low.next = self.acc_bits.val().get_bits::<COMB_HALF_BITS>(0);
-        self.acc_high.next = self.acc_bits.val().get_bits::<COMB_HALF_BITS>(40);
-        self.delay_low.next = self.delay_bits.val().get_bits::<COMB_HALF_BITS>(0);
-        self.low_difference.next = bit_cast::<COMB_CARRY_BITS, COMB_HALF_BITS>(self.acc_low.val())
-            - bit_cast::<COMB_CARRY_BITS, COMB_HALF_BITS>(self.delay_low.val());
+        self.acc_low.next = self.acc_bits.val().get_bits::<REGISTER_HALF_BITS>(0);
+        self.acc_high.next = self.acc_bits.val().get_bits::<REGISTER_HALF_BITS>(40);
+        self.delay_low.next = self.delay_bits.val().get_bits::<REGISTER_HALF_BITS>(0);
+        self.low_difference.next =
+            bit_cast::<COMB_CARRY_BITS, REGISTER_HALF_BITS>(self.acc_low.val())
+                - bit_cast::<COMB_CARRY_BITS, REGISTER_HALF_BITS>(self.delay_low.val());
         self.high_difference.next =
-            (bit_cast::<COMB_CARRY_BITS, COMB_HALF_BITS>(self.acc_high.val()) << 1)
-                - ((bit_cast::<COMB_CARRY_BITS, COMB_HALF_BITS>(self.delay_high.q.val()) << 1)
+            (bit_cast::<COMB_CARRY_BITS, REGISTER_HALF_BITS>(self.acc_high.val()) << 1)
+                - ((bit_cast::<COMB_CARRY_BITS, REGISTER_HALF_BITS>(self.delay_high.q.val()) << 1)
                     | bit_cast::<COMB_CARRY_BITS, 1>(self.borrow.q.val()));
         self.delays.write_enable.next = self.comb_low.val();
         self.delays.write_address.next = self.delay_address.q.val();
@@ -496,22 +499,22 @@ impl Logic for CicDecimator {
         self.delays.read_address.next = self.delay_address.q.val();
         if self.comb_low.val() {
             self.acc.d.next = signed_cast(
-                (bit_cast::<REGISTER_BITS, COMB_HALF_BITS>(self.acc_high.val())
+                (bit_cast::<REGISTER_BITS, REGISTER_HALF_BITS>(self.acc_high.val())
                     << self.half_shift.val())
-                    | bit_cast::<REGISTER_BITS, COMB_HALF_BITS>(
-                        self.low_difference.val().get_bits::<COMB_HALF_BITS>(0),
+                    | bit_cast::<REGISTER_BITS, REGISTER_HALF_BITS>(
+                        self.low_difference.val().get_bits::<REGISTER_HALF_BITS>(0),
                     ),
             );
             self.borrow.d.next = self.low_difference.val().get_bits::<1>(40);
-            self.delay_high.d.next = self.delay_bits.val().get_bits::<COMB_HALF_BITS>(40);
+            self.delay_high.d.next = self.delay_bits.val().get_bits::<REGISTER_HALF_BITS>(40);
             self.delays.read_address.next = self.delay_address.q.val() + self.next_address.val();
         }
         if self.comb_high.val() {
             self.acc.d.next = signed_cast(
-                (bit_cast::<REGISTER_BITS, COMB_HALF_BITS>(
-                    self.high_difference.val().get_bits::<COMB_HALF_BITS>(1),
+                (bit_cast::<REGISTER_BITS, REGISTER_HALF_BITS>(
+                    self.high_difference.val().get_bits::<REGISTER_HALF_BITS>(1),
                 ) << self.half_shift.val())
-                    | bit_cast::<REGISTER_BITS, COMB_HALF_BITS>(self.acc_low.val()),
+                    | bit_cast::<REGISTER_BITS, REGISTER_HALF_BITS>(self.acc_low.val()),
             );
             self.delay_address.d.next = self.delay_address.q.val() + self.next_address.val();
             self.delays.read_address.next = self.delay_address.q.val() + self.next_address.val();

@@ -18,10 +18,9 @@
 //! 80-bit add took 34 ns on an iCE40 UP5K (29 MHz); a 41-bit one half that.
 //! Power-up: 0. Resources: 81 flip-flops, two 41-bit adders.
 
+use crate::cic_decimator::REGISTER_HALF_BITS as HALF_BITS;
 use rust_hdl::prelude::*;
 
-/// Width of each half.
-pub const HALF_BITS: usize = 40;
 /// A half with its carry.
 const CARRY_BITS: usize = HALF_BITS + 1;
 
@@ -88,9 +87,5 @@ impl Logic for CicIntegratorStage {
         self.high.next = self.high_sum.q.val();
     }
 }
-
-// `get_bits` offsets are literals (rust-hdl prints a named constant there
-// verbatim): 40 is `HALF_BITS`.
-const _: () = assert!(HALF_BITS == 40);
 
 crate::impl_clocked!(CicIntegratorStage);
