@@ -2,10 +2,10 @@
 //! factor against the rate table of the same simulation, and the
 //! factory-calibrated baseline beside it.
 
+use gyrocal_host::selfcal;
 use gyrocal_sim::drift::Drift;
-use gyrocal_sim::field::drive_ratio::DriveProbe;
+use gyrocal_sim::field::probe::DriveProbe;
 use gyrocal_sim::field::scenario::{self, FieldReport};
-use gyrocal_sim::field::selfcal;
 use gyrocal_sim::noise::ThermalNoise;
 use gyrocal_sim::rate_noise;
 

@@ -2,9 +2,9 @@
 //! never sees: the paper's device at drifted temperatures and front-end
 //! phases up to +-5 deg.
 
+use gyrocal_host::identify::{self, Identified};
 use gyrocal_sim::config::Experiment;
 use gyrocal_sim::drift::Drift;
-use gyrocal_sim::field::identify::{self, Identified};
 use gyrocal_sim::field::scenario::{board_at, build};
 
 fn drift(phase_deg: f64) -> Drift {

@@ -104,23 +104,18 @@ use crate::primitives::convert::signed_bit_cast_exact;
 use rust_hdl::prelude::*;
 
 /// Number of integrator and comb stages.
-pub const STAGES: u32 = 4;
+pub use gyrocal_regs::datapath::CIC_STAGES as STAGES;
 /// Width of the input word.
 pub const INPUT_BITS: usize = 32;
-/// log2 of the largest decimation.
-pub const MAX_DECIMATION_LOG2: u32 = 12;
-/// Largest decimation: 2^12.
-pub const MAX_DECIMATION: u32 = 1 << MAX_DECIMATION_LOG2;
+pub use gyrocal_regs::datapath::{MAX_DECIMATION, MAX_DECIMATION_LOG2, OUTPUT_FRACTION_BITS};
 /// Hogenauer register width: B_in + N log2(R_max) = 32 + 4 * 12 = 80.
 pub const REGISTER_BITS: usize = INPUT_BITS + (STAGES * MAX_DECIMATION_LOG2) as usize;
 /// Width of the output word.
 pub const OUTPUT_BITS: usize = 40;
 /// Width of the decimation word: R up to 2^12 needs 13 bits.
-pub const DECIMATION_BITS: usize = MAX_DECIMATION_LOG2 as usize + 1;
+pub const DECIMATION_BITS: usize = gyrocal_regs::datapath::DECIMATION_BITS as usize;
 /// Width of the output shift word: shifts 0..=40 need 6 bits.
-pub const SHIFT_BITS: usize = 6;
-/// Fractional bits kept at the output (y = average * 2^8 * G).
-pub const OUTPUT_FRACTION_BITS: u32 = 8;
+pub const SHIFT_BITS: usize = gyrocal_regs::datapath::SHIFT_BITS as usize;
 /// Low bits of the shift applied by the last (fine) output step: 0..=7.
 pub const FINE_SHIFT_BITS: usize = 3;
 /// The shift bits of the fine step: `shift & 0b000111`.

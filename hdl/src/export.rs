@@ -564,6 +564,16 @@ pub fn files() -> Vec<(&'static str, String)> {
 mod tests {
     use super::*;
 
+    /// The decimation port's documented range is the limits of record
+    /// (`gyrocal_regs::datapath`), as the register map's text says.
+    #[test]
+    fn decimation_port_text_follows_the_limits() {
+        use gyrocal_regs::datapath::{MAX_DECIMATION, MIN_DECIMATION};
+        let range = format!("{MIN_DECIMATION}..{MAX_DECIMATION}");
+        let port = PORTS.iter().find(|p| p.name == "cic_decimation");
+        assert_eq!(port.map(|p| p.format), Some(range.as_str()));
+    }
+
     #[test]
     fn port_table_matches_the_verilog_declarations() {
         check_port_table(&verilog(), TOP_MODULE, PORTS);

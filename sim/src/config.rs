@@ -246,18 +246,8 @@ pub const MAX_BUDGET_S: f64 = 86_400.0;
 pub const SAMPLES_PER_RIPPLE: f64 = 20.0;
 
 /// The filter and first window derived from the device, with the user's
-/// explicit values where given.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Derived {
-    /// CIC decimation R.
-    pub decimation: u32,
-    /// Butterworth cut-off (Hz).
-    pub butterworth_hz: f64,
-    /// RC cut-off (Hz).
-    pub rc_hz: f64,
-    /// First averaging window (s).
-    pub min_window_s: f64,
-}
+/// explicit values where given (the host programs them: `gyrocal_host`).
+pub use gyrocal_host::Derived;
 
 /// Ratio of the RC cut-off to the Butterworth cut-off, and of the
 /// Butterworth cut-off to the slowest signal (`Experiment::derived`).

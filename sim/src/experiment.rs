@@ -291,19 +291,7 @@ pub fn ratio_target(tolerance: f64, ratio: f64) -> f64 {
     tolerance * ratio.abs().max(RATIO_FLOOR)
 }
 
-/// The lead of the reference envelopes over the drive envelopes the
-/// datapath leaves in calibration (rad): the references are lined up with
-/// the drives' carrier to the half clock of the DAC's hold by `ref_phase`,
-/// but their envelope is not, so it is off by Om T / 2
-/// (`hdl/src/settings.rs`). Negligible in phase (1e-6 rad), but it mixes
-/// the resonant part of the response into the calibration output: 2e-4 of
-/// the calibration scale factor on a Q 200 device at 100 kHz and 3.33 MHz.
-pub fn envelope_lead_rad(cal_hz: f64, clock_hz: f64) -> f64 {
-    ENVELOPE_LEAD_SIGN * PI * cal_hz / clock_hz
-}
-
-/// The sign of the datapath's envelope lead (see `envelope_lead_rad`).
-const ENVELOPE_LEAD_SIGN: f64 = -1.0;
+pub use crate::theory::envelope_lead_rad;
 
 /// Fundamental gain of a sine generator, sin and cos alike: the phase
 /// average of its output times the exact sine (a carrier whose frequency
@@ -376,7 +364,7 @@ pub fn plan(exp: &Experiment) -> Result<Plan, String> {
         dac_latency: fe.dac_latency,
         adc_latency: fe.adc_latency,
     };
-    let (readout_regs, realized) = settings::registers(&base)?;
+    let (readout_regs, realized) = settings::registers(&base).map_err(|e| e.to_string())?;
     let filter = realized.filter.clone();
     let drive_words = realized_words(readout_regs.amp, Mode::Readout);
     let cal_drive_words = realized_words(readout_regs.amp, Mode::Calibration);
@@ -431,7 +419,8 @@ pub fn plan(exp: &Experiment) -> Result<Plan, String> {
             };
             settings::registers(&p).map(|(r, real)| (r, real.cal_hz))
         })
-        .collect::<Result<_, _>>()?;
+        .collect::<Result<_, _>>()
+        .map_err(|e| e.to_string())?;
     // ADC gains: the largest displacement of any point at `adc_headroom`.
     let mut peak_x = [0.0f64; 2];
     for &r in rates {

@@ -45,22 +45,7 @@
 use crate::noise::{self, Mat4, StateNoise, ThermalNoise};
 use nalgebra::SMatrix;
 
-/// Physical parameters of the two-mode gyroscope (the `[gyro]` section of
-/// a configuration file: every key required).
-#[derive(Clone, Debug, PartialEq, serde::Deserialize, serde::Serialize)]
-#[serde(deny_unknown_fields)]
-pub struct GyroParams {
-    /// Resonance frequency of mode 1 (Hz).
-    pub f1_hz: f64,
-    /// Resonance frequency of mode 2 (Hz).
-    pub f2_hz: f64,
-    /// Quality factor of mode 1 (B1 = w1/q1).
-    pub q1: f64,
-    /// Quality factor of mode 2 (B2 = w2/q2).
-    pub q2: f64,
-    /// Angular gain lambda (Coriolis coupling is 2 lambda Omz).
-    pub angular_gain: f64,
-}
+pub use gyrocal_host::GyroParams;
 
 /// Transition and input matrices of one clock period, as plain arrays.
 #[derive(Clone, Debug, PartialEq)]

@@ -7,7 +7,8 @@
 //! staircase), `fit` (scale factors).
 
 pub mod allan;
-pub mod average;
+/// Exact window means (`gyrocal_host::average`).
+pub use gyrocal_host::average;
 pub mod bench;
 pub mod config;
 pub mod cosim;
@@ -21,7 +22,8 @@ pub mod gyro;
 pub mod noise;
 pub mod rate_noise;
 pub mod report;
-pub mod theory;
+/// The exact theory (`gyrocal_host::theory`), shared with the host's prediction.
+pub use gyrocal_host::theory;
 #[cfg(feature = "verilator")]
 pub mod verilator;
 pub mod waveform;

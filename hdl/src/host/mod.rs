@@ -10,7 +10,8 @@
 
 pub mod axi_top;
 pub mod model;
-pub mod register_map;
+/// The register map, from the leaf crate `gyrocal-regs`.
+pub use gyrocal_regs::map as register_map;
 pub mod rtl;
 pub mod sample_fifo;
 pub mod setting_register;
@@ -18,7 +19,7 @@ pub mod status_word;
 pub mod traffic;
 
 /// Width of z1 and z2 (40-bit two's complement, 8 fractional bits).
-pub const Z_BITS: usize = 40;
+pub const Z_BITS: usize = gyrocal_regs::datapath::Z_BITS as usize;
 /// Width of an AXI response code.
 pub const RESP_BITS: usize = 2;
 /// AXI response OKAY.

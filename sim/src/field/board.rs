@@ -1,11 +1,11 @@
-//! A board as host software sees it: 32-bit registers at the byte offsets
-//! of `gyrocal_hdl::host::register_map` (the map the gateware decodes),
-//! coherent z snapshots, and time passing.
+//! The simulated board: the bit-true model engine, the converters and the
+//! gyroscope at one temperature behind the register map, as host code
+//! (`gyrocal_host`, through its [`Board`] trait) sees a real one.
 //!
-//! [`SimBoard`] closes the loop of the bit-true model engine over the
-//! gyroscope at one temperature ([`crate::drift::DeviceAt`]): drive gains
-//! scale the DAC forces, ADC gains the pick-offs, and an unmodelled phase
-//! lag ([`crate::frontend::PickoffPhase`]) sits before both ADCs. Per clock,
+//! [`SimBoard`] closes the loop of the model engine over the gyroscope at
+//! one temperature ([`crate::drift::DeviceAt`]): drive gains scale the DAC
+//! forces, ADC gains the pick-offs, and an unmodelled phase lag
+//! ([`crate::frontend::PickoffPhase`]) sits before both ADCs. Per clock,
 //! as in [`crate::cosim`]: the ADCs sample, the engine plays an edge, the
 //! gyroscope advances under the held force. Register writes act from the
 //! next clock on; the settings are decoded from the bank once per write.
@@ -20,45 +20,9 @@ use crate::engine::{Engine, ModelEngine};
 use crate::frontend::{Converters, FrontEnd, PickoffPhase};
 use crate::gyro::GyroModel;
 use crate::noise::ThermalNoise;
-use gyrocal_hdl::host::register_map::{
-    self, BusError, RegisterAccess, SAMPLE_COUNT, Z1_HI, Z1_LO, Z2_HI, Z2_LO,
-};
-use gyrocal_hdl::model::gyro_interface::{Outputs, Registers};
-
-/// One coherent z snapshot: the count and both outputs, in z LSB
-/// (2^-8 mixer LSB, the register's raw value over 256).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ZSample {
-    /// SAMPLE_COUNT at the snapshot.
-    pub count: u32,
-    /// z1, z2 (z LSB).
-    pub z: [f64; 2],
-}
-
-/// A gateware board: registers, z snapshots, time.
-pub trait Board: RegisterAccess {
-    /// Let `clocks` periods of the FPGA clock pass.
-    fn wait_clocks(&mut self, clocks: u64);
-
-    /// Read SAMPLE_COUNT (which latches z) then the four z words.
-    fn read_z(&mut self) -> Result<ZSample, BusError> {
-        let count = self.read_register(SAMPLE_COUNT.offset)?;
-        let mut word = |lo: u32, hi: u32| -> Result<f64, BusError> {
-            let (lo, hi) = (self.read_register(lo)?, self.read_register(hi)?);
-            Ok(((i64::from(hi as i32) << 32) | i64::from(lo)) as f64 / 256.0)
-        };
-        let z1 = word(Z1_LO.offset, Z1_HI.offset)?;
-        let z2 = word(Z2_LO.offset, Z2_HI.offset)?;
-        Ok(ZSample { count, z: [z1, z2] })
-    }
-
-    /// Write every setting of `regs` (the register map's own encoding).
-    fn program(&mut self, regs: &Registers) -> Result<(), BusError> {
-        register_map::encode(regs)
-            .into_iter()
-            .try_for_each(|(offset, word)| self.write_register(offset, word))
-    }
-}
+use gyrocal_hdl::model::gyro_interface::Outputs;
+pub use gyrocal_host::board::{Board, ZSample};
+use gyrocal_regs::map::{BusError, RegisterAccess};
 
 /// The model engine, converters and gyroscope behind the register map.
 pub struct SimBoard {
@@ -135,10 +99,20 @@ impl SimBoard {
 }
 
 impl Board for SimBoard {
-    fn wait_clocks(&mut self, clocks: u64) {
+    fn wait_clocks(&mut self, clocks: u64) -> Result<(), BusError> {
         for _ in 0..clocks {
             self.step();
         }
+        Ok(())
+    }
+
+    /// Steps the clock until the count moves past `after` (at most R
+    /// clocks when `after` is the current count), then reads the snapshot.
+    fn next_sample(&mut self, after: u32) -> Result<ZSample, BusError> {
+        while self.samples == after {
+            self.step();
+        }
+        self.read_z()
     }
 }
 

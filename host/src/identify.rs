@@ -54,14 +54,12 @@
 //! resonant part of the response into the output (13% of the detuned
 //! output of a 25 kHz device with 3 deg, measured).
 
-use super::board::Board;
-use crate::config::{Derived, Experiment};
-use crate::gyro::GyroParams;
-use gyrocal_hdl::host::register_map::BusError;
-use gyrocal_hdl::model::gyro_interface::Registers;
-use gyrocal_hdl::model::q15_multiplier::q15_product;
-use gyrocal_hdl::settings::{self, FrequencyPlan, Realized};
-use gyrocal_hdl::sine_table::PEAK;
+use crate::board::Board;
+use crate::device::GyroParams;
+use crate::error::Error;
+use crate::knowns::{FILTER_SETTLE, Knowns, TAU_MARGIN};
+use crate::sampling::average_z;
+use gyrocal_regs::datapath::{CONVERTER_FULL_SCALE, PEAK};
 use nalgebra::{Complex, DMatrix, DVector};
 use serde::Serialize;
 use std::f64::consts::{PI, TAU};
@@ -91,141 +89,13 @@ pub const SAMPLES_PER_PHASE: u64 = 128;
 pub fn settling_residue() -> f64 {
     (-SETTLE_TAUS).exp() + FILTER_SETTLE
 }
-/// Margin on an amplitude time constant estimated from a bandwidth.
-const TAU_MARGIN: f64 = 1.2;
 /// Most coarse-search moves before giving up.
 const MAX_MOVES: usize = 12;
-/// The filter's transient is waited down to this fraction.
-const FILTER_SETTLE: f64 = 1e-6;
-/// Full-scale ADC amplitude (LSB).
-const ADC_FULL_SCALE: f64 = 32767.0;
-
-/// What host software knows: the clock, the datasheet (the nominal device
-/// at the factory temperature, a starting guess), the drives it writes,
-/// the board's latencies and design force gains, and its own settings.
-/// Never the device's true parameters at the current temperature.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Knowns {
-    /// FPGA clock (Hz).
-    pub clock_hz: f64,
-    /// Datasheet device (at the factory temperature).
-    pub nominal: GyroParams,
-    /// Readout drive amplitudes (fractions of full scale).
-    pub amplitude: (f64, f64),
-    /// Design force per full-scale DAC word of drive 1 and 2 (N/kg): only
-    /// their ratio enters the scale factors in z LSB.
-    pub force_full_scale: [f64; 2],
-    /// DAC latency (clocks).
-    pub dac_latency: u32,
-    /// ADC latency (clocks).
-    pub adc_latency: u32,
-    /// Output filter and first averaging window.
-    pub filter: Derived,
-    /// Operating carrier minus mode 1's frequency (Hz), kept when retuning.
-    pub carrier_offset_hz: f64,
-    /// Rates of the factory rate table (deg/s).
-    pub rates_dps: Vec<f64>,
-    /// Calibration frequencies of the staircase (Hz).
-    pub cal_freqs_hz: Vec<f64>,
-}
-
-impl Knowns {
-    /// What a host programmed for `exp` would know (its `[gyro]` read as
-    /// the datasheet).
-    pub fn from_experiment(exp: &Experiment) -> Result<Self, String> {
-        Ok(Self {
-            clock_hz: exp.drive.clock_hz,
-            nominal: exp.gyro.clone(),
-            amplitude: exp.drive.amplitude(),
-            force_full_scale: exp.drive.force_full_scale(),
-            dac_latency: exp.frontend.dac_latency,
-            adc_latency: exp.frontend.adc_latency,
-            filter: exp.derived()?,
-            carrier_offset_hz: exp.drive.carrier_hz - exp.gyro.f1_hz,
-            rates_dps: exp.points.readout_rates_dps.clone(),
-            cal_freqs_hz: exp.points.cal_freqs_hz.clone(),
-        })
-    }
-
-    /// Registers for a carrier, calibration frequency (`None`: readout),
-    /// drive amplitudes and a reference phase lag (deg) on top of the
-    /// aligned value.
-    pub fn registers(
-        &self,
-        carrier_hz: f64,
-        cal_hz: Option<f64>,
-        amplitude: (f64, f64),
-        ref_lag_deg: f64,
-    ) -> Result<(Registers, Realized), String> {
-        let plan = FrequencyPlan {
-            clock_hz: self.clock_hz,
-            carrier_hz,
-            cal_hz: cal_hz.unwrap_or(0.0),
-            calibration: cal_hz.is_some(),
-            amplitude,
-            decimation: self.filter.decimation,
-            butterworth_hz: self.filter.butterworth_hz,
-            rc_hz: self.filter.rc_hz,
-            dac_latency: self.dac_latency,
-            adc_latency: self.adc_latency,
-        };
-        let (mut regs, realized) = settings::registers(&plan)?;
-        regs.ref_phase = regs.ref_phase.wrapping_add(phase_word(-ref_lag_deg));
-        Ok((regs, realized))
-    }
-
-    /// Clocks for the output filter to settle to `FILTER_SETTLE` (the
-    /// slowest Butterworth pole, the RC pole, the CIC's 4 R).
-    pub fn filter_settle_clocks(&self) -> u64 {
-        let f = &self.filter;
-        let sigma = (TAU * f.butterworth_hz / 2f64.sqrt()).min(TAU * f.rc_hz);
-        let t = (1.0 / FILTER_SETTLE).ln() / sigma;
-        (t * self.clock_hz).ceil() as u64 + 5 * u64::from(f.decimation)
-    }
-
-    /// Amplitude time constant of mode k from the datasheet, with a 20%
-    /// margin for Q drift (s).
-    pub fn tau_s(&self, k: usize) -> f64 {
-        let (f, q) = match k {
-            0 => (self.nominal.f1_hz, self.nominal.q1),
-            _ => (self.nominal.f2_hz, self.nominal.q2),
-        };
-        TAU_MARGIN * q / (PI * f)
-    }
-
-    /// Clocks to wait `taus` of the slower mode's time constant plus the
-    /// filter.
-    pub fn settle_clocks(&self, taus: f64) -> u64 {
-        let tau = self.tau_s(0).max(self.tau_s(1));
-        (taus * tau * self.clock_hz).ceil() as u64 + self.filter_settle_clocks()
-    }
-
-    /// Datasheet bandwidth f / Q of mode k (Hz).
-    fn bandwidth_hz(&self, k: usize) -> f64 {
-        match k {
-            0 => self.nominal.f1_hz / self.nominal.q1,
-            _ => self.nominal.f2_hz / self.nominal.q2,
-        }
-    }
-}
-
-/// REF_PHASE word of a phase in degrees (2^32 = 360 deg), wrapping.
-pub fn phase_word(deg: f64) -> u32 {
-    (deg / 360.0 * 2f64.powi(32)).round() as i64 as u32
-}
 
 /// Fundamental amplitude (LSB) of a readout drive word for a Q1.15
-/// amplitude `amp`: the envelope amp x PEAK / 2^15 rounded as the AM
-/// mixer rounds it, times the carrier table's amplitude PEAK / 2^15 (the
-/// table's own gain, 1 - 1.3e-7, is below anything this module resolves).
+/// amplitude (`gyrocal_regs::datapath::readout_word`), unsigned.
 pub fn readout_word(amp: i16) -> f64 {
-    signed_readout_word(amp).abs()
-}
-
-/// [`readout_word`] with its sign: the word follows the sign of `amp`
-/// (rounded half up, so -amp's word is not always the exact negative).
-pub fn signed_readout_word(amp: i16) -> f64 {
-    f64::from(q15_product(amp, PEAK as i16)) * f64::from(PEAK) / 32768.0
+    gyrocal_regs::datapath::readout_word(amp).abs()
 }
 
 /// A value and its 1-sigma uncertainty.
@@ -283,30 +153,6 @@ impl Identified {
     }
 }
 
-/// The one-line error of a refused register access.
-pub(super) fn bus(e: BusError) -> String {
-    format!("board refused a register access: {e:?}")
-}
-
-/// Let `clocks` pass, then average `n` consecutive z samples (one per R
-/// clocks after the wait).
-pub fn average_z(
-    board: &mut dyn Board,
-    decimation: u32,
-    clocks: u64,
-    n: u64,
-) -> Result<[f64; 2], String> {
-    board.wait_clocks(clocks);
-    let mut sum = [0.0; 2];
-    for _ in 0..n {
-        board.wait_clocks(u64::from(decimation));
-        let s = board.read_z().map_err(bus)?;
-        sum[0] += s.z[0];
-        sum[1] += s.z[1];
-    }
-    Ok(sum.map(|v| v / n as f64))
-}
-
 /// Measures mode k's complex response through one drive.
 struct Prober<'a> {
     board: &'a mut dyn Board,
@@ -323,7 +169,7 @@ struct Prober<'a> {
 impl Prober<'_> {
     /// Y at `carrier_hz` (ADC LSB per drive LSB): I, then Q a quarter turn
     /// later; returns the realized carrier.
-    fn measure_once(&mut self, carrier_hz: f64) -> Result<(f64, C64, f64), String> {
+    fn measure_once(&mut self, carrier_hz: f64) -> Result<(f64, C64, f64), Error> {
         let kn = self.knowns;
         let amps = if self.k == 0 {
             (self.amplitude, 0.0)
@@ -331,26 +177,26 @@ impl Prober<'_> {
             (0.0, self.amplitude)
         };
         let (regs, real) = kn.registers(carrier_hz, None, amps, 0.0)?;
-        self.board.program(&regs).map_err(bus)?;
+        self.board.program(&regs)?;
         let r = kn.filter.decimation;
         let settle =
             (SETTLE_TAUS * self.tau_s * kn.clock_hz).ceil() as u64 + kn.filter_settle_clocks();
-        let zi = average_z(self.board, r, settle, SAMPLES_PER_PHASE)?[self.k];
+        let zi = average_z(self.board, settle, SAMPLES_PER_PHASE)?[self.k];
         let mut quarter = regs;
         quarter.ref_phase = regs.ref_phase.wrapping_add(1 << 30);
-        self.board.program(&quarter).map_err(bus)?;
+        self.board.program(&quarter)?;
         let filter = kn.filter_settle_clocks();
-        let zq = average_z(self.board, r, filter, SAMPLES_PER_PHASE)?[self.k];
+        let zq = average_z(self.board, filter, SAMPLES_PER_PHASE)?[self.k];
         self.clocks += settle + filter + 2 * SAMPLES_PER_PHASE * u64::from(r);
         let amp_word = [regs.amp.0, regs.amp.1][self.k];
         let w = readout_word(amp_word);
         let y = C64::new(zi, zq) * (2.0 / (real.filter.dc_gain * w * w));
-        Ok((real.carrier_hz, y, y.norm() * w / ADC_FULL_SCALE))
+        Ok((real.carrier_hz, y, y.norm() * w / CONVERTER_FULL_SCALE))
     }
 
     /// `measure_once`, again at a quarter of the amplitude while the ADC
     /// may clip.
-    fn measure(&mut self, carrier_hz: f64) -> Result<(f64, C64), String> {
+    fn measure(&mut self, carrier_hz: f64) -> Result<(f64, C64), Error> {
         loop {
             let (f, y, full_scale) = self.measure_once(carrier_hz)?;
             if full_scale <= ADC_CLIP {
@@ -358,10 +204,10 @@ impl Prober<'_> {
             }
             self.amplitude /= 4.0;
             if self.amplitude * 32768.0 < 1.0 {
-                return Err(format!(
-                    "identification of mode {}: the response clips the ADC even at one DAC LSB",
-                    self.k + 1
-                ));
+                return Err(Error::Identification {
+                    mode: self.k + 1,
+                    reason: "the response clips the ADC even at one DAC LSB".into(),
+                });
             }
         }
     }
@@ -372,7 +218,7 @@ impl Prober<'_> {
         let max = [self.knowns.amplitude.0, self.knowns.amplitude.1][self.k].abs();
         // Word amplitude ~ a x PEAK^2 / 2^15 per unit amplitude.
         let per_unit = f64::from(PEAK) * f64::from(PEAK) / 32768.0;
-        let wanted = ADC_TARGET * ADC_FULL_SCALE / (peak * per_unit);
+        let wanted = ADC_TARGET * CONVERTER_FULL_SCALE / (peak * per_unit);
         if wanted.is_finite() && wanted > 0.0 {
             self.amplitude = wanted.min(max);
         }
@@ -407,7 +253,7 @@ fn narrow_band(points: &[(f64, C64)]) -> Option<(f64, f64, f64)> {
 
 /// Gauss-Newton fit of Y = C / ((fk - f)(fk + f) + j f bk) from a start
 /// (fk, bk); returns the mode's estimates.
-fn fit_mode(points: &[(f64, C64)], fk0: f64, bk0: f64) -> Result<ModeFit, String> {
+fn fit_mode(points: &[(f64, C64)], fk0: f64, bk0: f64) -> Result<ModeFit, &'static str> {
     let den = |fk: f64, bk: f64, f: f64| C64::new((fk - f) * (fk + f), f * bk);
     // Best C for given (fk, bk) is linear: C = sum(Y conj(1/den)) / sum |1/den|^2.
     let best_c = |fk: f64, bk: f64| {
@@ -469,7 +315,7 @@ fn fit_mode(points: &[(f64, C64)], fk0: f64, bk0: f64) -> Result<ModeFit, String
     let mut rss = 0.0;
     for _ in 0..30 {
         let (j, r) = jacobian(&p);
-        let (step, c) = scaled_solve(&j, &r).ok_or("identification: singular fit")?;
+        let (step, c) = scaled_solve(&j, &r).ok_or("singular fit")?;
         for (v, s) in p.iter_mut().zip(step.iter()) {
             *v += s;
         }
@@ -489,9 +335,7 @@ fn fit_mode(points: &[(f64, C64)], fk0: f64, bk0: f64) -> Result<ModeFit, String
     let sd = |a: usize| (s2 * cov[(a, a)]).sqrt();
     let (fk, bk) = (p[2], p[3]);
     if !(fk.is_finite() && bk.is_finite() && bk > 0.0) {
-        return Err(format!(
-            "identification: the fit diverged (f {fk} Hz, bandwidth {bk} Hz)"
-        ));
+        return Err("the fit diverged (no finite, positive bandwidth)");
     }
     let q = fk / bk;
     let q_sd = q * ((sd(3) / bk).powi(2) + (sd(2) / fk).powi(2)).sqrt();
@@ -525,7 +369,7 @@ pub fn identify_mode(
     knowns: &Knowns,
     k: usize,
     guess_hz: f64,
-) -> Result<(ModeFit, u64), String> {
+) -> Result<(ModeFit, u64), Error> {
     let max = [knowns.amplitude.0, knowns.amplitude.1][k].abs();
     let mut probe = Prober {
         board,
@@ -544,10 +388,10 @@ pub fn identify_mode(
             .map(|s| probe.measure(centre + s * bw))
             .collect::<Result<_, _>>()?;
         let Some((fk, bk, peak)) = narrow_band(&pts) else {
-            return Err(format!(
-                "identification of mode {}: no resonance seen near {centre} Hz",
-                k + 1
-            ));
+            return Err(Error::Identification {
+                mode: k + 1,
+                reason: format!("no resonance seen near {centre} Hz"),
+            });
         };
         probe.set_amplitude_for_peak(peak);
         let moved = fk - centre;
@@ -557,11 +401,9 @@ pub fn identify_mode(
             break;
         }
     }
-    let bk = found.ok_or_else(|| {
-        format!(
-            "identification of mode {}: the coarse search did not settle within {MAX_MOVES} moves",
-            k + 1
-        )
+    let bk = found.ok_or_else(|| Error::Identification {
+        mode: k + 1,
+        reason: format!("the coarse search did not settle within {MAX_MOVES} moves"),
     })?;
     // The mode's own time constant 1 / (pi bk), with the datasheet's 20%
     // margin for the narrow-band estimate of bk.
@@ -574,7 +416,10 @@ pub fn identify_mode(
     for s in order {
         sweep.push(probe.measure(centre + s * bk)?);
     }
-    let mut fit = fit_mode(&sweep, centre, bk)?;
+    let mut fit = fit_mode(&sweep, centre, bk).map_err(|reason| Error::Identification {
+        mode: k + 1,
+        reason: reason.into(),
+    })?;
     let eps = settling_residue();
     let floor = |e: &mut Estimate, bias: f64| e.uncertainty = e.uncertainty.hypot(bias);
     let bk = fit.f_hz.value / fit.q.value;
@@ -591,7 +436,7 @@ pub fn identify(
     board: &mut dyn Board,
     knowns: &Knowns,
     guess: &GyroParams,
-) -> Result<Identified, String> {
+) -> Result<Identified, Error> {
     let (m1, c1) = identify_mode(board, knowns, 0, guess.f1_hz)?;
     // Mode 2 from mode 1 plus the guess's split, scaled with mode 1's
     // move: the common drift (hundreds of Hz per K) is gone, what is left is

@@ -39,7 +39,7 @@
 //! holds the drive-gain ratio alone: the rate cancels. The cross responses
 //! are lambda Omega / bandwidth of the direct ones, so it needs a rate well
 //! above the noise: the cycle at rest cannot use it. When the device turns
-//! at a steady rate, [`super::drive_ratio`] measures it (the ratio is exact
+//! at a steady rate, [`crate::drive_ratio`] measures it (the ratio is exact
 //! at any rate, not only to first order) and [`apply_drive_ratio`] predicts
 //! again with it.
 //!
@@ -54,15 +54,16 @@
 //! words' realized amplitudes in each mode. Eqs. (5)/(6) at the same
 //! parameters are given beside it.
 
-use super::board::Board;
-use super::drive_ratio::DriveRatio;
-use super::identify::{self, Identified, Knowns, bus, readout_word};
-use crate::average::window_mean;
-use crate::experiment::envelope_lead_rad;
-use crate::fit::linear_fit;
-use crate::gyro::GyroParams;
-use crate::theory::{self, Device};
-use gyrocal_hdl::sine_table::PEAK;
+use crate::board::Board;
+use crate::device::GyroParams;
+use crate::drive_ratio::DriveRatio;
+use crate::error::Error;
+use crate::identify::{self, Identified, readout_word};
+use crate::knowns::Knowns;
+use crate::sampling::part_means;
+use crate::stats::linear_fit;
+use crate::theory::{self, Device, envelope_lead_rad, hold_gain};
+use gyrocal_regs::datapath::calibration_word;
 use serde::Serialize;
 use std::f64::consts::{PI, TAU};
 
@@ -160,7 +161,7 @@ pub struct SelfCal {
 
 /// The operating point for an identification: carrier at identified f1 plus
 /// the configured offset, reference lagged by the identified loop phase.
-pub fn operating(knowns: &Knowns, id: &Identified) -> Result<Operating, String> {
+pub fn operating(knowns: &Knowns, id: &Identified) -> Result<Operating, Error> {
     let asked = id.modes[0].f_hz.value + knowns.carrier_offset_hz;
     let lag = id.loop_phase_deg.value;
     let (_, real) = knowns.registers(asked, None, knowns.amplitude, lag)?;
@@ -169,47 +170,6 @@ pub fn operating(knowns: &Knowns, id: &Identified) -> Result<Operating, String> 
         ref_lag_deg: lag,
         envelope_delay_s: id.group_delay_s.value,
     })
-}
-
-/// Collect z from now for `span` clocks (one sample per R) and return the
-/// mean over [t0, t0 + length) clocks from now (interpolated: `average`).
-pub fn window_z(
-    board: &mut dyn Board,
-    decimation: u32,
-    t0: f64,
-    length: f64,
-) -> Result<[f64; 2], String> {
-    Ok(period_means(board, decimation, t0, length, 1)?[0])
-}
-
-/// As [`window_z`], the window cut into `periods` equal parts: the mean
-/// of each part, in order (their mean is the window's).
-pub fn period_means(
-    board: &mut dyn Board,
-    decimation: u32,
-    t0: f64,
-    length: f64,
-    periods: usize,
-) -> Result<Vec<[f64; 2]>, String> {
-    let r = f64::from(decimation);
-    let mut t = vec![];
-    let mut z = [vec![], vec![]];
-    let mut now = 0.0;
-    while now < t0 + length + r {
-        board.wait_clocks(u64::from(decimation));
-        now += r;
-        let s = board.read_z().map_err(bus)?;
-        t.push(now);
-        z[0].push(s.z[0]);
-        z[1].push(s.z[1]);
-    }
-    let part = length / periods as f64;
-    Ok((0..periods)
-        .map(|p| {
-            let a = t0 + p as f64 * part;
-            std::array::from_fn(|k| window_mean(&t, &z[k], a, a + part))
-        })
-        .collect())
 }
 
 /// A measured staircase.
@@ -241,7 +201,7 @@ pub fn staircase(
     board: &mut dyn Board,
     knowns: &Knowns,
     op: &Operating,
-) -> Result<Staircase, String> {
+) -> Result<Staircase, Error> {
     let clock = knowns.clock_hz;
     let r = knowns.filter.decimation;
     let mut cal_hz = vec![];
@@ -250,20 +210,20 @@ pub fn staircase(
     for (i, &f) in knowns.cal_freqs_hz.iter().enumerate() {
         let (regs, real) =
             knowns.registers(op.carrier_hz, Some(f), knowns.amplitude, op.ref_lag_deg)?;
-        board.program(&regs).map_err(bus)?;
+        board.program(&regs)?;
         let taus = if i == 0 {
             FIRST_SETTLE_TAUS
         } else {
             identify::SETTLE_TAUS
         };
         let settle = knowns.settle_clocks(taus);
-        board.wait_clocks(settle);
+        board.wait_clocks(settle)?;
         let period = clock / (2.0 * real.cal_hz);
         let periods = (knowns.filter.min_window_s * 2.0 * real.cal_hz)
             .ceil()
             .max(MIN_RIPPLE_PERIODS as f64);
         let length = periods * period;
-        parts.push(period_means(
+        parts.push(part_means(
             board,
             r,
             f64::from(r),
@@ -316,12 +276,6 @@ fn pooled_slope_uncertainty(
     var.sqrt()
 }
 
-/// Fundamental gain of the DAC's zero-order hold at `f_hz`.
-fn hold_gain(f_hz: f64, clock_hz: f64) -> f64 {
-    let x = PI * f_hz / clock_hz;
-    x.sin() / x
-}
-
 /// The predicted readout over calibration ratio in z LSB (module header)
 /// for a device `gyro` operated at `op`, with calibration frequencies
 /// `cal_hz` (realized).
@@ -330,7 +284,7 @@ pub fn predicted_ratio(
     gyro: &GyroParams,
     op: &Operating,
     cal_hz: &[f64],
-) -> Result<Ratio, String> {
+) -> Result<Ratio, Error> {
     predicted_ratio_lagged(knowns, gyro, op, cal_hz, 0.0)
 }
 
@@ -342,14 +296,13 @@ fn predicted_ratio_lagged(
     op: &Operating,
     cal_hz: &[f64],
     lag_rad: f64,
-) -> Result<Ratio, String> {
+) -> Result<Ratio, Error> {
     let clock = knowns.clock_hz;
     let (regs, _) = knowns.registers(op.carrier_hz, None, knowns.amplitude, 0.0)?;
     let amp = [regs.amp.0, regs.amp.1];
     let per_lsb = knowns.force_full_scale.map(|f| f / 32768.0);
-    let carrier_word = f64::from(PEAK) / 32768.0;
     let read_words = amp.map(readout_word);
-    let cal_words = amp.map(|a| (f64::from(a) * f64::from(PEAK) / 32768.0 * carrier_word).abs());
+    let cal_words = amp.map(|a| calibration_word(a).abs());
     let device = |words: [f64; 2]| Device {
         f1_hz: gyro.f1_hz,
         f2_hz: gyro.f2_hz,
@@ -399,7 +352,7 @@ pub fn self_calibrate(
     board: &mut dyn Board,
     knowns: &Knowns,
     guess: &GyroParams,
-) -> Result<SelfCal, String> {
+) -> Result<SelfCal, Error> {
     let identified = identify::identify(board, knowns, guess)?;
     let op = operating(knowns, &identified)?;
     let Staircase {
@@ -446,7 +399,7 @@ fn identified_uncertainty(
     op: &Operating,
     cal_hz: &[f64],
     ratio: &Ratio,
-) -> Result<[f64; 2], String> {
+) -> Result<[f64; 2], Error> {
     let gyro = id.gyro(&knowns.nominal);
     let [m1, m2] = &id.modes;
     let mut moved = vec![];
@@ -491,7 +444,7 @@ pub fn apply_drive_ratio(
     knowns: &Knowns,
     cal: &mut SelfCal,
     measured: DriveRatio,
-) -> Result<(), String> {
+) -> Result<(), Error> {
     let gyro = cal.identified.gyro(&knowns.nominal);
     let predict = |relative: f64| {
         predicted_ratio(

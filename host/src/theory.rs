@@ -2,7 +2,7 @@
 //!
 //! # Model and conventions
 //!
-//! Paper eqs (1)/(3) generalized to mismatched modes (see [`crate::gyro`]):
+//! Paper eqs (1)/(3) generalized to mismatched modes (see [`crate::device`]):
 //!
 //! ```text
 //! x1'' + B1 x1' - 2 lam Omz x2' + w1^2 x1 = f1,   x2'' + B2 x2' + 2 lam Omz x1' + w2^2 x2 = f2
@@ -54,12 +54,12 @@
 //! scale factors in (m^2/s^2) per rad/s.
 //!
 //! The functions do not validate their inputs (a NaN or a zero frequency
-//! propagates to the result); [`crate::gyro::GyroModel::new`] does.
+//! propagates to the result); the simulator's `GyroModel::new` does.
 
 use nalgebra::Complex;
 use std::f64::consts::TAU;
 
-use crate::gyro::GyroParams;
+use crate::device::GyroParams;
 
 type C64 = Complex<f64>;
 
@@ -85,7 +85,7 @@ pub struct Device {
 }
 
 impl Device {
-    /// The mechanical parameters, for [`crate::gyro::GyroModel::new`].
+    /// The mechanical parameters of the device.
     pub fn gyro_params(&self) -> GyroParams {
         GyroParams {
             f1_hz: self.f1_hz,
@@ -360,6 +360,27 @@ pub fn calibration_peak_displacement(dev: &Device, f_cal_hz: f64) -> [f64; 2] {
     let peak =
         |k: usize, f: f64| 0.5 * f * (1.0 / n.d(k, -om).norm() + 1.0 / n.d(k, om).norm()) / wb2;
     [peak(0, dev.f1_force), peak(1, dev.f2_force)]
+}
+
+/// The lead of the reference envelopes over the drive envelopes the
+/// datapath leaves in calibration (rad): the references are lined up with
+/// the drives' carrier to the half clock of the DAC's hold by `ref_phase`,
+/// but their envelope is not, so it is off by Om T / 2
+/// (`gyrocal_regs::plan`). Negligible in phase (1e-6 rad), but it mixes
+/// the resonant part of the response into the calibration output: 2e-4 of
+/// the calibration scale factor on a Q 200 device at 100 kHz and 3.33 MHz.
+pub fn envelope_lead_rad(cal_hz: f64, clock_hz: f64) -> f64 {
+    ENVELOPE_LEAD_SIGN * std::f64::consts::PI * cal_hz / clock_hz
+}
+
+/// The sign of the datapath's envelope lead (see `envelope_lead_rad`).
+const ENVELOPE_LEAD_SIGN: f64 = -1.0;
+
+/// Fundamental gain of the DAC's zero-order hold at `f_hz`, sin(x) / x with
+/// x = pi f / f_clk.
+pub fn hold_gain(f_hz: f64, clock_hz: f64) -> f64 {
+    let x = std::f64::consts::PI * f_hz / clock_hz;
+    x.sin() / x
 }
 
 #[cfg(test)]
