@@ -6,7 +6,7 @@
 #define GYRO_INTERFACE_REGS_H
 
 #define GYRO_ID_VALUE 0x4759524fu
-#define GYRO_VERSION_VALUE 0x00010000u
+#define GYRO_VERSION_VALUE 0x00010001u
 /* Samples the AXI4-Stream FIFO holds before it drops one. */
 #define GYRO_STREAM_FIFO_DEPTH 256u
 /* Clocks after configuration before the drives leave 0: the core fills its
@@ -142,6 +142,11 @@
 #define GYRO_Z2_HI_OFFSET 0x58u
 #define GYRO_Z2_HI_BITS 8u
 #define GYRO_Z2_HI_MASK 0x000000ffu
+
+/* ADC_CLIP: read-only, 32 bits. Clocks on which ADC1 (bits 15..0) and ADC2 (bits 31..16) read a rail code, -32768 or +32767, since the last read of this word; each count saturates at 65535. A read returns the counts and restarts them (a rail code on the clock of the read counts toward the next read). Any count means a measurement over that time was not linear. */
+#define GYRO_ADC_CLIP_OFFSET 0x5cu
+#define GYRO_ADC_CLIP_BITS 32u
+#define GYRO_ADC_CLIP_MASK 0xffffffffu
 
 /* z from the snapshot: read SAMPLE_COUNT first (it latches the set), then
  * z = ((int64_t)(int32_t)Z1_HI << 32) | Z1_LO, in 1/256 mixer LSB. */

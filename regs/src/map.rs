@@ -45,7 +45,7 @@ pub const DATA_BITS: usize = 32;
 /// The identification word: ASCII "GYRO".
 pub const ID_WORD: u32 = 0x4759_524f;
 /// Register map version: major in bits 31..16, minor in 15..0.
-pub const VERSION_WORD: u32 = 0x0001_0000;
+pub const VERSION_WORD: u32 = 0x0001_0001;
 
 /// Who may write a register.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -353,8 +353,17 @@ pub const Z2_HI: Register = status(
     "Bits 39..32 of the latched z2, sign-extended.",
 );
 
+/// ADC over-range counts; reading clears them.
+pub const ADC_CLIP: Register = status(
+    "ADC_CLIP",
+    0x5c,
+    32,
+    false,
+    "Clocks on which ADC1 (bits 15..0) and ADC2 (bits 31..16) read a rail code, -32768 or +32767, since the last read of this word; each count saturates at 65535. A read returns the counts and restarts them (a rail code on the clock of the read counts toward the next read). Any count means a measurement over that time was not linear.",
+);
+
 /// Every register, in offset order.
-pub const REGISTERS: [Register; 23] = [
+pub const REGISTERS: [Register; 24] = [
     ID,
     VERSION,
     SELECT,
@@ -378,6 +387,7 @@ pub const REGISTERS: [Register; 23] = [
     Z1_HI,
     Z2_LO,
     Z2_HI,
+    ADC_CLIP,
 ];
 
 /// The register at a byte offset (bits 1..0 ignored), if any.
@@ -600,6 +610,9 @@ const COHERENCE_NOTES: &str = r#"
   FIFO is full is dropped and counted in `STREAM_OVERFLOW`.
 - **Reset.** `aresetn` low (synchronous) returns every register above to its power-up
   value and empties the FIFO; the datapath core itself has no reset.
+- **Over range.** `ADC_CLIP` counts the clocks on which each ADC read a rail code; reading
+  it restarts both counts. Read it before and after a measurement: a non-zero second read
+  means the converter clipped during it.
 - **Power-up.** The core fills its carrier tables during its first clocks: the drives are
   0 until clock {drive_start} after configuration (`GYRO_DRIVE_START_CLOCKS`), and so are
   the references the demodulators use.

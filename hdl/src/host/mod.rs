@@ -9,6 +9,7 @@
 //!   design driven directly with the same interface.
 
 pub mod axi_top;
+pub mod clip_counter;
 pub mod model;
 /// The register map, from the leaf crate `gyrocal-regs`.
 pub use gyrocal_regs::map as register_map;

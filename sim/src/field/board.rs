@@ -20,9 +20,10 @@ use crate::engine::{Engine, ModelEngine};
 use crate::frontend::{Converters, FrontEnd, PickoffPhase};
 use crate::gyro::GyroModel;
 use crate::noise::ThermalNoise;
+use gyrocal_hdl::host::clip_counter::{ClipCount, clip_word};
 use gyrocal_hdl::model::gyro_interface::Outputs;
 pub use gyrocal_host::board::{Board, ZSample};
-use gyrocal_regs::map::{BusError, RegisterAccess};
+use gyrocal_regs::map::{ADC_CLIP, BusError, RegisterAccess};
 
 /// The model engine, converters and gyroscope behind the register map.
 pub struct SimBoard {
@@ -34,6 +35,7 @@ pub struct SimBoard {
     outputs: Outputs,
     samples: u32,
     cycle: u64,
+    clip: [ClipCount; 2],
 }
 
 impl SimBoard {
@@ -68,6 +70,7 @@ impl SimBoard {
             outputs: Outputs::default(),
             samples: 0,
             cycle: 0,
+            clip: [ClipCount::default(); 2],
         })
     }
 
@@ -91,6 +94,8 @@ impl SimBoard {
             }
         };
         let (adc, force) = self.converters.step(self.outputs.dac, x);
+        self.clip[0].step(adc.0, false);
+        self.clip[1].step(adc.1, false);
         self.outputs = self.engine.step(adc, self.host.registers());
         self.gyro.step(force.0, force.1);
         self.samples = self.samples.wrapping_add(self.outputs.z_valid as u32);
@@ -122,9 +127,15 @@ impl RegisterAccess for SimBoard {
         self.host.write(offset, word)
     }
 
-    /// A read between two clocks; SAMPLE_COUNT latches z. STREAM_OVERFLOW
-    /// is 0: the board has no stream consumer.
+    /// A read between two clocks; SAMPLE_COUNT latches z, ADC_CLIP returns
+    /// the over-range counts and restarts them. STREAM_OVERFLOW is 0: the
+    /// board has no stream consumer.
     fn read_register(&mut self, offset: u32) -> Result<u32, BusError> {
+        if offset & !3 == ADC_CLIP.offset {
+            let word = clip_word(self.clip);
+            self.clip = [ClipCount::default(); 2];
+            return Ok(word);
+        }
         self.host.read(offset, self.outputs.z, self.samples)
     }
 }
