@@ -6,9 +6,18 @@
 //! mismatched modes (one frequency and one Q per mode):
 //!
 //! ```text
-//! x1'' + B1 x1' - 2 lam Omz x2' + w1^2 x1 = f1(t)
-//! x2'' + B2 x2' + 2 lam Omz x1' + w2^2 x2 = f2(t)        Bk = wk / Qk,  wk = 2 pi fk
+//! x1'' + B1 x1' - 2 lam Omz x2' + w1^2 x1 + d x2' + k x2 = f1(t)
+//! x2'' + B2 x2' + 2 lam Omz x1' + w2^2 x2 + d x1' + k x1 = f2(t)
+//! Bk = wk / Qk,  wk = 2 pi fk,  k = 2 lam w1 Omq,  d = 2 lam Omd
 //! ```
+//!
+//! `k` is the quadrature (stiffness) coupling, `Omq` = `quadrature_dps` in
+//! rad/s: at mode 1's frequency its force on mode 2 is as large as the
+//! Coriolis force of a rate `Omq`, 90 deg from it. `d` is the damping
+//! coupling, `Omd` = `damping_coupling_dps` in rad/s: its force is as large
+//! as the Coriolis force of a rate `Omd` at every frequency, in phase with
+//! it, but symmetric (it acts on mode 1 with the same sign as on mode 2,
+//! where Coriolis changes sign). Both default to 0 (the paper's model).
 //!
 //! # Units
 //!
@@ -44,9 +53,15 @@
 
 use crate::noise::{self, Mat4, StateNoise, ThermalNoise};
 use nalgebra::SMatrix;
+use std::f64::consts::TAU;
+
+/// Largest |quadrature_dps| and |damping_coupling_dps| (deg/s), as for a
+/// rate: real devices carry tens to thousands of deg/s of quadrature.
+pub const MAX_COUPLING_DPS: f64 = 1e5;
 
 /// Physical parameters of the two-mode gyroscope (the `[gyro]` section of
-/// a configuration file: every key required).
+/// a configuration file: the mode keys required, the couplings 0 unless
+/// given).
 #[derive(Clone, Debug, PartialEq, serde::Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct GyroParams {
@@ -60,7 +75,111 @@ pub struct GyroParams {
     pub q2: f64,
     /// Angular gain lambda (Coriolis coupling is 2 lambda Omz).
     pub angular_gain: f64,
+    /// Quadrature (stiffness) coupling Omq (deg/s, default 0): `+ k x2` in
+    /// mode 1's equation and `+ k x1` in mode 2's, `k = 2 lambda w1 Omq`
+    /// (Omq in rad/s; module header).
+    #[serde(default)]
+    pub quadrature_dps: f64,
+    /// Damping coupling Omd (deg/s, default 0): `+ d x2'` in mode 1's
+    /// equation and `+ d x1'` in mode 2's, `d = 2 lambda Omd` (Omd in rad/s).
+    #[serde(default)]
+    pub damping_coupling_dps: f64,
 }
+
+impl GyroParams {
+    /// The quadrature stiffness `k = 2 lambda w1 Omq` (1/s^2).
+    pub fn quadrature_stiffness(&self) -> f64 {
+        2.0 * self.angular_gain * TAU * self.f1_hz * self.quadrature_dps.to_radians()
+    }
+
+    /// The damping coupling `d = 2 lambda Omd` (1/s).
+    pub fn damping_coupling(&self) -> f64 {
+        2.0 * self.angular_gain * self.damping_coupling_dps.to_radians()
+    }
+
+    /// Whether the modes are coupled at rest (a coupling is not zero).
+    pub fn coupled_at_rest(&self) -> bool {
+        self.quadrature_stiffness() != 0.0 || self.damping_coupling() != 0.0
+    }
+
+    /// The slowest amplitude time constant of the free modes (s): `2 Qk /
+    /// wk` of the slower mode; with a damping coupling `d`, `2 / b_min`
+    /// with `b_min` the smallest eigenvalue of the damping matrix
+    /// `[[B1, d], [d, B2]]`, `(B1 + B2)/2 - sqrt(((B1 - B2)/2)^2 + d^2)`
+    /// (the modes may mix fully; a stiffness coupling or a rotation only
+    /// mixes them, each mixed mode decaying between B1/2 and B2/2).
+    pub fn slowest_time_constant_s(&self) -> f64 {
+        let (w1, w2) = (TAU * self.f1_hz, TAU * self.f2_hz);
+        let d = self.damping_coupling();
+        if d == 0.0 {
+            (2.0 * self.q1 / w1).max(2.0 * self.q2 / w2)
+        } else {
+            let (b1, b2) = (w1 / self.q1, w2 / self.q2);
+            2.0 / (0.5 * (b1 + b2) - (0.25 * (b1 - b2).powi(2) + d * d).sqrt())
+        }
+    }
+
+    /// The stability limits of |quadrature_dps| and |damping_coupling_dps|
+    /// (deg/s, exclusive) of a passive device: a positive definite
+    /// stiffness matrix, `k^2 < w1^2 w2^2`, i.e. `|Omq| < w2 / (2 |lambda|)`,
+    /// and a positive definite damping matrix, `d^2 < B1 B2`, i.e.
+    /// `|Omd| < sqrt(B1 B2) / (2 |lambda|)` (infinite for lambda = 0).
+    pub fn coupling_limits_dps(&self) -> [f64; 2] {
+        let two_lambda = 2.0 * self.angular_gain.abs();
+        let (w1, w2) = (TAU * self.f1_hz, TAU * self.f2_hz);
+        let damping = (w1 / self.q1 * w2 / self.q2).sqrt();
+        [w2, damping].map(|limit| (limit / two_lambda).to_degrees())
+    }
+
+    /// Checks both couplings: finite, |value| <= `MAX_COUPLING_DPS` and
+    /// below [`GyroParams::coupling_limits_dps`] (the other fields must be
+    /// valid).
+    pub fn check_couplings(&self) -> Result<(), CouplingOutOfRange> {
+        let limits = self.coupling_limits_dps();
+        let fields = [
+            ("quadrature_dps", self.quadrature_dps),
+            ("damping_coupling_dps", self.damping_coupling_dps),
+        ];
+        for ((field, value), limit_dps) in fields.into_iter().zip(limits) {
+            if !(value.is_finite() && value.abs() <= MAX_COUPLING_DPS && value.abs() < limit_dps) {
+                return Err(CouplingOutOfRange {
+                    field,
+                    value,
+                    limit_dps,
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A coupling out of its range ([`GyroParams::check_couplings`]); its
+/// message is one line naming the field, its value and what is allowed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CouplingOutOfRange {
+    /// `quadrature_dps` or `damping_coupling_dps`.
+    pub field: &'static str,
+    /// The value (deg/s).
+    pub value: f64,
+    /// The stability limit (deg/s, exclusive).
+    pub limit_dps: f64,
+}
+
+impl std::fmt::Display for CouplingOutOfRange {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (name, value, limit) = (self.field, self.value, self.limit_dps);
+        let matrix = match name {
+            "quadrature_dps" => "w2",
+            _ => "sqrt(B1 B2)",
+        };
+        write!(
+            f,
+            "{name} = {value}: allowed |{name}| <= {MAX_COUPLING_DPS:e} deg/s and < {limit:.6e} deg/s ({matrix} / (2 |angular_gain|), beyond which a mode is unstable)"
+        )
+    }
+}
+
+impl std::error::Error for CouplingOutOfRange {}
 
 /// Transition and input matrices of one clock period, as plain arrays.
 #[derive(Clone, Debug, PartialEq)]
@@ -80,7 +199,8 @@ pub struct GyroModel {
     /// Reference angular frequency used to scale velocities (rad/s).
     wr: f64,
     omz: f64,
-    /// `Omz != 0` (and lambda != 0): the full 4x4 step is needed.
+    /// The modes are coupled (a coupling, or `Omz != 0` and lambda != 0):
+    /// the full 4x4 step is needed.
     coupled: bool,
     rest: Discrete,
     cur: Discrete,
@@ -102,7 +222,8 @@ impl GyroModel {
     ///
     /// Errors (one line, naming the field) unless `clock_hz` is finite and > 0,
     /// both mode frequencies are finite and in (0, clock_hz/2), both Q are finite
-    /// and > 0, and the angular gain is finite.
+    /// and > 0, the angular gain is finite and both couplings are in range
+    /// ([`GyroParams::check_couplings`]).
     pub fn new(params: &GyroParams, clock_hz: f64) -> Result<GyroModel, String> {
         check("clock_hz", clock_hz, clock_hz > 0.0, "finite and > 0 Hz")?;
         let nyq = clock_hz / 2.0;
@@ -122,6 +243,7 @@ impl GyroModel {
         check("q1", params.q1, params.q1 > 0.0, "finite and > 0")?;
         check("q2", params.q2, params.q2 > 0.0, "finite and > 0")?;
         check("angular_gain", params.angular_gain, true, "finite")?;
+        params.check_couplings().map_err(|e| e.to_string())?;
         let w1 = std::f64::consts::TAU * params.f1_hz;
         let w2 = std::f64::consts::TAU * params.f2_hz;
         let wr = 0.5 * (w1 + w2);
@@ -130,7 +252,7 @@ impl GyroModel {
             clock_hz,
             wr,
             omz: 0.0,
-            coupled: false,
+            coupled: params.coupled_at_rest(),
             rest: Discrete {
                 phi: [[0.0; 4]; 4],
                 gamma: [[0.0; 2]; 4],
@@ -143,16 +265,18 @@ impl GyroModel {
             thermal: None,
         };
         let mut rest = model.discretize(0.0);
-        // Decoupled modes: the off-diagonal blocks are zero in exact arithmetic
-        // (and in nalgebra's Pade evaluation); make that explicit, since step()
-        // skips them at Omz = 0.
-        for (i, j) in [(0, 2), (0, 3), (1, 2), (1, 3)] {
-            rest.phi[i][j] = 0.0;
-            rest.phi[j][i] = 0.0;
-        }
-        for i in 0..2 {
-            rest.gamma[i][1] = 0.0;
-            rest.gamma[i + 2][0] = 0.0;
+        if !model.coupled {
+            // Decoupled modes: the off-diagonal blocks are zero in exact
+            // arithmetic (and in nalgebra's Pade evaluation); make that
+            // explicit, since step() skips them when uncoupled.
+            for (i, j) in [(0, 2), (0, 3), (1, 2), (1, 3)] {
+                rest.phi[i][j] = 0.0;
+                rest.phi[j][i] = 0.0;
+            }
+            for i in 0..2 {
+                rest.gamma[i][1] = 0.0;
+                rest.gamma[i + 2][0] = 0.0;
+            }
         }
         model.rest = rest;
         model.cur = model.rest.clone();
@@ -169,14 +293,16 @@ impl GyroModel {
         let (b1, b2) = (w1 / p.q1, w2 / p.q2);
         let g = 2.0 * p.angular_gain * omz;
         let wr = self.wr;
+        let k = p.quadrature_stiffness() / wr;
+        let d = p.damping_coupling();
         // Scaled state s = [x1, u1, x2, u2], u = v/wr; scaled input g_k = f_k/wr^2:
-        //   x1' = wr u1,  u1' = -(w1^2/wr) x1 - B1 u1 + 2 lam Omz u2 + wr g1
-        //   x2' = wr u2,  u2' = -(w2^2/wr) x2 - B2 u2 - 2 lam Omz u1 + wr g2
+        //   x1' = wr u1,  u1' = -(w1^2/wr) x1 - B1 u1 - (k/wr) x2 + (2 lam Omz - d) u2 + wr g1
+        //   x2' = wr u2,  u2' = -(w2^2/wr) x2 - B2 u2 - (k/wr) x1 - (2 lam Omz + d) u1 + wr g2
         SMatrix::<f64, 6, 6>::from_row_slice(&[
-            0.0,           wr,  0.0,           0.0, 0.0, 0.0,
-            -w1 * w1 / wr, -b1, 0.0,           g,   wr,  0.0,
-            0.0,           0.0, 0.0,           wr,  0.0, 0.0,
-            0.0,           -g,  -w2 * w2 / wr, -b2, 0.0, wr,
+            0.0,           wr,     0.0,           0.0,   0.0, 0.0,
+            -w1 * w1 / wr, -b1,    -k,            g - d, wr,  0.0,
+            0.0,           0.0,    0.0,           wr,    0.0, 0.0,
+            -k,            -g - d, -w2 * w2 / wr, -b2,   0.0, wr,
             0.0,           0.0, 0.0,           0.0, 0.0, 0.0,
             0.0,           0.0, 0.0,           0.0, 0.0, 0.0,
         ])
@@ -191,10 +317,18 @@ impl GyroModel {
         let a = self.augmented(omz).fixed_view::<4, 4>(0, 0).into_owned() * t;
         let inv_wr2 = 1.0 / (self.wr * self.wr);
         let mut intensity = Mat4::zeros();
-        intensity[(1, 1)] = noise.force_psd(p.f1_hz, p.q1) / 2.0 * inv_wr2 * t;
+        let psd1 = noise.force_psd(p.f1_hz, p.q1);
+        intensity[(1, 1)] = psd1 / 2.0 * inv_wr2 * t;
         intensity[(3, 3)] = noise.force_psd(p.f2_hz, p.q2) / 2.0 * inv_wr2 * t;
+        // Fluctuation-dissipation: the force noise's covariance is that of
+        // the damping matrix [[B1, d], [d, B2]], so the damping coupling
+        // correlates the two forces by d / B1 of mode 1's PSD.
+        let b1 = TAU * p.f1_hz / p.q1;
+        let cross = psd1 * (p.damping_coupling() / b1) / 2.0 * inv_wr2 * t;
+        intensity[(1, 3)] = cross;
+        intensity[(3, 1)] = cross;
         let mut qd = noise::discrete_covariance(&a, &intensity);
-        if omz == 0.0 || p.angular_gain == 0.0 {
+        if !self.coupled_at(omz) {
             // Decoupled modes: independent increments (zero in exact arithmetic).
             for i in 0..2 {
                 for j in 2..4 {
@@ -223,6 +357,11 @@ impl GyroModel {
     /// The Brownian noise settings, when the noise is on.
     pub fn thermal_noise(&self) -> Option<&ThermalNoise> {
         self.thermal.as_ref().map(|(settings, _)| settings)
+    }
+
+    /// Whether the modes are coupled at rate `omz` (rad/s).
+    fn coupled_at(&self, omz: f64) -> bool {
+        (omz != 0.0 && self.params.angular_gain != 0.0) || self.params.coupled_at_rest()
     }
 
     /// Exact ZOH discretization at rate `omz` (rad/s).
@@ -261,7 +400,7 @@ impl GyroModel {
             return;
         }
         self.omz = omz_rad_s;
-        self.coupled = omz_rad_s != 0.0 && self.params.angular_gain != 0.0;
+        self.coupled = self.coupled_at(omz_rad_s);
         self.cur = if omz_rad_s == 0.0 {
             self.rest.clone()
         } else {
@@ -280,8 +419,9 @@ impl GyroModel {
     /// Advances one clock period with the forces per unit mass `f1`, `f2` (N/kg)
     /// held constant over it (zero-order hold).
     ///
-    /// At `Omz = 0` the modes are decoupled and only the two 2x2 diagonal blocks
-    /// are used (the others are exactly zero): about 1.3x faster, same result.
+    /// At `Omz = 0` without coupling the modes are decoupled and only the two
+    /// 2x2 diagonal blocks are used (the others are exactly zero): about 1.3x
+    /// faster, same result. A coupling keeps the full 4x4 step at rest.
     /// With thermal noise on, the clock's Brownian increment is added.
     #[inline]
     pub fn step(&mut self, f1: f64, f2: f64) {
