@@ -11,13 +11,15 @@
 //! ratio without it (same points, same fit) lies more than 10 sigma of
 //! the run away on the output it moves most, so a model or a theory that
 //! dropped the coupling would fail. Each test prints the ratio shift the
-//! coupling causes (the figure README quotes).
+//! coupling causes, fitted over its points and small-signal (the figures
+//! README quotes).
 
 use gyrocal_sim::config;
 use gyrocal_sim::engine::EngineKind;
 use gyrocal_sim::experiment::{self, Experiment, Mode};
 use gyrocal_sim::fit::linear_fit;
 use gyrocal_sim::report::{Report, run};
+use gyrocal_sim::theory::sf_ratio;
 
 /// The exact theory's fitted ratios of `exp` at its planned points.
 fn exact_ratio(exp: &Experiment) -> [f64; 2] {
@@ -43,9 +45,17 @@ fn check(name: &str, text: &str) {
     uncoupled.gyro.quadrature_dps = 0.0;
     uncoupled.gyro.damping_coupling_dps = 0.0;
     let without = exact_ratio(&uncoupled);
+    let plan = experiment::plan(&uncoupled).expect("plan");
+    let small_without = sf_ratio(&plan.theory_device(&uncoupled));
+    let small = r.theory.small_signal.ratio;
     eprintln!(
-        "{name}: {} rounds, {} clocks in {:.1} s",
-        r.timing.rounds, r.timing.cycles, r.timing.wall_s
+        "{name}: {} rounds, {} clocks in {:.1} s; small-signal ratios {small:.6?}, \
+         without the coupling {small_without:.6?}: moved by {:+.3}%, {:+.3}%",
+        r.timing.rounds,
+        r.timing.cycles,
+        r.timing.wall_s,
+        100.0 * (small[0] / small_without[0] - 1.0),
+        100.0 * (small[1] / small_without[1] - 1.0)
     );
     let mut sigmas_from_uncoupled = 0.0f64;
     for (k, &w) in without.iter().enumerate() {
