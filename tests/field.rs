@@ -37,6 +37,7 @@ fn gains_only(adc: [f64; 2], drive: [f64; 2]) -> Drift {
         front_end_phase_deg_per_k: 0.0,
         adc_gain_ppm_per_k: adc,
         drive_gain_ppm_per_k: drive,
+        quadrature_dps_per_k: 0.0,
     }
 }
 

@@ -17,6 +17,7 @@ fn drift(phase_deg: f64) -> Drift {
         front_end_phase_deg_per_k: 0.0,
         adc_gain_ppm_per_k: [0.0; 2],
         drive_gain_ppm_per_k: [0.0; 2],
+        quadrature_dps_per_k: 0.0,
     }
 }
 

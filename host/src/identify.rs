@@ -141,14 +141,15 @@ pub struct Identified {
 }
 
 impl Identified {
-    /// The identified mechanical parameters, lambda from the datasheet.
+    /// The identified mechanical parameters, lambda and the couplings from
+    /// the datasheet.
     pub fn gyro(&self, nominal: &GyroParams) -> GyroParams {
         GyroParams {
             f1_hz: self.modes[0].f_hz.value,
             f2_hz: self.modes[1].f_hz.value,
             q1: self.modes[0].q.value,
             q2: self.modes[1].q.value,
-            angular_gain: nominal.angular_gain,
+            ..nominal.clone()
         }
     }
 }

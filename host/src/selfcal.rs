@@ -309,6 +309,8 @@ fn predicted_ratio_lagged(
         q1: gyro.q1,
         q2: gyro.q2,
         angular_gain: gyro.angular_gain,
+        quadrature_dps: gyro.quadrature_dps,
+        damping_coupling_dps: gyro.damping_coupling_dps,
         carrier_hz: op.carrier_hz,
         f1_force: words[0] * per_lsb[0],
         f2_force: words[1] * per_lsb[1],

@@ -3,6 +3,7 @@
 //!
 //! ```toml
 //! [gyro]        # required: f1_hz, f2_hz, q1, q2, angular_gain
+//!               # quadrature_dps, damping_coupling_dps (0): mode couplings
 //! [drive]       # required: carrier_hz, clock_hz
 //!               # amplitude1, amplitude2 (0.9), force_full_scale1_n_per_kg,
 //!               # force_full_scale2_n_per_kg (1.0)
@@ -317,6 +318,8 @@ impl Experiment {
                 q1: 55_000.0,
                 q2: 55_000.0,
                 angular_gain: 0.6,
+                quadrature_dps: 0.0,
+                damping_coupling_dps: 0.0,
             },
             drive: Drive::new(9.64e6, 50e6),
             // Dithered converters, the default: the readout's rate signal
@@ -420,7 +423,8 @@ impl Experiment {
             g.angular_gain,
             true,
             "must be a finite number",
-        )
+        )?;
+        g.check_couplings().map_err(|e| format!("[gyro] {e}"))
     }
 
     fn validate_drive(&self) -> Result<(), String> {
@@ -708,6 +712,25 @@ mod tests {
     }
 
     #[test]
+    fn the_couplings_default_to_zero_and_round_trip() {
+        let e = parse("c.toml", REQUIRED).unwrap();
+        assert_eq!(
+            [e.gyro.quadrature_dps, e.gyro.damping_coupling_dps],
+            [0.0; 2]
+        );
+        let text = REQUIRED.replace(
+            "q1 = 5000",
+            "q1 = 5000\nquadrature_dps = -300.5\ndamping_coupling_dps = 20",
+        );
+        let e = parse("c.toml", &text).unwrap();
+        assert_eq!(
+            [e.gyro.quadrature_dps, e.gyro.damping_coupling_dps],
+            [-300.5, 20.0]
+        );
+        assert_eq!(parse("c.toml", &toml::to_string(&e).unwrap()).unwrap(), e);
+    }
+
+    #[test]
     fn a_missing_required_key_is_named() {
         let text = REQUIRED.replace("carrier_hz = 1.0123e6\n", "");
         let err = parse("c.toml", &text).unwrap_err();
@@ -768,6 +791,15 @@ mod tests {
             (
                 format!("{REQUIRED}[frontend]\nadc_per_meter1 = 1e9\n"),
                 "[frontend] adc_per_meter1 and adc_per_meter2",
+            ),
+            (
+                REQUIRED.replace("q1 = 5000", "q1 = 5000\nquadrature_dps = 2e5"),
+                "[gyro] quadrature_dps = 200000: allowed |quadrature_dps| <= 1e5 deg/s",
+            ),
+            (
+                // sqrt(B1 B2) / (2 lambda) = 1060.1 rad/s = 60,740 deg/s.
+                REQUIRED.replace("q1 = 5000", "q1 = 5000\ndamping_coupling_dps = -8e4"),
+                "[gyro] damping_coupling_dps = -80000: allowed",
             ),
         ];
         for (text, start) in cases {

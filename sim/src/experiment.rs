@@ -7,7 +7,8 @@
 //! made of equal batches (`crate::average`). Both are derived, never guessed:
 //!
 //! - Settling. From rest the resonator's transient decays as exp(-t / tau)
-//!   with tau = 2 Q_k / w_k (the slowest mode). It starts as large as the
+//!   with tau = 2 Q_k / w_k (the slowest mode; with a damping coupling,
+//!   `GyroParams::slowest_time_constant_s`). It starts as large as the
 //!   largest low-frequency term of z at that output, Z (the readout offset
 //!   of a detuned mode, or the calibration ripple), and must fall below
 //!   `tolerance / SETTLE_MARGIN` times the signal the fit measures at that
@@ -232,6 +233,8 @@ impl Plan {
             q1: exp.gyro.q1,
             q2: exp.gyro.q2,
             angular_gain: exp.gyro.angular_gain,
+            quadrature_dps: exp.gyro.quadrature_dps,
+            damping_coupling_dps: exp.gyro.damping_coupling_dps,
             carrier_hz: self.carrier_hz,
             f1_force: words[0] * self.front_end.force_per_lsb[0],
             f2_force: words[1] * self.front_end.force_per_lsb[1],
@@ -441,8 +444,7 @@ pub fn plan(exp: &Experiment) -> Result<Plan, String> {
     Converters::new(&plan.front_end)?;
 
     // Settling: see the module header.
-    let w = [TAU * exp.gyro.f1_hz, TAU * exp.gyro.f2_hz];
-    plan.tau_s = (2.0 * exp.gyro.q1 / w[0]).max(2.0 * exp.gyro.q2 / w[1]);
+    plan.tau_s = exp.gyro.slowest_time_constant_s();
     let sigma = (TAU * derived.butterworth_hz / 2f64.sqrt()).min(TAU * derived.rc_hz);
     let sf_read = theory::sf_read_per_rad_s(&dev).map(|v| v * rad);
     let sf_cal = theory::sf_cal_per_rad_s(&dev).map(|v| v * rad);

@@ -114,6 +114,9 @@ pub fn parse(name: &str, text: &str) -> Result<Scenario, String> {
     exp.validate().map_err(|e| format!("{name}: {e}"))?;
     let derived = exp.derived().map_err(|e| format!("{name}: {e}"))?;
     file.drift.validate().map_err(|e| format!("{name}: {e}"))?;
+    file.drift
+        .validate_device(&exp.gyro)
+        .map_err(|e| format!("{name}: {e}"))?;
     if let Some(p) = &file.profile {
         let sample_s = f64::from(derived.decimation) / exp.drive.clock_hz;
         p.validate(sample_s).map_err(|e| format!("{name}: {e}"))?;
