@@ -170,6 +170,7 @@ fn rounding_moves_the_resonant_outputs_rate_table() {
             carrier_hz: sc.exp.drive.carrier_hz,
             ref_lag_deg: 0.0,
             envelope_delay_s: 0.0,
+            amplitude: knowns.amplitude,
         };
         let (sf0, _) = scenario::rate_table(&sc.exp, &fe, &at, &knowns, &op).unwrap();
         for level in [0.99, 0.98, 0.9, 0.5] {

@@ -194,10 +194,7 @@ pub fn measure(
     let mut w1 = 0.0;
     let mut clocks = 0;
     for (s, sign) in [1.0, -1.0].into_iter().enumerate() {
-        let amps = (
-            DRIVE1_FRACTION * knowns.amplitude.0,
-            sign * knowns.amplitude.1,
-        );
+        let amps = (DRIVE1_FRACTION * op.amplitude.0, sign * op.amplitude.1);
         let (regs, _) = knowns.registers(op.carrier_hz, None, amps, op.ref_lag_deg)?;
         w1 = signed_readout_word(regs.amp.0);
         words[s] = signed_readout_word(regs.amp.1);

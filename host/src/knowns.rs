@@ -49,8 +49,9 @@ pub struct Knowns {
     pub adc_latency: u32,
     /// Output filter and first averaging window.
     pub filter: Derived,
-    /// Operating carrier minus mode 1's frequency (Hz), kept when retuning.
-    pub carrier_offset_hz: f64,
+    /// The configured carrier (Hz): where the host operates against the
+    /// datasheet's modes (`operating_carrier`).
+    pub carrier_hz: f64,
     /// Rates of the factory rate table (deg/s).
     pub rates_dps: Vec<f64>,
     /// Calibration frequencies of the staircase (Hz).
@@ -110,6 +111,32 @@ impl Knowns {
     pub fn settle_clocks(&self, taus: f64) -> u64 {
         let tau = self.tau_s(0).max(self.tau_s(1));
         (taus * tau * self.clock_hz).ceil() as u64 + self.filter_settle_clocks()
+    }
+
+    /// The carrier for identified modes at `f1` and `f2` (Hz): the
+    /// configured carrier keeps its offset from the nearer datasheet mode,
+    /// so a carrier written at the datasheet's mode 1 follows mode 1
+    /// wherever it is found, one written midway keeps its offset from the
+    /// nearer mode, and a datasheet whose f1 is off (process spread)
+    /// carries no error into the operating point.
+    pub fn operating_carrier(&self, f1: f64, f2: f64) -> f64 {
+        let (d1, d2) = (self.nominal.f1_hz, self.nominal.f2_hz);
+        let c = self.carrier_hz;
+        if (c - d1).abs() <= (c - d2).abs() {
+            f1 + (c - d1)
+        } else {
+            f2 + (c - d2)
+        }
+    }
+
+    /// These knowns with `gyro` as the device: every wait after
+    /// identification uses the identified modes, not the datasheet's.
+    pub fn with_device(&self, gyro: &GyroParams) -> Self {
+        Self {
+            nominal: gyro.clone(),
+            carrier_hz: self.operating_carrier(gyro.f1_hz, gyro.f2_hz),
+            ..self.clone()
+        }
     }
 
     /// Datasheet bandwidth f / Q of mode k (Hz).

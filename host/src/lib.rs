@@ -8,7 +8,8 @@
 //! Read in order, from a call to [`selfcal::self_calibrate`] down to a
 //! register write:
 //!
-//! - [`device`]: the gyroscope's parameters (datasheet, identified, truth);
+//! - [`device`]: the gyroscope's parameters (datasheet, identified, truth),
+//!   and [`datasheet`], what the host is told;
 //! - [`knowns`]: what the host knows (clock, datasheet, its settings) and
 //!   the registers it writes for a carrier, a calibration frequency, drive
 //!   amplitudes and a phase correction (`gyrocal_regs::plan`);
@@ -28,6 +29,8 @@
 
 pub mod average;
 pub mod board;
+pub mod clip;
+pub mod datasheet;
 pub mod device;
 pub mod drive_ratio;
 pub mod error;

@@ -72,6 +72,11 @@ pub struct Experiment {
     /// `[noise]`: thermomechanical force noise (off, 0 K, when unset).
     #[serde(default)]
     pub noise: ThermalNoise,
+    /// `[datasheet]`: what host code is told about the device, key by key
+    /// over `[gyro]` (`gyrocal field`, `gyrocal calibrate`; `run` compares
+    /// with `[gyro]` and does not use it).
+    #[serde(default)]
+    pub datasheet: gyrocal_host::datasheet::Datasheet,
 }
 
 /// `[drive]`.
@@ -350,6 +355,7 @@ impl Experiment {
                 )
             },
             noise: ThermalNoise::default(),
+            datasheet: Default::default(),
         }
     }
 
@@ -369,6 +375,7 @@ impl Experiment {
             filter: Filter::default(),
             points: Points::new(readout_rates_dps, cal_freqs_hz),
             noise: ThermalNoise::default(),
+            datasheet: Default::default(),
         }
     }
 
@@ -386,6 +393,7 @@ impl Experiment {
         self.validate_drive()?;
         self.validate_frontend()?;
         self.validate_points()?;
+        self.datasheet.over(&self.gyro).map_err(|e| e.to_string())?;
         self.noise.validate().map_err(|e| format!("[noise] {e}"))
     }
 

@@ -138,7 +138,7 @@ mod tests {
                 _ => (r >> 8) as i16,
             };
             // Rare clears early on, none in the middle stretch: the count saturates.
-            let clear = (cycle < 2000 || cycle > 68_000) && (r >> 40) % 50 == 0;
+            let clear = !(2000..=68_000).contains(&cycle) && (r >> 40).is_multiple_of(50);
             uut.adc.next = i64::from(adc).into();
             uut.clear.next = clear;
             uut.reset.next = false;

@@ -38,6 +38,7 @@ use crate::frontend::FrontEnd;
 use crate::gyro::GyroParams;
 use crate::noise::ThermalNoise;
 use gyrocal_host::Knowns;
+use gyrocal_host::datasheet::Datasheet;
 use gyrocal_host::drive_ratio;
 use gyrocal_host::sampling::window_z;
 use gyrocal_host::selfcal::{self, Operating, SelfCal};
@@ -73,6 +74,8 @@ struct ScenarioFile {
     profile: Option<Profile>,
     #[serde(default)]
     drive_probe: Option<DriveProbe>,
+    #[serde(default)]
+    datasheet: Datasheet,
 }
 
 /// A checked scenario.
@@ -110,6 +113,7 @@ pub fn parse(name: &str, text: &str) -> Result<Scenario, String> {
         filter: file.filter,
         points: file.experiment,
         noise: file.noise,
+        datasheet: file.datasheet,
     };
     exp.validate().map_err(|e| format!("{name}: {e}"))?;
     let derived = exp.derived().map_err(|e| format!("{name}: {e}"))?;
@@ -242,19 +246,26 @@ pub struct FieldReport {
     pub wall_s: f64,
 }
 
-/// What a host programmed for `exp` would know: its `[gyro]` read as the
-/// datasheet, its drive, latencies, filter and points.
+/// What a host programmed for `exp` would know: its `[datasheet]` over its
+/// `[gyro]` (the keys the datasheet leaves out), its drive, latencies,
+/// filter and points. The filter and first window are derived from the
+/// datasheet, as a host must.
 pub fn knowns(exp: &Experiment) -> Result<Knowns, String> {
+    let nominal = exp.datasheet.over(&exp.gyro).map_err(|e| e.to_string())?;
+    let host_view = Experiment {
+        gyro: nominal.gyro.clone(),
+        ..exp.clone()
+    };
     Ok(Knowns {
         clock_hz: exp.drive.clock_hz,
-        nominal: exp.gyro.clone(),
-        angular_gain_uncertainty: 0.0,
+        nominal: nominal.gyro,
+        angular_gain_uncertainty: nominal.angular_gain_uncertainty,
         amplitude: exp.drive.amplitude(),
         force_full_scale: exp.drive.force_full_scale(),
         dac_latency: exp.frontend.dac_latency,
         adc_latency: exp.frontend.adc_latency,
-        filter: exp.derived()?,
-        carrier_offset_hz: exp.drive.carrier_hz - exp.gyro.f1_hz,
+        filter: host_view.derived()?,
+        carrier_hz: exp.drive.carrier_hz,
         rates_dps: exp.points.readout_rates_dps.clone(),
         cal_freqs_hz: exp.points.cal_freqs_hz.clone(),
     })
@@ -301,7 +312,7 @@ fn settled_readout_board(
 
 fn program_readout(board: &mut dyn Board, knowns: &Knowns, op: &Operating) -> Result<(), String> {
     let (regs, _) = knowns
-        .registers(op.carrier_hz, None, knowns.amplitude, op.ref_lag_deg)
+        .registers(op.carrier_hz, None, op.amplitude, op.ref_lag_deg)
         .map_err(|e| e.to_string())?;
     board.program(&regs).map_err(|e| e.to_string())
 }
