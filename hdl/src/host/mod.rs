@@ -3,6 +3,7 @@
 //!
 //! - [`register_map`]: the one source of the register map (decoding,
 //!   `REGISTERS.md`, the C header, `Registers` <-> bus words);
+//! - [`systemrdl`]: the same map as SystemRDL (`gyro_interface.rdl`);
 //! - [`axi_top`]: the rust-hdl top `GyroInterfaceAxi`, built from
 //!   [`setting_register`], [`status_word`] and [`sample_fifo`];
 //! - [`model`]: its bit-true, cycle-true model; [`rtl`]: the rust-hdl
@@ -15,6 +16,7 @@ pub mod rtl;
 pub mod sample_fifo;
 pub mod setting_register;
 pub mod status_word;
+pub mod systemrdl;
 pub mod traffic;
 
 /// Width of z1 and z2 (40-bit two's complement, 8 fractional bits).
