@@ -25,6 +25,8 @@ pub const AXI_VERILOG_FILE: &str = "gyro_interface_axi.v";
 pub const REGISTERS_FILE: &str = "REGISTERS.md";
 /// File name of the register map's C header inside `verilog-out/`.
 pub const C_HEADER_FILE: &str = "gyro_interface_regs.h";
+/// File name of the register map's SystemRDL description inside `verilog-out/`.
+pub const SYSTEMRDL_FILE: &str = "gyro_interface.rdl";
 
 /// Direction of a top-level port.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -557,6 +559,10 @@ pub fn files() -> Vec<(&'static str, String)> {
         (AXI_VERILOG_FILE, axi_verilog()),
         (REGISTERS_FILE, crate::host::register_map::markdown()),
         (C_HEADER_FILE, crate::host::register_map::c_header()),
+        (
+            SYSTEMRDL_FILE,
+            gyrocal_regs::systemrdl::systemrdl(&crate::host::register_map::REGISTERS),
+        ),
     ]
 }
 

@@ -9,6 +9,7 @@
 //!      │        │
 //!      │        ├──► map  (bus words: offsets, widths, encode / decode,
 //!      │        │          REGISTERS.md, the C header, RegisterAccess)
+//!      │        │     └──► systemrdl  (the same map as SystemRDL 2.0)
 //!      │        │
 //!      └──► filter_design ──► plan  (FrequencyPlan in Hz ──► Registers)
 //! ```
@@ -23,6 +24,7 @@ pub mod filter_design;
 pub mod map;
 pub mod plan;
 pub mod registers;
+pub mod systemrdl;
 
 pub use registers::{Coefficients, Registers};
 

@@ -71,6 +71,8 @@ pub struct Register {
     pub access: Access,
     /// Value after power-up and after `aresetn` (the field, as read).
     pub power_up: u32,
+    /// A read returns the field and clears it (a read side effect).
+    pub read_clears: bool,
     /// The core port or status it maps to, and its meaning.
     pub doc: &'static str,
 }
@@ -125,6 +127,7 @@ const fn setting(
         signed,
         access: Access::ReadWrite,
         power_up,
+        read_clears: false,
         doc,
     }
 }
@@ -143,6 +146,7 @@ const fn status(
         signed,
         access: Access::ReadOnly,
         power_up: 0,
+        read_clears: false,
         doc,
     }
 }
@@ -354,13 +358,16 @@ pub const Z2_HI: Register = status(
 );
 
 /// ADC over-range counts; reading clears them.
-pub const ADC_CLIP: Register = status(
-    "ADC_CLIP",
-    0x5c,
-    32,
-    false,
-    "Clocks on which ADC1 (bits 15..0) and ADC2 (bits 31..16) read a rail code, -32768 or +32767, since the last read of this word; each count saturates at 65535. A read returns the counts and restarts them (a rail code on the clock of the read counts toward the next read). Any count means a measurement over that time was not linear.",
-);
+pub const ADC_CLIP: Register = Register {
+    read_clears: true,
+    ..status(
+        "ADC_CLIP",
+        0x5c,
+        32,
+        false,
+        "Clocks on which ADC1 (bits 15..0) and ADC2 (bits 31..16) read a rail code, -32768 or +32767, since the last read of this word; each count saturates at 65535. A read returns the counts and restarts them (a rail code on the clock of the read counts toward the next read). Any count means a measurement over that time was not linear.",
+    )
+};
 
 /// Every register, in offset order.
 pub const REGISTERS: [Register; 24] = [
@@ -567,9 +574,10 @@ pub fn markdown() -> String {
          |---|---|---|---|---|---|\n",
     );
     for r in &REGISTERS {
-        let access = match r.access {
-            Access::ReadWrite => "RW",
-            Access::ReadOnly => "RO",
+        let access = match (r.access, r.read_clears) {
+            (Access::ReadWrite, _) => "RW",
+            (Access::ReadOnly, false) => "RO",
+            (Access::ReadOnly, true) => "RO, read clears",
         };
         let signed = if r.signed { " signed" } else { "" };
         let power_up = match r.access {

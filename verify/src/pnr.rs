@@ -316,7 +316,7 @@ fn yosys_script(part: &Part, files: &[String]) -> String {
 }
 
 /// The pin constraint file (name, text) of `part`.
-fn pin_file(part: &Part) -> (&'static str, String) {
+pub fn pin_file(part: &Part) -> (&'static str, String) {
     let names = [CLOCK_PIN, SETTINGS_PIN, FOLD_PIN];
     match part.family {
         Family::Ice40 => (

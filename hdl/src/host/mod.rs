@@ -3,6 +3,7 @@
 //!
 //! - [`register_map`]: the one source of the register map (decoding,
 //!   `REGISTERS.md`, the C header, `Registers` <-> bus words);
+//! - `gyrocal_regs::systemrdl`: the same map as SystemRDL (`gyro_interface.rdl`);
 //! - [`axi_top`]: the rust-hdl top `GyroInterfaceAxi`, built from
 //!   [`setting_register`], [`status_word`] and [`sample_fifo`];
 //! - [`model`]: its bit-true, cycle-true model; [`rtl`]: the rust-hdl
