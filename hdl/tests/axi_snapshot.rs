@@ -1,21 +1,26 @@
-//! The coherent z snapshot of `gyro_interface_axi` on a live datapath, in
-//! the bit-true model and in rust-hdl's simulation of the design.
+//! The bus top `gyro_interface_axi` on a live datapath: the coherent z
+//! snapshot, in the bit-true model and in rust-hdl's simulation of the
+//! design, and the two engines against each other.
 //!
-//! The bus writes readout settings (the least decimation, R = 166)
+//! The bus writes calibration settings (SELECT = 1, a 48-bit modulation step
+//! with both words non-zero, both drives on, the least decimation, R = 166)
 //! and turns the stream on; the ADC words are random, so once the carrier
-//! tables are filled (`DRIVE_START_CLOCKS` = 8232) z is non-zero and
-//! changes with every sample. Then, around 9 consecutive z samples, the
-//! bus reads SAMPLE_COUNT one clock before, during and one clock after the
-//! sample's `z_valid` clock, and Z1_LO, Z1_HI, Z2_LO, Z2_HI after it. The
-//! test checks the header's contract (`host::axi_top`):
+//! tables are filled (`DRIVE_START_CLOCKS` = 8232) the DAC words move and z
+//! is non-zero and changes with every sample. Then, around 9 consecutive z
+//! samples, the bus reads SAMPLE_COUNT one clock before, during and one
+//! clock after the sample's `z_valid` clock, and Z1_LO, Z1_HI, Z2_LO, Z2_HI
+//! after it. The test checks the header's contract (`host::axi_top`):
 //! - the count includes a sample from its `z_valid` clock on;
 //! - the four z words hold the sample the count names: the one the stream
-//!   carried with that sequence number.
+//!   carried with that sequence number;
+//! and that rust-hdl's outputs equal the model's on every clock, DAC words
+//! included (`axi_model_vs_rtl` stops before the drives start).
 //!
 //! Issue 19: latching the snapshot on a read of STREAM_OVERFLOW instead of
-//! SAMPLE_COUNT passed every other hdl test (their z was 0 throughout).
-//! About 10,000 clocks: 2.5 s of CPU in release (9 s wall on the loaded
-//! 2-core machine).
+//! SAMPLE_COUNT passed every other hdl test (their z was 0 throughout), and
+//! so did applying MOD_STEP_LO on its own write instead of with MOD_STEP_HI
+//! (their drives were 0). About 10,000 clocks: 2.5 s of CPU in release (9 s
+//! wall on the loaded 2-core machine).
 
 use gyrocal_hdl::filter_design::{self, MIN_DECIMATION};
 use gyrocal_hdl::gyro_interface::DRIVE_START_CLOCKS;
@@ -33,13 +38,16 @@ const GROUP_READS: [Register; 5] = [SAMPLE_COUNT, Z1_LO, Z1_HI, Z2_LO, Z2_HI];
 /// Clocks per read: AR taken, read, R taken (`rready` always high).
 const READ_CLOCKS: usize = 3;
 
-/// Readout settings (a non-round carrier, both drives on, the least
-/// decimation and its filter) and STREAM_ENABLE, written through the bus:
-/// AW and W together for 3 clocks, then an idle clock.
+/// Calibration settings (a non-round carrier, a 5 kHz modulation at a
+/// 10 MHz clock, both drives on, the least decimation and its filter) and
+/// STREAM_ENABLE, written through the bus in register order (MOD_STEP_LO
+/// before MOD_STEP_HI): AW and W together for 3 clocks, then an idle clock.
 fn configuration() -> Vec<BusInputs> {
     let filter = filter_design::design(10e6, MIN_DECIMATION, 5e3, 10e3).unwrap();
     let regs = Registers {
+        select: true,
         carrier_step: 0x19e9_1d37,
+        mod_step: 0x0020_c49b_a5e3,
         amp: (29491, -22937),
         cic_decimation: MIN_DECIMATION as u16,
         cic_shift: filter.cic_shift as u8,
@@ -193,7 +201,17 @@ fn the_snapshot_is_the_counted_sample_on_a_live_datapath() {
     let mut model = GyroInterfaceAxi::new();
     let seen = observe(model.outputs(), &inputs, |i| model.step(i));
     check("model", &seen, &groups, &count_at);
-    let mut rtl = RtlGyroInterfaceAxi::new();
-    let seen = observe(rtl.outputs(), &inputs, |i| rtl.step(i));
+    // rust-hdl, with the model beside it: every output of every clock agrees.
+    let (mut rtl, mut twin) = (RtlGyroInterfaceAxi::new(), GyroInterfaceAxi::new());
+    assert_eq!(rtl.outputs(), twin.outputs(), "power-up");
+    let (mut clock, mut driving) = (0, 0);
+    let seen = observe(rtl.outputs(), &inputs, |i| {
+        let (r, m) = (rtl.step(i), twin.step(i));
+        clock += 1;
+        assert_eq!(r, m, "rust-hdl against the model after clock {clock}");
+        driving += usize::from(r.dac != (0, 0));
+        r
+    });
     check("rust-hdl", &seen, &groups, &count_at);
+    assert!(driving > 1000, "the drives ran for {driving} clocks only");
 }
