@@ -674,6 +674,45 @@ mod tests {
     }
 
     #[test]
+    fn rtl_matches_model_where_the_80_bit_registers_overflow() {
+        // Outside the supported range, where the model's 80-bit wrap alone
+        // decides: R = 4874 (the 13-bit port holds up to 8191) and
+        // full-scale inputs make the comb output of the strobe at 2R need
+        // 83 bits, whose bits 79 and 80 differ for both words; shift 63 (the
+        // 6-bit port's largest) reads bits 63..102, so the output is the
+        // sign of the 80-bit wrap, not of the exact value (the plain
+        // `reference`, which does not wrap below 128 bits).
+        let (r, shift) = (4874u32, 63u32);
+        let x = (i32::MAX, i32::MIN);
+        let cycles = 2 * r as usize + SAMPLE_TO_OUTPUT + 1;
+        let mut uut = CicDecimator::new();
+        prepare(&mut uut);
+        uut.x1.next = i128_to_signed(x.0 as i128);
+        uut.x2.next = i128_to_signed(x.1 as i128);
+        uut.decimation.next = u128_to_bits(r as u128);
+        uut.shift.next = u128_to_bits(shift as u128);
+        let mut model = Model::default();
+        let mut got = Vec::new();
+        for n in 0..cycles {
+            tick(&mut uut);
+            let hw = (
+                (
+                    signed_to_i128(uut.y1.val()) as i64,
+                    signed_to_i128(uut.y2.val()) as i64,
+                ),
+                uut.valid.val(),
+            );
+            assert_eq!(hw, model.step(x, r, shift), "cycle {n}");
+            if hw.1 {
+                got.push(hw.0);
+            }
+        }
+        let exact = reference(&vec![(r, shift); cycles], &vec![x; cycles]);
+        assert_eq!(got.len(), 3);
+        assert_ne!(got[2], exact[2].1, "the strobe at 2R does not overflow");
+    }
+
+    #[test]
     fn the_schedule_fits_the_least_decimation() {
         // At R = MIN_DECIMATION every strobe gives an output, R clocks apart.
         let r = MIN_DECIMATION;
