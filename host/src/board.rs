@@ -84,6 +84,42 @@ pub const STALL_TIMEOUT: Duration = Duration::from_secs(20);
 /// so that "let N clocks pass" becomes "let ceil(N / R) + 1 samples pass"
 /// (the first count change may come at once, so one more than N / R
 /// guarantees N clocks).
+///
+/// ```
+/// use gyrocal_host::board::{Board, Polled};
+/// use gyrocal_regs::map::{BusError, CIC_DECIMATION, RegisterAccess, SAMPLE_COUNT};
+///
+/// /// A register file whose SAMPLE_COUNT moves by one sample at each read.
+/// struct Ticking {
+///     count: u32,
+///     r: u32,
+/// }
+///
+/// impl RegisterAccess for Ticking {
+///     fn write_register(&mut self, offset: u32, word: u32) -> Result<(), BusError> {
+///         if offset == CIC_DECIMATION.offset {
+///             self.r = word;
+///         }
+///         Ok(())
+///     }
+///     fn read_register(&mut self, offset: u32) -> Result<u32, BusError> {
+///         Ok(match offset {
+///             o if o == SAMPLE_COUNT.offset => {
+///                 self.count += 1;
+///                 self.count
+///             }
+///             o if o == CIC_DECIMATION.offset => self.r,
+///             _ => 0,
+///         })
+///     }
+/// }
+///
+/// let mut board = Polled::new(Ticking { count: 0, r: 250 })?; // reads R = 250
+/// board.wait_clocks(1000)?; // from count 1 until 1 + 1000 / 250 + 1 = 6
+/// let s = board.read_z()?;
+/// assert_eq!(s.count, 7);
+/// # Ok::<(), BusError>(())
+/// ```
 pub struct Polled<T: RegisterAccess> {
     inner: T,
     decimation: u32,

@@ -4,7 +4,8 @@
 //! `theory` (exact steady state and the paper's equations), `frontend`
 //! (DACs and ADCs), `engine` (the three simulators of the datapath),
 //! `cosim` (the closed loop), `experiment` (readout sweep and calibration
-//! staircase), `fit` (scale factors).
+//! staircase), `fit` (scale factors); `field` (the simulated board and the drifting
+//! device) and `serve` (that board on the wire, over Etherbone).
 
 pub mod allan;
 /// Exact window means (`gyrocal_host::average`).
@@ -22,6 +23,7 @@ pub mod gyro;
 pub mod noise;
 pub mod rate_noise;
 pub mod report;
+pub mod serve;
 /// The exact theory (`gyrocal_host::theory`), shared with the host's prediction.
 pub use gyrocal_host::theory;
 #[cfg(feature = "verilator")]

@@ -128,6 +128,40 @@ pub fn check_id(bus: &mut impl RegisterAccess) -> Result<(), BusError> {
 
 /// Open the board a URL names, check its ID, and give it a clock from
 /// SAMPLE_COUNT.
+///
+/// ```
+/// use gyrocal_host::transport::{self, etherbone::{Record, read_frame}};
+/// use gyrocal_regs::map::RegisterAccess;
+/// use std::io::Write;
+///
+/// // A stand-in for litex_server with the core at 0x4000_0000: its
+/// // greeting, then each read record answered (ID at the base, 0 elsewhere).
+/// let listener = std::net::TcpListener::bind("127.0.0.1:0")?;
+/// let url = format!("etherbone://{}?base=0x40000000", listener.local_addr()?);
+/// std::thread::spawn(move || -> std::io::Result<()> {
+///     let (mut s, _) = listener.accept()?;
+///     s.write_all(b"CommTest:127.0.0.1:0")?;
+///     while let Some(frame) = read_frame(&mut s)? {
+///         let reads = Record::decode(&frame).unwrap().reads;
+///         if reads.is_empty() {
+///             continue; // a write: not answered
+///         }
+///         let writes = reads.iter().map(|&a| if a == 0x4000_0000 { 0x4759_524f } else { 0 });
+///         let answer = Record { writes: writes.collect(), ..Record::default() };
+///         s.write_all(&answer.encode().unwrap())?;
+///     }
+///     Ok(())
+/// });
+/// let mut board = transport::open(&url)?; // connects, checks ID, clocks by SAMPLE_COUNT
+/// assert_eq!(board.read_register(0)?, 0x4759_524f);
+///
+/// // Nothing listens on port 1 here, and an unknown scheme names the allowed ones.
+/// let refused = transport::open("etherbone://127.0.0.1:1").err().unwrap();
+/// assert!(refused.to_string().contains("cannot connect to 127.0.0.1:1"));
+/// let wrong = transport::open("http://board").err().unwrap();
+/// assert!(wrong.to_string().contains("allowed etherbone://HOST:PORT"));
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
 pub fn open(url: &str) -> Result<Box<dyn Board + Send>, crate::Error> {
     let target = parse(url).map_err(|e| BusError::Transport(e.to_string()))?;
     Ok(match target {

@@ -1,8 +1,9 @@
-//! The simulated board: the bit-true model engine, the converters and the
-//! gyroscope at one temperature behind the register map, as host code
-//! (`gyrocal_host`, through its [`Board`] trait) sees a real one.
+//! The simulated board: a datapath engine (the bit-true model by default),
+//! the converters and the gyroscope at one temperature behind the register
+//! map, as host code (`gyrocal_host`, through its [`Board`] trait) sees a
+//! real one.
 //!
-//! [`SimBoard`] closes the loop of the model engine over the gyroscope at
+//! [`SimBoard`] closes the loop of an engine over the gyroscope at
 //! one temperature ([`crate::drift::DeviceAt`]): drive gains scale the DAC
 //! forces, ADC gains the pick-offs, and an unmodelled phase lag
 //! ([`crate::frontend::PickoffPhase`]) sits before both ADCs. Per clock,
@@ -25,9 +26,11 @@ use gyrocal_hdl::model::gyro_interface::Outputs;
 pub use gyrocal_host::board::{Board, ZSample};
 use gyrocal_regs::map::{ADC_CLIP, BusError, RegisterAccess};
 
-/// The model engine, converters and gyroscope behind the register map.
-pub struct SimBoard {
-    engine: ModelEngine,
+/// An engine (`E`: the model engine unless asked otherwise, e.g.
+/// `crate::verilator::VerilatorEngine`), converters and gyroscope behind
+/// the register map.
+pub struct SimBoard<E: Engine = ModelEngine> {
+    engine: E,
     converters: Converters,
     gyro: GyroModel,
     phase: Option<PickoffPhase>,
@@ -38,7 +41,7 @@ pub struct SimBoard {
     clip: [ClipCount; 2],
 }
 
-impl SimBoard {
+impl<E: Engine> SimBoard<E> {
     /// A board at power-up with the device and front end of `at`:
     /// `front_end` holds the converters as built (gains at T0), which
     /// `at`'s drive and ADC multipliers scale; the front-end phase lag is
@@ -62,7 +65,7 @@ impl SimBoard {
             Some(PickoffPhase::new(p, phase_reference_hz)?)
         };
         Ok(Self {
-            engine: ModelEngine::power_up()?,
+            engine: E::power_up()?,
             converters: Converters::new(&fe)?,
             gyro: GyroModel::new(&at.gyro, clock_hz)?.with_thermal_noise(noise)?,
             phase,
@@ -103,7 +106,7 @@ impl SimBoard {
     }
 }
 
-impl Board for SimBoard {
+impl<E: Engine> Board for SimBoard<E> {
     fn wait_clocks(&mut self, clocks: u64) -> Result<(), BusError> {
         for _ in 0..clocks {
             self.step();
@@ -121,7 +124,7 @@ impl Board for SimBoard {
     }
 }
 
-impl RegisterAccess for SimBoard {
+impl<E: Engine> RegisterAccess for SimBoard<E> {
     /// A write between two clocks: acts from the next clock on.
     fn write_register(&mut self, offset: u32, word: u32) -> Result<(), BusError> {
         self.host.write(offset, word)

@@ -32,6 +32,7 @@ use super::profile::{self, Profile, ProfileRun, RateTrace};
 use crate::config::Experiment;
 use crate::config::{Drive, Filter, Frontend, Points};
 use crate::drift::{DeviceAt, Drift};
+use crate::engine::Engine;
 use crate::experiment;
 use crate::fit::linear_fit;
 use crate::frontend::FrontEnd;
@@ -277,10 +278,19 @@ pub fn build(exp: &Experiment) -> Result<(FrontEnd, Knowns), String> {
     Ok((plan.front_end, knowns(exp)?))
 }
 
-/// A fresh board at one step. The front-end phase lag is exact at the
-/// nominal modes' mean frequency; the Brownian noise is `[noise]` as given
-/// (off unless its temperature is set).
+/// A fresh board at one step, on the model engine ([`board_on`]).
 pub fn board_at(exp: &Experiment, fe: &FrontEnd, at: &DeviceAt) -> Result<SimBoard, String> {
+    board_on(exp, fe, at)
+}
+
+/// A fresh board at one step on engine `E`, powered up. The front-end
+/// phase lag is exact at the nominal modes' mean frequency; the Brownian
+/// noise is `[noise]` as given (off unless its temperature is set).
+pub fn board_on<E: Engine>(
+    exp: &Experiment,
+    fe: &FrontEnd,
+    at: &DeviceAt,
+) -> Result<SimBoard<E>, String> {
     let reference = 0.5 * (exp.gyro.f1_hz + exp.gyro.f2_hz);
     let mut board = SimBoard::new(at, fe, &exp.noise, exp.drive.clock_hz, reference)?;
     // As a host does: wait until the core has filled its carrier tables
