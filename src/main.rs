@@ -38,6 +38,10 @@ enum Command {
     Registers(commands::registers::Args),
     /// Predict and measure the rate output's noise floor: Allan deviation, angle random walk, bias instability.
     Allan(commands::allan::Args),
+    /// Measure an IEEE 952/1431-style datasheet: ARW, bias instability,
+    /// rate random walk, Allan deviation with confidence intervals, scale
+    /// factor, nonlinearity, temperature coefficients, bandwidth, turn-on.
+    Datasheet(commands::datasheet::Args),
 }
 
 /// A failure, with the exit status it deserves.
@@ -66,6 +70,7 @@ fn main() -> ExitCode {
         Command::Synth(args) => commands::synth::run(&args),
         Command::Registers(args) => commands::registers::run(&args),
         Command::Allan(args) => commands::allan::run(&args),
+        Command::Datasheet(args) => commands::datasheet::run(&args),
         Command::Field(args) => commands::field::run(&args),
     };
     match result {

@@ -12,7 +12,9 @@ pub use gyrocal_host::average;
 pub mod bench;
 pub mod config;
 pub mod cosim;
+pub mod datasheet;
 pub mod drift;
+pub mod edf;
 pub mod engine;
 pub mod experiment;
 pub mod field;
@@ -20,6 +22,8 @@ pub mod fit;
 pub mod frontend;
 pub mod gyro;
 pub mod noise;
+pub mod noise_terms;
+pub mod rate_drift;
 pub mod rate_noise;
 pub mod report;
 /// The exact theory (`gyrocal_host::theory`), shared with the host's prediction.

@@ -2,6 +2,7 @@
 
 pub mod allan;
 pub mod bench;
+pub mod datasheet;
 pub mod experiment;
 pub mod export;
 pub mod field;
