@@ -138,10 +138,11 @@ fn inverse_edf(j: f64, m_count: f64, stride: f64, f: Option<f64>, weights: &[f64
 /// Equivalent degrees of freedom of the overlapping Allan variance at `m`
 /// samples from `n` rate samples, for a mixture of the three rate noises
 /// with the Allan-variance shares `weights` (white, flicker, random walk;
-/// summing to 1). `None` when `2m > n - 1` or the weights are not shares.
+/// summing to 1). `None` when `2m > n` or the weights are not shares.
 pub fn edf_mixture(n: usize, m: usize, weights: [f64; 3]) -> Option<f64> {
     let total: f64 = weights.iter().sum();
-    if m == 0 || n + 1 <= 2 * m + 1 || weights.iter().any(|w| !(*w >= 0.0)) || total <= 0.0 {
+    let bad_weight = weights.iter().any(|w| w.is_nan() || *w < 0.0);
+    if m == 0 || n < 2 * m || bad_weight || total <= 0.0 {
         return None;
     }
     let weights = weights.map(|w| w / total);
@@ -237,7 +238,7 @@ mod tests {
                 "m {m}: {table} {direct}"
             );
         }
-        assert!(edf_mixture(10, 5, [1.0, 0.0, 0.0]).is_none());
+        assert!(edf_mixture(10, 6, [1.0, 0.0, 0.0]).is_none());
         assert!(edf_mixture(10, 1, [0.0, 0.0, 0.0]).is_none());
     }
 

@@ -159,6 +159,9 @@ fn summary(ds: &Datasheet) -> String {
     for o in &ds.outputs {
         let _ = writeln!(s, "output {}:", o.output);
         let _ = writeln!(s, "  ARW (deg/sqrt h) at 1 s          {}", reading(&o.arw));
+        if let (Some(_), Some(note)) = (o.arw.value, &o.arw.note) {
+            let _ = writeln!(s, "    ({note})");
+        }
         let _ = writeln!(
             s,
             "  bias instability (deg/h)        {} at tau {} s",

@@ -123,8 +123,7 @@ impl Plot for AdevFigure {
             .y_label_formatter(&|v: &f64| fmt_num(*v, 3))
             .draw()
             .map_err(err)?;
-        for k in 0..2 {
-            let color = OUT_COLOR[k];
+        for (k, &color) in OUT_COLOR.iter().enumerate() {
             let bars = &self.bars[k];
             chart
                 .draw_series(bars.iter().map(|&(t, lo, _, hi)| {
@@ -156,7 +155,7 @@ impl Plot for AdevFigure {
         }
         chart
             .configure_series_labels()
-            .position(SeriesLabelPosition::LowerLeft)
+            .position(SeriesLabelPosition::UpperLeft)
             .margin(10)
             .label_font(text_style(14))
             .background_style(WHITE.mix(0.9))
@@ -166,12 +165,15 @@ impl Plot for AdevFigure {
     }
 }
 
+/// A panel: its y label and one (x, y) series per output.
+type Panel = (String, [Vec<(f64, f64)>; 2]);
+
 /// A linear x-y figure of one or two panels, one series per output.
 pub(super) struct XyFigure {
     title: String,
     subtitle: String,
     x_desc: String,
-    panels: Vec<(String, [Vec<(f64, f64)>; 2])>,
+    panels: Vec<Panel>,
 }
 
 impl XyFigure {

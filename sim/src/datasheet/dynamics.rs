@@ -87,8 +87,11 @@ fn minus_3db(s: &[f64], fz: f64) -> Option<f64> {
     Some(0.5 * (a + b) * fz)
 }
 
+/// A normalized step response per z sample, and the bandwidths (Hz).
+type StepResult = (Vec<[f64; 2]>, [Option<f64>; 2]);
+
 /// The step response of both outputs (normalized) and the bandwidths.
-fn step(bench: &Bench, step_dps: f64) -> Result<(Vec<[f64; 2]>, [Option<f64>; 2]), Error> {
+fn step(bench: &Bench, step_dps: f64) -> Result<StepResult, Error> {
     let mut still = bench.board(&bench.at0, 0.0, false)?;
     let mut moved = bench.board(&bench.at0, 0.0, false)?;
     for b in [&mut still, &mut moved] {
