@@ -44,6 +44,10 @@ enum Command {
     /// Identify and self-calibrate a board (etherbone://, uio://, mem://),
     /// or without --board the file's device simulated in process.
     Calibrate(commands::calibrate::Args),
+    /// Measure an IEEE 952/1431-style datasheet: ARW, bias instability,
+    /// rate random walk, Allan deviation with confidence intervals, scale
+    /// factor, nonlinearity, temperature coefficients, bandwidth, turn-on.
+    Datasheet(commands::datasheet::Args),
 }
 
 /// A failure, with the exit status it deserves.
@@ -72,6 +76,7 @@ fn main() -> ExitCode {
         Command::Synth(args) => commands::synth::run(&args),
         Command::Registers(args) => commands::registers::run(&args),
         Command::Allan(args) => commands::allan::run(&args),
+        Command::Datasheet(args) => commands::datasheet::run(&args),
         Command::Field(args) => commands::field::run(&args),
         Command::Serve(args) => commands::serve::run(&args),
         Command::Calibrate(args) => commands::calibrate::run(&args),

@@ -14,7 +14,10 @@
 //! [experiment]  # required: readout_rates_dps, cal_freqs_hz
 //!               # tolerance (1e-4), min_window_s (derived), budget_s (60)
 //! [noise]       # Brownian force noise: mass_kg (1e-8), temperature_k
-//!               # (0: off), seed (1)
+//!               # (0: off), seed (1); and, read by `gyrocal datasheet`
+//!               # alone ([`NoiseModel`]), the rate noises
+//!               # arw_deg_per_sqrt_h, bias_instability_deg_per_h,
+//!               # rrw_deg_per_h_per_sqrt_h (0: off)
 //! ```
 //!
 //! A file with the required keys alone describes a complete experiment:
@@ -47,6 +50,7 @@
 
 use crate::gyro::GyroParams;
 use crate::noise::ThermalNoise;
+use crate::rate_drift::RateNoise;
 use gyrocal_hdl::cic_decimator::MAX_DECIMATION;
 use gyrocal_hdl::filter_design::{MAX_CUTOFF_RATIO, MIN_CUTOFF_RATIO, MIN_DECIMATION};
 use gyrocal_hdl::settings::{MAX_CAL_RATIO, MAX_REF_DELAY};
@@ -274,6 +278,70 @@ fn check(section: &str, key: &str, value: f64, ok: bool, allowed: &str) -> Resul
     }
 }
 
+/// The whole `[noise]` section as `gyrocal datasheet` reads it: the
+/// Brownian force noise's keys ([`ThermalNoise`]) and the rate noises'
+/// ([`RateNoise`], `crate::rate_drift`). The other commands read
+/// `[noise]` as [`ThermalNoise`] and refuse the rate keys by name, rather
+/// than run without them.
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct NoiseModel {
+    /// [`ThermalNoise::mass_kg`].
+    pub mass_kg: f64,
+    /// [`ThermalNoise::temperature_k`].
+    pub temperature_k: f64,
+    /// Seed of the Brownian noise, and (jumped) of the rate noises.
+    pub seed: u64,
+    /// [`RateNoise::arw_deg_per_sqrt_h`].
+    pub arw_deg_per_sqrt_h: f64,
+    /// [`RateNoise::bias_instability_deg_per_h`].
+    pub bias_instability_deg_per_h: f64,
+    /// [`RateNoise::rrw_deg_per_h_per_sqrt_h`].
+    pub rrw_deg_per_h_per_sqrt_h: f64,
+}
+
+impl Default for NoiseModel {
+    fn default() -> Self {
+        let t = ThermalNoise::default();
+        Self {
+            mass_kg: t.mass_kg,
+            temperature_k: t.temperature_k,
+            seed: t.seed,
+            arw_deg_per_sqrt_h: 0.0,
+            bias_instability_deg_per_h: 0.0,
+            rrw_deg_per_h_per_sqrt_h: 0.0,
+        }
+    }
+}
+
+impl NoiseModel {
+    /// The Brownian part.
+    pub fn thermal(&self) -> ThermalNoise {
+        ThermalNoise {
+            mass_kg: self.mass_kg,
+            temperature_k: self.temperature_k,
+            seed: self.seed,
+        }
+    }
+
+    /// The rate-noise part.
+    pub fn rate(&self) -> RateNoise {
+        RateNoise {
+            arw_deg_per_sqrt_h: self.arw_deg_per_sqrt_h,
+            bias_instability_deg_per_h: self.bias_instability_deg_per_h,
+            rrw_deg_per_h_per_sqrt_h: self.rrw_deg_per_h_per_sqrt_h,
+        }
+    }
+
+    /// Every key's range; one line naming `[noise]` and the key.
+    pub fn validate(&self) -> Result<(), String> {
+        self.thermal()
+            .validate()
+            .map_err(|e| format!("[noise] {e}"))?;
+        self.rate().validate()
+    }
+}
+
 /// The section a byte offset of `text` falls in.
 fn section_at(text: &str, offset: usize) -> Option<String> {
     text[..offset.min(text.len())]
@@ -285,7 +353,7 @@ fn section_at(text: &str, offset: usize) -> Option<String> {
 }
 
 /// One line from a TOML or schema error: position, section, message.
-fn parse_error(name: &str, text: &str, e: toml::de::Error) -> String {
+pub(crate) fn parse_error(name: &str, text: &str, e: toml::de::Error) -> String {
     let message = e.message().replace('\n', " ");
     match e.span() {
         Some(span) => {

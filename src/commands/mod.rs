@@ -3,6 +3,7 @@
 pub mod allan;
 pub mod bench;
 pub mod calibrate;
+pub mod datasheet;
 pub mod experiment;
 pub mod export;
 pub mod field;
