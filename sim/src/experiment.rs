@@ -7,7 +7,8 @@
 //! made of equal batches (`crate::average`). Both are derived, never guessed:
 //!
 //! - Settling. From rest the resonator's transient decays as exp(-t / tau)
-//!   with tau = 2 Q_k / w_k (the slowest mode). It starts as large as the
+//!   with tau = 2 Q_k / w_k (the slowest mode; with a damping coupling,
+//!   `GyroParams::slowest_time_constant_s`). It starts as large as the
 //!   largest low-frequency term of z at that output, Z (the readout offset
 //!   of a detuned mode, or the calibration ripple), and must fall below
 //!   `tolerance / SETTLE_MARGIN` times the signal the fit measures at that
@@ -232,6 +233,8 @@ impl Plan {
             q1: exp.gyro.q1,
             q2: exp.gyro.q2,
             angular_gain: exp.gyro.angular_gain,
+            quadrature_dps: exp.gyro.quadrature_dps,
+            damping_coupling_dps: exp.gyro.damping_coupling_dps,
             carrier_hz: self.carrier_hz,
             f1_force: words[0] * self.front_end.force_per_lsb[0],
             f2_force: words[1] * self.front_end.force_per_lsb[1],
@@ -291,19 +294,7 @@ pub fn ratio_target(tolerance: f64, ratio: f64) -> f64 {
     tolerance * ratio.abs().max(RATIO_FLOOR)
 }
 
-/// The lead of the reference envelopes over the drive envelopes the
-/// datapath leaves in calibration (rad): the references are lined up with
-/// the drives' carrier to the half clock of the DAC's hold by `ref_phase`,
-/// but their envelope is not, so it is off by Om T / 2
-/// (`hdl/src/settings.rs`). Negligible in phase (1e-6 rad), but it mixes
-/// the resonant part of the response into the calibration output: 2e-4 of
-/// the calibration scale factor on a Q 200 device at 100 kHz and 3.33 MHz.
-pub fn envelope_lead_rad(cal_hz: f64, clock_hz: f64) -> f64 {
-    ENVELOPE_LEAD_SIGN * PI * cal_hz / clock_hz
-}
-
-/// The sign of the datapath's envelope lead (see `envelope_lead_rad`).
-const ENVELOPE_LEAD_SIGN: f64 = -1.0;
+pub use crate::theory::envelope_lead_rad;
 
 /// Fundamental gain of a sine generator, sin and cos alike: the phase
 /// average of its output times the exact sine (a carrier whose frequency
@@ -376,7 +367,7 @@ pub fn plan(exp: &Experiment) -> Result<Plan, String> {
         dac_latency: fe.dac_latency,
         adc_latency: fe.adc_latency,
     };
-    let (readout_regs, realized) = settings::registers(&base)?;
+    let (readout_regs, realized) = settings::registers(&base).map_err(|e| e.to_string())?;
     let filter = realized.filter.clone();
     let drive_words = realized_words(readout_regs.amp, Mode::Readout);
     let cal_drive_words = realized_words(readout_regs.amp, Mode::Calibration);
@@ -431,7 +422,8 @@ pub fn plan(exp: &Experiment) -> Result<Plan, String> {
             };
             settings::registers(&p).map(|(r, real)| (r, real.cal_hz))
         })
-        .collect::<Result<_, _>>()?;
+        .collect::<Result<_, _>>()
+        .map_err(|e| e.to_string())?;
     // ADC gains: the largest displacement of any point at `adc_headroom`.
     let mut peak_x = [0.0f64; 2];
     for &r in rates {
@@ -452,8 +444,7 @@ pub fn plan(exp: &Experiment) -> Result<Plan, String> {
     Converters::new(&plan.front_end)?;
 
     // Settling: see the module header.
-    let w = [TAU * exp.gyro.f1_hz, TAU * exp.gyro.f2_hz];
-    plan.tau_s = (2.0 * exp.gyro.q1 / w[0]).max(2.0 * exp.gyro.q2 / w[1]);
+    plan.tau_s = exp.gyro.slowest_time_constant_s();
     let sigma = (TAU * derived.butterworth_hz / 2f64.sqrt()).min(TAU * derived.rc_hz);
     let sf_read = theory::sf_read_per_rad_s(&dev).map(|v| v * rad);
     let sf_cal = theory::sf_cal_per_rad_s(&dev).map(|v| v * rad);
