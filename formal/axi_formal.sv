@@ -1,6 +1,7 @@
 // axi_formal.sv: the property harness of `gyro_interface_axi` (the bus
 // wrapper of verilog-out/gyro_interface_axi.v with its DSP core replaced by
-// core_stub.v, whose z1, z2, z_valid are free on every clock).
+// a stub with the same ports, whose z1, z2, z_valid are free on every clock:
+// verify/src/formal/stub.rs).
 //
 // Written from the documented behaviour (README "The bus-attached top",
 // verilog-out/REGISTERS.md, hdl/src/host/axi_top.rs), not from the Verilog.
@@ -10,7 +11,8 @@
 //                  f_pick (which sample to follow)                │  z_valid = $anyseq
 //                                                                 ▼
 //  reference model here: pending AW/W/AR, the settings as written, the sample count,
-//  the stream FIFO's occupancy and drops; assertions compare the ports with it.
+//  the ADC_CLIP counts (adc1, adc2 free), the stream FIFO's occupancy and drops;
+//  assertions compare the ports with it.
 //
 // Two kinds of assertion, each with a label that sby reports when it fails:
 //  * spec_*: the claims (handshakes, one response per request, SLVERR, read
@@ -49,11 +51,12 @@ module axi_formal (
     input wire f_pick
 );
     localparam [1:0] OKAY = 2'b00, SLVERR = 2'b10;
-    localparam [31:0] ID_WORD = 32'h4759524f, VERSION_WORD = 32'h00010000;
+    localparam [31:0] ID_WORD = 32'h4759524f, VERSION_WORD = 32'h00010001;
     localparam [8:0] FIFO_DEPTH = 9'd256;
     // Word indices (byte offset / 4) of REGISTERS.md.
     localparam [5:0] I_STREAM_ENABLE = 6'd16, I_STREAM_OVERFLOW = 6'd17, I_SAMPLE_COUNT = 6'd18,
-        I_Z1_LO = 6'd19, I_Z1_HI = 6'd20, I_Z2_LO = 6'd21, I_Z2_HI = 6'd22;
+        I_Z1_LO = 6'd19, I_Z1_HI = 6'd20, I_Z2_LO = 6'd21, I_Z2_HI = 6'd22, I_ADC_CLIP = 6'd23;
+    localparam [15:0] CLIP_MAX = 16'hffff;
 
     wire s_axil_awready, s_axil_wready, s_axil_bvalid, s_axil_arready, s_axil_rvalid;
     wire [1:0] s_axil_bresp, s_axil_rresp;
@@ -89,6 +92,8 @@ module axi_formal (
     // and spec_t_overflow state the conservation law with them.
     wire [8:0] p_fifo_count;
     wire [31:0] p_overflow_count;
+    // ADC_CLIP's two counters (ADC1, ADC2): used by the inv_clip helper.
+    wire [15:0] p_clip1, p_clip2;
     // Internal state used only by the inv_* helpers.
     wire p_aw_held, p_w_held, p_ar_held;
     wire [5:0] p_aw_index, p_ar_index;
@@ -109,7 +114,7 @@ module axi_formal (
     function automatic [1:0] kind(input [5:0] idx);
         if (idx <= 6'd1) kind = 2'd2;
         else if (idx <= 6'd16) kind = 2'd1;
-        else if (idx <= 6'd22) kind = 2'd2;
+        else if (idx <= I_ADC_CLIP) kind = 2'd2;
         else kind = 2'd0;
     endfunction
     // The bits a setting keeps.
@@ -270,6 +275,31 @@ module axi_formal (
         end
     end
 
+    // ---- Reference model: ADC_CLIP ------------------------------------------
+    // clip1, clip2: the rail-code clocks of ADC1, ADC2 counted up to the last
+    // edge, saturating at 65535, as if that edge read no ADC_CLIP; a read at
+    // that edge (its data appearing now: clip_read) restarted them instead,
+    // with that edge's rail code counted (rail*_q). clip*_cur: as they stand
+    // this clock, which a read performed at this edge returns.
+    wire rail1 = adc1 == 16'sh7fff || adc1 == 16'sh8000;
+    wire rail2 = adc2 == 16'sh7fff || adc2 == 16'sh8000;
+    reg rail1_q = 1'b0, rail2_q = 1'b0;
+    reg [15:0] clip1 = 16'd0, clip2 = 16'd0;
+    wire clip_read = new_r && ar_n && q_ar == I_ADC_CLIP;
+    wire [15:0] clip1_cur = clip_read ? {15'd0, rail1_q} : clip1;
+    wire [15:0] clip2_cur = clip_read ? {15'd0, rail2_q} : clip2;
+    always @(posedge aclk) begin
+        rail1_q <= rail1;
+        rail2_q <= rail2;
+        if (!aresetn) begin
+            clip1 <= 16'd0;
+            clip2 <= 16'd0;
+        end else begin
+            clip1 <= clip1_cur + (rail1 && clip1_cur != CLIP_MAX);
+            clip2 <= clip2_cur + (rail2 && clip2_cur != CLIP_MAX);
+        end
+    end
+
     // One accepted sample, chosen by f_pick, followed to the stream: pos is
     // the number of samples ahead of it.
     reg trk = 1'b0;
@@ -310,6 +340,7 @@ module axi_formal (
             I_Z1_HI: expect_word = sext8(snap1_cur[39:32]);
             I_Z2_LO: expect_word = snap2_cur[31:0];
             I_Z2_HI: expect_word = sext8(snap2_cur[39:32]);
+            I_ADC_CLIP: expect_word = {clip2_cur, clip1_cur};
             default: ;
         endcase
     end
@@ -317,6 +348,8 @@ module axi_formal (
     always @(posedge aclk) expect_q <= expect_word;
 
     // ---- Properties -----------------------------------------------------------
+    reg clip_seen = 1'b0;   // an ADC_CLIP read has answered before (cover_clip)
+    always @(posedge aclk) clip_seen <= clip_seen || clip_read;
     reg [1:0] idle = 2'd0;  // consecutive clocks with occ > 0 and no TVALID
     reg b_due = 1'b0, r_due = 1'b0; // a request waited with its channel free
     always @(posedge aclk) begin
@@ -364,7 +397,11 @@ module axi_formal (
         // value at the edge that performed the read.
         if (new_r && ar_n) begin
             spec_r_resp: assert (s_axil_rresp == ((kind(q_ar) == 2'd0) ? SLVERR : OKAY));
-            if (kind(q_ar) != 2'd0) spec_r_data: assert (s_axil_rdata == expect_q);
+            if (kind(q_ar) != 2'd0 && q_ar != I_ADC_CLIP)
+                spec_r_data: assert (s_axil_rdata == expect_q);
+            // ADC_CLIP: the two saturating counts since the last read of it
+            // (or power-up, or reset), the read restarting them.
+            if (q_ar == I_ADC_CLIP) spec_clip: assert (s_axil_rdata == expect_q);
         end
         spec_ar_one: assert (!(ar_hs && ar_n && !new_r));
         if (!ar_n) spec_ar_ready: assert (s_axil_arready);
@@ -405,6 +442,9 @@ module axi_formal (
         cover_t_stall: cover (t_stall && m_axis_tready);
         // The followed sample taken with another one ahead of it first.
         cover_followed: cover (trk && pos == 9'd1 && t_hs);
+        // A second ADC_CLIP read with both counts non-zero (after a restart).
+        cover_clip: cover (clip_read && clip_seen && s_axil_rdata[15:0] != 16'd0
+            && s_axil_rdata[31:16] != 16'd0);
         // A reset with a response and a sample in flight.
         cover_reset: cover (!aresetn && s_axil_bvalid && occ != 9'd0);
     end
@@ -422,6 +462,7 @@ module axi_formal (
             && (!p_ar_held || p_ar_index == q_ar));
         inv_settings: assert (p_settings == cur);
         inv_count: assert (p_sample_count == count);
+        inv_clip: assert (p_clip1 == clip1_cur && p_clip2 == clip2_cur);
         inv_snapshot: assert (p_snapshot_z1 == snap1_cur && p_snapshot_z2 == snap2_cur);
         inv_fifo: assert (!(p_fetching && p_out_valid) && occ <= FIFO_DEPTH
             && (!busy || occ != 9'd0)

@@ -6,8 +6,9 @@
 use super::Mutant;
 
 /// One mutant per `spec_*` property (`spec_r_data` has two: a wrong
-/// register and a register that reset does not restore).
-pub const MUTANTS: [Mutant; 24] = [
+/// register and a register that reset does not restore; `spec_clip` two:
+/// a count a read does not restart, a rail code at the read lost).
+pub const MUTANTS: [Mutant; 26] = [
     Mutant {
         name: "reset_keeps_bvalid",
         what: "aresetn leaves BVALID as it was",
@@ -127,6 +128,22 @@ pub const MUTANTS: [Mutant; 24] = [
         find: "field$d = power_up;",
         replace: "field$d = field$q;",
         property: "spec_r_data",
+    },
+    Mutant {
+        name: "clip_not_cleared",
+        what: "a read of ADC_CLIP does not restart ADC1's count",
+        module: None,
+        find: "clip$0$clear = read & status$8$read_hit;",
+        replace: "clip$0$clear = 1'b0;",
+        property: "spec_clip",
+    },
+    Mutant {
+        name: "clip_read_rail_lost",
+        what: "ADC2's rail code on the clock of an ADC_CLIP read is not counted",
+        module: Some("gyro_interface_axi__clip__1"),
+        find: "counter$d = 32'h1;",
+        replace: "counter$d = 32'h0;",
+        property: "spec_clip",
     },
     Mutant {
         name: "arready_always",
