@@ -87,11 +87,36 @@ const PARAMETERS: [(&str, Option<&str>); 6] = [
 
 #[test]
 fn over_the_wire_agrees_with_in_process_and_the_truth() {
+    let (read, missed) = compare_over_the_wire(2);
+    assert!(
+        missed > 0.0 && missed <= read,
+        "paced at 2 R: at most one missed per read ({missed} of {read})"
+    );
+}
+
+/// A wire that lets 31 of every 32 samples go by (paced at 32 R: about 18
+/// samples per ripple period of the 8 Hz step): the staircase's period
+/// means are fitted across the gaps (`gyrocal_host::sampling`), and the
+/// figures still agree with in process and the truth. Interpolating, as
+/// with every sample, was off by +188% / +74% here (docs/real-board.md).
+#[test]
+fn a_wire_that_misses_31_of_32_samples_still_agrees() {
+    let (read, missed) = compare_over_the_wire(32);
+    assert!(
+        missed >= 30.0 * read,
+        "paced at 32 R: 31 missed per read ({missed} of {read})"
+    );
+}
+
+/// Calibrate in process and over a wire paced at `pace_r` R; compare every
+/// identified parameter and sf_selfcal with each other and the truth.
+/// Returns the wire's (read, missed) sample counts.
+fn compare_over_the_wire(pace_r: u64) -> (f64, f64) {
     let dir = tempfile::tempdir().unwrap();
     let config = dir.path().join("device.toml");
     std::fs::write(&config, DEVICE).unwrap();
     let local = calibrate(&config, &["--temperature", "45"]);
-    let pace = (2 * R).to_string();
+    let pace = (pace_r * R).to_string();
     let served = Served::start(&config, &["--temperature", "45", "--pace", &pace]);
     let wire = calibrate(&config, &["--board", &served.url]);
     let truth = &local["truth"];
@@ -164,10 +189,7 @@ fn over_the_wire_agrees_with_in_process_and_the_truth() {
         number(&local, &["samples", "read"])
     );
     assert_eq!(number(&local, &["samples", "missed"]), 0.0);
-    assert!(
-        missed > 0.0 && missed <= read,
-        "paced at 2 R: at most one missed per read ({missed} of {read})"
-    );
+    (read, missed)
 }
 
 fn refused(args: &[&str], code: i32, says: &str) {

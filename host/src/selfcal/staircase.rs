@@ -8,7 +8,7 @@ use crate::clip;
 use crate::error::Error;
 use crate::identify;
 use crate::knowns::Knowns;
-use crate::sampling::part_means;
+use crate::sampling::{Signal, part_means};
 use crate::stats::linear_fit;
 
 /// A measured staircase.
@@ -69,6 +69,7 @@ pub fn staircase(
             f64::from(r),
             length,
             periods as usize,
+            Signal::Periodic,
         )?);
         clip::check(board, "calibration staircase")?;
         clocks += settle + length as u64 + 2 * u64::from(r);
