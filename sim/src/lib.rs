@@ -9,6 +9,7 @@
 pub mod allan;
 pub mod average;
 pub mod bench;
+pub mod budget;
 pub mod config;
 pub mod cosim;
 pub mod drift;
@@ -18,9 +19,12 @@ pub mod field;
 pub mod fit;
 pub mod frontend;
 pub mod gyro;
+pub mod images;
 pub mod noise;
 pub mod rate_noise;
 pub mod report;
+pub mod ripple;
+pub mod settling;
 pub mod theory;
 #[cfg(feature = "verilator")]
 pub mod verilator;
