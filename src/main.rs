@@ -38,6 +38,16 @@ enum Command {
     Registers(commands::registers::Args),
     /// Predict and measure the rate output's noise floor: Allan deviation, angle random walk, bias instability.
     Allan(commands::allan::Args),
+    /// Put a simulated board (the file's gyroscope and the core) behind
+    /// Etherbone over TCP, as LiteX's litex_server serves a real one.
+    Serve(commands::serve::Args),
+    /// Identify and self-calibrate a board (etherbone://, uio://, mem://),
+    /// or without --board the file's device simulated in process.
+    Calibrate(commands::calibrate::Args),
+    /// Measure an IEEE 952/1431-style datasheet: ARW, bias instability,
+    /// rate random walk, Allan deviation with confidence intervals, scale
+    /// factor, nonlinearity, temperature coefficients, bandwidth, turn-on.
+    Datasheet(commands::datasheet::Args),
 }
 
 /// A failure, with the exit status it deserves.
@@ -66,7 +76,10 @@ fn main() -> ExitCode {
         Command::Synth(args) => commands::synth::run(&args),
         Command::Registers(args) => commands::registers::run(&args),
         Command::Allan(args) => commands::allan::run(&args),
+        Command::Datasheet(args) => commands::datasheet::run(&args),
         Command::Field(args) => commands::field::run(&args),
+        Command::Serve(args) => commands::serve::run(&args),
+        Command::Calibrate(args) => commands::calibrate::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -29,6 +29,8 @@ fn scaled_paper(carrier_offset_hz: f64) -> Experiment {
         q1: q,
         q2: q,
         angular_gain: 0.6,
+        quadrature_dps: 0.0,
+        damping_coupling_dps: 0.0,
     };
     e.drive.carrier_hz = f1 + carrier_offset_hz;
     e.drive.clock_hz = 10e6;
@@ -87,6 +89,8 @@ fn matched_modes_give_minus_two_lambda() {
         q1: 1000.0,
         q2: 1000.0,
         angular_gain: 0.8,
+        quadrature_dps: 0.0,
+        damping_coupling_dps: 0.0,
     };
     e.drive.carrier_hz = 1.0123e6;
     e.drive.clock_hz = 10e6;
@@ -161,6 +165,8 @@ fn unequal_q_and_negative_split() {
         q1: 10_000.0,
         q2: 8_300.0,
         angular_gain: 0.5,
+        quadrature_dps: 0.0,
+        damping_coupling_dps: 0.0,
     };
     e.drive.carrier_hz = e.gyro.f1_hz;
     e.points.cal_freqs_hz = vec![1.0, 1.7, 2.4];

@@ -28,6 +28,8 @@ mod with_verilator {
             q1: 3000.0,
             q2: 2500.0,
             angular_gain: 0.6,
+            quadrature_dps: 0.0,
+            damping_coupling_dps: 0.0,
         };
         e.drive.carrier_hz = 1.0123e6;
         e.drive.clock_hz = 10e6;

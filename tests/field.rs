@@ -2,10 +2,10 @@
 //! factor against the rate table of the same simulation, and the
 //! factory-calibrated baseline beside it.
 
+use gyrocal_host::selfcal;
 use gyrocal_sim::drift::Drift;
-use gyrocal_sim::field::drive_ratio::DriveProbe;
+use gyrocal_sim::field::probe::DriveProbe;
 use gyrocal_sim::field::scenario::{self, FieldReport};
-use gyrocal_sim::field::selfcal;
 use gyrocal_sim::noise::ThermalNoise;
 use gyrocal_sim::rate_noise;
 
@@ -37,6 +37,7 @@ fn gains_only(adc: [f64; 2], drive: [f64; 2]) -> Drift {
         front_end_phase_deg_per_k: 0.0,
         adc_gain_ppm_per_k: adc,
         drive_gain_ppm_per_k: drive,
+        quadrature_dps_per_k: 0.0,
     }
 }
 
@@ -169,6 +170,7 @@ fn rounding_moves_the_resonant_outputs_rate_table() {
             carrier_hz: sc.exp.drive.carrier_hz,
             ref_lag_deg: 0.0,
             envelope_delay_s: 0.0,
+            amplitude: knowns.amplitude,
         };
         let (sf0, _) = scenario::rate_table(&sc.exp, &fe, &at, &knowns, &op).unwrap();
         for level in [0.99, 0.98, 0.9, 0.5] {

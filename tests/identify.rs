@@ -2,9 +2,9 @@
 //! never sees: the paper's device at drifted temperatures and front-end
 //! phases up to +-5 deg.
 
+use gyrocal_host::identify::{self, Identified};
 use gyrocal_sim::config::Experiment;
 use gyrocal_sim::drift::Drift;
-use gyrocal_sim::field::identify::{self, Identified};
 use gyrocal_sim::field::scenario::{board_at, build};
 
 fn drift(phase_deg: f64) -> Drift {
@@ -17,6 +17,7 @@ fn drift(phase_deg: f64) -> Drift {
         front_end_phase_deg_per_k: 0.0,
         adc_gain_ppm_per_k: [0.0; 2],
         drive_gain_ppm_per_k: [0.0; 2],
+        quadrature_dps_per_k: 0.0,
     }
 }
 

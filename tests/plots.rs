@@ -36,6 +36,8 @@ fn small_report() -> &'static Report {
             q1: 5000.0,
             q2: 5000.0,
             angular_gain: 0.6,
+            quadrature_dps: 0.0,
+            damping_coupling_dps: 0.0,
         };
         e.drive.carrier_hz = 1.0123e6;
         e.drive.clock_hz = 10e6;

@@ -43,6 +43,8 @@ fn every_corner_plans_with_derived_values_in_range() {
                         q1: q,
                         q2: q,
                         angular_gain: 0.7,
+                        quadrature_dps: 0.0,
+                        damping_coupling_dps: 0.0,
                     };
                     let e = Experiment::with_required(gyro, carrier, clock, vec![10.0, 20.0], cals);
                     let what = format!("clock {clock} carrier {carrier} Q {q} split {split}");

@@ -40,7 +40,7 @@ module gyro_interface_axi(aclk,aresetn,adc1,adc2,dac1,dac2,s_axil_awvalid,s_axil
 
     // Constant declarations
     localparam  id_word = 32'h4759524f;
-    localparam  version_word = 32'h10000;
+    localparam  version_word = 32'h10001;
     localparam  slverr = 2'b10;
     localparam  byte_lane = 32'hff;
 
@@ -263,6 +263,20 @@ module gyro_interface_axi(aclk,aresetn,adc1,adc2,dac1,dac2,s_axil_awvalid,s_axil
     reg  [5:0] status$7$read_index;
     wire  status$7$read_hit;
     wire  [31:0] status$7$read_word;
+    reg  [31:0] status$8$live;
+    reg  [5:0] status$8$read_index;
+    wire  status$8$read_hit;
+    wire  [31:0] status$8$read_word;
+    reg  clip$0$clock;
+    reg  clip$0$reset;
+    reg signed [15:0] clip$0$adc;
+    reg  clip$0$clear;
+    wire  [15:0] clip$0$count;
+    reg  clip$1$clock;
+    reg  clip$1$reset;
+    reg signed [15:0] clip$1$adc;
+    reg  clip$1$clear;
+    wire  [15:0] clip$1$count;
     reg  fifo$clock;
     reg  fifo$reset;
     reg  fifo$push;
@@ -604,6 +618,26 @@ module gyro_interface_axi(aclk,aresetn,adc1,adc2,dac1,dac2,s_axil_awvalid,s_axil
         .read_index(status$7$read_index),
         .read_hit(status$7$read_hit),
         .read_word(status$7$read_word)
+    );
+    gyro_interface_axi__status__8 status$8(
+        .live(status$8$live),
+        .read_index(status$8$read_index),
+        .read_hit(status$8$read_hit),
+        .read_word(status$8$read_word)
+    );
+    gyro_interface_axi__clip__0 clip$0(
+        .clock(clip$0$clock),
+        .reset(clip$0$reset),
+        .adc(clip$0$adc),
+        .clear(clip$0$clear),
+        .count(clip$0$count)
+    );
+    gyro_interface_axi__clip__1 clip$1(
+        .clock(clip$1$clock),
+        .reset(clip$1$reset),
+        .adc(clip$1$adc),
+        .clear(clip$1$clear),
+        .count(clip$1$count)
     );
     gyro_interface_axi__fifo fifo(
         .clock(fifo$clock),
@@ -954,6 +988,7 @@ module gyro_interface_axi(aclk,aresetn,adc1,adc2,dac1,dac2,s_axil_awvalid,s_axil
         status$5$live = ((snapshot_z1$q[(32'h20)+:(8)]) & 32'hffffffff);
         status$6$live = snapshot_z2$q[(32'h0)+:(32)];
         status$7$live = ((snapshot_z2$q[(32'h20)+:(8)]) & 32'hffffffff);
+        status$8$live = ((clip$0$count) & 32'hffffffff) | (((clip$1$count) & 32'hffffffff) << 32'h10);
         s_axil_arready = ~ar_held$q;
         s_axil_rvalid = r_valid$q;
         s_axil_rdata = r_data$q;
@@ -1065,6 +1100,11 @@ module gyro_interface_axi(aclk,aresetn,adc1,adc2,dac1,dac2,s_axil_awvalid,s_axil
             read_ok = 1'b1;
             read_word = status$7$read_word;
         end
+        status$8$read_index = ar_index$q;
+        if (status$8$read_hit) begin
+            read_ok = 1'b1;
+            read_word = status$8$read_word;
+        end
         if (read) begin
             ar_held$d = 1'b0;
             r_valid$d = 1'b1;
@@ -1081,6 +1121,14 @@ module gyro_interface_axi(aclk,aresetn,adc1,adc2,dac1,dac2,s_axil_awvalid,s_axil
         if (r_valid$q & s_axil_rready) begin
             r_valid$d = 1'b0;
         end
+        clip$0$adc = adc1;
+        clip$1$adc = adc2;
+        clip$0$clock = aclk;
+        clip$0$reset = reset;
+        clip$0$clear = read & status$8$read_hit;
+        clip$1$clock = aclk;
+        clip$1$reset = reset;
+        clip$1$clear = read & status$8$read_hit;
         fifo$reset = reset;
         fifo$push = core$z_valid & settings$14$value[32'h0];
         fifo$push_data = ((z1_bits) & 96'hffffffffffffffffffffffff) | (((z2_bits) & 96'hffffffffffffffffffffffff) << 32'h28) | (((count_now[(32'h0)+:(16)]) & 96'hffffffffffffffffffffffff) << 32'h50);
@@ -1241,6 +1289,148 @@ module gyro_interface_axi__b_valid(d,q,clock);
     end
 
 endmodule // gyro_interface_axi__b_valid
+
+
+module gyro_interface_axi__clip__0(clock,reset,adc,clear,count);
+
+    // Module arguments
+    input wire  clock;
+    input wire  reset;
+    input wire signed [15:0] adc;
+    input wire  clear;
+    output reg  [15:0] count;
+
+    // Constant declarations
+    localparam signed top = 16'h7fff;
+    localparam signed bottom = 16'h8000;
+    localparam  full = 16'hffff;
+
+    // Stub signals
+    reg  [15:0] counter$d;
+    wire  [15:0] counter$q;
+    reg  counter$clock;
+
+    // Local signals
+    reg  at_rail;
+
+    // Sub module instances
+    gyro_interface_axi__clip__0__counter counter(
+        .d(counter$d),
+        .q(counter$q),
+        .clock(counter$clock)
+    );
+
+    // Update code
+    always @(*) begin
+        counter$clock = clock;
+        counter$d = counter$q;
+        at_rail = (adc == top) | (adc == bottom);
+        count = counter$q;
+        if (clear) begin
+            counter$d = 32'h0;
+            if (at_rail) begin
+                counter$d = 32'h1;
+            end
+        end
+        else if (at_rail & (counter$q != full)) begin
+            counter$d = counter$q + 32'h1;
+        end
+        if (reset) begin
+            counter$d = 32'h0;
+        end
+    end
+
+endmodule // gyro_interface_axi__clip__0
+
+
+module gyro_interface_axi__clip__0__counter(d,q,clock);
+
+    // Module arguments
+    input wire  [15:0] d;
+    output reg  [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__clip__0__counter
+
+
+module gyro_interface_axi__clip__1(clock,reset,adc,clear,count);
+
+    // Module arguments
+    input wire  clock;
+    input wire  reset;
+    input wire signed [15:0] adc;
+    input wire  clear;
+    output reg  [15:0] count;
+
+    // Constant declarations
+    localparam signed top = 16'h7fff;
+    localparam signed bottom = 16'h8000;
+    localparam  full = 16'hffff;
+
+    // Stub signals
+    reg  [15:0] counter$d;
+    wire  [15:0] counter$q;
+    reg  counter$clock;
+
+    // Local signals
+    reg  at_rail;
+
+    // Sub module instances
+    gyro_interface_axi__clip__1__counter counter(
+        .d(counter$d),
+        .q(counter$q),
+        .clock(counter$clock)
+    );
+
+    // Update code
+    always @(*) begin
+        counter$clock = clock;
+        counter$d = counter$q;
+        at_rail = (adc == top) | (adc == bottom);
+        count = counter$q;
+        if (clear) begin
+            counter$d = 32'h0;
+            if (at_rail) begin
+                counter$d = 32'h1;
+            end
+        end
+        else if (at_rail & (counter$q != full)) begin
+            counter$d = counter$q + 32'h1;
+        end
+        if (reset) begin
+            counter$d = 32'h0;
+        end
+    end
+
+endmodule // gyro_interface_axi__clip__1
+
+
+module gyro_interface_axi__clip__1__counter(d,q,clock);
+
+    // Module arguments
+    input wire  [15:0] d;
+    output reg  [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__clip__1__counter
 
 
 module gyro_interface_axi__core(clock,adc1,adc2,dac1,dac2,z1,z2,z_valid,select,carrier_step,ref_phase,ref_delay,mod_step,amp1,amp2,cic_decimation,cic_shift,iir_k0,iir_k1,iir_k2,iir_alpha);
@@ -15205,6 +15395,36 @@ module gyro_interface_axi__status__7(live,read_index,read_hit,read_word);
     end
 
 endmodule // gyro_interface_axi__status__7
+
+
+module gyro_interface_axi__status__8(live,read_index,read_hit,read_word);
+
+    // Module arguments
+    input wire  [31:0] live;
+    input wire  [5:0] read_index;
+    output reg  read_hit;
+    output reg  [31:0] read_word;
+
+    // Constant declarations
+    localparam  index = 6'b10111;
+    localparam  field_mask = 32'hffffffff;
+    localparam  sign_bit = 32'h0;
+    localparam  extension = 32'h0;
+
+    // Local signals
+    reg  [31:0] field;
+
+    // Update code
+    always @(*) begin
+        field = live & field_mask;
+        read_hit = read_index == index;
+        read_word = field;
+        if (|(field & sign_bit)) begin
+            read_word = field | extension;
+        end
+    end
+
+endmodule // gyro_interface_axi__status__8
 
 
 module gyro_interface_axi__w_data(d,q,clock);

@@ -104,23 +104,18 @@ use crate::primitives::convert::signed_bit_cast_exact;
 use rust_hdl::prelude::*;
 
 /// Number of integrator and comb stages.
-pub const STAGES: u32 = 4;
+pub use gyrocal_regs::datapath::CIC_STAGES as STAGES;
 /// Width of the input word.
 pub const INPUT_BITS: usize = 32;
-/// log2 of the largest decimation.
-pub const MAX_DECIMATION_LOG2: u32 = 12;
-/// Largest decimation: 2^12.
-pub const MAX_DECIMATION: u32 = 1 << MAX_DECIMATION_LOG2;
+pub use gyrocal_regs::datapath::{MAX_DECIMATION, MAX_DECIMATION_LOG2, OUTPUT_FRACTION_BITS};
 /// Hogenauer register width: B_in + N log2(R_max) = 32 + 4 * 12 = 80.
 pub const REGISTER_BITS: usize = INPUT_BITS + (STAGES * MAX_DECIMATION_LOG2) as usize;
 /// Width of the output word.
 pub const OUTPUT_BITS: usize = 40;
 /// Width of the decimation word: R up to 2^12 needs 13 bits.
-pub const DECIMATION_BITS: usize = MAX_DECIMATION_LOG2 as usize + 1;
+pub const DECIMATION_BITS: usize = gyrocal_regs::datapath::DECIMATION_BITS as usize;
 /// Width of the output shift word: shifts 0..=40 need 6 bits.
-pub const SHIFT_BITS: usize = 6;
-/// Fractional bits kept at the output (y = average * 2^8 * G).
-pub const OUTPUT_FRACTION_BITS: u32 = 8;
+pub const SHIFT_BITS: usize = gyrocal_regs::datapath::SHIFT_BITS as usize;
 /// Low bits of the shift applied by the last (fine) output step: 0..=7.
 pub const FINE_SHIFT_BITS: usize = 3;
 /// The shift bits of the fine step: `shift & 0b000111`.
@@ -676,6 +671,45 @@ mod tests {
             prop_assert!(want.len() >= 20, "only {} outputs", want.len());
             prop_assert_eq!(got, want);
         }
+    }
+
+    #[test]
+    fn rtl_matches_model_where_the_80_bit_registers_overflow() {
+        // Outside the supported range, where the model's 80-bit wrap alone
+        // decides: R = 4874 (the 13-bit port holds up to 8191) and
+        // full-scale inputs make the comb output of the strobe at 2R need
+        // 83 bits, whose bits 79 and 80 differ for both words; shift 63 (the
+        // 6-bit port's largest) reads bits 63..102, so the output is the
+        // sign of the 80-bit wrap, not of the exact value (the plain
+        // `reference`, which does not wrap below 128 bits).
+        let (r, shift) = (4874u32, 63u32);
+        let x = (i32::MAX, i32::MIN);
+        let cycles = 2 * r as usize + SAMPLE_TO_OUTPUT + 1;
+        let mut uut = CicDecimator::new();
+        prepare(&mut uut);
+        uut.x1.next = i128_to_signed(x.0 as i128);
+        uut.x2.next = i128_to_signed(x.1 as i128);
+        uut.decimation.next = u128_to_bits(r as u128);
+        uut.shift.next = u128_to_bits(shift as u128);
+        let mut model = Model::default();
+        let mut got = Vec::new();
+        for n in 0..cycles {
+            tick(&mut uut);
+            let hw = (
+                (
+                    signed_to_i128(uut.y1.val()) as i64,
+                    signed_to_i128(uut.y2.val()) as i64,
+                ),
+                uut.valid.val(),
+            );
+            assert_eq!(hw, model.step(x, r, shift), "cycle {n}");
+            if hw.1 {
+                got.push(hw.0);
+            }
+        }
+        let exact = reference(&vec![(r, shift); cycles], &vec![x; cycles]);
+        assert_eq!(got.len(), 3);
+        assert_ne!(got[2], exact[2].1, "the strobe at 2R does not overflow");
     }
 
     #[test]

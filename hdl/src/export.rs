@@ -25,6 +25,8 @@ pub const AXI_VERILOG_FILE: &str = "gyro_interface_axi.v";
 pub const REGISTERS_FILE: &str = "REGISTERS.md";
 /// File name of the register map's C header inside `verilog-out/`.
 pub const C_HEADER_FILE: &str = "gyro_interface_regs.h";
+/// File name of the register map's SystemRDL description inside `verilog-out/`.
+pub const SYSTEMRDL_FILE: &str = "gyro_interface.rdl";
 
 /// Direction of a top-level port.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -557,12 +559,26 @@ pub fn files() -> Vec<(&'static str, String)> {
         (AXI_VERILOG_FILE, axi_verilog()),
         (REGISTERS_FILE, crate::host::register_map::markdown()),
         (C_HEADER_FILE, crate::host::register_map::c_header()),
+        (
+            SYSTEMRDL_FILE,
+            gyrocal_regs::systemrdl::systemrdl(&crate::host::register_map::REGISTERS),
+        ),
     ]
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The decimation port's documented range is the limits of record
+    /// (`gyrocal_regs::datapath`), as the register map's text says.
+    #[test]
+    fn decimation_port_text_follows_the_limits() {
+        use gyrocal_regs::datapath::{MAX_DECIMATION, MIN_DECIMATION};
+        let range = format!("{MIN_DECIMATION}..{MAX_DECIMATION}");
+        let port = PORTS.iter().find(|p| p.name == "cic_decimation");
+        assert_eq!(port.map(|p| p.format), Some(range.as_str()));
+    }
 
     #[test]
     fn port_table_matches_the_verilog_declarations() {

@@ -51,6 +51,8 @@ use crate::am_mixer::AmMixer;
 pub const DRIVE_START_CLOCKS: usize = crate::carrier_table_fill::FILL_CLOCKS
     + crate::carrier_nco::LATENCY
     + crate::am_mixer::CARRIER_LATENCY;
+// The register map and the host read the figure from the leaf crate.
+const _: () = assert!(DRIVE_START_CLOCKS as u64 == gyrocal_regs::datapath::DRIVE_START_CLOCKS);
 use crate::carrier_nco::CarrierNco;
 use crate::cic_decimator::{CicDecimator, DECIMATION_BITS, OUTPUT_BITS, SHIFT_BITS};
 use crate::demod_mux::DemodMux;

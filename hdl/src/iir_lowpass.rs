@@ -92,11 +92,11 @@ use rust_hdl::prelude::*;
 /// Width of the input and output samples.
 pub const SAMPLE_BITS: usize = crate::cic_decimator::OUTPUT_BITS;
 /// Fractional bits of the coefficients (Q2.30).
-pub const COEFFICIENT_FRACTION_BITS: u32 = 30;
+pub use gyrocal_regs::datapath::COEFFICIENT_FRACTION_BITS;
 /// Width of the coefficients.
 pub const COEFFICIENT_BITS: usize = 32;
 /// Guard bits of the states below the output LSB.
-pub const GUARD_BITS: u32 = 16;
+pub use gyrocal_regs::datapath::GUARD_BITS;
 /// Width of the states y1, y2, u: 40-bit samples, guard bits, 2 bits of headroom.
 pub const STATE_BITS: usize = SAMPLE_BITS + GUARD_BITS as usize + 2;
 /// Width of the recorded multiplier operand: 2 y1 - y2 and y - u fit exactly.
@@ -109,7 +109,7 @@ pub const ACCUMULATOR_BITS: usize = PRODUCT_BITS + 2;
 pub const LATENCY: usize = 168;
 /// Clock cycles from a strobe to the next one accepted: the least decimation
 /// (`Program::schedule_clocks`, checked by a test).
-pub const SCHEDULE_CLOCKS: usize = 166;
+pub const SCHEDULE_CLOCKS: usize = gyrocal_regs::datapath::MIN_DECIMATION as usize;
 /// Width of the output staging register: two samples of three digits.
 const STAGE_BITS: usize = 6 * crate::iir_program::DIGIT_BITS;
 /// Width of the accumulator after dropping a finished 15-bit column digit.

@@ -9,7 +9,8 @@ pub mod cic_integrators;
 pub mod demod_mux;
 pub mod drive;
 pub mod export;
-pub mod filter_design;
+/// The output filter's design, from the leaf crate `gyrocal-regs`.
+pub use gyrocal_regs::filter_design;
 pub mod gyro_interface;
 pub mod host;
 pub mod iir_lowpass;
@@ -21,7 +22,8 @@ pub mod q15_multiplier;
 pub mod quarter_wave;
 pub mod reference_alignment;
 pub mod rtl;
-pub mod settings;
+/// The frequency plan (Hz to register values), from the leaf crate `gyrocal-regs`.
+pub use gyrocal_regs::plan as settings;
 pub mod sine;
 pub mod sine_table;
 pub mod table_sine;

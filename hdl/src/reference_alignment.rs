@@ -24,7 +24,7 @@ use crate::primitives::TappedDelayLine;
 use rust_hdl::prelude::*;
 
 /// Address bits of the delay: 64 taps.
-pub const DELAY_BITS: usize = 6;
+pub const DELAY_BITS: usize = gyrocal_regs::datapath::DELAY_BITS as usize;
 
 /// Two reference delay lines sharing one run-time delay.
 #[derive(LogicBlock)]

@@ -20,7 +20,7 @@ pub const ADDRESS_BITS: usize = 12;
 pub const ENTRIES: usize = 1 << ADDRESS_BITS;
 /// Peak amplitude of every sine/cosine in the datapath: full scale of a
 /// 16-bit signed word, kept symmetric (never -32768).
-pub const PEAK: i32 = 32767;
+pub use gyrocal_regs::datapath::PEAK;
 
 /// The table step D = (pi/2) / 4096 in radians.
 pub fn step_radians() -> f64 {

@@ -3,6 +3,7 @@
 //!
 //! ```toml
 //! [gyro]        # required: f1_hz, f2_hz, q1, q2, angular_gain
+//!               # quadrature_dps, damping_coupling_dps (0): mode couplings
 //! [drive]       # required: carrier_hz, clock_hz
 //!               # amplitude1, amplitude2 (0.9), force_full_scale1_n_per_kg,
 //!               # force_full_scale2_n_per_kg (1.0)
@@ -13,7 +14,10 @@
 //! [experiment]  # required: readout_rates_dps, cal_freqs_hz
 //!               # tolerance (1e-4), min_window_s (derived), budget_s (60)
 //! [noise]       # Brownian force noise: mass_kg (1e-8), temperature_k
-//!               # (0: off), seed (1)
+//!               # (0: off), seed (1); and, read by `gyrocal datasheet`
+//!               # alone ([`NoiseModel`]), the rate noises
+//!               # arw_deg_per_sqrt_h, bias_instability_deg_per_h,
+//!               # rrw_deg_per_h_per_sqrt_h (0: off)
 //! ```
 //!
 //! A file with the required keys alone describes a complete experiment:
@@ -46,6 +50,7 @@
 
 use crate::gyro::GyroParams;
 use crate::noise::ThermalNoise;
+use crate::rate_drift::RateNoise;
 use gyrocal_hdl::cic_decimator::MAX_DECIMATION;
 use gyrocal_hdl::filter_design::{MAX_CUTOFF_RATIO, MIN_CUTOFF_RATIO, MIN_DECIMATION};
 use gyrocal_hdl::settings::{MAX_CAL_RATIO, MAX_REF_DELAY};
@@ -71,6 +76,11 @@ pub struct Experiment {
     /// `[noise]`: thermomechanical force noise (off, 0 K, when unset).
     #[serde(default)]
     pub noise: ThermalNoise,
+    /// `[datasheet]`: what host code is told about the device, key by key
+    /// over `[gyro]` (`gyrocal field`, `gyrocal calibrate`; `run` compares
+    /// with `[gyro]` and does not use it).
+    #[serde(default)]
+    pub datasheet: gyrocal_host::datasheet::Datasheet,
 }
 
 /// `[drive]`.
@@ -246,18 +256,8 @@ pub const MAX_BUDGET_S: f64 = 86_400.0;
 pub const SAMPLES_PER_RIPPLE: f64 = 20.0;
 
 /// The filter and first window derived from the device, with the user's
-/// explicit values where given.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Derived {
-    /// CIC decimation R.
-    pub decimation: u32,
-    /// Butterworth cut-off (Hz).
-    pub butterworth_hz: f64,
-    /// RC cut-off (Hz).
-    pub rc_hz: f64,
-    /// First averaging window (s).
-    pub min_window_s: f64,
-}
+/// explicit values where given (the host programs them: `gyrocal_host`).
+pub use gyrocal_host::Derived;
 
 /// Ratio of the RC cut-off to the Butterworth cut-off, and of the
 /// Butterworth cut-off to the slowest signal (`Experiment::derived`).
@@ -278,6 +278,70 @@ fn check(section: &str, key: &str, value: f64, ok: bool, allowed: &str) -> Resul
     }
 }
 
+/// The whole `[noise]` section as `gyrocal datasheet` reads it: the
+/// Brownian force noise's keys ([`ThermalNoise`]) and the rate noises'
+/// ([`RateNoise`], `crate::rate_drift`). The other commands read
+/// `[noise]` as [`ThermalNoise`] and refuse the rate keys by name, rather
+/// than run without them.
+#[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct NoiseModel {
+    /// [`ThermalNoise::mass_kg`].
+    pub mass_kg: f64,
+    /// [`ThermalNoise::temperature_k`].
+    pub temperature_k: f64,
+    /// Seed of the Brownian noise, and (jumped) of the rate noises.
+    pub seed: u64,
+    /// [`RateNoise::arw_deg_per_sqrt_h`].
+    pub arw_deg_per_sqrt_h: f64,
+    /// [`RateNoise::bias_instability_deg_per_h`].
+    pub bias_instability_deg_per_h: f64,
+    /// [`RateNoise::rrw_deg_per_h_per_sqrt_h`].
+    pub rrw_deg_per_h_per_sqrt_h: f64,
+}
+
+impl Default for NoiseModel {
+    fn default() -> Self {
+        let t = ThermalNoise::default();
+        Self {
+            mass_kg: t.mass_kg,
+            temperature_k: t.temperature_k,
+            seed: t.seed,
+            arw_deg_per_sqrt_h: 0.0,
+            bias_instability_deg_per_h: 0.0,
+            rrw_deg_per_h_per_sqrt_h: 0.0,
+        }
+    }
+}
+
+impl NoiseModel {
+    /// The Brownian part.
+    pub fn thermal(&self) -> ThermalNoise {
+        ThermalNoise {
+            mass_kg: self.mass_kg,
+            temperature_k: self.temperature_k,
+            seed: self.seed,
+        }
+    }
+
+    /// The rate-noise part.
+    pub fn rate(&self) -> RateNoise {
+        RateNoise {
+            arw_deg_per_sqrt_h: self.arw_deg_per_sqrt_h,
+            bias_instability_deg_per_h: self.bias_instability_deg_per_h,
+            rrw_deg_per_h_per_sqrt_h: self.rrw_deg_per_h_per_sqrt_h,
+        }
+    }
+
+    /// Every key's range; one line naming `[noise]` and the key.
+    pub fn validate(&self) -> Result<(), String> {
+        self.thermal()
+            .validate()
+            .map_err(|e| format!("[noise] {e}"))?;
+        self.rate().validate()
+    }
+}
+
 /// The section a byte offset of `text` falls in.
 fn section_at(text: &str, offset: usize) -> Option<String> {
     text[..offset.min(text.len())]
@@ -289,7 +353,7 @@ fn section_at(text: &str, offset: usize) -> Option<String> {
 }
 
 /// One line from a TOML or schema error: position, section, message.
-fn parse_error(name: &str, text: &str, e: toml::de::Error) -> String {
+pub(crate) fn parse_error(name: &str, text: &str, e: toml::de::Error) -> String {
     let message = e.message().replace('\n', " ");
     match e.span() {
         Some(span) => {
@@ -327,6 +391,8 @@ impl Experiment {
                 q1: 55_000.0,
                 q2: 55_000.0,
                 angular_gain: 0.6,
+                quadrature_dps: 0.0,
+                damping_coupling_dps: 0.0,
             },
             drive: Drive::new(9.64e6, 50e6),
             // Dithered converters, the default: the readout's rate signal
@@ -357,6 +423,7 @@ impl Experiment {
                 )
             },
             noise: ThermalNoise::default(),
+            datasheet: Default::default(),
         }
     }
 
@@ -376,6 +443,7 @@ impl Experiment {
             filter: Filter::default(),
             points: Points::new(readout_rates_dps, cal_freqs_hz),
             noise: ThermalNoise::default(),
+            datasheet: Default::default(),
         }
     }
 
@@ -393,6 +461,7 @@ impl Experiment {
         self.validate_drive()?;
         self.validate_frontend()?;
         self.validate_points()?;
+        self.datasheet.over(&self.gyro).map_err(|e| e.to_string())?;
         self.noise.validate().map_err(|e| format!("[noise] {e}"))
     }
 
@@ -430,7 +499,8 @@ impl Experiment {
             g.angular_gain,
             true,
             "must be a finite number",
-        )
+        )?;
+        g.check_couplings().map_err(|e| format!("[gyro] {e}"))
     }
 
     fn validate_drive(&self) -> Result<(), String> {
@@ -718,6 +788,25 @@ mod tests {
     }
 
     #[test]
+    fn the_couplings_default_to_zero_and_round_trip() {
+        let e = parse("c.toml", REQUIRED).unwrap();
+        assert_eq!(
+            [e.gyro.quadrature_dps, e.gyro.damping_coupling_dps],
+            [0.0; 2]
+        );
+        let text = REQUIRED.replace(
+            "q1 = 5000",
+            "q1 = 5000\nquadrature_dps = -300.5\ndamping_coupling_dps = 20",
+        );
+        let e = parse("c.toml", &text).unwrap();
+        assert_eq!(
+            [e.gyro.quadrature_dps, e.gyro.damping_coupling_dps],
+            [-300.5, 20.0]
+        );
+        assert_eq!(parse("c.toml", &toml::to_string(&e).unwrap()).unwrap(), e);
+    }
+
+    #[test]
     fn a_missing_required_key_is_named() {
         let text = REQUIRED.replace("carrier_hz = 1.0123e6\n", "");
         let err = parse("c.toml", &text).unwrap_err();
@@ -778,6 +867,15 @@ mod tests {
             (
                 format!("{REQUIRED}[frontend]\nadc_per_meter1 = 1e9\n"),
                 "[frontend] adc_per_meter1 and adc_per_meter2",
+            ),
+            (
+                REQUIRED.replace("q1 = 5000", "q1 = 5000\nquadrature_dps = 2e5"),
+                "[gyro] quadrature_dps = 200000: allowed |quadrature_dps| <= 1e5 deg/s",
+            ),
+            (
+                // sqrt(B1 B2) / (2 lambda) = 1060.1 rad/s = 60,740 deg/s.
+                REQUIRED.replace("q1 = 5000", "q1 = 5000\ndamping_coupling_dps = -8e4"),
+                "[gyro] damping_coupling_dps = -80000: allowed",
             ),
         ];
         for (text, start) in cases {

@@ -11,6 +11,7 @@
 //! Qk(T)   = Qk (1 + q_ppm_per_k dT 1e-6)          both modes alike
 //! gain(T) = 1 + ppm_per_k dT 1e-6                 ADC k, DAC k: multipliers
 //! phase(T) = front_end_phase_deg + front_end_phase_deg_per_k dT
+//! Omq(T)  = quadrature_dps + quadrature_dps_per_k dT   quadrature coupling
 //! ```
 //!
 //! The two frequency coefficients are also read as a common drift (their
@@ -29,9 +30,10 @@
 //! front_end_phase_deg_per_k = 0
 //! adc_gain_ppm_per_k = [0, 0]
 //! drive_gain_ppm_per_k = [0, 0]
+//! quadrature_dps_per_k = 0          # deg/s per K
 //! ```
 
-use crate::gyro::GyroParams;
+use crate::gyro::{GyroParams, MAX_COUPLING_DPS};
 use serde::{Deserialize, Serialize};
 
 /// Lowest and highest temperature of a step (deg C): beyond any MEMS
@@ -74,6 +76,10 @@ pub struct Drift {
     /// Gain drift of drive (DAC) 1 and drive 2 (ppm/K).
     #[serde(default, deserialize_with = "exactly_two")]
     pub drive_gain_ppm_per_k: [f64; 2],
+    /// Drift of the quadrature coupling `quadrature_dps` (deg/s per K),
+    /// at most `MAX_COUPLING_DPS` in magnitude.
+    #[serde(default)]
+    pub quadrature_dps_per_k: f64,
 }
 
 /// A two-element list, refusing any other length (serde's `[f64; 2]`
@@ -158,6 +164,14 @@ impl Drift {
                 return Err(field_error(key, v, "must be finite"));
             }
         }
+        let q = self.quadrature_dps_per_k;
+        if !(q.is_finite() && q.abs() <= MAX_COUPLING_DPS) {
+            return Err(field_error(
+                "quadrature_dps_per_k",
+                q,
+                &format!("allowed -{MAX_COUPLING_DPS}..={MAX_COUPLING_DPS} deg/s per K"),
+            ));
+        }
         self.check_steps()
     }
 
@@ -193,6 +207,20 @@ impl Drift {
                     ),
                 ));
             }
+        }
+        Ok(())
+    }
+
+    /// Checks that the device `nominal` keeps its couplings in range at
+    /// every step ([`GyroParams::check_couplings`], with the drifted
+    /// quadrature, frequencies and Q). Errors are one line naming the step
+    /// and the coupling, its value there and what is allowed. Call after
+    /// [`Drift::validate`] and the `[gyro]` checks.
+    pub fn validate_device(&self, nominal: &GyroParams) -> Result<(), String> {
+        for &t in &self.temperatures_c {
+            let gyro = self.at(nominal, t).gyro;
+            gyro.check_couplings()
+                .map_err(|e| format!("[drift] at {t} deg C (temperatures_c) {e}"))?;
         }
         Ok(())
     }
@@ -237,6 +265,8 @@ impl Drift {
                 q1: nominal.q1 * q,
                 q2: nominal.q2 * q,
                 angular_gain: nominal.angular_gain,
+                quadrature_dps: nominal.quadrature_dps + self.quadrature_dps_per_k * dt,
+                damping_coupling_dps: nominal.damping_coupling_dps,
             },
             adc_gain: self.adc_gain_ppm_per_k.map(|ppm| scale(ppm, dt)),
             drive_gain: self.drive_gain_ppm_per_k.map(|ppm| scale(ppm, dt)),
@@ -269,6 +299,8 @@ mod tests {
             q1: 55_000.0,
             q2: 55_000.0,
             angular_gain: 0.6,
+            quadrature_dps: 0.0,
+            damping_coupling_dps: 0.0,
         }
     }
 
@@ -290,6 +322,7 @@ mod tests {
         assert_eq!(d.adc_gain_ppm_per_k, [0.0; 2]);
         assert_eq!(d.drive_gain_ppm_per_k, [0.0; 2]);
         assert_eq!(d.front_end_phase_deg, 0.0);
+        assert_eq!(d.quadrature_dps_per_k, 0.0);
         let at0 = d.at(&paper(), 25.0);
         assert_eq!(at0.gyro, paper());
         assert_eq!(at0.adc_gain, [1.0; 2]);
@@ -301,10 +334,15 @@ mod tests {
         let d = parse(
             "temperatures_c = [20, 30]\n tcf1_ppm_per_k = -30\n tcf2_ppm_per_k = -31\n\
              q_ppm_per_k = 500\n front_end_phase_deg = 1.5\n front_end_phase_deg_per_k = -0.1\n\
-             adc_gain_ppm_per_k = [100, -200]\n drive_gain_ppm_per_k = [1000, 0]\n",
+             adc_gain_ppm_per_k = [100, -200]\n drive_gain_ppm_per_k = [1000, 0]\n\
+             quadrature_dps_per_k = -2.5\n",
         )
         .unwrap();
-        let p = paper();
+        let p = GyroParams {
+            quadrature_dps: 300.0,
+            damping_coupling_dps: 4.0,
+            ..paper()
+        };
         let at = d.at(&p, 30.0);
         let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs().max(1.0);
         // -30 ppm/K x 10 K at 9.64 MHz: -2892 Hz (the issue's 290 Hz per K).
@@ -315,6 +353,8 @@ mod tests {
         assert!(close(at.drive_gain[0], 1.01) && at.drive_gain[1] == 1.0);
         assert!(close(at.front_end_phase_deg, 0.5));
         assert_eq!(at.gyro.angular_gain, p.angular_gain);
+        assert_eq!(at.gyro.quadrature_dps, 275.0);
+        assert_eq!(at.gyro.damping_coupling_dps, 4.0);
         // The split moves by f2 tcf2 - f1 tcf1: -1 ppm/K of 9.64 MHz is
         // -9.64 Hz/K, and the split over the step agrees.
         let split_rate = d.split_drift_hz_per_k(&p);
@@ -328,6 +368,27 @@ mod tests {
         assert_eq!(d.differential_tcf_ppm_per_k(), -1.0);
         assert_eq!(d.steps(&p).len(), 2);
         assert!((kelvin(25.0) - 298.15).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_quadrature_drifting_out_of_range_is_refused_at_its_step() {
+        // 9.5e4 deg/s + 1e3 deg/s/K reaches 1.05e5 at 35 deg C, beyond 1e5.
+        let d = parse(&format!("{MINIMAL}quadrature_dps_per_k = 1e3\n")).unwrap();
+        let p = GyroParams {
+            quadrature_dps: 9.5e4,
+            ..paper()
+        };
+        let err = d.validate_device(&p).unwrap_err();
+        assert!(
+            err.starts_with("[drift] at 35 deg C (temperatures_c) quadrature_dps = 105000:"),
+            "{err}"
+        );
+        assert!(!err.contains('\n'), "{err}");
+        let p = GyroParams {
+            quadrature_dps: 8e4,
+            ..paper()
+        };
+        assert!(d.validate_device(&p).is_ok());
     }
 
     #[test]
@@ -364,6 +425,10 @@ mod tests {
             (
                 &format!("{MINIMAL}front_end_phase_deg = 170\nfront_end_phase_deg_per_k = 2\n"),
                 "front_end_phase_deg_per_k",
+            ),
+            (
+                &format!("{MINIMAL}quadrature_dps_per_k = -2e5\n"),
+                "quadrature_dps_per_k",
             ),
         ];
         for (text, key) in cases {

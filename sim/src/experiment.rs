@@ -7,8 +7,9 @@
 //! made of equal batches (`crate::average`). Both are derived, never guessed:
 //!
 //! - Settling (`crate::settling`). From rest the resonator's transient
-//!   decays as exp(-t / tau) with tau = 2 Q_k / w_k (the slowest mode),
-//!   from Z, x_k's amplitude times its reference's. It must fall below
+//!   decays as exp(-t / tau) with tau = 2 Q_k / w_k (the slowest mode;
+//!   with a damping coupling, `GyroParams::slowest_time_constant_s`), from
+//!   Z, x_k's amplitude times its reference's. It must fall below
 //!   `settling::SETTLE_MARGIN`-th of `tolerance` of the signal the fit
 //!   measures at that output, S = |SF| x (span of the rates), and below a
 //!   share of a point's expected noise, both from the exact theory; the
@@ -241,6 +242,8 @@ impl Plan {
             q1: exp.gyro.q1,
             q2: exp.gyro.q2,
             angular_gain: exp.gyro.angular_gain,
+            quadrature_dps: exp.gyro.quadrature_dps,
+            damping_coupling_dps: exp.gyro.damping_coupling_dps,
             carrier_hz: self.carrier_hz,
             f1_force: words[0] * self.front_end.force_per_lsb[0],
             f2_force: words[1] * self.front_end.force_per_lsb[1],
@@ -300,19 +303,7 @@ pub fn ratio_target(tolerance: f64, ratio: f64) -> f64 {
     tolerance * ratio.abs().max(RATIO_FLOOR)
 }
 
-/// The lead of the reference envelopes over the drive envelopes the
-/// datapath leaves in calibration (rad): the references are lined up with
-/// the drives' carrier to the half clock of the DAC's hold by `ref_phase`,
-/// but their envelope is not, so it is off by Om T / 2
-/// (`hdl/src/settings.rs`). Negligible in phase (1e-6 rad), but it mixes
-/// the resonant part of the response into the calibration output: 2e-4 of
-/// the calibration scale factor on a Q 200 device at 100 kHz and 3.33 MHz.
-pub fn envelope_lead_rad(cal_hz: f64, clock_hz: f64) -> f64 {
-    ENVELOPE_LEAD_SIGN * PI * cal_hz / clock_hz
-}
-
-/// The sign of the datapath's envelope lead (see `envelope_lead_rad`).
-const ENVELOPE_LEAD_SIGN: f64 = -1.0;
+pub use crate::theory::envelope_lead_rad;
 
 /// Fundamental gain of a sine generator, sin and cos alike: the phase
 /// average of its output times the exact sine (a carrier whose frequency
@@ -393,7 +384,7 @@ pub fn plan(exp: &Experiment) -> Result<Plan, String> {
         dac_latency: fe.dac_latency,
         adc_latency: fe.adc_latency,
     };
-    let (readout_regs, realized) = settings::registers(&base)?;
+    let (readout_regs, realized) = settings::registers(&base).map_err(|e| e.to_string())?;
     let filter = realized.filter.clone();
     let drive_words = realized_words(readout_regs.amp, Mode::Readout);
     let cal_drive_words = realized_words(readout_regs.amp, Mode::Calibration);
@@ -412,8 +403,7 @@ pub fn plan(exp: &Experiment) -> Result<Plan, String> {
     }
 
     // Theory for gains and timing (the hold scales every force alike).
-    let w = [TAU * exp.gyro.f1_hz, TAU * exp.gyro.f2_hz];
-    let tau_s = (2.0 * exp.gyro.q1 / w[0]).max(2.0 * exp.gyro.q2 / w[1]);
+    let tau_s = exp.gyro.slowest_time_constant_s();
     let step = f64::from(1u32 << (16 - fe.adc_bits));
     let mut plan = Plan {
         points: vec![],
@@ -460,7 +450,8 @@ pub fn plan(exp: &Experiment) -> Result<Plan, String> {
             };
             settings::registers(&p).map(|(r, real)| (r, real.cal_hz))
         })
-        .collect::<Result<_, _>>()?;
+        .collect::<Result<_, _>>()
+        .map_err(|e| e.to_string())?;
     // ADC gains: the largest sampled displacement of any point (the DAC's
     // images included, `crate::images`) at `adc_headroom`.
     let mut peak_x = [0.0f64; 2];

@@ -6,9 +6,18 @@
 //! mismatched modes (one frequency and one Q per mode):
 //!
 //! ```text
-//! x1'' + B1 x1' - 2 lam Omz x2' + w1^2 x1 = f1(t)
-//! x2'' + B2 x2' + 2 lam Omz x1' + w2^2 x2 = f2(t)        Bk = wk / Qk,  wk = 2 pi fk
+//! x1'' + B1 x1' - 2 lam Omz x2' + w1^2 x1 + d x2' + k x2 = f1(t)
+//! x2'' + B2 x2' + 2 lam Omz x1' + w2^2 x2 + d x1' + k x1 = f2(t)
+//! Bk = wk / Qk,  wk = 2 pi fk,  k = 2 lam w1 Omq,  d = 2 lam Omd
 //! ```
+//!
+//! `k` is the quadrature (stiffness) coupling, `Omq` = `quadrature_dps` in
+//! rad/s: at mode 1's frequency its force on mode 2 is as large as the
+//! Coriolis force of a rate `Omq`, 90 deg from it. `d` is the damping
+//! coupling, `Omd` = `damping_coupling_dps` in rad/s: its force is as large
+//! as the Coriolis force of a rate `Omd` at every frequency, in phase with
+//! it, but symmetric (it acts on mode 1 with the same sign as on mode 2,
+//! where Coriolis changes sign). Both default to 0 (the paper's model).
 //!
 //! # Units
 //!
@@ -44,23 +53,9 @@
 
 use crate::noise::{self, Mat4, StateNoise, ThermalNoise};
 use nalgebra::SMatrix;
+use std::f64::consts::TAU;
 
-/// Physical parameters of the two-mode gyroscope (the `[gyro]` section of
-/// a configuration file: every key required).
-#[derive(Clone, Debug, PartialEq, serde::Deserialize, serde::Serialize)]
-#[serde(deny_unknown_fields)]
-pub struct GyroParams {
-    /// Resonance frequency of mode 1 (Hz).
-    pub f1_hz: f64,
-    /// Resonance frequency of mode 2 (Hz).
-    pub f2_hz: f64,
-    /// Quality factor of mode 1 (B1 = w1/q1).
-    pub q1: f64,
-    /// Quality factor of mode 2 (B2 = w2/q2).
-    pub q2: f64,
-    /// Angular gain lambda (Coriolis coupling is 2 lambda Omz).
-    pub angular_gain: f64,
-}
+pub use gyrocal_host::device::{CouplingOutOfRange, GyroParams, MAX_COUPLING_DPS};
 
 /// Transition and input matrices of one clock period, as plain arrays.
 #[derive(Clone, Debug, PartialEq)]
@@ -80,7 +75,8 @@ pub struct GyroModel {
     /// Reference angular frequency used to scale velocities (rad/s).
     wr: f64,
     omz: f64,
-    /// `Omz != 0` (and lambda != 0): the full 4x4 step is needed.
+    /// The modes are coupled (a coupling, or `Omz != 0` and lambda != 0):
+    /// the full 4x4 step is needed.
     coupled: bool,
     rest: Discrete,
     cur: Discrete,
@@ -102,7 +98,8 @@ impl GyroModel {
     ///
     /// Errors (one line, naming the field) unless `clock_hz` is finite and > 0,
     /// both mode frequencies are finite and in (0, clock_hz/2), both Q are finite
-    /// and > 0, and the angular gain is finite.
+    /// and > 0, the angular gain is finite and both couplings are in range
+    /// ([`GyroParams::check_couplings`]).
     pub fn new(params: &GyroParams, clock_hz: f64) -> Result<GyroModel, String> {
         check("clock_hz", clock_hz, clock_hz > 0.0, "finite and > 0 Hz")?;
         let nyq = clock_hz / 2.0;
@@ -122,6 +119,7 @@ impl GyroModel {
         check("q1", params.q1, params.q1 > 0.0, "finite and > 0")?;
         check("q2", params.q2, params.q2 > 0.0, "finite and > 0")?;
         check("angular_gain", params.angular_gain, true, "finite")?;
+        params.check_couplings().map_err(|e| e.to_string())?;
         let w1 = std::f64::consts::TAU * params.f1_hz;
         let w2 = std::f64::consts::TAU * params.f2_hz;
         let wr = 0.5 * (w1 + w2);
@@ -130,7 +128,7 @@ impl GyroModel {
             clock_hz,
             wr,
             omz: 0.0,
-            coupled: false,
+            coupled: params.coupled_at_rest(),
             rest: Discrete {
                 phi: [[0.0; 4]; 4],
                 gamma: [[0.0; 2]; 4],
@@ -143,16 +141,18 @@ impl GyroModel {
             thermal: None,
         };
         let mut rest = model.discretize(0.0);
-        // Decoupled modes: the off-diagonal blocks are zero in exact arithmetic
-        // (and in nalgebra's Pade evaluation); make that explicit, since step()
-        // skips them at Omz = 0.
-        for (i, j) in [(0, 2), (0, 3), (1, 2), (1, 3)] {
-            rest.phi[i][j] = 0.0;
-            rest.phi[j][i] = 0.0;
-        }
-        for i in 0..2 {
-            rest.gamma[i][1] = 0.0;
-            rest.gamma[i + 2][0] = 0.0;
+        if !model.coupled {
+            // Decoupled modes: the off-diagonal blocks are zero in exact
+            // arithmetic (and in nalgebra's Pade evaluation); make that
+            // explicit, since step() skips them when uncoupled.
+            for (i, j) in [(0, 2), (0, 3), (1, 2), (1, 3)] {
+                rest.phi[i][j] = 0.0;
+                rest.phi[j][i] = 0.0;
+            }
+            for i in 0..2 {
+                rest.gamma[i][1] = 0.0;
+                rest.gamma[i + 2][0] = 0.0;
+            }
         }
         model.rest = rest;
         model.cur = model.rest.clone();
@@ -169,14 +169,16 @@ impl GyroModel {
         let (b1, b2) = (w1 / p.q1, w2 / p.q2);
         let g = 2.0 * p.angular_gain * omz;
         let wr = self.wr;
+        let k = p.quadrature_stiffness() / wr;
+        let d = p.damping_coupling();
         // Scaled state s = [x1, u1, x2, u2], u = v/wr; scaled input g_k = f_k/wr^2:
-        //   x1' = wr u1,  u1' = -(w1^2/wr) x1 - B1 u1 + 2 lam Omz u2 + wr g1
-        //   x2' = wr u2,  u2' = -(w2^2/wr) x2 - B2 u2 - 2 lam Omz u1 + wr g2
+        //   x1' = wr u1,  u1' = -(w1^2/wr) x1 - B1 u1 - (k/wr) x2 + (2 lam Omz - d) u2 + wr g1
+        //   x2' = wr u2,  u2' = -(w2^2/wr) x2 - B2 u2 - (k/wr) x1 - (2 lam Omz + d) u1 + wr g2
         SMatrix::<f64, 6, 6>::from_row_slice(&[
-            0.0,           wr,  0.0,           0.0, 0.0, 0.0,
-            -w1 * w1 / wr, -b1, 0.0,           g,   wr,  0.0,
-            0.0,           0.0, 0.0,           wr,  0.0, 0.0,
-            0.0,           -g,  -w2 * w2 / wr, -b2, 0.0, wr,
+            0.0,           wr,     0.0,           0.0,   0.0, 0.0,
+            -w1 * w1 / wr, -b1,    -k,            g - d, wr,  0.0,
+            0.0,           0.0,    0.0,           wr,    0.0, 0.0,
+            -k,            -g - d, -w2 * w2 / wr, -b2,   0.0, wr,
             0.0,           0.0, 0.0,           0.0, 0.0, 0.0,
             0.0,           0.0, 0.0,           0.0, 0.0, 0.0,
         ])
@@ -191,10 +193,18 @@ impl GyroModel {
         let a = self.augmented(omz).fixed_view::<4, 4>(0, 0).into_owned() * t;
         let inv_wr2 = 1.0 / (self.wr * self.wr);
         let mut intensity = Mat4::zeros();
-        intensity[(1, 1)] = noise.force_psd(p.f1_hz, p.q1) / 2.0 * inv_wr2 * t;
+        let psd1 = noise.force_psd(p.f1_hz, p.q1);
+        intensity[(1, 1)] = psd1 / 2.0 * inv_wr2 * t;
         intensity[(3, 3)] = noise.force_psd(p.f2_hz, p.q2) / 2.0 * inv_wr2 * t;
+        // Fluctuation-dissipation: the force noise's covariance is that of
+        // the damping matrix [[B1, d], [d, B2]], so the damping coupling
+        // correlates the two forces by d / B1 of mode 1's PSD.
+        let b1 = TAU * p.f1_hz / p.q1;
+        let cross = psd1 * (p.damping_coupling() / b1) / 2.0 * inv_wr2 * t;
+        intensity[(1, 3)] = cross;
+        intensity[(3, 1)] = cross;
         let mut qd = noise::discrete_covariance(&a, &intensity);
-        if omz == 0.0 || p.angular_gain == 0.0 {
+        if !self.coupled_at(omz) {
             // Decoupled modes: independent increments (zero in exact arithmetic).
             for i in 0..2 {
                 for j in 2..4 {
@@ -223,6 +233,11 @@ impl GyroModel {
     /// The Brownian noise settings, when the noise is on.
     pub fn thermal_noise(&self) -> Option<&ThermalNoise> {
         self.thermal.as_ref().map(|(settings, _)| settings)
+    }
+
+    /// Whether the modes are coupled at rate `omz` (rad/s).
+    fn coupled_at(&self, omz: f64) -> bool {
+        (omz != 0.0 && self.params.angular_gain != 0.0) || self.params.coupled_at_rest()
     }
 
     /// Exact ZOH discretization at rate `omz` (rad/s).
@@ -261,7 +276,7 @@ impl GyroModel {
             return;
         }
         self.omz = omz_rad_s;
-        self.coupled = omz_rad_s != 0.0 && self.params.angular_gain != 0.0;
+        self.coupled = self.coupled_at(omz_rad_s);
         self.cur = if omz_rad_s == 0.0 {
             self.rest.clone()
         } else {
@@ -280,8 +295,9 @@ impl GyroModel {
     /// Advances one clock period with the forces per unit mass `f1`, `f2` (N/kg)
     /// held constant over it (zero-order hold).
     ///
-    /// At `Omz = 0` the modes are decoupled and only the two 2x2 diagonal blocks
-    /// are used (the others are exactly zero): about 1.3x faster, same result.
+    /// At `Omz = 0` without coupling the modes are decoupled and only the two
+    /// 2x2 diagonal blocks are used (the others are exactly zero): about 1.3x
+    /// faster, same result. A coupling keeps the full 4x4 step at rest.
     /// With thermal noise on, the clock's Brownian increment is added.
     #[inline]
     pub fn step(&mut self, f1: f64, f2: f64) {

@@ -127,6 +127,8 @@ mod tests {
             q1: 60.0,
             q2: 60.0,
             angular_gain: 0.7,
+            quadrature_dps: 0.0,
+            damping_coupling_dps: 0.0,
             carrier_hz: 100e3,
             f1_force: 0.8,
             f2_force: 0.6,

@@ -4,15 +4,19 @@
 //! `theory` (exact steady state and the paper's equations), `frontend`
 //! (DACs and ADCs), `engine` (the three simulators of the datapath),
 //! `cosim` (the closed loop), `experiment` (readout sweep and calibration
-//! staircase), `fit` (scale factors).
+//! staircase), `fit` (scale factors); `field` (the simulated board and the drifting
+//! device) and `serve` (that board on the wire, over Etherbone).
 
 pub mod allan;
-pub mod average;
+/// Exact window means (`gyrocal_host::average`).
+pub use gyrocal_host::average;
 pub mod bench;
 pub mod budget;
 pub mod config;
 pub mod cosim;
+pub mod datasheet;
 pub mod drift;
+pub mod edf;
 pub mod engine;
 pub mod experiment;
 pub mod field;
@@ -21,11 +25,15 @@ pub mod frontend;
 pub mod gyro;
 pub mod images;
 pub mod noise;
+pub mod noise_terms;
+pub mod rate_drift;
 pub mod rate_noise;
 pub mod report;
 pub mod ripple;
+pub mod serve;
 pub mod settling;
-pub mod theory;
+/// The exact theory (`gyrocal_host::theory`), shared with the host's prediction.
+pub use gyrocal_host::theory;
 #[cfg(feature = "verilator")]
 pub mod verilator;
 pub mod waveform;

@@ -466,6 +466,8 @@ mod tests {
                 q1: 1000.0,
                 q2: 1000.0,
                 angular_gain: 0.6,
+                quadrature_dps: 0.0,
+                damping_coupling_dps: 0.0,
             },
             101.23e3,
             1.2345e6,

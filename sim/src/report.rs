@@ -29,6 +29,10 @@ pub struct DeviceSummary {
     pub q2: f64,
     /// Angular gain lambda.
     pub angular_gain: f64,
+    /// Quadrature (stiffness) coupling (deg/s).
+    pub quadrature_dps: f64,
+    /// Damping coupling (deg/s).
+    pub damping_coupling_dps: f64,
     /// Realized carrier (Hz).
     pub carrier_hz: f64,
     /// FPGA clock (Hz).
@@ -252,6 +256,8 @@ impl Report {
                 q1: exp.gyro.q1,
                 q2: exp.gyro.q2,
                 angular_gain: exp.gyro.angular_gain,
+                quadrature_dps: exp.gyro.quadrature_dps,
+                damping_coupling_dps: exp.gyro.damping_coupling_dps,
                 carrier_hz: plan.carrier_hz,
                 clock_hz: exp.drive.clock_hz,
                 force_n_per_kg: [theory_device.f1_force, theory_device.f2_force],

@@ -133,8 +133,9 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     Ok(())
 }
 
-/// `dir` may not exist yet; its nearest existing ancestor must be a folder.
-fn check_folder(dir: &Path) -> Result<(), Failure> {
+/// `dir` may not exist yet; its nearest existing ancestor must be a folder
+/// (also `gyrocal datasheet`'s check).
+pub(super) fn check_folder(dir: &Path) -> Result<(), Failure> {
     match dir
         .ancestors()
         .find(|a| a.as_os_str().is_empty() || a.exists())

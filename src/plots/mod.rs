@@ -39,6 +39,7 @@
 mod allan;
 mod calibration;
 mod data;
+mod datasheet;
 mod field;
 pub(crate) mod field_rate;
 mod format;
@@ -178,6 +179,42 @@ pub fn write_field_figure(
     let plot = field::FieldPanel::new(report, title)?;
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     write_plot(&plot, field::SIZE, dir, name)
+}
+
+/// Write the datasheet's figures into `dir` (created if missing):
+/// `datasheet_adev`, `datasheet_nonlinearity` and, with `[drift]`,
+/// `datasheet_temperature`, PNG and SVG; every figure is laid out (and
+/// checked) before the first file is written.
+#[allow(dead_code)] // reason: tests/plots.rs includes this module; `gyrocal datasheet` calls it
+pub fn write_datasheet_figures(
+    ds: &gyrocal_sim::datasheet::Datasheet,
+    dir: &Path,
+) -> Result<Vec<PathBuf>, String> {
+    style::register_font()?;
+    let adev = datasheet::AdevFigure::new(ds)?;
+    let nonlinearity = datasheet::XyFigure::nonlinearity(ds)?;
+    let temperature = ds
+        .temperature
+        .as_ref()
+        .map(datasheet::XyFigure::temperature)
+        .transpose()?;
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let mut written = write_plot(&adev, datasheet::SIZE, dir, "datasheet_adev")?;
+    written.extend(write_plot(
+        &nonlinearity,
+        datasheet::SIZE,
+        dir,
+        "datasheet_nonlinearity",
+    )?);
+    if let Some(t) = temperature {
+        written.extend(write_plot(
+            &t,
+            datasheet::SIZE,
+            dir,
+            "datasheet_temperature",
+        )?);
+    }
+    Ok(written)
 }
 
 /// `plot` as `dir/name.png` then `dir/name.svg`.

@@ -108,7 +108,7 @@ pub fn lint_files(
     waivers: &[&Path],
 ) -> Result<LintReport, VerifyError> {
     let verilator = tools::verilator()?;
-    let tool_version = tools::version_line(&verilator, "--version")?;
+    let tool_version = tools::version_line(&verilator, "--version", "Verilator")?;
     let dir = ScratchDir::new("lint").map_err(io_error("cannot create a scratch folder"))?;
     let mut cmd = Command::new(&verilator);
     cmd.current_dir(dir.path())

@@ -22,7 +22,11 @@
 //! * The YoWASP tools run in a WebAssembly sandbox that sees the host's
 //!   files, but not a private `/tmp`: the scratch folders are under
 //!   `/var/tmp` ([`SCRATCH_BASE`]). The first run of each YoWASP tool
-//!   compiles it (a minute or two, cached in `~/.cache/YoWASP`).
+//!   compiles it (a minute or two, cached in `$YOWASP_CACHE_DIR`, default
+//!   `~/.cache/YoWASP`) and prints "Preparing to run ... This might take a
+//!   while..." before its own output: the version lines are found by
+//!   [`tools::parse_version`], which skips that banner
+//!   (`tests/yowasp_cold_start.rs` runs both tools on an empty cache).
 //! * The two parts run in parallel threads; [`place_and_route`] runs one.
 
 use crate::pnr_log::{self, BelUse, CriticalPath, Fmax};
@@ -280,22 +284,20 @@ fn programs(part: &Part) -> Result<Programs, VerifyError> {
     })
 }
 
-/// The first line of `program arg`'s output that matches `pattern` (YoWASP
-/// tools may print "Preparing to run ..." first).
-fn version(program: &Path, arg: &str, pattern: &str) -> Result<String, VerifyError> {
-    let mut cmd = Command::new(program);
-    cmd.arg(arg).current_dir(SCRATCH_BASE);
-    let (out, _) = run_ok(&mut cmd)?;
-    let text = combined_output(&out);
-    let re = Regex::new(pattern).expect("version pattern");
-    text.lines()
-        .find(|l| re.is_match(l))
-        .map(short_version)
-        .ok_or_else(|| VerifyError::ToolFailed {
-            command: describe(&cmd),
-            reason: format!("printed no line matching `{pattern}`"),
-            output: tail(&text, 10),
-        })
+/// The two version queries of `part`'s tools, each a command (run from
+/// [`SCRATCH_BASE`], which the YoWASP sandbox sees) and the name its
+/// version line carries: synthesis, then place and route.
+pub fn version_queries(part: &Part) -> Result<[(Command, &'static str); 2], VerifyError> {
+    let tools = programs(part)?;
+    let query = |program: &Path, arg: &str| {
+        let mut cmd = Command::new(program);
+        cmd.arg(arg).current_dir(SCRATCH_BASE);
+        cmd
+    };
+    Ok([
+        (query(&tools.yosys, "-V"), "Yosys"),
+        (query(&tools.nextpnr, "--version"), "nextpnr"),
+    ])
 }
 
 /// A version line without quotes and build details: YoWASP's Yosys adds
@@ -316,7 +318,7 @@ fn yosys_script(part: &Part, files: &[String]) -> String {
 }
 
 /// The pin constraint file (name, text) of `part`.
-fn pin_file(part: &Part) -> (&'static str, String) {
+pub fn pin_file(part: &Part) -> (&'static str, String) {
     let names = [CLOCK_PIN, SETTINGS_PIN, FOLD_PIN];
     match part.family {
         Family::Ice40 => (
@@ -435,8 +437,10 @@ fn uses(part: &Part, table: &[BelUse], stat: &str) -> Result<Vec<Use>, String> {
 /// on `part`.
 pub fn place_and_route(core: &Core, part: &Part) -> Result<PnrReport, VerifyError> {
     let tools = programs(part)?;
-    let yosys_version = version(&tools.yosys, "-V", r"Yosys \d")?;
-    let nextpnr_version = version(&tools.nextpnr, "--version", r"nextpnr")?;
+    // The version lines, YoWASP's first-run banner skipped, shortened.
+    let [yosys_version, nextpnr_version] = version_queries(part)?
+        .map(|(mut cmd, tool)| tools::version_of(&mut cmd, tool).map(|l| short_version(&l)));
+    let (yosys_version, nextpnr_version) = (yosys_version?, nextpnr_version?);
     let dir = ScratchDir::new_in(Path::new(SCRATCH_BASE), &format!("pnr-{}", part.key)).map_err(
         io_error(format!("cannot create a scratch folder in {SCRATCH_BASE}")),
     )?;

@@ -358,7 +358,7 @@ pub fn compile(simulator: Simulator, verilog: &Path) -> Result<CompiledTestbench
     let (tool_version, command, out, compile_time) = match simulator {
         Simulator::Icarus => {
             let icarus = tools::iverilog()?;
-            let version = tools::version_line(&icarus.iverilog, "-V")?;
+            let version = tools::version_line(&icarus.iverilog, "-V", "Icarus Verilog")?;
             let vvp_file = dir.path().join("replay.vvp");
             let mut cmd = Command::new(&icarus.iverilog);
             cmd.current_dir(dir.path())
@@ -371,7 +371,7 @@ pub fn compile(simulator: Simulator, verilog: &Path) -> Result<CompiledTestbench
         }
         Simulator::Verilator => {
             let build = tools::verilator_build()?;
-            let version = tools::version_line(&build.verilator, "--version")?;
+            let version = tools::version_line(&build.verilator, "--version", "Verilator")?;
             let jobs = std::thread::available_parallelism()
                 .map_or(1, |n| n.get())
                 .min(4);

@@ -183,7 +183,7 @@ fn check_problem_count(check: &str) -> Option<u64> {
 /// Synthesize `verilog` (top `gyro_interface`) for `target`.
 pub fn synthesize(verilog: &Path, target: Target) -> Result<SynthesisReport, VerifyError> {
     let yosys = tools::yosys()?;
-    let yosys_version = tools::version_line(&yosys, "-V")?;
+    let yosys_version = tools::version_line(&yosys, "-V", "Yosys")?;
     let dir = ScratchDir::new("yosys").map_err(io_error("cannot create a scratch folder"))?;
     let local = dir.path().join(gyrocal_hdl::export::VERILOG_FILE);
     std::fs::copy(verilog, &local)

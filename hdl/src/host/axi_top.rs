@@ -3,8 +3,9 @@
 //! ```text
 //!            ┌──────────────────────────── gyro_interface_axi ─────────────────────────────┐
 //!  s_axil_* ─┤ AXI4-Lite slave ─► SettingRegister x15 ──► settings ports ─► GyroInterface ├─ dac1, dac2
-//!            │        ▲          StatusWord x8 ◄─ ID, VERSION, counters,   (the core)    ├◄ adc1, adc2
-//!            │        └──────────────────────── z snapshot ◄── z1, z2, z_valid ──┘       │
+//!            │        ▲          StatusWord x9 ◄─ ID, VERSION, counters,   (the core)    ├◄ adc1, adc2
+//!            │        ├──────────────────────── z snapshot ◄── z1, z2, z_valid ──┘       │
+//!            │        └──────────────────────── ClipCounter x2 ◄── adc1, adc2            │
 //!  m_axis_* ◄┤ SampleFifo (256 x 96 bit) ◄── {count[15:0], z2, z1} when STREAM_ENABLE      │
 //!            └────────────────────────────────────────────────────────────────────────────┘
 //! ```
@@ -34,11 +35,12 @@
 //! AXI4-Stream master: `m_axis_tdata` 96 bits = {sample count [15:0], z2,
 //! z1} (z 40-bit two's complement, 8 fractional bits), `m_axis_tlast` = 1.
 
+use super::clip_counter::{COUNT_BITS, ClipCounter};
 use super::register_map::{
-    self, ADDRESS_BITS, AMP1, AMP2, CARRIER_STEP, CIC_DECIMATION, CIC_SHIFT, DATA_BITS, ID,
-    IIR_ALPHA, IIR_K0, IIR_K1, IIR_K2, MOD_STEP_HI, MOD_STEP_LO, REF_DELAY, REF_PHASE, Register,
-    SAMPLE_COUNT, SELECT, STREAM_ENABLE, STREAM_OVERFLOW, VERSION, WORD_INDEX_BITS, Z1_HI, Z1_LO,
-    Z2_HI, Z2_LO,
+    self, ADC_CLIP, ADDRESS_BITS, AMP1, AMP2, CARRIER_STEP, CIC_DECIMATION, CIC_SHIFT, DATA_BITS,
+    ID, IIR_ALPHA, IIR_K0, IIR_K1, IIR_K2, MOD_STEP_HI, MOD_STEP_LO, REF_DELAY, REF_PHASE,
+    Register, SAMPLE_COUNT, SELECT, STREAM_ENABLE, STREAM_OVERFLOW, VERSION, WORD_INDEX_BITS,
+    Z1_HI, Z1_LO, Z2_HI, Z2_LO,
 };
 use super::sample_fifo::{SAMPLE_BITS, SampleFifo};
 use super::setting_register::SettingRegister;
@@ -68,7 +70,7 @@ pub const SETTINGS: [Register; 15] = [
 ];
 
 /// The status words in the order of `GyroInterfaceAxi::status`.
-pub const STATUS: [Register; 8] = [
+pub const STATUS: [Register; 9] = [
     ID,
     VERSION,
     STREAM_OVERFLOW,
@@ -77,6 +79,7 @@ pub const STATUS: [Register; 8] = [
     Z1_HI,
     Z2_LO,
     Z2_HI,
+    ADC_CLIP,
 ];
 
 const _: () = assert!(Z_BITS == 40 && SAMPLE_BITS == 2 * Z_BITS + 16);
@@ -141,7 +144,8 @@ pub struct GyroInterfaceAxi {
     pub m_axis_tlast: Signal<Out, Bit>,
     core: GyroInterface,
     settings: [SettingRegister; 15],
-    status: [StatusWord; 8],
+    status: [StatusWord; 9],
+    clip: [ClipCounter; 2],
     fifo: SampleFifo,
     aw_held: DFF<Bit>,
     aw_index: DFF<Bits<WORD_INDEX_BITS>>,
@@ -213,6 +217,7 @@ impl GyroInterfaceAxi {
             core: GyroInterface::new(),
             settings: std::array::from_fn(|i| SettingRegister::new(&SETTINGS[i])),
             status: std::array::from_fn(|i| StatusWord::new(&STATUS[i])),
+            clip: Default::default(),
             fifo: SampleFifo::new(),
             aw_held: Default::default(),
             aw_index: Default::default(),
@@ -367,6 +372,9 @@ impl Logic for GyroInterfaceAxi {
         self.status[6].live.next = self.snapshot_z2.q.val().get_bits::<DATA_BITS>(0);
         self.status[7].live.next =
             bit_cast::<DATA_BITS, 8>(self.snapshot_z2.q.val().get_bits::<8>(32));
+        // Over-range counts of ADC1 (bits 15..0) and ADC2 (31..16), 16 = COUNT_BITS.
+        self.status[8].live.next = bit_cast::<DATA_BITS, COUNT_BITS>(self.clip[0].count.val())
+            | (bit_cast::<DATA_BITS, COUNT_BITS>(self.clip[1].count.val()) << 16);
         // Read channel: AR holding register, then one read.
         self.s_axil_arready.next = !self.ar_held.q.val();
         self.s_axil_rvalid.next = self.r_valid.q.val();
@@ -385,7 +393,7 @@ impl Logic for GyroInterfaceAxi {
                 self.read_word.next = self.settings[i].read_word.val();
             }
         }
-        for i in 0..8 {
+        for i in 0..9 {
             self.status[i].read_index.next = self.ar_index.q.val();
             if self.status[i].read_hit.val() {
                 self.read_ok.next = true;
@@ -407,6 +415,14 @@ impl Logic for GyroInterfaceAxi {
         }
         if self.r_valid.q.val() & self.s_axil_rready.val() {
             self.r_valid.d.next = false;
+        }
+        // The over-range counters restart on a read of ADC_CLIP.
+        self.clip[0].adc.next = self.adc1.val();
+        self.clip[1].adc.next = self.adc2.val();
+        for i in 0..2 {
+            self.clip[i].clock.next = self.aclk.val();
+            self.clip[i].reset.next = self.reset.val();
+            self.clip[i].clear.next = self.read.val() & self.status[8].read_hit.val();
         }
         // Stream.
         self.fifo.reset.next = self.reset.val();

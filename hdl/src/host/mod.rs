@@ -3,14 +3,17 @@
 //!
 //! - [`register_map`]: the one source of the register map (decoding,
 //!   `REGISTERS.md`, the C header, `Registers` <-> bus words);
+//! - `gyrocal_regs::systemrdl`: the same map as SystemRDL (`gyro_interface.rdl`);
 //! - [`axi_top`]: the rust-hdl top `GyroInterfaceAxi`, built from
 //!   [`setting_register`], [`status_word`] and [`sample_fifo`];
 //! - [`model`]: its bit-true, cycle-true model; [`rtl`]: the rust-hdl
 //!   design driven directly with the same interface.
 
 pub mod axi_top;
+pub mod clip_counter;
 pub mod model;
-pub mod register_map;
+/// The register map, from the leaf crate `gyrocal-regs`.
+pub use gyrocal_regs::map as register_map;
 pub mod rtl;
 pub mod sample_fifo;
 pub mod setting_register;
@@ -18,7 +21,7 @@ pub mod status_word;
 pub mod traffic;
 
 /// Width of z1 and z2 (40-bit two's complement, 8 fractional bits).
-pub const Z_BITS: usize = 40;
+pub const Z_BITS: usize = gyrocal_regs::datapath::Z_BITS as usize;
 /// Width of an AXI response code.
 pub const RESP_BITS: usize = 2;
 /// AXI response OKAY.

@@ -4,9 +4,10 @@
 //! with the inputs of the current cycle and returns the outputs after it,
 //! like every model in `crate::model`.
 
+use super::clip_counter::{ClipCount, clip_word};
 use super::register_map::{
-    self, Access, BusError, DATA_BITS, ID_WORD, RegisterBank, SAMPLE_COUNT, STREAM_OVERFLOW,
-    VERSION_WORD, Z1_HI, Z1_LO, Z2_HI, Z2_LO,
+    self, ADC_CLIP, Access, BusError, DATA_BITS, ID_WORD, RegisterBank, SAMPLE_COUNT,
+    STREAM_OVERFLOW, VERSION_WORD, Z1_HI, Z1_LO, Z2_HI, Z2_LO,
 };
 use super::sample_fifo::FIFO_DEPTH;
 use super::{OKAY, SLVERR, Z_BITS};
@@ -110,6 +111,7 @@ struct Wrapper {
     sample_count: u32,
     overflow_count: u32,
     snapshot: (u64, u64),
+    clip: [ClipCount; 2],
 }
 
 /// The stream FIFO's registers (`super::sample_fifo`): the words stored
@@ -179,6 +181,7 @@ impl Wrapper {
             sample_count: 0,
             overflow_count: 0,
             snapshot: (0, 0),
+            clip: [ClipCount::default(); 2],
         }
     }
 
@@ -198,6 +201,7 @@ impl Wrapper {
             o if o == Z2_HI.offset => (z2 >> DATA_BITS) as u32,
             o if o == register_map::ID.offset => ID_WORD,
             o if o == register_map::VERSION.offset => VERSION_WORD,
+            o if o == ADC_CLIP.offset => clip_word(self.clip),
             _ => unreachable!("status word {} has no source", reg.name),
         };
         Ok(reg.extend(live))
@@ -295,7 +299,11 @@ impl GyroInterfaceAxi {
             next.ar_held = true;
             next.ar_index = u32::from(i.araddr) >> 2;
         }
-        if now.ar_held && !now.r_valid {
+        let read = now.ar_held && !now.r_valid;
+        let clear_clip = read && now.ar_index == ADC_CLIP.word_index();
+        next.clip[0].step(i.adc.0, clear_clip);
+        next.clip[1].step(i.adc.1, clear_clip);
+        if read {
             let word = now.read_word(now.ar_index, count_now);
             next.ar_held = false;
             next.r_valid = true;

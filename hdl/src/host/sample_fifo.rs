@@ -38,7 +38,7 @@ use rust_hdl::prelude::*;
 
 /// Samples the FIFO holds (block RAM words; the output register holds the
 /// oldest of them).
-pub const FIFO_DEPTH: usize = 256;
+pub use gyrocal_regs::datapath::FIFO_DEPTH;
 /// Bits of a read or write pointer (FIFO_DEPTH = 2^POINTER_BITS).
 pub const POINTER_BITS: usize = 8;
 /// Bits of the fill count (0..=FIFO_DEPTH).

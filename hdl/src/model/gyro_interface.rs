@@ -5,58 +5,10 @@ use super::am_mixer::AmMixer;
 use super::carrier_nco::CarrierNco;
 use super::cic_decimator::CicDecimator;
 use super::demod_mux::DemodMux;
-use super::iir_lowpass::{Coefficients, IirLowpass};
+use super::iir_lowpass::IirLowpass;
 use super::modulation_nco::ModulationNco;
 use super::reference_alignment::ReferenceAlignment;
-
-/// The run-time settings of `GyroInterface`, one field per input port.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Registers {
-    /// SELECT: false readout, true calibration.
-    pub select: bool,
-    /// Carrier phase step (32 bits).
-    pub carrier_step: u32,
-    /// Reference phase advance (32 bits).
-    pub ref_phase: u32,
-    /// Reference delay (6 bits).
-    pub ref_delay: u8,
-    /// Modulation phase step (48 bits).
-    pub mod_step: u64,
-    /// Drive amplitudes F1, F2 (Q1.15).
-    pub amp: (i16, i16),
-    /// CIC decimation R (13 bits).
-    pub cic_decimation: u16,
-    /// CIC output shift (6 bits).
-    pub cic_shift: u8,
-    /// IIR coefficients (Q2.30).
-    pub iir: Coefficients,
-}
-
-impl Registers {
-    /// Width of the `ref_delay` port (bits).
-    pub const REF_DELAY_BITS: u32 = crate::reference_alignment::DELAY_BITS as u32;
-    /// Width of the `mod_step` port (bits).
-    pub const MOD_STEP_BITS: u32 = 48;
-    /// Width of the `cic_decimation` port (bits).
-    pub const CIC_DECIMATION_BITS: u32 = crate::cic_decimator::DECIMATION_BITS as u32;
-    /// Width of the `cic_shift` port (bits).
-    pub const CIC_SHIFT_BITS: u32 = crate::cic_decimator::SHIFT_BITS as u32;
-
-    /// The words as the ports hold them: a register word wider than its port
-    /// keeps only its low bits, as in the hardware (and in the rtl and
-    /// Verilator engines). Every engine sees registers through this.
-    #[inline(always)]
-    pub fn at_ports(&self) -> Self {
-        let low = |v: u64, bits: u32| v & ((1u64 << bits) - 1);
-        Self {
-            ref_delay: low(self.ref_delay.into(), Self::REF_DELAY_BITS) as u8,
-            mod_step: low(self.mod_step, Self::MOD_STEP_BITS),
-            cic_decimation: low(self.cic_decimation.into(), Self::CIC_DECIMATION_BITS) as u16,
-            cic_shift: low(self.cic_shift.into(), Self::CIC_SHIFT_BITS) as u8,
-            ..*self
-        }
-    }
-}
+pub use gyrocal_regs::Registers;
 
 /// The output ports of `GyroInterface` during one cycle.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

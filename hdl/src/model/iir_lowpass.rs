@@ -17,18 +17,7 @@ use crate::iir_program::{
     factor_value, physical_address,
 };
 
-/// The four filter coefficients, Q2.30.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Coefficients {
-    /// Biquad numerator gain g.
-    pub k0: i32,
-    /// Biquad feedback -a1 - 2.
-    pub k1: i32,
-    /// Biquad feedback 1 - a2.
-    pub k2: i32,
-    /// RC section coefficient.
-    pub alpha: i32,
-}
+pub use gyrocal_regs::Coefficients;
 
 /// Sign-extend the low `bits` bits of `x`.
 #[inline(always)]

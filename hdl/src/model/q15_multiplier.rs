@@ -1,10 +1,7 @@
 //! Bit-true model of `crate::q15_multiplier::Q15Multiplier`.
 
 /// `round(a * b / 2^15)`, rounded half up, wrapped to 16 bits.
-#[inline(always)]
-pub fn q15_product(a: i16, b: i16) -> i16 {
-    ((a as i32 * b as i32 + (1 << 14)) >> 15) as i16
-}
+pub use gyrocal_regs::datapath::q15_product;
 
 /// Cycle-true model: the factor, product and rounding registers.
 #[derive(Clone, Copy, Debug, Default)]

@@ -1,11 +1,12 @@
-//! A board as host software sees it: 32-bit registers at the byte offsets
-//! of `gyrocal_hdl::host::register_map` (the map the gateware decodes),
-//! coherent z snapshots, and time passing.
+//! The simulated board: a datapath engine (the bit-true model by default),
+//! the converters and the gyroscope at one temperature behind the register
+//! map, as host code (`gyrocal_host`, through its [`Board`] trait) sees a
+//! real one.
 //!
-//! [`SimBoard`] closes the loop of the bit-true model engine over the
-//! gyroscope at one temperature ([`crate::drift::DeviceAt`]): drive gains
-//! scale the DAC forces, ADC gains the pick-offs, and an unmodelled phase
-//! lag ([`crate::frontend::PickoffPhase`]) sits before both ADCs. Per clock,
+//! [`SimBoard`] closes the loop of an engine over the gyroscope at
+//! one temperature ([`crate::drift::DeviceAt`]): drive gains scale the DAC
+//! forces, ADC gains the pick-offs, and an unmodelled phase lag
+//! ([`crate::frontend::PickoffPhase`]) sits before both ADCs. Per clock,
 //! as in [`crate::cosim`]: the ADCs sample, the engine plays an edge, the
 //! gyroscope advances under the held force. Register writes act from the
 //! next clock on; the settings are decoded from the bank once per write.
@@ -20,49 +21,16 @@ use crate::engine::{Engine, ModelEngine};
 use crate::frontend::{Converters, FrontEnd, PickoffPhase};
 use crate::gyro::GyroModel;
 use crate::noise::ThermalNoise;
-use gyrocal_hdl::host::register_map::{
-    self, BusError, RegisterAccess, SAMPLE_COUNT, Z1_HI, Z1_LO, Z2_HI, Z2_LO,
-};
-use gyrocal_hdl::model::gyro_interface::{Outputs, Registers};
+use gyrocal_hdl::host::clip_counter::{ClipCount, clip_word};
+use gyrocal_hdl::model::gyro_interface::Outputs;
+pub use gyrocal_host::board::{Board, ZSample};
+use gyrocal_regs::map::{ADC_CLIP, BusError, RegisterAccess};
 
-/// One coherent z snapshot: the count and both outputs, in z LSB
-/// (2^-8 mixer LSB, the register's raw value over 256).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ZSample {
-    /// SAMPLE_COUNT at the snapshot.
-    pub count: u32,
-    /// z1, z2 (z LSB).
-    pub z: [f64; 2],
-}
-
-/// A gateware board: registers, z snapshots, time.
-pub trait Board: RegisterAccess {
-    /// Let `clocks` periods of the FPGA clock pass.
-    fn wait_clocks(&mut self, clocks: u64);
-
-    /// Read SAMPLE_COUNT (which latches z) then the four z words.
-    fn read_z(&mut self) -> Result<ZSample, BusError> {
-        let count = self.read_register(SAMPLE_COUNT.offset)?;
-        let mut word = |lo: u32, hi: u32| -> Result<f64, BusError> {
-            let (lo, hi) = (self.read_register(lo)?, self.read_register(hi)?);
-            Ok(((i64::from(hi as i32) << 32) | i64::from(lo)) as f64 / 256.0)
-        };
-        let z1 = word(Z1_LO.offset, Z1_HI.offset)?;
-        let z2 = word(Z2_LO.offset, Z2_HI.offset)?;
-        Ok(ZSample { count, z: [z1, z2] })
-    }
-
-    /// Write every setting of `regs` (the register map's own encoding).
-    fn program(&mut self, regs: &Registers) -> Result<(), BusError> {
-        register_map::encode(regs)
-            .into_iter()
-            .try_for_each(|(offset, word)| self.write_register(offset, word))
-    }
-}
-
-/// The model engine, converters and gyroscope behind the register map.
-pub struct SimBoard {
-    engine: ModelEngine,
+/// An engine (`E`: the model engine unless asked otherwise, e.g.
+/// `crate::verilator::VerilatorEngine`), converters and gyroscope behind
+/// the register map.
+pub struct SimBoard<E: Engine = ModelEngine> {
+    engine: E,
     converters: Converters,
     gyro: GyroModel,
     phase: Option<PickoffPhase>,
@@ -70,9 +38,10 @@ pub struct SimBoard {
     outputs: Outputs,
     samples: u32,
     cycle: u64,
+    clip: [ClipCount; 2],
 }
 
-impl SimBoard {
+impl<E: Engine> SimBoard<E> {
     /// A board at power-up with the device and front end of `at`:
     /// `front_end` holds the converters as built (gains at T0), which
     /// `at`'s drive and ADC multipliers scale; the front-end phase lag is
@@ -96,7 +65,7 @@ impl SimBoard {
             Some(PickoffPhase::new(p, phase_reference_hz)?)
         };
         Ok(Self {
-            engine: ModelEngine::power_up()?,
+            engine: E::power_up()?,
             converters: Converters::new(&fe)?,
             gyro: GyroModel::new(&at.gyro, clock_hz)?.with_thermal_noise(noise)?,
             phase,
@@ -104,6 +73,7 @@ impl SimBoard {
             outputs: Outputs::default(),
             samples: 0,
             cycle: 0,
+            clip: [ClipCount::default(); 2],
         })
     }
 
@@ -127,6 +97,8 @@ impl SimBoard {
             }
         };
         let (adc, force) = self.converters.step(self.outputs.dac, x);
+        self.clip[0].step(adc.0, false);
+        self.clip[1].step(adc.1, false);
         self.outputs = self.engine.step(adc, self.host.registers());
         self.gyro.step(force.0, force.1);
         self.samples = self.samples.wrapping_add(self.outputs.z_valid as u32);
@@ -134,23 +106,39 @@ impl SimBoard {
     }
 }
 
-impl Board for SimBoard {
-    fn wait_clocks(&mut self, clocks: u64) {
+impl<E: Engine> Board for SimBoard<E> {
+    fn wait_clocks(&mut self, clocks: u64) -> Result<(), BusError> {
         for _ in 0..clocks {
             self.step();
         }
+        Ok(())
+    }
+
+    /// Steps the clock until the count moves past `after` (at most R
+    /// clocks when `after` is the current count), then reads the snapshot.
+    fn next_sample(&mut self, after: u32) -> Result<ZSample, BusError> {
+        while self.samples == after {
+            self.step();
+        }
+        self.read_z()
     }
 }
 
-impl RegisterAccess for SimBoard {
+impl<E: Engine> RegisterAccess for SimBoard<E> {
     /// A write between two clocks: acts from the next clock on.
     fn write_register(&mut self, offset: u32, word: u32) -> Result<(), BusError> {
         self.host.write(offset, word)
     }
 
-    /// A read between two clocks; SAMPLE_COUNT latches z. STREAM_OVERFLOW
-    /// is 0: the board has no stream consumer.
+    /// A read between two clocks; SAMPLE_COUNT latches z, ADC_CLIP returns
+    /// the over-range counts and restarts them. STREAM_OVERFLOW is 0: the
+    /// board has no stream consumer.
     fn read_register(&mut self, offset: u32) -> Result<u32, BusError> {
+        if offset & !3 == ADC_CLIP.offset {
+            let word = clip_word(self.clip);
+            self.clip = [ClipCount::default(); 2];
+            return Ok(word);
+        }
         self.host.read(offset, self.outputs.z, self.samples)
     }
 }

@@ -32,10 +32,9 @@
 //! settle_s = 0.01                                     # optional
 //! ```
 
-use super::board::{Board, SimBoard};
-use super::identify::bus;
-use super::selfcal::window_z;
+use super::board::SimBoard;
 use crate::config::MAX_RATE_DPS;
+pub use gyrocal_host::rate::{calibrated, readout_null, rms_error};
 use serde::{Deserialize, Serialize};
 
 /// Records of a profile when `record_s` is not given.
@@ -191,7 +190,8 @@ pub struct ProfileRun {
 
 /// Apply `profile` through the rate table of `board` (already programmed
 /// and settled in readout), the rate updated once per z sample at the
-/// sample period's midpoint, and record block means.
+/// sample period's midpoint, and record block means
+/// (`gyrocal_host::rate::read_records`).
 pub fn run_profile(
     board: &mut SimBoard,
     profile: &Profile,
@@ -201,56 +201,34 @@ pub fn run_profile(
     let sample_s = f64::from(decimation) / clock_hz;
     let per_record = (profile.record_length_s() / sample_s).round().max(1.0) as usize;
     let records = ((profile.duration_s / (per_record as f64 * sample_s)).floor() as usize).max(1);
-    let mut run = ProfileRun {
-        time_s: Vec::with_capacity(records),
-        true_rate_dps: Vec::with_capacity(records),
-        z: Vec::with_capacity(records),
-        settled: Vec::with_capacity(records),
-        clocks: 0,
-    };
     let start = board.cycle();
-    let mut sample = 0usize;
-    for _ in 0..records {
-        let (mut rate_sum, mut z_sum) = (0.0, [0.0; 2]);
-        let t_first = sample as f64 * sample_s;
-        for _ in 0..per_record {
-            let rate = profile.rate_dps_at((sample as f64 + 0.5) * sample_s);
-            board.set_rate(rate.to_radians());
-            board.wait_clocks(u64::from(decimation));
-            let s = board.read_z().map_err(bus)?;
-            rate_sum += rate;
-            z_sum[0] += s.z[0];
-            z_sum[1] += s.z[1];
-            sample += 1;
-        }
-        let n = per_record as f64;
-        run.time_s.push(t_first + 0.5 * n * sample_s);
-        run.true_rate_dps.push(rate_sum / n);
-        run.z.push(z_sum.map(|v| v / n));
-        run.settled
-            .push(profile.is_settled(t_first, t_first + n * sample_s));
-    }
+    let mut applied = Vec::with_capacity(records * per_record);
+    let z = gyrocal_host::rate::read_records(board, per_record, records, |b, sample| {
+        let rate = profile.rate_dps_at((sample as f64 + 0.5) * sample_s);
+        b.set_rate(rate.to_radians());
+        applied.push(rate);
+    })
+    .map_err(|e| e.to_string())?;
     board.set_rate(0.0);
-    run.clocks = board.cycle() - start;
-    Ok(run)
-}
-
-/// The readout null: z at rest (mean over `length` clocks after one
-/// sample), on a board already programmed and settled in readout. The
-/// host measures it right after the cycle, with the device still.
-pub fn readout_null(
-    board: &mut dyn Board,
-    decimation: u32,
-    length: f64,
-) -> Result<[f64; 2], String> {
-    window_z(board, decimation, f64::from(decimation), length)
-}
-
-/// A calibrated rate series: (z - null) / SF per record and output.
-pub fn calibrated(z: &[[f64; 2]], null: [f64; 2], sf_per_dps: [f64; 2]) -> Vec<[f64; 2]> {
-    z.iter()
-        .map(|v| std::array::from_fn(|k| (v[k] - null[k]) / sf_per_dps[k]))
-        .collect()
+    let n = per_record as f64;
+    let time_s: Vec<f64> = (0..records)
+        .map(|i| (i as f64 + 0.5) * n * sample_s)
+        .collect();
+    Ok(ProfileRun {
+        true_rate_dps: applied
+            .chunks(per_record)
+            .map(|c| c.iter().sum::<f64>() / n)
+            .collect(),
+        settled: (0..records)
+            .map(|i| {
+                let t_first = i as f64 * n * sample_s;
+                profile.is_settled(t_first, t_first + n * sample_s)
+            })
+            .collect(),
+        time_s,
+        z,
+        clocks: board.cycle() - start,
+    })
 }
 
 /// The rate output of one step under the profile, self-calibrated and
@@ -273,22 +251,6 @@ pub struct RateTrace {
     pub selfcal_rms_error_dps: [f64; 2],
     /// RMS of baseline_rate - true_rate over the settled records (deg/s).
     pub baseline_rms_error_dps: [f64; 2],
-}
-
-/// RMS of `rate - truth` per output over the records marked in `keep`
-/// (NaN when none is).
-pub fn rms_error(rate: &[[f64; 2]], truth: &[f64], keep: &[bool]) -> [f64; 2] {
-    std::array::from_fn(|k| {
-        let (ss, n) = rate
-            .iter()
-            .zip(truth)
-            .zip(keep)
-            .filter(|(_, keep)| **keep)
-            .fold((0.0, 0usize), |(ss, n), ((r, t), _)| {
-                (ss + (r[k] - t).powi(2), n + 1)
-            });
-        (ss / n as f64).sqrt()
-    })
 }
 
 #[cfg(test)]

@@ -27,18 +27,22 @@
 //!   the factory's null and scale factor.
 
 use super::board::{Board, SimBoard};
-use super::drive_ratio::{self, DriveProbe};
-use super::identify::{Knowns, bus};
+use super::probe::DriveProbe;
 use super::profile::{self, Profile, ProfileRun, RateTrace};
-use super::selfcal::{self, Operating, SelfCal, window_z};
 use crate::config::Experiment;
 use crate::config::{Drive, Filter, Frontend, Points};
 use crate::drift::{DeviceAt, Drift};
+use crate::engine::Engine;
 use crate::experiment;
 use crate::fit::linear_fit;
 use crate::frontend::FrontEnd;
 use crate::gyro::GyroParams;
 use crate::noise::ThermalNoise;
+use gyrocal_host::Knowns;
+use gyrocal_host::datasheet::Datasheet;
+use gyrocal_host::drive_ratio;
+use gyrocal_host::sampling::window_z;
+use gyrocal_host::selfcal::{self, Operating, SelfCal};
 use rayon::prelude::*;
 use serde::Deserialize;
 use serde::Serialize;
@@ -71,6 +75,8 @@ struct ScenarioFile {
     profile: Option<Profile>,
     #[serde(default)]
     drive_probe: Option<DriveProbe>,
+    #[serde(default)]
+    datasheet: Datasheet,
 }
 
 /// A checked scenario.
@@ -108,10 +114,14 @@ pub fn parse(name: &str, text: &str) -> Result<Scenario, String> {
         filter: file.filter,
         points: file.experiment,
         noise: file.noise,
+        datasheet: file.datasheet,
     };
     exp.validate().map_err(|e| format!("{name}: {e}"))?;
     let derived = exp.derived().map_err(|e| format!("{name}: {e}"))?;
     file.drift.validate().map_err(|e| format!("{name}: {e}"))?;
+    file.drift
+        .validate_device(&exp.gyro)
+        .map_err(|e| format!("{name}: {e}"))?;
     if let Some(p) = &file.profile {
         let sample_s = f64::from(derived.decimation) / exp.drive.clock_hz;
         p.validate(sample_s).map_err(|e| format!("{name}: {e}"))?;
@@ -237,21 +247,57 @@ pub struct FieldReport {
     pub wall_s: f64,
 }
 
+/// What a host programmed for `exp` would know: its `[datasheet]` over its
+/// `[gyro]` (the keys the datasheet leaves out), its drive, latencies,
+/// filter and points. The filter and first window are derived from the
+/// datasheet, as a host must.
+pub fn knowns(exp: &Experiment) -> Result<Knowns, String> {
+    let nominal = exp.datasheet.over(&exp.gyro).map_err(|e| e.to_string())?;
+    let host_view = Experiment {
+        gyro: nominal.gyro.clone(),
+        ..exp.clone()
+    };
+    Ok(Knowns {
+        clock_hz: exp.drive.clock_hz,
+        nominal: nominal.gyro,
+        angular_gain_uncertainty: nominal.angular_gain_uncertainty,
+        amplitude: exp.drive.amplitude(),
+        force_full_scale: exp.drive.force_full_scale(),
+        dac_latency: exp.frontend.dac_latency,
+        adc_latency: exp.frontend.adc_latency,
+        filter: host_view.derived()?,
+        carrier_hz: exp.drive.carrier_hz,
+        rates_dps: exp.points.readout_rates_dps.clone(),
+        cal_freqs_hz: exp.points.cal_freqs_hz.clone(),
+    })
+}
+
 /// The board as built and what the host knows, for `exp`.
 pub fn build(exp: &Experiment) -> Result<(FrontEnd, Knowns), String> {
     let plan = experiment::plan(exp)?;
-    Ok((plan.front_end, Knowns::from_experiment(exp)?))
+    Ok((plan.front_end, knowns(exp)?))
 }
 
-/// A fresh board at one step. The front-end phase lag is exact at the
-/// nominal modes' mean frequency; the Brownian noise is `[noise]` as given
-/// (off unless its temperature is set).
+/// A fresh board at one step, on the model engine ([`board_on`]).
 pub fn board_at(exp: &Experiment, fe: &FrontEnd, at: &DeviceAt) -> Result<SimBoard, String> {
+    board_on(exp, fe, at)
+}
+
+/// A fresh board at one step on engine `E`, powered up. The front-end
+/// phase lag is exact at the nominal modes' mean frequency; the Brownian
+/// noise is `[noise]` as given (off unless its temperature is set).
+pub fn board_on<E: Engine>(
+    exp: &Experiment,
+    fe: &FrontEnd,
+    at: &DeviceAt,
+) -> Result<SimBoard<E>, String> {
     let reference = 0.5 * (exp.gyro.f1_hz + exp.gyro.f2_hz);
     let mut board = SimBoard::new(at, fe, &exp.noise, exp.drive.clock_hz, reference)?;
     // As a host does: wait until the core has filled its carrier tables
     // (GYRO_DRIVE_START_CLOCKS in the C header) before using it.
-    board.wait_clocks(gyrocal_hdl::gyro_interface::DRIVE_START_CLOCKS as u64);
+    board
+        .wait_clocks(gyrocal_regs::datapath::DRIVE_START_CLOCKS)
+        .map_err(|e| e.to_string())?;
     Ok(board)
 }
 
@@ -268,13 +314,17 @@ fn settled_readout_board(
     let mut board = board_at(exp, fe, at)?;
     program_readout(&mut board, knowns, op)?;
     board.set_rate(rate_dps.to_radians());
-    board.wait_clocks(knowns.settle_clocks(TABLE_FIRST_TAUS));
+    board
+        .wait_clocks(knowns.settle_clocks(TABLE_FIRST_TAUS))
+        .map_err(|e| e.to_string())?;
     Ok(board)
 }
 
 fn program_readout(board: &mut dyn Board, knowns: &Knowns, op: &Operating) -> Result<(), String> {
-    let (regs, _) = knowns.registers(op.carrier_hz, None, knowns.amplitude, op.ref_lag_deg)?;
-    board.program(&regs).map_err(bus)
+    let (regs, _) = knowns
+        .registers(op.carrier_hz, None, op.amplitude, op.ref_lag_deg)
+        .map_err(|e| e.to_string())?;
+    board.program(&regs).map_err(|e| e.to_string())
 }
 
 /// One point of the rate table: readout at `op` on a fresh board (from
@@ -291,7 +341,7 @@ fn table_point(
     let mut board = settled_readout_board(exp, fe, at, knowns, op, rate_dps)?;
     let r = knowns.filter.decimation;
     let length = (knowns.filter.min_window_s * knowns.clock_hz).ceil();
-    let z = window_z(&mut board, r, f64::from(r), length)?;
+    let z = window_z(&mut board, r, f64::from(r), length).map_err(|e| e.to_string())?;
     Ok((z, board.cycle()))
 }
 
@@ -352,21 +402,25 @@ struct Cycle {
 fn cycle_at(sc: &Scenario, fe: &FrontEnd, knowns: &Knowns, t: f64) -> Result<Cycle, String> {
     let at = sc.drift.at(&sc.exp.gyro, t);
     let mut board = board_at(&sc.exp, fe, &at)?;
-    let mut cal = selfcal::self_calibrate(&mut board, knowns, &knowns.nominal)?;
+    let e = |e: gyrocal_host::Error| e.to_string();
+    let mut cal = selfcal::self_calibrate(&mut board, knowns, &knowns.nominal).map_err(e)?;
     if let Some(probe) = &sc.drive_probe {
         board.set_rate(probe.rate_dps.to_radians());
-        let measured = drive_ratio::measure(&mut board, knowns, &cal.operating, &cal.identified)?;
+        let measured =
+            drive_ratio::measure(&mut board, knowns, &cal.operating, &cal.identified).map_err(e)?;
         board.set_rate(0.0);
-        selfcal::apply_drive_ratio(knowns, &mut cal, measured)?;
+        selfcal::apply_drive_ratio(knowns, &mut cal, measured).map_err(e)?;
     }
     let readout = match &sc.profile {
         None => None,
         Some(p) => {
             program_readout(&mut board, knowns, &cal.operating)?;
-            board.wait_clocks(knowns.settle_clocks(TABLE_FIRST_TAUS));
+            board
+                .wait_clocks(knowns.settle_clocks(TABLE_FIRST_TAUS))
+                .map_err(|e| e.to_string())?;
             let r = knowns.filter.decimation;
             let length = (knowns.filter.min_window_s * knowns.clock_hz).ceil();
-            let null = profile::readout_null(&mut board, r, length)?;
+            let null = profile::readout_null(&mut board, r, length).map_err(e)?;
             Some((
                 null,
                 profile::run_profile(&mut board, p, r, knowns.clock_hz)?,

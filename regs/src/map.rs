@@ -4,13 +4,15 @@
 //! [`REGISTERS`]: name, byte offset, field width, signedness, access,
 //! power-up value and documentation. From this table come
 //!
-//! - the slave's decoding (`super::axi_top` builds one decoder block per
+//! - the slave's decoding (`gyrocal_hdl::host::axi_top` builds one decoder block per
 //!   entry from it: offset, width mask, sign extension, power-up value),
 //! - `verilog-out/REGISTERS.md` ([`markdown`]) and the C header
 //!   `verilog-out/gyro_interface_regs.h` ([`c_header`]),
 //! - the conversion between the datapath's [`Registers`] and bus words
 //!   ([`encode`], [`RegisterBank::registers`]), which the co-simulation uses
-//!   to program its engines, and the bit-true bus model (`super::model`).
+//!   to program its engines, the bit-true bus model (`gyrocal_hdl::host::model`)
+//!   and the host code (`gyrocal-host`), which reaches a board through
+//!   [`RegisterAccess`].
 //!
 //! Bus words: a field occupies bits `bits-1..0` of its word. A write keeps
 //! the low `bits` bits (`WSTRB` selects bytes); a read returns the field
@@ -18,8 +20,8 @@
 //! [`ADDRESS_BITS`] wide; bits 1..0 are ignored (word access).
 //!
 //! ```
-//! use gyrocal_hdl::host::register_map::{self, RegisterBank};
-//! use gyrocal_hdl::model::gyro_interface::Registers;
+//! use gyrocal_regs::map::{self as register_map, RegisterBank};
+//! use gyrocal_regs::Registers;
 //! let mut regs = Registers::default();
 //! regs.mod_step = 0x1234_5678_9abc;
 //! regs.amp = (-5, 7);
@@ -31,9 +33,8 @@
 //! assert_eq!(bank.read(register_map::AMP1.offset), Ok(-5i32 as u32));
 //! ```
 
-use super::sample_fifo::FIFO_DEPTH;
-use crate::model::gyro_interface::Registers;
-use crate::model::iir_lowpass::Coefficients;
+use crate::datapath::{DELAY_BITS, DRIVE_START_CLOCKS, FIFO_DEPTH, Z_BITS};
+use crate::registers::{Coefficients, Registers};
 
 /// Width of the AXI4-Lite byte address (a 256-byte window).
 pub const ADDRESS_BITS: usize = 8;
@@ -44,7 +45,7 @@ pub const DATA_BITS: usize = 32;
 /// The identification word: ASCII "GYRO".
 pub const ID_WORD: u32 = 0x4759_524f;
 /// Register map version: major in bits 31..16, minor in 15..0.
-pub const VERSION_WORD: u32 = 0x0001_0000;
+pub const VERSION_WORD: u32 = 0x0001_0001;
 
 /// Who may write a register.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -70,6 +71,8 @@ pub struct Register {
     pub access: Access,
     /// Value after power-up and after `aresetn` (the field, as read).
     pub power_up: u32,
+    /// A read returns the field and clears it (a read side effect).
+    pub read_clears: bool,
     /// The core port or status it maps to, and its meaning.
     pub doc: &'static str,
 }
@@ -124,6 +127,7 @@ const fn setting(
         signed,
         access: Access::ReadWrite,
         power_up,
+        read_clears: false,
         doc,
     }
 }
@@ -142,6 +146,7 @@ const fn status(
         signed,
         access: Access::ReadOnly,
         power_up: 0,
+        read_clears: false,
         doc,
     }
 }
@@ -199,7 +204,7 @@ pub const REF_PHASE: Register = setting(
 pub const REF_DELAY: Register = setting(
     "REF_DELAY",
     0x14,
-    crate::reference_alignment::DELAY_BITS as u32,
+    DELAY_BITS,
     false,
     0,
     "Port `ref_delay`: references delayed by REF_DELAY + 1 clocks; set to L_dac + L_adc.",
@@ -331,7 +336,7 @@ pub const Z1_LO: Register = status(
 pub const Z1_HI: Register = status(
     "Z1_HI",
     0x50,
-    (crate::host::Z_BITS - 32) as u32,
+    Z_BITS - 32,
     true,
     "Bits 39..32 of the latched z1, sign-extended (z has 8 fractional bits).",
 );
@@ -347,13 +352,25 @@ pub const Z2_LO: Register = status(
 pub const Z2_HI: Register = status(
     "Z2_HI",
     0x58,
-    (crate::host::Z_BITS - 32) as u32,
+    Z_BITS - 32,
     true,
     "Bits 39..32 of the latched z2, sign-extended.",
 );
 
+/// ADC over-range counts; reading clears them.
+pub const ADC_CLIP: Register = Register {
+    read_clears: true,
+    ..status(
+        "ADC_CLIP",
+        0x5c,
+        32,
+        false,
+        "Clocks on which ADC1 (bits 15..0) and ADC2 (bits 31..16) read a rail code, -32768 or +32767, since the last read of this word; each count saturates at 65535. A read returns the counts and restarts them (a rail code on the clock of the read counts toward the next read). Any count means a measurement over that time was not linear.",
+    )
+};
+
 /// Every register, in offset order.
-pub const REGISTERS: [Register; 23] = [
+pub const REGISTERS: [Register; 24] = [
     ID,
     VERSION,
     SELECT,
@@ -377,6 +394,7 @@ pub const REGISTERS: [Register; 23] = [
     Z1_HI,
     Z2_LO,
     Z2_HI,
+    ADC_CLIP,
 ];
 
 /// The register at a byte offset (bits 1..0 ignored), if any.
@@ -412,13 +430,19 @@ pub fn encode(regs: &Registers) -> Vec<(u32, u32)> {
         .collect()
 }
 
-/// Why the slave answers SLVERR.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// Why a register access failed: the slave answered SLVERR, or the
+/// transport to the board did.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum BusError {
-    /// No register at this offset.
+    /// No register at this offset (SLVERR).
+    #[error("no register at this offset (SLVERR)")]
     Unmapped,
-    /// A write to a read-only register.
+    /// A write to a read-only register (SLVERR).
+    #[error("write to a read-only register (SLVERR)")]
     ReadOnly,
+    /// The transport failed (a socket, a device file): what and why.
+    #[error("{0}")]
+    Transport(String),
 }
 
 /// The settings as the slave holds them: one field per read-write register,
@@ -471,7 +495,7 @@ impl RegisterBank {
     }
 
     /// A bus read of a read-write register (status words come from the
-    /// datapath: `super::model` answers those).
+    /// datapath: `gyrocal_hdl::host::model` answers those).
     pub fn read(&self, offset: u32) -> Result<u32, BusError> {
         let i = Self::slot(offset).ok_or(BusError::Unmapped)?;
         Ok(REGISTERS[i].extend(self.fields[i]))
@@ -514,6 +538,11 @@ pub trait RegisterAccess {
     fn write_register(&mut self, offset: u32, word: u32) -> Result<(), BusError>;
     /// Read a word; `Err` where the slave answers SLVERR.
     fn read_register(&mut self, offset: u32) -> Result<u32, BusError>;
+    /// Read several words, in this order (a transport with a round trip
+    /// per request sends them as one: the bus still sees them in order).
+    fn read_registers(&mut self, offsets: &[u32]) -> Result<Vec<u32>, BusError> {
+        offsets.iter().map(|&o| self.read_register(o)).collect()
+    }
 }
 
 /// Program every setting of `regs` through `bus` ([`encode`]'s writes).
@@ -534,7 +563,7 @@ pub fn byte_mask(strobe: u8) -> u32 {
 pub fn markdown() -> String {
     let mut md = String::from(
         "# gyro_interface_axi registers\n\n\
-         Generated by `gyrocal export` from `hdl/src/host/register_map.rs`, the same source\n\
+         Generated by `gyrocal export` from `regs/src/map.rs`, the same source\n\
          as the AXI4-Lite slave's decoding and `gyro_interface_regs.h`; do not edit.\n\n\
          32-bit words at byte offsets from the slave's base address (8-bit address,\n\
          bits 1..0 ignored). A field occupies bits `bits-1..0`; a write keeps those\n\
@@ -545,9 +574,10 @@ pub fn markdown() -> String {
          |---|---|---|---|---|---|\n",
     );
     for r in &REGISTERS {
-        let access = match r.access {
-            Access::ReadWrite => "RW",
-            Access::ReadOnly => "RO",
+        let access = match (r.access, r.read_clears) {
+            (Access::ReadWrite, _) => "RW",
+            (Access::ReadOnly, false) => "RO",
+            (Access::ReadOnly, true) => "RO, read clears",
         };
         let signed = if r.signed { " signed" } else { "" };
         let power_up = match r.access {
@@ -565,14 +595,11 @@ pub fn markdown() -> String {
 }
 
 /// The access rules after the register table (the FIFO depth from
-/// `super::sample_fifo`).
+/// `crate::datapath`).
 fn coherence_notes() -> String {
     COHERENCE_NOTES
         .replace("{fifo_depth}", &FIFO_DEPTH.to_string())
-        .replace(
-            "{drive_start}",
-            &crate::gyro_interface::DRIVE_START_CLOCKS.to_string(),
-        )
+        .replace("{drive_start}", &DRIVE_START_CLOCKS.to_string())
 }
 
 const COHERENCE_NOTES: &str = r#"
@@ -591,6 +618,9 @@ const COHERENCE_NOTES: &str = r#"
   FIFO is full is dropped and counted in `STREAM_OVERFLOW`.
 - **Reset.** `aresetn` low (synchronous) returns every register above to its power-up
   value and empties the FIFO; the datapath core itself has no reset.
+- **Over range.** `ADC_CLIP` counts the clocks on which each ADC read a rail code; reading
+  it restarts both counts. Read it before and after a measurement: a non-zero second read
+  means the converter clipped during it.
 - **Power-up.** The core fills its carrier tables during its first clocks: the drives are
   0 until clock {drive_start} after configuration (`GYRO_DRIVE_START_CLOCKS`), and so are
   the references the demodulators use.
@@ -600,7 +630,7 @@ const COHERENCE_NOTES: &str = r#"
 pub fn c_header() -> String {
     let mut h = String::from(
         "/* gyro_interface_regs.h: register map of gyro_interface_axi (AXI4-Lite).\n \
-         * Generated by `gyrocal export` from hdl/src/host/register_map.rs, the same\n \
+         * Generated by `gyrocal export` from regs/src/map.rs, the same\n \
          * source as the hardware's decoding and REGISTERS.md; do not edit.\n \
          * Offsets are bytes from the slave's base address; access 32-bit words. */\n\
          #ifndef GYRO_INTERFACE_REGS_H\n#define GYRO_INTERFACE_REGS_H\n\n",
@@ -616,8 +646,7 @@ pub fn c_header() -> String {
     h.push_str(&format!(
         "/* Clocks after configuration before the drives leave 0: the core fills its\n \
          * carrier tables first. */\n\
-         #define GYRO_DRIVE_START_CLOCKS {}u\n\n",
-        crate::gyro_interface::DRIVE_START_CLOCKS
+         #define GYRO_DRIVE_START_CLOCKS {DRIVE_START_CLOCKS}u\n\n"
     ));
     for r in &REGISTERS {
         let access = match r.access {
@@ -662,18 +691,13 @@ pub fn c_header() -> String {
 mod tests {
     use super::*;
 
-    /// The decimation's documented range is the limits of record
-    /// (`filter_design`), and the power-up R and shift are a valid pair.
+    /// The decimation's documented range is the limits of record, and the
+    /// power-up R and shift are a valid pair.
     #[test]
     fn decimation_text_and_power_up_follow_the_limits() {
-        use crate::cic_decimator::MAX_DECIMATION;
-        use crate::filter_design::MIN_DECIMATION;
+        use crate::datapath::{MAX_DECIMATION, MIN_DECIMATION};
         let range = format!("{MIN_DECIMATION}..{MAX_DECIMATION}");
         assert!(CIC_DECIMATION.doc.contains(&range));
-        let port = crate::export::PORTS
-            .iter()
-            .find(|p| p.name == "cic_decimation");
-        assert_eq!(port.map(|p| p.format), Some(range.as_str()));
         let r = CIC_DECIMATION.power_up;
         assert!((MIN_DECIMATION..=MAX_DECIMATION).contains(&r));
         let shift = (4.0 * f64::from(r).log2()).ceil() as u32 - 8;
@@ -705,9 +729,15 @@ mod tests {
 
     #[test]
     fn encode_then_decode_gives_the_ports_values() {
-        let mut rng = crate::test_util::Rng::new(5);
+        // xorshift64*: a fixed sequence of 64-bit words.
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
         for _ in 0..1000 {
-            let mut x = || rng.next_u64();
+            let mut x = || {
+                state ^= state >> 12;
+                state ^= state << 25;
+                state ^= state >> 27;
+                state.wrapping_mul(0x2545_f491_4f6c_dd1d)
+            };
             let regs = Registers {
                 select: x() & 1 == 1,
                 carrier_step: x() as u32,

@@ -1,6 +1,6 @@
 //! Coefficients of the output filter from cut-off frequencies in Hz.
 //!
-//! The hardware (`crate::iir_lowpass`) runs at f_z = f_clk / R after the
+//! The hardware (`gyrocal_hdl::iir_lowpass`) runs at f_z = f_clk / R after the
 //! CIC. Its biquad is a 2nd-order Butterworth low-pass designed by the
 //! bilinear transform with pre-warping:
 //!
@@ -25,12 +25,12 @@
 //! output LSB (`dead_band_lsb` bounds it; the guard bits of the states are
 //! sized for this range); above f_z / 5, k1 would leave the Q2.30 range.
 
-use crate::cic_decimator::{MAX_DECIMATION, OUTPUT_FRACTION_BITS, STAGES};
-use crate::iir_lowpass::{COEFFICIENT_FRACTION_BITS, GUARD_BITS};
-use crate::model::iir_lowpass::Coefficients;
-
-/// Smallest decimation the filter schedule accepts (its length in clocks).
-pub const MIN_DECIMATION: u32 = crate::iir_lowpass::SCHEDULE_CLOCKS as u32;
+use crate::PlanError;
+use crate::datapath::{
+    CIC_STAGES as STAGES, COEFFICIENT_FRACTION_BITS, GUARD_BITS, OUTPUT_FRACTION_BITS,
+};
+pub use crate::datapath::{MAX_DECIMATION, MIN_DECIMATION};
+use crate::registers::Coefficients;
 /// Lowest cut-off as a fraction of the output rate.
 pub const MIN_CUTOFF_RATIO: f64 = 1.0 / 1000.0;
 /// Highest cut-off as a fraction of the output rate.
@@ -69,12 +69,13 @@ pub fn cic_bit_growth(decimation: u32) -> u32 {
     s
 }
 
-fn quantize(x: f64, what: &str) -> Result<i32, String> {
+fn quantize(x: f64, what: &'static str) -> Result<i32, PlanError> {
     let q = (x * f64::from(1u32 << COEFFICIENT_FRACTION_BITS)).round();
     if !(i32::MIN as f64..=i32::MAX as f64).contains(&q) {
-        return Err(format!(
-            "filter coefficient {what} = {x} does not fit Q2.30"
-        ));
+        return Err(PlanError::Coefficient {
+            name: what,
+            value: x,
+        });
     }
     Ok(q as i32)
 }
@@ -85,18 +86,24 @@ pub fn design(
     decimation: u32,
     butterworth_hz: f64,
     rc_hz: f64,
-) -> Result<FilterDesign, String> {
+) -> Result<FilterDesign, PlanError> {
     if !(MIN_DECIMATION..=MAX_DECIMATION).contains(&decimation) {
-        return Err(format!(
-            "cic decimation = {decimation}: allowed {MIN_DECIMATION}..={MAX_DECIMATION}"
+        return Err(PlanError::out_of_range(
+            "cic decimation",
+            decimation,
+            format!("allowed {MIN_DECIMATION}..={MAX_DECIMATION}"),
         ));
     }
     let fz = clock_hz / decimation as f64;
     for (name, f) in [("butterworth_hz", butterworth_hz), ("rc_hz", rc_hz)] {
         let (lo, hi) = (fz * MIN_CUTOFF_RATIO, fz * MAX_CUTOFF_RATIO);
         if !(f.is_finite() && f >= lo && f <= hi) {
-            return Err(format!(
-                "{name} = {f}: allowed {lo:.6} to {hi:.3} Hz (f_clk / R / 1000 to f_clk / R / 5 with R = {decimation})"
+            return Err(PlanError::out_of_range(
+                name,
+                f,
+                format!(
+                    "allowed {lo:.6} to {hi:.3} Hz (f_clk / R / 1000 to f_clk / R / 5 with R = {decimation})"
+                ),
             ));
         }
     }
@@ -123,9 +130,10 @@ pub fn design(
     // Quantized feedback a1 = -2 - k1, a2 = 1 - k2: the stability triangle.
     let (a1, a2) = (-2.0 - q1, 1.0 - q2);
     if !(a2.abs() < 1.0 && a1.abs() < 1.0 + a2) || coefficients.alpha <= 0 {
-        return Err(format!(
-            "filter with butterworth_hz = {butterworth_hz}, rc_hz = {rc_hz} is unstable once quantized"
-        ));
+        return Err(PlanError::Unstable {
+            butterworth_hz,
+            rc_hz,
+        });
     }
     let sum = -(coefficients.k1 as i64 + coefficients.k2 as i64) as f64;
     let dc_gain = cic_gain * 4.0 * coefficients.k0 as f64 / sum;
@@ -197,16 +205,19 @@ mod tests {
         assert!(
             design(50e6, 8, 100.0, 100.0)
                 .unwrap_err()
+                .to_string()
                 .starts_with("cic decimation = 8")
         );
         assert!(
             design(50e6, 1000, 20e3, 100.0)
                 .unwrap_err()
+                .to_string()
                 .starts_with("butterworth_hz = 20000")
         );
         assert!(
             design(50e6, 1000, 500.0, f64::NAN)
                 .unwrap_err()
+                .to_string()
                 .starts_with("rc_hz = NaN")
         );
     }

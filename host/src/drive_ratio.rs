@@ -83,13 +83,16 @@
 //! (a stiffness term, which this model of the device does not have) would
 //! break M_12 = -M_21 and is not covered.
 
-use super::board::Board;
-use super::identify::{self, Estimate, Identified, Knowns, average_z, bus, signed_readout_word};
-use super::selfcal::Operating;
-use crate::config::MAX_RATE_DPS;
-use crate::fit::mean_and_standard_error;
+use crate::board::Board;
+use crate::error::Error;
+use crate::identify::{self, Estimate, Identified};
+use crate::knowns::Knowns;
+use crate::sampling::average_z;
+use crate::selfcal::Operating;
+use crate::stats::mean_and_standard_error;
+use gyrocal_regs::datapath::readout_word as signed_readout_word;
 use nalgebra::Complex;
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
 type C64 = Complex<f64>;
 
@@ -99,36 +102,6 @@ pub const BATCHES: usize = 8;
 /// Drive 1's amplitude during the measurement, as a fraction of its
 /// readout amplitude (module header, "Drive 1 at a fraction").
 pub const DRIVE1_FRACTION: f64 = 0.125;
-
-/// The `[drive_probe]` section of a field scenario: after each step's
-/// cycle the simulation's rate table turns the device at `rate_dps` while
-/// the host measures the drive-gain ratio (the host is not told the rate).
-///
-/// ```toml
-/// [drive_probe]
-/// rate_dps = 200      # required: any non-zero rate within the rate limit
-/// ```
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct DriveProbe {
-    /// The steady rate during the measurement (deg/s).
-    pub rate_dps: f64,
-}
-
-impl DriveProbe {
-    /// Checks the rate; the error is one line naming the key.
-    pub fn validate(&self) -> Result<(), String> {
-        let r = self.rate_dps;
-        if r.is_finite() && r != 0.0 && r.abs() <= MAX_RATE_DPS {
-            Ok(())
-        } else {
-            Err(format!(
-                "[drive_probe] rate_dps = {r}: allowed non-zero, -{MAX_RATE_DPS}..={MAX_RATE_DPS} \
-                 deg/s (at rest the cross responses vanish)"
-            ))
-        }
-    }
-}
 
 /// The measured drive-gain ratio.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -194,15 +167,10 @@ fn mean_and_error(v: &[f64]) -> Estimate {
 
 /// `BATCHES` batch means of both outputs, `per_batch` z samples each,
 /// after waiting `settle` clocks.
-fn batch_means(
-    board: &mut dyn Board,
-    decimation: u32,
-    settle: u64,
-    per_batch: u64,
-) -> Result<Vec<[f64; 2]>, String> {
-    board.wait_clocks(settle);
+fn batch_means(board: &mut dyn Board, settle: u64, per_batch: u64) -> Result<Vec<[f64; 2]>, Error> {
+    board.wait_clocks(settle)?;
     (0..BATCHES)
-        .map(|_| average_z(board, decimation, 0, per_batch))
+        .map(|_| average_z(board, 0, per_batch))
         .collect()
 }
 
@@ -215,9 +183,9 @@ pub fn measure(
     knowns: &Knowns,
     op: &Operating,
     id: &Identified,
-) -> Result<DriveRatio, String> {
+) -> Result<DriveRatio, Error> {
     let r = knowns.filter.decimation;
-    let window = (knowns.filter.min_window_s * knowns.clock_hz / f64::from(r)).ceil() as u64;
+    let window = knowns.window_samples();
     let per_batch = window.div_ceil(BATCHES as u64).max(1);
     let settle = knowns.settle_clocks(identify::SETTLE_TAUS);
     let filter = knowns.filter_settle_clocks();
@@ -226,10 +194,7 @@ pub fn measure(
     let mut w1 = 0.0;
     let mut clocks = 0;
     for (s, sign) in [1.0, -1.0].into_iter().enumerate() {
-        let amps = (
-            DRIVE1_FRACTION * knowns.amplitude.0,
-            sign * knowns.amplitude.1,
-        );
+        let amps = (DRIVE1_FRACTION * op.amplitude.0, sign * op.amplitude.1);
         let (regs, _) = knowns.registers(op.carrier_hz, None, amps, op.ref_lag_deg)?;
         w1 = signed_readout_word(regs.amp.0);
         words[s] = signed_readout_word(regs.amp.1);
@@ -237,15 +202,18 @@ pub fn measure(
         for quarter in [0u32, 1 << 30] {
             let mut rotated = regs;
             rotated.ref_phase = regs.ref_phase.wrapping_add(quarter);
-            board.program(&rotated).map_err(bus)?;
+            board.program(&rotated)?;
             let wait = if quarter == 0 { settle } else { filter };
-            pair.push(batch_means(board, r, wait, per_batch)?);
+            pair.push(batch_means(board, wait, per_batch)?);
             clocks += wait + BATCHES as u64 * per_batch * u64::from(r);
         }
         means.push(pair);
     }
     if words[0] == words[1] || w1 == 0.0 {
-        return Err("drive-gain ratio: both drive amplitudes must be non-zero".into());
+        return Err(Error::Measurement {
+            what: "drive-gain ratio",
+            reason: "both drive amplitudes must be non-zero".into(),
+        });
     }
     let (g_ratio, g_error) = resonator_ratio(id, op.carrier_hz);
     let squared: Vec<C64> = (0..BATCHES)

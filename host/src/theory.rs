@@ -2,11 +2,14 @@
 //!
 //! # Model and conventions
 //!
-//! Paper eqs (1)/(3) generalized to mismatched modes (see [`crate::gyro`]):
+//! Paper eqs (1)/(3) generalized to mismatched modes and mode couplings
+//! (see [`crate::device`]):
 //!
 //! ```text
-//! x1'' + B1 x1' - 2 lam Omz x2' + w1^2 x1 = f1,   x2'' + B2 x2' + 2 lam Omz x1' + w2^2 x2 = f2
-//! Bk = wk/Qk, wk = 2 pi fk, wb = 2 pi carrier_hz.
+//! x1'' + B1 x1' - 2 lam Omz x2' + w1^2 x1 + d x2' + k x2 = f1
+//! x2'' + B2 x2' + 2 lam Omz x1' + w2^2 x2 + d x1' + k x1 = f2
+//! Bk = wk/Qk, wk = 2 pi fk, wb = 2 pi carrier_hz,
+//! k = 2 lam w1 Omq (quadrature), d = 2 lam Omd (damping coupling).
 //! Readout:     f1 = F1 cos(wb t),             f2 = F2 sin(wb t)
 //!              z1 = DC[x1 F1 cos(wb t)],      z2 = DC[x2 F2 sin(wb t)]
 //! Calibration: f1 = F1 cos(wb t) cos(Om t),   f2 = F2 sin(wb t) sin(Om t),  Omz = 0
@@ -19,29 +22,54 @@
 //!
 //! # Exact steady state (continuous time, no sampling/hold/quantization)
 //!
-//! With `Dk(w) = wk^2 - w^2 + j w Bk` and `c = 2 lam Omz wb`, the readout phasors
-//! solve `[[D1, -j c], [j c, D2]] X = [F1, -j F2]`, so with `det = D1 D2 - c^2`:
+//! With `Dk(w) = wk^2 - w^2 + j w Bk`, `c = 2 lam Omz wb` and the coupling
+//! `kap(w) = k + j w d` (both modes alike), the phasors at one frequency
+//! solve a 2x2 system: in readout `[[D1, kap - j c], [kap + j c, D2]] X =
+//! [F1, -j F2]` at `wb`. Without coupling (`det' = D1 D2 - c^2`):
 //!
 //! ```text
-//! z1 = F1/2 Re[(F1 D2 + c F2)/det] = F1/2 { F1 Re(1/D1) + Re[c (F2 D1 + c F1)/(D1 det)] }
-//! z2 = F2/2 Re[(F2 D1 + c F1)/det] = F2/2 { F2 Re(1/D2) + Re[c (F1 D2 + c F2)/(D2 det)] }
+//! z1 = F1/2 Re[(F1 D2 + c F2)/det'] = F1/2 { F1 Re(1/D1) + Re[c (F2 D1 + c F1)/(D1 det')] }
+//! z2 = F2/2 Re[(F2 D1 + c F1)/det'] = F2/2 { F2 Re(1/D2) + Re[c (F1 D2 + c F2)/(D2 det')] }
 //! ```
 //!
 //! The second form (offset + rate term) is what is evaluated: it avoids the
-//! cancellation between a large offset and a tiny rate signal. In calibration
-//! the modes are decoupled and each sees tones at `wb -+ Om`; only equal
-//! frequencies give DC, and `Hk(a) - Hk(b) = (b - a)(j Bk - a - b)/(Dk(a) Dk(b))`:
+//! cancellation between a large offset and a tiny rate signal. The coupling
+//! adds to the phasors `X1'` and `Y2' = j X2'` inside the brackets, with
+//! `det = det' - kap^2`:
+//!
+//! ```text
+//! X1 = X1' + kap (j F2 + kap X1') / det,    Y2 = Y2' + kap (-j F1 + kap Y2') / det
+//! ```
+//!
+//! In calibration (`Omz = 0`) each mode sees tones at `wb -+ Om` from both
+//! drives, through `H = M^-1`: `Hkk = 1/Dk + kap^2/(Dk det)`, `H12 = H21 =
+//! -kap/det`, `det = D1 D2 - kap^2`. The drive phasors are (F1/2, F2/2) at
+//! wb - Om and (F1/2, -F2/2) at wb + Om; only equal frequencies give DC:
+//!
+//! ```text
+//! z1 = F2/4 Re[X1(wb-Om) - X1(wb+Om)],   z2 = F1/4 Re[X2(wb-Om) + X2(wb+Om)]
+//! ```
+//!
+//! Without coupling `Hk(a) - Hk(b) = (b - a)(j Bk - a - b)/(Dk(a) Dk(b))` gives
+//! the closed form, and the coupling adds `H12`'s sum (an offset that does not
+//! vanish at Om = 0) and the `kap^2` terms' difference:
 //!
 //! ```text
 //! zk = F1 F2/8 Re[Hk(wb-Om) - Hk(wb+Om)] = F1 F2 Om/4 Re[(j Bk - 2 wb)/(Dk(wb-Om) Dk(wb+Om))]
 //! ```
 //!
-//! Small-signal scale factors (exact derivatives at 0, per rad/s):
+//! Small-signal scale factors (exact derivatives at 0, per rad/s; `'` is
+//! d/dw, `det = D1 D2 - kap^2` at wb):
 //!
 //! ```text
-//! SF_read,1 = SF_read,2 = lam wb F1 F2 Re[1/(D1 D2)]         (both outputs identical)
-//! SF_cal,k  = F1 F2/4 Re[(j Bk - 2 wb)/Dk^2]
+//! SF_read,1 = SF_read,2 = lam wb F1 F2 Re[1/det]           (both outputs identical)
+//! SF_cal,1  = F1 F2/4 Re[-H11'] = F1 F2/4 Re[(D1' D2^2 + D2' kap^2 - 2 D2 kap kap')/det^2]
 //! ```
+//!
+//! and `SF_cal,2` with 1 and 2 swapped (`D' = j B - 2 wb`, `kap' = j d`).
+//! Every coupling term is added to the uncoupled value and is exactly zero
+//! without coupling, so the functions then give the uncoupled theory bit for
+//! bit.
 //!
 //! All `Dk` are evaluated as `(wk - wb)(wk + wb) + j wb Bk` with `wk - wb`
 //! formed from `fk - fb` (exact in f64 for close frequencies), and everything is
@@ -54,17 +82,18 @@
 //! scale factors in (m^2/s^2) per rad/s.
 //!
 //! The functions do not validate their inputs (a NaN or a zero frequency
-//! propagates to the result); [`crate::gyro::GyroModel::new`] does.
+//! propagates to the result); the simulator's `GyroModel::new` does.
 
 use nalgebra::Complex;
 use std::f64::consts::TAU;
 
-use crate::gyro::GyroParams;
+use crate::device::GyroParams;
 
 type C64 = Complex<f64>;
 
-/// A gyroscope plus its excitation: everything the steady state depends on.
-#[derive(Clone, Debug, PartialEq)]
+/// A gyroscope plus its excitation: everything the steady state depends on
+/// (deserializable with the same names; the couplings default to 0).
+#[derive(Clone, Debug, PartialEq, serde::Deserialize)]
 pub struct Device {
     /// Resonance frequency of mode 1 (Hz).
     pub f1_hz: f64,
@@ -76,6 +105,12 @@ pub struct Device {
     pub q2: f64,
     /// Angular gain lambda.
     pub angular_gain: f64,
+    /// Quadrature (stiffness) coupling Omq (deg/s; [`GyroParams`]).
+    #[serde(default)]
+    pub quadrature_dps: f64,
+    /// Damping coupling Omd (deg/s; [`GyroParams`]).
+    #[serde(default)]
+    pub damping_coupling_dps: f64,
     /// Excitation (carrier) frequency `fb`, `wb = 2 pi fb` (Hz).
     pub carrier_hz: f64,
     /// Drive amplitude F1 on mode 1 (force per unit mass) (N/kg).
@@ -85,7 +120,7 @@ pub struct Device {
 }
 
 impl Device {
-    /// The mechanical parameters, for [`crate::gyro::GyroModel::new`].
+    /// The mechanical parameters of the device.
     pub fn gyro_params(&self) -> GyroParams {
         GyroParams {
             f1_hz: self.f1_hz,
@@ -93,6 +128,8 @@ impl Device {
             q1: self.q1,
             q2: self.q2,
             angular_gain: self.angular_gain,
+            quadrature_dps: self.quadrature_dps,
+            damping_coupling_dps: self.damping_coupling_dps,
         }
     }
 }
@@ -105,6 +142,19 @@ struct Norm {
     sigma: [f64; 2],
     /// Bk / wb
     b: [f64; 2],
+    /// Quadrature stiffness k / wb^2.
+    k: f64,
+    /// Damping coupling d / wb.
+    d: f64,
+}
+
+/// The coupling's part of the response `H = M^-1` at one frequency, times
+/// wb^2 (`M = [[d1, kap], [kap, d2]]` at rest, module header).
+struct Coupling {
+    /// `kap^2 / (dk det)`: what the coupling adds to `Hkk = 1/dk`.
+    extra: [C64; 2],
+    /// `H12 = H21 = -kap / det`.
+    cross: C64,
 }
 
 impl Norm {
@@ -113,11 +163,14 @@ impl Norm {
         let wb = TAU * fb;
         let f = [dev.f1_hz, dev.f2_hz];
         let q = [dev.q1, dev.q2];
+        let gyro = dev.gyro_params();
         Norm {
             wb,
             delta: [TAU * (f[0] - fb), TAU * (f[1] - fb)],
             sigma: [TAU * (f[0] + fb), TAU * (f[1] + fb)],
             b: [f[0] / fb / q[0], f[1] / fb / q[1]],
+            k: gyro.quadrature_stiffness() / (wb * wb),
+            d: gyro.damping_coupling() / wb,
         }
     }
 
@@ -127,6 +180,23 @@ impl Norm {
         let re = (self.delta[k] - dw) * (self.sigma[k] + dw) / wb2;
         let im = (self.wb + dw) * self.b[k] / self.wb;
         C64::new(re, im)
+    }
+
+    /// The coupling `kap(w) / wb^2 = (k + j w d) / wb^2` at `w = wb + dw`.
+    fn kappa(&self, dw: f64) -> C64 {
+        C64::new(self.k, (self.wb + dw) / self.wb * self.d)
+    }
+
+    /// The coupling's part of the response at rest at `wb + dw` (exactly
+    /// zero without coupling).
+    fn coupling(&self, dw: f64) -> Coupling {
+        let d = [self.d(0, dw), self.d(1, dw)];
+        let kap = self.kappa(dw);
+        let det = d[0] * d[1] - kap * kap;
+        Coupling {
+            extra: d.map(|dk| kap * kap / (dk * det)),
+            cross: -kap / det,
+        }
     }
 }
 
@@ -149,9 +219,15 @@ pub fn readout_z_lagged(dev: &Device, omz_rad_s: f64, lag_rad: f64) -> [f64; 2] 
     let c = 2.0 * dev.angular_gain * omz_rad_s / n.wb;
     let det = d1 * d2 - c * c;
     let scale = 1.0 / (2.0 * n.wb * n.wb);
-    let z1 = f1 * (rot * (f1 * d1.inv() + c * (f2 * d1 + c * f1) / (d1 * det))).re;
-    let z2 = f2 * (rot * (f2 * d2.inv() + c * (f1 * d2 + c * f2) / (d2 * det))).re;
-    [z1 * scale, z2 * scale]
+    // The uncoupled phasors X1 and Y2 = j X2 (times wb^2), then the coupling's part.
+    let x1 = f1 * d1.inv() + c * (f2 * d1 + c * f1) / (d1 * det);
+    let y2 = f2 * d2.inv() + c * (f1 * d2 + c * f2) / (d2 * det);
+    let kap = n.kappa(0.0);
+    let det = det - kap * kap;
+    let j = C64::i();
+    let x1 = x1 + kap * (j * f2 + kap * x1) / det;
+    let y2 = y2 + kap * (-j * f1 + kap * y2) / det;
+    [f1 * (rot * x1).re * scale, f2 * (rot * y2).re * scale]
 }
 
 /// Exact steady-state calibration outputs `[z1, z2]` (m^2/s^2) at calibration
@@ -160,9 +236,18 @@ pub fn calibration_z(dev: &Device, f_cal_hz: f64) -> [f64; 2] {
     let n = Norm::new(dev);
     let om = TAU * f_cal_hz;
     let k = dev.f1_force * dev.f2_force * om / (4.0 * n.wb.powi(3));
+    let (f1, f2) = (dev.f1_force, dev.f2_force);
+    // The coupling's part (module header): H12's sum, the kap^2 terms' difference.
+    let [lo, hi] = [-om, om].map(|dw| n.coupling(dw));
+    let cross = (lo.cross + hi.cross) / 2.0;
+    let extra = |m: usize| (lo.extra[m] - hi.extra[m]) / 2.0;
+    let coupled = [
+        f2 * (f1 * extra(0) + f2 * cross),
+        f1 * (f1 * cross + f2 * extra(1)),
+    ];
     let z = |m: usize| {
         let num = C64::new(-2.0, n.b[m]);
-        k * (num / (n.d(m, -om) * n.d(m, om))).re
+        k * (num / (n.d(m, -om) * n.d(m, om))).re + coupled[m].re / (4.0 * n.wb * n.wb)
     };
     [z(0), z(1)]
 }
@@ -172,17 +257,18 @@ pub fn calibration_z(dev: &Device, f_cal_hz: f64) -> [f64; 2] {
 /// (references cos(Om t + lead) cos(wb t) and sin(Om t + lead) sin(wb t)
 /// against drives cos(Om t) cos(wb t) and sin(Om t) sin(wb t)).
 ///
-/// Sideband by sideband: drive 1 is F1/2 at wb + Om and at wb - Om, drive 2
-/// is -F2/2 and +F2/2; at rest the modes are uncoupled, x_k = Re sum
-/// H_k(w) c_k(w) e^(iwt) with H_k = 1 / (w_k^2 - w^2 + i w w_k / Q_k), and
-/// the mean of a product of two tones at the same frequency is
-/// Re(a conj(b)) / 2. Output 1 mixes x1 with reference 2, output 2 x2
-/// with reference 1. With no lead this is [`calibration_z`]. A lead L adds
-/// -L F1 F2 (Im H_k(wb - Om) + Im H_k(wb + Om)) / 8 to output k: the
-/// resonant part of the response, which dwarfs the calibration signal
-/// (proportional to Om), so a lead of Om T / 2 (the half clock the
-/// datapath's envelope alignment leaves) moves a low-Q device's
-/// calibration scale factor by parts in 1e4 (`hdl/src/settings.rs`).
+/// Sideband by sideband: drive 1 is F1/2 at wb + Om and at wb - Om, drive
+/// 2 is -F2/2 and +F2/2; at rest x_k = Re sum (H_k1(w) c_1(w) + H_k2(w)
+/// c_2(w)) e^(iwt) (module header; without coupling H_kk = 1 / (w_k^2 -
+/// w^2 + i w w_k / Q_k) and H_12 = H_21 = 0), and the mean of a product of
+/// two tones at the same frequency is Re(a conj(b)) / 2. Output 1 mixes x1
+/// with reference 2, output 2 x2 with reference 1. With no lead this is
+/// [`calibration_z`]. Without coupling, a lead L adds to output k
+/// -L F1 F2 (Im H_k(wb - Om) + Im H_k(wb + Om)) / 8: the resonant part of
+/// the response, which dwarfs the calibration signal (proportional to
+/// Om), so a lead of Om T / 2 (the half clock the datapath's envelope
+/// alignment leaves) moves a low-Q device's calibration scale factor by
+/// parts in 1e4 (`hdl/src/settings.rs`).
 pub fn calibration_z_with_envelope_lead(
     dev: &Device,
     f_cal_hz: f64,
@@ -231,11 +317,14 @@ pub fn calibration_z_lagged(
         [f2 / 2.0 * lead.conj(), -f2 / 2.0 * lead],
     ];
     let dw = [-om, om];
+    let coupling = dw.map(|dw| n.coupling(dw));
     let z = |k: usize| {
         (0..2)
             .map(|s| {
-                let h = 1.0 / (n.d(k, dw[s]) * wb2) * rot;
-                0.5 * (h * drive[k][s] * reference[1 - k][s].conj()).re
+                let own = (1.0 / (n.d(k, dw[s]) * wb2) + coupling[s].extra[k] / wb2) * rot;
+                let cross = coupling[s].cross / wb2 * rot;
+                let x = own * drive[k][s] + cross * drive[1 - k][s];
+                0.5 * (x * reference[1 - k][s].conj()).re
             })
             .sum::<f64>()
     };
@@ -246,19 +335,31 @@ pub fn calibration_z_lagged(
 /// ((m^2/s^2)/(rad/s)); the two outputs are identical in exact arithmetic.
 pub fn sf_read_per_rad_s(dev: &Device) -> [f64; 2] {
     let n = Norm::new(dev);
+    let kap = n.kappa(0.0);
     let sf = dev.angular_gain * dev.f1_force * dev.f2_force / n.wb.powi(3)
-        * (n.d(0, 0.0) * n.d(1, 0.0)).inv().re;
+        * (n.d(0, 0.0) * n.d(1, 0.0) - kap * kap).inv().re;
     [sf, sf]
 }
 
 /// Exact small-signal calibration scale factors `dz/dOm` at `Om -> 0`
-/// ((m^2/s^2)/(rad/s) of virtual rate).
+/// ((m^2/s^2)/(rad/s) of virtual rate): `F1 F2/4 Re(-Hkk')` (module
+/// header), evaluated as the uncoupled `dk'/dk^2` plus what the coupling
+/// adds, `kap [dk' kap (2 d1 d2 - kap^2) + dk^2 (dj' kap - 2 dj kap')] /
+/// (dk^2 det^2)` (j the other mode; derivatives in w / wb).
 pub fn sf_cal_per_rad_s(dev: &Device) -> [f64; 2] {
     let n = Norm::new(dev);
     let k = dev.f1_force * dev.f2_force / (4.0 * n.wb.powi(3));
+    let d = [n.d(0, 0.0), n.d(1, 0.0)];
+    let slope = [0, 1].map(|m| C64::new(-2.0, n.b[m]));
+    let (kap, kap_slope) = (n.kappa(0.0), C64::new(0.0, n.d));
+    let det = d[0] * d[1] - kap * kap;
     let sf = |m: usize| {
-        let d = n.d(m, 0.0);
-        k * (C64::new(-2.0, n.b[m]) / (d * d)).re
+        let o = 1 - m;
+        let coupled = kap
+            * (slope[m] * kap * (2.0 * d[0] * d[1] - kap * kap)
+                + d[m] * d[m] * (slope[o] * kap - 2.0 * d[o] * kap_slope))
+            / (d[m] * d[m] * det * det);
+        k * (slope[m] / (d[m] * d[m]) + coupled).re
     };
     [sf(0), sf(1)]
 }
@@ -340,26 +441,57 @@ pub fn readout_peak_displacement(dev: &Device, omz_rad_s: f64) -> [f64; 2] {
     let d1 = n.d(0, 0.0);
     let d2 = n.d(1, 0.0);
     let c = 2.0 * dev.angular_gain * omz_rad_s / n.wb;
-    let det = d1 * d2 - c * c;
-    // [[D1, -j c], [j c, D2]] X = [F1, -j F2] (all over wb^2).
+    let kap = n.kappa(0.0);
+    let det = d1 * d2 - c * c - kap * kap;
+    // [[D1, kap - j c], [kap + j c, D2]] X = [F1, -j F2] (all over wb^2).
     let j = C64::new(0.0, 1.0);
     let (f1, f2) = (C64::new(dev.f1_force, 0.0), -j * dev.f2_force);
-    let x1 = (d2 * f1 + j * c * f2) / det;
-    let x2 = (d1 * f2 - j * c * f1) / det;
+    let x1 = (d2 * f1 + j * c * f2 - kap * f2) / det;
+    let x2 = (d1 * f2 - j * c * f1 - kap * f1) / det;
     let wb2 = n.wb * n.wb;
     [x1.norm() / wb2, x2.norm() / wb2]
 }
 
 /// Upper bound on the calibration displacements `[|x1|, |x2|]` (m) at
-/// `f_cal_hz`: each mode sees tones at wb -+ Om of amplitude Fk/2, so its
-/// peak is at most the sum of the two responses.
+/// `f_cal_hz`: each mode sees tones at wb -+ Om of amplitude Fk/2 from its
+/// own drive and F_j/2 from the other's through the coupling, so its peak
+/// is at most the sum of the moduli of the responses, `|Hkk| <= 1/|Dk| +
+/// |kap^2/(Dk det)|`.
 pub fn calibration_peak_displacement(dev: &Device, f_cal_hz: f64) -> [f64; 2] {
     let n = Norm::new(dev);
     let om = TAU * f_cal_hz;
     let wb2 = n.wb * n.wb;
-    let peak =
-        |k: usize, f: f64| 0.5 * f * (1.0 / n.d(k, -om).norm() + 1.0 / n.d(k, om).norm()) / wb2;
-    [peak(0, dev.f1_force), peak(1, dev.f2_force)]
+    let force = [dev.f1_force, dev.f2_force];
+    let coupling = [-om, om].map(|dw| n.coupling(dw));
+    let peak = |k: usize, f: f64| {
+        let coupled: f64 = coupling
+            .iter()
+            .map(|c| 0.5 * (f * c.extra[k].norm() + force[1 - k] * c.cross.norm()))
+            .sum();
+        (0.5 * f * (1.0 / n.d(k, -om).norm() + 1.0 / n.d(k, om).norm()) + coupled) / wb2
+    };
+    [peak(0, force[0]), peak(1, force[1])]
+}
+
+/// The lead of the reference envelopes over the drive envelopes the
+/// datapath leaves in calibration (rad): the references are lined up with
+/// the drives' carrier to the half clock of the DAC's hold by `ref_phase`,
+/// but their envelope is not, so it is off by Om T / 2
+/// (`gyrocal_regs::plan`). Negligible in phase (1e-6 rad), but it mixes
+/// the resonant part of the response into the calibration output: 2e-4 of
+/// the calibration scale factor on a Q 200 device at 100 kHz and 3.33 MHz.
+pub fn envelope_lead_rad(cal_hz: f64, clock_hz: f64) -> f64 {
+    ENVELOPE_LEAD_SIGN * std::f64::consts::PI * cal_hz / clock_hz
+}
+
+/// The sign of the datapath's envelope lead (see `envelope_lead_rad`).
+const ENVELOPE_LEAD_SIGN: f64 = -1.0;
+
+/// Fundamental gain of the DAC's zero-order hold at `f_hz`, sin(x) / x with
+/// x = pi f / f_clk.
+pub fn hold_gain(f_hz: f64, clock_hz: f64) -> f64 {
+    let x = std::f64::consts::PI * f_hz / clock_hz;
+    x.sin() / x
 }
 
 #[cfg(test)]
@@ -373,6 +505,8 @@ mod tests {
             q1: q[0],
             q2: q[1],
             angular_gain: 0.7,
+            quadrature_dps: 0.0,
+            damping_coupling_dps: 0.0,
             carrier_hz: 100.3e3 + carrier_offset,
             f1_force: 0.8,
             f2_force: 0.6,
@@ -402,12 +536,26 @@ mod tests {
         }
     }
 
+    /// `dev` with 2000 deg/s of quadrature and 20 deg/s of damping coupling.
+    fn coupled(dev: Device) -> Device {
+        Device {
+            quadrature_dps: 2000.0,
+            damping_coupling_dps: 20.0,
+            ..dev
+        }
+    }
+
     #[test]
     fn no_envelope_lead_is_the_closed_form() {
+        // With couplings too: the closed form plus the coupling's terms
+        // against the sideband-by-sideband sum.
         for (dev, f) in [
             (device(1e3, [200.0, 200.0], 0.0), 300.0),
             (device(-37.0, [5e4, 3e4], 12.0), 2.5),
             (device(0.0, [1e3, 1e3], 0.0), 40.0),
+            (coupled(device(1e3, [200.0, 200.0], 0.0)), 300.0),
+            (coupled(device(-37.0, [5e4, 3e4], 12.0)), 2.5),
+            (coupled(device(0.0, [1e3, 1e3], 0.0)), 40.0),
         ] {
             let a = calibration_z(&dev, f);
             let b = calibration_z_with_envelope_lead(&dev, f, 0.0);

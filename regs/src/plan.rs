@@ -12,7 +12,7 @@
 //! cycle m the sample taken at the edge of cycle m - L_adc. The hold's
 //! fundamental is the word sequence delayed by L_dac + 1/2 clocks (and
 //! scaled by sinc(f T)), so the sample reaching the mixer at cycle n
-//! (`demod_mux` uses adc(n - 2)) responds to drive word number
+//! (`gyrocal_hdl::demod_mux` uses adc(n - 2)) responds to drive word number
 //! n - 2 - L_adc - L_dac - 1/2. The reference used at cycle n is
 //! ref(n - 3 - ref_delay) (`demod_mux` 2 clocks, `reference_alignment`
 //! ref_delay + 1), advanced in phase by ref_phase / carrier_step words.
@@ -25,9 +25,10 @@
 //! The modulation envelope is delayed with the carrier, so only half a
 //! clock of it remains (Om T / 2, about 1e-6 rad: negligible).
 
+use crate::PlanError;
+use crate::datapath::DELAY_BITS;
 use crate::filter_design::{self, FilterDesign};
-use crate::model::gyro_interface::Registers;
-use crate::reference_alignment::DELAY_BITS;
+use crate::registers::Registers;
 
 /// Highest calibration rate as a fraction of the clock.
 pub const MAX_CAL_RATIO: f64 = 1e-3;
@@ -72,27 +73,31 @@ pub struct Realized {
 
 /// Registers and realized values for a plan; a one-line error names the
 /// setting that is out of range and what is allowed.
-pub fn registers(plan: &FrequencyPlan) -> Result<(Registers, Realized), String> {
+pub fn registers(plan: &FrequencyPlan) -> Result<(Registers, Realized), PlanError> {
     let clock = plan.clock_hz;
     if !(clock.is_finite() && clock > 0.0) {
-        return Err(format!(
-            "clock_hz = {clock}: must be a positive number of Hz"
+        return Err(PlanError::out_of_range(
+            "clock_hz",
+            clock,
+            "must be a positive number of Hz",
         ));
     }
     let nyquist = clock / 2.0;
     if !(plan.carrier_hz.is_finite() && plan.carrier_hz > 0.0 && plan.carrier_hz < nyquist) {
-        return Err(format!(
-            "carrier_hz = {}: must be above 0 and below clock_hz / 2 = {nyquist}",
-            plan.carrier_hz
+        return Err(PlanError::out_of_range(
+            "carrier_hz",
+            plan.carrier_hz,
+            format!("must be above 0 and below clock_hz / 2 = {nyquist}"),
         ));
     }
     let carrier_step = (plan.carrier_hz / clock * 2f64.powi(32)).round() as u32;
     let mod_step = if plan.calibration {
         let max = clock * MAX_CAL_RATIO;
         if !(plan.cal_hz.is_finite() && plan.cal_hz >= 0.0 && plan.cal_hz <= max) {
-            return Err(format!(
-                "cal_hz = {}: allowed 0 to clock_hz x {MAX_CAL_RATIO} = {max}",
-                plan.cal_hz
+            return Err(PlanError::out_of_range(
+                "cal_hz",
+                plan.cal_hz,
+                format!("allowed 0 to clock_hz x {MAX_CAL_RATIO} = {max}"),
             ));
         }
         (plan.cal_hz / clock * 2f64.powi(48)).round() as u64
@@ -102,9 +107,10 @@ pub fn registers(plan: &FrequencyPlan) -> Result<(Registers, Realized), String> 
     let mut amp = [0i16; 2];
     for (k, a) in [plan.amplitude.0, plan.amplitude.1].into_iter().enumerate() {
         if !(a.is_finite() && (-1.0..1.0).contains(&a)) {
-            return Err(format!(
-                "amplitude of drive {} = {a}: allowed -1 <= a < 1",
-                k + 1
+            return Err(PlanError::out_of_range(
+                format!("amplitude of drive {}", k + 1),
+                a,
+                "allowed -1 <= a < 1",
             ));
         }
         // Q1.15, nearest: just below 1.0 saturates to 32767.
@@ -112,8 +118,10 @@ pub fn registers(plan: &FrequencyPlan) -> Result<(Registers, Realized), String> 
     }
     let delay = plan.dac_latency + plan.adc_latency;
     if delay > MAX_REF_DELAY {
-        return Err(format!(
-            "dac_latency + adc_latency = {delay} clocks: at most {MAX_REF_DELAY}"
+        return Err(PlanError::out_of_range(
+            "dac_latency + adc_latency",
+            format!("{delay} clocks"),
+            format!("at most {MAX_REF_DELAY}"),
         ));
     }
     let filter = filter_design::design(clock, plan.decimation, plan.butterworth_hz, plan.rc_hz)?;
@@ -183,6 +191,7 @@ mod tests {
         assert!(
             registers(&p)
                 .unwrap_err()
+                .to_string()
                 .starts_with("carrier_hz = 25000000")
         );
         let mut p = plan();
@@ -190,6 +199,7 @@ mod tests {
         assert!(
             registers(&p)
                 .unwrap_err()
+                .to_string()
                 .starts_with("amplitude of drive 2")
         );
         let mut p = plan();
@@ -198,6 +208,7 @@ mod tests {
         assert!(
             registers(&p)
                 .unwrap_err()
+                .to_string()
                 .starts_with("dac_latency + adc_latency = 64")
         );
     }

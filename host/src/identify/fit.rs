@@ -1,0 +1,256 @@
+//! The fits of identification: the narrow-band form of the coarse search,
+//! the exact form over a whole scan, and the Gauss-Newton fit of the fine
+//! sweep (module header of `super`).
+
+use super::{C64, Estimate, ModeFit};
+use nalgebra::{DMatrix, DVector};
+
+/// The narrow-band solution: 1 / (Y f) = a + b (f - f0), so that
+/// D = -b / 2, fk = f0 + Re(a / D) / 2, bk = Im(a / D), peak |Y| = 1 / (|D| fk bk).
+/// Returns (fk, bk, peak) from two or more points.
+pub(super) fn narrow_band(points: &[(f64, C64)]) -> Option<(f64, f64, f64)> {
+    let f0 = points.iter().map(|p| p.0).sum::<f64>() / points.len() as f64;
+    // Complex least squares of v = a + b u.
+    let n = points.len() as f64;
+    let u: Vec<f64> = points.iter().map(|p| p.0 - f0).collect();
+    let v: Vec<C64> = points.iter().map(|p| 1.0 / (p.1 * p.0)).collect();
+    let mu = u.iter().sum::<f64>() / n;
+    let mv = v.iter().sum::<C64>() / n;
+    let suu: f64 = u.iter().map(|x| (x - mu) * (x - mu)).sum();
+    if suu <= 0.0 {
+        return None;
+    }
+    let suv: C64 = u.iter().zip(&v).map(|(x, y)| (y - mv) * (x - mu)).sum();
+    let b = suv / suu;
+    let a = mv - b * mu;
+    let d = -b / 2.0;
+    let r = a / d;
+    let fk = f0 + r.re / 2.0;
+    let bk = r.im;
+    let peak = 1.0 / (d.norm() * fk * bk.abs());
+    (fk.is_finite() && bk.is_finite() && bk > 0.0).then_some((fk, bk, peak))
+}
+
+/// Gauss-Newton fit of Y = C / ((fk - f)(fk + f) + j f bk) from a start
+/// (fk, bk); returns the mode's estimates.
+pub(super) fn fit_mode(points: &[(f64, C64)], fk0: f64, bk0: f64) -> Result<ModeFit, &'static str> {
+    let den = |fk: f64, bk: f64, f: f64| C64::new((fk - f) * (fk + f), f * bk);
+    // Best C for given (fk, bk) is linear: C = sum(Y conj(1/den)) / sum |1/den|^2.
+    let best_c = |fk: f64, bk: f64| {
+        let (mut num, mut norm) = (C64::new(0.0, 0.0), 0.0);
+        for &(f, y) in points {
+            let g = 1.0 / den(fk, bk, f);
+            num += y * g.conj();
+            norm += g.norm_sqr();
+        }
+        num / norm
+    };
+    let mut p = {
+        let c = best_c(fk0, bk0);
+        [c.re, c.im, fk0, bk0]
+    };
+    let n = points.len();
+    let jacobian = |p: &[f64; 4]| {
+        let c = C64::new(p[0], p[1]);
+        let mut j = DMatrix::<f64>::zeros(2 * n, 4);
+        let mut r = DVector::<f64>::zeros(2 * n);
+        for (i, &(f, y)) in points.iter().enumerate() {
+            let d = den(p[2], p[3], f);
+            let m = c / d;
+            let res = y - m;
+            r[2 * i] = res.re;
+            r[2 * i + 1] = res.im;
+            let cols = [
+                1.0 / d,
+                C64::new(0.0, 1.0) / d,
+                -c * 2.0 * p[2] / (d * d),
+                -c * C64::new(0.0, f) / (d * d),
+            ];
+            for (col, v) in cols.iter().enumerate() {
+                j[(2 * i, col)] = v.re;
+                j[(2 * i + 1, col)] = v.im;
+            }
+        }
+        (j, r)
+    };
+    let scaled_solve =
+        |j: &DMatrix<f64>, r: &DVector<f64>| -> Option<(DVector<f64>, DMatrix<f64>)> {
+            let scale: Vec<f64> = (0..4).map(|c| j.column(c).norm()).collect();
+            let mut js = j.clone();
+            for (c, s) in scale.iter().enumerate() {
+                js.column_mut(c).scale_mut(1.0 / s);
+            }
+            let normal = js.transpose() * &js;
+            let inv = normal.try_inverse()?;
+            let step = &inv * js.transpose() * r;
+            let mut cov = inv;
+            for a in 0..4 {
+                for b in 0..4 {
+                    cov[(a, b)] /= scale[a] * scale[b];
+                }
+            }
+            Some((step.component_div(&DVector::from_vec(scale)), cov))
+        };
+    let mut cov = DMatrix::<f64>::zeros(4, 4);
+    let mut rss = 0.0;
+    for _ in 0..30 {
+        let (j, r) = jacobian(&p);
+        let (step, c) = scaled_solve(&j, &r).ok_or("singular fit")?;
+        for (v, s) in p.iter_mut().zip(step.iter()) {
+            *v += s;
+        }
+        cov = c;
+        rss = r.norm_squared();
+        if step[2].abs() < 1e-9 * p[3] && step[3].abs() < 1e-9 * p[3] {
+            break;
+        }
+    }
+    let (j, r) = jacobian(&p);
+    if let Some((_, c)) = scaled_solve(&j, &r) {
+        cov = c;
+        rss = r.norm_squared();
+    }
+    let dof = (2 * n).saturating_sub(4).max(1) as f64;
+    let s2 = rss / dof;
+    let sd = |a: usize| (s2 * cov[(a, a)]).sqrt();
+    let (fk, bk) = (p[2], p[3]);
+    if !(fk.is_finite() && bk.is_finite() && bk > 0.0) {
+        return Err("the fit diverged (no finite, positive bandwidth)");
+    }
+    let q = fk / bk;
+    let q_sd = q * ((sd(3) / bk).powi(2) + (sd(2) / fk).powi(2)).sqrt();
+    let c = C64::new(p[0], p[1]);
+    // phi = -arg C; d arg / d (Cr, Ci) = (-Ci, Cr) / |C|^2.
+    let g = [-p[1] / c.norm_sqr(), p[0] / c.norm_sqr()];
+    let var_phi = s2
+        * (g[0] * g[0] * cov[(0, 0)] + 2.0 * g[0] * g[1] * cov[(0, 1)] + g[1] * g[1] * cov[(1, 1)]);
+    let peak = c.norm() / (fk * bk);
+    Ok(ModeFit {
+        f_hz: Estimate {
+            value: fk,
+            uncertainty: sd(2),
+        },
+        q: Estimate {
+            value: q,
+            uncertainty: q_sd,
+        },
+        phase_deg: Estimate {
+            value: -c.arg().to_degrees(),
+            uncertainty: var_phi.sqrt().to_degrees(),
+        },
+        relative_rms: (rss / n as f64).sqrt() / peak,
+        gain_hz2: c.norm(),
+        scanned: false,
+        sweep: points.to_vec(),
+    })
+}
+
+/// The exact form over a scan, 1 / Y = (fk^2 - f^2 + j f bk) / C: a
+/// quadratic in f, written in s = (f - f0) / h (f0 the scan's centre, h its
+/// half-width) for conditioning, 1 / Y = Q0 + Q1 s + Q2 s^2, fitted by
+/// weighted least squares (real regressors: the real and imaginary parts
+/// are two fits of one design), each row weighted by |Y|^2: the noise of a
+/// z average is additive, so the variance of 1 / Y is that of Y over
+/// |Y|^4. The weights span many decades, so the system is solved by SVD of
+/// the weighted rows, never through the squared normal equations. With r = h / f0, Q2 = -f0^2 r^2 / C,
+/// Q1 = (-2 f0^2 + j f0 bk) r / C and Q0 = (fk^2 - f0^2 + j f0 bk) / C, so
+/// fk^2 = f0^2 (1 - r^2 Re(Q0 / Q2)) and bk = -f0 r Im(Q1 / Q2). Returns
+/// (fk, bk) when fk^2 comes out positive.
+pub(super) fn scan_fit(points: &[(f64, C64)]) -> Option<(f64, f64)> {
+    let (lo, hi) = points
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), p| {
+            (l.min(p.0), h.max(p.0))
+        });
+    let (f0, h) = (0.5 * (lo + hi), 0.5 * (hi - lo));
+    let top = points.iter().map(|p| p.1.norm()).fold(0.0, f64::max);
+    if !(h > 0.0 && top > 0.0) {
+        return None;
+    }
+    let n = points.len();
+    let mut x = DMatrix::<f64>::zeros(n, 3);
+    let mut v = DMatrix::<f64>::zeros(n, 2);
+    for (i, &(f, y)) in points.iter().enumerate() {
+        let s = (f - f0) / h;
+        let w = (y.norm() / top).powi(2);
+        let inv = 1.0 / y;
+        for (c, value) in [1.0, s, s * s].into_iter().enumerate() {
+            x[(i, c)] = w * value;
+        }
+        v[(i, 0)] = w * inv.re;
+        v[(i, 1)] = w * inv.im;
+    }
+    let sol = x.svd(true, true).solve(&v, 1e-14).ok()?;
+    let (re, im) = (sol.column(0), sol.column(1));
+    let q = |i: usize| C64::new(re[i], im[i]);
+    let r = h / f0;
+    let fk2 = f0 * f0 * (1.0 - r * r * (q(0) / q(2)).re);
+    let bk = -f0 * r * (q(1) / q(2)).im;
+    (fk2.is_finite() && fk2 > 0.0).then(|| (fk2.sqrt(), bk))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn narrow_band_and_the_fit_recover_a_lorentzian() {
+        let (fk, bk, phi) = (9.64e6 + 123.0, 175.3f64, 3.0f64.to_radians());
+        let c = C64::from_polar(2.0e9, -phi);
+        let y = |f: f64| c / C64::new((fk - f) * (fk + f), f * bk);
+        let far: Vec<(f64, C64)> = [-1.0, 0.0, 1.0]
+            .iter()
+            .map(|s| (9.64e6 - 2000.0 + s * 175.0, y(9.64e6 - 2000.0 + s * 175.0)))
+            .collect();
+        let (f_est, b_est, _) = narrow_band(&far).unwrap();
+        assert!((f_est - fk).abs() < 1.0, "{f_est}");
+        assert!((b_est / bk - 1.0).abs() < 0.01, "{b_est}");
+        let near: Vec<(f64, C64)> = (0..9)
+            .map(|i| fk + 30.0 + bk * (i as f64 / 4.0 - 1.0))
+            .map(|f| (f, y(f)))
+            .collect();
+        let m = fit_mode(&near, fk + 30.0, 150.0).unwrap();
+        assert!((m.f_hz.value - fk).abs() < 1e-6, "{:?}", m.f_hz);
+        assert!((m.q.value / (fk / bk) - 1.0).abs() < 1e-9);
+        assert!((m.phase_deg.value - 3.0).abs() < 1e-9, "{:?}", m.phase_deg);
+    }
+
+    /// A scan over +-5% of a 9.64 MHz guess finds a resonance anywhere in
+    /// it (on a scan point or between two, near the centre or the edge),
+    /// with a front-end phase and noise on every point, to a small fraction
+    /// of the scan's spacing (noise-free, it is exact: the form is).
+    #[test]
+    fn the_scan_fit_finds_a_far_resonance() {
+        let guess = 9.64e6;
+        let spacing = guess * 0.005;
+        for shift in [0.985, 0.9873, 1.003, 1.0412, 0.9512] {
+            let (fk, bk) = (guess * shift, 175.3);
+            let c = C64::from_polar(2.0e9, -0.3);
+            let mut state = 7u64;
+            let mut noise = || {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+            };
+            let points: Vec<(f64, C64)> = (0..21)
+                .map(|i| guess * (1.0 + 0.05 * (i as f64 / 10.0 - 1.0)))
+                .map(|f| {
+                    let y = c / C64::new((fk - f) * (fk + f), f * bk);
+                    // Additive noise of 1e-6 of the peak response: some 3% of
+                    // the farthest points' (the simulated board's z averages
+                    // leave about 3e-7 of a peak at half the ADC's full scale).
+                    let n = C64::new(noise(), noise()) * 1e-6 * (c.norm() / (fk * bk));
+                    (f, y + n)
+                })
+                .collect();
+            let (f, _) = scan_fit(&points).unwrap();
+            // A quarter of the spacing (12 kHz, 69 bandwidths): where the
+            // coarse search starts; its narrow-band form reaches that far
+            // (1 / (Y f) is linear in f to Delta / f = 1e-3 there) and
+            // its spacing grows with the move (`search::coarse`). Near the
+            // scan's edge, with points on one side only, it is the worst.
+            assert!((f - fk).abs() < 0.25 * spacing, "{f} vs {fk}");
+        }
+    }
+}

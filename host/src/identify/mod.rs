@@ -1,0 +1,281 @@
+//! Host-side identification of a drifting gyroscope through the gateware's
+//! registers alone: f1, f2, Q1, Q2 and the loop (front-end) phase, each
+//! with a 1-sigma uncertainty from the data.
+//!
+//! # What is measured
+//!
+//! In readout (SELECT = 0) with one drive on (AMP_k, the other 0), output k
+//! is the mean of ADC_k times drive k's own word. At rest the modes are
+//! uncoupled, so the ADC sees mode k's response to that word alone. With
+//! REF_PHASE at its aligned value (carrier_step / 2, `settings`) the
+//! mixer gives the in-phase part; with REF_PHASE advanced by a quarter
+//! turn, the quadrature part. The complex response per drive LSB is
+//!
+//! ```text
+//! Y(f) = 2 (z_I + j z_Q) / (dc_gain W^2) = C / ((fk - f)(fk + f) + j f bk),   C = G e^(-j phi)
+//! ```
+//!
+//! with W the drive word's amplitude (known from AMP), dc_gain the filter's
+//! (known from its settings), bk = fk / Qk the bandwidth (Hz), G > 0 the
+//! product of drive gain, hold, pick-off and ADC gain (unknown, and not
+//! needed), and phi the front end's unmodelled phase lag. This is the
+//! exact steady state of the model (the DAC hold's delay is what
+//! REF_PHASE's aligned value cancels; its sinc moves G by 1e-5 over a sweep).
+//!
+//! # How
+//!
+//! 1. Coarse search from the datasheet frequency ([`search`]): Y at three
+//!    carriers around a centre, and the narrow-band form
+//!    1 / (Y f) = a + b (f - f0) (linear in two complex unknowns) gives fk,
+//!    bk and the peak response even many bandwidths away; the centre moves
+//!    there, the three carriers spread to a quarter of the move, until it
+//!    lands within a quarter bandwidth. The drive amplitude is set from the
+//!    predicted peak so that the ADC stays below `ADC_TARGET` of full
+//!    scale; a measurement during which the ADC clipped (`ADC_CLIP`
+//!    counts, or a response above `ADC_NEAR_CLIP` of full scale) is made
+//!    again at a quarter of the amplitude ([`probe`]). Mode 2's search
+//!    starts at mode 1's identified frequency plus the datasheet's split.
+//!    When the search cannot converge (a datasheet off by more than the
+//!    narrow-band form reaches: far from resonance the response is nearly
+//!    real and its bandwidth lost in the noise), a scan of `SCAN_POINTS`
+//!    carriers over +-`SCAN_SPAN` of the guess (process spread is 1 to 5%)
+//!    and the exact form 1 / Y = (fk^2 - f^2 + j f bk) / C, linear in its
+//!    three complex coefficients over all the scan's points ([`fit`]),
+//!    give the start of a second search.
+//! 2. Fine sweep: `FINE_POINTS` carriers over +-`FINE_SPAN` bandwidths,
+//!    up then down, so that any settling lag shows as a misfit instead of
+//!    a shift. Each point waits `SETTLE_TAUS` amplitude time constants
+//!    after a carrier step (the coarse search's bandwidth gives the time
+//!    constant; the datasheet's until then, each with a 20% margin) and the
+//!    filter's settling after a REF_PHASE step.
+//! 3. Gauss-Newton fit ([`fit`]) of the exact form above (4 real unknowns: C, fk, bk)
+//!    from the narrow-band solution. Uncertainties: the residual variance
+//!    times the inverse normal matrix, propagated to Qk = fk / bk and
+//!    phi = -arg C.
+//!
+//! The loop phase is read off the line through the two modes' phi at the
+//! operating carrier (both references go through one REF_PHASE, so one
+//! common correction is what the gateware can apply); the line's slope is
+//! the front end's group delay, which the prediction needs: a front end
+//! that lags the carrier by phi usually delays the envelope too (a pure
+//! delay by phi / w, the pick-off model of `frontend::PickoffPhase` by
+//! about sin(phi) cos(phi) / w), and in calibration that mixes the
+//! resonant part of the response into the output (13% of the detuned
+//! output of a 25 kHz device with 3 deg, measured).
+
+mod fit;
+mod probe;
+mod search;
+
+use crate::board::Board;
+use crate::device::GyroParams;
+use crate::error::Error;
+use crate::knowns::{FILTER_SETTLE, Knowns, TAU_MARGIN};
+use nalgebra::Complex;
+use probe::Prober;
+use serde::Serialize;
+use std::f64::consts::{PI, TAU};
+
+type C64 = Complex<f64>;
+
+/// Amplitude time constants Qk / (pi fk) waited after a carrier step: the
+/// transient falls to e^-12 = 6e-6 of the step in response.
+pub const SETTLE_TAUS: f64 = 12.0;
+/// Fraction of ADC full scale the identification drives the peak to.
+pub const ADC_TARGET: f64 = 0.5;
+/// Above this fraction of full scale a response is taken as clipped even
+/// before the ADC_CLIP counts say so (the counts see rail codes only).
+pub const ADC_NEAR_CLIP: f64 = 0.8;
+/// Carriers of the fine sweep (each measured going up and coming down).
+pub const FINE_POINTS: usize = 5;
+/// Half-width of the fine sweep in bandwidths bk.
+pub const FINE_SPAN: f64 = 1.5;
+/// z samples averaged for each of I and Q.
+pub const SAMPLES_PER_PHASE: u64 = 128;
+/// What the waits leave of a step in the response, relative to the peak
+/// response: the resonator's e^-SETTLE_TAUS and the filter's
+/// `FILTER_SETTLE`. It is a bias, not noise (the fit's residuals do not
+/// see it when it repeats from point to point), and it moves the fitted
+/// phase by at most this many radians, fk and bk by this times bk, and Q by
+/// this fraction: each estimate's uncertainty includes it in quadrature
+/// (a bound used as one sigma).
+pub fn settling_residue() -> f64 {
+    (-SETTLE_TAUS).exp() + FILTER_SETTLE
+}
+/// Most coarse-search moves before giving up.
+pub const MAX_MOVES: usize = 12;
+/// Half-width of the fallback scan, relative to the guessed frequency:
+/// the process spread of a resonance.
+pub const SCAN_SPAN: f64 = 0.05;
+/// Carriers of the fallback scan (odd: one at the guess).
+pub const SCAN_POINTS: usize = 21;
+
+/// Fundamental amplitude (LSB) of a readout drive word for a Q1.15
+/// amplitude (`gyrocal_regs::datapath::readout_word`), unsigned.
+pub fn readout_word(amp: i16) -> f64 {
+    gyrocal_regs::datapath::readout_word(amp).abs()
+}
+
+/// A value and its 1-sigma uncertainty.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Estimate {
+    /// The value.
+    pub value: f64,
+    /// 1-sigma uncertainty.
+    pub uncertainty: f64,
+}
+
+/// One mode's fitted response.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ModeFit {
+    /// Resonance frequency (Hz).
+    pub f_hz: Estimate,
+    /// Quality factor.
+    pub q: Estimate,
+    /// Loop phase lag seen through this mode (deg).
+    pub phase_deg: Estimate,
+    /// RMS residual over the peak response (relative misfit).
+    pub relative_rms: f64,
+    /// |C| of the fitted form Y = C / ((fk - f)(fk + f) + j f bk): ADC LSB
+    /// per drive LSB, times Hz^2 (the peak response is |C| / (fk bk)).
+    pub gain_hz2: f64,
+    /// The coarse search from the guess did not converge and the scan
+    /// over +-`SCAN_SPAN` found the mode: the datasheet was off.
+    pub scanned: bool,
+    /// Sweep points (carrier Hz) and responses (ADC LSB per drive LSB).
+    #[serde(skip)]
+    pub sweep: Vec<(f64, C64)>,
+}
+
+/// The identified device.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Identified {
+    /// Mode 1 and mode 2.
+    pub modes: [ModeFit; 2],
+    /// Loop phase lag at the operating carrier (deg): the line through
+    /// the two modes' phases, evaluated there.
+    pub loop_phase_deg: Estimate,
+    /// Group delay of the loop (s): the slope of that line, d phi / d w.
+    /// It delays the response's envelope against the references', which
+    /// REF_PHASE (a carrier phase) cannot undo: the prediction carries it
+    /// as an envelope lead (`selfcal::predicted_ratio`).
+    pub group_delay_s: Estimate,
+    /// Clocks the identification took.
+    pub clocks: u64,
+}
+
+impl Identified {
+    /// The identified mechanical parameters, lambda and the couplings from
+    /// the datasheet.
+    pub fn gyro(&self, nominal: &GyroParams) -> GyroParams {
+        GyroParams {
+            f1_hz: self.modes[0].f_hz.value,
+            f2_hz: self.modes[1].f_hz.value,
+            q1: self.modes[0].q.value,
+            q2: self.modes[1].q.value,
+            ..nominal.clone()
+        }
+    }
+}
+
+/// Identify mode k starting from `guess_hz`: the coarse search, the
+/// scan when it cannot converge, then the fine sweep and its fit.
+pub fn identify_mode(
+    board: &mut dyn Board,
+    knowns: &Knowns,
+    k: usize,
+    guess_hz: f64,
+) -> Result<(ModeFit, u64), Error> {
+    let max = [knowns.amplitude.0, knowns.amplitude.1][k].abs();
+    let mut probe = Prober::new(board, knowns, k, max / 8.0);
+    let bw = knowns.bandwidth_hz(k);
+    let mut scanned = false;
+    let found = match search::coarse(&mut probe, guess_hz, bw)? {
+        Some(found) => found,
+        None => {
+            scanned = true;
+            let start = search::scan(&mut probe, guess_hz)?;
+            search::coarse(&mut probe, start, bw)?.ok_or_else(|| Error::Identification {
+                mode: k + 1,
+                reason: format!(
+                    "the scan of +-{}% around {guess_hz} Hz pointed at {start:.1} Hz, but the search from there did not settle",
+                    100.0 * SCAN_SPAN
+                ),
+            })?
+        }
+    };
+    let (centre, bk) = found;
+    // The mode's own time constant 1 / (pi bk), with the datasheet's 20%
+    // margin for the narrow-band estimate of bk.
+    probe.tau_s = TAU_MARGIN / (PI * bk);
+    let offsets: Vec<f64> = (0..FINE_POINTS)
+        .map(|i| FINE_SPAN * (2.0 * i as f64 / (FINE_POINTS - 1) as f64 - 1.0))
+        .collect();
+    let order = offsets.iter().chain(offsets.iter().rev());
+    let mut sweep = vec![];
+    for s in order {
+        sweep.push(probe.measure(centre + s * bk)?);
+    }
+    let mut fit = fit::fit_mode(&sweep, centre, bk).map_err(|reason| Error::Identification {
+        mode: k + 1,
+        reason: reason.into(),
+    })?;
+    let eps = settling_residue();
+    let floor = |e: &mut Estimate, bias: f64| e.uncertainty = e.uncertainty.hypot(bias);
+    let bk = fit.f_hz.value / fit.q.value;
+    floor(&mut fit.f_hz, eps * bk);
+    let q = fit.q.value;
+    floor(&mut fit.q, eps * q);
+    floor(&mut fit.phase_deg, eps.to_degrees());
+    fit.scanned = scanned;
+    Ok((fit, probe.clocks))
+}
+
+/// Identify both modes, starting from `guess` (the datasheet or the last
+/// identification).
+pub fn identify(
+    board: &mut dyn Board,
+    knowns: &Knowns,
+    guess: &GyroParams,
+) -> Result<Identified, Error> {
+    let (m1, c1) = identify_mode(board, knowns, 0, guess.f1_hz)?;
+    // Mode 2 from mode 1 plus the guess's split, scaled with mode 1's
+    // move: the common drift (hundreds of Hz per K) is gone, what is left is
+    // the split's drift (a few Hz per K), within the coarse search's first
+    // look.
+    let guess_f2 = m1.f_hz.value + (guess.f2_hz - guess.f1_hz) * (m1.f_hz.value / guess.f1_hz);
+    let (m2, c2) = identify_mode(board, knowns, 1, guess_f2)?;
+    let carrier = knowns.operating_carrier(m1.f_hz.value, m2.f_hz.value);
+    let (f1, f2) = (m1.f_hz.value, m2.f_hz.value);
+    let (p1, p2) = (m1.phase_deg, m2.phase_deg);
+    // Modes closer than a tenth of a bandwidth: one frequency, one phase;
+    // the delay is not observable (and its envelope lead then negligible).
+    let resolvable = (f2 - f1).abs() > 0.1 * (f1 / m1.q.value).max(f2 / m2.q.value);
+    let w2 = if resolvable {
+        (carrier - f1) / (f2 - f1)
+    } else {
+        0.5
+    };
+    let loop_phase_deg = Estimate {
+        value: p1.value + w2 * (p2.value - p1.value),
+        uncertainty: ((1.0 - w2) * p1.uncertainty).hypot(w2 * p2.uncertainty),
+    };
+    let per_hz = 1.0f64.to_radians() / (TAU * (f2 - f1));
+    let group_delay_s = if resolvable {
+        Estimate {
+            value: (p2.value - p1.value) * per_hz,
+            uncertainty: p1.uncertainty.hypot(p2.uncertainty) * per_hz.abs(),
+        }
+    } else {
+        Estimate {
+            value: 0.0,
+            uncertainty: f64::INFINITY,
+        }
+    };
+    Ok(Identified {
+        modes: [m1, m2],
+        loop_phase_deg,
+        group_delay_s,
+        clocks: c1 + c2,
+    })
+}

@@ -1,0 +1,140 @@
+//! One measurement of identification: mode k's complex response at one
+//! carrier through drive k alone, I then Q, with the drive amplitude kept
+//! below clipping (module header of `super`).
+
+use super::{ADC_NEAR_CLIP, ADC_TARGET, C64, SAMPLES_PER_PHASE, SETTLE_TAUS, readout_word};
+use crate::board::Board;
+use crate::error::Error;
+use crate::knowns::Knowns;
+use crate::sampling::average_z;
+use gyrocal_regs::datapath::{CONVERTER_FULL_SCALE, PEAK};
+use gyrocal_regs::map::ADC_CLIP;
+
+/// Measures mode k's complex response through one drive.
+pub(super) struct Prober<'a> {
+    board: &'a mut dyn Board,
+    knowns: &'a Knowns,
+    k: usize,
+    /// Drive amplitude in use (fraction of full scale).
+    amplitude: f64,
+    /// Amplitude time constant waited on (s): the datasheet's until the
+    /// coarse search has measured the mode's bandwidth.
+    pub(super) tau_s: f64,
+    /// Clocks spent.
+    pub(super) clocks: u64,
+}
+
+/// What one measurement saw.
+struct Seen {
+    /// Realized carrier (Hz).
+    carrier_hz: f64,
+    /// Y (ADC LSB per drive LSB).
+    y: C64,
+    /// The response's amplitude at the ADC over full scale.
+    full_scale: f64,
+    /// Clocks on which ADC k read a rail code.
+    clipped: u32,
+}
+
+impl<'a> Prober<'a> {
+    /// A prober of mode `k` starting at `amplitude` (fraction of full scale).
+    pub(super) fn new(
+        board: &'a mut dyn Board,
+        knowns: &'a Knowns,
+        k: usize,
+        amplitude: f64,
+    ) -> Self {
+        Self {
+            board,
+            knowns,
+            k,
+            amplitude,
+            tau_s: knowns.tau_s(k),
+            clocks: 0,
+        }
+    }
+
+    /// The mode (1 or 2), for messages.
+    pub(super) fn mode(&self) -> usize {
+        self.k + 1
+    }
+
+    /// The clock (Hz).
+    pub(super) fn clock_hz(&self) -> f64 {
+        self.knowns.clock_hz
+    }
+
+    /// ADC k's clip count since the last read of ADC_CLIP.
+    fn clip_count(&mut self) -> Result<u32, Error> {
+        let word = self.board.read_register(ADC_CLIP.offset)?;
+        Ok((word >> (16 * self.k)) & 0xffff)
+    }
+
+    /// Y at `carrier_hz`: I, then Q a quarter turn later.
+    fn measure_once(&mut self, carrier_hz: f64) -> Result<Seen, Error> {
+        let kn = self.knowns;
+        let amps = if self.k == 0 {
+            (self.amplitude, 0.0)
+        } else {
+            (0.0, self.amplitude)
+        };
+        let (regs, real) = kn.registers(carrier_hz, None, amps, 0.0)?;
+        self.board.program(&regs)?;
+        let r = kn.filter.decimation;
+        let settle =
+            (SETTLE_TAUS * self.tau_s * kn.clock_hz).ceil() as u64 + kn.filter_settle_clocks();
+        self.board.wait_clocks(settle)?;
+        self.clip_count()?;
+        let zi = average_z(self.board, 0, SAMPLES_PER_PHASE)?[self.k];
+        let mut quarter = regs;
+        quarter.ref_phase = regs.ref_phase.wrapping_add(1 << 30);
+        self.board.program(&quarter)?;
+        let filter = kn.filter_settle_clocks();
+        let zq = average_z(self.board, filter, SAMPLES_PER_PHASE)?[self.k];
+        let clipped = self.clip_count()?;
+        self.clocks += settle + filter + 2 * SAMPLES_PER_PHASE * u64::from(r);
+        let amp_word = [regs.amp.0, regs.amp.1][self.k];
+        let w = readout_word(amp_word);
+        let y = C64::new(zi, zq) * (2.0 / (real.filter.dc_gain * w * w));
+        Ok(Seen {
+            carrier_hz: real.carrier_hz,
+            y,
+            full_scale: y.norm() * w / CONVERTER_FULL_SCALE,
+            clipped,
+        })
+    }
+
+    /// `measure_once`, again at a quarter of the amplitude while the ADC
+    /// clips or comes near it; returns the realized carrier and Y.
+    pub(super) fn measure(&mut self, carrier_hz: f64) -> Result<(f64, C64), Error> {
+        loop {
+            let seen = self.measure_once(carrier_hz)?;
+            if seen.clipped == 0 && seen.full_scale <= ADC_NEAR_CLIP {
+                return Ok((seen.carrier_hz, seen.y));
+            }
+            self.amplitude /= 4.0;
+            if self.amplitude * 32768.0 < 1.0 {
+                return Err(Error::Identification {
+                    mode: self.mode(),
+                    reason: format!(
+                        "the response at {carrier_hz:.3} Hz clips ADC {} even at one DAC LSB ({} clipped clocks)",
+                        self.mode(),
+                        seen.clipped
+                    ),
+                });
+            }
+        }
+    }
+
+    /// Drive amplitude that puts a peak response `peak` (per drive LSB) at
+    /// `ADC_TARGET` of full scale, at most the readout amplitude.
+    pub(super) fn set_amplitude_for_peak(&mut self, peak: f64) {
+        let max = [self.knowns.amplitude.0, self.knowns.amplitude.1][self.k].abs();
+        // Word amplitude ~ a x PEAK^2 / 2^15 per unit amplitude.
+        let per_unit = f64::from(PEAK) * f64::from(PEAK) / 32768.0;
+        let wanted = ADC_TARGET * CONVERTER_FULL_SCALE / (peak * per_unit);
+        if wanted.is_finite() && wanted > 0.0 {
+            self.amplitude = wanted.min(max);
+        }
+    }
+}

@@ -1,0 +1,151 @@
+//! What host code knows about a board and a device: the clock, the
+//! datasheet (a starting guess, never the device at the current
+//! temperature), the drives it writes, the board's latencies and design
+//! force gains, and its own settings. From these it writes registers.
+
+use crate::device::GyroParams;
+use crate::error::Error;
+use gyrocal_regs::Registers;
+use gyrocal_regs::plan::{self, FrequencyPlan, Realized};
+use serde::Serialize;
+use std::f64::consts::{PI, TAU};
+
+/// The output filter and first averaging window the host programs.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Derived {
+    /// CIC decimation R.
+    pub decimation: u32,
+    /// Butterworth cut-off (Hz).
+    pub butterworth_hz: f64,
+    /// RC cut-off (Hz).
+    pub rc_hz: f64,
+    /// First averaging window (s).
+    pub min_window_s: f64,
+}
+
+/// Margin on an amplitude time constant estimated from a bandwidth.
+pub const TAU_MARGIN: f64 = 1.2;
+/// The filter's transient is waited down to this fraction.
+pub const FILTER_SETTLE: f64 = 1e-6;
+
+/// What host software knows (module header).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Knowns {
+    /// FPGA clock (Hz).
+    pub clock_hz: f64,
+    /// Datasheet device (at the factory temperature).
+    pub nominal: GyroParams,
+    /// Relative 1-sigma uncertainty of the datasheet's angular gain
+    /// lambda (it enters every predicted ratio one for one).
+    pub angular_gain_uncertainty: f64,
+    /// Readout drive amplitudes (fractions of full scale).
+    pub amplitude: (f64, f64),
+    /// Design force per full-scale DAC word of drive 1 and 2 (N/kg): only
+    /// their ratio enters the scale factors in z LSB.
+    pub force_full_scale: [f64; 2],
+    /// DAC latency (clocks).
+    pub dac_latency: u32,
+    /// ADC latency (clocks).
+    pub adc_latency: u32,
+    /// Output filter and first averaging window.
+    pub filter: Derived,
+    /// The configured carrier (Hz): where the host operates against the
+    /// datasheet's modes (`operating_carrier`).
+    pub carrier_hz: f64,
+    /// Rates of the factory rate table (deg/s).
+    pub rates_dps: Vec<f64>,
+    /// Calibration frequencies of the staircase (Hz).
+    pub cal_freqs_hz: Vec<f64>,
+}
+
+/// REF_PHASE word of a phase in degrees (2^32 = 360 deg), wrapping.
+pub fn phase_word(deg: f64) -> u32 {
+    (deg / 360.0 * 2f64.powi(32)).round() as i64 as u32
+}
+
+impl Knowns {
+    /// Registers for a carrier, calibration frequency (`None`: readout),
+    /// drive amplitudes and a reference phase lag (deg) on top of the
+    /// aligned value.
+    pub fn registers(
+        &self,
+        carrier_hz: f64,
+        cal_hz: Option<f64>,
+        amplitude: (f64, f64),
+        ref_lag_deg: f64,
+    ) -> Result<(Registers, Realized), Error> {
+        let plan = FrequencyPlan {
+            clock_hz: self.clock_hz,
+            carrier_hz,
+            cal_hz: cal_hz.unwrap_or(0.0),
+            calibration: cal_hz.is_some(),
+            amplitude,
+            decimation: self.filter.decimation,
+            butterworth_hz: self.filter.butterworth_hz,
+            rc_hz: self.filter.rc_hz,
+            dac_latency: self.dac_latency,
+            adc_latency: self.adc_latency,
+        };
+        let (mut regs, realized) = plan::registers(&plan)?;
+        regs.ref_phase = regs.ref_phase.wrapping_add(phase_word(-ref_lag_deg));
+        Ok((regs, realized))
+    }
+
+    /// Clocks for the output filter to settle to `FILTER_SETTLE` (the
+    /// slowest Butterworth pole, the RC pole, the CIC's 4 R).
+    pub fn filter_settle_clocks(&self) -> u64 {
+        let f = &self.filter;
+        let sigma = (TAU * f.butterworth_hz / 2f64.sqrt()).min(TAU * f.rc_hz);
+        let t = (1.0 / FILTER_SETTLE).ln() / sigma;
+        (t * self.clock_hz).ceil() as u64 + 5 * u64::from(f.decimation)
+    }
+
+    /// Amplitude time constant of mode k from the datasheet, with a 20%
+    /// margin for Q drift (s).
+    pub fn tau_s(&self, k: usize) -> f64 {
+        TAU_MARGIN * self.nominal.q(k) / (PI * self.nominal.f_hz(k))
+    }
+
+    /// Clocks to wait `taus` of the slower mode's time constant plus the
+    /// filter.
+    pub fn settle_clocks(&self, taus: f64) -> u64 {
+        let tau = self.tau_s(0).max(self.tau_s(1));
+        (taus * tau * self.clock_hz).ceil() as u64 + self.filter_settle_clocks()
+    }
+
+    /// The carrier for identified modes at `f1` and `f2` (Hz): the
+    /// configured carrier keeps its offset from the nearer datasheet mode,
+    /// so a carrier written at the datasheet's mode 1 follows mode 1
+    /// wherever it is found, one written midway keeps its offset from the
+    /// nearer mode, and a datasheet whose f1 is off (process spread)
+    /// carries no error into the operating point.
+    pub fn operating_carrier(&self, f1: f64, f2: f64) -> f64 {
+        let (d1, d2) = (self.nominal.f1_hz, self.nominal.f2_hz);
+        let c = self.carrier_hz;
+        if (c - d1).abs() <= (c - d2).abs() {
+            f1 + (c - d1)
+        } else {
+            f2 + (c - d2)
+        }
+    }
+
+    /// These knowns with `gyro` as the device: every wait after
+    /// identification uses the identified modes, not the datasheet's.
+    pub fn with_device(&self, gyro: &GyroParams) -> Self {
+        Self {
+            nominal: gyro.clone(),
+            carrier_hz: self.operating_carrier(gyro.f1_hz, gyro.f2_hz),
+            ..self.clone()
+        }
+    }
+
+    /// Datasheet bandwidth f / Q of mode k (Hz).
+    pub fn bandwidth_hz(&self, k: usize) -> f64 {
+        self.nominal.bandwidth_hz(k)
+    }
+
+    /// z samples in the first averaging window.
+    pub fn window_samples(&self) -> u64 {
+        (self.filter.min_window_s * self.clock_hz / f64::from(self.filter.decimation)).ceil() as u64
+    }
+}

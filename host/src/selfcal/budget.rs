@@ -1,0 +1,114 @@
+//! The self-calibrated scale factor's uncertainty, by source: each term
+//! moves the prediction or the staircase by its own 1-sigma, through the
+//! same exact theory, and the terms add in quadrature (independent
+//! sources).
+
+use super::predict::{predicted_ratio, predicted_ratio_lagged};
+use super::{Operating, Ratio};
+use crate::device::GyroParams;
+use crate::error::Error;
+use crate::identify::Identified;
+use crate::knowns::Knowns;
+use serde::Serialize;
+
+/// Relative 1-sigma uncertainties of the self-calibrated scale factors,
+/// per output, by source, and their quadrature sum.
+///
+/// Not included: a drive-gain ratio that drifted unobserved (without
+/// `[drive_probe]` the design ratio is used as exact).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct SfUncertainty {
+    /// The staircase slope's noise (`staircase`).
+    pub staircase: [f64; 2],
+    /// The predicted ratio's, from the identified f1, f2, Q1, Q2, group
+    /// delay and loop phase (each moved by its uncertainty through the
+    /// exact theory).
+    pub identified: [f64; 2],
+    /// The datasheet's angular gain lambda: its relative 1-sigma moved
+    /// through the exact theory (the ratio scales with lambda, one for one
+    /// to first order).
+    pub angular_gain: [f64; 2],
+    /// The measured drive-gain ratio's (0 without one).
+    pub drive_ratio: [f64; 2],
+    /// All of them in quadrature.
+    pub total: [f64; 2],
+}
+
+impl SfUncertainty {
+    /// The quadrature sum into `total`.
+    pub fn with_total(mut self) -> Self {
+        self.total = std::array::from_fn(|k| {
+            [
+                self.staircase[k],
+                self.identified[k],
+                self.angular_gain[k],
+                self.drive_ratio[k],
+            ]
+            .into_iter()
+            .fold(0.0, f64::hypot)
+        });
+        self
+    }
+}
+
+/// Relative change of each output's ratio, in quadrature over `moved`.
+fn spread(moved: &[Ratio], ratio: &Ratio) -> [f64; 2] {
+    std::array::from_fn(|k| {
+        moved
+            .iter()
+            .map(|m| (m.exact[k] / ratio.exact[k] - 1.0).powi(2))
+            .sum::<f64>()
+            .sqrt()
+    })
+}
+
+/// The predicted ratio's relative 1-sigma uncertainty per output from the
+/// identified parameters: each of f1, Q1, f2, Q2, the group delay and the
+/// loop phase (as a residual error of the correction) moved by its
+/// uncertainty (independent fits), the changes added in quadrature.
+pub(super) fn identified(
+    knowns: &Knowns,
+    id: &Identified,
+    op: &Operating,
+    cal_hz: &[f64],
+    ratio: &Ratio,
+) -> Result<[f64; 2], Error> {
+    let gyro = id.gyro(&knowns.nominal);
+    let [m1, m2] = &id.modes;
+    let mut moved = vec![];
+    for (i, sd) in [m1.f_hz, m1.q, m2.f_hz, m2.q]
+        .map(|e| e.uncertainty)
+        .into_iter()
+        .enumerate()
+    {
+        let mut g = gyro.clone();
+        *[&mut g.f1_hz, &mut g.q1, &mut g.f2_hz, &mut g.q2][i] += sd;
+        moved.push(predicted_ratio(knowns, &g, op, cal_hz)?);
+    }
+    if id.group_delay_s.uncertainty.is_finite() {
+        let mut o = op.clone();
+        o.envelope_delay_s += id.group_delay_s.uncertainty;
+        moved.push(predicted_ratio(knowns, &gyro, &o, cal_hz)?);
+    }
+    let lag = id.loop_phase_deg.uncertainty.to_radians();
+    moved.push(predicted_ratio_lagged(knowns, &gyro, op, cal_hz, lag)?);
+    Ok(spread(&moved, ratio))
+}
+
+/// The predicted ratio's relative 1-sigma from the datasheet's lambda
+/// (`Knowns::angular_gain_uncertainty`), through the exact theory.
+pub(super) fn angular_gain(
+    knowns: &Knowns,
+    gyro: &GyroParams,
+    op: &Operating,
+    cal_hz: &[f64],
+    ratio: &Ratio,
+) -> Result<[f64; 2], Error> {
+    let u = knowns.angular_gain_uncertainty;
+    if u == 0.0 {
+        return Ok([0.0; 2]);
+    }
+    let mut g = gyro.clone();
+    g.angular_gain *= 1.0 + u;
+    Ok(spread(&[predicted_ratio(knowns, &g, op, cal_hz)?], ratio))
+}

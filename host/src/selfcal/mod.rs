@@ -1,0 +1,251 @@
+//! The self-calibration cycle, host side: identify, retune the carrier,
+//! correct the loop phase, run the calibration staircase, and predict the
+//! readout scale factor in the gateware's own units (z LSB per deg/s).
+//!
+//! # The ratio in z LSB, and which converter gains cancel
+//!
+//! Let a_k be ADC k's gain (LSB per metre), g_k drive k's force per DAC
+//! LSB, W_k the drive words' amplitudes (digital, known from AMP). Output k
+//! in z LSB is the mean of ADC_k times a reference word, so
+//!
+//! ```text
+//! readout     output k: ADC_k x drive k's word;  x_k's rate term is driven by drive (1-k)
+//!             SF_read,k ~ a_k W_k W_(1-k) g_(1-k) S_read,k
+//! calibration output k: ADC_k x drive (1-k)'s word;  x_k is driven by drive k
+//!             SF_cal,k  ~ a_k W_(1-k) W_k g_k S_cal,k
+//! ratio_k = SF_read,k / SF_cal,k = (S_read,k / S_cal,k) x g_(1-k) / g_k
+//! ```
+//!
+//! with S the theory's scale factors per unit force product. The ADC gain
+//! a_k and any gain common to both drives cancel exactly; the drive-gain
+//! ratio g_(1-k) / g_k enters one for one, with opposite signs on the two
+//! outputs. At rest the modes are uncoupled, so every response the gateware
+//! can observe carries a_k g_k together: the differential drive gain cannot
+//! be told from an ADC gain, and the cycle at rest uses the board's design
+//! ratio (`Knowns::force_full_scale`). Its drift is the one converter drift
+//! the cycle at rest cannot correct (measured in `tests/field.rs`).
+//!
+//! It becomes observable while the device turns, at any rate and without
+//! knowing it. With H_jk the response at ADC j to drive k, H_jk = a_j g_k
+//! M_jk. The Coriolis coupling is antisymmetric, M_12 = -M_21, and
+//! M_22 / M_11 = G_2 / G_1, the resonators' responses known from the
+//! identification (both exact: `drive_ratio` module header), so
+//!
+//! ```text
+//! (H_12 / H_21) / (H_11 / H_22) = (g_2 / g_1)^2 x (M_12 M_22) / (M_21 M_11)
+//!                               = -(g_2 / g_1)^2 x G_2 / G_1
+//! ```
+//!
+//! holds the drive-gain ratio alone: the rate cancels. The cross responses
+//! are lambda Omega / bandwidth of the direct ones, so it needs a rate well
+//! above the noise: the cycle at rest cannot use it. When the device turns
+//! at a steady rate, [`crate::drive_ratio`] measures it (the ratio is exact
+//! at any rate, not only to first order) and [`apply_drive_ratio`] predicts
+//! again with it.
+//!
+//! # The prediction
+//!
+//! `ratio` is the exact theory (phasor steady state, `crate::theory`) at
+//! the identified parameters, fitted with the same least-squares lines at
+//! the same rates and calibration frequencies as the measurements (the
+//! paper's 10-15 Hz are not deep in the linear region), with the
+//! datapath's known details: the hold's sinc at each sideband and the
+//! envelope lead (`theory::calibration_z_of_datapath`), and the drive
+//! words' realized amplitudes in each mode. Eqs. (5)/(6) at the same
+//! parameters are given beside it.
+
+//!
+//! # Drive amplitudes and clipping
+//!
+//! The configured amplitudes (`[drive] amplitude1/2`) are the largest the
+//! cycle uses. From the identified responses the host predicts each ADC's
+//! peak over every readout rate and calibration frequency of its plan
+//! (exact theory, [`predict::adc_peaks`]) and scales both drives by one
+//! factor so that no peak exceeds `ADC_OPERATING` of full scale; the ratio
+//! of the drives, which the prediction needs, is kept. Every window then
+//! watches the ADC_CLIP counts ([`crate::clip`]): a clipped window is an
+//! error, never a figure.
+mod budget;
+mod predict;
+mod staircase;
+
+pub use budget::SfUncertainty;
+pub use predict::{Ratio, adc_peaks, predicted_ratio};
+pub use staircase::{Staircase, staircase};
+
+use crate::board::Board;
+use crate::device::GyroParams;
+use crate::drive_ratio::DriveRatio;
+use crate::error::Error;
+use crate::identify::{self, Identified};
+use crate::knowns::Knowns;
+use serde::Serialize;
+
+/// Amplitude time constants waited after leaving the identification (the
+/// resonators' state changes completely; the first staircase point must
+/// settle to 1e-4 of a calibration signal some 1e3 times smaller).
+pub const FIRST_SETTLE_TAUS: f64 = 30.0;
+
+/// Fewest ripple periods in a staircase window: two, so that the spread of
+/// the period means estimates the window's noise (`staircase`).
+pub const MIN_RIPPLE_PERIODS: usize = 2;
+
+/// Fraction of ADC full scale the operating drives put the largest
+/// predicted peak at, at most: 1600 LSB below the rail, far above the
+/// converter's noise (1 LSB) and the prediction's error (the identified
+/// gains to 1e-4), and above the 0.9 that the simulator's front end is
+/// built for (`[frontend] adc_headroom`), so a board that is as planned
+/// keeps its configured drives.
+pub const ADC_OPERATING: f64 = 0.95;
+
+/// Where the cycle operates the gateware.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Operating {
+    /// Realized carrier (Hz).
+    pub carrier_hz: f64,
+    /// Reference phase lag written on top of the aligned REF_PHASE (deg).
+    pub ref_lag_deg: f64,
+    /// The loop's group delay (s), which the references' envelope does not
+    /// follow.
+    pub envelope_delay_s: f64,
+    /// Drive amplitudes (fractions of full scale): the configured ones
+    /// scaled so that no ADC is predicted above `ADC_OPERATING`.
+    pub amplitude: (f64, f64),
+}
+
+/// One cycle's result.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SelfCal {
+    /// What identification found.
+    pub identified: Identified,
+    /// Carrier and phase correction used.
+    pub operating: Operating,
+    /// Realized calibration frequencies (Hz).
+    pub cal_hz: Vec<f64>,
+    /// Staircase window means (z LSB).
+    pub cal_z: Vec<[f64; 2]>,
+    /// Calibration scale factors (z LSB per deg/s of virtual rate).
+    pub sf_cal_per_dps: [f64; 2],
+    /// The predicted ratios.
+    pub ratio: Ratio,
+    /// SF_cal x ratio.exact (z LSB per deg/s).
+    pub sf_selfcal_per_dps: [f64; 2],
+    /// SF_cal x ratio.eq56 (z LSB per deg/s).
+    pub sf_eq56_per_dps: [f64; 2],
+    /// The drive-gain ratio measured while the device turned, when it
+    /// was (`drive_ratio`); the prediction above then uses it instead of
+    /// the design ratio.
+    pub drive_ratio: Option<DriveRatio>,
+    /// SF_cal x ratio.exact at the design drive-gain ratio (z LSB per
+    /// deg/s): `sf_selfcal_per_dps` before the measured ratio replaced it.
+    pub sf_design_ratio_per_dps: [f64; 2],
+    /// Relative 1-sigma uncertainty of `sf_selfcal_per_dps`, by source.
+    pub sf_selfcal_uncertainty: SfUncertainty,
+    /// Clocks of the whole cycle.
+    pub clocks: u64,
+}
+
+/// The operating point for an identification: carrier kept at its
+/// configured place against the nearer mode (`Knowns::operating_carrier`),
+/// reference lagged by the identified loop phase, drives scaled below
+/// clipping (module header).
+pub fn operating(knowns: &Knowns, id: &Identified) -> Result<Operating, Error> {
+    let asked = knowns.operating_carrier(id.modes[0].f_hz.value, id.modes[1].f_hz.value);
+    let lag = id.loop_phase_deg.value;
+    let (_, real) = knowns.registers(asked, None, knowns.amplitude, lag)?;
+    let mut op = Operating {
+        carrier_hz: real.carrier_hz,
+        ref_lag_deg: lag,
+        envelope_delay_s: id.group_delay_s.value,
+        amplitude: knowns.amplitude,
+    };
+    let peak = adc_peaks(knowns, id, &op)?.into_iter().fold(0.0, f64::max);
+    if peak > ADC_OPERATING {
+        let s = ADC_OPERATING / peak;
+        op.amplitude = (s * knowns.amplitude.0, s * knowns.amplitude.1);
+    }
+    Ok(op)
+}
+
+/// One self-calibration cycle from a starting guess of the device. After
+/// identification every wait uses the identified modes, not the datasheet.
+pub fn self_calibrate(
+    board: &mut dyn Board,
+    knowns: &Knowns,
+    guess: &GyroParams,
+) -> Result<SelfCal, Error> {
+    let identified = identify::identify(board, knowns, guess)?;
+    let gyro = identified.gyro(&knowns.nominal);
+    let measured = knowns.with_device(&gyro);
+    let op = operating(&measured, &identified)?;
+    let Staircase {
+        cal_hz,
+        z: cal_z,
+        sf_per_dps: sf_cal,
+        sf_uncertainty: sf_cal_sd,
+        clocks,
+    } = staircase(board, &measured, &op)?;
+    let ratio = predicted_ratio(knowns, &gyro, &op, &cal_hz)?;
+    let uncertainty = SfUncertainty {
+        staircase: std::array::from_fn(|k| (sf_cal_sd[k] / sf_cal[k]).abs()),
+        identified: budget::identified(knowns, &identified, &op, &cal_hz, &ratio)?,
+        angular_gain: budget::angular_gain(knowns, &gyro, &op, &cal_hz, &ratio)?,
+        ..SfUncertainty::default()
+    }
+    .with_total();
+    let sf_selfcal_per_dps = std::array::from_fn(|k| sf_cal[k] * ratio.exact[k]);
+    let sf_eq56_per_dps = std::array::from_fn(|k| sf_cal[k] * ratio.eq56[k]);
+    Ok(SelfCal {
+        clocks: identified.clocks + clocks,
+        identified,
+        operating: op,
+        cal_hz,
+        cal_z,
+        sf_cal_per_dps: sf_cal,
+        ratio,
+        sf_selfcal_per_dps,
+        sf_eq56_per_dps,
+        drive_ratio: None,
+        sf_design_ratio_per_dps: sf_selfcal_per_dps,
+        sf_selfcal_uncertainty: uncertainty,
+    })
+}
+
+/// `knowns` with drive 2's force gain moved by `relative` (g_2 / g_1 over
+/// the design ratio).
+fn with_drive_ratio(knowns: &Knowns, relative: f64) -> Knowns {
+    let mut moved = knowns.clone();
+    moved.force_full_scale[1] *= relative;
+    moved
+}
+
+/// Predict again with a measured drive-gain ratio (`drive_ratio`): the
+/// exact theory at the same identified device, operating point and
+/// staircase, with drive 2's force gain moved by the measured ratio; the
+/// ratio's uncertainty is propagated to each scale factor.
+pub fn apply_drive_ratio(
+    knowns: &Knowns,
+    cal: &mut SelfCal,
+    measured: DriveRatio,
+) -> Result<(), Error> {
+    let gyro = cal.identified.gyro(&knowns.nominal);
+    let predict = |relative: f64| {
+        predicted_ratio(
+            &with_drive_ratio(knowns, relative),
+            &gyro,
+            &cal.operating,
+            &cal.cal_hz,
+        )
+    };
+    let rho = measured.relative;
+    let ratio = predict(rho.value)?;
+    let moved = predict(rho.value + rho.uncertainty)?;
+    cal.sf_selfcal_uncertainty.drive_ratio =
+        std::array::from_fn(|k| (moved.exact[k] / ratio.exact[k] - 1.0).abs());
+    cal.sf_selfcal_uncertainty = cal.sf_selfcal_uncertainty.with_total();
+    cal.sf_selfcal_per_dps = std::array::from_fn(|k| cal.sf_cal_per_dps[k] * ratio.exact[k]);
+    cal.sf_eq56_per_dps = std::array::from_fn(|k| cal.sf_cal_per_dps[k] * ratio.eq56[k]);
+    cal.ratio = ratio;
+    cal.drive_ratio = Some(measured);
+    Ok(())
+}

@@ -1,0 +1,136 @@
+//! The prediction: the readout over calibration ratio in z LSB from the
+//! exact theory at the identified device and the operating point, and
+//! each ADC's predicted peak there (for the drive amplitudes).
+
+use super::Operating;
+use crate::device::GyroParams;
+use crate::error::Error;
+use crate::identify::{Identified, readout_word};
+use crate::knowns::Knowns;
+use crate::stats::linear_fit;
+use crate::theory::{self, Device, envelope_lead_rad, hold_gain};
+use gyrocal_regs::datapath::{CONVERTER_FULL_SCALE, calibration_word};
+use serde::Serialize;
+use std::f64::consts::{PI, TAU};
+
+/// Readout and calibration ratio predictions per output.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Ratio {
+    /// Exact theory, fitted at the measurement points (z LSB units).
+    pub exact: [f64; 2],
+    /// Eqs. (5)/(6), small signal (z LSB units).
+    pub eq56: [f64; 2],
+}
+
+/// The theory's device at `op` in readout and in calibration: the drive
+/// words' realized amplitudes as forces (design force per LSB).
+fn devices(knowns: &Knowns, gyro: &GyroParams, op: &Operating) -> Result<[Device; 2], Error> {
+    let (regs, _) = knowns.registers(op.carrier_hz, None, op.amplitude, 0.0)?;
+    let amp = [regs.amp.0, regs.amp.1];
+    let per_lsb = knowns.force_full_scale.map(|f| f / 32768.0);
+    let device = |words: [f64; 2]| Device {
+        f1_hz: gyro.f1_hz,
+        f2_hz: gyro.f2_hz,
+        q1: gyro.q1,
+        q2: gyro.q2,
+        angular_gain: gyro.angular_gain,
+        quadrature_dps: gyro.quadrature_dps,
+        damping_coupling_dps: gyro.damping_coupling_dps,
+        carrier_hz: op.carrier_hz,
+        f1_force: words[0] * per_lsb[0],
+        f2_force: words[1] * per_lsb[1],
+    };
+    Ok([
+        device(amp.map(readout_word)),
+        device(amp.map(|a| calibration_word(a).abs())),
+    ])
+}
+
+/// Each ADC's predicted peak over the cycle's readout rates and
+/// calibration frequencies at `op`, as a fraction of full scale.
+///
+/// The identified mode k answers its own drive with Y = C_k / D_k(f) (ADC
+/// LSB per drive LSB, D in Hz^2), while the theory gives displacements x_k
+/// = F_k / (4 pi^2 D_k) for a force F_k = g_k W: so ADC k's gain is
+/// a_k = 4 pi^2 |C_k| / g_k (LSB per metre), with g_k the design force per
+/// DAC LSB. The peaks are a_k times the theory's peak displacements
+/// (`theory::readout_peak_displacement`, `calibration_peak_displacement`),
+/// which include the Coriolis and coupling cross terms.
+pub fn adc_peaks(knowns: &Knowns, id: &Identified, op: &Operating) -> Result<[f64; 2], Error> {
+    let gyro = id.gyro(&knowns.nominal);
+    let [read, cal] = devices(knowns, &gyro, op)?;
+    let per_lsb = knowns.force_full_scale.map(|f| f / 32768.0);
+    let gain: [f64; 2] = std::array::from_fn(|k| 4.0 * PI * PI * id.modes[k].gain_hz2 / per_lsb[k]);
+    let mut peak = [0.0f64; 2];
+    let rates = knowns
+        .rates_dps
+        .iter()
+        .map(|r| theory::readout_peak_displacement(&read, r.to_radians()));
+    let cals = knowns
+        .cal_freqs_hz
+        .iter()
+        .map(|&f| theory::calibration_peak_displacement(&cal, f));
+    for x in rates.chain(cals) {
+        for k in 0..2 {
+            peak[k] = peak[k].max(gain[k] * x[k] / CONVERTER_FULL_SCALE);
+        }
+    }
+    Ok(peak)
+}
+
+/// The predicted readout over calibration ratio in z LSB (module header)
+/// for a device `gyro` operated at `op`, with calibration frequencies
+/// `cal_hz` (realized).
+pub fn predicted_ratio(
+    knowns: &Knowns,
+    gyro: &GyroParams,
+    op: &Operating,
+    cal_hz: &[f64],
+) -> Result<Ratio, Error> {
+    predicted_ratio_lagged(knowns, gyro, op, cal_hz, 0.0)
+}
+
+/// [`predicted_ratio`] with a residual loop phase error `lag_rad` left by
+/// the correction (the responses lag their references by that much more).
+pub(super) fn predicted_ratio_lagged(
+    knowns: &Knowns,
+    gyro: &GyroParams,
+    op: &Operating,
+    cal_hz: &[f64],
+    lag_rad: f64,
+) -> Result<Ratio, Error> {
+    let clock = knowns.clock_hz;
+    let per_lsb = knowns.force_full_scale.map(|f| f / 32768.0);
+    let [dev_read, dev_cal] = devices(knowns, gyro, op)?;
+    let rad = PI / 180.0;
+    let rates = &knowns.rates_dps;
+    let read_z: Vec<[f64; 2]> = rates
+        .iter()
+        .map(|r| theory::readout_z_lagged(&dev_read, r * rad, lag_rad))
+        .collect();
+    let hold = hold_gain(op.carrier_hz, clock);
+    let cal_z: Vec<[f64; 2]> = cal_hz
+        .iter()
+        .map(|&f| {
+            let sidebands = [-1.0, 1.0].map(|s| hold_gain(op.carrier_hz + s * f, clock) / hold);
+            // The response's envelope comes late by the group delay: the
+            // references' envelope leads it by that much more.
+            let lead = envelope_lead_rad(f, clock) + TAU * f * op.envelope_delay_s;
+            theory::calibration_z_lagged(&dev_cal, f, lead, sidebands, lag_rad)
+        })
+        .collect();
+    let virtual_dps: Vec<f64> = cal_hz.iter().map(|f| 360.0 * f).collect();
+    let slope = |x: &[f64], z: &[[f64; 2]], k: usize| {
+        let y: Vec<f64> = z.iter().map(|v| v[k]).collect();
+        linear_fit(x, &y).0
+    };
+    // z LSB: readout output k divides by g_k, calibration output k by g_(1-k).
+    let to_lsb = |k: usize| per_lsb[1 - k] / per_lsb[k];
+    let exact = std::array::from_fn(|k| {
+        slope(rates, &read_z, k) / slope(&virtual_dps, &cal_z, k) * to_lsb(k)
+    });
+    let eq5 = theory::eq5_sf_read_per_rad_s(&dev_read);
+    let eq6 = theory::eq6_sf_cal_per_rad_s(&dev_cal);
+    let eq56 = std::array::from_fn(|k| eq5 / eq6[k] * to_lsb(k));
+    Ok(Ratio { exact, eq56 })
+}

@@ -1,0 +1,77 @@
+//! The datapath's numbers that the register map, the frequency plan and the
+//! host code need: port widths, limits, the carrier peak, power-up timing.
+//!
+//! They are defined here, in the leaf crate, and the gateware
+//! (`gyrocal-hdl`) imports them downward: the RTL, its bit-true model, the
+//! filter design and the host code all read one definition. Where the
+//! gateware derives a value from its own structure (a schedule's length, a
+//! fill time), `gyrocal-hdl` asserts at compile time that it equals the
+//! constant here.
+
+/// Number of CIC integrator and comb stages.
+pub const CIC_STAGES: u32 = 4;
+/// log2 of the largest CIC decimation.
+pub const MAX_DECIMATION_LOG2: u32 = 12;
+/// Largest CIC decimation R: 2^12.
+pub const MAX_DECIMATION: u32 = 1 << MAX_DECIMATION_LOG2;
+/// Smallest decimation: the IIR's micro-program takes this many clocks per
+/// sample (`gyrocal_hdl::iir_lowpass::SCHEDULE_CLOCKS`, asserted equal).
+pub const MIN_DECIMATION: u32 = 166;
+/// Width of the `cic_decimation` port: R up to 2^12 needs 13 bits.
+pub const DECIMATION_BITS: u32 = MAX_DECIMATION_LOG2 + 1;
+/// Width of the `cic_shift` port: shifts 0..=40 need 6 bits.
+pub const SHIFT_BITS: u32 = 6;
+/// Fractional bits of the CIC output and of z (z = average x 2^8).
+pub const OUTPUT_FRACTION_BITS: u32 = 8;
+/// Fractional bits of the IIR coefficients (Q2.30).
+pub const COEFFICIENT_FRACTION_BITS: u32 = 30;
+/// Guard bits of the IIR states below the output LSB.
+pub const GUARD_BITS: u32 = 16;
+/// Width of z1 and z2 (two's complement, `OUTPUT_FRACTION_BITS` fractional).
+pub const Z_BITS: u32 = 40;
+/// Width of the `ref_delay` port: delays 0..=63 clocks.
+pub const DELAY_BITS: u32 = 6;
+/// Width of the `mod_step` port.
+pub const MOD_STEP_BITS: u32 = 48;
+/// Width of the `carrier_step` port and of the carrier phase accumulator.
+pub const CARRIER_STEP_BITS: u32 = 32;
+/// Peak amplitude of every sine and cosine word of the datapath: full scale
+/// of a 16-bit signed word, kept symmetric (never -32768).
+pub const PEAK: i32 = 32767;
+/// Full-scale amplitude of a 16-bit converter word (LSB).
+pub const CONVERTER_FULL_SCALE: f64 = 32767.0;
+/// Samples the AXI4-Stream FIFO holds before it drops one.
+pub const FIFO_DEPTH: usize = 256;
+/// Clocks from configuration until the DAC words can leave 0: the carrier
+/// tables are filled first (`gyrocal_hdl::gyro_interface::DRIVE_START_CLOCKS`,
+/// asserted equal to the fill plus the carrier and AM latencies).
+pub const DRIVE_START_CLOCKS: u64 = 8232;
+
+/// The AM mixer's Q1.15 product: `round(a b / 2^15)`, rounded half up,
+/// wrapped to 16 bits (the model of `gyrocal_hdl::q15_multiplier`).
+///
+/// ```
+/// use gyrocal_regs::datapath::q15_product;
+/// assert_eq!(q15_product(16384, 16384), 8192);
+/// assert_eq!(q15_product(32767, 32767), 32766);
+/// ```
+#[inline(always)]
+pub fn q15_product(a: i16, b: i16) -> i16 {
+    ((a as i32 * b as i32 + (1 << 14)) >> 15) as i16
+}
+
+/// Fundamental amplitude (LSB) of a readout drive word for a Q1.15
+/// amplitude `amp`, with its sign: the envelope `amp x PEAK / 2^15`
+/// rounded as the AM mixer rounds it, times the carrier table's amplitude
+/// `PEAK / 2^15` (the table's own fundamental gain, 1 - 1.3e-7, is below
+/// anything the host resolves). In readout the modulation factor is PEAK.
+pub fn readout_word(amp: i16) -> f64 {
+    f64::from(q15_product(amp, PEAK as i16)) * f64::from(PEAK) / 32768.0
+}
+
+/// Fundamental amplitude (LSB) of a calibration drive word's envelope
+/// crest for a Q1.15 amplitude `amp`: `amp x PEAK / 2^15 x PEAK / 2^15`
+/// (the modulation's own rounding averages out over a period).
+pub fn calibration_word(amp: i16) -> f64 {
+    f64::from(amp) * f64::from(PEAK) / 32768.0 * f64::from(PEAK) / 32768.0
+}

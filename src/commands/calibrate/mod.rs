@@ -1,0 +1,160 @@
+//! `gyrocal calibrate [--board URL] --config FILE [--json] [--temperature C]`:
+//! the host's self-calibration cycle (`gyrocal_host::selfcal`) against any
+//! board.
+//!
+//! - `--board URL`: a board reached through its registers alone
+//!   (`gyrocal_host::transport`: `etherbone://HOST:PORT[?base=0xADDR]`,
+//!   `uio:///dev/uioN`, `mem:///dev/mem?base=0xADDR`), time measured by
+//!   SAMPLE_COUNT. Without it: the file's device on the in-process
+//!   simulated board (model engine, powered up), at `--temperature` when
+//!   the file has `[drift]`; the truth is then given too: the device, and
+//!   the rate table's scale factor at the cycle's settings.
+//! - The file's `[gyro]` is the datasheet the host starts from, `[drive]`
+//!   and `[experiment]` its settings (`serve::device::DeviceFile::knowns`).
+//! - Output: a table, or with `--json` one object on stdout: `identified`
+//!   (f1_hz, f2_hz, q1, q2, loop_phase_deg, group_delay_s, each with an
+//!   `_uncertainty` twin, 1 sigma), `sf_cal_per_dps`, `ratio`,
+//!   `sf_selfcal_per_dps` and `sf_selfcal_uncertainty` (relative 1 sigma,
+//!   as in `gyrocal field`), one per output, `clocks`, `wall_s`, `samples`
+//!   (read and missed over the run) and `truth` (null over the wire).
+//!   Progress goes to stderr.
+
+pub mod output;
+pub mod watch;
+
+use super::experiment::read_config;
+use crate::Failure;
+use gyrocal_host::selfcal::{self, SelfCal};
+use gyrocal_host::{Board, Knowns, transport};
+use gyrocal_sim::drift::DeviceAt;
+use gyrocal_sim::field::board::SimBoard;
+use gyrocal_sim::field::scenario;
+use gyrocal_sim::serve::device::{self, DeviceFile};
+use std::path::PathBuf;
+use std::time::Instant;
+use watch::{SampleCounts, Watched};
+
+/// Options of `gyrocal calibrate`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// The board: etherbone://HOST:PORT[?base=0xADDR], uio:///dev/uioN[?base=0xOFFSET]
+    /// or mem:///dev/mem?base=0xADDR; without it, the file's device simulated in process.
+    #[arg(long)]
+    pub board: Option<String>,
+    /// `[gyro]` (the datasheet), `[drive]` and `[experiment]` (the host's
+    /// settings): a `gyrocal run` or `gyrocal field` file.
+    #[arg(long)]
+    pub config: PathBuf,
+    /// Print one JSON object to stdout instead of the table.
+    #[arg(long)]
+    pub json: bool,
+    /// In process, with `[drift]`: the device at this temperature (deg C;
+    /// default the first step).
+    #[arg(long, allow_negative_numbers = true)]
+    pub temperature: Option<f64>,
+}
+
+/// What no board tells: the simulated device and its rate table.
+pub struct Truth {
+    /// The device and front end on the board.
+    pub device: DeviceAt,
+    /// Rate-table slope at the cycle's carrier and phase (z LSB per deg/s).
+    pub sf_true_per_dps: [f64; 2],
+    /// Clocks the rate table simulated.
+    pub clocks: u64,
+}
+
+/// One run's result.
+pub struct Outcome {
+    /// The board's URL, or "in-process".
+    pub board: String,
+    /// The cycle's result.
+    pub cal: SelfCal,
+    /// z samples read and missed.
+    pub samples: SampleCounts,
+    /// Wall time of the cycle (s).
+    pub wall_s: f64,
+    /// The truth, in process.
+    pub truth: Option<Truth>,
+}
+
+/// Calibrate and print.
+pub fn run(args: &Args) -> Result<(), Failure> {
+    let (name, text) = read_config(&args.config)?;
+    let file = device::parse(&name, &text).map_err(Failure::Input)?;
+    let knowns = file.knowns().map_err(Failure::Input)?;
+    let outcome = match &args.board {
+        Some(url) => over_the_wire(url, &knowns, args.temperature)?,
+        None => in_process(&file, &knowns, args.temperature)?,
+    };
+    eprintln!(
+        "cycle done in {:.1} s wall, {:.3e} clocks; {} z samples read, {} went by unread",
+        outcome.wall_s, outcome.cal.clocks as f64, outcome.samples.read, outcome.samples.missed
+    );
+    if args.json {
+        println!("{}", output::json(&outcome));
+    } else {
+        print!("{}", output::table(&outcome));
+    }
+    Ok(())
+}
+
+/// The cycle on a watched board; its wall time.
+fn cycle(board: &mut dyn Board, knowns: &Knowns) -> Result<(SelfCal, SampleCounts, f64), Failure> {
+    let sample_s = f64::from(knowns.filter.decimation) / knowns.clock_hz;
+    let start = Instant::now();
+    let mut watched = Watched::new(board, sample_s);
+    let cal = selfcal::self_calibrate(&mut watched, knowns, &knowns.nominal);
+    let samples = watched.finish();
+    let cal = cal.map_err(|e| Failure::Run(e.to_string()))?;
+    Ok((cal, samples, start.elapsed().as_secs_f64()))
+}
+
+fn over_the_wire(url: &str, knowns: &Knowns, temperature: Option<f64>) -> Result<Outcome, Failure> {
+    if temperature.is_some() {
+        return Err(Failure::Input(
+            "--temperature: applies to the in-process board only (a served board's device is set by gyrocal serve --temperature)"
+                .into(),
+        ));
+    }
+    transport::parse(url).map_err(|e| Failure::Input(format!("--board: {e}")))?;
+    let mut board =
+        transport::open(url).map_err(|e| Failure::Run(format!("--board {url}: {e}")))?;
+    eprintln!("calibrating the board at {url}");
+    let (cal, samples, wall_s) = cycle(board.as_mut(), knowns)?;
+    Ok(Outcome {
+        board: url.into(),
+        cal,
+        samples,
+        wall_s,
+        truth: None,
+    })
+}
+
+fn in_process(
+    file: &DeviceFile,
+    knowns: &Knowns,
+    temperature: Option<f64>,
+) -> Result<Outcome, Failure> {
+    let at = file
+        .at(temperature)
+        .map_err(|e| Failure::Input(format!("--{e}")))?;
+    let mut board: SimBoard = file.board(&at).map_err(Failure::Run)?;
+    eprintln!("calibrating the in-process simulated board");
+    let (cal, samples, wall_s) = cycle(&mut board, knowns)?;
+    eprintln!("rate table at the calibrated carrier and phase (the truth)");
+    let fe = file.front_end().map_err(Failure::Run)?;
+    let (sf_true_per_dps, clocks) =
+        scenario::rate_table(&file.exp, &fe, &at, knowns, &cal.operating).map_err(Failure::Run)?;
+    Ok(Outcome {
+        board: "in-process".into(),
+        cal,
+        samples,
+        wall_s,
+        truth: Some(Truth {
+            device: at,
+            sf_true_per_dps,
+            clocks,
+        }),
+    })
+}

@@ -1,0 +1,140 @@
+//! What `gyrocal calibrate` prints: one JSON object, or a table. Scale
+//! factors are z LSB per deg/s, one per output; uncertainties 1 sigma
+//! (relative for the scale factors, as in `gyrocal field`).
+
+use super::Outcome;
+use gyrocal_host::identify::Estimate;
+use serde_json::{Map, Value, json};
+use std::fmt::Write as _;
+
+/// `name` and `name_uncertainty` of an estimate.
+fn put(map: &mut Map<String, Value>, name: &str, e: Estimate) {
+    map.insert(name.into(), json!(e.value));
+    map.insert(format!("{name}_uncertainty"), json!(e.uncertainty));
+}
+
+/// The identified parameters, in the order the table shows them.
+fn estimates(o: &Outcome) -> [(&'static str, Estimate); 6] {
+    let id = &o.cal.identified;
+    let [m1, m2] = &id.modes;
+    [
+        ("f1_hz", m1.f_hz),
+        ("f2_hz", m2.f_hz),
+        ("q1", m1.q),
+        ("q2", m2.q),
+        ("loop_phase_deg", id.loop_phase_deg),
+        ("group_delay_s", id.group_delay_s),
+    ]
+}
+
+/// sf / sf_true - 1 per output.
+fn error(sf: [f64; 2], truth: [f64; 2]) -> [f64; 2] {
+    std::array::from_fn(|k| sf[k] / truth[k] - 1.0)
+}
+
+/// The one JSON object of `--json`.
+pub fn json(o: &Outcome) -> Value {
+    let mut identified = Map::new();
+    for (name, e) in estimates(o) {
+        put(&mut identified, name, e);
+    }
+    let cal = &o.cal;
+    let truth = o.truth.as_ref().map(|t| {
+        let d = &t.device;
+        json!({
+            "temperature_c": d.temperature_c,
+            "f1_hz": d.gyro.f1_hz,
+            "f2_hz": d.gyro.f2_hz,
+            "q1": d.gyro.q1,
+            "q2": d.gyro.q2,
+            "front_end_phase_deg": d.front_end_phase_deg,
+            "adc_gain": d.adc_gain,
+            "drive_gain": d.drive_gain,
+            "sf_true_per_dps": t.sf_true_per_dps,
+            "selfcal_error": error(cal.sf_selfcal_per_dps, t.sf_true_per_dps),
+            "clocks": t.clocks,
+        })
+    });
+    json!({
+        "board": o.board,
+        "identified": identified,
+        "operating": cal.operating,
+        "cal_hz": cal.cal_hz,
+        "sf_cal_per_dps": cal.sf_cal_per_dps,
+        "ratio": cal.ratio.exact,
+        "ratio_eq56": cal.ratio.eq56,
+        "sf_selfcal_per_dps": cal.sf_selfcal_per_dps,
+        "sf_selfcal_uncertainty": cal.sf_selfcal_uncertainty.total,
+        "sf_selfcal_uncertainty_sources": cal.sf_selfcal_uncertainty,
+        "sf_eq56_per_dps": cal.sf_eq56_per_dps,
+        "clocks": cal.clocks,
+        "wall_s": o.wall_s,
+        "samples": {"read": o.samples.read, "missed": o.samples.missed},
+        "truth": truth,
+    })
+}
+
+/// The table.
+pub fn table(o: &Outcome) -> String {
+    let mut s = String::new();
+    let cal = &o.cal;
+    let _ = writeln!(s, "board: {}", o.board);
+    let truth = o.truth.as_ref().map(|t| &t.device.gyro);
+    let true_values = truth.map(|g| [g.f1_hz, g.f2_hz, g.q1, g.q2]);
+    let _ = writeln!(
+        s,
+        "{:<16} {:>18} {:>12} {:>18}",
+        "identified", "value", "1-sigma", "truth"
+    );
+    for (i, (name, e)) in estimates(o).into_iter().enumerate() {
+        let t = true_values
+            .and_then(|v| v.get(i).copied())
+            .map_or(String::new(), |v| format!("{v:.6}"));
+        let value = if e.value.abs() < 1e-2 {
+            format!("{:.6e}", e.value)
+        } else {
+            format!("{:.6}", e.value)
+        };
+        let _ = writeln!(s, "{name:<16} {value:>18} {:>12.3e} {t:>18}", e.uncertainty);
+    }
+    let _ = writeln!(
+        s,
+        "operating: carrier {:.6} Hz, phase correction {:.5} deg",
+        cal.operating.carrier_hz, cal.operating.ref_lag_deg
+    );
+    let _ = writeln!(
+        s,
+        "{:<32} {:>14} {:>14}",
+        "z LSB per deg/s", "output 1", "output 2"
+    );
+    let mut row = |name: &str, v: [f64; 2], pct: bool| {
+        let _ = if pct {
+            writeln!(
+                s,
+                "{name:<32} {:>13.4}% {:>13.4}%",
+                100.0 * v[0],
+                100.0 * v[1]
+            )
+        } else {
+            writeln!(s, "{name:<32} {:>14.6e} {:>14.6e}", v[0], v[1])
+        };
+    };
+    row("SF_cal", cal.sf_cal_per_dps, false);
+    row("ratio (exact theory)", cal.ratio.exact, false);
+    row("SF_selfcal", cal.sf_selfcal_per_dps, false);
+    row("SF_selfcal 1-sigma", cal.sf_selfcal_uncertainty.total, true);
+    if let Some(t) = &o.truth {
+        row("SF_true (rate table)", t.sf_true_per_dps, false);
+        row(
+            "self-cal error",
+            error(cal.sf_selfcal_per_dps, t.sf_true_per_dps),
+            true,
+        );
+    }
+    let _ = writeln!(
+        s,
+        "{:.3e} clocks, {:.1} s wall; {} z samples read, {} went by unread",
+        cal.clocks as f64, o.wall_s, o.samples.read, o.samples.missed
+    );
+    s
+}
