@@ -16,24 +16,41 @@
 //! Each run gives six figures, SF_read, SF_cal and the ratio of both
 //! outputs, and t = (simulated - exact theory) / reported sigma for each.
 //!
-//! Assertions, and why they can fail:
-//! - between 90% and 99.5% of all t within 2 (`reported sigma` = the
-//!   budget's total: its statistical term carries the coverage factor of
-//!   its degrees of freedom, so a t with 7 degrees of freedom is 98%
-//!   within 2 and a normal 95%; a sigma 1.5 times too small (a bare batch
-//!   spread, or a missing systematic) drops below 90% on its share of
-//!   the runs, one 2 times too large puts 99.99% within 2);
-//! - every t within 3: a systematic the budget misses puts its runs far
+//! Assertions (issue 20 section 1), and why they can fail. The reported
+//! sigma is the budget's total (`gyrocal_sim::budget`): its statistical
+//! term carries the coverage factor of its degrees of freedom (1.51 at the
+//! readout's 7), and the systematic terms add in quadrature.
+//! - Between 90% and 99.5% of all t within 2. Expected: 95.4% if every
+//!   sigma were a normal's, 98.1% if every figure were a t with 7 degrees
+//!   of freedom over its coverage factor (|t7| <= 3.02); the runs mix both.
+//!   A sigma 1.5 times too small (a missing systematic of the size of the
+//!   statistics) puts 81% of a normal within 2; sigmas twice too large put
+//!   99.99% within 2. The figures of one run are correlated (a ratio's
+//!   error is mostly its SF_read's or its SF_cal's), so the 366 count as
+//!   about 180 trials: a binomial standard deviation of 1.3% at 97%,
+//!   and 90% lies 5 of them below it.
+//! - Every t within 3: a systematic the budget misses puts its runs far
 //!   outside (before this budget, 5 of 20 ratios lay 3.4 to 11.6 sigma
-//!   from the theory). For a calibrated sigma each figure has a 0.27%
-//!   chance to land outside, so this holds over the pinned seeds or
-//!   fails on one figure a few percent beyond 3;
-//! - spread: for each of the `SPREAD_DEVICES` devices and each figure,
+//!   from the theory), and the bare batch spread without its coverage
+//!   factor leaves 2% of a t7 beyond 3 (7 of 366). For a calibrated sigma
+//!   each figure has a 0.27% chance (1 expected in 366 if they were
+//!   independent normals, fewer here since the batch spread errs high on
+//!   deterministic residues), so this is a guard on the pinned seeds: it
+//!   holds on them (largest |t| 2.93) and other seeds may need a look
+//!   before they are pinned.
+//! - No sigma inflated: for each figure, the RMS of t over all runs is at
+//!   least 0.2 (the sigmas at most 5 times the errors, on average); an
+//!   honest set gives 0.78 to 1 (a t7, standard deviation 1.18, over its
+//!   coverage factor 1.51; a normal), and the RMS of 61 such t falls
+//!   below 0.2 (a mean square 15 times below its expectation) with a
+//!   probability far below 1e-9.
+//! - Spread: for each of the `SPREAD_DEVICES` devices and each figure,
 //!   the mean reported sigma over its 8 dither seeds is at most 5 times
 //!   the root mean square of its 8 errors (the spread it describes,
 //!   systematic shifts included). For an honest sigma the ratio is about
 //!   1.5 (the coverage factor at 7 degrees of freedom); the RMS of 8
-//!   errors falls below 0.3 of its expectation with probability 1e-4.
+//!   errors falls below 0.3 of its expectation with probability 5e-4
+//!   (chi-square, 8 degrees of freedom, below 0.72), 1% over the 18.
 //!
 //! `survey` (ignored) prints one JSON line per device of the wide span
 //! (10 kHz..10 MHz, Q 100..1e5, required keys only) for exploring, and
@@ -166,40 +183,25 @@ fn the_exact_theory_lies_within_the_reported_sigmas_as_promised() {
         .collect();
     let t: Vec<f64> = runs
         .iter()
-        .flat_map(|r| r.errors.iter().map(|(x, s)| (x / s).abs()))
+        .flat_map(|r| r.errors.iter().map(|(x, s)| x / s))
         .collect();
-    let within = |n: f64| t.iter().filter(|x| **x <= n).count();
-    let n = t.len();
-    eprintln!(
-        "{} runs, {n} figures: within 1 sigma {}, 2 sigma {} ({:.1}%), 3 sigma {}; largest |t| {:.2}",
-        runs.len(),
-        within(1.0),
-        within(2.0),
-        100.0 * within(2.0) as f64 / n as f64,
-        within(3.0),
-        t.iter().cloned().fold(0.0, f64::max)
-    );
-    for (lo, hi) in [
-        (0.0, 0.5),
-        (0.5, 1.0),
-        (1.0, 1.5),
-        (1.5, 2.0),
-        (2.0, 2.5),
-        (2.5, 3.0),
-        (3.0, f64::MAX),
-    ] {
-        let c = t.iter().filter(|x| (lo..hi).contains(*x)).count();
-        eprintln!("|t| in [{lo}, {hi}): {c}");
-    }
-    let spread = spread_ratios(&runs);
-    let in2 = within(2.0) as f64 / n as f64;
+    print_distribution(&t);
+    let within = |n: f64| t.iter().filter(|x| x.abs() <= n).count();
+    let in2 = within(2.0) as f64 / t.len() as f64;
     assert!(
         (0.90..=0.995).contains(&in2),
         "{:.1}% within 2 sigma",
         100.0 * in2
     );
-    assert_eq!(within(3.0), n, "figures beyond 3 sigma");
-    for (i, k, ratio) in spread {
+    assert_eq!(within(3.0), t.len(), "figures beyond 3 sigma");
+    for (k, rms) in rms_by_figure(&runs).into_iter().enumerate() {
+        assert!(
+            rms >= 0.2,
+            "{}: RMS error / sigma {rms:.2} over all runs",
+            FIGURES[k]
+        );
+    }
+    for (i, k, ratio) in spread_ratios(&runs) {
         assert!(
             ratio <= 5.0,
             "device {}, {}: sigma {ratio:.2} x the RMS error",
@@ -207,6 +209,58 @@ fn the_exact_theory_lies_within_the_reported_sigmas_as_promised() {
             FIGURES[k]
         );
     }
+}
+
+/// Print the distribution of the signed t = error / sigma: counts within
+/// 1, 2, 3, and a histogram in half-sigma bins.
+fn print_distribution(t: &[f64]) {
+    let within = |n: f64| t.iter().filter(|x| x.abs() <= n).count();
+    let n = t.len();
+    let mean = t.iter().sum::<f64>() / n as f64;
+    let rms = (t.iter().map(|x| x * x).sum::<f64>() / n as f64).sqrt();
+    eprintln!(
+        "{n} figures: within 1 sigma {} ({:.1}%), 2 sigma {} ({:.1}%), 3 sigma {}; \
+         mean t {mean:+.3}, RMS t {rms:.3}, largest |t| {:.2}",
+        within(1.0),
+        100.0 * within(1.0) as f64 / n as f64,
+        within(2.0),
+        100.0 * within(2.0) as f64 / n as f64,
+        within(3.0),
+        t.iter().map(|x| x.abs()).fold(0.0, f64::max)
+    );
+    let bins: Vec<String> = (-7..7)
+        .map(|i| {
+            let (lo, hi) = (f64::from(i) * 0.5, f64::from(i + 1) * 0.5);
+            let c = t
+                .iter()
+                .filter(|x| match i {
+                    -7 => **x < hi,
+                    6 => **x >= lo,
+                    _ => (lo..hi).contains(*x),
+                })
+                .count();
+            match i {
+                -7 => format!("t < {hi}: {c}"),
+                6 => format!("t >= {lo}: {c}"),
+                _ => format!("[{lo:+}, {hi:+}): {c}"),
+            }
+        })
+        .collect();
+    eprintln!("error / sigma histogram: {}", bins.join(", "));
+}
+
+/// For each figure: the RMS of t over all runs (1 / (how many times the
+/// sigmas exceed the errors they describe), on average).
+fn rms_by_figure(runs: &[Run]) -> [f64; 6] {
+    std::array::from_fn(|k| {
+        let sum: f64 = runs
+            .iter()
+            .map(|r| (r.errors[k].0 / r.errors[k].1).powi(2))
+            .sum();
+        let rms = (sum / runs.len() as f64).sqrt();
+        eprintln!("{}: RMS t {rms:.3} over {} runs", FIGURES[k], runs.len());
+        rms
+    })
 }
 
 /// For each spread device and figure: mean reported sigma over the RMS
