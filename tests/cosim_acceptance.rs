@@ -176,7 +176,7 @@ fn unequal_q_and_negative_split() {
 #[test]
 fn the_papers_device_at_full_scale() {
     // `gyrocal reproduce`'s experiment: 9.64 MHz, Q 55,000, 250 Hz split,
-    // 50 MHz clock, 1..20 deg/s, 10..15 Hz, dithered converters: 2.4e8 clocks.
+    // 50 MHz clock, 1..20 deg/s, 10..15 Hz, dithered converters: 2.45e8 clocks.
     let r = run(&Experiment::paper());
     assert_eq!(r.detuned_output, Some(1));
     // The exact fitted ratio at the paper's points is about 1.534 and the
