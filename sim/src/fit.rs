@@ -82,7 +82,7 @@ pub fn fit_batches(x: &[f64], batches: &[Vec<f64>]) -> Line {
 /// The factor that makes a standard deviation estimated with `dof`
 /// degrees of freedom cover what a normal's does at 3 sigma: the
 /// Student t quantile at 0.99865 over 3 (1.51 at 7 degrees of freedom,
-/// 1.18 at 15, 1 in the limit). Cornish-Fisher expansion of the t
+/// 1.20 at 15, 1 in the limit). Cornish-Fisher expansion of the t
 /// quantile to 1/dof^4, within 0.002 of it from 7 degrees of freedom
 /// (checked against the quantile integrated from the density); below 7 it
 /// underestimates it by a few percent (2.3% at 3; the runs have 7 or more).
