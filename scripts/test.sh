@@ -3,8 +3,8 @@
 #
 # Installs the tools the tests need (iverilog, verilator, yosys, make, g++,
 # nextpnr-ice40, python3, python3-venv) with apt-get when they are missing (root,
-# non-interactive) and the YoWASP ECP5 tools into a Python virtual environment
-# (scripts/fpga/install-venv.sh: $GYROCAL_FPGA_VENV, default .venv-fpga/), then runs the whole
+# non-interactive) and the pinned PyPI tools into Python virtual environments
+# (scripts/*/install-venv.sh, below), then runs the whole
 # test suite in release mode (the co-simulation tests need optimized code),
 # with the Verilator engine enabled, and the format and lint checks.
 set -euo pipefail
@@ -29,7 +29,15 @@ if [ ${#missing[@]} -gt 0 ]; then
   $SUDO apt-get update -q
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q "${missing[@]}"
 fi
+# Pinned PyPI tools, one venv per purpose (each script says what and where;
+# each does nothing when its venv already holds exactly its pins):
+# YoWASP yosys/nextpnr-ecp5/sby and the yices solver (place and route,
+# formal proofs); FuseSoC, PeakRDL and LiteX (IP packaging); LiteX's
+# RemoteClient (gyrocal serve); allantools (the datasheet's Allan check).
 scripts/fpga/install-venv.sh
+scripts/ip/install-venv.sh
+scripts/host/install-venv.sh
+scripts/noise/install-venv.sh
 
 # The bus tests (tests/axi_bus.rs) run cocotb with cocotbext-axi, a
 # third-party AXI4-Lite master, in a venv of pinned PyPI packages. cocotb 1.9

@@ -5,14 +5,21 @@
 use gyrocal_host::selfcal;
 use gyrocal_sim::drift::Drift;
 use gyrocal_sim::field::probe::DriveProbe;
-use gyrocal_sim::field::scenario::{self, FieldReport};
+use gyrocal_sim::field::scenario::{self, FieldReport, Scenario};
 use gyrocal_sim::noise::ThermalNoise;
 use gyrocal_sim::rate_noise;
 
 fn run(path: &str) -> FieldReport {
     let text = std::fs::read_to_string(path).unwrap();
     let sc = scenario::parse(path, &text).unwrap();
-    scenario::run(&sc, &|line| eprintln!("{line}")).unwrap()
+    finished(&sc)
+}
+
+/// The scenario's report, every step of which finished.
+fn finished(sc: &Scenario) -> FieldReport {
+    let report = scenario::run(sc, &|line| eprintln!("{line}")).unwrap();
+    assert!(report.failed.is_empty(), "{:?}", report.failed);
+    report
 }
 
 /// The consumer device of `tests/data/field_consumer.toml` with its
@@ -23,7 +30,7 @@ fn run_consumer(drift: Drift) -> FieldReport {
     let mut sc = scenario::parse(path, &text).unwrap();
     sc.drift = drift;
     sc.profile = None;
-    scenario::run(&sc, &|line| eprintln!("{line}")).unwrap()
+    finished(&sc)
 }
 
 /// No drift but the converters' gains (ppm/K), from 25 to 35 deg C.
@@ -70,7 +77,7 @@ fn consumer_and_high_q_devices_self_calibrate_over_ten_kelvin() {
     let text = std::fs::read_to_string(path).unwrap();
     let mut sc = scenario::parse(path, &text).unwrap();
     sc.drift.temperatures_c = vec![25.0, 15.0, 35.0];
-    let report = scenario::run(&sc, &|line| eprintln!("{line}")).unwrap();
+    let report = finished(&sc);
     assert_within_target(&report);
 }
 
@@ -86,14 +93,15 @@ fn consumer_and_high_q_devices_self_calibrate_over_ten_kelvin() {
 /// magnitude (a fixed null on an output whose offset moves with the
 /// detuning).
 fn assert_rate_output_tracks_temperature(report: &FieldReport) {
-    let k = usize::from(report.sf_factory_per_dps[1].abs() > report.sf_factory_per_dps[0].abs());
+    let sf = report.sf_factory_per_dps.expect("the factory calibration");
+    let k = usize::from(sf[1].abs() > sf[0].abs());
     let at_t0 = report.steps[0].profile.as_ref().unwrap();
     let reference = at_t0.selfcal_rms_error_dps[k];
     for s in &report.steps[1..] {
         let trace = s.profile.as_ref().unwrap();
         let (own, base) = (
             trace.selfcal_rms_error_dps[k],
-            trace.baseline_rms_error_dps[k],
+            trace.baseline_rms_error_dps.expect("a baseline")[k],
         );
         eprintln!(
             "{} deg C output {}: rate RMS error self-cal {own:.4} deg/s, baseline {base:.4e} deg/s (T0 {reference:.4})",
@@ -211,7 +219,7 @@ fn a_differential_drive_gain_is_measured_while_turning_and_corrected() {
     sc.drift.temperatures_c = vec![25.0, 35.0, 15.0];
     sc.profile = None;
     sc.drive_probe = Some(DriveProbe { rate_dps: 200.0 });
-    let report = scenario::run(&sc, &|line| eprintln!("{line}")).unwrap();
+    let report = finished(&sc);
     for s in &report.steps {
         let m = s.selfcal.drive_ratio.as_ref().unwrap();
         let sigmas = (m.relative.value - s.drive_gain_ratio_true) / m.relative.uncertainty;
@@ -283,7 +291,10 @@ fn paper_device_self_calibrates_over_ten_kelvin() {
         .filter(|s| (s.temperature_c - 25.0).abs() >= 5.0);
     for s in far {
         assert!(
-            s.baseline_error.iter().all(|e| e.abs() > 1.0),
+            s.baseline_error
+                .expect("a baseline")
+                .iter()
+                .all(|e| e.abs() > 1.0),
             "{:?}",
             s.baseline_error
         );
@@ -322,9 +333,9 @@ fn self_calibration_holds_with_brownian_noise() {
         );
         assert!(share > 0.5, "{share}");
     }
-    let first = scenario::run(&sc, &|line| eprintln!("{line}")).unwrap();
+    let first = finished(&sc);
     sc.exp.noise.seed = 2;
-    let second = scenario::run(&sc, &|line| eprintln!("{line}")).unwrap();
+    let second = finished(&sc);
     assert_within_target(&first);
     assert_within_target(&second);
     for k in 0..2 {

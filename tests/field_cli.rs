@@ -74,3 +74,62 @@ fn bad_scenario_files_are_refused_in_one_line() {
         assert!(!out.exists(), "{key}: wrote {}", out.display());
     }
 }
+
+/// A step the host cannot calibrate (at 45 deg C the modes have drifted
+/// 20% below the datasheet, beyond the +-5% scan) is reported, in the JSON
+/// and in one closing line with exit status 1, while the step that
+/// finished (25 deg C) stands, written whole with its figures.
+#[test]
+fn a_failed_step_is_reported_and_the_finished_steps_stand() {
+    let drift =
+        "[drift]\ntemperatures_c = [25, 45]\ntcf1_ppm_per_k = -10000\ntcf2_ppm_per_k = -10000\n";
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("drifting_out.toml");
+    std::fs::write(&config, format!("{GOOD}{drift}")).unwrap();
+    let out = dir.path().join("out");
+    let run = gyrocal(&[
+        OsStr::new("field"),
+        OsStr::new("--config"),
+        config.as_os_str(),
+        OsStr::new("--json"),
+        OsStr::new("--out"),
+        out.as_os_str(),
+    ]);
+    let stderr = common::stderr(&run);
+    assert_eq!(run.status.code(), Some(1), "{stderr}");
+    let last = stderr.trim_end().lines().last().unwrap();
+    assert!(
+        last.contains("1 of 2 steps failed") && last.contains("45 deg C"),
+        "{last}"
+    );
+    let text = String::from_utf8(run.stdout).unwrap();
+    assert_eq!(
+        text.trim().lines().count(),
+        1,
+        "one JSON object on one line"
+    );
+    let report: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let steps = report["steps"].as_array().unwrap();
+    assert_eq!(steps.len(), 1, "{report}");
+    assert_eq!(steps[0]["temperature_c"], 25.0);
+    assert!(
+        steps[0]["sf_selfcal_per_dps"][0]
+            .as_f64()
+            .unwrap()
+            .is_finite()
+    );
+    let failed = report["failed"].as_array().unwrap();
+    assert_eq!(failed.len(), 1, "{report}");
+    assert_eq!(failed[0]["temperature_c"], 45.0);
+    assert_eq!(failed[0]["stage"], "self-calibration cycle");
+    assert!(
+        failed[0]["error"]
+            .as_str()
+            .unwrap()
+            .contains("no resonance found"),
+        "{failed:?}"
+    );
+    let written: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("field.json")).unwrap()).unwrap();
+    assert_eq!(written, report);
+}

@@ -25,6 +25,26 @@
 //! folds 1/G into its numerator (`crate::filter_design`), so z has unity
 //! gain. |x| < 2^31 gives |y| < 2^39: 40 bits, no overflow.
 //!
+//! Overflow bound, for every input sequence of 32-bit words (|x| <= 2^31;
+//! the demodulator's product of two 16-bit words is at most 2^30):
+//! - integrators and the first three combs: arithmetic modulo 2^80; they
+//!   wrap by design (their true values grow without bound), and the last
+//!   comb is exact modulo 2^80 (Hogenauer);
+//! - the last comb: c = sum h[k] x[n - k] with h the cascade of four
+//!   length-R boxcars, h >= 0 and sum h = R^4, so |c| <= 2^31 R^4 <= 2^79
+//!   for R <= 4096: the 80-bit register holds it (c = -2^79 at x = i32::MIN
+//!   and R = 4096, no margin for any i32; one bit for |x| <= 2^30);
+//! - the output y = round(c / 2^shift), shift = ceil(4 log2 R) - 8:
+//!   |y| <= 2^31 G 2^8 <= 2^39, in 40 signed bits (y = -2^39 at x = i32::MIN
+//!   and G = 1; one bit of margin for |x| <= 2^30); the 41-bit half word
+//!   floor(2c / 2^shift) of the output stage likewise.
+//!
+//! Since h >= 0, the sign sequence of h, the worst case for each of these,
+//! is a constant: `full_scale_inputs_come_out_exact` holds i32::MIN and
+//! i32::MAX at R = 166 (the least), 182 (G = 0.51) and 4096 (the most,
+//! every integrator wrapping thousands of times) through the model and the
+//! rust-hdl design, and gets the exact rounded average.
+//!
 //! The rounding needs no adder as wide as the comb: with b the comb output
 //! and s the shift, floor(b / 2^s + 1/2) = floor((floor(2b / 2^s) + 1) / 2)
 //! (for real t, floor((floor(t) + 1) / 2) = floor((t + 1) / 2)). So the
@@ -768,14 +788,58 @@ mod tests {
         }
     }
 
+    /// Run the rust-hdl design with `x` on channel 1 and -1 - x on channel 2
+    /// (the other extreme); return both channels' outputs in order.
+    fn rtl_outputs(x: i32, r: u32, shift: u32, clocks: usize) -> Vec<(i64, i64)> {
+        let mut uut = CicDecimator::new();
+        prepare(&mut uut);
+        uut.x1.next = i128_to_signed(x as i128);
+        uut.x2.next = i128_to_signed(-1 - x as i128);
+        uut.decimation.next = u128_to_bits(r as u128);
+        uut.shift.next = u128_to_bits(shift as u128);
+        let mut out = Vec::new();
+        for _ in 0..clocks {
+            tick(&mut uut);
+            if uut.valid.val() {
+                let y = |v| signed_to_i128(v) as i64;
+                out.push((y(uut.y1.val()), y(uut.y2.val())));
+            }
+        }
+        out
+    }
+
     #[test]
-    fn full_scale_inputs_wrap_the_integrators_and_come_out_exact() {
-        // R = 4096: the 80-bit integrators wrap thousands of times; the
-        // output is still the exact average times 2^8 (G = 1 for R = 2^12).
-        let shift = cic_bit_growth(4096) - OUTPUT_FRACTION_BITS;
-        for c in [i32::MIN, i32::MAX] {
-            let y = outputs(&vec![c; 6 * 4096], 4096, shift);
-            assert_eq!(*y.last().unwrap(), c as i64 * 256);
+    fn full_scale_inputs_come_out_exact() {
+        // The worst case of every register (module header): constant full
+        // scale. The settled output is round(c R^4 / 2^shift) exactly, the
+        // 80-bit integrators having wrapped (R = 4096: thousands of times);
+        // any overflow of the last comb or the output would change it.
+        for r in [MIN_DECIMATION, 182, MAX_DECIMATION] {
+            let shift = cic_bit_growth(r) - OUTPUT_FRACTION_BITS;
+            let exact = |c: i32| {
+                let c4 = c as i128 * (r as i128).pow(4);
+                assert!(c4.abs() <= 1i128 << (REGISTER_BITS - 1), "the comb word");
+                let y = (c4 + (1i128 << (shift - 1))).div_euclid(1i128 << shift) as i64;
+                assert!(y.abs() <= 1i64 << (OUTPUT_BITS - 1), "the output word");
+                y
+            };
+            if r == MAX_DECIMATION {
+                // The extreme reaches the end of both registers: -2^79, -2^39.
+                assert_eq!(exact(i32::MIN), -(1i64 << (OUTPUT_BITS - 1)));
+            }
+            let clocks = 7 * r as usize;
+            let rtl = rtl_outputs(i32::MIN, r, shift, clocks);
+            assert!(rtl.len() >= 4, "R {r}: {} outputs", rtl.len());
+            assert_eq!(
+                rtl[rtl.len() - 1],
+                (exact(i32::MIN), exact(i32::MAX)),
+                "R {r}"
+            );
+            assert_eq!(rtl[rtl.len() - 2], rtl[rtl.len() - 1], "R {r} not settled");
+            for c in [i32::MIN, i32::MAX] {
+                let y = outputs(&vec![c; clocks], r, shift);
+                assert_eq!(y[y.len() - 2..], [exact(c); 2], "model, R {r}, x {c}");
+            }
         }
     }
 

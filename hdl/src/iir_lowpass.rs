@@ -38,6 +38,39 @@
 //!   rounded half up to 8 fractional bits, 40 bits. The 60-bit difference
 //!   y - u is taken from the 94-bit sum before y is cut to 58 bits.
 //!
+//! Overflow bound for the filters `crate::filter_design` makes (its whole
+//! range): the input x is the CIC output for mixer words of at most 2^30
+//! (a product of two 16-bit words), so |x| <= x_max = 2^38 G (+1/2), G the
+//! CIC gain, and the filter's DC gain is 1/G. Each linear register is at
+//! most x_max times the l1 norm of its impulse response, which the sign
+//! sequence of that response read backwards reaches; l1 x G depends on the
+//! cut-off ratios only. Largest l1 x G over the range (corners R = 166, 182,
+//! 4096 with each cut-off at f_z / 1000 or f_z / 5, and a 40 x 8 sweep):
+//! 1.168 for y, 1.091 for u, 1.864 for 2 y1 - y2, 2.127 for y - u, 2.810
+//! for 2 y1 - y2 - u. Peaks of the worst-case sequences against the range
+//! of each register (the accumulators peak with their section's worst
+//! case; v is at most 4 x_max 2^16 for any input):
+//!
+//! | register | bits | peak | margin |
+//! |---|---|---|---|
+//! | v = (x + 2 x0 + x1) 2^16 | 60 | 2^56.00 | 3.00 bits |
+//! | 2 y1 - y2 | 60 | 2^54.90 | 4.10 bits |
+//! | biquad accumulator | 94 | 2^84.22 | 8.78 bits |
+//! | 2 y1 - y2 - u | 60 | 2^55.49 | 3.51 bits |
+//! | difference accumulator | 94 | 2^85.09 | 7.91 bits |
+//! | y (y1, y2) | 58 | 2^54.22 | 2.78 bits |
+//! | y - u | 60 | 2^55.09 | 3.91 bits |
+//! | RC accumulator | 94 | 2^84.12 | 8.88 bits |
+//! | u, u + 2^15 | 58 | 2^54.12 | 2.88 bits |
+//! | z | 40 | 2^38.12 | 0.88 bits |
+//!
+//! `model::iir_lowpass`'s `worst_case_sequences_fit_every_register` drives
+//! each worst case through the i128 arithmetic of record at the corners
+//! (no register wraps, each reaches its bound) and z's through the bit-true
+//! model; `worst_case_of_z_through_the_rust_hdl_design` drives z's through
+//! this design. A 40-bit x beyond 2^38 G (from a CIC shift smaller than
+//! the designed one) can overflow z: outside the supported settings.
+//!
 //! Datapath (the widths of `crate::iir_program`):
 //!
 //! ```text
@@ -516,7 +549,7 @@ mod tests {
     use super::*;
     use crate::drive::{prepare, tick};
     use crate::filter_design::{self, FilterDesign};
-    use crate::model::iir_lowpass::{Coefficients, IirLowpass as Model};
+    use crate::model::iir_lowpass::{Coefficients, IirLowpass as Model, reference};
     use crate::primitives::convert::{i128_to_signed, signed_to_i128};
     use crate::test_util::{Rng, segments};
     use proptest::prelude::*;
@@ -558,26 +591,10 @@ mod tests {
             .collect()
     }
 
-    /// The same recursion in f64 with the quantized coefficients: the
-    /// fixed-point model may differ from it only by its roundings.
+    /// u of the f64 recursion (`reference::float_run`): the fixed-point
+    /// model may differ from it only by its roundings.
     fn run_float(k: &Coefficients, x: &[i64]) -> Vec<f64> {
-        let s = 2f64.powi(30);
-        let (k0, k1, k2, a) = (
-            k.k0 as f64 / s,
-            k.k1 as f64 / s,
-            k.k2 as f64 / s,
-            k.alpha as f64 / s,
-        );
-        let (mut x1, mut x2, mut y1, mut y2, mut u) = (0.0, 0.0, 0.0, 0.0, 0.0);
-        x.iter()
-            .map(|&x0| {
-                let x0 = x0 as f64;
-                let y = 2.0 * y1 - y2 + k0 * (x0 + 2.0 * x1 + x2) + k1 * y1 + k2 * y2;
-                (x2, x1, y2, y1) = (x1, x0, y1, y);
-                u += a * (y - u);
-                u
-            })
-            .collect()
+        reference::float_run(k, x).iter().map(|s| s.u).collect()
     }
 
     proptest! {
@@ -686,37 +703,57 @@ mod tests {
     }
 
     #[test]
-    fn worst_case_full_scale_input_does_not_overflow() {
-        // The input that maximizes the output at sample N is the sign
-        // pattern of the impulse response read backwards; its peak is
-        // FULL_SCALE times the l1 norm of h (about 1.1 for these filters).
-        // Any wrap-around would show as a huge error against the float run.
-        for f in designs() {
-            let k = f.coefficients;
-            let n = 3000;
-            let mut impulse = vec![0i64; n];
-            impulse[0] = 1 << 30;
-            let h = run_float(&k, &impulse);
-            for sign in [1i64, -1] {
-                let x: Vec<i64> = (0..n)
-                    .map(|i| sign * FULL_SCALE * h[n - 1 - i].signum() as i64)
-                    .collect();
-                let z = run(&mut Model::default(), &k, &x);
-                let reference = run_float(&k, &x);
-                let peak = reference.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-                assert!(
-                    peak > FULL_SCALE as f64,
-                    "worst case did not exceed full scale"
-                );
-                for (i, (&zi, &ri)) in z.iter().zip(&reference).enumerate() {
-                    assert!(
-                        (zi as f64 - ri).abs() < 1.0,
-                        "R {} sample {i}",
-                        f.decimation
-                    );
+    fn worst_case_of_z_through_the_rust_hdl_design() {
+        // The overflow bound's worst case (header; all registers and the
+        // corners of the supported range: `model::iir_lowpass`, test
+        // `worst_case_sequences_fit_every_register`) through the design
+        // itself: x = +-x_max times the signs of u's impulse response read
+        // backwards, x_max = 2^38 G, on a design whose response fades within
+        // a hundred samples (both cut-offs at f_z / 5, R = 166), so that the
+        // rust-hdl simulation stays short. z must equal the exact i128
+        // recursion with no register wrapped, and exceed x_max (the l1
+        // norm of u's response is above 1: the stimulus is the worst case).
+        let fz = 50e6 / 166.0;
+        let f = filter_design::design(50e6, 166, 0.2 * fz, 0.2 * fz).unwrap();
+        let k = f.coefficients;
+        let x_max = ((1u64 << 38) as f64 * f.cic_gain).ceil() as i64;
+        let mut impulse = vec![0i64; 400];
+        impulse[0] = 1;
+        let h = run_float(&k, &impulse);
+        let n = (0..h.len())
+            .find(|&n| h[n..].iter().map(|v| v.abs()).sum::<f64>() < 1e-9)
+            .unwrap();
+        assert!(n < 120, "the response fades in {n} samples");
+        let x = reference::worst_case_input(&h, n, x_max, 1);
+        let (mut c1, mut c2) = (reference::Channel::default(), reference::Channel::default());
+        let want: Vec<(i64, i64)> = x
+            .iter()
+            .map(|&v| (c1.sample(v, &k), c2.sample(-v, &k)))
+            .collect();
+        assert!(!c1.peaks.wrapped && !c2.peaks.wrapped);
+        assert!(want[n - 1].0 > x_max, "{} against {x_max}", want[n - 1].0);
+        let mut uut = IirLowpass::new();
+        prepare(&mut uut);
+        let s = |v: i32| i128_to_signed::<32>(v as i128);
+        (uut.k0.next, uut.k1.next, uut.k2.next, uut.alpha.next) =
+            (s(k.k0), s(k.k1), s(k.k2), s(k.alpha));
+        let mut got = Vec::new();
+        for &v in &x {
+            for t in 0..SCHEDULE_CLOCKS {
+                uut.x1.next = i128_to_signed(if t == 0 { v } else { 0 } as i128);
+                uut.x2.next = i128_to_signed(if t == 0 { -v } else { 0 } as i128);
+                uut.x_valid.next = t == 0;
+                tick(&mut uut);
+                if uut.z_valid.val() {
+                    let z = |v: Signed<SAMPLE_BITS>| signed_to_i128(v) as i64;
+                    got.push((z(uut.z1.val()), z(uut.z2.val())));
                 }
             }
         }
+        // z comes LATENCY > SCHEDULE_CLOCKS after its strobe: the last one
+        // is still on its way.
+        assert_eq!(got[..], want[..got.len()]);
+        assert_eq!(got.len(), n - 1);
     }
 
     #[test]

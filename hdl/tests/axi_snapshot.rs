@@ -13,6 +13,7 @@
 //! - the count includes a sample from its `z_valid` clock on;
 //! - the four z words hold the sample the count names: the one the stream
 //!   carried with that sequence number;
+//!
 //! and that rust-hdl's outputs equal the model's on every clock, DAC words
 //! included (`axi_model_vs_rtl` stops before the drives start).
 //!

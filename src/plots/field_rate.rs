@@ -54,10 +54,13 @@ impl RatePanels {
                 .as_ref()
                 .ok_or("field rate figure: a step has no profile")?;
             let offset = i as f64 * duration;
-            for (row, rates) in [&trace.selfcal_rate_dps, &trace.baseline_rate_dps]
-                .into_iter()
-                .enumerate()
-            {
+            let rows = [
+                Some(&trace.selfcal_rate_dps),
+                trace.baseline_rate_dps.as_ref(),
+            ];
+            // A step without a baseline leaves its baseline panels blank.
+            for (row, rates) in rows.into_iter().enumerate() {
+                let Some(rates) = rates else { continue };
                 for (k, panel) in panels[row].iter_mut().enumerate() {
                     let points: Vec<(f64, f64)> = trace
                         .time_s
@@ -158,8 +161,11 @@ impl RatePanels {
 }
 
 /// Lowest and highest error of the settled records (of all records when
-/// none is settled).
+/// none is settled); -1..1 for a blank panel (no baseline).
 fn y_range(series: &[StepSeries]) -> (f64, f64) {
+    if series.iter().all(|s| s.points.is_empty()) {
+        return (-1.0, 1.0);
+    }
     let any_settled = series.iter().any(|s| s.settled.iter().any(|&b| b));
     series
         .iter()

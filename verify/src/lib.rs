@@ -31,6 +31,7 @@
 //! for inspection.
 
 mod atomic;
+pub mod formal;
 pub mod lint;
 pub mod pnr;
 pub mod pnr_log;

@@ -177,7 +177,9 @@ impl IirLowpass {
 }
 
 /// The arithmetic of record in i128: the header's equations, one sample at
-/// a time, every register wrapping at its recorded width.
+/// a time, every register wrapping at its recorded width; it also records
+/// each register's largest exact magnitude and whether any wrapped (the
+/// overflow bounds), and runs the same recursion in f64.
 #[cfg(test)]
 pub mod reference {
     use crate::iir_lowpass::{
@@ -189,6 +191,73 @@ pub mod reference {
         (x << (128 - bits)) >> (128 - bits)
     }
 
+    /// The registers of record, in the order a sample computes them.
+    #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+    pub enum Register {
+        /// (x + 2 x0 + x1) 2^16, the numerator operand.
+        V,
+        /// 2 y1 - y2, the feedback operand.
+        Feedback,
+        /// The biquad's accumulator, about y 2^30.
+        AccY,
+        /// Feedback - u, the RC difference's feedback part.
+        FeedbackMinusU,
+        /// The difference's accumulator, about (y - u) 2^30.
+        AccD,
+        /// y, the biquad state.
+        Y,
+        /// y - u, the RC section's operand.
+        Difference,
+        /// The RC section's accumulator, about u 2^30.
+        AccU,
+        /// u, the RC state.
+        U,
+        /// u + 2^15, before the output rounding's shift.
+        Rounded,
+        /// z, the output.
+        Z,
+    }
+
+    impl Register {
+        /// Every register.
+        pub const ALL: [Register; 11] = [
+            Register::V,
+            Register::Feedback,
+            Register::AccY,
+            Register::FeedbackMinusU,
+            Register::AccD,
+            Register::Y,
+            Register::Difference,
+            Register::AccU,
+            Register::U,
+            Register::Rounded,
+            Register::Z,
+        ];
+
+        /// Its recorded width (two's complement).
+        pub fn bits(self) -> usize {
+            match self {
+                Register::V
+                | Register::Feedback
+                | Register::FeedbackMinusU
+                | Register::Difference => OPERAND_BITS,
+                Register::AccY | Register::AccD | Register::AccU => ACCUMULATOR_BITS,
+                Register::Y | Register::U | Register::Rounded => STATE_BITS,
+                Register::Z => SAMPLE_BITS,
+            }
+        }
+    }
+
+    /// The largest exact magnitude of each register (index: its place in
+    /// `Register::ALL`), and whether any value wrapped.
+    #[derive(Clone, Copy, Debug, Default)]
+    pub struct Peaks {
+        /// Largest |value| before wrapping.
+        pub max: [u128; 11],
+        /// Some value did not fit its register.
+        pub wrapped: bool,
+    }
+
     /// One channel's registers.
     #[derive(Clone, Copy, Debug, Default)]
     pub struct Channel {
@@ -197,35 +266,97 @@ pub mod reference {
         y1: i128,
         y2: i128,
         u: i128,
+        /// Peaks since the channel was made.
+        pub peaks: Peaks,
     }
 
     impl Channel {
+        /// `x` wrapped to register `r`'s width, recorded in the peaks.
+        fn fit(&mut self, x: i128, r: Register) -> i128 {
+            let w = wrap(x, r.bits());
+            let slot = &mut self.peaks.max[r as usize];
+            *slot = (*slot).max(x.unsigned_abs());
+            self.peaks.wrapped |= w != x;
+            w
+        }
+
         /// Filter one sample; returns z.
         pub fn sample(&mut self, x: i64, k: &super::Coefficients) -> i64 {
+            use Register as R;
             let f = COEFFICIENT_FRACTION_BITS;
             let half = 1i128 << (f - 1);
-            let v = wrap(
+            let v = self.fit(
                 (x as i128 + 2 * self.x0 as i128 + self.x1 as i128) << GUARD_BITS,
-                OPERAND_BITS,
+                R::V,
             );
-            let feedback = wrap(2 * self.y1 - self.y2, OPERAND_BITS);
+            let feedback = self.fit(2 * self.y1 - self.y2, R::Feedback);
             let products = k.k1 as i128 * self.y1 + k.k2 as i128 * self.y2 + k.k0 as i128 * v;
-            let acc_y = wrap((feedback << f | half) + products, ACCUMULATOR_BITS);
-            let acc_d = wrap(
-                (wrap(feedback - self.u, OPERAND_BITS) << f | half) + products,
-                ACCUMULATOR_BITS,
-            );
-            let y = wrap(acc_y >> f, STATE_BITS);
-            let difference = wrap(acc_d >> f, OPERAND_BITS);
-            let t = wrap(
-                (self.u << f | half) + k.alpha as i128 * difference,
-                ACCUMULATOR_BITS,
-            );
-            self.u = wrap(t >> f, STATE_BITS);
+            let acc_y = self.fit((feedback << f | half) + products, R::AccY);
+            let fed = self.fit(feedback - self.u, R::FeedbackMinusU);
+            let acc_d = self.fit((fed << f | half) + products, R::AccD);
+            let y = self.fit(acc_y >> f, R::Y);
+            let difference = self.fit(acc_d >> f, R::Difference);
+            let t = self.fit((self.u << f | half) + k.alpha as i128 * difference, R::AccU);
+            self.u = self.fit(t >> f, R::U);
             (self.x1, self.x0, self.y2, self.y1) = (self.x0, x, self.y1, y);
-            let rounded = wrap(self.u + (1 << (GUARD_BITS - 1)), STATE_BITS);
-            wrap(rounded >> GUARD_BITS, SAMPLE_BITS) as i64
+            let rounded = self.fit(self.u + (1 << (GUARD_BITS - 1)), R::Rounded);
+            self.fit(rounded >> GUARD_BITS, R::Z) as i64
         }
+    }
+
+    /// The linear registers of one sample of the f64 recursion, in input
+    /// units (the fixed-point states carry 2^16 more).
+    #[derive(Clone, Copy, Debug, Default)]
+    pub struct FloatSample {
+        /// 2 y1 - y2.
+        pub feedback: f64,
+        /// Feedback - u (before the sample).
+        pub feedback_minus_u: f64,
+        /// y.
+        pub y: f64,
+        /// y - u (u before the sample).
+        pub difference: f64,
+        /// u, which z rounds.
+        pub u: f64,
+    }
+
+    /// The same recursion in f64 with the quantized coefficients: the
+    /// fixed-point one may differ from it only by its roundings.
+    pub fn float_run(k: &super::Coefficients, x: &[i64]) -> Vec<FloatSample> {
+        let s = 2f64.powi(COEFFICIENT_FRACTION_BITS as i32);
+        let (k0, k1, k2, a) = (
+            k.k0 as f64 / s,
+            k.k1 as f64 / s,
+            k.k2 as f64 / s,
+            k.alpha as f64 / s,
+        );
+        let (mut x1, mut x2, mut y1, mut y2, mut u) = (0.0, 0.0, 0.0, 0.0, 0.0);
+        x.iter()
+            .map(|&x0| {
+                let x0 = x0 as f64;
+                let feedback = 2.0 * y1 - y2;
+                let y = feedback + k0 * (x0 + 2.0 * x1 + x2) + k1 * y1 + k2 * y2;
+                let out = FloatSample {
+                    feedback,
+                    feedback_minus_u: feedback - u,
+                    y,
+                    difference: y - u,
+                    u: u + a * (y - u),
+                };
+                (x2, x1, y2, y1, u) = (x1, x0, y1, y, out.u);
+                out
+            })
+            .collect()
+    }
+
+    /// The input of `n` samples, each +-`full_scale`, that drives the
+    /// linear register whose impulse response is `h` to `full_scale` times
+    /// sum |h[0..n]| at the last sample: the signs of h read backwards
+    /// (times `sign`).
+    pub fn worst_case_input(h: &[f64], n: usize, full_scale: i64, sign: i64) -> Vec<i64> {
+        (0..n)
+            .map(|i| sign * full_scale * if h[n - 1 - i] < 0.0 { -1 } else { 1 })
+            .collect()
     }
 }
 
@@ -363,6 +494,145 @@ mod tests {
                     "{k:?} {x}"
                 );
             }
+        }
+    }
+
+    /// Designs at the corners of the supported range: the least decimation,
+    /// one with a CIC gain near 1/2 (R = 182) and the largest, each with
+    /// either cut-off at either end of its range (`filter_design`).
+    fn corner_designs() -> Vec<filter_design::FilterDesign> {
+        let mut out = Vec::new();
+        for r in [MIN_DECIMATION, 182, 4096] {
+            let fz = 50e6 / r as f64;
+            for b in [MIN_CUTOFF_RATIO, 0.02, MAX_CUTOFF_RATIO] {
+                for c in [MIN_CUTOFF_RATIO, MAX_CUTOFF_RATIO] {
+                    out.push(filter_design::design(50e6, r, b * fz, c * fz).unwrap());
+                }
+            }
+        }
+        out
+    }
+
+    /// The impulse response of each linear register (f64, input units) and
+    /// the length after which its tail is below 1e-9 of its l1 norm.
+    fn impulse_responses(k: &Coefficients) -> (Vec<[f64; 5]>, usize) {
+        let mut impulse = vec![0i64; 20_000];
+        impulse[0] = 1;
+        let h: Vec<[f64; 5]> = reference::float_run(k, &impulse)
+            .into_iter()
+            .map(|s| [s.feedback, s.feedback_minus_u, s.y, s.difference, s.u])
+            .collect();
+        // tail[n][j] = sum over m >= n of |h[m][j]|.
+        let mut tail = vec![[0f64; 5]; h.len() + 1];
+        for n in (0..h.len()).rev() {
+            for j in 0..5 {
+                tail[n][j] = tail[n + 1][j] + h[n][j].abs();
+            }
+        }
+        let n = (0..h.len())
+            .find(|&n| (0..5).all(|j| tail[n][j] < 1e-9 * tail[0][j]))
+            .expect("the impulse response decays within 20000 samples");
+        (h, n)
+    }
+
+    #[test]
+    fn worst_case_sequences_fit_every_register() {
+        // Header of crate::iir_lowpass, "Overflow bound". x is the CIC
+        // output for mixer words of at most 2^30 (a product of two 16-bit
+        // words): |x| <= 2^38 G + 1/2 with G the CIC gain. Each linear
+        // register (the five of `FloatSample`) is driven by the sign
+        // sequence of its own impulse response at that full scale, both
+        // signs; it must reach x_max times the l1 norm of its response
+        // (the stimulus is the worst case) and no register may wrap. The
+        // bit-true model gives the same z on the worst case of u.
+        use reference::Register as R;
+        let linear = [R::Feedback, R::FeedbackMinusU, R::Y, R::Difference, R::U];
+        let mut worst = [0u128; 11];
+        let mut largest_l1 = [0f64; 5];
+        for d in corner_designs() {
+            let k = d.coefficients;
+            let full_scale = ((1u64 << 38) as f64 * d.cic_gain).ceil() as i64;
+            let (h, n) = impulse_responses(&k);
+            for (j, &register) in linear.iter().enumerate() {
+                let response: Vec<f64> = h.iter().map(|v| v[j]).collect();
+                let l1: f64 = response.iter().map(|v| v.abs()).sum();
+                let l1_n: f64 = response[..n].iter().map(|v| v.abs()).sum();
+                largest_l1[j] = largest_l1[j].max(l1 * d.cic_gain);
+                for sign in [1, -1] {
+                    let x = reference::worst_case_input(&response, n, full_scale, sign);
+                    let mut channel = Channel::default();
+                    let z: Vec<i64> = x.iter().map(|&v| channel.sample(v, &k)).collect();
+                    let peaks = channel.peaks;
+                    assert!(
+                        !peaks.wrapped,
+                        "R {} {register:?}: a register wrapped",
+                        d.decimation
+                    );
+                    let scale = (1u64 << crate::iir_lowpass::GUARD_BITS) as f64;
+                    let peak = peaks.max[register as usize] as f64;
+                    let (low, high) = (
+                        full_scale as f64 * l1_n * scale,
+                        full_scale as f64 * l1 * scale,
+                    );
+                    assert!(
+                        peak >= low - scale && peak <= high + scale,
+                        "R {} {register:?}: peak {peak:e}, bound {high:e}",
+                        d.decimation
+                    );
+                    for (w, p) in worst.iter_mut().zip(peaks.max) {
+                        *w = (*w).max(p);
+                    }
+                    if register == R::U && sign == 1 {
+                        let mut mirror = Channel::default();
+                        let want: Vec<(i64, i64)> = x
+                            .iter()
+                            .zip(&z)
+                            .map(|(&v, &z1)| (z1, mirror.sample(-v, &k)))
+                            .collect();
+                        let samples: Vec<_> =
+                            x.iter().map(|&v| (v, -v, SCHEDULE_CLOCKS, false)).collect();
+                        assert_eq!(run_model(&k, &samples), want, "R {}: model", d.decimation);
+                    }
+                }
+            }
+        }
+        for register in R::ALL {
+            let peak = worst[register as usize];
+            let limit = 1u128 << (register.bits() - 1);
+            let margin = (limit as f64 / peak as f64).log2();
+            eprintln!(
+                "{register:?}: {} bits, peak 2^{:.2}, margin {margin:.2} bits",
+                register.bits(),
+                (peak as f64).log2()
+            );
+            assert!(peak < limit, "{register:?}");
+        }
+        eprintln!("corners: largest l1 x G (feedback, feedback - u, y, y - u, u) {largest_l1:.4?}");
+        // l1 x G depends on the cut-off ratios only (up to the rounding of
+        // the coefficients): a sweep of 40 x 8 ratios over the range may not
+        // exceed the corners' by more than 1%.
+        let mut swept = [0f64; 5];
+        for i in 0..40 {
+            for j in 0..8 {
+                let ratio =
+                    |t: f64| MIN_CUTOFF_RATIO * (MAX_CUTOFF_RATIO / MIN_CUTOFF_RATIO).powf(t);
+                let fz = 50e6 / 1000.0;
+                let d = filter_design::design(
+                    50e6,
+                    1000,
+                    fz * ratio(i as f64 / 39.0),
+                    fz * ratio(j as f64 / 7.0),
+                )
+                .unwrap();
+                let (h, _) = impulse_responses(&d.coefficients);
+                for (k, w) in swept.iter_mut().enumerate() {
+                    *w = w.max(h.iter().map(|v| v[k].abs()).sum::<f64>() * d.cic_gain);
+                }
+            }
+        }
+        eprintln!("sweep: largest l1 x G {swept:.4?}");
+        for (w, c) in swept.iter().zip(largest_l1) {
+            assert!(*w <= 1.01 * c, "the sweep found {w}, the corners {c}");
         }
     }
 }

@@ -41,7 +41,9 @@
 //!    carriers over +-`SCAN_SPAN` of the guess (process spread is 1 to 5%)
 //!    and the exact form 1 / Y = (fk^2 - f^2 + j f bk) / C, linear in its
 //!    three complex coefficients over all the scan's points ([`fit`]),
-//!    give the start of a second search.
+//!    give an estimate; scans zooming in around it (each a third of the
+//!    last one's span, `search::scan`) narrow it down to a couple of
+//!    bandwidths, where a second search starts.
 //! 2. Fine sweep: `FINE_POINTS` carriers over +-`FINE_SPAN` bandwidths,
 //!    up then down, so that any settling lag shows as a misfit instead of
 //!    a shift. Each point waits `SETTLE_TAUS` amplitude time constants
@@ -194,7 +196,7 @@ pub fn identify_mode(
         Some(found) => found,
         None => {
             scanned = true;
-            let start = search::scan(&mut probe, guess_hz)?;
+            let start = search::scan(&mut probe, guess_hz, bw)?;
             search::coarse(&mut probe, start, bw)?.ok_or_else(|| Error::Identification {
                 mode: k + 1,
                 reason: format!(

@@ -241,16 +241,18 @@ pub struct RateTrace {
     pub true_rate_dps: Vec<f64>,
     /// (z - null_selfcal) / SF_selfcal per output (deg/s).
     pub selfcal_rate_dps: Vec<[f64; 2]>,
-    /// (z - null_factory) / SF_factory at the factory's settings (deg/s).
-    pub baseline_rate_dps: Vec<[f64; 2]>,
+    /// (z - null_factory) / SF_factory at the factory's settings (deg/s);
+    /// null without a baseline.
+    pub baseline_rate_dps: Option<Vec<[f64; 2]>>,
     /// Whether each record is settled (module header).
     pub settled: Vec<bool>,
     /// The self-calibration's null (z LSB).
     pub null_selfcal_z: [f64; 2],
     /// RMS of selfcal_rate - true_rate over the settled records (deg/s).
     pub selfcal_rms_error_dps: [f64; 2],
-    /// RMS of baseline_rate - true_rate over the settled records (deg/s).
-    pub baseline_rms_error_dps: [f64; 2],
+    /// RMS of baseline_rate - true_rate over the settled records (deg/s);
+    /// null without a baseline.
+    pub baseline_rms_error_dps: Option<[f64; 2]>,
 }
 
 #[cfg(test)]

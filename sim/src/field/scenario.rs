@@ -153,14 +153,16 @@ pub struct FieldStep {
     pub sf_selfcal_uncertainty: [f64; 2],
     /// SF_cal x eqs. (5)/(6) ratio (z LSB per deg/s).
     pub sf_eq56_per_dps: [f64; 2],
-    /// The factory scale factor (z LSB per deg/s).
-    pub sf_baseline_per_dps: [f64; 2],
-    /// Rate-table scale factor at the factory settings (z LSB per deg/s).
-    pub sf_true_at_factory_settings_per_dps: [f64; 2],
+    /// The factory scale factor (z LSB per deg/s); null without a
+    /// baseline (the report's `failed` says why).
+    pub sf_baseline_per_dps: Option<[f64; 2]>,
+    /// Rate-table scale factor at the factory settings (z LSB per deg/s);
+    /// null without a baseline.
+    pub sf_true_at_factory_settings_per_dps: Option<[f64; 2]>,
     /// sf_selfcal / sf_true - 1.
     pub selfcal_error: [f64; 2],
-    /// sf_baseline / sf_true_at_factory_settings - 1.
-    pub baseline_error: [f64; 2],
+    /// sf_baseline / sf_true_at_factory_settings - 1; null without a baseline.
+    pub baseline_error: Option<[f64; 2]>,
     /// The true g_2 / g_1 over the design ratio (what `[drive_probe]`'s
     /// measurement, `selfcal.drive_ratio`, estimates).
     pub drive_gain_ratio_true: f64,
@@ -231,16 +233,19 @@ impl From<&SelfCal> for IdentifiedJson {
 pub struct FieldReport {
     /// What the host knew.
     pub knowns: Knowns,
-    /// The factory calibration at T0.
-    pub factory: Operating,
-    /// The factory scale factor (z LSB per deg/s).
-    pub sf_factory_per_dps: [f64; 2],
+    /// The factory calibration at T0 (null when that step failed).
+    pub factory: Option<Operating>,
+    /// The factory scale factor (z LSB per deg/s; null when T0 failed).
+    pub sf_factory_per_dps: Option<[f64; 2]>,
     /// The factory's readout null at its settings (z LSB).
     pub null_factory_z: Option<[f64; 2]>,
     /// The rate profile applied at every step.
     pub profile: Option<Profile>,
-    /// One entry per temperature, in the scenario's order.
+    /// One entry per finished step, in the scenario's order.
     pub steps: Vec<FieldStep>,
+    /// The steps (or their baselines) that failed, in the scenario's order;
+    /// empty when every step finished.
+    pub failed: Vec<StepFailure>,
     /// Clocks simulated, all steps.
     pub clocks: u64,
     /// Wall time (s).
@@ -446,15 +451,24 @@ enum Job {
     BaselineProfile { step: usize },
 }
 
+impl Job {
+    fn step(&self) -> usize {
+        match *self {
+            Job::Factory { step, .. } | Job::BaselineProfile { step } => step,
+        }
+    }
+}
+
 enum Done {
     Point([f64; 2]),
     Profile(ProfileRun),
 }
 
-/// Every step but the first (at T0 the factory's settings are its own).
-fn jobs(steps: usize, rates: usize, with_profile: bool) -> Vec<Job> {
+/// Every step but the first (at T0 the factory's settings are its own)
+/// whose own cycle finished.
+fn jobs(cycles: &[Result<Cycle, String>], rates: usize, with_profile: bool) -> Vec<Job> {
     let mut jobs = vec![];
-    for step in 1..steps {
+    for step in (1..cycles.len()).filter(|&i| cycles[i].is_ok()) {
         jobs.extend((0..rates).map(|rate| Job::Factory { step, rate }));
         if with_profile {
             jobs.push(Job::BaselineProfile { step });
@@ -463,148 +477,274 @@ fn jobs(steps: usize, rates: usize, with_profile: bool) -> Vec<Job> {
     jobs
 }
 
-/// The factory-settings rate table's z of `step` from the finished jobs.
-fn table_z(jobs: &[Job], done: &[Done], step: usize, rates: usize) -> Vec<[f64; 2]> {
-    let mut z = vec![[0.0; 2]; rates];
-    for (job, d) in jobs.iter().zip(done) {
-        match (job, d) {
-            (Job::Factory { step: s, rate }, Done::Point(v)) if *s == step => z[*rate] = *v,
-            _ => {}
-        }
-    }
-    z
+/// A step, or a part of one, that failed: the scenario's other steps stand.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct StepFailure {
+    /// Temperature of the step (deg C).
+    pub temperature_c: f64,
+    /// What failed: [`FAILED_CYCLE`] (the step has no entry in `steps`) or
+    /// [`FAILED_BASELINE`] (its baseline fields are null).
+    pub stage: &'static str,
+    /// The error, one line.
+    pub error: String,
 }
 
-/// Run a scenario: every step's cycle and rate table in parallel (the
-/// first step's cycle is the factory calibration), then every rate-table
-/// point and baseline profile at the factory's settings in parallel;
-/// `progress` gets one line per step.
-pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldReport, String> {
-    let (exp, drift) = (&sc.exp, &sc.drift);
-    exp.validate()?;
-    drift.validate()?;
-    let start = Instant::now();
-    let (fe, knowns) = build(exp)?;
-    let cycles: Vec<Cycle> = drift
+/// [`StepFailure::stage`] of a self-calibration cycle (or its rate table).
+pub const FAILED_CYCLE: &str = "self-calibration cycle";
+/// [`StepFailure::stage`] of the measurements at the factory's settings.
+pub const FAILED_BASELINE: &str = "baseline at the factory settings";
+
+/// The factory calibration: the first step's cycle, when it finished.
+struct Factory {
+    operating: Operating,
+    sf_per_dps: [f64; 2],
+    null_z: Option<[f64; 2]>,
+}
+
+/// Every step's cycle and rate table in parallel; a failed one is kept as
+/// its error.
+fn run_cycles(
+    sc: &Scenario,
+    fe: &FrontEnd,
+    knowns: &Knowns,
+    progress: &(dyn Fn(&str) + Sync),
+) -> Vec<Result<Cycle, String>> {
+    sc.drift
         .temperatures_c
         .par_iter()
         .map(|&t| {
-            let c = cycle_at(sc, &fe, &knowns, t)?;
-            progress(&format!(
-                "{t} deg C: cycle and rate table done, self-cal error {:+.4}% / {:+.4}%",
-                100.0 * (c.cal.sf_selfcal_per_dps[0] / c.sf_true[0] - 1.0),
-                100.0 * (c.cal.sf_selfcal_per_dps[1] / c.sf_true[1] - 1.0),
-            ));
-            Ok(c)
+            let c = cycle_at(sc, fe, knowns, t);
+            match &c {
+                Ok(c) => progress(&format!(
+                    "{t} deg C: cycle and rate table done, self-cal error {:+.4}% / {:+.4}%",
+                    100.0 * (c.cal.sf_selfcal_per_dps[0] / c.sf_true[0] - 1.0),
+                    100.0 * (c.cal.sf_selfcal_per_dps[1] / c.sf_true[1] - 1.0),
+                )),
+                Err(e) => progress(&format!("{t} deg C: FAILED: {e}")),
+            }
+            c
         })
-        .collect::<Result<_, String>>()?;
-    let factory = cycles[0].cal.operating.clone();
-    progress(&format!(
-        "factory calibration at {} deg C: carrier {:.3} Hz, phase {:.4} deg",
-        drift.reference_c(),
-        factory.carrier_hz,
-        factory.ref_lag_deg
-    ));
+        .collect()
+}
+
+/// The rate-table points and baseline profiles at the factory's settings,
+/// in parallel; each job's result (and its clocks) or its error.
+fn run_jobs(
+    sc: &Scenario,
+    fe: &FrontEnd,
+    knowns: &Knowns,
+    factory: &Operating,
+    cycles: &[Result<Cycle, String>],
+    jobs: &[Job],
+) -> Vec<Result<(Done, u64), String>> {
+    let exp = &sc.exp;
     let rates = &knowns.rates_dps;
-    let jobs = jobs(cycles.len(), rates.len(), sc.profile.is_some());
-    let done: Vec<(Done, u64)> = jobs
-        .par_iter()
+    jobs.par_iter()
         .map(|job| -> Result<(Done, u64), String> {
+            let at = &cycles[job.step()].as_ref().map_err(Clone::clone)?.at;
             match *job {
-                Job::Factory { step, rate } => {
-                    let at = &cycles[step].at;
-                    let (z, n) = table_point(exp, &fe, at, &knowns, &factory, rates[rate])?;
+                Job::Factory { rate, .. } => {
+                    let (z, n) = table_point(exp, fe, at, knowns, factory, rates[rate])?;
                     Ok((Done::Point(z), n))
                 }
-                Job::BaselineProfile { step } => {
-                    let at = &cycles[step].at;
+                Job::BaselineProfile { .. } => {
                     let p = sc.profile.as_ref().ok_or("no profile")?;
-                    let mut board = settled_readout_board(exp, &fe, at, &knowns, &factory, 0.0)?;
+                    let mut board = settled_readout_board(exp, fe, at, knowns, factory, 0.0)?;
                     let r = knowns.filter.decimation;
                     let run = profile::run_profile(&mut board, p, r, knowns.clock_hz)?;
                     Ok((Done::Profile(run), board.cycle()))
                 }
             }
         })
-        .collect::<Result<_, String>>()?;
-    let job_clocks: u64 = done.iter().map(|d| d.1).sum();
-    let done: Vec<Done> = done.into_iter().map(|d| d.0).collect();
-    let sf_factory = cycles[0].sf_true;
-    let null_factory = cycles[0].readout.as_ref().map(|r| r.0);
+        .collect()
+}
+
+/// Run a scenario: every step's cycle and rate table in parallel (the
+/// first step's cycle is the factory calibration), then every rate-table
+/// point and baseline profile at the factory's settings in parallel;
+/// `progress` gets one line per step.
+///
+/// A step whose cycle fails is reported in [`FieldReport::failed`] and the
+/// other steps stand; without the factory calibration (the first step
+/// failed) no step has a baseline. Only a scenario that cannot start (its
+/// board or the host's knowledge cannot be built) is an error.
+pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldReport, String> {
+    let (exp, drift) = (&sc.exp, &sc.drift);
+    exp.validate()?;
+    drift.validate()?;
+    let start = Instant::now();
+    let (fe, knowns) = build(exp)?;
+    let cycles = run_cycles(sc, &fe, &knowns, progress);
+    let factory = cycles[0].as_ref().ok().map(|c| Factory {
+        operating: c.cal.operating.clone(),
+        sf_per_dps: c.sf_true,
+        null_z: c.readout.as_ref().map(|r| r.0),
+    });
+    let rates = &knowns.rates_dps;
+    let (jobs, done) = match &factory {
+        Some(f) => {
+            progress(&format!(
+                "factory calibration at {} deg C: carrier {:.3} Hz, phase {:.4} deg",
+                drift.reference_c(),
+                f.operating.carrier_hz,
+                f.operating.ref_lag_deg
+            ));
+            let jobs = jobs(&cycles, rates.len(), sc.profile.is_some());
+            let done = run_jobs(sc, &fe, &knowns, &f.operating, &cycles, &jobs);
+            (jobs, done)
+        }
+        None => (vec![], vec![]),
+    };
+    let mut failed = vec![];
+    let job_clocks: u64 = done.iter().flatten().map(|d| d.1).sum();
     let mut steps = vec![];
     for (i, c) in cycles.into_iter().enumerate() {
-        let sf_true = c.sf_true;
-        let sf_fixed = if i == 0 {
-            sf_true
-        } else {
-            table_slopes(rates, &table_z(&jobs, &done, i, rates.len()))
-        };
-        let baseline_run = jobs.iter().zip(&done).find_map(|(j, d)| match (j, d) {
-            (Job::BaselineProfile { step }, Done::Profile(run)) if *step == i => Some(run),
-            _ => None,
-        });
-        let trace = c.readout.as_ref().map(|(null, run)| {
-            let base = baseline_run.unwrap_or(run);
-            let selfcal_rate = profile::calibrated(&run.z, *null, c.cal.sf_selfcal_per_dps);
-            let nf = null_factory.unwrap_or(*null);
-            let baseline_rate = profile::calibrated(&base.z, nf, sf_factory);
-            RateTrace {
-                selfcal_rms_error_dps: profile::rms_error(
-                    &selfcal_rate,
-                    &run.true_rate_dps,
-                    &run.settled,
-                ),
-                baseline_rms_error_dps: profile::rms_error(
-                    &baseline_rate,
-                    &base.true_rate_dps,
-                    &base.settled,
-                ),
-                settled: run.settled.clone(),
-                time_s: run.time_s.clone(),
-                true_rate_dps: run.true_rate_dps.clone(),
-                selfcal_rate_dps: selfcal_rate,
-                baseline_rate_dps: baseline_rate,
-                null_selfcal_z: *null,
+        let t = drift.temperatures_c[i];
+        let c = match c {
+            Ok(c) => c,
+            Err(error) => {
+                failed.push(StepFailure {
+                    temperature_c: t,
+                    stage: FAILED_CYCLE,
+                    error,
+                });
+                continue;
             }
+        };
+        let baseline = factory.as_ref().and_then(|f| {
+            baseline_of(i, &c, f, &jobs, &done, rates)
+                .map_err(|error| {
+                    failed.push(StepFailure {
+                        temperature_c: t,
+                        stage: FAILED_BASELINE,
+                        error,
+                    })
+                })
+                .ok()
         });
-        let t = c.at.temperature_c;
-        let drive_gain_ratio_true = c.at.drive_gain[1] / c.at.drive_gain[0];
-        let selfcal_error = ratio_error(c.cal.sf_selfcal_per_dps, sf_true);
-        let baseline_error = ratio_error(sf_factory, sf_fixed);
-        progress(&format!(
-            "{t} deg C: self-cal error {:+.4}% / {:+.4}%, baseline {:+.2}% / {:+.2}%",
-            100.0 * selfcal_error[0],
-            100.0 * selfcal_error[1],
-            100.0 * baseline_error[0],
-            100.0 * baseline_error[1],
-        ));
-        steps.push(FieldStep {
-            temperature_c: t,
-            truth: c.at,
-            sf_true_per_dps: sf_true,
-            sf_selfcal_per_dps: c.cal.sf_selfcal_per_dps,
-            sf_selfcal_uncertainty: c.cal.sf_selfcal_uncertainty.total,
-            sf_eq56_per_dps: c.cal.sf_eq56_per_dps,
-            sf_baseline_per_dps: sf_factory,
-            sf_true_at_factory_settings_per_dps: sf_fixed,
-            selfcal_error,
-            baseline_error,
-            drive_gain_ratio_true,
-            identified: IdentifiedJson::from(&c.cal),
-            clocks: c.clocks,
-            selfcal: c.cal,
-            profile: trace,
-        });
+        let step = field_step(c, baseline);
+        progress(&step_line(&step));
+        steps.push(step);
+    }
+    if factory.is_none() && !steps.is_empty() {
+        progress("no factory calibration (the first step failed): no step has a baseline");
     }
     let clocks = job_clocks + steps.iter().map(|s| s.clocks).sum::<u64>();
     Ok(FieldReport {
         knowns,
-        factory,
-        sf_factory_per_dps: sf_factory,
-        null_factory_z: null_factory,
+        sf_factory_per_dps: factory.as_ref().map(|f| f.sf_per_dps),
+        null_factory_z: factory.as_ref().and_then(|f| f.null_z),
+        factory: factory.map(|f| f.operating),
         profile: sc.profile.clone(),
         steps,
+        failed,
         clocks,
         wall_s: start.elapsed().as_secs_f64(),
     })
+}
+
+/// Step `i`'s measurements at the factory's settings: the rate table's
+/// slopes and (with a profile) the baseline's run; at the first step the
+/// factory's settings are the cycle's own (`run` None: the cycle's run).
+struct Baseline<'a> {
+    sf_fixed: [f64; 2],
+    run: Option<&'a ProfileRun>,
+    sf_factory: [f64; 2],
+    null_factory: Option<[f64; 2]>,
+}
+
+fn baseline_of<'a>(
+    i: usize,
+    c: &Cycle,
+    f: &Factory,
+    jobs: &[Job],
+    done: &'a [Result<(Done, u64), String>],
+    rates: &[f64],
+) -> Result<Baseline<'a>, String> {
+    if i == 0 {
+        return Ok(Baseline {
+            sf_fixed: c.sf_true,
+            run: None,
+            sf_factory: f.sf_per_dps,
+            null_factory: f.null_z,
+        });
+    }
+    let mut z = vec![[0.0; 2]; rates.len()];
+    let mut run = None;
+    for (job, d) in jobs.iter().zip(done).filter(|(j, _)| j.step() == i) {
+        match (job, &d.as_ref().map_err(Clone::clone)?.0) {
+            (Job::Factory { rate, .. }, Done::Point(v)) => z[*rate] = *v,
+            (Job::BaselineProfile { .. }, Done::Profile(r)) => run = Some(r),
+            _ => unreachable!("a job's result is of its kind"),
+        }
+    }
+    Ok(Baseline {
+        sf_fixed: table_slopes(rates, &z),
+        run,
+        sf_factory: f.sf_per_dps,
+        null_factory: f.null_z,
+    })
+}
+
+/// The report's entry of a finished cycle, with its baseline when the
+/// factory calibration and the step's measurements at its settings exist.
+fn field_step(c: Cycle, baseline: Option<Baseline>) -> FieldStep {
+    let sf_true = c.sf_true;
+    let trace = c.readout.as_ref().map(|(null, run)| {
+        let selfcal_rate = profile::calibrated(&run.z, *null, c.cal.sf_selfcal_per_dps);
+        let base = baseline.as_ref().map(|b| {
+            let base = b.run.unwrap_or(run);
+            let rate = profile::calibrated(&base.z, b.null_factory.unwrap_or(*null), b.sf_factory);
+            let rms = profile::rms_error(&rate, &base.true_rate_dps, &base.settled);
+            (rate, rms)
+        });
+        RateTrace {
+            selfcal_rms_error_dps: profile::rms_error(
+                &selfcal_rate,
+                &run.true_rate_dps,
+                &run.settled,
+            ),
+            baseline_rms_error_dps: base.as_ref().map(|b| b.1),
+            settled: run.settled.clone(),
+            time_s: run.time_s.clone(),
+            true_rate_dps: run.true_rate_dps.clone(),
+            selfcal_rate_dps: selfcal_rate,
+            baseline_rate_dps: base.map(|b| b.0),
+            null_selfcal_z: *null,
+        }
+    });
+    FieldStep {
+        temperature_c: c.at.temperature_c,
+        drive_gain_ratio_true: c.at.drive_gain[1] / c.at.drive_gain[0],
+        truth: c.at,
+        sf_true_per_dps: sf_true,
+        sf_selfcal_per_dps: c.cal.sf_selfcal_per_dps,
+        sf_selfcal_uncertainty: c.cal.sf_selfcal_uncertainty.total,
+        sf_eq56_per_dps: c.cal.sf_eq56_per_dps,
+        sf_baseline_per_dps: baseline.as_ref().map(|b| b.sf_factory),
+        sf_true_at_factory_settings_per_dps: baseline.as_ref().map(|b| b.sf_fixed),
+        selfcal_error: ratio_error(c.cal.sf_selfcal_per_dps, sf_true),
+        baseline_error: baseline
+            .as_ref()
+            .map(|b| ratio_error(b.sf_factory, b.sf_fixed)),
+        identified: IdentifiedJson::from(&c.cal),
+        clocks: c.clocks,
+        selfcal: c.cal,
+        profile: trace,
+    }
+}
+
+/// The progress line of a finished step.
+fn step_line(st: &FieldStep) -> String {
+    let e = st.selfcal_error;
+    let base = match st.baseline_error {
+        Some(b) => format!("baseline {:+.2}% / {:+.2}%", 100.0 * b[0], 100.0 * b[1]),
+        None => "no baseline".to_string(),
+    };
+    format!(
+        "{} deg C: self-cal error {:+.4}% / {:+.4}%, {base}",
+        st.temperature_c,
+        100.0 * e[0],
+        100.0 * e[1],
+    )
 }

@@ -1,0 +1,96 @@
+//! A datasheet that is off, as every real one is (issue 20 §2): the paper
+//! device of `tests/data/field_paper.toml` at its factory temperature,
+//! self-calibrated by a host whose `[datasheet]` differs from the device.
+//!
+//! - f1 1.5% low: beyond the narrow-band search's reach, so the host scans
+//!   +-5% and zooms in (`identify` module header); the cycle must finish.
+//! - Q half the truth: every wait before identification is half as long
+//!   as the device needs (after it, the identified Q sets them).
+//! - lambda 1% high, with the datasheet's 1% uncertainty on it: the
+//!   self-calibrated scale factor moves by about that much, and its
+//!   reported sigma must say so.
+//!
+//! Each must finish (no step in `failed`), identify f1 within 3 of its
+//! sigmas of the truth and put the self-calibrated scale factor within 3
+//! reported sigma of the rate table's on both outputs (the promise of a
+//! sigma), and within the project's 0.1% where the datasheet's lambda is
+//! right. Cost: three single-step scenarios, in parallel (about 2 minutes
+//! of CPU, most of it the scans of the first).
+
+use gyrocal_sim::field::scenario::{self, FieldReport};
+
+/// The paper scenario at 25 deg C alone, without its profile, with `datasheet`.
+fn scenario_with(datasheet: &str) -> scenario::Scenario {
+    let path = "tests/data/field_paper.toml";
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut sc = scenario::parse(path, &format!("{text}\n[datasheet]\n{datasheet}\n")).unwrap();
+    sc.drift.temperatures_c = vec![25.0];
+    sc.profile = None;
+    sc
+}
+
+fn check(name: &str, report: &FieldReport, lambda_right: bool) {
+    assert!(report.failed.is_empty(), "{name}: {:?}", report.failed);
+    let st = &report.steps[0];
+    let id = &st.identified;
+    let f1 = st.truth.gyro.f1_hz;
+    eprintln!(
+        "{name}: f1 {:.3} +- {:.3} Hz (truth {f1}), self-cal error {:+.4}% / {:+.4}%, sigma {:.4}% / {:.4}%",
+        id.f1_hz,
+        id.f1_hz_uncertainty,
+        100.0 * st.selfcal_error[0],
+        100.0 * st.selfcal_error[1],
+        100.0 * st.sf_selfcal_uncertainty[0],
+        100.0 * st.sf_selfcal_uncertainty[1],
+    );
+    assert!(
+        (id.f1_hz - f1).abs() <= 3.0 * id.f1_hz_uncertainty,
+        "{name}: f1 {} +- {} against {f1}",
+        id.f1_hz,
+        id.f1_hz_uncertainty
+    );
+    for k in 0..2 {
+        let (e, s) = (st.selfcal_error[k], st.sf_selfcal_uncertainty[k]);
+        assert!(
+            e.abs() <= 3.0 * s,
+            "{name}: output {}: {e} at sigma {s}",
+            k + 1
+        );
+        if lambda_right {
+            assert!(e.abs() < 1e-3, "{name}: output {}: {e}", k + 1);
+        }
+    }
+}
+
+#[test]
+fn a_datasheet_off_by_the_process_spread_is_found_and_its_lambda_budgeted() {
+    let cases = [
+        ("f1 1.5% low", "f1_hz = 9.4954e6", true),
+        ("Q half the truth", "q1 = 27500\nq2 = 27500", true),
+        (
+            "lambda 1% high, 1% uncertain",
+            "angular_gain = 0.606\nangular_gain_uncertainty = 0.01",
+            false,
+        ),
+    ];
+    let reports: Vec<FieldReport> = std::thread::scope(|s| {
+        let runs: Vec<_> = cases
+            .iter()
+            .map(|(_, datasheet, _)| {
+                s.spawn(|| scenario::run(&scenario_with(datasheet), &|_| {}).unwrap())
+            })
+            .collect();
+        runs.into_iter().map(|r| r.join().unwrap()).collect()
+    });
+    for ((name, _, lambda_right), report) in cases.iter().zip(&reports) {
+        check(name, report, *lambda_right);
+    }
+    // lambda's term is in the budget: 1% of lambda is at least 1% of the
+    // ratio (`selfcal::budget`), so the sigma is at least half that.
+    let st = &reports[2].steps[0];
+    assert!(
+        st.sf_selfcal_uncertainty.iter().all(|&s| s > 0.005),
+        "{:?}",
+        st.sf_selfcal_uncertainty
+    );
+}
