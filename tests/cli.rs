@@ -39,6 +39,30 @@ fn run_json_holds_the_scale_factors_and_the_theory() {
     assert!(v["sf_cal_per_dps"][0].as_f64().unwrap() > 0.0);
     let error = v["ratio_error"][0].as_f64().unwrap();
     assert!(error.abs() < 1e-3, "ratio error {error}");
+    assert_budget_adds_up(&v);
+}
+
+/// The budget by source of each figure adds up, root sum of squares, to
+/// the total 1-sigma reported under the figure's own key.
+fn assert_budget_adds_up(v: &serde_json::Value) {
+    for (figure, key) in [
+        ("sf_read_per_dps", "sf_read_uncertainty"),
+        ("sf_cal_per_dps", "sf_cal_uncertainty"),
+        ("ratio", "ratio_uncertainty"),
+    ] {
+        for k in 0..2 {
+            let terms = &v["uncertainty_budget"][figure][k];
+            let term = |name: &str| terms[name].as_f64().unwrap_or_else(|| panic!("{name}"));
+            let rss = ["statistical", "settling", "images"]
+                .map(|t| term(t).powi(2))
+                .iter()
+                .sum::<f64>()
+                .sqrt();
+            let total = v[key][k].as_f64().unwrap();
+            assert_eq!(term("total"), total, "{figure} {k}");
+            assert!((rss / total - 1.0).abs() < 1e-12, "{figure} {k}");
+        }
+    }
 }
 
 /// Write `text` to a config file in `dir`, run it with `--out`, and check

@@ -9,7 +9,8 @@
 //! whole-period window average, below 1e-6 (`average.rs`).
 
 use gyrocal_sim::engine::EngineKind;
-use gyrocal_sim::experiment::{self, Experiment};
+use gyrocal_sim::experiment::{self, BATCHES, Experiment};
+use gyrocal_sim::fit::coverage_factor;
 use gyrocal_sim::gyro::GyroParams;
 use gyrocal_sim::report::Report;
 
@@ -196,10 +197,15 @@ fn the_papers_device_at_full_scale() {
     // probability 0.999. This run's dither is fixed (seed 1): the assertion
     // is a regression guard; a bias of a few 1e-5 introduced later (a
     // latency the theory does not know, a rounding) would push it out.
-    // The honesty of sigma is tests/uncertainty_is_honest.rs.
-    let (error, sigma) = (r.ratio_error[1], r.ratio_uncertainty[1] / r.ratio[1].abs());
-    eprintln!("paper's device: detuned ratio error {error:+.2e}, 1 sigma {sigma:.2e}");
-    assert!(sigma < 5e-5, "1 sigma {sigma:.2e}");
+    // The honesty of sigma is tests/uncertainty_is_honest.rs. The guard is
+    // on the bare batch spread: the reported sigma is that spread times the
+    // coverage factor of its 7 degrees of freedom (1.51) plus systematic
+    // terms (`gyrocal_sim::budget`), 4.85e-5 x 1.51 on this run.
+    let error = r.ratio_error[1];
+    let spread =
+        r.uncertainty_budget.ratio[1].statistical / coverage_factor(BATCHES - 1) / r.ratio[1].abs();
+    eprintln!("paper's device: detuned ratio error {error:+.2e}, batch spread {spread:.2e}");
+    assert!(spread < 5e-5, "batch spread {spread:.2e}");
     assert!(error.abs() < 1e-4, "detuned ratio error {error:+.2e}");
 }
 

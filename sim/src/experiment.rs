@@ -6,18 +6,17 @@
 //! A point runs for a settling time, then z1, z2 are averaged over a window
 //! made of equal batches (`crate::average`). Both are derived, never guessed:
 //!
-//! - Settling. From rest the resonator's transient decays as exp(-t / tau)
-//!   with tau = 2 Q_k / w_k (the slowest mode; with a damping coupling,
-//!   `GyroParams::slowest_time_constant_s`). It starts as large as the
-//!   largest low-frequency term of z at that output, Z (the readout offset
-//!   of a detuned mode, or the calibration ripple), and must fall below
-//!   `tolerance / SETTLE_MARGIN` times the signal the fit measures at that
-//!   output, S = |SF| x (span of the rates). So t_res = tau ln(Z / (tolerance S / SETTLE_MARGIN)),
-//!   both from the exact theory; on the paper's device the detuned readout
-//!   output has Z / S near 8e3 and t_res near 18 tau = 33 ms. The filters
-//!   then need ln(Z / (tolerance S)) / sigma more, sigma the slowest decay
-//!   rate of the Butterworth poles (w_c / sqrt 2) and the RC pole, plus the
-//!   CIC's 4 R clocks.
+//! - Settling (`crate::settling`). From rest the resonator's transient
+//!   decays as exp(-t / tau) with tau = 2 Q_k / w_k (the slowest mode;
+//!   with a damping coupling, `GyroParams::slowest_time_constant_s`), from
+//!   Z, x_k's amplitude times its reference's. It must fall below
+//!   `settling::SETTLE_MARGIN`-th of `tolerance` of the signal the fit
+//!   measures at that output, S = |SF| x (span of the rates), and below a
+//!   share of a point's expected noise, both from the exact theory; the
+//!   filters lag it and add their own transient. On the paper's device
+//!   the detuned readout output waits about 24 tau = 43 ms. The plan keeps
+//!   each point's bound on what is left (`PointPlan::residue`), and the
+//!   budget its bias on the window's mean.
 //! - Window and batches, readout. The window is cut into `BATCHES` equal
 //!   batches, each a whole number of units: the first window
 //!   (`Derived::min_window_s`) over `BATCHES`.
@@ -27,6 +26,9 @@
 //!   value in the mean; M is the same at every point of the staircase, at
 //!   least `MIN_RIPPLE_PERIODS` and enough for the first window at the
 //!   slowest point. Each period is cut into I = `RIPPLE_BATCHES` batches.
+//!   The ripple's first harmonics are fitted to the window's samples and
+//!   subtracted before the batches are cut (`crate::ripple`): a few dozen
+//!   z samples per period leave an interpolation error in every batch.
 //!   Beside the sinusoid, the ripple has a deterministic shape that
 //!   repeats every period: on the paper's device at 10 Hz, with the 2 Om and
 //!   4 Om sinusoids fitted out, 10 ms batch means still repeat each period
@@ -42,15 +44,19 @@
 //!   2 to 3 periods then measures what took 8 (on the paper's device
 //!   0.1 to 0.15 s instead of 0.27 to 0.4 s per point).
 //! - Uncertainty. A point's value is the mean of its batch means. A slope's
-//!   1-sigma uncertainty is the spread of the slopes fitted batch by batch
-//!   (`crate::fit::fit_batches`): estimated from the data, never from the
-//!   theory. The number of batches is fixed and their length grows with
-//!   the window (batch means with a fixed number of batches): for a white
-//!   residue this is the usual estimate (t distribution, BATCHES - 1
-//!   degrees of freedom); for the deterministic residue of a clean
-//!   converter (spectral lines from its quantization) it errs high by about
-//!   sqrt(BATCHES / 2) and still falls as fast as the error, 1 / window.
-//!   Points of a sweep share their settling time, so their batches line up.
+//!   statistical uncertainty is the spread of the slopes fitted batch by
+//!   batch (`crate::fit::fit_batches`): estimated from the data, never from
+//!   the theory, times the coverage factor of its degrees of freedom
+//!   (`fit::coverage_factor`). The number of batches is fixed and their
+//!   length grows with the window (batch means with a fixed number of
+//!   batches): for a white residue this is the usual estimate (t
+//!   distribution, BATCHES - 1 degrees of freedom); for the deterministic
+//!   residue of a clean converter (spectral lines from its quantization)
+//!   it errs high by about sqrt(BATCHES / 2) and still falls as fast as
+//!   the error, 1 / window. Points of a sweep share their settling time,
+//!   so their batches line up. The report adds the systematic terms
+//!   (`crate::budget`): the settling bound and the DAC's images
+//!   (`crate::images`).
 //! - Growth. Rounds: all points run; if a sweep's slope uncertainty is above
 //!   its share of the ratio's target, tolerance x max(|ratio|,
 //!   `RATIO_FLOOR`), that sweep runs again from power-up with longer
@@ -74,9 +80,14 @@ use crate::config::Derived;
 pub use crate::config::Experiment;
 use crate::cosim::CoSim;
 use crate::engine::{Engine, EngineKind, ModelEngine, RtlEngine};
-use crate::fit::{Line, ScaleFactors, fit_batches, linear_fit, mean_and_standard_error};
+use crate::fit::{
+    Line, ScaleFactors, coverage_factor, fit_batches, linear_fit, mean_and_standard_error,
+};
 use crate::frontend::{Converters, FrontEnd};
 use crate::gyro::GyroModel;
+use crate::images::sampled_peak;
+use crate::ripple;
+use crate::settling::{self, Sweep};
 use crate::theory::{self, Device};
 use gyrocal_hdl::cic_decimator::OUTPUT_FRACTION_BITS;
 use gyrocal_hdl::filter_design::FilterDesign;
@@ -90,13 +101,6 @@ use serde::Serialize;
 use std::f64::consts::{PI, TAU};
 use std::time::Instant;
 
-/// The transient left at the start of a window is `tolerance / SETTLE_MARGIN`
-/// of the signal: it decays with tau and biases the window's mean by that
-/// times tau / window, which must stay well below the uncertainty the
-/// plan aims at (`tolerance` of the ratio); with a margin of 1 it was 5e-6
-/// of the calibration scale factor of a Q 1e4 device (tau 6 ms, 0.13 s
-/// windows), 40 of its sigmas.
-const SETTLE_MARGIN: f64 = 10.0;
 /// Batches per window; the uncertainty of a mean of n batch means is
 /// estimated with n - 1 degrees of freedom.
 pub const BATCHES: u32 = 8;
@@ -146,6 +150,9 @@ pub struct PointPlan {
     pub unit_cycles: f64,
     /// Units per batch of the first window.
     pub units: u32,
+    /// Bound on the transient left at the window's start, per output (z
+    /// in m^2/s^2, `crate::settling`).
+    pub residue: [f64; 2],
 }
 
 impl PointPlan {
@@ -205,6 +212,8 @@ pub struct Plan {
     pub hold_gain: f64,
     /// Slowest resonator amplitude time constant (s).
     pub tau_s: f64,
+    /// What settling depends on (`crate::settling`).
+    pub settling: settling::Timing,
     /// The rate signal each output's fit sees, in ADC LSB of in-phase
     /// amplitude over the whole span of rates, [readout, calibration]
     /// (below 1 without dither: the converters' quantization decides).
@@ -284,7 +293,7 @@ impl Plan {
 
 /// Fundamental gain of the DAC's zero-order hold at `f_hz`, sin(x) / x with
 /// x = pi f / f_clk.
-fn hold_gain(f_hz: f64, clock_hz: f64) -> f64 {
+pub(crate) fn hold_gain(f_hz: f64, clock_hz: f64) -> f64 {
     let x = PI * f_hz / clock_hz;
     x.sin() / x
 }
@@ -311,35 +320,43 @@ fn table_gain(sine: impl Fn(u32) -> i16) -> f64 {
     2.0 * sum / PHASES as f64 / f64::from(PEAK)
 }
 
-/// Fundamental gain of the carriers' 8192-word table (1 - 1.3e-7).
-fn carrier_table_gain() -> f64 {
+/// The carriers' 8192-word table at a 32-bit phase (drive cos and sin
+/// share its gain: a quarter turn is a whole number of its intervals).
+fn carrier_sine(phase: u32) -> i16 {
     let table = gyrocal_hdl::model::carrier_nco::table();
-    table_gain(|phase| gyrocal_hdl::model::carrier_nco::table_sine(table, phase, 0))
-}
-
-/// Fundamental gain of the modulation NCO's 4096-word table (1 - 1.2e-7).
-fn modulation_table_gain() -> f64 {
-    table_gain(|phase| gyrocal_hdl::model::sine::sine(phase, 0))
+    gyrocal_hdl::model::carrier_nco::table_sine(table, phase, 0)
 }
 
 /// Fundamental amplitude (LSB) of the drive and reference words per
-/// channel, as the AM mixer realizes them: the envelope amp x am / 2^15
-/// rounded (`q15_product`), times the carrier table (PEAK x its gain)
-/// / 2^15. In readout am is the constant PEAK, so the envelope is one
-/// rounded integer (29490 for amplitude 0.9, where amp x PEAK / 2^15 is
-/// 29490.1: 3.4e-6 less, and z carries it twice); in calibration am is the
-/// modulation table's cosine or sine, so the rounding is noise around the
-/// exact product, and the envelope's amplitude carries that table's gain.
+/// channel, as the AM mixer realizes them, rounding included: each word is
+/// a Q15 product rounded half up (`q15_product`), and the rounding error
+/// is a deterministic function of the table values that correlates with
+/// the sine (neglecting it left 2.3e-7 of the amplitude in readout and
+/// 5.3e-7 in calibration at amplitude 0.9; z carries the amplitude twice,
+/// so 1.1e-6 of the calibration scale factor, 4 to 6 of its sigmas on
+/// resonant outputs).
+/// - Readout: the envelope is one integer E = q15(amp, PEAK) (29490 for
+///   amplitude 0.9), and the word q15(E, carrier), whose fundamental is
+///   averaged over the carrier's phases (`table_gain`).
+/// - Calibration: the envelope q15(amp, am) follows the modulation table;
+///   its fundamental is averaged over the modulation phases, and the
+///   carrier product's rounding, a different integer envelope at every
+///   step, averages out (below 1e-8 over the thousands of envelope values
+///   of a period), so the carrier enters with its table's gain.
 fn realized_words(amp: (i16, i16), mode: Mode) -> [f64; 2] {
     let peak = f64::from(PEAK);
-    let carrier = peak * carrier_table_gain() / 32768.0;
-    let modulation = modulation_table_gain();
     [amp.0, amp.1].map(|a| {
-        let envelope = match mode {
-            Mode::Readout => f64::from(q15_product(a, PEAK as i16)),
-            Mode::Calibration => f64::from(a) * peak * modulation / 32768.0,
+        let words = match mode {
+            Mode::Readout => {
+                let envelope = q15_product(a, PEAK as i16);
+                peak * table_gain(|p| q15_product(envelope, carrier_sine(p)))
+            }
+            Mode::Calibration => {
+                let modulation = |p| q15_product(a, gyrocal_hdl::model::sine::sine(p, 0));
+                peak * table_gain(modulation) * peak * table_gain(carrier_sine) / 32768.0
+            }
         };
-        (envelope * carrier).abs()
+        words.abs()
     })
 }
 
@@ -386,6 +403,8 @@ pub fn plan(exp: &Experiment) -> Result<Plan, String> {
     }
 
     // Theory for gains and timing (the hold scales every force alike).
+    let tau_s = exp.gyro.slowest_time_constant_s();
+    let step = f64::from(1u32 << (16 - fe.adc_bits));
     let mut plan = Plan {
         points: vec![],
         derived: derived.clone(),
@@ -404,7 +423,16 @@ pub fn plan(exp: &Experiment) -> Result<Plan, String> {
         drive_words,
         cal_drive_words,
         hold_gain,
-        tau_s: 0.0,
+        tau_s,
+        settling: settling::Timing {
+            tau_s,
+            butterworth_hz: derived.butterworth_hz,
+            rc_hz: derived.rc_hz,
+            decimation: derived.decimation,
+            clock_hz: clock,
+            adc_variance: fe.noise_lsb * fe.noise_lsb + step * step / 12.0,
+            drive_start: DRIVE_START_CLOCKS as u64,
+        },
         signal_lsb: [[0.0; 2]; 2],
         warnings,
     };
@@ -424,14 +452,19 @@ pub fn plan(exp: &Experiment) -> Result<Plan, String> {
         })
         .collect::<Result<_, _>>()
         .map_err(|e| e.to_string())?;
-    // ADC gains: the largest displacement of any point at `adc_headroom`.
+    // ADC gains: the largest sampled displacement of any point (the DAC's
+    // images included, `crate::images`) at `adc_headroom`.
     let mut peak_x = [0.0f64; 2];
     for &r in rates {
-        let x = theory::readout_peak_displacement(&dev, r * rad);
+        let x = sampled_peak(&dev, clock, |d| {
+            theory::readout_peak_displacement(d, r * rad)
+        });
         peak_x = [peak_x[0].max(x[0]), peak_x[1].max(x[1])];
     }
     for (_, f) in &cal_plans {
-        let x = theory::calibration_peak_displacement(&dev, *f);
+        let x = sampled_peak(&dev, clock, |d| {
+            theory::calibration_peak_displacement(d, *f)
+        });
         peak_x = [peak_x[0].max(x[0]), peak_x[1].max(x[1])];
     }
     plan.front_end.adc_per_meter = match exp.adc_per_meter() {
@@ -443,24 +476,12 @@ pub fn plan(exp: &Experiment) -> Result<Plan, String> {
     };
     Converters::new(&plan.front_end)?;
 
-    // Settling: see the module header.
-    plan.tau_s = exp.gyro.slowest_time_constant_s();
-    let sigma = (TAU * derived.butterworth_hz / 2f64.sqrt()).min(TAU * derived.rc_hz);
+    // Settling: see the module header and `crate::settling`.
     let sf_read = theory::sf_read_per_rad_s(&dev).map(|v| v * rad);
     let sf_cal = theory::sf_cal_per_rad_s(&dev).map(|v| v * rad);
     let virtual_rates: Vec<f64> = cal_plans.iter().map(|c| 360.0 * c.1).collect();
     let read_signal = sf_read.map(|s| s.abs() * span(rates));
     let cal_signal = sf_cal.map(|s| s.abs() * span(&virtual_rates));
-    let decimation = derived.decimation;
-    let settle = |big: [f64; 2], signal: [f64; 2]| -> u64 {
-        let ratio = (0..2)
-            .map(|k| big[k] / (exp.points.tolerance * signal[k] / SETTLE_MARGIN))
-            .fold(1.0f64, f64::max);
-        let t = plan.tau_s * ratio.ln() + ratio.ln() / sigma + 5.0 * decimation as f64 / clock;
-        // Every point starts at power-up, and the drives start only once
-        // the core has filled its carrier tables.
-        (t * clock).ceil() as u64 + DRIVE_START_CLOCKS as u64
-    };
 
     // Rate signal in ADC LSB of in-phase amplitude: mean(adc x ref) = A W / 2.
     let forces = [dev.f1_force, dev.f2_force];
@@ -470,23 +491,49 @@ pub fn plan(exp: &Experiment) -> Result<Plan, String> {
         std::array::from_fn(|k| 2.0 * cal_signal[k] * adc[k] / forces[1 - k]),
     ];
     let window_cycles = derived.min_window_s * clock;
-    // One settling time per sweep, so the points' batches line up.
-    let read_settle = rates
-        .iter()
-        .map(|&r| settle(theory::readout_z(&dev, r * rad).map(f64::abs), read_signal))
-        .max()
-        .unwrap_or(0);
-    let cal_settle = cal_plans
-        .iter()
-        .map(|&(_, f)| {
-            // Every low-frequency term of x_k times its reference is at most
-            // the product of their peaks.
-            let x = theory::calibration_peak_displacement(&dev, f);
-            settle([x[0] * dev.f2_force, x[1] * dev.f1_force], cal_signal)
-        })
-        .max()
-        .unwrap_or(0);
-    for &r in rates {
+    // Whole ripple periods, the same number at every point of the
+    // staircase (their batches pair up in the slope fit): enough for the
+    // first window at the slowest point, and at least `MIN_RIPPLE_PERIODS`.
+    let slowest = cal_plans.iter().map(|c| c.1).fold(f64::INFINITY, f64::min);
+    let fastest = cal_plans.iter().map(|c| c.1).fold(0.0, f64::max);
+    let periods = ((window_cycles * 2.0 * slowest / clock).ceil() as u32).max(MIN_RIPPLE_PERIODS);
+    // One settling time per sweep, so the points' batches line up. The
+    // transient's scale is the peak product: x_k's amplitude times its
+    // reference's (output k mixes with drive k in readout, the other in
+    // calibration).
+    let (read_settle, read_residues) = settling::settle(
+        &Sweep {
+            transient: rates
+                .iter()
+                .map(|&r| {
+                    let x = theory::readout_peak_displacement(&dev, r * rad);
+                    [x[0] * forces[0], x[1] * forces[1]]
+                })
+                .collect(),
+            signal: read_signal,
+            signal_lsb: plan.signal_lsb[0],
+            window_cycles,
+        },
+        &plan.settling,
+        exp.points.tolerance,
+    );
+    let (cal_settle, cal_residues) = settling::settle(
+        &Sweep {
+            transient: cal_plans
+                .iter()
+                .map(|&(_, f)| {
+                    let x = theory::calibration_peak_displacement(&dev, f);
+                    [x[0] * forces[1], x[1] * forces[0]]
+                })
+                .collect(),
+            signal: cal_signal,
+            signal_lsb: plan.signal_lsb[1],
+            window_cycles: f64::from(periods) * clock / (2.0 * fastest),
+        },
+        &plan.settling,
+        exp.points.tolerance,
+    );
+    for (&r, residue) in rates.iter().zip(read_residues) {
         plan.points.push(PointPlan {
             mode: Mode::Readout,
             rate_dps: r,
@@ -496,14 +543,10 @@ pub fn plan(exp: &Experiment) -> Result<Plan, String> {
             settle_cycles: read_settle,
             unit_cycles: window_cycles / f64::from(BATCHES),
             units: 1,
+            residue,
         });
     }
-    // Whole ripple periods, the same number at every point of the
-    // staircase (their batches pair up in the slope fit): enough for the
-    // first window at the slowest point, and at least `MIN_RIPPLE_PERIODS`.
-    let slowest = cal_plans.iter().map(|c| c.1).fold(f64::INFINITY, f64::min);
-    let periods = ((window_cycles * 2.0 * slowest / clock).ceil() as u32).max(MIN_RIPPLE_PERIODS);
-    for (regs, f) in cal_plans {
+    for ((regs, f), residue) in cal_plans.into_iter().zip(cal_residues) {
         plan.points.push(PointPlan {
             mode: Mode::Calibration,
             rate_dps: 360.0 * f,
@@ -513,6 +556,7 @@ pub fn plan(exp: &Experiment) -> Result<Plan, String> {
             settle_cycles: cal_settle,
             unit_cycles: clock / (2.0 * f),
             units: periods,
+            residue,
         });
     }
     Ok(plan)
@@ -549,6 +593,16 @@ pub struct PointResult {
     pub z_uncertainty: [f64; 2],
     /// Exact theory at this point (m^2/s^2).
     pub z_theory: [f64; 2],
+    /// What the DAC's images add to `z_theory` in the sampled loop
+    /// (m^2/s^2, `crate::images`).
+    pub z_images: [f64; 2],
+    /// Bound on the bias the settling transient leaves on `z` (m^2/s^2,
+    /// `crate::settling`).
+    pub settling_bound: [f64; 2],
+    /// Degrees of freedom of the batches' spread: `BATCHES` - 1 in
+    /// readout, `RIPPLE_BATCHES` (periods - 1) in calibration.
+    #[serde(skip)]
+    pub dof: u32,
     /// The batch means of z1, z2 (m^2/s^2).
     #[serde(skip)]
     pub batch_z: Vec<[f64; 2]>,
@@ -730,6 +784,13 @@ pub fn run_point<E: Engine>(
     };
     advance(&mut sim, &mut samples, end, progress);
     let batch = point.batch_cycles(units);
+    if point.mode == Mode::Calibration {
+        let t0 = point.settle_cycles as f64;
+        let t1 = t0 + point.window_cycles(units);
+        for z in &mut samples.z {
+            ripple::remove(&samples.t, z, point.unit_cycles, t0, t1);
+        }
+    }
     let raw = samples.batch_means(point.settle_cycles as f64, batch, point.batch_count(units));
     let batch_lsb = match point.mode {
         Mode::Readout => raw,
@@ -738,12 +799,13 @@ pub fn run_point<E: Engine>(
     let (mean, sigma) = mean_and_uncertainty(&batch_lsb);
     let per_lsb = plan.z_per_lsb(point.mode);
     let clock = exp.drive.clock_hz;
+    let window_s = point.window_cycles(units) / clock;
     Ok(PointResult {
         mode: point.mode,
         rate_dps: point.rate_dps,
         cal_hz: point.cal_hz,
         settle_s: point.settle_cycles as f64 / clock,
-        window_s: point.window_cycles(units) / clock,
+        window_s,
         batch_s: batch / clock,
         cycles: end,
         z_lsb: mean,
@@ -751,6 +813,12 @@ pub fn run_point<E: Engine>(
         z: [mean[0] * per_lsb[0], mean[1] * per_lsb[1]],
         z_uncertainty: [sigma[0] * per_lsb[0], sigma[1] * per_lsb[1]],
         z_theory: plan.theory_z(exp, point),
+        z_images: plan.image_z(exp, point),
+        settling_bound: settling::bias_bound(point.residue, &plan.settling, window_s),
+        dof: match point.mode {
+            Mode::Readout => BATCHES - 1,
+            Mode::Calibration => RIPPLE_BATCHES * (units - 1),
+        },
         batch_z: batch_lsb
             .iter()
             .map(|b| [b[0] * per_lsb[0], b[1] * per_lsb[1]])
@@ -764,16 +832,23 @@ pub fn run_point<E: Engine>(
 }
 
 /// Lines of each output against the rate over one sweep, from the points'
-/// batch means (with uncertainties).
+/// batch means, with their statistical uncertainties: the batch slopes'
+/// spread times the `coverage_factor` of its degrees of freedom
+/// (`crate::budget`).
 pub fn measured_lines(points: &[PointResult], mode: Mode) -> [Line; 2] {
     let sweep: Vec<&PointResult> = points.iter().filter(|p| p.mode == mode).collect();
     let x: Vec<f64> = sweep.iter().map(|p| p.rate_dps).collect();
+    let dof = sweep.iter().map(|p| p.dof).min().unwrap_or(1);
     std::array::from_fn(|k| {
         let batches: Vec<Vec<f64>> = sweep
             .iter()
             .map(|p| p.batch_z.iter().map(|b| b[k]).collect())
             .collect();
-        fit_batches(&x, &batches)
+        let line = fit_batches(&x, &batches);
+        Line {
+            slope_uncertainty: line.slope_uncertainty * coverage_factor(dof),
+            ..line
+        }
     })
 }
 

@@ -11,6 +11,7 @@ pub mod allan;
 /// Exact window means (`gyrocal_host::average`).
 pub use gyrocal_host::average;
 pub mod bench;
+pub mod budget;
 pub mod config;
 pub mod cosim;
 pub mod datasheet;
@@ -22,12 +23,15 @@ pub mod field;
 pub mod fit;
 pub mod frontend;
 pub mod gyro;
+pub mod images;
 pub mod noise;
 pub mod noise_terms;
 pub mod rate_drift;
 pub mod rate_noise;
 pub mod report;
+pub mod ripple;
 pub mod serve;
+pub mod settling;
 /// The exact theory (`gyrocal_host::theory`), shared with the host's prediction.
 pub use gyrocal_host::theory;
 #[cfg(feature = "verilator")]

@@ -2,6 +2,7 @@
 //! theory at the same points, the paper's closed forms, and the readout
 //! scale factor predicted from calibration, in one serializable value.
 
+use crate::budget::{Budget, ImageShifts, budget};
 use crate::config::{Derived, Experiment};
 use crate::engine::EngineKind;
 use crate::experiment::{
@@ -79,6 +80,10 @@ pub struct Theory {
     pub sf_cal_per_dps: [f64; 2],
     /// Ratio of the two.
     pub ratio: [f64; 2],
+    /// What the DAC's images, aliased back by the ADC, add to the fitted
+    /// values in the sampled loop (signed; `crate::images`): the theory
+    /// leaves them out, and the budget counts them.
+    pub images: ImageShifts,
     /// Small-signal values and the paper's closed forms.
     pub small_signal: SmallSignal,
 }
@@ -88,7 +93,8 @@ pub struct Theory {
 pub struct Report {
     /// Simulated readout scale factor [output 1, output 2], (m^2/s^2) per deg/s.
     pub sf_read_per_dps: [f64; 2],
-    /// Its 1-sigma uncertainty, from the points' batch means.
+    /// Its 1-sigma uncertainty against the exact theory, all sources
+    /// (`uncertainty_budget`).
     pub sf_read_uncertainty: [f64; 2],
     /// Simulated calibration scale factor, per deg/s of virtual rate 360 f_cal.
     pub sf_cal_per_dps: [f64; 2],
@@ -100,6 +106,9 @@ pub struct Report {
     pub ratio_uncertainty: [f64; 2],
     /// The ratio's target uncertainty, tolerance x max(|ratio|, 0.5).
     pub ratio_target_uncertainty: [f64; 2],
+    /// The 1-sigma terms of each figure by source, whose root sum of
+    /// squares is its `_uncertainty` (`crate::budget`).
+    pub uncertainty_budget: Budget,
     /// The readout scale factor in the gateware's own units, what a board
     /// measures: z LSB (one unit of the 40-bit z word, 1/256 of a mixer
     /// LSB) per deg/s. It carries the DAC and ADC gains that the equations'
@@ -153,7 +162,14 @@ impl Report {
     /// Assemble the report of a finished run.
     pub fn new(exp: &Experiment, plan: &Plan, measured: Measured) -> Self {
         let points = measured.points;
-        let sim: ScaleFactors = measured_scale_factors(&points);
+        let statistical: ScaleFactors = measured_scale_factors(&points);
+        let (uncertainty_budget, images) = budget(&points, &statistical);
+        let sim = ScaleFactors {
+            sf_read_uncertainty: uncertainty_budget.sf_read_per_dps.map(|t| t.total),
+            sf_cal_uncertainty: uncertainty_budget.sf_cal_per_dps.map(|t| t.total),
+            ratio_uncertainty: uncertainty_budget.ratio.map(|t| t.total),
+            ..statistical
+        };
         // Equations' units per z LSB, per output: a constant of each mode.
         let read_per_lsb = plan.z_per_lsb(Mode::Readout);
         let cal_per_lsb = plan.z_per_lsb(Mode::Calibration);
@@ -188,8 +204,13 @@ impl Report {
             exp,
             plan,
             measured.budget_exhausted,
-            &sim,
+            &statistical,
             target,
+        ));
+        warnings.extend(crate::budget::warnings(
+            &uncertainty_budget,
+            target,
+            plan.carrier_hz / exp.drive.clock_hz,
         ));
         let theory_device = plan.theory_device(exp);
         Report {
@@ -209,6 +230,7 @@ impl Report {
             ratio: sim.ratio,
             ratio_uncertainty: sim.ratio_uncertainty,
             ratio_target_uncertainty: target,
+            uncertainty_budget,
             sf_read_lsb_per_dps: in_lsb(sim.sf_read_per_dps, read_per_lsb),
             sf_read_lsb_uncertainty: in_lsb(sim.sf_read_uncertainty, read_per_lsb),
             sf_cal_lsb_per_dps: in_lsb(sim.sf_cal_per_dps, cal_per_lsb),
@@ -217,6 +239,7 @@ impl Report {
                 sf_read_per_dps: exact.sf_read_per_dps,
                 sf_cal_per_dps: exact.sf_cal_per_dps,
                 ratio: exact.ratio,
+                images,
                 small_signal: SmallSignal {
                     sf_read_per_dps: sf_read,
                     sf_cal_per_dps: sf_cal,
@@ -257,7 +280,8 @@ impl Report {
 
 /// One line per output whose ratio missed its target because the budget
 /// ran out, or whose rate signal is below the ADC's resolution: which
-/// output, the uncertainty reached, and what would lower it.
+/// output, the statistical uncertainty reached (`sim`'s, what longer
+/// windows lower), and what would lower it.
 fn accuracy_warnings(
     exp: &Experiment,
     plan: &Plan,
