@@ -16,7 +16,7 @@
 //!
 //! The converters are dithered by default (1 LSB RMS): without dither, an
 //! ideal quantizer leaves a static, rate-dependent bias that no uncertainty
-//! estimated from the data can see (README, "How far to trust a figure").
+//! estimated from the data can see (docs/your-device.md, "How far to trust a figure").
 
 use gyrocal_sim::config;
 use gyrocal_sim::engine::EngineKind;

@@ -12,7 +12,7 @@
 //! the run away on the output it moves most, so a model or a theory that
 //! dropped the coupling would fail. Each test prints the ratio shift the
 //! coupling causes, fitted over its points and small-signal (the figures
-//! README quotes).
+//! docs/your-device.md points to).
 
 use gyrocal_sim::config;
 use gyrocal_sim::engine::EngineKind;

@@ -1,4 +1,4 @@
-//! The corners of the supported ranges (README "Supported ranges") plan
+//! The corners of the supported ranges (docs/your-device.md, "Supported ranges") plan
 //! with the required keys alone: no error, and every derived value inside
 //! the limits of the block it sets.
 //!

@@ -653,7 +653,7 @@ impl Experiment {
     }
 
     /// The filter and first window, derived from the device where the user
-    /// left them unset (see README "Derived settings"):
+    /// left them unset (see docs/your-device.md, "Derived settings"):
     ///
     /// - Butterworth cut-off `CUTOFF_STEP` x the signal band, RC cut-off
     ///   `CUTOFF_STEP` x that;

@@ -355,7 +355,11 @@ pub fn summary(report: &Report) -> String {
     s.push_str(&plain("  exact small-signal", t.small_signal.ratio));
     s.push_str(&plain("  paper eqs. (5)/(6)", t.small_signal.eq56_ratio));
     let sigmas: [f64; 2] =
-        std::array::from_fn(|k| (report.ratio[k] - t.ratio[k]) / report.ratio_uncertainty[k]);
+        // The relative error over the relative sigma: the sign of the
+        // error column beside it.
+        std::array::from_fn(|k| {
+            report.ratio_error[k] / (report.ratio_uncertainty[k] / t.ratio[k].abs())
+        });
     s.push_str(&format!(
         "{:<32}{:>+16.4}% {:>+5.1}s  {:>+16.4}% {:>+5.1}s\n",
         "ratio error vs exact theory",
@@ -364,6 +368,6 @@ pub fn summary(report: &Report) -> String {
         100.0 * report.ratio_error[1],
         sigmas[1]
     ));
-    s.push_str("(+- is 1 sigma from the points' batch means; s: the error in sigmas)\n");
+    s.push_str("(+- is the 1-sigma budget: batch spread, settling, DAC images; docs/error-budget.md; s: the error in sigmas)\n");
     s
 }
