@@ -20,23 +20,23 @@
 //!   e[2j]     = round((r[j-1] + 3 r[j]) / 4)      e[2j+1] = round((3 r[j] + r[j+1]) / 4)
 //! ```
 //!
-//! rounded half to even, where r[k] is the sine generator's output for the
-//! centre of ROM interval k: r[-1] = -r[0] (quadrant 3) and r[4096] =
-//! r[4095] (quadrant 1) come from the generator's own quadrant rules.
+//! rounded half to even, where r\[k\] is the sine generator's output for the
+//! centre of ROM interval k: r\[-1\] = -r\[0\] (quadrant 3) and r\[4096\] =
+//! r\[4095\] (quadrant 1) come from the generator's own quadrant rules.
 //! Error against the exact centre sine: the ROM's 0.5 LSB, the
 //! interpolation's rounding 0.5 LSB and its curvature term,
 //! 32767 (2 pi / 2^15)^2 3/32 = 4e-5 LSB: at most 1 LSB. The sums' quarter
 //! fractions are equally likely, so rounding half up would add 1/8 LSB on
 //! average, a fundamental gain of 1 + 4.5e-6; half to even adds nothing on
 //! average. Every word lies in [0, 32767] (a convex combination of words
-//! in [-r[0], 32767]; e[0] = r[0] / 2 >= 0).
+//! in \[-r\[0\], 32767\]; e\[0\] = r\[0\] / 2 >= 0).
 //!
 //! Schedule (cycles after power-up): during cycle c < 8195 the sine
 //! generator is asked for ROM entry c/2 - 1 (each entry on two
 //! consecutive clocks: `busy` high, it is taken from the modulation NCO);
 //! its word comes out 5 clocks later, and the word two clocks before it is
 //! its ROM predecessor. The arrival of entry k's first copy makes e[2k-1],
-//! of its second e[2k]; the interpolation is registered, so the words are
+//! of its second e\[2k\]; the interpolation is registered, so the words are
 //! written during cycles 9..8200, `address` 0..8191 in order. `count`
 //! stops at `FILL_CLOCKS` = 8224 and `ready` is high from that cycle on,
 //! forever: the 24 clocks after the last write let the modulation NCO's

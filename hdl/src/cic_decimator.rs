@@ -30,7 +30,7 @@
 //! - integrators and the first three combs: arithmetic modulo 2^80; they
 //!   wrap by design (their true values grow without bound), and the last
 //!   comb is exact modulo 2^80 (Hogenauer);
-//! - the last comb: c = sum h[k] x[n - k] with h the cascade of four
+//! - the last comb: c = sum h\[k\] x\[n - k\] with h the cascade of four
 //!   length-R boxcars, h >= 0 and sum h = R^4, so |c| <= 2^31 R^4 <= 2^79
 //!   for R <= 4096: the 80-bit register holds it (c = -2^79 at x = i32::MIN
 //!   and R = 4096, no margin for any i32; one bit for |x| <= 2^30);
@@ -81,7 +81,7 @@
 //! | clock | state | subtractor / RAM | output stage |
 //! |---|---|---|---|
 //! | t0 | `Idle` | acc <- integral 1, sample2 <- integral 2, shift held | |
-//! | t1..t8 | `FirstLow1`, `FirstHigh1` .. `FirstHigh4` | acc <- acc - delay[k], delay[k] <- acc (channel 1), low then high half | |
+//! | t1..t8 | `FirstLow1`, `FirstHigh1` .. `FirstHigh4` | acc <- acc - delay\[k\], delay\[k\] <- acc (channel 1), low then high half | |
 //! | t9 | `SecondLoad` | acc <- sample2 | coarse (channel 1) |
 //! | t10..t17 | `SecondLow1` .. `SecondHigh4` | the same for channel 2 | fine (t10), round (t11) -> y_first |
 //! | t18 | `SecondCoarse` | | coarse (channel 2) |

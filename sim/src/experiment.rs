@@ -22,7 +22,7 @@
 //!   (`Derived::min_window_s`) over `BATCHES`.
 //! - Window and batches, calibration. The window is M whole periods P of
 //!   the 2 Om ripple (P = 1 / (2 f_cal), realized f_cal), because any other
-//!   length leaves part of a ripple about 100 / f_cal[Hz] times the DC
+//!   length leaves part of a ripple about 100 / f_cal\[Hz\] times the DC
 //!   value in the mean; M is the same at every point of the staircase, at
 //!   least `MIN_RIPPLE_PERIODS` and enough for the first window at the
 //!   slowest point. Each period is cut into I = `RIPPLE_BATCHES` batches.

@@ -30,7 +30,7 @@ struct StepSeries {
     settled: Vec<bool>,
 }
 
-/// The four panels' data: [self-cal, baseline][output].
+/// The four panels' data: \[self-cal, baseline\]\[output\].
 pub(super) struct RatePanels {
     panels: [[Vec<StepSeries>; 2]; 2],
     /// Coldest and hottest step (deg C).

@@ -32,7 +32,7 @@
 //! sample. The count during a z_valid clock includes that sample (the core's
 //! z ports hold it during that clock).
 //!
-//! AXI4-Stream master: `m_axis_tdata` 96 bits = {sample count [15:0], z2,
+//! AXI4-Stream master: `m_axis_tdata` 96 bits = {sample count \[15:0\], z2,
 //! z1} (z 40-bit two's complement, 8 fractional bits), `m_axis_tlast` = 1.
 
 use super::clip_counter::{COUNT_BITS, ClipCounter};
@@ -138,7 +138,7 @@ pub struct GyroInterfaceAxi {
     pub m_axis_tvalid: Signal<Out, Bit>,
     /// AXI4-Stream consumer ready.
     pub m_axis_tready: Signal<In, Bit>,
-    /// AXI4-Stream sample: {count[15:0], z2[39:0], z1[39:0]}.
+    /// AXI4-Stream sample: {count\[15:0\], z2\[39:0\], z1\[39:0\]}.
     pub m_axis_tdata: Signal<Out, Bits<SAMPLE_BITS>>,
     /// AXI4-Stream end of packet: always 1 (one sample per packet).
     pub m_axis_tlast: Signal<Out, Bit>,

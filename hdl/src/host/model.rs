@@ -332,7 +332,7 @@ impl GyroInterfaceAxi {
     }
 }
 
-/// The stream word of a sample: {count[15:0], z2, z1}.
+/// The stream word of a sample: {count\[15:0\], z2, z1}.
 pub fn sample_word(core: Outputs, count: u32) -> u128 {
     let z = |v: i64| u128::from(v as u64 & Z_MASK);
     z(core.z.0) | (z(core.z.1) << Z_BITS) | (u128::from(count & 0xffff) << (2 * Z_BITS))

@@ -24,7 +24,7 @@
 //!
 //! # How
 //!
-//! 1. Coarse search from the datasheet frequency ([`search`]): Y at three
+//! 1. Coarse search from the datasheet frequency (`search`): Y at three
 //!    carriers around a centre, and the narrow-band form
 //!    1 / (Y f) = a + b (f - f0) (linear in two complex unknowns) gives fk,
 //!    bk and the peak response even many bandwidths away; the centre moves
@@ -33,14 +33,14 @@
 //!    predicted peak so that the ADC stays below `ADC_TARGET` of full
 //!    scale; a measurement during which the ADC clipped (`ADC_CLIP`
 //!    counts, or a response above `ADC_NEAR_CLIP` of full scale) is made
-//!    again at a quarter of the amplitude ([`probe`]). Mode 2's search
+//!    again at a quarter of the amplitude (`probe`). Mode 2's search
 //!    starts at mode 1's identified frequency plus the datasheet's split.
 //!    When the search cannot converge (a datasheet off by more than the
 //!    narrow-band form reaches: far from resonance the response is nearly
 //!    real and its bandwidth lost in the noise), a scan of `SCAN_POINTS`
 //!    carriers over +-`SCAN_SPAN` of the guess (process spread is 1 to 5%)
 //!    and the exact form 1 / Y = (fk^2 - f^2 + j f bk) / C, linear in its
-//!    three complex coefficients over all the scan's points ([`fit`]),
+//!    three complex coefficients over all the scan's points (`fit`),
 //!    give an estimate; scans zooming in around it (each a third of the
 //!    last one's span, `search::scan`) narrow it down to a couple of
 //!    bandwidths, where a second search starts.
@@ -50,7 +50,7 @@
 //!    after a carrier step (the coarse search's bandwidth gives the time
 //!    constant; the datasheet's until then, each with a 20% margin) and the
 //!    filter's settling after a REF_PHASE step.
-//! 3. Gauss-Newton fit ([`fit`]) of the exact form above (4 real unknowns: C, fk, bk)
+//! 3. Gauss-Newton fit (`fit`) of the exact form above (4 real unknowns: C, fk, bk)
 //!    from the narrow-band solution. Uncertainties: the residual variance
 //!    times the inverse normal matrix, propagated to Qk = fk / bk and
 //!    phi = -arg C.

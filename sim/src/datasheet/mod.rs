@@ -3,7 +3,7 @@
 //!
 //! - [`setup`]: the file (`[noise]` with the rate noises, optional
 //!   `[drift]`).
-//! - [`bench`]: fresh boards at a temperature, in readout at the factory's
+//! - [`bench`](mod@bench): fresh boards at a temperature, in readout at the factory's
 //!   settings.
 //! - [`sweep`]: scale factor, nonlinearity, asymmetry over +-full scale.
 //! - [`dynamics`]: -3 dB bandwidth (rate step) and turn-on time.
