@@ -55,4 +55,5 @@ fi
 
 cargo fmt --all -- --check
 cargo clippy --release --workspace --all-targets --all-features -- -D warnings
+RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --quiet
 cargo test --release --workspace --all-features
