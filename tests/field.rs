@@ -180,10 +180,16 @@ fn rounding_moves_the_resonant_outputs_rate_table() {
             envelope_delay_s: 0.0,
             amplitude: knowns.amplitude,
         };
-        let (sf0, _) = scenario::rate_table(&sc.exp, &fe, &at, &knowns, &op).unwrap();
+        let sf0 = scenario::rate_table(&sc.exp, &fe, &at, &knowns, &op)
+            .unwrap()
+            .0
+            .sf_per_dps;
         for level in [0.99, 0.98, 0.9, 0.5] {
             at.adc_gain = [level; 2];
-            let (sf, _) = scenario::rate_table(&sc.exp, &fe, &at, &knowns, &op).unwrap();
+            let sf = scenario::rate_table(&sc.exp, &fe, &at, &knowns, &op)
+                .unwrap()
+                .0
+                .sf_per_dps;
             eprintln!(
                 "dither {noise} LSB, level {level}: rate table / level moved {:+.2e} / {:+.2e}",
                 sf[0] / (level * sf0[0]) - 1.0,

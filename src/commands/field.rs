@@ -7,7 +7,10 @@
 //! (`gyrocal_sim::drift`). Progress and the wall time go to stderr; with
 //! `--json` stdout is one object whose `steps` hold, per temperature,
 //! `temperature_c`, `sf_true_per_dps`, `sf_selfcal_per_dps`,
-//! `sf_baseline_per_dps` (z LSB per deg/s, one per output) and
+//! `sf_baseline_per_dps` (z LSB per deg/s, one per output),
+//! `sf_selfcal_uncertainty` and `sf_true_uncertainty` (relative 1-sigma:
+//! the truth is a measurement too), `selfcal_error` with its own 1-sigma
+//! `selfcal_error_uncertainty` (the two in quadrature), and
 //! `identified` (`f1_hz`, `f2_hz`, `q1`, `q2`, `loop_phase_deg`, each with
 //! an `_uncertainty` twin). `--out` writes field.json, field.csv and
 //! fig_field_error.png/.svg; with a `[profile]`, also the rate output
@@ -236,8 +239,8 @@ pub fn summary(report: &FieldReport) -> String {
             st.sf_true_per_dps[1],
             100.0 * st.selfcal_error[0],
             100.0 * st.selfcal_error[1],
-            100.0 * st.sf_selfcal_uncertainty[0],
-            100.0 * st.sf_selfcal_uncertainty[1],
+            100.0 * st.selfcal_error_uncertainty[0],
+            100.0 * st.selfcal_error_uncertainty[1],
             100.0 * b[0],
             100.0 * b[1],
             i.f1_hz,

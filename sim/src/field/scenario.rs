@@ -41,7 +41,7 @@ use crate::noise::ThermalNoise;
 use gyrocal_host::Knowns;
 use gyrocal_host::datasheet::Datasheet;
 use gyrocal_host::drive_ratio;
-use gyrocal_host::sampling::window_z;
+use gyrocal_host::sampling::{Signal, part_means};
 use gyrocal_host::selfcal::{self, Operating, SelfCal};
 use rayon::prelude::*;
 use serde::Deserialize;
@@ -146,6 +146,9 @@ pub struct FieldStep {
     pub truth: DeviceAt,
     /// Rate-table scale factor at the self-calibration's settings (z LSB per deg/s).
     pub sf_true_per_dps: [f64; 2],
+    /// Its own relative 1-sigma uncertainty ([`RateTable::uncertainty`]):
+    /// the truth is a measurement too.
+    pub sf_true_uncertainty: [f64; 2],
     /// SF_cal x ratio(identified) (z LSB per deg/s).
     pub sf_selfcal_per_dps: [f64; 2],
     /// Its relative 1-sigma uncertainty (`selfcal.sf_selfcal_uncertainty`
@@ -161,6 +164,10 @@ pub struct FieldStep {
     pub sf_true_at_factory_settings_per_dps: Option<[f64; 2]>,
     /// sf_selfcal / sf_true - 1.
     pub selfcal_error: [f64; 2],
+    /// That error's own relative 1-sigma: `sf_selfcal_uncertainty` and
+    /// `sf_true_uncertainty` in quadrature (the two are independent
+    /// measurements).
+    pub selfcal_error_uncertainty: [f64; 2],
     /// sf_baseline / sf_true_at_factory_settings - 1; null without a baseline.
     pub baseline_error: Option<[f64; 2]>,
     /// The true g_2 / g_1 over the design ratio (what `[drive_probe]`'s
@@ -332,9 +339,14 @@ fn program_readout(board: &mut dyn Board, knowns: &Knowns, op: &Operating) -> Re
     board.program(&regs).map_err(|e| e.to_string())
 }
 
+/// Parts each rate-table window is cut into: the table's slope per part
+/// gives the truth's own uncertainty ([`RateTable`]).
+pub const TABLE_PARTS: usize = 8;
+
 /// One point of the rate table: readout at `op` on a fresh board (from
 /// power-up, as `experiment` runs its points), settled and averaged over
-/// the first window; returns z (z LSB) and the clocks.
+/// the first window in `TABLE_PARTS` equal parts; returns the parts' z
+/// (z LSB; their mean is the window's) and the clocks.
 fn table_point(
     exp: &Experiment,
     fe: &FrontEnd,
@@ -342,12 +354,25 @@ fn table_point(
     knowns: &Knowns,
     op: &Operating,
     rate_dps: f64,
-) -> Result<([f64; 2], u64), String> {
+) -> Result<(Vec<[f64; 2]>, u64), String> {
     let mut board = settled_readout_board(exp, fe, at, knowns, op, rate_dps)?;
     let r = knowns.filter.decimation;
     let length = (knowns.filter.min_window_s * knowns.clock_hz).ceil();
-    let z = window_z(&mut board, r, f64::from(r), length).map_err(|e| e.to_string())?;
-    Ok((z, board.cycle()))
+    let parts = part_means(
+        &mut board,
+        r,
+        f64::from(r),
+        length,
+        TABLE_PARTS,
+        Signal::Steady,
+    )
+    .map_err(|e| e.to_string())?;
+    Ok((parts, board.cycle()))
+}
+
+/// The mean of a point's parts (the window's mean).
+fn point_mean(parts: &[[f64; 2]]) -> [f64; 2] {
+    std::array::from_fn(|k| parts.iter().map(|p| p[k]).sum::<f64>() / parts.len() as f64)
 }
 
 /// Least-squares slopes of the table's z against its rates (z LSB per deg/s).
@@ -358,8 +383,46 @@ fn table_slopes(rates_dps: &[f64], z: &[[f64; 2]]) -> [f64; 2] {
     })
 }
 
+/// The truth of a field step: the rate table's slopes and their own
+/// uncertainty.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct RateTable {
+    /// Least-squares slopes of z against the rates (z LSB per deg/s).
+    pub sf_per_dps: [f64; 2],
+    /// Their relative 1-sigma uncertainty: the spread of the slopes
+    /// fitted part by part (`TABLE_PARTS` parts of every window, part i of
+    /// every rate together) over sqrt(parts). Noise common to the rates
+    /// (every board starts from the same seed) cancels in it as it does in
+    /// the slope; it does not see the carrier spurs' beats, which repeat
+    /// from power-up at every rate (`rate_table`).
+    pub uncertainty: [f64; 2],
+}
+
+impl RateTable {
+    /// The table of `parts[rate][part]` at `rates_dps`.
+    fn from_parts(rates_dps: &[f64], parts: &[Vec<[f64; 2]>]) -> Self {
+        let means: Vec<[f64; 2]> = parts.iter().map(|p| point_mean(p)).collect();
+        let sf = table_slopes(rates_dps, &means);
+        let n = parts[0].len();
+        let slopes: Vec<[f64; 2]> = (0..n)
+            .map(|i| {
+                let z: Vec<[f64; 2]> = parts.iter().map(|p| p[i]).collect();
+                table_slopes(rates_dps, &z)
+            })
+            .collect();
+        let uncertainty = std::array::from_fn(|k| {
+            let ss: f64 = slopes.iter().map(|s| (s[k] - sf[k]).powi(2)).sum();
+            (ss / (n - 1) as f64 / n as f64).sqrt() / sf[k].abs()
+        });
+        Self {
+            sf_per_dps: sf,
+            uncertainty,
+        }
+    }
+}
+
 /// The rate table: readout at `op` on a fresh board per rate, the rates in
-/// parallel; returns the slopes (z LSB per deg/s) and the clocks.
+/// parallel; returns the slopes with their uncertainty, and the clocks.
 ///
 /// Fresh boards, not one board stepping through the rates: the carrier
 /// table's residual spurs (below -80 dBc; 90 dBc measured) mix with the resonant output's
@@ -375,15 +438,15 @@ pub fn rate_table(
     at: &DeviceAt,
     knowns: &Knowns,
     op: &Operating,
-) -> Result<([f64; 2], u64), String> {
-    let points: Vec<([f64; 2], u64)> = knowns
+) -> Result<(RateTable, u64), String> {
+    let points: Vec<(Vec<[f64; 2]>, u64)> = knowns
         .rates_dps
         .par_iter()
         .map(|&rate| table_point(exp, fe, at, knowns, op, rate))
         .collect::<Result<_, String>>()?;
-    let z: Vec<[f64; 2]> = points.iter().map(|p| p.0).collect();
+    let parts: Vec<Vec<[f64; 2]>> = points.iter().map(|p| p.0.clone()).collect();
     let clocks = points.iter().map(|p| p.1).sum();
-    Ok((table_slopes(&knowns.rates_dps, &z), clocks))
+    Ok((RateTable::from_parts(&knowns.rates_dps, &parts), clocks))
 }
 
 fn ratio_error(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
@@ -396,8 +459,8 @@ struct Cycle {
     cal: SelfCal,
     /// Readout null at rest and the profile's run, with `[profile]`.
     readout: Option<([f64; 2], ProfileRun)>,
-    /// The rate table's slopes at the cycle's settings (z LSB per deg/s).
-    sf_true: [f64; 2],
+    /// The rate table at the cycle's settings.
+    truth: RateTable,
     clocks: u64,
 }
 
@@ -432,12 +495,12 @@ fn cycle_at(sc: &Scenario, fe: &FrontEnd, knowns: &Knowns, t: f64) -> Result<Cyc
             ))
         }
     };
-    let (sf_true, table_clocks) = rate_table(&sc.exp, fe, &at, knowns, &cal.operating)?;
+    let (truth, table_clocks) = rate_table(&sc.exp, fe, &at, knowns, &cal.operating)?;
     Ok(Cycle {
         at,
         cal,
         readout,
-        sf_true,
+        truth,
         clocks: board.cycle() + table_clocks,
     })
 }
@@ -517,8 +580,8 @@ fn run_cycles(
             match &c {
                 Ok(c) => progress(&format!(
                     "{t} deg C: cycle and rate table done, self-cal error {:+.4}% / {:+.4}%",
-                    100.0 * (c.cal.sf_selfcal_per_dps[0] / c.sf_true[0] - 1.0),
-                    100.0 * (c.cal.sf_selfcal_per_dps[1] / c.sf_true[1] - 1.0),
+                    100.0 * (c.cal.sf_selfcal_per_dps[0] / c.truth.sf_per_dps[0] - 1.0),
+                    100.0 * (c.cal.sf_selfcal_per_dps[1] / c.truth.sf_per_dps[1] - 1.0),
                 )),
                 Err(e) => progress(&format!("{t} deg C: FAILED: {e}")),
             }
@@ -544,8 +607,8 @@ fn run_jobs(
             let at = &cycles[job.step()].as_ref().map_err(Clone::clone)?.at;
             match *job {
                 Job::Factory { rate, .. } => {
-                    let (z, n) = table_point(exp, fe, at, knowns, factory, rates[rate])?;
-                    Ok((Done::Point(z), n))
+                    let (parts, n) = table_point(exp, fe, at, knowns, factory, rates[rate])?;
+                    Ok((Done::Point(point_mean(&parts)), n))
                 }
                 Job::BaselineProfile { .. } => {
                     let p = sc.profile.as_ref().ok_or("no profile")?;
@@ -577,7 +640,7 @@ pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldRepor
     let cycles = run_cycles(sc, &fe, &knowns, progress);
     let factory = cycles[0].as_ref().ok().map(|c| Factory {
         operating: c.cal.operating.clone(),
-        sf_per_dps: c.sf_true,
+        sf_per_dps: c.truth.sf_per_dps,
         null_z: c.readout.as_ref().map(|r| r.0),
     });
     let rates = &knowns.rates_dps;
@@ -663,7 +726,7 @@ fn baseline_of<'a>(
 ) -> Result<Baseline<'a>, String> {
     if i == 0 {
         return Ok(Baseline {
-            sf_fixed: c.sf_true,
+            sf_fixed: c.truth.sf_per_dps,
             run: None,
             sf_factory: f.sf_per_dps,
             null_factory: f.null_z,
@@ -689,7 +752,7 @@ fn baseline_of<'a>(
 /// The report's entry of a finished cycle, with its baseline when the
 /// factory calibration and the step's measurements at its settings exist.
 fn field_step(c: Cycle, baseline: Option<Baseline>) -> FieldStep {
-    let sf_true = c.sf_true;
+    let sf_true = c.truth.sf_per_dps;
     let trace = c.readout.as_ref().map(|(null, run)| {
         let selfcal_rate = profile::calibrated(&run.z, *null, c.cal.sf_selfcal_per_dps);
         let base = baseline.as_ref().map(|b| {
@@ -718,12 +781,16 @@ fn field_step(c: Cycle, baseline: Option<Baseline>) -> FieldStep {
         drive_gain_ratio_true: c.at.drive_gain[1] / c.at.drive_gain[0],
         truth: c.at,
         sf_true_per_dps: sf_true,
+        sf_true_uncertainty: c.truth.uncertainty,
         sf_selfcal_per_dps: c.cal.sf_selfcal_per_dps,
         sf_selfcal_uncertainty: c.cal.sf_selfcal_uncertainty.total,
         sf_eq56_per_dps: c.cal.sf_eq56_per_dps,
         sf_baseline_per_dps: baseline.as_ref().map(|b| b.sf_factory),
         sf_true_at_factory_settings_per_dps: baseline.as_ref().map(|b| b.sf_fixed),
         selfcal_error: ratio_error(c.cal.sf_selfcal_per_dps, sf_true),
+        selfcal_error_uncertainty: std::array::from_fn(|k| {
+            c.cal.sf_selfcal_uncertainty.total[k].hypot(c.truth.uncertainty[k])
+        }),
         baseline_error: baseline
             .as_ref()
             .map(|b| ratio_error(b.sf_factory, b.sf_fixed)),

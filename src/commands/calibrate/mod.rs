@@ -60,6 +60,8 @@ pub struct Truth {
     pub device: DeviceAt,
     /// Rate-table slope at the cycle's carrier and phase (z LSB per deg/s).
     pub sf_true_per_dps: [f64; 2],
+    /// Its own relative 1-sigma uncertainty (`scenario::RateTable`).
+    pub sf_true_uncertainty: [f64; 2],
     /// Clocks the rate table simulated.
     pub clocks: u64,
 }
@@ -144,7 +146,7 @@ fn in_process(
     let (cal, samples, wall_s) = cycle(&mut board, knowns)?;
     eprintln!("rate table at the calibrated carrier and phase (the truth)");
     let fe = file.front_end().map_err(Failure::Run)?;
-    let (sf_true_per_dps, clocks) =
+    let (table, clocks) =
         scenario::rate_table(&file.exp, &fe, &at, knowns, &cal.operating).map_err(Failure::Run)?;
     Ok(Outcome {
         board: "in-process".into(),
@@ -153,7 +155,8 @@ fn in_process(
         wall_s,
         truth: Some(Truth {
             device: at,
-            sf_true_per_dps,
+            sf_true_per_dps: table.sf_per_dps,
+            sf_true_uncertainty: table.uncertainty,
             clocks,
         }),
     })

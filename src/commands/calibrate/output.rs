@@ -51,6 +51,7 @@ pub fn json(o: &Outcome) -> Value {
             "adc_gain": d.adc_gain,
             "drive_gain": d.drive_gain,
             "sf_true_per_dps": t.sf_true_per_dps,
+            "sf_true_uncertainty": t.sf_true_uncertainty,
             "selfcal_error": error(cal.sf_selfcal_per_dps, t.sf_true_per_dps),
             "clocks": t.clocks,
         })
