@@ -23,7 +23,8 @@
 //!   scale factor with the exact theory ([`theory`]);
 //! - [`drive_ratio`]: the drive-gain ratio while the device turns;
 //! - [`rate`]: the null and the calibrated rate output;
-//! - [`transport`]: Etherbone over TCP and memory-mapped boards.
+//! - [`transport`]: Etherbone over TCP and memory-mapped boards;
+//! - [`fake`]: a board of two exact Lorentzian modes, for examples and tests.
 //!
 //! Errors are [`error::Error`], one line each.
 
@@ -34,6 +35,7 @@ pub mod datasheet;
 pub mod device;
 pub mod drive_ratio;
 pub mod error;
+pub mod fake;
 pub mod identify;
 pub mod knowns;
 pub mod rate;

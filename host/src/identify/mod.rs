@@ -235,6 +235,33 @@ pub fn identify_mode(
 
 /// Identify both modes, starting from `guess` (the datasheet or the last
 /// identification).
+///
+/// On a [`fake`](crate::fake) board with the paper's modes, from a
+/// datasheet whose f1 is 0.3% high:
+///
+/// ```
+/// use gyrocal_host::{GyroParams, identify, fake::Lorentzian};
+/// use gyrocal_host::knowns::{Derived, Knowns};
+/// use nalgebra::Complex;
+/// let c = Complex::from_polar(2.0e9, -3f64.to_radians());
+/// let (f1, f2) = (9.64e6, 9.64025e6);
+/// let mut board = Lorentzian::new(50e6, [(f1, f1 / 55e3, c), (f2, f2 / 55e3, c)], 1e-3);
+/// let datasheet = GyroParams { f1_hz: 1.003 * f1, f2_hz: 1.003 * f1 + 250.0, q1: 55e3,
+///     q2: 55e3, angular_gain: 0.6, quadrature_dps: 0.0, damping_coupling_dps: 0.0 };
+/// let knowns = Knowns {
+///     clock_hz: 50e6, angular_gain_uncertainty: 0.0, amplitude: (0.9, 0.9),
+///     force_full_scale: [1.0, 1.0], dac_latency: 2, adc_latency: 3,
+///     filter: Derived { decimation: 1000, butterworth_hz: 500.0, rc_hz: 2000.0,
+///         min_window_s: 0.05 },
+///     carrier_hz: 1.003 * f1, rates_dps: vec![1.0, 20.0], cal_freqs_hz: vec![10.0, 15.0],
+///     nominal: datasheet.clone(),
+/// };
+/// let id = identify::identify(&mut board, &knowns, &datasheet).unwrap();
+/// let mode1 = &id.modes[0];
+/// assert!((mode1.f_hz.value - f1).abs() < 3.0 * mode1.f_hz.uncertainty);
+/// assert!((mode1.q.value / 55e3 - 1.0).abs() < 1e-3);
+/// assert!((id.loop_phase_deg.value - 3.0).abs() < 0.01);
+/// ```
 pub fn identify(
     board: &mut dyn Board,
     knowns: &Knowns,
