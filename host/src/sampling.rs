@@ -61,6 +61,12 @@ pub fn mean(samples: &[ZSample]) -> [f64; 2] {
     std::array::from_fn(|k| samples.iter().map(|s| s.z[k]).sum::<f64>() / n)
 }
 
+/// Mean of both outputs over part means (the window's mean when the parts
+/// are equal).
+pub fn mean_of_parts(parts: &[[f64; 2]]) -> [f64; 2] {
+    std::array::from_fn(|k| parts.iter().map(|p| p[k]).sum::<f64>() / parts.len() as f64)
+}
+
 /// Wait `clocks`, then average `n` successive z samples.
 pub fn average_z(board: &mut dyn Board, clocks: u64, n: u64) -> Result<[f64; 2], Error> {
     Ok(mean(&collect(board, clocks, n)?))

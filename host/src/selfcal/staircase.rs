@@ -8,7 +8,7 @@ use crate::clip;
 use crate::error::Error;
 use crate::identify;
 use crate::knowns::Knowns;
-use crate::sampling::{Signal, part_means};
+use crate::sampling::{Signal, mean_of_parts, part_means};
 use crate::stats::linear_fit;
 
 /// A measured staircase.
@@ -75,10 +75,7 @@ pub fn staircase(
         clocks += settle + length as u64 + 2 * u64::from(r);
         cal_hz.push(real.cal_hz);
     }
-    let means: Vec<[f64; 2]> = parts
-        .iter()
-        .map(|p| std::array::from_fn(|k| p.iter().map(|m| m[k]).sum::<f64>() / p.len() as f64))
-        .collect();
+    let means: Vec<[f64; 2]> = parts.iter().map(|p| mean_of_parts(p)).collect();
     let x: Vec<f64> = cal_hz.iter().map(|f| 360.0 * f).collect();
     let sf = std::array::from_fn(|k| {
         let y: Vec<f64> = means.iter().map(|m| m[k]).collect();

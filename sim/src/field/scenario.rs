@@ -41,7 +41,7 @@ use crate::noise::ThermalNoise;
 use gyrocal_host::Knowns;
 use gyrocal_host::datasheet::Datasheet;
 use gyrocal_host::drive_ratio;
-use gyrocal_host::sampling::{Signal, part_means};
+use gyrocal_host::sampling::{Signal, mean_of_parts, part_means};
 use gyrocal_host::selfcal::{self, Operating, SelfCal};
 use rayon::prelude::*;
 use serde::Deserialize;
@@ -370,11 +370,6 @@ fn table_point(
     Ok((parts, board.cycle()))
 }
 
-/// The mean of a point's parts (the window's mean).
-fn point_mean(parts: &[[f64; 2]]) -> [f64; 2] {
-    std::array::from_fn(|k| parts.iter().map(|p| p[k]).sum::<f64>() / parts.len() as f64)
-}
-
 /// Least-squares slopes of the table's z against its rates (z LSB per deg/s).
 fn table_slopes(rates_dps: &[f64], z: &[[f64; 2]]) -> [f64; 2] {
     std::array::from_fn(|k| {
@@ -401,7 +396,7 @@ pub struct RateTable {
 impl RateTable {
     /// The table of `parts[rate][part]` at `rates_dps`.
     fn from_parts(rates_dps: &[f64], parts: &[Vec<[f64; 2]>]) -> Self {
-        let means: Vec<[f64; 2]> = parts.iter().map(|p| point_mean(p)).collect();
+        let means: Vec<[f64; 2]> = parts.iter().map(|p| mean_of_parts(p)).collect();
         let sf = table_slopes(rates_dps, &means);
         let n = parts[0].len();
         let slopes: Vec<[f64; 2]> = (0..n)
@@ -608,7 +603,7 @@ fn run_jobs(
             match *job {
                 Job::Factory { rate, .. } => {
                     let (parts, n) = table_point(exp, fe, at, knowns, factory, rates[rate])?;
-                    Ok((Done::Point(point_mean(&parts)), n))
+                    Ok((Done::Point(mean_of_parts(&parts)), n))
                 }
                 Job::BaselineProfile { .. } => {
                     let p = sc.profile.as_ref().ok_or("no profile")?;
