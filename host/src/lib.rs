@@ -37,6 +37,7 @@ pub mod drive_ratio;
 pub mod error;
 pub mod fake;
 pub mod identify;
+pub mod images;
 pub mod knowns;
 pub mod rate;
 pub mod sampling;

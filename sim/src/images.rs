@@ -1,84 +1,13 @@
-//! The DAC's images, aliased back by the ADC: the part of the simulated
-//! loop that the exact theory leaves out (the truth's own error).
-//!
-//! The DAC holds each word for a clock T, so a drive phasor F at w leaves
-//! it at every w + j ws (ws = 2 pi / T, j any integer), each with the
-//! hold's response (1 - e^(-i v T)) / (i v T) at v = w + j ws. At those
-//! frequencies that response is the carrier's times w / (w + j ws)
-//! exactly (the phase factors e^(-i j pi) and sin(... + j pi) cancel).
-//! The ADC samples x at the clock, where e^(i j ws n T) = 1: every image
-//! lands on the carrier's own phasor. So the sampled loop sees, for each
-//! mode, the response
-//!
-//! ```text
-//! H_sampled(w) = sum_j H(w + j ws) w / (w + j ws)
-//! ```
-//!
-//! of which the theory keeps j = 0 (its hold gain and delay). The images
-//! are off resonance, 1 / (wk^2 - v^2) each, so they matter when the
-//! carrier is a large fraction of the clock and the resonance is broad: on
-//! a Q 160 device with its carrier at 0.38 of the clock they moved the
-//! detuned output's calibration scale factor by +3.9% (measured +3.6%
-//! before the ADC gains counted them, +3.9% since), at 0.13 of the clock
-//! by 1e-4. They fall as 1 / j^3; `IMAGES` on each side leave
-//! 1 / (2 IMAGES^2) of the first.
-//!
-//! The same sums bound the sampled displacement, which sets the ADC gains
-//! (`sampled_peak`): an image adds to the continuous amplitude, and at
-//! `adc_headroom` 0.9 a few percent more clip.
+//! The DAC's images in the simulated loop: the part of the simulation
+//! that the exact theory leaves out (the truth's own error). The sums
+//! themselves are the host's (`gyrocal_host::images`), which predicts with
+//! them; this module adds them at a point of a plan.
+
+pub use gyrocal_host::images::{calibration_images, readout_images, sampled_peak};
 
 use crate::experiment::{Experiment, Mode, Plan, PointPlan, envelope_lead_rad, hold_gain};
+#[cfg(test)]
 use crate::theory::{self, Device};
-
-/// Images summed on each side of the carrier.
-const IMAGES: i32 = 64;
-
-/// The image indices j != 0 as frequency shifts j f_clk (Hz).
-fn shifts(clock_hz: f64) -> impl Iterator<Item = f64> {
-    (-IMAGES..=IMAGES)
-        .filter(|&j| j != 0)
-        .map(move |j| f64::from(j) * clock_hz)
-}
-
-/// `dev` with its carrier moved by `shift_hz` (the phasor solves take
-/// signed frequencies).
-fn moved(dev: &Device, shift_hz: f64) -> Device {
-    Device {
-        carrier_hz: dev.carrier_hz + shift_hz,
-        ..dev.clone()
-    }
-}
-
-/// What the images add to `theory::readout_z(dev, omz_rad_s)` (before the
-/// hold gain, as that z is).
-pub fn readout_images(dev: &Device, clock_hz: f64, omz_rad_s: f64) -> [f64; 2] {
-    let fc = dev.carrier_hz;
-    shifts(clock_hz).fold([0.0; 2], |sum, shift| {
-        let z = theory::readout_z(&moved(dev, shift), omz_rad_s);
-        let w = fc / (fc + shift);
-        [sum[0] + w * z[0], sum[1] + w * z[1]]
-    })
-}
-
-/// What the images add to `theory::calibration_z_of_datapath(dev, cal_hz,
-/// lead_rad, sideband_gain)`.
-pub fn calibration_images(
-    dev: &Device,
-    clock_hz: f64,
-    cal_hz: f64,
-    lead_rad: f64,
-    sideband_gain: [f64; 2],
-) -> [f64; 2] {
-    let fc = dev.carrier_hz;
-    shifts(clock_hz).fold([0.0; 2], |sum, shift| {
-        let gain: [f64; 2] = std::array::from_fn(|s| {
-            let f = fc + [-cal_hz, cal_hz][s];
-            sideband_gain[s] * f / (f + shift)
-        });
-        let z = theory::calibration_z_of_datapath(&moved(dev, shift), cal_hz, lead_rad, gain);
-        [sum[0] + z[0], sum[1] + z[1]]
-    })
-}
 
 impl Plan {
     /// z the images add at a point (m^2/s^2), hold included, per output:
@@ -97,19 +26,6 @@ impl Plan {
         };
         z.map(|z| z * self.hold_gain)
     }
-}
-
-/// Upper bound on the sampled displacement amplitudes `[|x1|, |x2|]` (m):
-/// `peak` (a theory peak function of a device, carrier included) summed
-/// over the carrier and its images, each weighted by |w / (w + j ws)|.
-/// `dev` carries the forces as applied (hold gain included).
-pub fn sampled_peak(dev: &Device, clock_hz: f64, peak: impl Fn(&Device) -> [f64; 2]) -> [f64; 2] {
-    let fc = dev.carrier_hz;
-    shifts(clock_hz).fold(peak(dev), |sum, shift| {
-        let x = peak(&moved(dev, shift));
-        let w = (fc / (fc + shift)).abs();
-        [sum[0] + w * x[0], sum[1] + w * x[1]]
-    })
 }
 
 #[cfg(test)]

@@ -218,9 +218,11 @@ pub fn identify_mode(
     for s in order {
         sweep.push(probe.measure(centre + s * bk)?);
     }
-    let mut fit = fit::fit_mode(&sweep, centre, bk).map_err(|reason| Error::Identification {
-        mode: k + 1,
-        reason: reason.into(),
+    let mut fit = fit::fit_mode(&sweep, centre, bk, Some(knowns.clock_hz)).map_err(|reason| {
+        Error::Identification {
+            mode: k + 1,
+            reason: reason.into(),
+        }
     })?;
     let eps = settling_residue();
     let floor = |e: &mut Estimate, bias: f64| e.uncertainty = e.uncertainty.hypot(bias);

@@ -6,6 +6,7 @@ use super::Operating;
 use crate::device::GyroParams;
 use crate::error::Error;
 use crate::identify::{Identified, readout_word};
+use crate::images;
 use crate::knowns::Knowns;
 use crate::stats::linear_fit;
 use crate::theory::{self, Device, envelope_lead_rad, hold_gain};
@@ -104,9 +105,18 @@ pub(super) fn predicted_ratio_lagged(
     let [dev_read, dev_cal] = devices(knowns, gyro, op)?;
     let rad = PI / 180.0;
     let rates = &knowns.rates_dps;
+    // The sampled loop: the carrier's phasor and the DAC's images that the
+    // ADC aliases onto it (`images`; the images without the residual lag,
+    // a second-order change of a small term).
+    let add = |a: [f64; 2], b: [f64; 2]| [a[0] + b[0], a[1] + b[1]];
     let read_z: Vec<[f64; 2]> = rates
         .iter()
-        .map(|r| theory::readout_z_lagged(&dev_read, r * rad, lag_rad))
+        .map(|r| {
+            add(
+                theory::readout_z_lagged(&dev_read, r * rad, lag_rad),
+                images::readout_images(&dev_read, clock, r * rad),
+            )
+        })
         .collect();
     let hold = hold_gain(op.carrier_hz, clock);
     let cal_z: Vec<[f64; 2]> = cal_hz
@@ -116,7 +126,10 @@ pub(super) fn predicted_ratio_lagged(
             // The response's envelope comes late by the group delay: the
             // references' envelope leads it by that much more.
             let lead = envelope_lead_rad(f, clock) + TAU * f * op.envelope_delay_s;
-            theory::calibration_z_lagged(&dev_cal, f, lead, sidebands, lag_rad)
+            add(
+                theory::calibration_z_lagged(&dev_cal, f, lead, sidebands, lag_rad),
+                images::calibration_images(&dev_cal, clock, f, lead, sidebands),
+            )
         })
         .collect();
     let virtual_dps: Vec<f64> = cal_hz.iter().map(|f| 360.0 * f).collect();
