@@ -149,13 +149,9 @@ fn errors(r: &Report) -> [(f64, f64); 6] {
 fn describe(d: &RandomDevice, dither: u64, r: &Report, e: &[(f64, f64); 6]) -> String {
     let t: Vec<String> = e.iter().map(|(x, s)| format!("{:+5.2}", x / s)).collect();
     format!(
-        "seed {:>7} dither {dither}: f {:.4e} Q {:.0}/{:.0} split {:+.1} bw, clock/carrier {:.2}, {} rounds {:.1e} clocks: t = {}",
+        "seed {:>7} dither {dither}: {}, {} rounds {:.1e} clocks: t = {}",
         d.seed,
-        d.f_hz[0],
-        d.q[0],
-        d.q[1],
-        (d.f_hz[1] - d.f_hz[0]) * d.q[0] / d.f_hz[0],
-        d.clock_hz / d.carrier_hz,
+        d.summary(),
         r.timing.rounds,
         r.timing.cycles as f64,
         t.join(" ")

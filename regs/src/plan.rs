@@ -156,6 +156,35 @@ pub fn commensurate_period(carrier_hz: f64, clock_hz: f64) -> Option<u64> {
     })
 }
 
+/// Longest period [`nearest_fold`] looks at. With the carrier r = fc /
+/// fclk near n / q, the DAC and ADC see the carrier's q sample phases
+/// drifting slowly, and their quantization errors (the carrier tables',
+/// 16 bits) come back as harmonics q +- 1 of the carrier folded to
+/// eps = fclk |q r - n| from it; in the output's passband, a ripple on the
+/// rate. On the paper device (`tests/data/field_paper.toml`) the two steps
+/// whose calibrated rate ripples are the two that fold in the passband
+/// (30 deg C: q = 83, eps = 18.2 Hz and its multiples, 0.25 deg/s RMS;
+/// 25 deg C: q = 1250, eps = 4.8 Hz, 0.47 deg/s RMS), the three others
+/// (0.02 to 0.08 deg/s) fold nowhere below 1 kHz for q up to 5000. The
+/// error's power spreads over q harmonics, so long periods matter less.
+pub const MAX_FOLD_PERIOD: u64 = 4096;
+
+/// The nearest fold of `carrier_hz` on `clock_hz` among periods up to
+/// [`MAX_FOLD_PERIOD`]: (q, eps in Hz), the period whose harmonics land
+/// closest to the carrier.
+pub fn nearest_fold(carrier_hz: f64, clock_hz: f64) -> (u64, f64) {
+    let r = carrier_hz / clock_hz;
+    (1..=MAX_FOLD_PERIOD)
+        .map(|q| {
+            let x = r * q as f64;
+            (q, clock_hz * (x - x.round()).abs())
+        })
+        .fold(
+            (0, f64::INFINITY),
+            |best, c| if c.1 < best.1 { c } else { best },
+        )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -217,6 +246,21 @@ mod tests {
     fn commensurate_plans_are_flagged() {
         assert_eq!(commensurate_period(1e6, 10e6), Some(10));
         assert_eq!(commensurate_period(1.0123e6, 10e6), None);
+    }
+
+    /// The paper device's carriers at 30 and 25 deg C of
+    /// `tests/data/field_paper.toml` fold at 18.2 and 4.8 Hz; at 15 deg C
+    /// the nearest fold is 342 Hz away (period 40968 is beyond the search).
+    #[test]
+    fn the_paper_devices_folds_are_found() {
+        let clock = 50e6;
+        let (q, eps) = nearest_fold(9_638_553.997_5, clock);
+        assert_eq!(q, 83);
+        assert!((eps - 18.2).abs() < 0.1, "{eps}");
+        let (q, eps) = nearest_fold(9_640_000.003_9, clock);
+        assert_eq!(q, 1250);
+        assert!((eps - 4.8).abs() < 0.1, "{eps}");
+        assert!(nearest_fold(9_642_892.004_9, clock).1 > 1000.0);
         assert_eq!(commensurate_period(9.64e6, 50e6), None); // 241/1250
     }
 }

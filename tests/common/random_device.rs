@@ -171,6 +171,19 @@ impl RandomDevice {
         })
     }
 
+    /// One line of what matters about the device: mode 1, the Qs, the
+    /// split in mode-1 bandwidths and the clock in carriers.
+    pub fn summary(&self) -> String {
+        format!(
+            "f {:.4e} Q {:.0}/{:.0} split {:+.1} bw, clock/carrier {:.2}",
+            self.f_hz[0],
+            self.q[0],
+            self.q[1],
+            (self.f_hz[1] - self.f_hz[0]) * self.q[0] / self.f_hz[0],
+            self.clock_hz / self.carrier_hz,
+        )
+    }
+
     /// The configuration file: required keys alone, then `extra` lines
     /// appended to `[experiment]` (e.g. "tolerance = 1e-3").
     pub fn toml(&self, extra: &str) -> String {

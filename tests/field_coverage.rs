@@ -1,0 +1,165 @@
+//! The field's sigmas are honest: over random devices, none of them a
+//! device the field was tuned on, the self-calibrated scale factor lies
+//! within 2 and 3 of its reported sigma (self-calibration and the rate
+//! table's truth in quadrature, `selfcal_error_uncertainty`) as often as
+//! promised (issue 20).
+//!
+//! Devices. `DEVICES` drawn by `common/random_device.rs` from seeds 2001
+//! on in its `FAST` span (10 kHz..10 MHz, Q 100..1e4, split 0..20
+//! bandwidths either sign, carrier at a mode or between, clock 2.6 to 40
+//! carriers, 2..8 rates, 2..6 calibration frequencies), keeping those
+//! with a clock of at most `MAX_CLOCK_HZ` (a field step's cost grows with
+//! the clock: these take 0.1 to 1 s each). The run coverage test uses
+//! seeds 1001..; the field was tuned on `tests/data/field_*.toml` alone.
+//! Each device drifts over two steps, 25 and 35 deg C (`DRIFT`: -30 and
+//! -31 ppm/K, Q -2000 ppm/K, a 1 deg front-end phase growing 0.1 deg/K),
+//! so each gives four figures, t = selfcal_error / its sigma.
+//!
+//! What was found with it, and fixed: on seed 2047 (clock 2.6 carriers,
+//! Q 960) the identified loop phase lay 4 sigma low and the self-cal
+//! error at 3.2 sigma: the fine fit left out the DAC's images, which the
+//! ADC folds onto the carrier (`gyrocal_host::images`); the fit and the
+//! prediction now carry them (seeds 2082 and 2096, Q 129 and 154 at 3
+//! and 3.8 carriers per clock, were at 7.2 and 4.6 sigma). The rate
+//! table's part spread with 7 degrees of freedom let one dither seed of
+//! the consumer device read at 50 and 100 deg/s sit 5.4 sigma off
+//! (`TABLE_WINDOWS`).
+//!
+//! Assertions, and why they can fail:
+//! - Between 90% and 99.5% of all t within 2 (95.4% for normal errors
+//!   over honest sigmas; the truth's part spread has 15 degrees of
+//!   freedom and carries its coverage factor). A systematic the budget
+//!   misses, of the size of the sigma, puts a normal's 81% within 2;
+//!   sigmas twice too large put 99.99% within 2. The four figures of a
+//!   device share its identification, so the 160 count as 40 to 160
+//!   trials: at 96% a binomial standard deviation of 1.5 to 3%.
+//! - Every t within 3. The pinned devices hold it (largest |t| 2.30);
+//!   seeds up to 2100 (85 devices, 340 figures) gave 96.2% within 2 and
+//!   one figure at 3.13 (seed 2080, Q 111, an output whose self-cal
+//!   sigma is 0.01%): 0.9 such are expected in 340 figures of honest
+//!   normal sigmas, so other seeds may need a look before they are
+//!   pinned.
+//! - Not inflated: the RMS of t at least 0.3 (an honest set gives about
+//!   0.85 to 1).
+//! - Every step finishes: a failed step is a clear error, but these
+//!   devices are inside the supported ranges.
+//!
+//! To look at other seeds (one line per device):
+//! ```sh
+//! GYROCAL_FIELD_SEEDS=2001..2101 cargo test --release --test field_coverage -- --ignored --nocapture explore
+//! ```
+
+#[path = "common/random_device.rs"]
+mod random_device;
+
+use gyrocal_sim::field::scenario::{self, FieldReport};
+use random_device::{FAST, RandomDevice};
+
+/// Devices in the coverage test.
+const DEVICES: usize = 40;
+/// First seed drawn.
+const FIRST_SEED: u64 = 2001;
+/// Devices with a faster clock are skipped (cost).
+const MAX_CLOCK_HZ: f64 = 3e7;
+/// The drift every device goes through.
+const DRIFT: &str = "[drift]\ntemperatures_c = [25, 35]\ntcf1_ppm_per_k = -30.0\n\
+                     tcf2_ppm_per_k = -31.0\nq_ppm_per_k = -2000\nfront_end_phase_deg = 1.0\n\
+                     front_end_phase_deg_per_k = 0.1\n";
+
+/// The field run of the device of `seed`, or None when its clock is too
+/// fast for the test.
+fn field(seed: u64) -> Option<(RandomDevice, FieldReport)> {
+    let d = RandomDevice::draw(seed, FAST);
+    if d.clock_hz > MAX_CLOCK_HZ {
+        return None;
+    }
+    let text = format!("{}{DRIFT}", d.toml(""));
+    let sc = scenario::parse("random.toml", &text).unwrap();
+    let report = scenario::run(&sc, &|_| {}).unwrap();
+    Some((d, report))
+}
+
+/// t = error / sigma of each step and output.
+fn t_values(r: &FieldReport) -> Vec<f64> {
+    r.steps
+        .iter()
+        .flat_map(|s| (0..2).map(move |k| s.selfcal_error[k] / s.selfcal_error_uncertainty[k]))
+        .collect()
+}
+
+/// One line per device.
+fn describe(d: &RandomDevice, r: &FieldReport) -> String {
+    let mut line = format!(
+        "seed {} {}, {:.2e} clocks:",
+        d.seed,
+        d.summary(),
+        r.clocks as f64
+    );
+    for s in &r.steps {
+        for k in 0..2 {
+            line += &format!(
+                " {:+.4}%/{:.4}% t={:+.2}",
+                100.0 * s.selfcal_error[k],
+                100.0 * s.selfcal_error_uncertainty[k],
+                s.selfcal_error[k] / s.selfcal_error_uncertainty[k]
+            );
+        }
+    }
+    for f in &r.failed {
+        line += &format!(
+            " FAILED at {} deg C ({}): {}",
+            f.temperature_c, f.stage, f.error
+        );
+    }
+    line
+}
+
+#[test]
+fn self_calibrated_scale_factors_lie_within_their_sigmas_as_promised() {
+    let runs: Vec<(RandomDevice, FieldReport)> =
+        (FIRST_SEED..).filter_map(field).take(DEVICES).collect();
+    let mut t = vec![];
+    for (d, r) in &runs {
+        eprintln!("{}", describe(d, r));
+        assert!(r.failed.is_empty(), "seed {}: {:?}", d.seed, r.failed);
+        t.extend(t_values(r));
+    }
+    let n = t.len() as f64;
+    let in2 = t.iter().filter(|x| x.abs() <= 2.0).count() as f64 / n;
+    let rms = (t.iter().map(|x| x * x).sum::<f64>() / n).sqrt();
+    let worst = t.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    eprintln!(
+        "{} figures: {:.1}% within 2 sigma, largest |t| {worst:.2}, RMS t {rms:.2}",
+        t.len(),
+        100.0 * in2
+    );
+    assert_eq!(t.len(), 4 * DEVICES);
+    assert!(
+        (0.90..=0.995).contains(&in2),
+        "{:.1}% within 2 sigma",
+        100.0 * in2
+    );
+    assert!(worst <= 3.0, "a figure at {worst:.2} sigma");
+    assert!(rms >= 0.3, "RMS t {rms:.2}: sigmas inflated");
+}
+
+/// One line per device of `GYROCAL_FIELD_SEEDS` (A..B), for exploring.
+#[test]
+#[ignore]
+fn explore() {
+    let seeds = std::env::var("GYROCAL_FIELD_SEEDS").unwrap_or_else(|_| "2001..2011".into());
+    let (a, b) = seeds.split_once("..").expect("GYROCAL_FIELD_SEEDS=A..B");
+    let range = a.parse::<u64>().unwrap()..b.parse::<u64>().unwrap();
+    let mut t = vec![];
+    for (d, r) in range.filter_map(field) {
+        println!("{}", describe(&d, &r));
+        t.extend(t_values(&r));
+    }
+    let n = t.len() as f64;
+    println!(
+        "{} figures: {:.1}% within 2 sigma, {} beyond 3",
+        t.len(),
+        100.0 * t.iter().filter(|x| x.abs() <= 2.0).count() as f64 / n,
+        t.iter().filter(|x| x.abs() > 3.0).count()
+    );
+}
