@@ -119,23 +119,20 @@ pub struct DriveRatio {
 }
 
 /// G_k(f) up to a common factor: 1 / ((f_k - f)(f_k + f) + j f b_k).
-fn resonator(f_k: f64, q_k: f64, f: f64) -> C64 {
+pub(crate) fn resonator(f_k: f64, q_k: f64, f: f64) -> C64 {
     1.0 / C64::new((f_k - f) * (f_k + f), f * f_k / q_k)
 }
 
 /// The line y = P + Q W_2 through `y` measured at drive 2's two signed
 /// words `w2`: (P, Q).
-fn line(y: [C64; 2], w2: [f64; 2]) -> (C64, C64) {
+pub(crate) fn line(y: [C64; 2], w2: [f64; 2]) -> (C64, C64) {
     let q = (y[0] - y[1]) / (w2[0] - w2[1]);
     (y[0] - q * w2[0], q)
 }
 
-/// (g_2 / g_1)^2 from the four complex window means (outputs 1 and 2 at
-/// drive 2's two signed words `w2`) and G_1 / G_2.
-fn ratio_squared(z: [[C64; 2]; 2], w1: f64, w2: [f64; 2], g1_over_g2: C64) -> C64 {
-    // Output 1: Z_1 = P_1 + Q_1 W_2; output 2: Z_2 / W_2 = P_2 + Q_2 W_2.
-    let (p1, q1) = line([z[0][0], z[1][0]], w2);
-    let (p2, q2) = line([z[0][1] / w2[0], z[1][1] / w2[1]], w2);
+/// (g_2 / g_1)^2 from the two outputs' lines in W_2 (Z_1 = P_1 + Q_1
+/// W_2, Z_2 / W_2 = P_2 + Q_2 W_2), drive 1's word and G_1 / G_2.
+fn ratio_squared(p1: C64, q1: C64, p2: C64, q2: C64, w1: f64, g1_over_g2: C64) -> C64 {
     q1 * q2 * w1 * w1 / (p1 * p2) * g1_over_g2
 }
 
@@ -174,52 +171,100 @@ fn batch_means(board: &mut dyn Board, settle: u64, per_batch: u64) -> Result<Vec
         .collect()
 }
 
+/// The four responses' windows (module header, "How the gateware exposes
+/// the four responses"): both drives at the readout amplitudes (drive 1 at
+/// `DRIVE1_FRACTION`), drive 2 at its two signs, I and Q of each; every
+/// window `min_window_s` long, cut into `BATCHES` batches.
+pub(crate) struct CrossWindows {
+    /// Batch means, `means[sign][quadrature][batch][output]`.
+    means: Vec<Vec<Vec<[f64; 2]>>>,
+    /// Drive 1's signed readout word.
+    pub w1: f64,
+    /// Drive 2's signed readout words at its two signs.
+    pub words: [f64; 2],
+    /// Clocks the windows took.
+    pub clocks: u64,
+}
+
+impl CrossWindows {
+    /// Measure the windows at the operating point `op`.
+    pub fn measure(board: &mut dyn Board, knowns: &Knowns, op: &Operating) -> Result<Self, Error> {
+        let r = knowns.filter.decimation;
+        let window = knowns.window_samples();
+        let per_batch = window.div_ceil(BATCHES as u64).max(1);
+        let settle = knowns.settle_clocks(identify::SETTLE_TAUS);
+        let filter = knowns.filter_settle_clocks();
+        let mut means = vec![];
+        let mut words = [0.0; 2];
+        let mut w1 = 0.0;
+        let mut clocks = 0;
+        for (s, sign) in [1.0, -1.0].into_iter().enumerate() {
+            let amps = (DRIVE1_FRACTION * op.amplitude.0, sign * op.amplitude.1);
+            let (regs, _) = knowns.registers(op.carrier_hz, None, amps, op.ref_lag_deg)?;
+            w1 = signed_readout_word(regs.amp.0);
+            words[s] = signed_readout_word(regs.amp.1);
+            let mut pair = vec![];
+            for quarter in [0u32, 1 << 30] {
+                let mut rotated = regs;
+                rotated.ref_phase = regs.ref_phase.wrapping_add(quarter);
+                board.program(&rotated)?;
+                let wait = if quarter == 0 { settle } else { filter };
+                pair.push(batch_means(board, wait, per_batch)?);
+                clocks += wait + BATCHES as u64 * per_batch * u64::from(r);
+            }
+            means.push(pair);
+        }
+        if words[0] == words[1] || w1 == 0.0 {
+            return Err(Error::Measurement {
+                what: "cross responses",
+                reason: "both drive amplitudes must be non-zero".into(),
+            });
+        }
+        Ok(Self {
+            means,
+            w1,
+            words,
+            clocks,
+        })
+    }
+
+    /// Output k's complex mean at drive 2's sign s, batch b (`None`: all).
+    fn z(&self, s: usize, k: usize, b: Option<usize>) -> C64 {
+        let part = |q: usize| match b {
+            Some(b) => self.means[s][q][b][k],
+            None => self.means[s][q].iter().map(|m| m[k]).sum::<f64>(),
+        };
+        C64::new(part(0), part(1))
+    }
+
+    /// Both outputs' lines in W_2 of batch `b` (`None`: the sums):
+    /// ((P_1, Q_1), (P_2, Q_2)), Z_1 = P_1 + Q_1 W_2 and Z_2 / W_2 = P_2 +
+    /// Q_2 W_2.
+    pub fn lines(&self, b: Option<usize>) -> ((C64, C64), (C64, C64)) {
+        let w2 = self.words;
+        (
+            line([self.z(0, 0, b), self.z(1, 0, b)], w2),
+            line([self.z(0, 1, b) / w2[0], self.z(1, 1, b) / w2[1]], w2),
+        )
+    }
+}
+
 /// Measure g_2 / g_1 on a board that turns at a steady (unknown) rate,
-/// at the operating point `op` of identification `id`: both drives at the
-/// readout amplitudes, drive 2 at its two signs, I and Q of each; every
-/// window `min_window_s` long.
+/// at the operating point `op` of identification `id` (the four
+/// responses of the module header, "How the gateware exposes the four
+/// responses").
 pub fn measure(
     board: &mut dyn Board,
     knowns: &Knowns,
     op: &Operating,
     id: &Identified,
 ) -> Result<DriveRatio, Error> {
-    let r = knowns.filter.decimation;
-    let window = knowns.window_samples();
-    let per_batch = window.div_ceil(BATCHES as u64).max(1);
-    let settle = knowns.settle_clocks(identify::SETTLE_TAUS);
-    let filter = knowns.filter_settle_clocks();
-    let mut means = vec![]; // [sign][phase] -> batches
-    let mut words = [0.0; 2];
-    let mut w1 = 0.0;
-    let mut clocks = 0;
-    for (s, sign) in [1.0, -1.0].into_iter().enumerate() {
-        let amps = (DRIVE1_FRACTION * op.amplitude.0, sign * op.amplitude.1);
-        let (regs, _) = knowns.registers(op.carrier_hz, None, amps, op.ref_lag_deg)?;
-        w1 = signed_readout_word(regs.amp.0);
-        words[s] = signed_readout_word(regs.amp.1);
-        let mut pair = vec![];
-        for quarter in [0u32, 1 << 30] {
-            let mut rotated = regs;
-            rotated.ref_phase = regs.ref_phase.wrapping_add(quarter);
-            board.program(&rotated)?;
-            let wait = if quarter == 0 { settle } else { filter };
-            pair.push(batch_means(board, wait, per_batch)?);
-            clocks += wait + BATCHES as u64 * per_batch * u64::from(r);
-        }
-        means.push(pair);
-    }
-    if words[0] == words[1] || w1 == 0.0 {
-        return Err(Error::Measurement {
-            what: "drive-gain ratio",
-            reason: "both drive amplitudes must be non-zero".into(),
-        });
-    }
+    let windows = CrossWindows::measure(board, knowns, op)?;
     let (g_ratio, g_error) = resonator_ratio(id, op.carrier_hz);
     let squared: Vec<C64> = (0..BATCHES)
         .map(|b| {
-            let z = |s: usize, k: usize| C64::new(means[s][0][b][k], means[s][1][b][k]);
-            ratio_squared([[z(0, 0), z(0, 1)], [z(1, 0), z(1, 1)]], w1, words, g_ratio)
+            let ((p1, q1), (p2, q2)) = windows.lines(Some(b));
+            ratio_squared(p1, q1, p2, q2, windows.w1, g_ratio)
         })
         .collect();
     let design = knowns.force_full_scale[1] / knowns.force_full_scale[0];
@@ -227,21 +272,12 @@ pub fn measure(
     let phase: Vec<f64> = squared.iter().map(|v| 0.5 * v.arg().to_degrees()).collect();
     let mut relative = mean_and_error(&magnitude);
     relative.uncertainty = relative.uncertainty.hypot(0.5 * g_error * relative.value);
-    let cross = {
-        let z = |s: usize, k: usize| {
-            C64::new(
-                means[s][0].iter().map(|m| m[k]).sum::<f64>(),
-                means[s][1].iter().map(|m| m[k]).sum::<f64>(),
-            )
-        };
-        let (p, q) = line([z(0, 1) / words[0], z(1, 1) / words[1]], words);
-        (p / (q * w1)).norm()
-    };
+    let (_, (p2, q2)) = windows.lines(None);
     Ok(DriveRatio {
         relative,
         phase_deg: mean_and_error(&phase),
-        cross_over_direct: cross,
-        clocks,
+        cross_over_direct: (p2 / (q2 * windows.w1)).norm(),
+        clocks: windows.clocks,
     })
 }
 
@@ -270,7 +306,10 @@ mod tests {
                 let x2 = a2 * (gain1 * m[1][0] * w1 - j * gain2 * m[1][1] * w);
                 [kappa1 * w1 * x1, kappa2 * w * x2]
             };
-            let got = ratio_squared([z(w2[0]), z(w2[1])], w1, w2, g1 / g2);
+            let (y0, y1) = (z(w2[0]), z(w2[1]));
+            let (p1, q1) = line([y0[0], y1[0]], w2);
+            let (p2, q2) = line([y0[1] / w2[0], y1[1] / w2[1]], w2);
+            let got = ratio_squared(p1, q1, p2, q2, w1, g1 / g2);
             // Exact algebra; the lines subtract windows whose terms differ
             // by up to 1e4 in size, so double rounding leaves some 1e-12.
             assert!((got - rho * rho).norm() < 1e-10, "{got} vs {}", rho * rho);

@@ -31,6 +31,7 @@
 pub mod average;
 pub mod board;
 pub mod clip;
+pub mod coupling;
 pub mod datasheet;
 pub mod device;
 pub mod drive_ratio;

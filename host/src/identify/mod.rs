@@ -162,12 +162,19 @@ pub struct Identified {
     /// REF_PHASE (a carrier phase) cannot undo: the prediction carries it
     /// as an envelope lead (`selfcal::predicted_ratio`).
     pub group_delay_s: Estimate,
+    /// The quadrature (stiffness) coupling Omega_q (deg/s, the sign
+    /// convention of `[gyro] quadrature_dps`), measured at rest from the
+    /// cross responses once the operating point is known
+    /// ([`crate::coupling`]); `None` until then, when the datasheet's is
+    /// used.
+    pub quadrature_dps: Option<Estimate>,
     /// Clocks the identification took.
     pub clocks: u64,
 }
 
 impl Identified {
-    /// The identified mechanical parameters, lambda and the couplings from
+    /// The identified mechanical parameters and quadrature coupling (the
+    /// datasheet's until measured), lambda and the damping coupling from
     /// the datasheet.
     pub fn gyro(&self, nominal: &GyroParams) -> GyroParams {
         GyroParams {
@@ -175,6 +182,9 @@ impl Identified {
             f2_hz: self.modes[1].f_hz.value,
             q1: self.modes[0].q.value,
             q2: self.modes[1].q.value,
+            quadrature_dps: self
+                .quadrature_dps
+                .map_or(nominal.quadrature_dps, |q| q.value),
             ..nominal.clone()
         }
     }
@@ -307,6 +317,7 @@ pub fn identify(
         modes: [m1, m2],
         loop_phase_deg,
         group_delay_s,
+        quadrature_dps: None,
         clocks: c1 + c2,
     })
 }

@@ -20,9 +20,9 @@ use serde::Serialize;
 pub struct SfUncertainty {
     /// The staircase slope's noise (`staircase`).
     pub staircase: [f64; 2],
-    /// The predicted ratio's, from the identified f1, f2, Q1, Q2, group
-    /// delay and loop phase (each moved by its uncertainty through the
-    /// exact theory).
+    /// The predicted ratio's, from the identified f1, f2, Q1, Q2,
+    /// quadrature coupling, group delay and loop phase (each moved by its
+    /// uncertainty through the exact theory).
     pub identified: [f64; 2],
     /// The datasheet's angular gain lambda: its relative 1-sigma moved
     /// through the exact theory (the ratio scales with lambda, one for one
@@ -63,8 +63,8 @@ fn spread(moved: &[Ratio], ratio: &Ratio) -> [f64; 2] {
 }
 
 /// The predicted ratio's relative 1-sigma uncertainty per output from the
-/// identified parameters: each of f1, Q1, f2, Q2, the group delay and the
-/// loop phase (as a residual error of the correction) moved by its
+/// identified parameters: each of f1, Q1, f2, Q2, the quadrature coupling,
+/// the group delay and the loop phase (as a residual error of the correction) moved by its
 /// uncertainty (independent fits), the changes added in quadrature.
 pub(super) fn identified(
     knowns: &Knowns,
@@ -83,6 +83,11 @@ pub(super) fn identified(
     {
         let mut g = gyro.clone();
         *[&mut g.f1_hz, &mut g.q1, &mut g.f2_hz, &mut g.q2][i] += sd;
+        moved.push(predicted_ratio(knowns, &g, op, cal_hz)?);
+    }
+    if let Some(q) = id.quadrature_dps {
+        let mut g = gyro.clone();
+        g.quadrature_dps += q.uncertainty;
         moved.push(predicted_ratio(knowns, &g, op, cal_hz)?);
     }
     if id.group_delay_s.uncertainty.is_finite() {

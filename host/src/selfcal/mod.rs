@@ -74,6 +74,7 @@ pub use predict::{Ratio, adc_peaks, predicted_ratio};
 pub use staircase::{Staircase, staircase};
 
 use crate::board::Board;
+use crate::coupling;
 use crate::device::GyroParams;
 use crate::drive_ratio::DriveRatio;
 use crate::error::Error;
@@ -174,7 +175,17 @@ pub fn self_calibrate(
     knowns: &Knowns,
     guess: &GyroParams,
 ) -> Result<SelfCal, Error> {
-    let identified = identify::identify(board, knowns, guess)?;
+    let mut identified = identify::identify(board, knowns, guess)?;
+    // The quadrature coupling at rest, at the operating point of the
+    // uncoupled device; then the operating point again with it (its
+    // cross responses move the predicted ADC peaks).
+    let first = knowns.with_device(&identified.gyro(&knowns.nominal));
+    let op = operating(&first, &identified)?;
+    let measured_coupling = coupling::measure(board, &first, &op, &identified)?;
+    let q = measured_coupling.quadrature_dps;
+    coupling::uncouple(&mut identified, q.value, knowns.nominal.angular_gain);
+    identified.quadrature_dps = Some(q);
+    identified.clocks += measured_coupling.clocks;
     let gyro = identified.gyro(&knowns.nominal);
     let measured = knowns.with_device(&gyro);
     let op = operating(&measured, &identified)?;

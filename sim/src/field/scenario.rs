@@ -41,6 +41,7 @@ use crate::noise::ThermalNoise;
 use gyrocal_host::Knowns;
 use gyrocal_host::datasheet::Datasheet;
 use gyrocal_host::drive_ratio;
+use gyrocal_host::identify::Estimate;
 use gyrocal_host::sampling::{Signal, mean_of_parts, part_means};
 use gyrocal_host::selfcal::{self, Operating, SelfCal};
 use gyrocal_regs::plan::nearest_fold;
@@ -240,6 +241,12 @@ pub struct IdentifiedJson {
     pub loop_phase_deg: f64,
     /// Its 1-sigma uncertainty.
     pub loop_phase_deg_uncertainty: f64,
+    /// Quadrature (stiffness) coupling Omega_q (deg/s, the sign convention
+    /// of `[gyro] quadrature_dps`), measured at rest
+    /// (`gyrocal_host::coupling`).
+    pub quadrature_dps: f64,
+    /// Its 1-sigma uncertainty.
+    pub quadrature_dps_uncertainty: f64,
     /// Drive-gain ratio g2 / g1 over the design ratio, measured while the
     /// device turned (`[drive_probe]`; null without it).
     pub drive_gain_ratio: Option<f64>,
@@ -252,6 +259,10 @@ impl From<&SelfCal> for IdentifiedJson {
         let id = &cal.identified;
         let ratio = cal.drive_ratio.as_ref().map(|d| d.relative);
         let [m1, m2] = &id.modes;
+        let quadrature = id.quadrature_dps.unwrap_or(Estimate {
+            value: f64::NAN,
+            uncertainty: f64::NAN,
+        });
         Self {
             f1_hz: m1.f_hz.value,
             f1_hz_uncertainty: m1.f_hz.uncertainty,
@@ -263,6 +274,8 @@ impl From<&SelfCal> for IdentifiedJson {
             q2_uncertainty: m2.q.uncertainty,
             loop_phase_deg: id.loop_phase_deg.value,
             loop_phase_deg_uncertainty: id.loop_phase_deg.uncertainty,
+            quadrature_dps: quadrature.value,
+            quadrature_dps_uncertainty: quadrature.uncertainty,
             drive_gain_ratio: ratio.map(|r| r.value),
             drive_gain_ratio_uncertainty: ratio.map(|r| r.uncertainty),
         }

@@ -1,0 +1,207 @@
+//! The quadrature (stiffness) coupling, measured at rest through the same
+//! four cross responses as the drive-gain ratio ([`crate::drive_ratio`]).
+//!
+//! # Why rest suffices
+//!
+//! With a stiffness coupling k (x1'' gets + k x2, x2'' gets + k x1; k =
+//! 2 lambda w1 Omega_q, `[gyro] quadrature_dps` Omega_q) the phasor
+//! equations at the carrier are, with G_k = 1 / (w_k^2 - w^2 + j w b_k)
+//! and c = j w 2 lambda Omega,
+//!
+//! ```text
+//! [ 1/G_1  k - c ] [X_1]   [F_1]              1   [ 1/G_2   -(k - c) ]
+//! [ k + c  1/G_2 ] [X_2] = [F_2],   M = ----- [                    ]
+//!                                        det   [ -(k + c)   1/G_1  ]
+//! ```
+//!
+//! At rest (c = 0) the cross responses are M_12 = M_21 = -k / det, and
+//! with the lines of [`crate::drive_ratio`] (Z_1 = P_1 + Q_1 W_2, Z_2 /
+//! W_2 = P_2 + Q_2 W_2; rho = g_2 / g_1 the drive-gain ratio)
+//!
+//! ```text
+//! Q_1 / P_1 = -j rho M_12 / (M_11 W_1) =  j rho k G_2 / W_1   ->  k_1 = -j W_1 (Q_1 / P_1) / (rho G_2)
+//! P_2 / Q_2 =  j W_1 M_21 / (rho M_22) = -j k G_1 W_1 / rho   ->  k_2 =  j rho (P_2 / Q_2) / (W_1 G_1)
+//! ```
+//!
+//! ADC gains and each output's reference phase and filter gain cancel in
+//! each; rho (the design ratio here) enters k_1 as 1 / r and k_2 as r for
+//! a true ratio r times the design's, so their mean carries (r + 1 / r) / 2,
+//! 1 + 5e-5 for a ratio 1% off. The coupling is a real stiffness: the
+//! imaginary part of the mean is a check (a damping coupling would put
+//! it there), the real part the estimate, linear in the windows (no
+//! square root), so a device without coupling reads 0 within its noise.
+//! In deg/s, with G in 1 / Hz^2 (k in Hz^2, 4 pi^2 of it in rad^2/s^2),
+//! Omega_q = 4 pi^2 k / (2 lambda 2 pi f_1) rad/s = 180 k / (lambda f_1)
+//! deg/s with the datasheet's lambda. The prediction turns it back into k
+//! with the same lambda, so lambda's error does not enter.
+//!
+//! # Uncertainty
+//!
+//! The spread of the `BATCHES` batch estimates (standard error) and the
+//! identified G_1, G_2 (each k_i moves with |G|; finite differences over
+//! f_k and Q_k), in quadrature.
+
+use crate::board::Board;
+use crate::drive_ratio::{BATCHES, CrossWindows, resonator};
+use crate::error::Error;
+use crate::identify::{Estimate, Identified};
+use crate::knowns::Knowns;
+use crate::selfcal::Operating;
+use crate::stats::mean_and_standard_error;
+use nalgebra::Complex;
+use serde::Serialize;
+
+type C64 = Complex<f64>;
+
+/// The measured coupling.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Coupling {
+    /// Omega_q (deg/s), the sign convention of `[gyro] quadrature_dps`.
+    pub quadrature_dps: Estimate,
+    /// The imaginary part of the same estimate (deg/s): zero for a pure
+    /// stiffness coupling.
+    pub imaginary_dps: f64,
+    /// Clocks the measurement took.
+    pub clocks: u64,
+}
+
+/// k (Hz^2) from one batch's lines (module header), for resonators `g`
+/// and the design drive-gain ratio `rho`.
+fn coupling_hz2(lines: ((C64, C64), (C64, C64)), w1: f64, g: [C64; 2], rho: f64) -> C64 {
+    let j = C64::new(0.0, 1.0);
+    let ((p1, q1), (p2, q2)) = lines;
+    let k1 = -j * w1 * (q1 / p1) / (rho * g[1]);
+    let k2 = j * rho * (p2 / q2) / (w1 * g[0]);
+    0.5 * (k1 + k2)
+}
+
+/// G_1 and G_2 at `carrier_hz` from `id`, and the relative 1-sigma of
+/// their mean magnitude (finite differences over f_k, Q_k).
+fn resonators(id: &Identified, carrier_hz: f64) -> ([C64; 2], f64) {
+    let [m1, m2] = &id.modes;
+    let p = [m1.f_hz, m1.q, m2.f_hz, m2.q];
+    let at = |v: [f64; 4]| {
+        [
+            resonator(v[0], v[1], carrier_hz),
+            resonator(v[2], v[3], carrier_hz),
+        ]
+    };
+    let values = p.map(|e| e.value);
+    let g = at(values);
+    // k_1 scales as 1 / |G_2| and k_2 as 1 / |G_1|: the mean as their mean.
+    let size = |g: [C64; 2]| 0.5 * (1.0 / g[0].norm() + 1.0 / g[1].norm());
+    let centre = size(g);
+    let variance: f64 = (0..4)
+        .map(|i| {
+            let mut moved = values;
+            let h = 1e-3 * p[i].uncertainty.max(1e-9 * p[i].value.abs());
+            moved[i] += h;
+            let slope = (size(at(moved)) / centre).ln() / h;
+            (slope * p[i].uncertainty).powi(2)
+        })
+        .sum();
+    (g, variance.sqrt())
+}
+
+/// Measure the quadrature coupling at rest at the operating point `op` of
+/// identification `id`.
+pub fn measure(
+    board: &mut dyn Board,
+    knowns: &Knowns,
+    op: &Operating,
+    id: &Identified,
+) -> Result<Coupling, Error> {
+    let windows = CrossWindows::measure(board, knowns, op)?;
+    let (g, g_error) = resonators(id, op.carrier_hz);
+    let rho = knowns.force_full_scale[1] / knowns.force_full_scale[0];
+    let per_hz2 = 180.0 / (knowns.nominal.angular_gain * id.modes[0].f_hz.value);
+    let batches: Vec<C64> = (0..BATCHES)
+        .map(|b| per_hz2 * coupling_hz2(windows.lines(Some(b)), windows.w1, g, rho))
+        .collect();
+    if batches.iter().any(|k| !k.re.is_finite()) {
+        return Err(Error::Measurement {
+            what: "quadrature coupling",
+            reason: "a direct response (P_1 or Q_2) read zero".into(),
+        });
+    }
+    let re: Vec<f64> = batches.iter().map(|k| k.re).collect();
+    let (value, noise) = mean_and_standard_error(&re);
+    let imaginary = batches.iter().map(|k| k.im).sum::<f64>() / BATCHES as f64;
+    Ok(Coupling {
+        quadrature_dps: Estimate {
+            value,
+            uncertainty: noise.hypot(g_error * value),
+        },
+        imaginary_dps: imaginary,
+        clocks: windows.clocks,
+    })
+}
+
+/// The uncoupled modes behind the identified ones: each mode's fit sees
+/// its direct response M_kk = 1 / (1/G_k - k^2 G_(1-k)), a resonator whose
+/// 1/G is moved by -k^2 G_(1-k)(f), nearly constant across its fine sweep
+/// (the other mode is many bandwidths away). So the fitted f_k^2 is the
+/// uncoupled one minus k^2 Re G_(1-k)(f_k), and the fitted bandwidth the
+/// uncoupled one minus k^2 Im G_(1-k)(f_k) / f_k: this undoes both, with
+/// `quadrature_dps` (deg/s) turned back into k with the datasheet's
+/// lambda. On the consumer device with 250 deg/s the shift is 4e-4 Hz
+/// (k^2 / (f_2^2 - f_1^2) / 2 f_1), which its detuned output's scale
+/// factor feels.
+pub fn uncouple(id: &mut Identified, quadrature_dps: f64, angular_gain: f64) {
+    let f1 = id.modes[0].f_hz.value;
+    let k = quadrature_dps * angular_gain * f1 / 180.0;
+    let [m1, m2] = &id.modes;
+    let (f, q) = ([m1.f_hz.value, m2.f_hz.value], [m1.q.value, m2.q.value]);
+    for i in 0..2 {
+        let other = resonator(f[1 - i], q[1 - i], f[i]) * (k * k);
+        let fk = (f[i] * f[i] + other.re).sqrt();
+        let bk = f[i] / q[i] + other.im / f[i];
+        id.modes[i].f_hz.value = fk;
+        id.modes[i].q.value = fk / bk;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The module header's model with a stiffness coupling at rest, chosen
+    /// gains, pick-off phases and a drive-gain ratio 1% off the design's:
+    /// the estimate returns k within (r + 1/r) / 2.
+    #[test]
+    fn the_cross_responses_at_rest_return_the_coupling() {
+        let f = 25.1e3;
+        let g = [resonator(25.1e3, 3000.0, f), resonator(25.8e3, 3000.0, f)];
+        for k in [3.0e3, -1.2e4, 0.0] {
+            let det = 1.0 / (g[0] * g[1]) - C64::new(k * k, 0.0);
+            let m = [
+                [1.0 / (g[1] * det), -k / det],
+                [-k / det, 1.0 / (g[0] * det)],
+            ];
+            let r = 1.01;
+            let (gain1, gain2) = (2.0, 2.0 * r);
+            let (a1, a2) = (C64::from_polar(3.0, 0.2), C64::from_polar(5.0, -0.4));
+            let (kappa1, kappa2) = (C64::from_polar(0.7, -1.0), C64::from_polar(0.4, 2.0));
+            let w1 = 2500.0;
+            let w2 = [15000.0, -14999.0];
+            let j = C64::new(0.0, 1.0);
+            let z = |w: f64| {
+                let x1 = a1 * (gain1 * m[0][0] * w1 - j * gain2 * m[0][1] * w);
+                let x2 = a2 * (gain1 * m[1][0] * w1 - j * gain2 * m[1][1] * w);
+                [kappa1 * w1 * x1, kappa2 * w * x2]
+            };
+            let (y0, y1) = (z(w2[0]), z(w2[1]));
+            let lines = (
+                crate::drive_ratio::line([y0[0], y1[0]], w2),
+                crate::drive_ratio::line([y0[1] / w2[0], y1[1] / w2[1]], w2),
+            );
+            let got = coupling_hz2(lines, w1, g, 1.0);
+            let expected = k * 0.5 * (r + 1.0 / r);
+            assert!(
+                (got.re - expected).abs() <= 1e-9 * k.abs().max(1.0),
+                "{got} vs {k}"
+            );
+            assert!(got.im.abs() <= 1e-9 * k.abs().max(1.0), "{got}");
+        }
+    }
+}
