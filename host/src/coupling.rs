@@ -112,6 +112,16 @@ pub fn measure(
     id: &Identified,
 ) -> Result<Coupling, Error> {
     let windows = CrossWindows::measure(board, knowns, op)?;
+    from_windows(&windows, knowns, op, id)
+}
+
+/// The coupling from windows measured at rest.
+pub(crate) fn from_windows(
+    windows: &CrossWindows,
+    knowns: &Knowns,
+    op: &Operating,
+    id: &Identified,
+) -> Result<Coupling, Error> {
     let (g, g_error) = resonators(id, op.carrier_hz);
     let rho = knowns.force_full_scale[1] / knowns.force_full_scale[0];
     let per_hz2 = 180.0 / (knowns.nominal.angular_gain * id.modes[0].f_hz.value);

@@ -79,9 +79,10 @@
 //! `BATCHES` estimates gives the noise's standard error. The identified
 //! parameters' uncertainties enter through G_1 / G_2 (propagated by finite
 //! differences). A rate that drifts between the two signs cancels to first
-//! order (each of Q_1 and P_2 is the mean over both); quadrature coupling
-//! (a stiffness term, which this model of the device does not have) would
-//! break M_12 = -M_21 and is not covered.
+//! order (each of Q_1 and P_2 is the mean over both). A quadrature
+//! (stiffness) coupling breaks M_12 = -M_21 but not the magnitude of the
+//! estimate (`from_windows`); it makes the ratio observable at rest,
+//! where the cycle measures it ([`crate::coupling`]).
 
 use crate::board::Board;
 use crate::error::Error;
@@ -109,7 +110,9 @@ pub struct DriveRatio {
     /// |g_2 / g_1| over the design ratio (`Knowns::force_full_scale`).
     pub relative: Estimate,
     /// Half the phase of the measured (g_2 / g_1)^2 (deg): zero when the
-    /// drives differ in gain only.
+    /// drives differ in gain only and the modes are coupled by the
+    /// rotation alone; +-90 at rest with a quadrature coupling
+    /// (`from_windows` says why).
     pub phase_deg: Estimate,
     /// |H_21 / H_22|: the cross response over the direct one on output 2,
     /// which sets the precision (it grows with the rate).
@@ -260,6 +263,23 @@ pub fn measure(
     id: &Identified,
 ) -> Result<DriveRatio, Error> {
     let windows = CrossWindows::measure(board, knowns, op)?;
+    Ok(from_windows(&windows, knowns, op, id))
+}
+
+/// g_2 / g_1 from measured windows. With a quadrature coupling k the
+/// cross responses are M_12 = -(k - c) / det and M_21 = -(k + c) / det
+/// (`crate::coupling`), so the identity of the module header reads
+/// -(g_2 / g_1)^2 (k - c) / (k + c) on the right where it read
+/// (g_2 / g_1)^2. For a stiffness k (real) and the Coriolis c (imaginary)
+/// that factor has magnitude 1: |g_2 / g_1| stays exact while turning, at
+/// rest (c = 0, when k is large enough to see) or both; only the phase
+/// moves.
+pub(crate) fn from_windows(
+    windows: &CrossWindows,
+    knowns: &Knowns,
+    op: &Operating,
+    id: &Identified,
+) -> DriveRatio {
     let (g_ratio, g_error) = resonator_ratio(id, op.carrier_hz);
     let squared: Vec<C64> = (0..BATCHES)
         .map(|b| {
@@ -269,16 +289,22 @@ pub fn measure(
         .collect();
     let design = knowns.force_full_scale[1] / knowns.force_full_scale[0];
     let magnitude: Vec<f64> = squared.iter().map(|v| v.norm().sqrt() / design).collect();
-    let phase: Vec<f64> = squared.iter().map(|v| 0.5 * v.arg().to_degrees()).collect();
+    // Phases about the batches' mean (at rest with a coupling they sit at
+    // +-180 deg, where a plain mean of arguments would wrap).
+    let centre = squared.iter().sum::<C64>();
+    let phase: Vec<f64> = squared
+        .iter()
+        .map(|v| 0.5 * ((v / centre).arg() + centre.arg()).to_degrees())
+        .collect();
     let mut relative = mean_and_error(&magnitude);
     relative.uncertainty = relative.uncertainty.hypot(0.5 * g_error * relative.value);
     let (_, (p2, q2)) = windows.lines(None);
-    Ok(DriveRatio {
+    DriveRatio {
         relative,
         phase_deg: mean_and_error(&phase),
         cross_over_direct: (p2 / (q2 * windows.w1)).norm(),
         clocks: windows.clocks,
-    })
+    }
 }
 
 #[cfg(test)]

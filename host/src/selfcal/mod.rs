@@ -19,11 +19,15 @@
 //! with S the theory's scale factors per unit force product. The ADC gain
 //! a_k and any gain common to both drives cancel exactly; the drive-gain
 //! ratio g_(1-k) / g_k enters one for one, with opposite signs on the two
-//! outputs. At rest the modes are uncoupled, so every response the gateware
-//! can observe carries a_k g_k together: the differential drive gain cannot
-//! be told from an ADC gain, and the cycle at rest uses the board's design
-//! ratio (`Knowns::force_full_scale`). Its drift is the one converter drift
-//! the cycle at rest cannot correct (measured in `tests/field.rs`).
+//! outputs. At rest, on a device without a quadrature coupling, the modes
+//! are uncoupled, so every response the gateware can observe carries a_k
+//! g_k together: the differential drive gain cannot be told from an ADC
+//! gain, and the cycle at rest uses the board's design ratio
+//! (`Knowns::force_full_scale`). Its drift is the one converter drift the
+//! cycle at rest cannot correct (measured in `tests/field.rs`). A
+//! quadrature coupling couples the modes at rest: the cycle measures it
+//! ([`crate::coupling`]) and, when it is strong enough, the ratio with it
+//! (`AT_REST_RATIO_SIGMA`).
 //!
 //! It becomes observable while the device turns, at any rate and without
 //! knowing it. With H_jk the response at ADC j to drive k, H_jk = a_j g_k
@@ -77,6 +81,7 @@ use crate::board::Board;
 use crate::coupling;
 use crate::device::GyroParams;
 use crate::drive_ratio::DriveRatio;
+use crate::drive_ratio::{self, CrossWindows};
 use crate::error::Error;
 use crate::identify::{self, Identified};
 use crate::knowns::Knowns;
@@ -98,6 +103,15 @@ pub const MIN_RIPPLE_PERIODS: usize = 2;
 /// built for (`[frontend] adc_headroom`), so a board that is as planned
 /// keeps its configured drives.
 pub const ADC_OPERATING: f64 = 0.95;
+
+/// Largest relative 1-sigma of a drive-gain ratio measured at rest for the
+/// cycle to predict with it instead of the design ratio: at rest the ratio
+/// is seen only through a quadrature coupling (`drive_ratio::from_windows`),
+/// and without one the estimate is 0 / 0. A tenth of the 1% by which a
+/// drive-gain drift of 0.5% moves a detuned output (`tests/field.rs`):
+/// below it the measured ratio's sigma costs less than the drift it
+/// removes. The 250 deg/s coupled device measures it to 4e-5.
+pub const AT_REST_RATIO_SIGMA: f64 = 1e-3;
 
 /// Where the cycle operates the gateware.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -181,11 +195,14 @@ pub fn self_calibrate(
     // cross responses move the predicted ADC peaks).
     let first = knowns.with_device(&identified.gyro(&knowns.nominal));
     let op = operating(&first, &identified)?;
-    let measured_coupling = coupling::measure(board, &first, &op, &identified)?;
-    let q = measured_coupling.quadrature_dps;
+    let windows = CrossWindows::measure(board, &first, &op)?;
+    let q = coupling::from_windows(&windows, &first, &op, &identified)?.quadrature_dps;
     coupling::uncouple(&mut identified, q.value, knowns.nominal.angular_gain);
     identified.quadrature_dps = Some(q);
-    identified.clocks += measured_coupling.clocks;
+    identified.clocks += windows.clocks;
+    // The same windows give the drive-gain ratio when the coupling makes
+    // it observable (`drive_ratio::from_windows`), applied below.
+    let at_rest = drive_ratio::from_windows(&windows, &first, &op, &identified);
     let gyro = identified.gyro(&knowns.nominal);
     let measured = knowns.with_device(&gyro);
     let op = operating(&measured, &identified)?;
@@ -206,7 +223,7 @@ pub fn self_calibrate(
     .with_total();
     let sf_selfcal_per_dps = std::array::from_fn(|k| sf_cal[k] * ratio.exact[k]);
     let sf_eq56_per_dps = std::array::from_fn(|k| sf_cal[k] * ratio.eq56[k]);
-    Ok(SelfCal {
+    let mut cal = SelfCal {
         clocks: identified.clocks + clocks,
         identified,
         operating: op,
@@ -219,7 +236,17 @@ pub fn self_calibrate(
         drive_ratio: None,
         sf_design_ratio_per_dps: sf_selfcal_per_dps,
         sf_selfcal_uncertainty: uncertainty,
-    })
+    };
+    if at_rest.relative.uncertainty < AT_REST_RATIO_SIGMA {
+        // The coupling's estimate carried (r + 1/r) / 2 of the ratio r
+        // against the design (`coupling` header): take it out.
+        let r = at_rest.relative.value;
+        if let Some(q) = cal.identified.quadrature_dps.as_mut() {
+            q.value *= 2.0 / (r + 1.0 / r);
+        }
+        apply_drive_ratio(knowns, &mut cal, at_rest)?;
+    }
+    Ok(cal)
 }
 
 /// `knowns` with drive 2's force gain moved by `relative` (g_2 / g_1 over
