@@ -121,3 +121,20 @@ fn the_drive_gain_ratio_measured_while_turning_holds_with_a_coupling() {
         assert!(s.selfcal_error[1].abs() < 1e-3);
     }
 }
+
+/// Where the correction stops: a coupling so strong that the modes mix
+/// (`coupling::MAX_MIXING`; 4,000 deg/s on this device, where the
+/// self-calibration was 2.9 sigma off) is a step that fails with one line
+/// naming the coupling, not a figure.
+#[test]
+fn a_coupling_too_strong_to_separate_is_a_one_line_failure() {
+    let mut sc = coupled();
+    sc.exp.gyro.quadrature_dps = 4000.0;
+    sc.drift.temperatures_c = vec![25.0];
+    let report = scenario::run(&sc, &|_| {}).unwrap();
+    assert!(report.steps.is_empty());
+    let error = &report.failed[0].error;
+    eprintln!("{error}");
+    assert!(error.contains("couples the modes too strongly"), "{error}");
+    assert!(!error.contains('\n'));
+}

@@ -196,10 +196,14 @@ pub fn self_calibrate(
     let first = knowns.with_device(&identified.gyro(&knowns.nominal));
     let op = operating(&first, &identified)?;
     let windows = CrossWindows::measure(board, &first, &op)?;
-    let q = coupling::from_windows(&windows, &first, &op, &identified)?.quadrature_dps;
-    coupling::uncouple(&mut identified, q.value, knowns.nominal.angular_gain);
-    identified.quadrature_dps = Some(q);
     identified.clocks += windows.clocks;
+    let identified = uncoupled(
+        &windows,
+        &first,
+        &op,
+        identified,
+        knowns.nominal.angular_gain,
+    )?;
     // The same windows give the drive-gain ratio when the coupling makes
     // it observable (`drive_ratio::from_windows`), applied below.
     let at_rest = drive_ratio::from_windows(&windows, &first, &op, &identified);
@@ -247,6 +251,33 @@ pub fn self_calibrate(
         apply_drive_ratio(knowns, &mut cal, at_rest)?;
     }
     Ok(cal)
+}
+
+/// Rounds of estimating the coupling with the modes uncoupled by the last
+/// estimate (the estimator needs the uncoupled resonators,
+/// `coupling::uncouple` needs the coupling): on the consumer device at
+/// 3,000 deg/s one round left -0.23 deg/s (23 sigma), at 10,000 deg/s
+/// -129 deg/s; the fixed point contracts by about k^2 |G_1 G_2| a round.
+const COUPLING_ROUNDS: usize = 8;
+
+/// The identified modes uncoupled by the coupling measured in `windows`,
+/// which they carry.
+fn uncoupled(
+    windows: &CrossWindows,
+    knowns: &Knowns,
+    op: &Operating,
+    apparent: Identified,
+    angular_gain: f64,
+) -> Result<Identified, Error> {
+    let mut id = apparent.clone();
+    let mut q = coupling::from_windows(windows, knowns, op, &id)?.quadrature_dps;
+    for _ in 0..COUPLING_ROUNDS {
+        id = coupling::uncouple(&apparent, q.value, angular_gain)?;
+        q = coupling::from_windows(windows, knowns, op, &id)?.quadrature_dps;
+    }
+    id = coupling::uncouple(&apparent, q.value, angular_gain)?;
+    id.quadrature_dps = Some(q);
+    Ok(id)
 }
 
 /// `knowns` with drive 2's force gain moved by `relative` (g_2 / g_1 over
