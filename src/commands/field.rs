@@ -203,6 +203,30 @@ fn write_results(
     Ok(written)
 }
 
+/// Per step: the quadrature coupling the cycle measured, and a carrier
+/// that folds in the output's passband (the rate ripples there).
+fn step_notes(s: &mut String, report: &FieldReport) {
+    for st in &report.steps {
+        let i = &st.identified;
+        let _ = writeln!(
+            s,
+            "{:>8.2}  quadrature coupling {:.3} +- {:.3} deg/s (true {:.3})",
+            st.temperature_c,
+            i.quadrature_dps,
+            i.quadrature_dps_uncertainty,
+            st.truth.gyro.quadrature_dps
+        );
+    }
+    for st in report.steps.iter().filter(|st| st.carrier_fold.in_passband) {
+        let f = st.carrier_fold;
+        let _ = writeln!(
+            s,
+            "{:>8.2}  the carrier folds {:.1} Hz from itself (period {} clocks): the rate may ripple at that offset",
+            st.temperature_c, f.offset_hz, f.period
+        );
+    }
+}
+
 /// The human-readable table.
 pub fn summary(report: &FieldReport) -> String {
     let mut s = String::new();
@@ -248,6 +272,7 @@ pub fn summary(report: &FieldReport) -> String {
             i.loop_phase_deg
         );
     }
+    step_notes(&mut s, report);
     for st in &report.steps {
         if let Some(d) = &st.selfcal.drive_ratio {
             let _ = writeln!(

@@ -869,7 +869,7 @@ fn step_line(st: &FieldStep) -> String {
     let f = st.carrier_fold;
     let fold = if f.in_passband {
         format!(
-            "; the carrier folds {:.1} Hz from itself (period {} clocks): the rate ripples at that offset",
+            "; the carrier folds {:.1} Hz from itself (period {} clocks): the rate may ripple at that offset",
             f.offset_hz, f.period
         )
     } else {
