@@ -19,6 +19,7 @@ commands=(
   "$bin reproduce --out target/results-page/reproduce"
   "$bin run --config tests/data/small_device.toml"
   "$bin field --config tests/data/field_paper.toml"
+  "$bin field --config tests/data/field_coupled.toml"
   "$bin calibrate --config tests/data/small_device.toml"
   "$bin datasheet --config tests/data/datasheet_small.toml"
 )
