@@ -26,14 +26,16 @@
 //! ADC gains and each output's reference phase and filter gain cancel in
 //! each; rho (the design ratio here) enters k_1 as 1 / r and k_2 as r for
 //! a true ratio r times the design's, so their mean carries (r + 1 / r) / 2,
-//! 1 + 5e-5 for a ratio 1% off. The coupling is a real stiffness: the
-//! imaginary part of the mean is a check (a damping coupling would put
-//! it there), the real part the estimate, linear in the windows (no
+//! 1 + 5e-5 for a ratio 1% off. The estimate is linear in the windows (no
 //! square root), so a device without coupling reads 0 within its noise.
-//! In deg/s, with G in 1 / Hz^2 (k in Hz^2, 4 pi^2 of it in rad^2/s^2),
-//! Omega_q = 4 pi^2 k / (2 lambda 2 pi f_1) rad/s = 180 k / (lambda f_1)
-//! deg/s with the datasheet's lambda. The prediction turns it back into k
-//! with the same lambda, so lambda's error does not enter.
+//! Its real part is the stiffness k; a damping coupling d (`[gyro]
+//! damping_coupling_dps`, kappa = k + j w d on both modes,
+//! `crate::theory`) is its imaginary part, at the carrier. In deg/s, with
+//! G in 1 / Hz^2 (k in Hz^2, 4 pi^2 of it in rad^2/s^2), Omega_q = 4 pi^2
+//! k / (2 lambda 2 pi f_1) rad/s = 180 k / (lambda f_1) deg/s and
+//! Omega_d = 180 Im / (lambda f_c) deg/s, with the datasheet's lambda. The
+//! prediction turns them back with the same lambda, so lambda's error
+//! does not enter.
 //!
 //! # Uncertainty
 //!
@@ -58,9 +60,10 @@ type C64 = Complex<f64>;
 pub struct Coupling {
     /// Omega_q (deg/s), the sign convention of `[gyro] quadrature_dps`.
     pub quadrature_dps: Estimate,
-    /// The imaginary part of the same estimate (deg/s): zero for a pure
-    /// stiffness coupling.
-    pub imaginary_dps: f64,
+    /// The damping coupling Omega_d (deg/s, the sign convention of
+    /// `[gyro] damping_coupling_dps`), from the same estimate's imaginary
+    /// part.
+    pub damping_dps: Estimate,
     /// Clocks the measurement took.
     pub clocks: u64,
 }
@@ -134,15 +137,19 @@ pub(crate) fn from_windows(
             reason: "a direct response (P_1 or Q_2) read zero".into(),
         });
     }
-    let re: Vec<f64> = batches.iter().map(|k| k.re).collect();
-    let (value, noise) = mean_and_standard_error(&re);
-    let imaginary = batches.iter().map(|k| k.im).sum::<f64>() / BATCHES as f64;
-    Ok(Coupling {
-        quadrature_dps: Estimate {
+    // The real part is Omega_q (k = 2 lambda w1 Omega_q); the imaginary
+    // part w_c d with d = 2 lambda Omega_d, so Omega_d is it times f1 / fc.
+    let estimate = |v: Vec<f64>| {
+        let (value, noise) = mean_and_standard_error(&v);
+        Estimate {
             value,
             uncertainty: noise.hypot(g_error * value),
-        },
-        imaginary_dps: imaginary,
+        }
+    };
+    let to_damping = id.modes[0].f_hz.value / op.carrier_hz;
+    Ok(Coupling {
+        quadrature_dps: estimate(batches.iter().map(|k| k.re).collect()),
+        damping_dps: estimate(batches.iter().map(|k| k.im * to_damping).collect()),
         clocks: windows.clocks,
     })
 }
@@ -163,25 +170,35 @@ const UNCOUPLE_ROUNDS: usize = 100;
 /// 0.65).
 pub const MAX_MIXING: f64 = 0.02;
 
-/// The uncoupled modes behind the `apparent` identified ones: each mode's
+/// The uncoupled modes behind the `apparent` identified ones, for the
+/// couplings `[Omega_q, Omega_d]` (deg/s; kappa^2 in place of k^2 below
+/// when there is a damping coupling): each mode's
 /// fit sees its direct response M_kk = 1 / (1/G_k - k^2 G_(1-k)), a
 /// resonator whose 1/G is moved by -k^2 G_(1-k)(f), nearly constant across
 /// its fine sweep (the other mode is many bandwidths away). So the fitted
 /// f_k^2 is the uncoupled one minus k^2 Re G_(1-k)(f_k), and the fitted
 /// bandwidth the uncoupled one minus k^2 Im G_(1-k)(f_k) / f_k, where
 /// G_(1-k) is the other mode's uncoupled response: a fixed point, iterated
-/// from the apparent modes. `quadrature_dps` (deg/s) is turned back into k
+/// from the apparent modes. The couplings (deg/s) are turned back into kappa
 /// with the datasheet's lambda. On the consumer device with 250 deg/s the
 /// shift is 4e-4 Hz (k^2 / (f_2^2 - f_1^2) / 2 f_1), which its detuned
 /// output's scale factor feels.
 pub fn uncouple(
     apparent: &Identified,
-    quadrature_dps: f64,
+    coupling_dps: [f64; 2],
     angular_gain: f64,
 ) -> Result<Identified, Error> {
     let [m1, m2] = &apparent.modes;
     let (fa, qa) = ([m1.f_hz.value, m2.f_hz.value], [m1.q.value, m2.q.value]);
-    let k = quadrature_dps * angular_gain * fa[0] / 180.0;
+    let [quadrature_dps, damping_dps] = coupling_dps;
+    // kappa(f) = k + j w d in Hz^2 (`crate::theory`): k from Omega_q at f1,
+    // the damping term j f (lambda Omega_d / 180) at f.
+    let kappa = |f: f64| {
+        C64::new(
+            quadrature_dps * angular_gain * fa[0] / 180.0,
+            damping_dps * angular_gain * f / 180.0,
+        )
+    };
     let (mut f, mut q) = (fa, qa);
     let too_strong = |reason: String| Error::Measurement {
         what: "quadrature coupling",
@@ -192,7 +209,7 @@ pub fn uncouple(
     let mut converged = false;
     for _ in 0..UNCOUPLE_ROUNDS {
         let next: [(f64, f64); 2] = std::array::from_fn(|i| {
-            let other = resonator(f[1 - i], q[1 - i], fa[i]) * (k * k);
+            let other = resonator(f[1 - i], q[1 - i], fa[i]) * kappa(fa[i]).powi(2);
             let fk = (fa[i] * fa[i] + other.re).sqrt();
             let bk = fa[i] / qa[i] + other.im / fa[i];
             (fk, fk / bk)
@@ -210,7 +227,7 @@ pub fn uncouple(
     }
     for i in 0..2 {
         let g = [resonator(f[0], q[0], f[i]), resonator(f[1], q[1], f[i])];
-        let mixing = (g[0] * g[1]).norm() * k * k;
+        let mixing = (g[0] * g[1] * kappa(f[i]).powi(2)).norm();
         if mixing > MAX_MIXING {
             return Err(too_strong(format!(
                 "k^2 |G_1 G_2| = {mixing:.2} at mode {}, at most {MAX_MIXING}",

@@ -210,11 +210,14 @@ fn step_notes(s: &mut String, report: &FieldReport) {
         let i = &st.identified;
         let _ = writeln!(
             s,
-            "{:>8.2}  quadrature coupling {:.3} +- {:.3} deg/s (true {:.3})",
+            "{:>8.2}  quadrature coupling {:.3} +- {:.3} deg/s (true {:.3}), damping coupling {:.3} +- {:.3} deg/s (true {:.3})",
             st.temperature_c,
             i.quadrature_dps,
             i.quadrature_dps_uncertainty,
-            st.truth.gyro.quadrature_dps
+            st.truth.gyro.quadrature_dps,
+            i.damping_coupling_dps,
+            i.damping_coupling_dps_uncertainty,
+            st.truth.gyro.damping_coupling_dps
         );
     }
     for st in report.steps.iter().filter(|st| st.carrier_fold.in_passband) {

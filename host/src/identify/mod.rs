@@ -168,14 +168,16 @@ pub struct Identified {
     /// ([`crate::coupling`]); `None` until then, when the datasheet's is
     /// used.
     pub quadrature_dps: Option<Estimate>,
+    /// The damping coupling Omega_d (deg/s, the sign convention of
+    /// `[gyro] damping_coupling_dps`), measured with it; `None` until then.
+    pub damping_coupling_dps: Option<Estimate>,
     /// Clocks the identification took.
     pub clocks: u64,
 }
 
 impl Identified {
-    /// The identified mechanical parameters and quadrature coupling (the
-    /// datasheet's until measured), lambda and the damping coupling from
-    /// the datasheet.
+    /// The identified mechanical parameters and mode couplings (the
+    /// datasheet's until measured), lambda from the datasheet.
     pub fn gyro(&self, nominal: &GyroParams) -> GyroParams {
         GyroParams {
             f1_hz: self.modes[0].f_hz.value,
@@ -185,6 +187,9 @@ impl Identified {
             quadrature_dps: self
                 .quadrature_dps
                 .map_or(nominal.quadrature_dps, |q| q.value),
+            damping_coupling_dps: self
+                .damping_coupling_dps
+                .map_or(nominal.damping_coupling_dps, |d| d.value),
             ..nominal.clone()
         }
     }
@@ -318,6 +323,7 @@ pub fn identify(
         loop_phase_deg,
         group_delay_s,
         quadrature_dps: None,
+        damping_coupling_dps: None,
         clocks: c1 + c2,
     })
 }

@@ -21,7 +21,7 @@ pub struct SfUncertainty {
     /// The staircase slope's noise (`staircase`).
     pub staircase: [f64; 2],
     /// The predicted ratio's, from the identified f1, f2, Q1, Q2,
-    /// quadrature coupling, group delay and loop phase (each moved by its
+    /// mode couplings, group delay and loop phase (each moved by its
     /// uncertainty through the exact theory).
     pub identified: [f64; 2],
     /// The datasheet's angular gain lambda: its relative 1-sigma moved
@@ -63,7 +63,7 @@ fn spread(moved: &[Ratio], ratio: &Ratio) -> [f64; 2] {
 }
 
 /// The predicted ratio's relative 1-sigma uncertainty per output from the
-/// identified parameters: each of f1, Q1, f2, Q2, the quadrature coupling,
+/// identified parameters: each of f1, Q1, f2, Q2, the two mode couplings,
 /// the group delay and the loop phase (as a residual error of the correction) moved by its
 /// uncertainty (independent fits), the changes added in quadrature.
 pub(super) fn identified(
@@ -88,6 +88,11 @@ pub(super) fn identified(
     if let Some(q) = id.quadrature_dps {
         let mut g = gyro.clone();
         g.quadrature_dps += q.uncertainty;
+        moved.push(predicted_ratio(knowns, &g, op, cal_hz)?);
+    }
+    if let Some(d) = id.damping_coupling_dps {
+        let mut g = gyro.clone();
+        g.damping_coupling_dps += d.uncertainty;
         moved.push(predicted_ratio(knowns, &g, op, cal_hz)?);
     }
     if id.group_delay_s.uncertainty.is_finite() {

@@ -247,6 +247,11 @@ pub struct IdentifiedJson {
     pub quadrature_dps: f64,
     /// Its 1-sigma uncertainty.
     pub quadrature_dps_uncertainty: f64,
+    /// Damping coupling Omega_d (deg/s, the sign convention of `[gyro]
+    /// damping_coupling_dps`), measured with it.
+    pub damping_coupling_dps: f64,
+    /// Its 1-sigma uncertainty.
+    pub damping_coupling_dps_uncertainty: f64,
     /// Drive-gain ratio g2 / g1 over the design ratio, measured while the
     /// device turned (`[drive_probe]`; null without it).
     pub drive_gain_ratio: Option<f64>,
@@ -259,10 +264,12 @@ impl From<&SelfCal> for IdentifiedJson {
         let id = &cal.identified;
         let ratio = cal.drive_ratio.as_ref().map(|d| d.relative);
         let [m1, m2] = &id.modes;
-        let quadrature = id.quadrature_dps.unwrap_or(Estimate {
+        let none = Estimate {
             value: f64::NAN,
             uncertainty: f64::NAN,
-        });
+        };
+        let quadrature = id.quadrature_dps.unwrap_or(none);
+        let damping = id.damping_coupling_dps.unwrap_or(none);
         Self {
             f1_hz: m1.f_hz.value,
             f1_hz_uncertainty: m1.f_hz.uncertainty,
@@ -276,6 +283,8 @@ impl From<&SelfCal> for IdentifiedJson {
             loop_phase_deg_uncertainty: id.loop_phase_deg.uncertainty,
             quadrature_dps: quadrature.value,
             quadrature_dps_uncertainty: quadrature.uncertainty,
+            damping_coupling_dps: damping.value,
+            damping_coupling_dps_uncertainty: damping.uncertainty,
             drive_gain_ratio: ratio.map(|r| r.value),
             drive_gain_ratio_uncertainty: ratio.map(|r| r.uncertainty),
         }
