@@ -36,7 +36,7 @@
 //!   device share its identification, so the 160 count as 40 to 160
 //!   trials: at 96% a binomial standard deviation of 1.5 to 3%.
 //! - Every t within 3. The pinned devices hold it (96.9% within 2, largest
-//!   |t| 2.74, RMS 0.85); seeds up to 2100 (85 devices, 340 figures) gave
+//!   |t| 2.74, RMS 0.86); seeds up to 2100 (85 devices, 340 figures) gave
 //!   95.6% within 2 and none beyond 3 (without the couplings: 96.2% and
 //!   one figure at 3.13, seed 2080, Q 111, an output whose self-cal sigma
 //!   is 0.01%). 0.9 such are expected in 340 figures of honest normal
