@@ -43,8 +43,7 @@
 //! identified G_1, G_2 (each k_i moves with |G|; finite differences over
 //! f_k and Q_k), in quadrature.
 
-use crate::board::Board;
-use crate::drive_ratio::{BATCHES, CrossWindows, resonator};
+use crate::drive_ratio::{BATCHES, CrossWindows, propagated, resonator};
 use crate::error::Error;
 use crate::identify::{Estimate, Identified};
 use crate::knowns::Knowns;
@@ -79,46 +78,27 @@ fn coupling_hz2(lines: ((C64, C64), (C64, C64)), w1: f64, g: [C64; 2], rho: f64)
 }
 
 /// G_1 and G_2 at `carrier_hz` from `id`, and the relative 1-sigma of
-/// their mean magnitude (finite differences over f_k, Q_k).
+/// their mean inverse magnitude (`drive_ratio::propagated`): k_1 scales as
+/// 1 / |G_2| and k_2 as 1 / |G_1|.
 fn resonators(id: &Identified, carrier_hz: f64) -> ([C64; 2], f64) {
-    let [m1, m2] = &id.modes;
-    let p = [m1.f_hz, m1.q, m2.f_hz, m2.q];
     let at = |v: [f64; 4]| {
         [
             resonator(v[0], v[1], carrier_hz),
             resonator(v[2], v[3], carrier_hz),
         ]
     };
-    let values = p.map(|e| e.value);
-    let g = at(values);
-    // k_1 scales as 1 / |G_2| and k_2 as 1 / |G_1|: the mean as their mean.
-    let size = |g: [C64; 2]| 0.5 * (1.0 / g[0].norm() + 1.0 / g[1].norm());
-    let centre = size(g);
-    let variance: f64 = (0..4)
-        .map(|i| {
-            let mut moved = values;
-            let h = 1e-3 * p[i].uncertainty.max(1e-9 * p[i].value.abs());
-            moved[i] += h;
-            let slope = (size(at(moved)) / centre).ln() / h;
-            (slope * p[i].uncertainty).powi(2)
-        })
-        .sum();
-    (g, variance.sqrt())
+    let [m1, m2] = &id.modes;
+    let g = at([m1.f_hz.value, m1.q.value, m2.f_hz.value, m2.q.value]);
+    let size = |v: [f64; 4]| {
+        let g = at(v);
+        0.5 * (1.0 / g[0].norm() + 1.0 / g[1].norm())
+    };
+    (g, propagated(id, size))
 }
 
-/// Measure the quadrature coupling at rest at the operating point `op` of
-/// identification `id`.
-pub fn measure(
-    board: &mut dyn Board,
-    knowns: &Knowns,
-    op: &Operating,
-    id: &Identified,
-) -> Result<Coupling, Error> {
-    let windows = CrossWindows::measure(board, knowns, op)?;
-    from_windows(&windows, knowns, op, id)
-}
-
-/// The coupling from windows measured at rest.
+/// The coupling from the cross-response windows measured at rest at the
+/// operating point `op` of identification `id`: one round, which the
+/// cycle iterates with [`uncouple`] (`selfcal`).
 pub(crate) fn from_windows(
     windows: &CrossWindows,
     knowns: &Knowns,

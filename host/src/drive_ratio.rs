@@ -139,24 +139,33 @@ fn ratio_squared(p1: C64, q1: C64, p2: C64, q2: C64, w1: f64, g1_over_g2: C64) -
     q1 * q2 * w1 * w1 / (p1 * p2) * g1_over_g2
 }
 
-/// G_1 / G_2 at the carrier from the identified modes, and the relative
-/// 1-sigma uncertainty of its magnitude (finite differences over f_k, Q_k).
-fn resonator_ratio(id: &Identified, carrier_hz: f64) -> (C64, f64) {
+/// The relative 1-sigma of a positive `size` of the identified modes'
+/// (f_1, Q_1, f_2, Q_2), each moved by its uncertainty (finite
+/// differences, independent fits, in quadrature).
+pub(crate) fn propagated(id: &Identified, size: impl Fn([f64; 4]) -> f64) -> f64 {
     let [m1, m2] = &id.modes;
     let p = [m1.f_hz, m1.q, m2.f_hz, m2.q];
-    let ratio = |v: [f64; 4]| resonator(v[0], v[1], carrier_hz) / resonator(v[2], v[3], carrier_hz);
     let values = p.map(|e| e.value);
-    let centre = ratio(values);
-    let variance: f64 = (0..4)
+    let centre = size(values);
+    (0..4)
         .map(|i| {
             let mut moved = values;
             let h = 1e-3 * p[i].uncertainty.max(1e-9 * p[i].value.abs());
             moved[i] += h;
-            let slope = (ratio(moved).norm() / centre.norm()).ln() / h;
+            let slope = (size(moved) / centre).ln() / h;
             (slope * p[i].uncertainty).powi(2)
         })
-        .sum();
-    (centre, variance.sqrt())
+        .sum::<f64>()
+        .sqrt()
+}
+
+/// G_1 / G_2 at the carrier from the identified modes, and the relative
+/// 1-sigma uncertainty of its magnitude ([`propagated`]).
+fn resonator_ratio(id: &Identified, carrier_hz: f64) -> (C64, f64) {
+    let ratio = |v: [f64; 4]| resonator(v[0], v[1], carrier_hz) / resonator(v[2], v[3], carrier_hz);
+    let [m1, m2] = &id.modes;
+    let centre = ratio([m1.f_hz.value, m1.q.value, m2.f_hz.value, m2.q.value]);
+    (centre, propagated(id, |v| ratio(v).norm()))
 }
 
 /// Mean and standard error of `v`.

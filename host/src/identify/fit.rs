@@ -68,12 +68,12 @@ pub(super) fn fit_mode(
         }
         (g, dfk, dbk)
     };
-    let den = |fk: f64, bk: f64, f: f64| 1.0 / shape(fk, bk, f).0;
-    // Best C for given (fk, bk) is linear: C = sum(Y conj(1/den)) / sum |1/den|^2.
+    // Best C for given (fk, bk) is linear: C = sum(Y conj(g)) / sum |g|^2,
+    // g the model's shape.
     let best_c = |fk: f64, bk: f64| {
         let (mut num, mut norm) = (C64::new(0.0, 0.0), 0.0);
         for &(f, y) in points {
-            let g = 1.0 / den(fk, bk, f);
+            let g = shape(fk, bk, f).0;
             num += y * g.conj();
             norm += g.norm_sqr();
         }
