@@ -2,7 +2,7 @@
 # Runs every test of gyrocal on a fresh Debian machine.
 #
 # Installs the tools the tests need (iverilog, verilator, yosys, make, g++,
-# nextpnr-ice40, python3, python3-venv) with apt-get when they are missing (root,
+# nextpnr-ice40, python3, python3-venv, parallel) with apt-get when they are missing (root,
 # non-interactive) and the pinned PyPI tools into Python virtual environments
 # (scripts/*/install-venv.sh, below), then runs the whole
 # test suite in release mode (the co-simulation tests need optimized code),
@@ -21,6 +21,8 @@ command -v g++ >/dev/null 2>&1 || missing+=(g++)
 command -v nextpnr-ice40 >/dev/null 2>&1 || missing+=(nextpnr-ice40)
 # The ECP5 tools and the cocotb bus tests run in Python venvs (below).
 command -v python3 >/dev/null 2>&1 || missing+=(python3)
+# GNU parallel: tests/sweep_cli.rs runs examples/sweep/parallel.sh.
+command -v parallel >/dev/null 2>&1 || missing+=(parallel)
 python3 -c 'import ensurepip, venv' >/dev/null 2>&1 || missing+=(python3-venv)
 if [ ${#missing[@]} -gt 0 ]; then
   echo "installing Debian packages: ${missing[*]}"

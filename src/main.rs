@@ -44,6 +44,9 @@ enum Command {
     /// Identify and self-calibrate a board (etherbone://, uio://, mem://),
     /// or without --board the file's device simulated in process.
     Calibrate(commands::calibrate::Args),
+    /// Self-calibrate a production spread of devices (TOML with `[spread]`),
+    /// whole or one shard (`--shard I/N`); `sweep merge` joins the shards.
+    Sweep(commands::sweep::Args),
     /// Measure an IEEE 952/1431-style datasheet: ARW, bias instability,
     /// rate random walk, Allan deviation with confidence intervals, scale
     /// factor, nonlinearity, temperature coefficients, bandwidth, turn-on.
@@ -78,6 +81,7 @@ fn main() -> ExitCode {
         Command::Allan(args) => commands::allan::run(&args),
         Command::Datasheet(args) => commands::datasheet::run(&args),
         Command::Field(args) => commands::field::run(&args),
+        Command::Sweep(args) => commands::sweep::run(&args),
         Command::Serve(args) => commands::serve::run(&args),
         Command::Calibrate(args) => commands::calibrate::run(&args),
     };

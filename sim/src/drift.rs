@@ -225,6 +225,23 @@ impl Drift {
         Ok(())
     }
 
+    /// No drift: the one step at `temperature_c`, where the nominal values
+    /// hold (`gyrocal sweep` without `[drift]`: the factory calibration
+    /// alone).
+    pub fn constant(temperature_c: f64) -> Self {
+        Self {
+            temperatures_c: vec![temperature_c],
+            tcf1_ppm_per_k: 0.0,
+            tcf2_ppm_per_k: 0.0,
+            q_ppm_per_k: 0.0,
+            front_end_phase_deg: 0.0,
+            front_end_phase_deg_per_k: 0.0,
+            adc_gain_ppm_per_k: [0.0; 2],
+            drive_gain_ppm_per_k: [0.0; 2],
+            quadrature_dps_per_k: 0.0,
+        }
+    }
+
     /// The factory-calibration temperature T0 (deg C): the first step.
     ///
     /// # Panics

@@ -32,6 +32,7 @@ pub mod report;
 pub mod ripple;
 pub mod serve;
 pub mod settling;
+pub mod sweep;
 /// The exact theory (`gyrocal_host::theory`), shared with the host's prediction.
 pub use gyrocal_host::theory;
 #[cfg(feature = "verilator")]

@@ -11,4 +11,5 @@ pub mod registers;
 pub mod reproduce;
 pub mod run;
 pub mod serve;
+pub mod sweep;
 pub mod synth;

@@ -48,6 +48,7 @@ mod readout;
 mod residuals;
 mod staircase;
 mod style;
+mod sweep;
 
 use gyrocal_sim::allan::AllanAnalysis;
 use gyrocal_sim::report::Report;
@@ -179,6 +180,22 @@ pub fn write_field_figure(
     let plot = field::FieldPanel::new(report, title)?;
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     write_plot(&plot, field::SIZE, dir, name)
+}
+
+/// Write a sweep's figure into `dir` (created if missing) as `name`.png
+/// and `name`.svg; returns the two files. Errors as [`write_figures`]; the
+/// report is checked first (at least one device finished).
+#[allow(dead_code)] // reason: tests/plots.rs includes this module; `gyrocal sweep` calls it
+pub fn write_sweep_figure(
+    report: &gyrocal_sim::sweep::SweepReport,
+    title: &str,
+    dir: &Path,
+    name: &str,
+) -> Result<Vec<PathBuf>, String> {
+    style::register_font()?;
+    let plot = sweep::SweepFigure::new(report, title)?;
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    write_plot(&plot, sweep::SIZE, dir, name)
 }
 
 /// Write the datasheet's figures into `dir` (created if missing):

@@ -38,6 +38,7 @@ use crate::fit::{coverage_factor, linear_fit};
 use crate::frontend::FrontEnd;
 use crate::gyro::GyroParams;
 use crate::noise::ThermalNoise;
+use crate::sweep::spread::Spread;
 use gyrocal_host::Knowns;
 use gyrocal_host::datasheet::Datasheet;
 use gyrocal_host::drive_ratio;
@@ -72,13 +73,16 @@ struct ScenarioFile {
     experiment: Points,
     #[serde(default)]
     noise: ThermalNoise,
-    drift: Drift,
+    #[serde(default)]
+    drift: Option<Drift>,
     #[serde(default)]
     profile: Option<Profile>,
     #[serde(default)]
     drive_probe: Option<DriveProbe>,
     #[serde(default)]
     datasheet: Datasheet,
+    #[serde(default)]
+    spread: Option<Spread>,
 }
 
 /// A checked scenario.
@@ -97,8 +101,30 @@ pub struct Scenario {
 /// Parse a scenario file's text: the experiment (checked as `gyrocal run`
 /// checks it), its `[drift]` (checked by `Drift::validate`) and its
 /// `[profile]` (`Profile::validate`). Errors are one line; `name` labels
-/// them (the file path).
+/// them (the file path). A `[spread]` is refused: it is `gyrocal sweep`'s
+/// (`crate::sweep::parse`).
 pub fn parse(name: &str, text: &str) -> Result<Scenario, String> {
+    let (sc, spread, has_drift) = parse_file(name, text)?;
+    if spread.is_some() {
+        return Err(format!(
+            "{name}: [spread] is read by `gyrocal sweep` (many devices); `gyrocal field` runs the file's one device: remove it"
+        ));
+    }
+    if !has_drift {
+        return Err(format!(
+            "{name}: missing [drift]: `gyrocal field` needs its temperature steps (temperatures_c, tcf1_ppm_per_k, tcf2_ppm_per_k)"
+        ));
+    }
+    Ok(sc)
+}
+
+/// The scenario of a file, its `[spread]` and whether it had a `[drift]`
+/// (without one, the scenario's drift is the single step
+/// [`Drift::constant`] at [`FACTORY_C`]).
+pub(crate) fn parse_file(
+    name: &str,
+    text: &str,
+) -> Result<(Scenario, Option<Spread>, bool), String> {
     let file: ScenarioFile = toml::from_str(text).map_err(|e| {
         let message = e.message().replace('\n', " ");
         match e.span() {
@@ -118,25 +144,39 @@ pub fn parse(name: &str, text: &str) -> Result<Scenario, String> {
         noise: file.noise,
         datasheet: file.datasheet,
     };
-    exp.validate().map_err(|e| format!("{name}: {e}"))?;
-    let derived = exp.derived().map_err(|e| format!("{name}: {e}"))?;
-    file.drift.validate().map_err(|e| format!("{name}: {e}"))?;
-    file.drift
-        .validate_device(&exp.gyro)
-        .map_err(|e| format!("{name}: {e}"))?;
-    if let Some(p) = &file.profile {
-        let sample_s = f64::from(derived.decimation) / exp.drive.clock_hz;
-        p.validate(sample_s).map_err(|e| format!("{name}: {e}"))?;
-    }
-    if let Some(p) = &file.drive_probe {
-        p.validate().map_err(|e| format!("{name}: {e}"))?;
-    }
-    Ok(Scenario {
+    let has_drift = file.drift.is_some();
+    let drift = file.drift.unwrap_or_else(|| Drift::constant(FACTORY_C));
+    let sc = Scenario {
         exp,
-        drift: file.drift,
+        drift,
         profile: file.profile,
         drive_probe: file.drive_probe,
-    })
+    };
+    sc.validate().map_err(|e| format!("{name}: {e}"))?;
+    Ok((sc, file.spread, has_drift))
+}
+
+/// The factory temperature of a file without `[drift]` (deg C).
+pub const FACTORY_C: f64 = 25.0;
+
+impl Scenario {
+    /// Checks the experiment (as `gyrocal run` does), the drift over the
+    /// device, the profile and the drive probe: one line naming the key.
+    pub fn validate(&self) -> Result<(), String> {
+        let exp = &self.exp;
+        exp.validate()?;
+        let derived = exp.derived()?;
+        self.drift.validate()?;
+        self.drift.validate_device(&exp.gyro)?;
+        if let Some(p) = &self.profile {
+            let sample_s = f64::from(derived.decimation) / exp.drive.clock_hz;
+            p.validate(sample_s)?;
+        }
+        if let Some(p) = &self.drive_probe {
+            p.validate()?;
+        }
+        Ok(())
+    }
 }
 
 /// Where a near-commensurate carrier folds the carrier tables'
@@ -219,7 +259,7 @@ pub struct FieldStep {
 }
 
 /// The identified parameters as the interface names them.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct IdentifiedJson {
     /// Mode 1 frequency (Hz).
     pub f1_hz: f64,

@@ -1,0 +1,446 @@
+//! `gyrocal sweep`: self-calibration over a production spread. Each device
+//! of `[spread]` ([`spread`]) runs the field cycle of
+//! [`crate::field::scenario`]: at the factory temperature alone, or over the
+//! whole `[drift]` when the file has one. Its error is against the rate
+//! table of its own simulation, as in `gyrocal field`.
+//!
+//! **What the host knows.** One datasheet for every part: the file's
+//! `[datasheet]` over its `[gyro]`, i.e. the nominal device, never the part
+//! drawn. When lambda spreads and the file's `[datasheet]` does not give its
+//! uncertainty, the datasheet states the spread's relative sigma
+//! (`angular_gain_uncertainty`): a host cannot know a part's lambda better
+//! than the process makes it, and the reported sigma must say so.
+//!
+//! **Sharding.** A sweep can be cut in N shards ([`Shard`], `--shard I/N`,
+//! I from 1): shard I runs the devices whose index i has i mod N = I - 1.
+//! Device i is drawn from the seed and i alone ([`spread::Spread::draw`]),
+//! so it is the same in any shard, and [`merge`] of the N shards' reports
+//! is the unsharded report, bit for bit (the report holds no wall time; the
+//! JSON's floats read back exactly, serde_json's `float_roundtrip`).
+//!
+//! Read in order: [`spread`] (the section and the draws), this file (one
+//! device, the run, the merge), [`summary`] (yield and percentiles).
+
+pub mod spread;
+pub mod summary;
+
+use crate::field::scenario::{self, IdentifiedJson, Scenario};
+use crate::gyro::GyroParams;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use spread::{Drawn, Spread, SpreadError};
+use std::fmt;
+use std::str::FromStr;
+use summary::Summary;
+
+/// What can go wrong with a sweep's input: each is one line.
+#[derive(Debug, thiserror::Error)]
+pub enum SweepError {
+    /// The file (a section, a key) is wrong.
+    #[error("{0}")]
+    Config(String),
+    /// The file has no `[spread]`.
+    #[error(
+        "{0}: missing [spread]: `gyrocal sweep` needs `devices` and the parameters' spread (see `gyrocal sweep --help`)"
+    )]
+    NoSpread(String),
+    /// A `[spread]` key is wrong.
+    #[error("{name}: {source}")]
+    Spread {
+        /// The file.
+        name: String,
+        /// The key at fault.
+        source: SpreadError,
+    },
+    /// `--shard` is not `I/N` with 1 <= I <= N.
+    #[error("--shard {0}: give I/N with 1 <= I <= N, e.g. 2/8")]
+    Shard(String),
+    /// Shard reports that do not make one sweep.
+    #[error("merge: {0}")]
+    Merge(String),
+}
+
+/// A checked sweep: the scenario every device runs (around the nominal
+/// `[gyro]`) and its spread.
+#[derive(Clone, Debug)]
+pub struct Sweep {
+    /// The file's scenario: the nominal device, its drive, plan and drift.
+    pub scenario: Scenario,
+    /// The spread.
+    pub spread: Spread,
+    /// FNV-1a hash of the file's text (hex): shards merge only with shards
+    /// of the same file.
+    pub fingerprint: String,
+}
+
+/// Parse a sweep file: the sections of `gyrocal field` (`[drift]` and
+/// `[profile]` optional) plus `[spread]`. `name` labels the errors.
+pub fn parse(name: &str, text: &str) -> Result<Sweep, SweepError> {
+    let (scenario, spread, _) = scenario::parse_file(name, text).map_err(SweepError::Config)?;
+    let spread = spread.ok_or_else(|| SweepError::NoSpread(name.into()))?;
+    spread
+        .validate(&scenario.exp.gyro)
+        .map_err(|source| SweepError::Spread {
+            name: name.into(),
+            source,
+        })?;
+    Ok(Sweep {
+        scenario,
+        spread,
+        fingerprint: format!("{:016x}", fnv1a(text.as_bytes())),
+    })
+}
+
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    })
+}
+
+/// Shard `index` of `count` (1 <= index <= count): the devices whose index
+/// i has i mod count = index - 1.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Shard {
+    /// This shard, from 1.
+    pub index: u32,
+    /// How many shards.
+    pub count: u32,
+}
+
+impl FromStr for Shard {
+    type Err = SweepError;
+    fn from_str(s: &str) -> Result<Self, SweepError> {
+        let bad = || SweepError::Shard(s.into());
+        let (i, n) = s.split_once('/').ok_or_else(bad)?;
+        let (index, count) = (
+            i.trim().parse::<u32>().map_err(|_| bad())?,
+            n.trim().parse::<u32>().map_err(|_| bad())?,
+        );
+        if index == 0 || index > count {
+            return Err(bad());
+        }
+        Ok(Self { index, count })
+    }
+}
+
+impl fmt::Display for Shard {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}/{}", self.index, self.count)
+    }
+}
+
+impl Shard {
+    /// Whether device `i` is this shard's.
+    pub fn holds(&self, i: u32) -> bool {
+        i % self.count == self.index - 1
+    }
+}
+
+/// One temperature step of one device.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DeviceStep {
+    /// Temperature (deg C).
+    pub temperature_c: f64,
+    /// sf_selfcal / sf_true - 1, per output.
+    pub sf_selfcal_error: [f64; 2],
+    /// The self-calibrated scale factor's relative 1-sigma.
+    pub sf_selfcal_uncertainty: [f64; 2],
+    /// The error's own 1-sigma (the truth's in quadrature).
+    pub selfcal_error_uncertainty: [f64; 2],
+    /// The truth: the rate table's slope (z LSB per deg/s).
+    pub sf_true_per_dps: [f64; 2],
+    /// What the host identified.
+    pub identified: IdentifiedJson,
+}
+
+/// A part of a device's run that failed (the rest stands).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DeviceFailure {
+    /// The step's temperature (null when the device could not start).
+    pub temperature_c: Option<f64>,
+    /// What failed: a field stage, or "device" (the drawn device is outside
+    /// what the simulation supports).
+    pub stage: String,
+    /// The error, one line.
+    pub error: String,
+}
+
+/// One device of the sweep.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DeviceResult {
+    /// Its index in the spread, from 0.
+    pub index: u32,
+    /// The part drawn.
+    pub device: GyroParams,
+    /// Its `[frontend] seed`.
+    pub frontend_seed: u64,
+    /// Its `[noise] seed`.
+    pub noise_seed: u64,
+    /// Temperature of the worst step: the one with the largest |error|
+    /// (either output); null when no step finished.
+    pub worst_temperature_c: Option<f64>,
+    /// The worst step's self-calibration error, per output.
+    pub sf_selfcal_error: Option<[f64; 2]>,
+    /// The worst step's self-calibrated scale factor's relative 1-sigma.
+    pub sf_selfcal_uncertainty: Option<[f64; 2]>,
+    /// What the host identified at the worst step.
+    pub identified: Option<IdentifiedJson>,
+    /// Every step finished and each |error| is within the tolerance.
+    pub within_tolerance: bool,
+    /// Every finished step.
+    pub steps: Vec<DeviceStep>,
+    /// What failed.
+    pub failed: Vec<DeviceFailure>,
+    /// Clocks simulated.
+    pub clocks: u64,
+}
+
+/// A sweep's report (or one shard's).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SweepReport {
+    /// [`Sweep::fingerprint`].
+    pub fingerprint: String,
+    /// The nominal device (`[gyro]`).
+    pub nominal: GyroParams,
+    /// The spread.
+    pub spread: Spread,
+    /// The temperature steps every device runs (deg C).
+    pub temperatures_c: Vec<f64>,
+    /// This report's shard; null for the whole sweep (or a merge).
+    pub shard: Option<Shard>,
+    /// The devices, by index.
+    pub devices: Vec<DeviceResult>,
+    /// Yield and percentiles over `devices`.
+    pub summary: Summary,
+}
+
+impl Sweep {
+    /// Device `index`'s scenario: the part drawn, its noise seeds, and the
+    /// one datasheet of the nominal device (module header).
+    pub fn device_scenario(&self, drawn: &Drawn) -> Scenario {
+        let mut sc = self.scenario.clone();
+        let nominal = &self.scenario.exp.gyro;
+        let ds = &mut sc.exp.datasheet;
+        let fill = |v: &mut Option<f64>, nominal: f64| {
+            v.get_or_insert(nominal);
+        };
+        fill(&mut ds.f1_hz, nominal.f1_hz);
+        fill(&mut ds.f2_hz, nominal.f2_hz);
+        fill(&mut ds.q1, nominal.q1);
+        fill(&mut ds.q2, nominal.q2);
+        fill(&mut ds.quadrature_dps, nominal.quadrature_dps);
+        fill(&mut ds.damping_coupling_dps, nominal.damping_coupling_dps);
+        if ds.angular_gain.is_none() {
+            ds.angular_gain = Some(nominal.angular_gain);
+            let spread = self.spread.angular_gain.map_or(0.0, |s| {
+                s.sd.map_or_else(
+                    || s.rel_sd.unwrap_or(0.0),
+                    |sd| sd / nominal.angular_gain.abs(),
+                )
+            });
+            ds.angular_gain_uncertainty.get_or_insert(spread);
+        }
+        sc.exp.gyro = drawn.gyro.clone();
+        sc.exp.frontend.seed = drawn.frontend_seed;
+        sc.exp.noise.seed = drawn.noise_seed;
+        sc
+    }
+
+    /// Run device `index`: draw it, run its field scenario, keep every
+    /// step and every failure.
+    pub fn run_device(&self, index: u32) -> DeviceResult {
+        let nominal = &self.scenario.exp.gyro;
+        let drawn = self
+            .spread
+            .draw(nominal, index)
+            .expect("the spread was validated by `parse`");
+        let sc = self.device_scenario(&drawn);
+        let mut failed = vec![];
+        let mut steps = vec![];
+        let mut clocks = 0;
+        let started = sc.validate().and_then(|()| scenario::run(&sc, &|_| {}));
+        match started {
+            Err(error) => failed.push(DeviceFailure {
+                temperature_c: None,
+                stage: "device".into(),
+                error,
+            }),
+            Ok(report) => {
+                clocks = report.clocks;
+                failed.extend(report.failed.into_iter().map(|f| DeviceFailure {
+                    temperature_c: Some(f.temperature_c),
+                    stage: f.stage.into(),
+                    error: f.error,
+                }));
+                steps.extend(report.steps.into_iter().map(|st| DeviceStep {
+                    temperature_c: st.temperature_c,
+                    sf_selfcal_error: st.selfcal_error,
+                    sf_selfcal_uncertainty: st.sf_selfcal_uncertainty,
+                    selfcal_error_uncertainty: st.selfcal_error_uncertainty,
+                    sf_true_per_dps: st.sf_true_per_dps,
+                    identified: st.identified,
+                }));
+            }
+        }
+        DeviceResult::new(index, drawn, steps, failed, clocks, self.spread.tolerance)
+    }
+
+    /// Run the sweep's devices (`shard`'s alone, if given) in parallel;
+    /// `progress` gets each device when it finishes.
+    pub fn run(
+        &self,
+        shard: Option<Shard>,
+        progress: &(dyn Fn(&DeviceResult) + Sync),
+    ) -> SweepReport {
+        let indices: Vec<u32> = (0..self.spread.devices)
+            .filter(|&i| shard.is_none_or(|s| s.holds(i)))
+            .collect();
+        let devices: Vec<DeviceResult> = indices
+            .par_iter()
+            .map(|&i| {
+                let d = self.run_device(i);
+                progress(&d);
+                d
+            })
+            .collect();
+        SweepReport {
+            fingerprint: self.fingerprint.clone(),
+            nominal: self.scenario.exp.gyro.clone(),
+            spread: self.spread.clone(),
+            temperatures_c: self.scenario.drift.temperatures_c.clone(),
+            shard,
+            summary: Summary::of(&devices, self.spread.tolerance),
+            devices,
+        }
+    }
+
+    /// The devices a shard holds (all without one).
+    pub fn device_count(&self, shard: Option<Shard>) -> u32 {
+        (0..self.spread.devices)
+            .filter(|&i| shard.is_none_or(|s| s.holds(i)))
+            .count() as u32
+    }
+}
+
+impl DeviceResult {
+    fn new(
+        index: u32,
+        drawn: Drawn,
+        steps: Vec<DeviceStep>,
+        failed: Vec<DeviceFailure>,
+        clocks: u64,
+        tolerance: f64,
+    ) -> Self {
+        let size = |s: &DeviceStep| {
+            s.sf_selfcal_error
+                .iter()
+                .fold(0.0f64, |m, e| m.max(e.abs()))
+        };
+        let worst = steps.iter().max_by(|a, b| size(a).total_cmp(&size(b)));
+        Self {
+            index,
+            device: drawn.gyro,
+            frontend_seed: drawn.frontend_seed,
+            noise_seed: drawn.noise_seed,
+            worst_temperature_c: worst.map(|s| s.temperature_c),
+            sf_selfcal_error: worst.map(|s| s.sf_selfcal_error),
+            sf_selfcal_uncertainty: worst.map(|s| s.sf_selfcal_uncertainty),
+            identified: worst.map(|s| s.identified.clone()),
+            within_tolerance: failed.is_empty()
+                && !steps.is_empty()
+                && steps.iter().all(|s| size(s) <= tolerance),
+            steps,
+            failed,
+            clocks,
+        }
+    }
+}
+
+/// The whole sweep from its shards' reports: every shard of one file's
+/// sweep, each once, in any order. The result equals the unsharded run's
+/// report.
+pub fn merge(parts: Vec<SweepReport>) -> Result<SweepReport, SweepError> {
+    let bad = |m: String| Err(SweepError::Merge(m));
+    let Some(first) = parts.first() else {
+        return bad("no reports given".into());
+    };
+    let count = match first.shard {
+        Some(s) => s.count,
+        None => return bad("part 1 is a whole sweep, not a shard (it has no `shard`)".into()),
+    };
+    let mut seen = vec![false; count as usize];
+    for (k, p) in parts.iter().enumerate() {
+        if p.fingerprint != first.fingerprint || p.spread != first.spread {
+            return bad(format!(
+                "part {} is from another file or spread than part 1 (fingerprint {} against {})",
+                k + 1,
+                p.fingerprint,
+                first.fingerprint
+            ));
+        }
+        match p.shard {
+            Some(s) if s.count == count => {
+                if std::mem::replace(&mut seen[s.index as usize - 1], true) {
+                    return bad(format!("shard {s} is given twice"));
+                }
+                if let Some(d) = p.devices.iter().find(|d| !s.holds(d.index)) {
+                    return bad(format!("shard {s} holds device {}, not its own", d.index));
+                }
+            }
+            Some(s) => return bad(format!("part {} is shard {s}, part 1 is of {count}", k + 1)),
+            None => return bad(format!("part {} is a whole sweep, not a shard", k + 1)),
+        }
+    }
+    if let Some(missing) = seen.iter().position(|s| !s) {
+        return bad(format!(
+            "shard {}/{count} is missing ({} of {count} given)",
+            missing + 1,
+            parts.len()
+        ));
+    }
+    let template = first.clone();
+    let mut devices: Vec<DeviceResult> = parts.into_iter().flat_map(|p| p.devices).collect();
+    devices.sort_by_key(|d| d.index);
+    let complete = devices.len() == template.spread.devices as usize
+        && devices
+            .iter()
+            .enumerate()
+            .all(|(i, d)| d.index as usize == i);
+    if !complete {
+        return bad(format!(
+            "the shards hold {} devices, the spread has {}",
+            devices.len(),
+            template.spread.devices
+        ));
+    }
+    Ok(SweepReport {
+        shard: None,
+        summary: Summary::of(&devices, template.spread.tolerance),
+        devices,
+        ..template
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shards_parse_and_cover_every_device_once() {
+        let s: Shard = "2/3".parse().unwrap();
+        assert_eq!((s.index, s.count), (2, 3));
+        assert_eq!(s.to_string(), "2/3");
+        for bad in ["0/3", "4/3", "3", "a/b", "1/0", ""] {
+            let e = bad.parse::<Shard>().unwrap_err().to_string();
+            assert!(e.contains("give I/N"), "{e}");
+        }
+        for n in 1..6 {
+            for i in 0..50 {
+                let holders = (1..=n)
+                    .filter(|&k| Shard { index: k, count: n }.holds(i))
+                    .count();
+                assert_eq!(holders, 1);
+            }
+        }
+    }
+}

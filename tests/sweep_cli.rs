@@ -1,0 +1,275 @@
+//! `gyrocal sweep`: a production spread, whole and sharded. The shards run
+//! by the repository's Slurm job-array script (with the variables Slurm
+//! would set; Slurm is not installed here) and by its GNU parallel script,
+//! then merged, give the unsharded report byte for byte. Bad input is
+//! refused in one line with exit status 2.
+
+mod common;
+
+use common::{gyrocal, json_object, stderr};
+use std::path::Path;
+use std::process::Command;
+
+/// The consumer device (tests/data/field_consumer.toml) with a short plan,
+/// five parts of a spread that is not the example's.
+const SWEEP: &str = "[gyro]\nf1_hz = 25.1e3\nf2_hz = 25.8e3\nq1 = 3000\nq2 = 3000\nangular_gain = 0.8\n\
+[drive]\ncarrier_hz = 25.1e3\nclock_hz = 1.2345e6\n\
+[experiment]\nreadout_rates_dps = [50, 100]\ncal_freqs_hz = [2, 4]\n\
+[spread]\ndevices = 5\nseed = 11\nf1_hz = { sd = 30.0 }\nsplit_hz = { sd = 20.0 }\n\
+q1 = { rel_sd = 0.08 }\nq2 = { rel_sd = 0.08 }\nquadrature_dps = { sd = 30.0 }\n";
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// Run an example script with `envs`; it must succeed.
+fn script(path: &str, args: &[&str], envs: &[(&str, &str)]) {
+    let o = Command::new("bash")
+        .arg(root().join(path))
+        .args(args)
+        .envs(envs.iter().copied())
+        .env("GYROCAL", env!("CARGO_BIN_EXE_gyrocal"))
+        .output()
+        .unwrap();
+    assert!(
+        o.status.success(),
+        "{path}: {}\n{}",
+        String::from_utf8_lossy(&o.stdout),
+        stderr(&o)
+    );
+}
+
+fn read(p: &Path) -> String {
+    std::fs::read_to_string(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+}
+
+#[test]
+fn shards_run_by_slurm_and_gnu_parallel_merge_into_the_unsharded_sweep() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("spread.toml");
+    std::fs::write(&config, SWEEP).unwrap();
+    let config = config.to_str().unwrap();
+    let full_dir = dir.path().join("full");
+    let full_out = full_dir.display().to_string();
+    let o = gyrocal(&["sweep", "--config", config, "--json", "--out", &full_out]);
+    let full = String::from_utf8(o.stdout.clone()).unwrap();
+    let report = json_object(o);
+
+    // What the report says, checked against itself and the physics.
+    let devices = report["devices"].as_array().unwrap();
+    assert_eq!(devices.len(), 5);
+    let mut within = 0;
+    for (i, d) in devices.iter().enumerate() {
+        assert_eq!(d["index"], i);
+        assert_ne!(d["device"]["f1_hz"], 25.1e3, "device {i} is drawn");
+        assert!(d["failed"].as_array().unwrap().is_empty(), "{d}");
+        // Every error within 3 of its reported sigmas (the field's
+        // coverage test: none beyond 3 over 160 figures).
+        for s in d["steps"].as_array().unwrap() {
+            for k in 0..2 {
+                let e = s["sf_selfcal_error"][k].as_f64().unwrap();
+                let sigma = s["selfcal_error_uncertainty"][k].as_f64().unwrap();
+                assert!(
+                    e.abs() <= 3.0 * sigma,
+                    "device {i} output {}: {e} at sigma {sigma}",
+                    k + 1
+                );
+            }
+        }
+        within += usize::from(d["within_tolerance"].as_bool().unwrap());
+    }
+    let summary = &report["summary"];
+    assert_eq!(summary["yield_both"].as_f64().unwrap(), within as f64 / 5.0);
+    assert_eq!(summary["error_percentiles"].as_array().unwrap().len(), 4);
+    assert!(report["shard"].is_null());
+    let csv = read(&full_dir.join("sweep.csv"));
+    assert_eq!(csv.lines().count(), 1 + 5, "a header and a row per device");
+    assert_eq!(read(&full_dir.join("sweep.json")).trim(), full.trim());
+    assert!(full_dir.join("fig_sweep.png").exists() && full_dir.join("fig_sweep.svg").exists());
+
+    // Slurm: three array tasks, as `sbatch --array=1-3` would run them,
+    // then the merge job.
+    let parts = dir.path().join("slurm");
+    let out = parts.to_str().unwrap();
+    for i in ["1", "2", "3"] {
+        script(
+            "examples/sweep/slurm.sbatch",
+            &[],
+            &[
+                ("CONFIG", config),
+                ("OUT", out),
+                ("SLURM_ARRAY_TASK_ID", i),
+                ("SLURM_ARRAY_TASK_COUNT", "3"),
+            ],
+        );
+    }
+    script("examples/sweep/slurm-merge.sbatch", &[], &[("OUT", out)]);
+    assert_eq!(
+        read(&parts.join("merged.json")),
+        full,
+        "Slurm shards merged"
+    );
+    assert!(parts.join("merged/fig_sweep.png").exists());
+
+    // GNU parallel: two shards at once on this machine.
+    let par = dir.path().join("parallel");
+    script(
+        "examples/sweep/parallel.sh",
+        &[config, "2", par.to_str().unwrap()],
+        &[],
+    );
+    assert_eq!(
+        read(&par.join("merged.json")),
+        full,
+        "GNU parallel shards merged"
+    );
+
+    // Shards that do not make one sweep are refused in one line.
+    let shard = |i: u32| {
+        parts
+            .join(format!("shard-{i}-of-3.json"))
+            .display()
+            .to_string()
+    };
+    let foreign = dir.path().join("foreign.json");
+    std::fs::write(
+        &foreign,
+        read(Path::new(&shard(3))).replace("\"fingerprint\":\"", "\"fingerprint\":\"0"),
+    )
+    .unwrap();
+    let refusals = [
+        (vec![shard(1), shard(2)], "shard 3/3 is missing"),
+        (
+            vec![shard(1), shard(2), shard(2)],
+            "shard 2/3 is given twice",
+        ),
+        (
+            vec![shard(1), shard(2), foreign.display().to_string()],
+            "another file",
+        ),
+        (
+            vec![full_dir.join("sweep.json").display().to_string()],
+            "not a shard",
+        ),
+        (vec![config.to_string()], "not a sweep report"),
+    ];
+    for (files, what) in refusals {
+        let mut args = vec!["sweep".to_string(), "merge".into()];
+        args.extend(files);
+        let o = gyrocal(&args);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{what}: {err}");
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+        assert!(err.contains(what), "{what}: {err}");
+        assert!(o.stdout.is_empty());
+    }
+}
+
+#[test]
+fn with_a_drift_every_part_runs_every_step() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("drift.toml");
+    let text = SWEEP.replace("devices = 5", "devices = 2")
+        + "[drift]\ntemperatures_c = [25, 40]\ntcf1_ppm_per_k = -30\ntcf2_ppm_per_k = -31\n";
+    std::fs::write(&config, text).unwrap();
+    let report = json_object(gyrocal(&[
+        "sweep",
+        "--config",
+        config.to_str().unwrap(),
+        "--json",
+    ]));
+    assert_eq!(report["temperatures_c"], serde_json::json!([25.0, 40.0]));
+    for d in report["devices"].as_array().unwrap() {
+        let steps = d["steps"].as_array().unwrap();
+        assert_eq!(steps.len(), 2, "{d}");
+        // The worst step is the one with the largest |error|.
+        let size = |s: &serde_json::Value| {
+            (0..2)
+                .map(|k| s["sf_selfcal_error"][k].as_f64().unwrap().abs())
+                .fold(0.0, f64::max)
+        };
+        let worst = steps
+            .iter()
+            .max_by(|a, b| size(a).total_cmp(&size(b)))
+            .unwrap();
+        assert_eq!(d["worst_temperature_c"], worst["temperature_c"]);
+        assert_eq!(d["sf_selfcal_error"], worst["sf_selfcal_error"]);
+    }
+}
+
+#[test]
+fn bad_sweep_input_is_refused_in_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases = [
+        (
+            SWEEP.split("[spread]").next().unwrap().to_string(),
+            "missing [spread]",
+        ),
+        (
+            SWEEP.replace("devices = 5", "devices = 0"),
+            "[spread] devices = 0",
+        ),
+        (
+            SWEEP.replace("q1 = { rel_sd = 0.08 }", "q1 = { rel_sd = 0.8 }"),
+            "q1.rel_sd = 0.8",
+        ),
+        (
+            SWEEP.replace("q1 = { rel_sd = 0.08 }", "q1 = { sd = 3, rel_sd = 0.1 }"),
+            "exactly one",
+        ),
+        (
+            SWEEP.replace(
+                "quadrature_dps = { sd = 30.0 }",
+                "quadrature_dps = { rel_sd = 0.1 }",
+            ),
+            "give `sd`",
+        ),
+        (
+            SWEEP.replace("seed = 11", "seed = 11\nq3 = { sd = 1 }"),
+            "q3",
+        ),
+        (SWEEP.replace("q1 = 3000", "q1 = -3"), "q1"),
+    ];
+    for (i, (text, what)) in cases.iter().enumerate() {
+        let config = dir.path().join(format!("bad{i}.toml"));
+        std::fs::write(&config, text).unwrap();
+        let o = gyrocal(&[
+            "sweep",
+            "--config",
+            config.to_str().unwrap(),
+            "--out",
+            dir.path().join("out").to_str().unwrap(),
+        ]);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "case {i}: {err}");
+        assert_eq!(err.trim().lines().count(), 1, "case {i}: {err}");
+        assert!(err.contains(what), "case {i} ({what}): {err}");
+        assert!(!dir.path().join("out").exists(), "nothing written");
+    }
+    // A shard that is not I/N with 1 <= I <= N.
+    let config = dir.path().join("good.toml");
+    std::fs::write(&config, SWEEP).unwrap();
+    for shard in ["0/3", "4/3", "2", "x/y"] {
+        let o = gyrocal(&[
+            "sweep",
+            "--config",
+            config.to_str().unwrap(),
+            "--shard",
+            shard,
+        ]);
+        assert_eq!(o.status.code(), Some(2), "{shard}");
+        assert!(stderr(&o).contains("give I/N"), "{}", stderr(&o));
+    }
+    // `field` runs one device: it refuses [spread], and needs [drift].
+    let o = gyrocal(&["field", "--config", config.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("[spread] is read by `gyrocal sweep`"),
+        "{}",
+        stderr(&o)
+    );
+    std::fs::write(&config, SWEEP.split("[spread]").next().unwrap()).unwrap();
+    let o = gyrocal(&["field", "--config", config.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("missing [drift]"), "{}", stderr(&o));
+}
