@@ -133,3 +133,30 @@ fn a_failed_step_is_reported_and_the_finished_steps_stand() {
         serde_json::from_str(&std::fs::read_to_string(out.join("field.json")).unwrap()).unwrap();
     assert_eq!(written, report);
 }
+
+/// A drive-gain ratio the cycle cannot measure (no coupling, no
+/// `[drive_probe]`) is the design's: the summary says, in one line, that
+/// its error is not in the sigma unless `[datasheet]
+/// drive_gain_ratio_uncertainty` bounds it, and with that key it is silent.
+#[test]
+fn an_unbudgeted_design_drive_ratio_is_said() {
+    let drift = "[drift]\ntemperatures_c = [25]\ntcf1_ppm_per_k = -30\ntcf2_ppm_per_k = -30\n";
+    let dir = tempfile::tempdir().unwrap();
+    let note =
+        "gives no drive_gain_ratio_uncertainty: a drive gain that drifted is not in the sigma";
+    for (datasheet, said) in [
+        ("", true),
+        ("[datasheet]\ndrive_gain_ratio_uncertainty = 0.005\n", false),
+    ] {
+        let config = dir.path().join("design_ratio.toml");
+        std::fs::write(&config, format!("{GOOD}{drift}{datasheet}")).unwrap();
+        let run = gyrocal(&[
+            OsStr::new("field"),
+            OsStr::new("--config"),
+            config.as_os_str(),
+        ]);
+        assert!(run.status.success(), "{}", common::stderr(&run));
+        let text = String::from_utf8(run.stdout).unwrap();
+        assert_eq!(text.contains(note), said, "{datasheet}: {text}");
+    }
+}

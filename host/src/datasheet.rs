@@ -6,7 +6,12 @@
 //! truth and `[gyro]` is the datasheet itself. Process spread moves a
 //! resonance by 1 to 5% and a Q by a factor of 2; the angular gain
 //! lambda comes from design and enters every predicted ratio one for one,
-//! so it carries its own relative uncertainty.
+//! so it carries its own relative uncertainty. So does the ratio of the
+//! two drive channels' force gains, g2 / g1 against the design: the host
+//! measures it only when a quadrature coupling or a `[drive_probe]` turn
+//! makes it observable, and otherwise predicts at the design ratio, whose
+//! error (channel matching, and the drift of each drive's gain over the
+//! field's temperatures) only the datasheet can bound.
 //!
 //! ```toml
 //! [datasheet]
@@ -14,6 +19,7 @@
 //! q1 = 30000
 //! angular_gain = 0.61
 //! angular_gain_uncertainty = 0.01    # relative 1-sigma; required with angular_gain
+//! drive_gain_ratio_uncertainty = 0.005  # relative 1-sigma of g2/g1 over the design, in the field
 //! ```
 
 use crate::device::GyroParams;
@@ -21,6 +27,8 @@ use serde::{Deserialize, Serialize};
 
 /// Largest relative 1-sigma of the angular gain.
 pub const MAX_ANGULAR_GAIN_UNCERTAINTY: f64 = 0.5;
+/// Largest relative 1-sigma of the drive-gain ratio.
+pub const MAX_DRIVE_GAIN_RATIO_UNCERTAINTY: f64 = 0.5;
 
 /// The `[datasheet]` section: each key overrides `[gyro]`'s for the host.
 #[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize)]
@@ -42,6 +50,9 @@ pub struct Datasheet {
     pub quadrature_dps: Option<f64>,
     /// Damping coupling (deg/s).
     pub damping_coupling_dps: Option<f64>,
+    /// Relative 1-sigma of the drive-gain ratio g2 / g1 against the design
+    /// over the field's conditions (default 0: the design ratio exact).
+    pub drive_gain_ratio_uncertainty: Option<f64>,
 }
 
 /// A `[datasheet]` key out of range: one line naming it.
@@ -63,6 +74,8 @@ pub struct Nominal {
     pub gyro: GyroParams,
     /// Relative 1-sigma of its angular gain.
     pub angular_gain_uncertainty: f64,
+    /// Relative 1-sigma of the drive-gain ratio against the design.
+    pub drive_gain_ratio_uncertainty: f64,
 }
 
 impl Datasheet {
@@ -77,6 +90,8 @@ impl Datasheet {
     /// assert_eq!((n.gyro.f1_hz, n.gyro.f2_hz, n.angular_gain_uncertainty), (1.02e5, 1.001e5, 0.0));
     /// let bad = Datasheet { angular_gain: Some(0.7), ..Default::default() };
     /// assert!(bad.over(&gyro).unwrap_err().to_string().contains("angular_gain_uncertainty"));
+    /// let wide = Datasheet { drive_gain_ratio_uncertainty: Some(0.7), ..Default::default() };
+    /// assert!(wide.over(&gyro).unwrap_err().to_string().contains("drive_gain_ratio_uncertainty = 0.7"));
     /// ```
     pub fn over(&self, gyro: &GyroParams) -> Result<Nominal, DatasheetError> {
         let pick = |v: Option<f64>, d: f64| v.unwrap_or(d);
@@ -135,9 +150,17 @@ impl Datasheet {
             (0.0..=MAX_ANGULAR_GAIN_UNCERTAINTY).contains(&u),
             &format!("allowed 0..={MAX_ANGULAR_GAIN_UNCERTAINTY} (relative 1-sigma)"),
         )?;
+        let r = self.drive_gain_ratio_uncertainty.unwrap_or(0.0);
+        check(
+            "drive_gain_ratio_uncertainty",
+            r,
+            (0.0..=MAX_DRIVE_GAIN_RATIO_UNCERTAINTY).contains(&r),
+            &format!("allowed 0..={MAX_DRIVE_GAIN_RATIO_UNCERTAINTY} (relative 1-sigma)"),
+        )?;
         Ok(Nominal {
             gyro: g,
             angular_gain_uncertainty: u,
+            drive_gain_ratio_uncertainty: r,
         })
     }
 }

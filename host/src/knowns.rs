@@ -38,6 +38,10 @@ pub struct Knowns {
     /// Relative 1-sigma uncertainty of the datasheet's angular gain
     /// lambda (it enters every predicted ratio one for one).
     pub angular_gain_uncertainty: f64,
+    /// Relative 1-sigma of the drive-gain ratio g2 / g1 against the
+    /// design, from the datasheet: the budget's term for a ratio the cycle
+    /// could not measure (`selfcal::budget::design_drive_ratio`).
+    pub drive_gain_ratio_uncertainty: f64,
     /// Readout drive amplitudes (fractions of full scale).
     pub amplitude: (f64, f64),
     /// Design force per full-scale DAC word of drive 1 and 2 (N/kg): only

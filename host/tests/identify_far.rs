@@ -25,6 +25,7 @@ fn knowns(datasheet: GyroParams) -> Knowns {
     Knowns {
         clock_hz: 50e6,
         angular_gain_uncertainty: 0.0,
+        drive_gain_ratio_uncertainty: 0.0,
         amplitude: (0.9, 0.9),
         force_full_scale: [1.0, 1.0],
         dac_latency: 2,

@@ -203,8 +203,9 @@ fn write_results(
     Ok(written)
 }
 
-/// Per step: the quadrature coupling the cycle measured, and a carrier
-/// that folds in the output's passband (the rate ripples there).
+/// Per step: the quadrature coupling the cycle measured, a drive-gain
+/// ratio taken as the design's with no sigma, and a carrier that folds in
+/// the output's passband (the rate ripples there).
 fn step_notes(s: &mut String, report: &FieldReport) {
     for st in &report.steps {
         let i = &st.identified;
@@ -218,6 +219,19 @@ fn step_notes(s: &mut String, report: &FieldReport) {
             i.damping_coupling_dps,
             i.damping_coupling_dps_uncertainty,
             st.truth.gyro.damping_coupling_dps
+        );
+    }
+    let design: Vec<String> = report
+        .steps
+        .iter()
+        .filter(|st| st.selfcal.drive_ratio.is_none())
+        .map(|st| format!("{}", st.temperature_c))
+        .collect();
+    if !design.is_empty() && report.knowns.drive_gain_ratio_uncertainty == 0.0 {
+        let _ = writeln!(
+            s,
+            "note: at {} deg C the drive-gain ratio g2/g1 is the design's (no quadrature coupling seen at rest, no [drive_probe]) and [datasheet] gives no drive_gain_ratio_uncertainty: a drive gain that drifted is not in the sigma",
+            design.join(", ")
         );
     }
     for st in report.steps.iter().filter(|st| st.carrier_fold.in_passband) {

@@ -14,8 +14,9 @@ use serde::Serialize;
 /// Relative 1-sigma uncertainties of the self-calibrated scale factors,
 /// per output, by source, and their quadrature sum.
 ///
-/// Not included: a drive-gain ratio that drifted unobserved (without
-/// `[drive_probe]` the design ratio is used as exact).
+/// A drive-gain ratio the cycle could not measure (no quadrature coupling
+/// at rest, no `[drive_probe]`) is the design's, with the datasheet's
+/// `drive_gain_ratio_uncertainty` in `drive_ratio`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct SfUncertainty {
     /// The staircase slope's noise (`staircase`).
@@ -28,7 +29,8 @@ pub struct SfUncertainty {
     /// through the exact theory (the ratio scales with lambda, one for one
     /// to first order).
     pub angular_gain: [f64; 2],
-    /// The measured drive-gain ratio's (0 without one).
+    /// The drive-gain ratio's: the measured ratio's sigma, or without a
+    /// measurement the datasheet's on the design ratio.
     pub drive_ratio: [f64; 2],
     /// All of them in quadrature.
     pub total: [f64; 2],
@@ -121,4 +123,22 @@ pub(super) fn angular_gain(
     let mut g = gyro.clone();
     g.angular_gain *= 1.0 + u;
     Ok(spread(&[predicted_ratio(knowns, &g, op, cal_hz)?], ratio))
+}
+
+/// The predicted ratio's relative 1-sigma from the design drive-gain
+/// ratio's (`Knowns::drive_gain_ratio_uncertainty`): drive 2's force gain
+/// moved by it through the exact theory (`super::with_drive_ratio`).
+pub(super) fn design_drive_ratio(
+    knowns: &Knowns,
+    gyro: &GyroParams,
+    op: &Operating,
+    cal_hz: &[f64],
+    ratio: &Ratio,
+) -> Result<[f64; 2], Error> {
+    let u = knowns.drive_gain_ratio_uncertainty;
+    if u == 0.0 {
+        return Ok([0.0; 2]);
+    }
+    let moved = super::with_drive_ratio(knowns, 1.0 + u);
+    Ok(spread(&[predicted_ratio(&moved, gyro, op, cal_hz)?], ratio))
 }

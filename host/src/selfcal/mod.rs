@@ -221,6 +221,8 @@ pub fn self_calibrate(
         staircase: std::array::from_fn(|k| (sf_cal_sd[k] / sf_cal[k]).abs()),
         identified: budget::identified(knowns, &identified, &op, &cal_hz, &ratio)?,
         angular_gain: budget::angular_gain(knowns, &gyro, &op, &cal_hz, &ratio)?,
+        // The design ratio's own; a measured ratio replaces it below.
+        drive_ratio: budget::design_drive_ratio(knowns, &gyro, &op, &cal_hz, &ratio)?,
         ..SfUncertainty::default()
     }
     .with_total();

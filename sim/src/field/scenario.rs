@@ -369,6 +369,7 @@ pub fn knowns(exp: &Experiment) -> Result<Knowns, String> {
         clock_hz: exp.drive.clock_hz,
         nominal: nominal.gyro,
         angular_gain_uncertainty: nominal.angular_gain_uncertainty,
+        drive_gain_ratio_uncertainty: nominal.drive_gain_ratio_uncertainty,
         amplitude: exp.drive.amplitude(),
         force_full_scale: exp.drive.force_full_scale(),
         dac_latency: exp.frontend.dac_latency,
