@@ -692,7 +692,7 @@ mod tests {
     use super::*;
 
     /// The decimation's documented range is the limits of record, and the
-    /// power-up R and shift are a valid pair.
+    /// power-up R and shift are a valid pair with unit CIC gain.
     #[test]
     fn decimation_text_and_power_up_follow_the_limits() {
         use crate::datapath::{MAX_DECIMATION, MIN_DECIMATION};
@@ -702,6 +702,11 @@ mod tests {
         assert!((MIN_DECIMATION..=MAX_DECIMATION).contains(&r));
         let shift = (4.0 * f64::from(r).log2()).ceil() as u32 - 8;
         assert_eq!(CIC_SHIFT.power_up, shift);
+        // A power of two: the CIC's residual gain R^4 / 2^ceil(4 log2 R)
+        // (`filter_design`) is then exactly 1, and z at the power-up
+        // settings needs no gain divided out (R = 255 would leave 0.98).
+        assert!(r.is_power_of_two(), "power-up R = {r}");
+        assert_eq!(u64::from(r).pow(4), 1 << (shift + 8));
     }
 
     #[test]
