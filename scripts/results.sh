@@ -4,7 +4,7 @@
 # Nothing in that page is typed by hand; rerun this after a change that
 # moves a figure.
 #
-# Usage: scripts/results.sh            (about 5 minutes of CPU on 2 cores)
+# Usage: scripts/results.sh            (about 10 minutes of CPU on 2 cores)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -20,6 +20,7 @@ commands=(
   "$bin run --config tests/data/small_device.toml"
   "$bin field --config tests/data/field_paper.toml"
   "$bin field --config tests/data/field_coupled.toml"
+  "$bin sweep --config examples/sweep/consumer.toml"
   "$bin calibrate --config tests/data/small_device.toml"
   "$bin datasheet --config tests/data/datasheet_small.toml"
 )
