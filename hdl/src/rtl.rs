@@ -14,35 +14,49 @@ pub struct RtlGyroInterface {
     applied: Option<Registers>,
 }
 
-/// The first cycle on which two engines' outputs differ.
+/// The first cycle on which two engines' outputs or internal signals
+/// differ.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Mismatch {
     /// Rising edge number (1 for the first).
     pub cycle: usize,
-    /// Outputs of the rust-hdl design.
-    pub rtl: Outputs,
-    /// Outputs of the model.
-    pub model: Outputs,
+    /// Outputs and internal signals of the rust-hdl design.
+    pub rtl: (Outputs, Probes),
+    /// Outputs and internal signals of the model.
+    pub model: (Outputs, Probes),
 }
 
 /// Drive the rust-hdl design and the model with the same ADC words and
 /// registers (`regs[n]` during cycle n, `adc[n]` likewise) and return the
-/// first cycle whose outputs differ, checking the power-up outputs first.
+/// first cycle whose outputs or internal signals ([`Probes`]: the
+/// modulation factors, the references, the mixers, the CIC) differ,
+/// checking the power-up state first. The internal signals catch what the
+/// ports cannot see: the modulation words while the carrier tables fill,
+/// when every drive and reference is still zero.
 pub fn first_mismatch(
     rtl: &mut RtlGyroInterface,
     adc: &[(i16, i16)],
     regs: &[Registers],
 ) -> Option<Mismatch> {
     let mut model = crate::model::gyro_interface::GyroInterface::new();
-    if rtl.outputs() != model.outputs() {
+    let state = |rtl: &RtlGyroInterface, model: &crate::model::gyro_interface::GyroInterface| {
+        (
+            (rtl.outputs(), probes(rtl.design())),
+            (model.outputs(), model.probes()),
+        )
+    };
+    let (x, y) = state(rtl, &model);
+    if x != y {
         return Some(Mismatch {
             cycle: 0,
-            rtl: rtl.outputs(),
-            model: model.outputs(),
+            rtl: x,
+            model: y,
         });
     }
     for (n, (a, r)) in adc.iter().zip(regs).enumerate() {
-        let (x, y) = (rtl.step(*a, r), model.step(*a, r));
+        rtl.step(*a, r);
+        model.step(*a, r);
+        let (x, y) = state(rtl, &model);
         if x != y {
             return Some(Mismatch {
                 cycle: n + 1,

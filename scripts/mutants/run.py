@@ -8,7 +8,10 @@ catch it (a named check of the list's [checks]: commands run in order until
 one fails; default "hdl", i.e. `cargo test --release -p gyrocal-hdl` in
 three stages, unit tests first). An entry marked
 `equivalent = "why"` is a mutant that no test can catch, because it changes
-nothing observable; it is checked to apply but not run.
+nothing observable; it is checked to apply but not run. An entry marked
+`compile_time = "what stops it"` is one the compiler must refuse (a const
+assertion ties the value to its other home): its build error is its catch,
+and a mutant that builds is judged by its check as any other.
 
 How a run works:
   1. The working tree (tracked files and untracked, not ignored ones, as they
@@ -54,7 +57,8 @@ HERE = pathlib.Path(__file__).resolve().parent
 TIMEOUT_FACTOR = 4
 TIMEOUT_MARGIN = 600
 EXPORT = ["cargo", "run", "--release", "--quiet", "--", "export"]
-ENTRY_KEYS = {"id", "file", "original", "replacement", "why", "check", "equivalent"}
+ENTRY_KEYS = {"id", "file", "original", "replacement", "why", "check", "equivalent",
+              "compile_time"}
 
 
 class ListError(Exception):
@@ -311,7 +315,12 @@ def run_all(checks, mutants, root, work, results, complete_list):
             row.update(verdict="equivalent", tests=[], seconds=0.0, note=m["equivalent"])
         else:
             row.update(run_mutant(m, checks, files, tree, env, baselines))
-            if row["verdict"] in ("build error", "export failed"):
+            if "compile_time" in m and row["verdict"] == "build error":
+                first = next((line for line in row["log"].splitlines()
+                              if line.startswith("error")), "")
+                row.update(verdict="caught", tests=[f"compiler: {first}"],
+                           note=m["compile_time"])
+            elif row["verdict"] in ("build error", "export failed"):
                 row["note"] = row["log"].splitlines()[-1] if row["log"] else ""
         row.pop("log", None)
         rows.append(row)

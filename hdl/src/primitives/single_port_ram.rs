@@ -114,3 +114,45 @@ end",
         }]
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::drive::{prepare, tick};
+
+    crate::impl_clocked!(SinglePortRam<8, 4>);
+
+    /// The port's contract, which the hand-written Verilog and the SPRAM
+    /// share: a write leaves `q` as it was (no write-through), a read
+    /// gives the word one clock later, and each address keeps its own word.
+    #[test]
+    fn writes_leave_q_alone_and_reads_return_the_words() {
+        let mut ram = SinglePortRam::<8, 4>::new();
+        prepare(&mut ram);
+        let word = |a: u64| a as i128 * 13 - 100;
+        let set = |ram: &mut SinglePortRam<8, 4>, write: bool, a: u64, d: i128| {
+            ram.write_enable.next = write;
+            ram.address.next = a.into();
+            ram.write_data.next = i128_to_signed(d);
+        };
+        // A read of address 3 before any write: the model's 0.
+        set(&mut ram, false, 3, 0);
+        tick(&mut ram);
+        let q = |ram: &SinglePortRam<8, 4>| super::super::convert::signed_to_i128(ram.q.val());
+        assert_eq!(q(&ram), 0);
+        for a in 0..16 {
+            set(&mut ram, true, a, word(a));
+            tick(&mut ram);
+            assert_eq!(q(&ram), 0, "a write at {a} changed q");
+        }
+        for a in (0..16).rev() {
+            set(&mut ram, false, a, -1);
+            tick(&mut ram);
+            assert_eq!(q(&ram), word(a), "read {a}");
+            // A write elsewhere leaves the word read on q.
+            set(&mut ram, true, (a + 5) % 16, word((a + 5) % 16));
+            tick(&mut ram);
+            assert_eq!(q(&ram), word(a), "write after read {a}");
+        }
+    }
+}
