@@ -116,3 +116,49 @@ pub fn sfdr_dbc(x: &[f64]) -> f64 {
         .fold(0.0, f64::max);
     10.0 * (power[peak] / spur).log10()
 }
+
+/// Run a leaf block's Verilog (`generate_verilog` of it: module `top`) in
+/// Icarus under `testbench` (a module `tb` that instantiates `top` and
+/// `$display`s), and return the lines it printed. The hand-written Verilog
+/// of a primitive is checked this way against its own Rust model, on
+/// traffic the whole design never makes (`tests/verilog_replay.rs` replays
+/// only the design's). Needs `iverilog` and `vvp` (scripts/test.sh installs
+/// them).
+pub fn icarus_lines(design: &str, testbench: &str) -> Vec<String> {
+    use std::process::Command;
+    let dir = std::env::temp_dir().join(format!(
+        "gyrocal-icarus-{}-{}",
+        std::process::id(),
+        Rng::new(design.len() as u64 ^ testbench.len() as u64).next_u64()
+    ));
+    std::fs::create_dir_all(&dir).expect("a scratch folder");
+    let (v, out) = (dir.join("top.v"), dir.join("top.vvp"));
+    std::fs::write(&v, format!("{design}\n{testbench}\n")).expect("write the Verilog");
+    let compile = Command::new("iverilog")
+        .args(["-g2012", "-s", "tb", "-o"])
+        .arg(&out)
+        .arg(&v)
+        .output()
+        .expect("iverilog not found: install the Debian package iverilog (scripts/test.sh does)");
+    assert!(
+        compile.status.success(),
+        "iverilog: {}",
+        String::from_utf8_lossy(&compile.stderr)
+    );
+    let run = Command::new("vvp")
+        .arg("-n")
+        .arg(&out)
+        .output()
+        .expect("vvp");
+    assert!(
+        run.status.success(),
+        "vvp: {}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+    String::from_utf8_lossy(&run.stdout)
+        .lines()
+        .filter(|l| !l.starts_with("VCD") && !l.is_empty())
+        .map(String::from)
+        .collect()
+}
