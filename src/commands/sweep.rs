@@ -32,7 +32,7 @@ use std::time::Instant;
 pub struct Args {
     #[command(subcommand)]
     pub merge: Option<Sub>,
-    /// Sweep: the sections of `gyrocal field` ([drift] optional) plus [spread] (TOML).
+    /// Sweep: the sections of `gyrocal field` (`[drift]` optional) plus `[spread]` (TOML).
     #[arg(long)]
     pub config: Option<PathBuf>,
     /// Run shard I of N (I from 1): the devices i with i mod N = I - 1.

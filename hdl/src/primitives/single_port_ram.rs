@@ -169,7 +169,11 @@ mod tests {
         ops.push((false, 0, 0));
         ops.extend((0..400).map(|_| {
             let r = rng.next_u64();
-            (r.is_multiple_of(3), (r >> 8) % 16, ((r >> 16) % 256) as i128 - 128)
+            (
+                r.is_multiple_of(3),
+                (r >> 8) % 16,
+                ((r >> 16) % 256) as i128 - 128,
+            )
         }));
         let mut expected = vec![];
         let mut stimulus = String::new();
