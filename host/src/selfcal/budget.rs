@@ -107,6 +107,20 @@ pub(super) fn identified(
     Ok(spread(&moved, ratio))
 }
 
+/// A datasheet sigma `u` (relative) through the exact theory: the ratio
+/// predicted with the quantity moved by `u` (`moved`), against `ratio`;
+/// no term for `u` = 0.
+fn datasheet_term(
+    u: f64,
+    ratio: &Ratio,
+    moved: impl FnOnce(f64) -> Result<Ratio, Error>,
+) -> Result<[f64; 2], Error> {
+    if u == 0.0 {
+        return Ok([0.0; 2]);
+    }
+    Ok(spread(&[moved(u)?], ratio))
+}
+
 /// The predicted ratio's relative 1-sigma from the datasheet's lambda
 /// (`Knowns::angular_gain_uncertainty`), through the exact theory.
 pub(super) fn angular_gain(
@@ -116,13 +130,11 @@ pub(super) fn angular_gain(
     cal_hz: &[f64],
     ratio: &Ratio,
 ) -> Result<[f64; 2], Error> {
-    let u = knowns.angular_gain_uncertainty;
-    if u == 0.0 {
-        return Ok([0.0; 2]);
-    }
-    let mut g = gyro.clone();
-    g.angular_gain *= 1.0 + u;
-    Ok(spread(&[predicted_ratio(knowns, &g, op, cal_hz)?], ratio))
+    datasheet_term(knowns.angular_gain_uncertainty, ratio, |u| {
+        let mut g = gyro.clone();
+        g.angular_gain *= 1.0 + u;
+        predicted_ratio(knowns, &g, op, cal_hz)
+    })
 }
 
 /// The predicted ratio's relative 1-sigma from the design drive-gain
@@ -135,10 +147,7 @@ pub(super) fn design_drive_ratio(
     cal_hz: &[f64],
     ratio: &Ratio,
 ) -> Result<[f64; 2], Error> {
-    let u = knowns.drive_gain_ratio_uncertainty;
-    if u == 0.0 {
-        return Ok([0.0; 2]);
-    }
-    let moved = super::with_drive_ratio(knowns, 1.0 + u);
-    Ok(spread(&[predicted_ratio(&moved, gyro, op, cal_hz)?], ratio))
+    datasheet_term(knowns.drive_gain_ratio_uncertainty, ratio, |u| {
+        predicted_ratio(&super::with_drive_ratio(knowns, 1.0 + u), gyro, op, cal_hz)
+    })
 }
