@@ -16,8 +16,6 @@
 use crate::Failure;
 use gyrocal_sim::config::Experiment;
 use gyrocal_sim::rate_noise::{self, NoisyRun, RateNoisePrediction};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 /// Default run length (simulated s): the reading at tau = 1 s then has
@@ -97,7 +95,11 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         eprintln!("note: [noise] temperature_k is 0: no Brownian noise, the ADC's alone");
     }
     let total = plan.points[0].settle_cycles + (args.seconds * exp.drive.clock_hz).ceil() as u64;
-    let bar = progress_bar(args.quiet, total);
+    let bar = super::progress_bar(
+        args.quiet,
+        total,
+        "{spinner} noisy readout [{bar:40}] {percent:>3}%  {human_pos}/{human_len} clocks  {per_sec}  eta {eta}",
+    );
     let tick = |n: u64| bar.inc(n);
     let run = rate_noise::run_noisy(&exp, &plan, args.rate_dps, args.seconds, &tick)
         .map_err(Failure::Run)?;
@@ -147,21 +149,6 @@ pub(super) fn check_folder(dir: &Path) -> Result<(), Failure> {
         ))),
         _ => Ok(()),
     }
-}
-
-fn progress_bar(quiet: bool, total: u64) -> ProgressBar {
-    if quiet || !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{spinner} noisy readout [{bar:40}] {percent:>3}%  {human_pos}/{human_len} clocks  {per_sec}  eta {eta}",
-        )
-        .expect("a valid template")
-        .progress_chars("=> "),
-    );
-    bar
 }
 
 /// One row per tau: measured and predicted deviations of both outputs.

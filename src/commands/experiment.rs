@@ -6,8 +6,6 @@ use gyrocal_sim::engine::EngineKind;
 use gyrocal_sim::experiment::{self, Experiment, Mode, Tick};
 use gyrocal_sim::report::Report;
 use gyrocal_sim::waveform::{Probe, VcdRecorder, parse_window};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 /// The text of `--config FILE`, and the name its errors go by (the path).
@@ -158,24 +156,16 @@ pub fn execute(
             total as f64 / 7000.0 / 3600.0 / rayon_threads()
         );
     }
-    let bar = if options.quiet || !std::io::stderr().is_terminal() {
-        ProgressBar::hidden()
-    } else {
-        let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
-        bar.set_style(
-            ProgressStyle::with_template(
-                "{spinner} {msg} [{bar:40}] {percent:>3}%  {human_pos}/{human_len} clocks  {per_sec}  eta {eta}",
-            )
-            .unwrap()
-            .progress_chars("=> "),
-        );
-        bar.set_message(format!(
-            "{} points on {}",
-            plan.points.len(),
-            checked.engine.name()
-        ));
-        bar
-    };
+    let bar = super::progress_bar(
+        options.quiet,
+        total,
+        "{spinner} {msg} [{bar:40}] {percent:>3}%  {human_pos}/{human_len} clocks  {per_sec}  eta {eta}",
+    );
+    bar.set_message(format!(
+        "{} points on {}",
+        plan.points.len(),
+        checked.engine.name()
+    ));
     let tick = |t: Tick| match t {
         Tick::Clocks(n) => bar.inc(n),
         Tick::Planned(n) => bar.inc_length(n),

@@ -20,9 +20,7 @@
 
 use crate::Failure;
 use gyrocal_sim::sweep::{self, Shard, SweepReport, summary::Summary};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::fmt::Write as _;
-use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -90,7 +88,11 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         "{total} devices{shard}, {} temperature step(s) each",
         sw.scenario.drift.temperatures_c.len()
     );
-    let bar = progress_bar(u64::from(total));
+    let bar = super::progress_bar(
+        false,
+        u64::from(total),
+        "devices [{bar:40}] {pos}/{len}  eta {eta}",
+    );
     let start = Instant::now();
     let report = sw.run(args.shard, &|d| {
         if bar.is_hidden() {
@@ -106,19 +108,6 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         clocks = clocks as f64
     );
     emit(&report, &name, &args.output)
-}
-
-fn progress_bar(total: u64) -> ProgressBar {
-    if !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
-    bar.set_style(
-        ProgressStyle::with_template("devices [{bar:40}] {pos}/{len}  eta {eta}")
-            .expect("a valid template")
-            .progress_chars("=> "),
-    );
-    bar
 }
 
 /// A device's progress line.
