@@ -36,14 +36,10 @@ impl SweepFigure {
                 .iter()
                 .filter(|d| d.failed.is_empty() && !d.steps.is_empty())
                 .map(|d| {
-                    let worst = d
-                        .steps
-                        .iter()
-                        .fold(0.0f64, |m, s| m.max(s.sf_selfcal_error[k].abs()));
                     (
                         d.device.f2_hz - d.device.f1_hz,
                         d.device.q1,
-                        100.0 * worst.max(FLOOR),
+                        100.0 * d.worst_error(k).max(FLOOR),
                     )
                 })
                 .collect()

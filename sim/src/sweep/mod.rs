@@ -153,6 +153,13 @@ pub struct DeviceStep {
     pub identified: IdentifiedJson,
 }
 
+impl DeviceStep {
+    /// |self-calibration error| of output `k`.
+    pub fn error(&self, k: usize) -> f64 {
+        self.sf_selfcal_error[k].abs()
+    }
+}
+
 /// A part of a device's run that failed (the rest stands).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct DeviceFailure {
@@ -232,12 +239,10 @@ impl Sweep {
         fill(&mut ds.damping_coupling_dps, nominal.damping_coupling_dps);
         if ds.angular_gain.is_none() {
             ds.angular_gain = Some(nominal.angular_gain);
-            let spread = self.spread.angular_gain.map_or(0.0, |s| {
-                s.sd.map_or_else(
-                    || s.rel_sd.unwrap_or(0.0),
-                    |sd| sd / nominal.angular_gain.abs(),
-                )
-            });
+            let spread = self
+                .spread
+                .angular_gain
+                .map_or(0.0, |s| s.relative(nominal.angular_gain));
             ds.angular_gain_uncertainty.get_or_insert(spread);
         }
         sc.exp.gyro = drawn.gyro.clone();
@@ -292,10 +297,8 @@ impl Sweep {
         shard: Option<Shard>,
         progress: &(dyn Fn(&DeviceResult) + Sync),
     ) -> SweepReport {
-        let indices: Vec<u32> = (0..self.spread.devices)
-            .filter(|&i| shard.is_none_or(|s| s.holds(i)))
-            .collect();
-        let devices: Vec<DeviceResult> = indices
+        let devices: Vec<DeviceResult> = self
+            .indices(shard)
             .par_iter()
             .map(|&i| {
                 let d = self.run_device(i);
@@ -314,15 +317,26 @@ impl Sweep {
         }
     }
 
-    /// The devices a shard holds (all without one).
-    pub fn device_count(&self, shard: Option<Shard>) -> u32 {
+    /// The indices of the devices a shard holds (all without one).
+    fn indices(&self, shard: Option<Shard>) -> Vec<u32> {
         (0..self.spread.devices)
             .filter(|&i| shard.is_none_or(|s| s.holds(i)))
-            .count() as u32
+            .collect()
+    }
+
+    /// How many devices a shard holds (all without one).
+    pub fn device_count(&self, shard: Option<Shard>) -> u32 {
+        self.indices(shard).len() as u32
     }
 }
 
 impl DeviceResult {
+    /// The largest |self-calibration error| of output `k` over the finished
+    /// steps (0 without one).
+    pub fn worst_error(&self, k: usize) -> f64 {
+        self.steps.iter().fold(0.0, |m, s| m.max(s.error(k)))
+    }
+
     fn new(
         index: u32,
         drawn: Drawn,
@@ -331,11 +345,7 @@ impl DeviceResult {
         clocks: u64,
         tolerance: f64,
     ) -> Self {
-        let size = |s: &DeviceStep| {
-            s.sf_selfcal_error
-                .iter()
-                .fold(0.0f64, |m, e| m.max(e.abs()))
-        };
+        let size = |s: &DeviceStep| 0.0f64.max(s.error(0)).max(s.error(1));
         let worst = steps.iter().max_by(|a, b| size(a).total_cmp(&size(b)));
         Self {
             index,

@@ -125,6 +125,13 @@ struct Param {
 }
 
 impl Sd {
+    /// The standard deviation relative to `nominal` (of a spread
+    /// [`Spread::validate`] accepted: one of the two given).
+    pub fn relative(&self, nominal: f64) -> f64 {
+        self.rel_sd
+            .unwrap_or_else(|| self.sd.unwrap_or(0.0) / nominal.abs())
+    }
+
     /// The absolute standard deviation around `nominal`, checked.
     fn absolute(&self, key: &str, nominal: f64) -> Result<f64, SpreadError> {
         match (self.sd, self.rel_sd) {

@@ -54,14 +54,7 @@ impl Summary {
         let n = devices.len().max(1) as f64;
         let finished: Vec<&DeviceResult> = devices.iter().filter(|d| d.failed.is_empty()).collect();
         let worst = |k: usize| -> Vec<f64> {
-            let mut v: Vec<f64> = finished
-                .iter()
-                .map(|d| {
-                    d.steps
-                        .iter()
-                        .fold(0.0f64, |m, s| m.max(s.sf_selfcal_error[k].abs()))
-                })
-                .collect();
+            let mut v: Vec<f64> = finished.iter().map(|d| d.worst_error(k)).collect();
             v.sort_by(f64::total_cmp);
             v
         };
