@@ -162,3 +162,40 @@ pub fn icarus_lines(design: &str, testbench: &str) -> Vec<String> {
         .map(String::from)
         .collect()
 }
+
+/// [`icarus_lines`] under a clocked testbench `tb` for a leaf block's
+/// `top`: `inputs` are its input registers (name, width, signed) besides
+/// `clock`, `output` its output (name, width), printed signed in decimal.
+/// Each of `steps` (Verilog assignments to the inputs) is applied with the
+/// clock low, then a rising edge, then the output is printed: one line a
+/// step, as the block's Rust model reads after `drive::tick`.
+pub fn icarus_clocked(
+    design: &str,
+    inputs: &[(&str, usize, bool)],
+    output: (&str, usize),
+    steps: &[String],
+) -> Vec<String> {
+    let range = |w: usize| {
+        if w == 1 {
+            String::new()
+        } else {
+            format!(" [{}:0]", w - 1)
+        }
+    };
+    let mut tb = String::from("module tb;\n   reg clock = 0;\n");
+    let mut ports = vec![".clock(clock)".to_string()];
+    for &(name, width, signed) in inputs {
+        let sign = if signed { " signed" } else { "" };
+        tb += &format!("   reg{sign}{} {name} = 0;\n", range(width));
+        ports.push(format!(".{name}({name})"));
+    }
+    let (out, width) = output;
+    tb += &format!("   wire signed{} {out};\n", range(width));
+    ports.push(format!(".{out}({out})"));
+    tb += &format!("   top uut({});\n   initial begin\n", ports.join(", "));
+    for step in steps {
+        tb += &format!("      {step} #1 clock = 1; #1 $display(\"%0d\", {out}); clock = 0; #1;\n");
+    }
+    tb += "   end\nendmodule";
+    icarus_lines(design, &tb)
+}

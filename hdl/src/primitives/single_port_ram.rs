@@ -176,22 +176,28 @@ mod tests {
             )
         }));
         let mut expected = vec![];
-        let mut stimulus = String::new();
+        let mut steps = vec![];
         for &(write, a, d) in &ops {
             ram.write_enable.next = write;
             ram.address.next = a.into();
             ram.write_data.next = i128_to_signed(d);
             tick(&mut ram);
             expected.push(super::super::convert::signed_to_i128(ram.q.val()).to_string());
-            stimulus += &format!(
-                "      write_enable = {}; address = {a}; write_data = {d}; #1 clock = 1; #1 $display(\"%0d\", q); clock = 0; #1;\n",
+            steps.push(format!(
+                "write_enable = {}; address = {a}; write_data = {d};",
                 u8::from(write)
-            );
+            ));
         }
-        let testbench = format!(
-            "module tb;\n   reg clock = 0;\n   reg write_enable = 0;\n   reg [3:0] address = 0;\n   reg signed [7:0] write_data = 0;\n   wire signed [7:0] q;\n   top uut(.clock(clock), .write_enable(write_enable), .address(address), .write_data(write_data), .q(q));\n   initial begin\n{stimulus}   end\nendmodule"
+        let got = crate::test_util::icarus_clocked(
+            &generate_verilog(&ram),
+            &[
+                ("write_enable", 1, false),
+                ("address", 4, false),
+                ("write_data", 8, true),
+            ],
+            ("q", 8),
+            &steps,
         );
-        let got = crate::test_util::icarus_lines(&generate_verilog(&ram), &testbench);
         // The first 16 edges write: q is the (never read) X of an SPRAM there.
         assert_eq!(got.len(), expected.len());
         for (n, (g, e)) in got.iter().zip(&expected).enumerate().skip(16) {

@@ -151,7 +151,7 @@ mod verilog_tests {
             (write, w, ((r >> 16) % 256) as i128 - 128, rd)
         }));
         let mut expected = vec![];
-        let mut stimulus = String::new();
+        let mut steps = vec![];
         for &(write, w, d, rd) in &ops {
             ram.write_enable.next = write;
             ram.write_address.next = w.into();
@@ -159,15 +159,22 @@ mod verilog_tests {
             ram.read_address.next = rd.into();
             tick(&mut ram);
             expected.push(signed_to_i128(ram.q.val()).to_string());
-            stimulus += &format!(
-                "      write_enable = {}; write_address = {w}; write_data = {d}; read_address = {rd}; #1 clock = 1; #1 $display(\"%0d\", q); clock = 0; #1;\n",
+            steps.push(format!(
+                "write_enable = {}; write_address = {w}; write_data = {d}; read_address = {rd};",
                 u8::from(write)
-            );
+            ));
         }
-        let testbench = format!(
-            "module tb;\n   reg clock = 0;\n   reg write_enable = 0;\n   reg [2:0] write_address = 0;\n   reg signed [7:0] write_data = 0;\n   reg [2:0] read_address = 0;\n   wire signed [7:0] q;\n   top uut(.clock(clock), .write_enable(write_enable), .write_address(write_address), .write_data(write_data), .read_address(read_address), .q(q));\n   initial begin\n{stimulus}   end\nendmodule"
+        let got = crate::test_util::icarus_clocked(
+            &generate_verilog(&ram),
+            &[
+                ("write_enable", 1, false),
+                ("write_address", 3, false),
+                ("write_data", 8, true),
+                ("read_address", 3, false),
+            ],
+            ("q", 8),
+            &steps,
         );
-        let got = crate::test_util::icarus_lines(&generate_verilog(&ram), &testbench);
         assert_eq!(got, expected);
     }
 }
