@@ -1,9 +1,10 @@
 //! A fake board for examples and tests without the simulator: two
 //! Lorentzian modes behind the register map, z their exact steady state
-//! (no transient), each mode seen only through its own drive as the
-//! gateware's readout sees it (`identify` module header). It runs in
-//! microseconds per measurement, so the host's logic can be shown and
-//! tested alone; the simulated board (`gyrocal-sim`) is the real check.
+//! (no transient) through the DAC hold's gain, each mode seen only
+//! through its own drive as the gateware's readout sees it (`identify`
+//! module header). It runs in microseconds per measurement, so the host's
+//! logic can be shown and tested alone; the simulated board
+//! (`gyrocal-sim`) is the real check.
 //!
 //! ```
 //! use gyrocal_host::fake::Lorentzian;
@@ -16,6 +17,7 @@
 //! ```
 
 use crate::board::{Board, ZSample};
+use crate::theory::hold_gain;
 use gyrocal_regs::datapath::readout_word;
 use gyrocal_regs::filter_design::cic_bit_growth;
 use gyrocal_regs::map::{
@@ -66,7 +68,7 @@ impl Lorentzian {
         let amps = [r.amp.0, r.amp.1];
         std::array::from_fn(|m| {
             let (fk, bk, c) = self.modes[m];
-            let y = c / C64::new((fk - f) * (fk + f), f * bk);
+            let y = hold_gain(f, self.clock_hz) * c / C64::new((fk - f) * (fk + f), f * bk);
             let w = readout_word(amps[m]);
             self.state = self.state.wrapping_mul(6364136223846793005).wrapping_add(1);
             let n = ((self.state >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 2.0 * self.noise;

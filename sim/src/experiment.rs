@@ -291,12 +291,9 @@ impl Plan {
     }
 }
 
-/// Fundamental gain of the DAC's zero-order hold at `f_hz`, sin(x) / x with
-/// x = pi f / f_clk.
-pub(crate) fn hold_gain(f_hz: f64, clock_hz: f64) -> f64 {
-    let x = PI * f_hz / clock_hz;
-    x.sin() / x
-}
+/// Fundamental gain of the DAC's zero-order hold (the host's theory holds
+/// the one definition).
+pub(crate) use gyrocal_host::theory::hold_gain;
 
 /// A ratio's 1-sigma target: `tolerance x max(|ratio|, RATIO_FLOOR)`.
 pub fn ratio_target(tolerance: f64, ratio: f64) -> f64 {

@@ -20,7 +20,8 @@
 //! product of drive gain, hold, pick-off and ADC gain (unknown, and not
 //! needed), and phi the front end's unmodelled phase lag. This is the
 //! exact steady state of the model (the DAC hold's delay is what
-//! REF_PHASE's aligned value cancels; its sinc moves G by 1e-5 over a sweep).
+//! REF_PHASE's aligned value cancels; its gain, the hold's sinc, falls by
+//! 2e-5 across a sweep, enough to pull fk, and is in the fine fit's model).
 //!
 //! # How
 //!
@@ -138,8 +139,9 @@ pub struct ModeFit {
     pub phase_deg: Estimate,
     /// RMS residual over the peak response (relative misfit).
     pub relative_rms: f64,
-    /// |C| of the fitted form Y = C / ((fk - f)(fk + f) + j f bk): ADC LSB
-    /// per drive LSB, times Hz^2 (the peak response is |C| / (fk bk)).
+    /// |C| of the fitted form Y = C / ((fk - f)(fk + f) + j f bk), with
+    /// the DAC hold's gain at fk in C: ADC LSB per drive LSB, times Hz^2
+    /// (the peak response is |C| / (fk bk)).
     pub gain_hz2: f64,
     /// The coarse search from the guess did not converge and the scan
     /// over +-`SCAN_SPAN` found the mode: the datasheet was off.

@@ -5,6 +5,7 @@ use super::fit::{narrow_band, scan_fit};
 use super::probe::Prober;
 use super::{C64, MAX_MOVES, SCAN_POINTS, SCAN_SPAN};
 use crate::error::Error;
+use crate::theory::hold_gain;
 
 /// A bandwidth the coarse search accepts, against the datasheet's: Q is
 /// within a factor of 20 of it (process spread is a factor of 2).
@@ -59,8 +60,8 @@ pub(super) fn coarse(probe: &mut Prober, start: f64, bw: f64) -> Result<Option<(
 /// Why zoom: the first scan's points lie hundreds of bandwidths from the
 /// resonance (a 5% scan of a Q 55,000 mode is 2,700 bandwidths wide), where
 /// the response is small and any departure from the exact form (the front
-/// end's frequency-dependent phase across 10% of the carrier, the drive
-/// hold's sinc) moves fk by a fraction of the spacing: measured on the
+/// end's frequency-dependent phase across 10% of the carrier; the drive
+/// hold's gain is divided out) moves fk by a fraction of the spacing: measured on the
 /// paper device with a datasheet 1.5% low, 30 kHz off a 47.5 kHz spacing.
 /// Each zoom divides that error with the span; the estimate stays inside
 /// the next scan as long as it is within `ZOOM_SPACINGS` spacings.
@@ -94,7 +95,10 @@ fn scan_once(probe: &mut Prober, lo: f64, hi: f64, guess: f64) -> Result<f64, Er
     for i in 0..SCAN_POINTS {
         let f = lo + (hi - lo) * i as f64 / (SCAN_POINTS - 1) as f64;
         if f > 0.0 {
-            pts.push(probe.measure(f)?);
+            // The exact form leaves out the hold's gain, which falls by
+            // several percent across a wide scan (`theory::hold_gain`).
+            let (f, y) = probe.measure(f)?;
+            pts.push((f, y / hold_gain(f, probe.clock_hz())));
         }
     }
     let largest = pts
