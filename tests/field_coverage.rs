@@ -35,8 +35,8 @@
 //!   sigmas twice too large put 99.99% within 2. The four figures of a
 //!   device share its identification, so the 160 count as 40 to 160
 //!   trials: at 96% a binomial standard deviation of 1.5 to 3%.
-//! - Every t within 3. The pinned devices hold it (96.9% within 2, largest
-//!   |t| 2.74, RMS 0.86); seeds up to 2100 (85 devices, 340 figures) gave
+//! - Every t within 3. The pinned devices hold it (98.8% within 2, largest
+//!   |t| 2.40, RMS 0.79); seeds up to 2100 (85 devices, 340 figures) gave
 //!   95.6% within 2 and none beyond 3 (without the couplings: 96.2% and
 //!   one figure at 3.13, seed 2080, Q 111, an output whose self-cal sigma
 //!   is 0.01%). 0.9 such are expected in 340 figures of honest normal
@@ -115,6 +115,32 @@ fn t_values(r: &FieldReport) -> Vec<f64> {
         .collect()
 }
 
+/// The identified parameters that have a truth, as (name, t = error /
+/// sigma) for each step: f1, f2, Q1, Q2 against the device at that step.
+fn identified_t(r: &FieldReport) -> Vec<(&'static str, f64)> {
+    r.steps
+        .iter()
+        .flat_map(|s| {
+            let (id, g) = (&s.identified, &s.truth.gyro);
+            [
+                ("f1", (id.f1_hz - g.f1_hz) / id.f1_hz_uncertainty),
+                ("f2", (id.f2_hz - g.f2_hz) / id.f2_hz_uncertainty),
+                ("Q1", (id.q1 - g.q1) / id.q1_uncertainty),
+                ("Q2", (id.q2 - g.q2) / id.q2_uncertainty),
+            ]
+        })
+        .collect()
+}
+
+/// Share within 2, largest |t| and RMS of `t`.
+fn coverage(t: &[f64]) -> (f64, f64, f64) {
+    let n = t.len() as f64;
+    let in2 = t.iter().filter(|x| x.abs() <= 2.0).count() as f64 / n;
+    let worst = t.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let rms = (t.iter().map(|x| x * x).sum::<f64>() / n).sqrt();
+    (in2, worst, rms)
+}
+
 /// One line per device.
 fn describe(d: &RandomDevice, r: &FieldReport) -> String {
     let mut line = format!(
@@ -148,15 +174,21 @@ fn self_calibrated_scale_factors_lie_within_their_sigmas_as_promised() {
     let runs: Vec<(RandomDevice, FieldReport)> =
         (FIRST_SEED..).filter_map(field).take(DEVICES).collect();
     let mut t = vec![];
+    let mut id_t = vec![];
     for (d, r) in &runs {
         eprintln!("{}", describe(d, r));
         assert!(r.failed.is_empty(), "seed {}: {:?}", d.seed, r.failed);
         t.extend(t_values(r));
+        id_t.extend(identified_t(r));
+        eprintln!(
+            "   id t: {:?}",
+            identified_t(r)
+                .iter()
+                .map(|p| format!("{} {:+.2}", p.0, p.1))
+                .collect::<Vec<_>>()
+        );
     }
-    let n = t.len() as f64;
-    let in2 = t.iter().filter(|x| x.abs() <= 2.0).count() as f64 / n;
-    let rms = (t.iter().map(|x| x * x).sum::<f64>() / n).sqrt();
-    let worst = t.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let (in2, worst, rms) = coverage(&t);
     eprintln!(
         "{} figures: {:.1}% within 2 sigma, largest |t| {worst:.2}, RMS t {rms:.2}",
         t.len(),
@@ -170,6 +202,47 @@ fn self_calibrated_scale_factors_lie_within_their_sigmas_as_promised() {
     );
     assert!(worst <= 3.0, "a figure at {worst:.2} sigma");
     assert!(rms >= 0.3, "RMS t {rms:.2}: sigmas inflated");
+    identified_coverage(&id_t);
+}
+
+/// The identified f1, f2, Q1 and Q2 against each step's device: every t
+/// within 3 and at least 90% of them within 2.
+///
+/// What this found: Q1 and Q2 of seeds 2003 and 2025 (modes 4 to 5
+/// bandwidths apart, coupled) at 3 to 7.5 sigma, from uncoupling with a
+/// pull taken as constant across the sweep (`coupling::uncouple` now
+/// refits each sweep with it); with the waits' bounds tightened to what
+/// they leave (`identify::settling_residue`, `identify::REF_STEP_PULL`),
+/// the residuals' sigma alone left Q at RMS t 2.4 (14% within 2): the
+/// jackknife over carriers (`identify::refit`) covers it.
+///
+/// Not asserted, because it does not hold yet: no sigma more than 5 times
+/// its spread. f1's RMS t is 0.15 (its sigma 6.7 times its errors'
+/// spread; 0.25 before the jackknife), so 99.7% of these figures lie
+/// within 2 sigma, above the 99.5% an honest sigma gives. The per-parameter
+/// RMS is printed.
+fn identified_coverage(id_t: &[(&'static str, f64)]) {
+    let all: Vec<f64> = id_t.iter().map(|p| p.1).collect();
+    let (in2, worst, rms) = coverage(&all);
+    eprintln!(
+        "identified f and Q, {} figures: {:.1}% within 2 sigma, largest |t| {worst:.2}, RMS t {rms:.2}",
+        all.len(),
+        100.0 * in2
+    );
+    for name in ["f1", "f2", "Q1", "Q2"] {
+        let t: Vec<f64> = id_t.iter().filter(|p| p.0 == name).map(|p| p.1).collect();
+        let (in2, worst, rms) = coverage(&t);
+        eprintln!(
+            "  {name}: {:.1}% within 2, largest |t| {worst:.2}, RMS t {rms:.2}",
+            100.0 * in2
+        );
+    }
+    assert!(
+        in2 >= 0.90,
+        "identified: {:.1}% within 2 sigma",
+        100.0 * in2
+    );
+    assert!(worst <= 3.0, "an identified parameter at {worst:.2} sigma");
 }
 
 /// One line per device of `GYROCAL_FIELD_SEEDS` (A..B), for exploring.

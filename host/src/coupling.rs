@@ -45,7 +45,7 @@
 
 use crate::drive_ratio::{BATCHES, CrossWindows, propagated, resonator};
 use crate::error::Error;
-use crate::identify::{Estimate, Identified};
+use crate::identify::{self, Estimate, Identified};
 use crate::knowns::Knowns;
 use crate::selfcal::Operating;
 use crate::stats::mean_and_standard_error;
@@ -134,8 +134,10 @@ pub(crate) fn from_windows(
     })
 }
 
-/// Fixed-point rounds of [`uncouple`] at most.
-const UNCOUPLE_ROUNDS: usize = 100;
+/// Fixed-point rounds of [`uncouple`] at most (each mode's pull is
+/// k^2 |G_1 G_2| <= `MAX_MIXING` of its response, so each round shrinks
+/// the change some fiftyfold).
+const UNCOUPLE_ROUNDS: usize = 20;
 
 /// Largest coupling strength |k^2 G_1 G_2| at either mode's resonance for
 /// which [`uncouple`] separates the modes. Each mode's fit is a Lorentzian
@@ -152,24 +154,31 @@ pub const MAX_MIXING: f64 = 0.02;
 
 /// The uncoupled modes behind the `apparent` identified ones, for the
 /// couplings `[Omega_q, Omega_d]` (deg/s; kappa^2 in place of k^2 below
-/// when there is a damping coupling): each mode's
-/// fit sees its direct response M_kk = 1 / (1/G_k - k^2 G_(1-k)), a
-/// resonator whose 1/G is moved by -k^2 G_(1-k)(f), nearly constant across
-/// its fine sweep (the other mode is many bandwidths away). So the fitted
-/// f_k^2 is the uncoupled one minus k^2 Re G_(1-k)(f_k), and the fitted
-/// bandwidth the uncoupled one minus k^2 Im G_(1-k)(f_k) / f_k, where
-/// G_(1-k) is the other mode's uncoupled response: a fixed point, iterated
-/// from the apparent modes. The couplings (deg/s) are turned back into kappa
-/// with the datasheet's lambda. On the consumer device with 250 deg/s the
-/// shift is 4e-4 Hz (k^2 / (f_2^2 - f_1^2) / 2 f_1), which its detuned
-/// output's scale factor feels.
+/// when there is a damping coupling): each mode's fit sees its direct
+/// response M_kk = 1 / (1/G_k - k^2 G_(1-k)), a resonator whose 1/G is
+/// pulled by k^2 G_(1-k)(f), the other mode's uncoupled response. Each
+/// mode's fine sweep is fitted again with that pull in the model
+/// (`identify::refit`), the other mode's G from its last refit: a fixed
+/// point, iterated from the apparent modes. The pull is nearly constant
+/// across a sweep when the other mode is many bandwidths away (it then
+/// moves f_k^2 by k^2 Re G_(1-k)(f_k), the bandwidth by k^2 Im
+/// G_(1-k)(f_k) / f_k); with the modes 4 to 5 bandwidths apart it changes
+/// across the sweep, and a constant correction left Q 3 to 7.5 sigma high
+/// (seeds 2003 and 2025 of `tests/field_coverage.rs`). The couplings
+/// (deg/s) are turned back into kappa with the datasheet's lambda. The
+/// loop phase at `carrier_hz` and the group delay are read again off the
+/// refitted modes' phases, which the pull had moved. On the
+/// consumer device with 250 deg/s the shift is 4e-4 Hz (k^2 / (f_2^2 -
+/// f_1^2) / 2 f_1), which its detuned output's scale factor feels.
 pub fn uncouple(
     apparent: &Identified,
     coupling_dps: [f64; 2],
     angular_gain: f64,
+    clock_hz: f64,
+    carrier_hz: f64,
 ) -> Result<Identified, Error> {
     let [m1, m2] = &apparent.modes;
-    let (fa, qa) = ([m1.f_hz.value, m2.f_hz.value], [m1.q.value, m2.q.value]);
+    let fa = [m1.f_hz.value, m2.f_hz.value];
     let [quadrature_dps, damping_dps] = coupling_dps;
     // kappa(f) = k + j w d in Hz^2 (`crate::theory`): k from Omega_q at f1,
     // the damping term j f (lambda Omega_d / 180) at f.
@@ -179,32 +188,39 @@ pub fn uncouple(
             damping_dps * angular_gain * f / 180.0,
         )
     };
-    let (mut f, mut q) = (fa, qa);
     let too_strong = |reason: String| Error::Measurement {
         what: "quadrature coupling",
         reason: format!(
             "{quadrature_dps:.1} deg/s couples the modes too strongly to separate: {reason}"
         ),
     };
+    let mut modes = apparent.modes.clone();
     let mut converged = false;
     for _ in 0..UNCOUPLE_ROUNDS {
-        let next: [(f64, f64); 2] = std::array::from_fn(|i| {
-            let other = resonator(f[1 - i], q[1 - i], fa[i]) * kappa(fa[i]).powi(2);
-            let fk = (fa[i] * fa[i] + other.re).sqrt();
-            let bk = fa[i] / qa[i] + other.im / fa[i];
-            (fk, fk / bk)
-        });
-        let change = (0..2).fold(0.0f64, |m, i| m.max((next[i].0 / f[i] - 1.0).abs()));
-        f = [next[0].0, next[1].0];
-        q = [next[0].1, next[1].1];
+        let before = [modes[0].f_hz.value, modes[1].f_hz.value];
+        for i in 0..2 {
+            let o = &modes[1 - i];
+            let (fo, qo) = (o.f_hz.value, o.q.value);
+            let pull = |v: f64| kappa(v).powi(2) * resonator(fo, qo, v);
+            modes[i] = identify::refit(&apparent.modes[i], i, clock_hz, &pull)
+                .map_err(|e| too_strong(format!("no uncoupled modes behind the fits ({e})")))?;
+        }
+        let f = [modes[0].f_hz.value, modes[1].f_hz.value];
+        let q = [modes[0].q.value, modes[1].q.value];
         if !(f.iter().chain(&q).all(|v| v.is_finite() && *v > 0.0)) {
             return Err(too_strong("no uncoupled modes behind the fits".into()));
         }
-        if change < 1e-15 {
+        // Settled when no frequency moves by a thousandth of its sigma.
+        let settled = (0..2).all(|i| (f[i] - before[i]).abs() < 1e-3 * modes[i].f_hz.uncertainty);
+        if settled {
             converged = true;
             break;
         }
     }
+    let (f, q) = (
+        [modes[0].f_hz.value, modes[1].f_hz.value],
+        [modes[0].q.value, modes[1].q.value],
+    );
     for i in 0..2 {
         let g = [resonator(f[0], q[0], f[i]), resonator(f[1], q[1], f[i])];
         let mixing = (g[0] * g[1] * kappa(f[i]).powi(2)).norm();
@@ -219,10 +235,8 @@ pub fn uncouple(
         return Err(too_strong("the uncoupled modes did not converge".into()));
     }
     let mut id = apparent.clone();
-    for i in 0..2 {
-        id.modes[i].f_hz.value = f[i];
-        id.modes[i].q.value = q[i];
-    }
+    (id.loop_phase_deg, id.group_delay_s) = identify::loop_phase(&modes, carrier_hz);
+    id.modes = modes;
     Ok(id)
 }
 

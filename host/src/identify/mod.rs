@@ -96,15 +96,24 @@ pub const FINE_SPAN: f64 = 1.5;
 /// z samples averaged for each of I and Q.
 pub const SAMPLES_PER_PHASE: u64 = 128;
 /// What the waits leave of a step in the response, relative to the peak
-/// response: the resonator's e^-SETTLE_TAUS and the filter's
-/// `FILTER_SETTLE`. It is a bias, not noise (the fit's residuals do not
-/// see it when it repeats from point to point), and it moves the fitted
-/// phase by at most this many radians, fk and bk by this times bk, and Q by
-/// this fraction: each estimate's uncertainty includes it in quadrature
-/// (a bound used as one sigma).
-pub fn settling_residue() -> f64 {
-    (-SETTLE_TAUS).exp() + FILTER_SETTLE
+/// response: the resonator's transient e^(-pi bk t) after the `waited_s`
+/// from a carrier step to the I window, with the fitted bandwidth bk (the
+/// wait is `SETTLE_TAUS` time constants of the coarse search's bandwidth
+/// with the 20% `TAU_MARGIN`, so some e^-14.4 when that bandwidth was
+/// right, e^-12 when it was 20% high). It is a bias, not noise (the fit's
+/// residuals do not see it when it repeats from point to point), and it
+/// moves the fitted phase by at most this many radians, fk and bk by this
+/// times bk, and Q by this fraction (a bound: the up and down sweeps
+/// cancel it to first order).
+pub fn settling_residue(bk_hz: f64, waited_s: f64) -> f64 {
+    (-PI * bk_hz * waited_s).exp()
 }
+/// How far the filter's residue after the REF_PHASE step, `FILTER_SETTLE`
+/// of the step from I to Q kept in the Q window, moves fk (in bk), Q
+/// (relative) and the phase (rad), per unit of residue: 0.185, 0.368 and
+/// 0.519 at worst over C's phase and seven modes, from the fit itself
+/// (`fit::tests::the_ref_phase_residue_moves_the_estimates_within_its_bound`).
+pub const REF_STEP_PULL: [f64; 3] = [0.2, 0.4, 0.55];
 /// Most coarse-search moves before giving up.
 pub const MAX_MOVES: usize = 12;
 /// Half-width of the fallback scan, relative to the guessed frequency:
@@ -149,6 +158,10 @@ pub struct ModeFit {
     /// Sweep points (carrier Hz) and responses (ADC LSB per drive LSB).
     #[serde(skip)]
     pub sweep: Vec<(f64, C64)>,
+    /// Time from each carrier step to its I window (s), for the settling
+    /// bound (`settling_residue`).
+    #[serde(skip)]
+    pub waited_s: f64,
 }
 
 /// The identified device.
@@ -235,21 +248,89 @@ pub fn identify_mode(
     for s in order {
         sweep.push(probe.measure(centre + s * bk)?);
     }
-    let mut fit = fit::fit_mode(&sweep, centre, bk, Some(knowns.clock_hz)).map_err(|reason| {
-        Error::Identification {
+    let mut fit = fit::fit_mode(&sweep, centre, bk, Some(knowns.clock_hz), &fit::no_pull).map_err(
+        |reason| Error::Identification {
             mode: k + 1,
             reason: reason.into(),
-        }
-    })?;
-    let eps = settling_residue();
-    let floor = |e: &mut Estimate, bias: f64| e.uncertainty = e.uncertainty.hypot(bias);
-    let bk = fit.f_hz.value / fit.q.value;
-    floor(&mut fit.f_hz, eps * bk);
-    let q = fit.q.value;
-    floor(&mut fit.q, eps * q);
-    floor(&mut fit.phase_deg, eps.to_degrees());
+        },
+    )?;
+    fit.waited_s = probe.waited_s();
+    let mut fit = refit(&fit, k, knowns.clock_hz, &fit::no_pull)?;
     fit.scanned = scanned;
     Ok((fit, probe.clocks))
+}
+
+/// Mode k's fine sweep fitted again, with the other mode's `pull`
+/// (`fit::fit_mode`), from `mode`'s estimates, and each uncertainty
+/// completed: the residuals' sigma takes every point's noise as alike,
+/// the jackknife over carriers (`fit::jackknife`) sees noise that differs
+/// from point to point and misfits that move with the carrier, and the
+/// larger of the two is taken; then the waits' bounds (`settling_residue`,
+/// `REF_STEP_PULL`) in quadrature.
+pub(crate) fn refit(
+    mode: &ModeFit,
+    k: usize,
+    clock_hz: f64,
+    pull: &dyn Fn(f64) -> C64,
+) -> Result<ModeFit, Error> {
+    let failed = |reason: &str| Error::Identification {
+        mode: k + 1,
+        reason: reason.into(),
+    };
+    let bk0 = mode.f_hz.value / mode.q.value;
+    let mut fit =
+        fit::fit_mode(&mode.sweep, mode.f_hz.value, bk0, Some(clock_hz), pull).map_err(failed)?;
+    let jk = fit::jackknife(&mode.sweep, &fit, Some(clock_hz), pull);
+    for (e, j) in [&mut fit.f_hz, &mut fit.q, &mut fit.phase_deg]
+        .into_iter()
+        .zip(jk)
+    {
+        e.uncertainty = e.uncertainty.max(j);
+    }
+    let bk = fit.f_hz.value / fit.q.value;
+    let settle = settling_residue(bk, mode.waited_s);
+    let [f_pull, q_pull, phase_pull] = REF_STEP_PULL.map(|p| settle + p * FILTER_SETTLE);
+    let floor = |e: &mut Estimate, bias: f64| e.uncertainty = e.uncertainty.hypot(bias);
+    floor(&mut fit.f_hz, f_pull * bk);
+    let q = fit.q.value;
+    floor(&mut fit.q, q_pull * q);
+    floor(&mut fit.phase_deg, phase_pull.to_degrees());
+    fit.waited_s = mode.waited_s;
+    fit.scanned = mode.scanned;
+    Ok(fit)
+}
+
+/// The loop phase at `carrier_hz` and the group delay (module header):
+/// the line through the two modes' phases.
+pub(crate) fn loop_phase(modes: &[ModeFit; 2], carrier_hz: f64) -> (Estimate, Estimate) {
+    let [m1, m2] = modes;
+    let (f1, f2) = (m1.f_hz.value, m2.f_hz.value);
+    let (p1, p2) = (m1.phase_deg, m2.phase_deg);
+    // Modes closer than a tenth of a bandwidth: one frequency, one phase;
+    // the delay is not observable (and its envelope lead then negligible).
+    let resolvable = (f2 - f1).abs() > 0.1 * (f1 / m1.q.value).max(f2 / m2.q.value);
+    let w2 = if resolvable {
+        (carrier_hz - f1) / (f2 - f1)
+    } else {
+        0.5
+    };
+    let loop_phase_deg = Estimate {
+        value: p1.value + w2 * (p2.value - p1.value),
+        uncertainty: ((1.0 - w2) * p1.uncertainty).hypot(w2 * p2.uncertainty),
+    };
+    let per_hz = 1.0f64.to_radians() / (TAU * (f2 - f1));
+    let group_delay_s = if resolvable {
+        Estimate {
+            value: (p2.value - p1.value) * per_hz,
+            uncertainty: p1.uncertainty.hypot(p2.uncertainty) * per_hz.abs(),
+        }
+    } else {
+        Estimate {
+            value: 0.0,
+            uncertainty: f64::INFINITY,
+        }
+    };
+    (loop_phase_deg, group_delay_s)
 }
 
 /// Identify both modes, starting from `guess` (the datasheet or the last
@@ -294,34 +375,10 @@ pub fn identify(
     let guess_f2 = m1.f_hz.value + (guess.f2_hz - guess.f1_hz) * (m1.f_hz.value / guess.f1_hz);
     let (m2, c2) = identify_mode(board, knowns, 1, guess_f2)?;
     let carrier = knowns.operating_carrier(m1.f_hz.value, m2.f_hz.value);
-    let (f1, f2) = (m1.f_hz.value, m2.f_hz.value);
-    let (p1, p2) = (m1.phase_deg, m2.phase_deg);
-    // Modes closer than a tenth of a bandwidth: one frequency, one phase;
-    // the delay is not observable (and its envelope lead then negligible).
-    let resolvable = (f2 - f1).abs() > 0.1 * (f1 / m1.q.value).max(f2 / m2.q.value);
-    let w2 = if resolvable {
-        (carrier - f1) / (f2 - f1)
-    } else {
-        0.5
-    };
-    let loop_phase_deg = Estimate {
-        value: p1.value + w2 * (p2.value - p1.value),
-        uncertainty: ((1.0 - w2) * p1.uncertainty).hypot(w2 * p2.uncertainty),
-    };
-    let per_hz = 1.0f64.to_radians() / (TAU * (f2 - f1));
-    let group_delay_s = if resolvable {
-        Estimate {
-            value: (p2.value - p1.value) * per_hz,
-            uncertainty: p1.uncertainty.hypot(p2.uncertainty) * per_hz.abs(),
-        }
-    } else {
-        Estimate {
-            value: 0.0,
-            uncertainty: f64::INFINITY,
-        }
-    };
+    let modes = [m1, m2];
+    let (loop_phase_deg, group_delay_s) = loop_phase(&modes, carrier);
     Ok(Identified {
-        modes: [m1, m2],
+        modes,
         loop_phase_deg,
         group_delay_s,
         quadrature_dps: None,

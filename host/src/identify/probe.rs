@@ -24,6 +24,20 @@ pub(super) struct Prober<'a> {
     pub(super) clocks: u64,
 }
 
+impl Prober<'_> {
+    /// Clocks waited after a carrier step before the I window: the
+    /// resonator's `SETTLE_TAUS` time constants and the filter's settling.
+    fn settle_clocks(&self) -> u64 {
+        let kn = self.knowns;
+        (SETTLE_TAUS * self.tau_s * kn.clock_hz).ceil() as u64 + kn.filter_settle_clocks()
+    }
+
+    /// The same in seconds.
+    pub(super) fn waited_s(&self) -> f64 {
+        self.settle_clocks() as f64 / self.knowns.clock_hz
+    }
+}
+
 /// What one measurement saw.
 struct Seen {
     /// Realized carrier (Hz).
@@ -81,8 +95,7 @@ impl<'a> Prober<'a> {
         let (regs, real) = kn.registers(carrier_hz, None, amps, 0.0)?;
         self.board.program(&regs)?;
         let r = kn.filter.decimation;
-        let settle =
-            (SETTLE_TAUS * self.tau_s * kn.clock_hz).ceil() as u64 + kn.filter_settle_clocks();
+        let settle = self.settle_clocks();
         self.board.wait_clocks(settle)?;
         self.clip_count()?;
         let zi = average_z(self.board, 0, SAMPLES_PER_PHASE)?[self.k];

@@ -283,9 +283,18 @@ fn uncoupled(
 ) -> Result<Identified, Error> {
     let mut id = apparent.clone();
     let mut c = coupling::from_windows(windows, knowns, op, &id)?;
-    let values = |c: &coupling::Coupling| [c.quadrature_dps.value, c.damping_dps.value];
+    let uncouple = |c: &coupling::Coupling| {
+        let values = [c.quadrature_dps.value, c.damping_dps.value];
+        coupling::uncouple(
+            &apparent,
+            values,
+            angular_gain,
+            knowns.clock_hz,
+            op.carrier_hz,
+        )
+    };
     for _ in 0..COUPLING_ROUNDS {
-        id = coupling::uncouple(&apparent, values(&c), angular_gain)?;
+        id = uncouple(&c)?;
         c = coupling::from_windows(windows, knowns, op, &id)?;
     }
     let damping = c.damping_dps;
@@ -297,7 +306,7 @@ fn uncoupled(
             uncertainty: damping.value.hypot(damping.uncertainty),
         };
     }
-    id = coupling::uncouple(&apparent, values(&c), angular_gain)?;
+    id = uncouple(&c)?;
     id.quadrature_dps = Some(c.quadrature_dps);
     id.damping_coupling_dps = Some(c.damping_dps);
     Ok(id)
