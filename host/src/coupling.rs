@@ -45,7 +45,7 @@
 
 use crate::drive_ratio::{BATCHES, CrossWindows, propagated, resonator};
 use crate::error::Error;
-use crate::identify::{self, Estimate, Identified};
+use crate::identify::{self, Estimate, Identified, ModeFit};
 use crate::knowns::Knowns;
 use crate::selfcal::Operating;
 use crate::stats::mean_and_standard_error;
@@ -194,33 +194,40 @@ pub fn uncouple(
             "{quadrature_dps:.1} deg/s couples the modes too strongly to separate: {reason}"
         ),
     };
+    // The other mode's pull on mode i, from the other's current estimate.
+    let pull_on = |modes: &[ModeFit; 2], i: usize| {
+        let o = &modes[1 - i];
+        let (fo, qo) = (o.f_hz.value, o.q.value);
+        move |v: f64| kappa(v).powi(2) * resonator(fo, qo, v)
+    };
+    let values = |modes: &[ModeFit; 2]| {
+        (
+            [modes[0].f_hz.value, modes[1].f_hz.value],
+            [modes[0].q.value, modes[1].q.value],
+        )
+    };
     let mut modes = apparent.modes.clone();
     let mut converged = false;
     for _ in 0..UNCOUPLE_ROUNDS {
-        let before = [modes[0].f_hz.value, modes[1].f_hz.value];
+        let (before, _) = values(&modes);
         for i in 0..2 {
-            let o = &modes[1 - i];
-            let (fo, qo) = (o.f_hz.value, o.q.value);
-            let pull = |v: f64| kappa(v).powi(2) * resonator(fo, qo, v);
+            let pull = pull_on(&modes, i);
             modes[i] = identify::refit(&apparent.modes[i], i, clock_hz, &pull)
                 .map_err(|e| too_strong(format!("no uncoupled modes behind the fits ({e})")))?;
         }
-        let f = [modes[0].f_hz.value, modes[1].f_hz.value];
-        let q = [modes[0].q.value, modes[1].q.value];
+        let (f, q) = values(&modes);
         if !(f.iter().chain(&q).all(|v| v.is_finite() && *v > 0.0)) {
             return Err(too_strong("no uncoupled modes behind the fits".into()));
         }
-        // Settled when no frequency moves by a thousandth of its sigma.
+        // Settled when no frequency moves by a thousandth of its
+        // (residuals') sigma.
         let settled = (0..2).all(|i| (f[i] - before[i]).abs() < 1e-3 * modes[i].f_hz.uncertainty);
         if settled {
             converged = true;
             break;
         }
     }
-    let (f, q) = (
-        [modes[0].f_hz.value, modes[1].f_hz.value],
-        [modes[0].q.value, modes[1].q.value],
-    );
+    let (f, q) = values(&modes);
     for i in 0..2 {
         let g = [resonator(f[0], q[0], f[i]), resonator(f[1], q[1], f[i])];
         let mixing = (g[0] * g[1] * kappa(f[i]).powi(2)).norm();
@@ -234,6 +241,12 @@ pub fn uncouple(
     if !converged {
         return Err(too_strong("the uncoupled modes did not converge".into()));
     }
+    // The uncertainties once, at the fixed point (each mode's jackknife
+    // refits its sweep five times).
+    let settled = modes.clone();
+    let modes: [ModeFit; 2] = std::array::from_fn(|i| {
+        identify::with_uncertainty(settled[i].clone(), clock_hz, &pull_on(&settled, i))
+    });
     let mut id = apparent.clone();
     (id.loop_phase_deg, id.group_delay_s) = identify::loop_phase(&modes, carrier_hz);
     id.modes = modes;

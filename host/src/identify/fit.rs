@@ -3,6 +3,7 @@
 //! sweep (module header of `super`).
 
 use super::{C64, Estimate, ModeFit};
+use crate::stats::mean_and_standard_error;
 use crate::theory::hold_gain;
 use nalgebra::{DMatrix, DVector};
 
@@ -197,7 +198,8 @@ pub(super) fn fit_mode(
 }
 
 /// Delete-one-carrier jackknife standard errors of (fk, Q, phase): each
-/// carrier of the sweep (its up and down points) left out in turn.
+/// carrier of the sweep (its up and down points) left out in turn; a
+/// leave-one-out fit that fails is not counted.
 pub(super) fn jackknife(
     points: &[(f64, C64)],
     full: &ModeFit,
@@ -207,7 +209,6 @@ pub(super) fn jackknife(
     let mut carriers: Vec<f64> = points.iter().map(|p| p.0).collect();
     carriers.sort_by(f64::total_cmp);
     carriers.dedup();
-    let g = carriers.len() as f64;
     let bk = full.f_hz.value / full.q.value;
     let fits: Vec<[f64; 3]> = carriers
         .iter()
@@ -218,9 +219,12 @@ pub(super) fn jackknife(
                 .map(|m| [m.f_hz.value, m.q.value, m.phase_deg.value])
         })
         .collect();
+    // (g - 1) / g times the sum of squared deviations over the g fits that
+    // converged, which is (g - 1) standard errors of their mean.
+    let g = fits.len() as f64;
     std::array::from_fn(|i| {
-        let mean = fits.iter().map(|f| f[i]).sum::<f64>() / fits.len() as f64;
-        ((g - 1.0) / g * fits.iter().map(|f| (f[i] - mean).powi(2)).sum::<f64>()).sqrt()
+        let values: Vec<f64> = fits.iter().map(|f| f[i]).collect();
+        (g - 1.0) * mean_and_standard_error(&values).1
     })
 }
 

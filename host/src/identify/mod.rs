@@ -255,32 +255,46 @@ pub fn identify_mode(
         },
     )?;
     fit.waited_s = probe.waited_s();
-    let mut fit = refit(&fit, k, knowns.clock_hz, &fit::no_pull)?;
     fit.scanned = scanned;
-    Ok((fit, probe.clocks))
+    Ok((
+        with_uncertainty(fit, knowns.clock_hz, &fit::no_pull),
+        probe.clocks,
+    ))
 }
 
 /// Mode k's fine sweep fitted again, with the other mode's `pull`
-/// (`fit::fit_mode`), from `mode`'s estimates, and each uncertainty
-/// completed: the residuals' sigma takes every point's noise as alike,
-/// the jackknife over carriers (`fit::jackknife`) sees noise that differs
-/// from point to point and misfits that move with the carrier, and the
-/// larger of the two is taken; then the waits' bounds (`settling_residue`,
-/// `REF_STEP_PULL`) in quadrature.
+/// (`fit::fit_mode`), from `mode`'s estimates; the uncertainties are the
+/// residuals' alone until [`with_uncertainty`] completes them.
 pub(crate) fn refit(
     mode: &ModeFit,
     k: usize,
     clock_hz: f64,
     pull: &dyn Fn(f64) -> C64,
 ) -> Result<ModeFit, Error> {
-    let failed = |reason: &str| Error::Identification {
-        mode: k + 1,
-        reason: reason.into(),
-    };
     let bk0 = mode.f_hz.value / mode.q.value;
-    let mut fit =
-        fit::fit_mode(&mode.sweep, mode.f_hz.value, bk0, Some(clock_hz), pull).map_err(failed)?;
-    let jk = fit::jackknife(&mode.sweep, &fit, Some(clock_hz), pull);
+    let mut fit = fit::fit_mode(&mode.sweep, mode.f_hz.value, bk0, Some(clock_hz), pull).map_err(
+        |reason| Error::Identification {
+            mode: k + 1,
+            reason: reason.into(),
+        },
+    )?;
+    fit.waited_s = mode.waited_s;
+    fit.scanned = mode.scanned;
+    Ok(fit)
+}
+
+/// `fit` (fitted with `pull`) with each uncertainty completed: the
+/// residuals' sigma takes every point's noise as alike, the jackknife
+/// over carriers (`fit::jackknife`) sees noise that differs from point to
+/// point and misfits that move with the carrier, and the larger of the
+/// two is taken; then the waits' bounds (`settling_residue`,
+/// `REF_STEP_PULL`) in quadrature.
+pub(crate) fn with_uncertainty(
+    mut fit: ModeFit,
+    clock_hz: f64,
+    pull: &dyn Fn(f64) -> C64,
+) -> ModeFit {
+    let jk = fit::jackknife(&fit.sweep, &fit, Some(clock_hz), pull);
     for (e, j) in [&mut fit.f_hz, &mut fit.q, &mut fit.phase_deg]
         .into_iter()
         .zip(jk)
@@ -288,16 +302,14 @@ pub(crate) fn refit(
         e.uncertainty = e.uncertainty.max(j);
     }
     let bk = fit.f_hz.value / fit.q.value;
-    let settle = settling_residue(bk, mode.waited_s);
+    let settle = settling_residue(bk, fit.waited_s);
     let [f_pull, q_pull, phase_pull] = REF_STEP_PULL.map(|p| settle + p * FILTER_SETTLE);
     let floor = |e: &mut Estimate, bias: f64| e.uncertainty = e.uncertainty.hypot(bias);
     floor(&mut fit.f_hz, f_pull * bk);
     let q = fit.q.value;
     floor(&mut fit.q, q_pull * q);
     floor(&mut fit.phase_deg, phase_pull.to_degrees());
-    fit.waited_s = mode.waited_s;
-    fit.scanned = mode.scanned;
-    Ok(fit)
+    fit
 }
 
 /// The loop phase at `carrier_hz` and the group delay (module header):
