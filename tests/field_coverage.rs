@@ -35,12 +35,18 @@
 //!   sigmas twice too large put 99.99% within 2. The four figures of a
 //!   device share its identification, so the 160 count as 40 to 160
 //!   trials: at 96% a binomial standard deviation of 1.5 to 3%.
-//! - Every t within 3. The pinned devices hold it (98.8% within 2, largest
-//!   |t| 2.40, RMS 0.79); seeds up to 2100 (85 devices, 340 figures) gave
-//!   95.6% within 2 and none beyond 3 (without the couplings: 96.2% and
-//!   one figure at 3.13, seed 2080, Q 111, an output whose self-cal sigma
-//!   is 0.01%). 0.9 such are expected in 340 figures of honest normal
-//!   sigmas, so other seeds may need a look before they are pinned.
+//! - Every t within 3. The pinned devices hold it (98.1% within 2, largest
+//!   |t| 2.40, RMS 0.83); seeds up to 2100 (85 devices, 340 figures) give
+//!   96.5% within 2 and one beyond 3 (0.9 are expected in 340 figures of
+//!   honest normal sigmas): seed 2096 (Q 154, 3.8 clocks per carrier),
+//!   output 1 at 35 deg C, -0.049% +- 0.014% (-3.4 sigma). On that step
+//!   the error does not follow the front end's lag smoothly (-0.013,
+//!   -0.019, -0.049, -0.045, -0.040% at 0 to 4 deg, -0.016% at -2 deg;
+//!   25 and 45 deg C stay within 0.025%): the timing-dependent spur
+//!   beats of issue 20, not in the budget yet. Before the front end's
+//!   delay was in the identification it read -0.026% +- 0.026%, covered
+//!   by a Q sigma the delay's misfit had inflated. Other seeds may need a
+//!   look before they are pinned.
 //! - Not inflated: the RMS of t at least 0.3 (an honest set gives about
 //!   0.85 to 1).
 //! - Every step finishes: a failed step is a clear error, but these
@@ -206,7 +212,9 @@ fn self_calibrated_scale_factors_lie_within_their_sigmas_as_promised() {
 }
 
 /// The identified f1, f2, Q1 and Q2 against each step's device: every t
-/// within 3 and at least 90% of them within 2.
+/// within 3, between 90% and 99.5% of them within 2, and no sigma
+/// inflated: each parameter's RMS t at least 0.3 (the issue's rule, no
+/// sigma above 5 times its errors' spread, is 0.2).
 ///
 /// What this found: Q1 and Q2 of seeds 2003 and 2025 (modes 4 to 5
 /// bandwidths apart, coupled) at 3 to 7.5 sigma, from uncoupling with a
@@ -214,13 +222,13 @@ fn self_calibrated_scale_factors_lie_within_their_sigmas_as_promised() {
 /// refits each sweep with it); with the waits' bounds tightened to what
 /// they leave (`identify::settling_residue`, `identify::REF_STEP_PULL`),
 /// the residuals' sigma alone left Q at RMS t 2.4 (14% within 2): the
-/// jackknife over carriers (`identify::refit`) covers it.
-///
-/// Not asserted, because it does not hold yet: no sigma more than 5 times
-/// its spread. f1's RMS t is 0.15 (its sigma 6.7 times its errors'
-/// spread; 0.25 before the jackknife), so 99.7% of these figures lie
-/// within 2 sigma, above the 99.5% an honest sigma gives. The per-parameter
-/// RMS is printed.
+/// jackknife over carriers (`identify::refit`) covers it. Then f1's RMS t
+/// was 0.15 (its sigma 6.7 times its errors' spread) and every Q came out
+/// high, by 0.86 phi (absolute) at a pick-off lag phi: the front end's
+/// group delay, a phase sloping across each sweep, which narrows the
+/// fitted resonance and whose misfit had doubled the sigmas of fk
+/// (`identify::FrontEnd`, now in the fit's model). Pinned now: 99.1%
+/// within 2, largest |t| 2.71, RMS t f1 0.62, f2 0.72, Q1 0.61, Q2 0.59.
 fn identified_coverage(id_t: &[(&'static str, f64)]) {
     let all: Vec<f64> = id_t.iter().map(|p| p.1).collect();
     let (in2, worst, rms) = coverage(&all);
@@ -238,11 +246,16 @@ fn identified_coverage(id_t: &[(&'static str, f64)]) {
         );
     }
     assert!(
-        in2 >= 0.90,
+        (0.90..=0.995).contains(&in2),
         "identified: {:.1}% within 2 sigma",
         100.0 * in2
     );
     assert!(worst <= 3.0, "an identified parameter at {worst:.2} sigma");
+    for name in ["f1", "f2", "Q1", "Q2"] {
+        let t: Vec<f64> = id_t.iter().filter(|p| p.0 == name).map(|p| p.1).collect();
+        let rms = coverage(&t).2;
+        assert!(rms >= 0.3, "{name}: RMS t {rms:.2}, its sigma inflated");
+    }
 }
 
 /// One line per device of `GYROCAL_FIELD_SEEDS` (A..B), for exploring.

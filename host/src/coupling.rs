@@ -45,7 +45,7 @@
 
 use crate::drive_ratio::{BATCHES, CrossWindows, propagated, resonator};
 use crate::error::Error;
-use crate::identify::{self, Estimate, Identified, ModeFit};
+use crate::identify::{self, Estimate, FrontEnd, Identified, ModeFit};
 use crate::knowns::Knowns;
 use crate::selfcal::Operating;
 use crate::stats::mean_and_standard_error;
@@ -210,9 +210,10 @@ pub fn uncouple(
     let mut converged = false;
     for _ in 0..UNCOUPLE_ROUNDS {
         let (before, _) = values(&modes);
+        let front = FrontEnd::of(&modes, carrier_hz);
         for i in 0..2 {
             let pull = pull_on(&modes, i);
-            modes[i] = identify::refit(&apparent.modes[i], i, clock_hz, &pull)
+            modes[i] = identify::refit(&apparent.modes[i], i, clock_hz, &pull, &front)
                 .map_err(|e| too_strong(format!("no uncoupled modes behind the fits ({e})")))?;
         }
         let (f, q) = values(&modes);
@@ -243,10 +244,8 @@ pub fn uncouple(
     }
     // The uncertainties once, at the fixed point (each mode's jackknife
     // refits its sweep five times).
-    let settled = modes.clone();
-    let modes: [ModeFit; 2] = std::array::from_fn(|i| {
-        identify::with_uncertainty(settled[i].clone(), clock_hz, &pull_on(&settled, i))
-    });
+    let (pull1, pull2) = (pull_on(&modes, 0), pull_on(&modes, 1));
+    let modes = FrontEnd::complete(&modes, carrier_hz, clock_hz, [&pull1, &pull2])?;
     let mut id = apparent.clone();
     (id.loop_phase_deg, id.group_delay_s) = identify::loop_phase(&modes, carrier_hz);
     id.modes = modes;

@@ -6,6 +6,7 @@ use super::{C64, Estimate, ModeFit};
 use crate::stats::mean_and_standard_error;
 use crate::theory::hold_gain;
 use nalgebra::{DMatrix, DVector};
+use std::f64::consts::TAU;
 
 /// The narrow-band solution: 1 / (Y f) = a + b (f - f0), so that
 /// D = -b / 2, fk = f0 + Re(a / D) / 2, bk = Im(a / D), peak |Y| = 1 / (|D| fk bk).
@@ -37,11 +38,64 @@ pub(super) fn narrow_band(points: &[(f64, C64)]) -> Option<(f64, f64, f64)> {
 /// (`crate::images`): they fall as 1 / j^3 against the first, so 32 leave
 /// 5e-4 of it; the first is at most 1e-3 of the resonant response over
 /// the supported span (clock at least 2.6 carriers, Q at least 100).
-const FIT_IMAGES: i32 = 32;
+pub(super) const FIT_IMAGES: i32 = 32;
 
 /// No other mode's pull (`fit_mode`).
 pub(crate) fn no_pull(_: f64) -> C64 {
     C64::new(0.0, 0.0)
+}
+
+/// The front end's response across a sweep, relative to its value at the
+/// mode, to first order: (1 + a (f - fk)) e^(-j 2 pi tau (f - fk)), a
+/// gain slope a (per Hz) and a group delay tau (s). A front end that lags
+/// the carrier by phi has a slope of that order: the pick-off of
+/// `frontend::PickoffPhase` (x cos phi - v sin phi / w) a group delay
+/// sin(phi) cos(phi) / w and a gain slope sin(phi)^2 / f, a first-order
+/// low-pass the same delay and the opposite slope, a pure delay phi / w
+/// and none. To the fit of a mode alone, a phase sloping across a
+/// Lorentzian is a constant background in quadrature with C (as the
+/// hold's gain slope is one in phase) that narrows or widens the
+/// resonance: with 1 and 2 deg of pick-off lag, Q came out higher by
+/// 0.86 phi (absolute, phi in radians) on every device of
+/// `tests/field_coverage.rs`, from Q 100 to 1e4, and the misfit
+/// it left inflated the residuals' and the jackknife's sigmas of fk
+/// twofold. The delay is measured (the line through the two modes'
+/// phases, `super::loop_phase`) and put in the model
+/// (`super::FrontEnd`); the gain slope cannot be measured (each mode has
+/// its own channel gains) and is bounded instead.
+///
+/// Across the sweep the two forms below agree; at the DAC's images, some
+/// clocks away, they part, and what a front end does there is not known
+/// (a pick-off's gain grows with frequency, a low-pass's falls, a delay's
+/// stays): the unit-magnitude turn is the model, the first-order
+/// (linear) form the other end of what `super::FrontEnd::moves` counts.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct FrontSlope {
+    /// Group delay tau (s).
+    pub delay_s: f64,
+    /// Relative gain slope a (per Hz).
+    pub gain_per_hz: f64,
+    /// The first-order form 1 + (a - j 2 pi tau)(f - fk) instead (exact
+    /// for the simulator's pick-off).
+    pub linear: bool,
+}
+
+impl FrontSlope {
+    /// The response h at `f` relative to the mode `fk`, and its
+    /// derivative in fk.
+    fn at(self, f: f64, fk: f64) -> (C64, C64) {
+        let d = f - fk;
+        if self.linear {
+            let s = C64::new(self.gain_per_hz, -TAU * self.delay_s);
+            return (1.0 + s * d, -s);
+        }
+        let turn = C64::from_polar(1.0, -TAU * self.delay_s * d);
+        let gain = 1.0 + self.gain_per_hz * d;
+        (
+            turn * gain,
+            turn * C64::new(-self.gain_per_hz, TAU * self.delay_s * gain),
+        )
+    }
 }
 
 /// Gauss-Newton fit of the sampled response
@@ -72,6 +126,7 @@ pub(super) fn fit_mode(
     bk0: f64,
     clock_hz: Option<f64>,
     pull: &dyn Fn(f64) -> C64,
+    front: FrontSlope,
 ) -> Result<ModeFit, &'static str> {
     let images = if clock_hz.is_some() { FIT_IMAGES } else { 0 };
     let fs = clock_hz.unwrap_or(0.0);
@@ -83,11 +138,14 @@ pub(super) fn fit_mode(
         let hold = clock_hz.map_or(1.0, |fs| hold_gain(f, fs));
         for j in -images..=images {
             let v = f + f64::from(j) * fs;
+            // The front end acts on the analog response, each image at
+            // its own frequency v.
+            let (h, dh) = front.at(v, fk);
             let w = hold * f / v;
             let d = den1(fk, bk, v);
-            g += w / d;
-            dfk += -w * 2.0 * fk / (d * d);
-            dbk += -w * C64::new(0.0, v) / (d * d);
+            g += h * w / d;
+            dfk += (dh - h * 2.0 * fk / d) * w / d;
+            dbk += -h * w * C64::new(0.0, v) / (d * d);
         }
         (g, dfk, dbk)
     };
@@ -205,6 +263,7 @@ pub(super) fn jackknife(
     full: &ModeFit,
     clock_hz: Option<f64>,
     pull: &dyn Fn(f64) -> C64,
+    front: FrontSlope,
 ) -> [f64; 3] {
     let mut carriers: Vec<f64> = points.iter().map(|p| p.0).collect();
     carriers.sort_by(f64::total_cmp);
@@ -214,7 +273,7 @@ pub(super) fn jackknife(
         .iter()
         .filter_map(|&c| {
             let kept: Vec<(f64, C64)> = points.iter().copied().filter(|p| p.0 != c).collect();
-            fit_mode(&kept, full.f_hz.value, bk, clock_hz, pull)
+            fit_mode(&kept, full.f_hz.value, bk, clock_hz, pull, front)
                 .ok()
                 .map(|m| [m.f_hz.value, m.q.value, m.phase_deg.value])
         })
@@ -292,7 +351,15 @@ mod tests {
             .map(|i| fk + 30.0 + bk * (i as f64 / 4.0 - 1.0))
             .map(|f| (f, y(f)))
             .collect();
-        let m = fit_mode(&near, fk + 30.0, 150.0, None, &no_pull).unwrap();
+        let m = fit_mode(
+            &near,
+            fk + 30.0,
+            150.0,
+            None,
+            &no_pull,
+            FrontSlope::default(),
+        )
+        .unwrap();
         assert!((m.f_hz.value - fk).abs() < 1e-6, "{:?}", m.f_hz);
         assert!((m.q.value / (fk / bk) - 1.0).abs() < 1e-9);
         assert!((m.phase_deg.value - 3.0).abs() < 1e-9, "{:?}", m.phase_deg);
@@ -360,7 +427,15 @@ mod tests {
                 .map(|i| fk + bk * 1.5 * (i as f64 / 2.0 - 1.0))
                 .map(|f| (f, y(f)))
                 .collect();
-            let m = fit_mode(&points, fk + 0.01 * bk, bk, Some(fs), &no_pull).unwrap();
+            let m = fit_mode(
+                &points,
+                fk + 0.01 * bk,
+                bk,
+                Some(fs),
+                &no_pull,
+                FrontSlope::default(),
+            )
+            .unwrap();
             let bias = (m.f_hz.value - fk) / bk;
             assert!(bias.abs() < 1e-9, "fk {fk}: {bias:e} bk");
             assert!((m.q.value / q - 1.0).abs() < 1e-9, "{:?}", m.q);
@@ -396,7 +471,7 @@ mod tests {
                         .map(|i| fk + bk * 1.5 * (i as f64 / 2.0 - 1.0))
                         .map(|f| (f, y(f) + C64::new(0.0, e * (y(f).re - y(f).im))))
                         .collect();
-                    fit_mode(&points, fk, bk, Some(fs), &no_pull).unwrap()
+                    fit_mode(&points, fk, bk, Some(fs), &no_pull, FrontSlope::default()).unwrap()
                 };
                 // Against the fit of the same points without the residue:
                 // the model's own misfit (no images in `y`) cancels.

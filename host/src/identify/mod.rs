@@ -52,9 +52,17 @@
 //!    constant; the datasheet's until then, each with a 20% margin) and the
 //!    filter's settling after a REF_PHASE step.
 //! 3. Gauss-Newton fit (`fit`) of the exact form above (4 real unknowns: C, fk, bk)
-//!    from the narrow-band solution. Uncertainties: the residual variance
+//!    from the narrow-band solution, each mode alone.
+//! 4. Both fits again with the front end's group delay in the model
+//!    (`front`): the line through the two modes' phases gives it, and a
+//!    phase sloping across a resonance narrows it (2 deg of pick-off lag
+//!    had put Q 0.86 phi high on every device, and its misfit had doubled
+//!    fk's sigma). Uncertainties: the larger of the residuals' (variance
 //!    times the inverse normal matrix, propagated to Qk = fk / bk and
-//!    phi = -arg C.
+//!    phi = -arg C) and a jackknife over the carriers, then in quadrature
+//!    the waits' bounds, the delay's sigma, the bound of the front end's
+//!    unmeasurable gain slope and its weighting of the DAC's images
+//!    (`with_uncertainty`).
 //!
 //! The loop phase is read off the line through the two modes' phi at the
 //! operating carrier (both references go through one REF_PHASE, so one
@@ -67,6 +75,7 @@
 //! output of a 25 kHz device with 3 deg, measured).
 
 mod fit;
+mod front;
 mod probe;
 mod search;
 
@@ -74,6 +83,7 @@ use crate::board::Board;
 use crate::device::GyroParams;
 use crate::error::Error;
 use crate::knowns::{FILTER_SETTLE, Knowns, TAU_MARGIN};
+pub(crate) use front::FrontEnd;
 use nalgebra::Complex;
 use probe::Prober;
 use serde::Serialize;
@@ -172,10 +182,13 @@ pub struct Identified {
     /// Loop phase lag at the operating carrier (deg): the line through
     /// the two modes' phases, evaluated there.
     pub loop_phase_deg: Estimate,
-    /// Group delay of the loop (s): the slope of that line, d phi / d w.
-    /// It delays the response's envelope against the references', which
-    /// REF_PHASE (a carrier phase) cannot undo: the prediction carries it
-    /// as an envelope lead (`selfcal::predicted_ratio`).
+    /// Group delay of the loop (s): the slope of that line, d phi / d w
+    /// (with the modes not resolved, a first-order front end's at the
+    /// loop phase, +-100%). It delays the response's envelope against the
+    /// references', which REF_PHASE (a carrier phase) cannot undo: the
+    /// prediction carries it as an envelope lead
+    /// (`selfcal::predicted_ratio`), and the fine fits and the images as
+    /// a phase sloping with frequency (`FrontEnd`, `images::ImageFront`).
     pub group_delay_s: Estimate,
     /// The quadrature (stiffness) coupling Omega_q (deg/s, the sign
     /// convention of `[gyro] quadrature_dps`), measured at rest from the
@@ -211,7 +224,9 @@ impl Identified {
 }
 
 /// Identify mode k starting from `guess_hz`: the coarse search, the
-/// scan when it cannot converge, then the fine sweep and its fit.
+/// scan when it cannot converge, then the fine sweep and its fit (the
+/// mode alone, no front-end slope, the residuals' sigmas: [`identify`]
+/// refits it with the front end's delay and completes the sigmas).
 pub fn identify_mode(
     board: &mut dyn Board,
     knowns: &Knowns,
@@ -248,78 +263,102 @@ pub fn identify_mode(
     for s in order {
         sweep.push(probe.measure(centre + s * bk)?);
     }
-    let mut fit = fit::fit_mode(&sweep, centre, bk, Some(knowns.clock_hz), &fit::no_pull).map_err(
-        |reason| Error::Identification {
-            mode: k + 1,
-            reason: reason.into(),
-        },
-    )?;
+    let alone = fit::FrontSlope::default();
+    let mut fit = fit::fit_mode(
+        &sweep,
+        centre,
+        bk,
+        Some(knowns.clock_hz),
+        &fit::no_pull,
+        alone,
+    )
+    .map_err(|reason| Error::Identification {
+        mode: k + 1,
+        reason: reason.into(),
+    })?;
     fit.waited_s = probe.waited_s();
     fit.scanned = scanned;
-    Ok((
-        with_uncertainty(fit, knowns.clock_hz, &fit::no_pull),
-        probe.clocks,
-    ))
+    Ok((fit, probe.clocks))
 }
 
-/// Mode k's fine sweep fitted again, with the other mode's `pull`
-/// (`fit::fit_mode`), from `mode`'s estimates; the uncertainties are the
-/// residuals' alone until [`with_uncertainty`] completes them.
+/// Mode k's fine sweep fitted again, with the other mode's `pull` and
+/// the `front` end's delay (`fit::fit_mode`), from `mode`'s estimates;
+/// the uncertainties are the residuals' alone until [`with_uncertainty`]
+/// completes them.
 pub(crate) fn refit(
     mode: &ModeFit,
     k: usize,
     clock_hz: f64,
     pull: &dyn Fn(f64) -> C64,
+    front: &FrontEnd,
 ) -> Result<ModeFit, Error> {
     let bk0 = mode.f_hz.value / mode.q.value;
-    let mut fit = fit::fit_mode(&mode.sweep, mode.f_hz.value, bk0, Some(clock_hz), pull).map_err(
-        |reason| Error::Identification {
-            mode: k + 1,
-            reason: reason.into(),
-        },
-    )?;
+    let mut fit = fit::fit_mode(
+        &mode.sweep,
+        mode.f_hz.value,
+        bk0,
+        Some(clock_hz),
+        pull,
+        front.slope,
+    )
+    .map_err(|reason| Error::Identification {
+        mode: k + 1,
+        reason: reason.into(),
+    })?;
     fit.waited_s = mode.waited_s;
     fit.scanned = mode.scanned;
     Ok(fit)
 }
 
-/// `fit` (fitted with `pull`) with each uncertainty completed: the
-/// residuals' sigma takes every point's noise as alike, the jackknife
-/// over carriers (`fit::jackknife`) sees noise that differs from point to
-/// point and misfits that move with the carrier, and the larger of the
-/// two is taken; then the waits' bounds (`settling_residue`,
-/// `REF_STEP_PULL`) in quadrature.
+/// `fit` (fitted with `pull` and `front`, [`refit`]) with each
+/// uncertainty completed: the residuals' sigma takes every point's noise
+/// as alike, the jackknife over carriers (`fit::jackknife`) sees noise
+/// that differs from point to point and misfits that move with the
+/// carrier, and the larger of the two is taken; then in quadrature the
+/// waits' bounds (`settling_residue`, `REF_STEP_PULL`) and the front
+/// end's terms (`FrontEnd::moves`): its delay's sigma; its gain slope's
+/// bound, taken as one sigma (the first-order front ends sit at its ends,
+/// a pick-off at +a, a low-pass at -a, a pure delay at 0: a device's is
+/// not spread evenly between, and a / sqrt 3 left the pick-off's pull at
+/// 1.7 sigma); and what the images' weighting can move.
 pub(crate) fn with_uncertainty(
     mut fit: ModeFit,
+    k: usize,
     clock_hz: f64,
     pull: &dyn Fn(f64) -> C64,
-) -> ModeFit {
-    let jk = fit::jackknife(&fit.sweep, &fit, Some(clock_hz), pull);
-    for (e, j) in [&mut fit.f_hz, &mut fit.q, &mut fit.phase_deg]
-        .into_iter()
-        .zip(jk)
-    {
-        e.uncertainty = e.uncertainty.max(j);
-    }
-    let bk = fit.f_hz.value / fit.q.value;
+    front: &FrontEnd,
+) -> Result<ModeFit, Error> {
+    let jk = fit::jackknife(&fit.sweep, &fit, Some(clock_hz), pull, front.slope);
+    let [delay, gain, images] = front.moves(&fit, k, clock_hz, pull)?;
+    let (bk, q) = (fit.f_hz.value / fit.q.value, fit.q.value);
     let settle = settling_residue(bk, fit.waited_s);
-    let [f_pull, q_pull, phase_pull] = REF_STEP_PULL.map(|p| settle + p * FILTER_SETTLE);
-    let floor = |e: &mut Estimate, bias: f64| e.uncertainty = e.uncertainty.hypot(bias);
-    floor(&mut fit.f_hz, f_pull * bk);
-    let q = fit.q.value;
-    floor(&mut fit.q, q_pull * q);
-    floor(&mut fit.phase_deg, phase_pull.to_degrees());
-    fit
+    let waits = REF_STEP_PULL.map(|p| settle + p * FILTER_SETTLE);
+    let waits = [waits[0] * bk, waits[1] * q, waits[2].to_degrees()];
+    for (i, e) in [&mut fit.f_hz, &mut fit.q, &mut fit.phase_deg]
+        .into_iter()
+        .enumerate()
+    {
+        e.uncertainty = e
+            .uncertainty
+            .max(jk[i])
+            .hypot(waits[i])
+            .hypot(delay[i])
+            .hypot(gain[i])
+            .hypot(images[i]);
+    }
+    Ok(fit)
 }
 
 /// The loop phase at `carrier_hz` and the group delay (module header):
-/// the line through the two modes' phases.
+/// the line through the two modes' phases. With the modes closer than a
+/// tenth of a bandwidth the delay is not observable, and a first-order
+/// front end's is taken, sin(phi) cos(phi) / w at the lag phi, with all of
+/// itself as its sigma (`FrontEnd::of`).
 pub(crate) fn loop_phase(modes: &[ModeFit; 2], carrier_hz: f64) -> (Estimate, Estimate) {
     let [m1, m2] = modes;
     let (f1, f2) = (m1.f_hz.value, m2.f_hz.value);
     let (p1, p2) = (m1.phase_deg, m2.phase_deg);
-    // Modes closer than a tenth of a bandwidth: one frequency, one phase;
-    // the delay is not observable (and its envelope lead then negligible).
+    // Modes closer than a tenth of a bandwidth: one frequency, one phase.
     let resolvable = (f2 - f1).abs() > 0.1 * (f1 / m1.q.value).max(f2 / m2.q.value);
     let w2 = if resolvable {
         (carrier_hz - f1) / (f2 - f1)
@@ -337,9 +376,11 @@ pub(crate) fn loop_phase(modes: &[ModeFit; 2], carrier_hz: f64) -> (Estimate, Es
             uncertainty: p1.uncertainty.hypot(p2.uncertainty) * per_hz.abs(),
         }
     } else {
+        let phi = loop_phase_deg.value.to_radians();
+        let first_order = phi.sin() * phi.cos() / (TAU * 0.5 * (f1 + f2));
         Estimate {
-            value: 0.0,
-            uncertainty: f64::INFINITY,
+            value: first_order,
+            uncertainty: first_order.abs(),
         }
     };
     (loop_phase_deg, group_delay_s)
@@ -387,7 +428,8 @@ pub fn identify(
     let guess_f2 = m1.f_hz.value + (guess.f2_hz - guess.f1_hz) * (m1.f_hz.value / guess.f1_hz);
     let (m2, c2) = identify_mode(board, knowns, 1, guess_f2)?;
     let carrier = knowns.operating_carrier(m1.f_hz.value, m2.f_hz.value);
-    let modes = [m1, m2];
+    let modes = FrontEnd::refit_both(&[m1, m2], carrier, knowns.clock_hz)?;
+    let modes = FrontEnd::complete(&modes, carrier, knowns.clock_hz, [&fit::no_pull; 2])?;
     let (loop_phase_deg, group_delay_s) = loop_phase(&modes, carrier);
     Ok(Identified {
         modes,
