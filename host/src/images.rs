@@ -28,6 +28,42 @@
 //! `adc_headroom` 0.9 a few percent more clip.
 
 use crate::theory::{self, Device};
+use nalgebra::Complex;
+use std::f64::consts::TAU;
+
+/// The front end's response at the images relative to the carrier's,
+/// which the sampled loop carries onto it. A group delay tau turns the
+/// image `shift` away by 2 pi tau shift: the model, as the fine fits take
+/// it (`identify::FrontEnd`). `linear` is the first-order form
+/// 1 + (a - j 2 pi tau) shift instead, with a gain slope a: exact for the
+/// simulator's pick-off (a = sin(phi)^2 / f), whose gain grows with the
+/// shift, a low-pass's falls (a = -sin(phi)^2 / f). At the first image,
+/// some clocks away, a few clocks per carrier make that percents, and the
+/// images can be percents of the response: the budget moves the
+/// prediction to both ends. [`ImageFront::default`] is a flat front end
+/// (the theory's).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ImageFront {
+    /// Group delay tau (s).
+    pub delay_s: f64,
+    /// Relative gain slope a (per Hz), in the `linear` form.
+    pub gain_per_hz: f64,
+    /// The first-order form instead of the turn.
+    pub linear: bool,
+}
+
+impl ImageFront {
+    /// (gain, lag in rad) at an image `shift_hz` from the carrier.
+    fn at(self, shift_hz: f64) -> (f64, f64) {
+        let turn = TAU * self.delay_s * shift_hz;
+        if self.linear {
+            let h = Complex::new(1.0 + self.gain_per_hz * shift_hz, -turn);
+            (h.norm(), -h.arg())
+        } else {
+            (1.0, turn)
+        }
+    }
+}
 
 /// Images summed on each side of the carrier.
 const IMAGES: i32 = 64;
@@ -49,32 +85,35 @@ fn moved(dev: &Device, shift_hz: f64) -> Device {
 }
 
 /// What the images add to `theory::readout_z(dev, omz_rad_s)` (before the
-/// hold gain, as that z is).
-pub fn readout_images(dev: &Device, clock_hz: f64, omz_rad_s: f64) -> [f64; 2] {
+/// hold gain, as that z is), through the `front` end.
+pub fn readout_images(dev: &Device, clock_hz: f64, omz_rad_s: f64, front: ImageFront) -> [f64; 2] {
     let fc = dev.carrier_hz;
     shifts(clock_hz).fold([0.0; 2], |sum, shift| {
-        let z = theory::readout_z(&moved(dev, shift), omz_rad_s);
-        let w = fc / (fc + shift);
+        let (gain, lag) = front.at(shift);
+        let z = theory::readout_z_lagged(&moved(dev, shift), omz_rad_s, lag);
+        let w = gain * fc / (fc + shift);
         [sum[0] + w * z[0], sum[1] + w * z[1]]
     })
 }
 
 /// What the images add to `theory::calibration_z_of_datapath(dev, cal_hz,
-/// lead_rad, sideband_gain)`.
+/// lead_rad, sideband_gain)`, through the `front` end.
 pub fn calibration_images(
     dev: &Device,
     clock_hz: f64,
     cal_hz: f64,
     lead_rad: f64,
     sideband_gain: [f64; 2],
+    front: ImageFront,
 ) -> [f64; 2] {
     let fc = dev.carrier_hz;
     shifts(clock_hz).fold([0.0; 2], |sum, shift| {
+        let (front_gain, lag) = front.at(shift);
         let gain: [f64; 2] = std::array::from_fn(|s| {
             let f = fc + [-cal_hz, cal_hz][s];
-            sideband_gain[s] * f / (f + shift)
+            front_gain * sideband_gain[s] * f / (f + shift)
         });
-        let z = theory::calibration_z_of_datapath(&moved(dev, shift), cal_hz, lead_rad, gain);
+        let z = theory::calibration_z_lagged(&moved(dev, shift), cal_hz, lead_rad, gain, lag);
         [sum[0] + z[0], sum[1] + z[1]]
     })
 }

@@ -3,7 +3,7 @@
 //! themselves are the host's (`gyrocal_host::images`), which predicts with
 //! them; this module adds them at a point of a plan.
 
-pub use gyrocal_host::images::{calibration_images, readout_images, sampled_peak};
+pub use gyrocal_host::images::{ImageFront, calibration_images, readout_images, sampled_peak};
 
 use crate::experiment::{Experiment, Mode, Plan, PointPlan, envelope_lead_rad, hold_gain};
 #[cfg(test)]
@@ -16,12 +16,12 @@ impl Plan {
         let dev = self.theory_device_in(exp, p.mode);
         let clock = exp.drive.clock_hz;
         let z = match p.mode {
-            Mode::Readout => readout_images(&dev, clock, p.omz_rad_s),
+            Mode::Readout => readout_images(&dev, clock, p.omz_rad_s, ImageFront::default()),
             Mode::Calibration => {
                 let gain = [-1.0, 1.0]
                     .map(|s| hold_gain(self.carrier_hz + s * p.cal_hz, clock) / self.hold_gain);
                 let lead = envelope_lead_rad(p.cal_hz, clock);
-                calibration_images(&dev, clock, p.cal_hz, lead, gain)
+                calibration_images(&dev, clock, p.cal_hz, lead, gain, ImageFront::default())
             }
         };
         z.map(|z| z * self.hold_gain)
@@ -117,7 +117,8 @@ mod tests {
             |t| [f1 * (th * t).cos(), f2 * (th * t).sin()],
         );
         let exact = theory::readout_z(&dev, omz).map(|z| z * hold(dev.carrier_hz));
-        let images = readout_images(&dev, CLOCK, omz).map(|z| z * hold(dev.carrier_hz));
+        let images = readout_images(&dev, CLOCK, omz, ImageFront::default())
+            .map(|z| z * hold(dev.carrier_hz));
         assert_closed(sim, exact, images);
     }
 
@@ -144,7 +145,8 @@ mod tests {
         let h = hold(dev.carrier_hz);
         let gain = [-1.0, 1.0].map(|s| hold(dev.carrier_hz + s * cal) / h);
         let exact = theory::calibration_z_of_datapath(&dev, cal, 0.0, gain).map(|z| z * h);
-        let images = calibration_images(&dev, CLOCK, cal, 0.0, gain).map(|z| z * h);
+        let images =
+            calibration_images(&dev, CLOCK, cal, 0.0, gain, ImageFront::default()).map(|z| z * h);
         assert_closed(sim, exact, images);
     }
 }

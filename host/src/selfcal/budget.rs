@@ -23,7 +23,8 @@ pub struct SfUncertainty {
     pub staircase: [f64; 2],
     /// The predicted ratio's, from the identified f1, f2, Q1, Q2,
     /// mode couplings, group delay and loop phase (each moved by its
-    /// uncertainty through the exact theory).
+    /// uncertainty through the exact theory), and the front end's
+    /// unmeasured response at the DAC's images.
     pub identified: [f64; 2],
     /// The datasheet's angular gain lambda: its relative 1-sigma moved
     /// through the exact theory (the ratio scales with lambda, one for one
@@ -66,8 +67,10 @@ fn spread(moved: &[Ratio], ratio: &Ratio) -> [f64; 2] {
 
 /// The predicted ratio's relative 1-sigma uncertainty per output from the
 /// identified parameters: each of f1, Q1, f2, Q2, the two mode couplings,
-/// the group delay and the loop phase (as a residual error of the correction) moved by its
-/// uncertainty (independent fits), the changes added in quadrature.
+/// the group delay and the loop phase (as a residual error of the
+/// correction) moved by its uncertainty (independent fits), and the front
+/// end's response at the images moved to its other form, the changes
+/// added in quadrature.
 pub(super) fn identified(
     knowns: &Knowns,
     id: &Identified,
@@ -103,8 +106,42 @@ pub(super) fn identified(
         moved.push(predicted_ratio(knowns, &gyro, &o, cal_hz)?);
     }
     let lag = id.loop_phase_deg.uncertainty.to_radians();
-    moved.push(predicted_ratio_lagged(knowns, &gyro, op, cal_hz, lag)?);
+    moved.push(predicted_ratio_lagged(
+        knowns, &gyro, op, cal_hz, lag, None,
+    )?);
+    moved.push(image_front(knowns, id, op, cal_hz, ratio)?);
     Ok(spread(&moved, ratio))
+}
+
+/// What the front end does at the DAC's images is not measured: the
+/// prediction with its first-order form there instead of the delay's
+/// turn (`images::ImageFront`), with the gain slope at either end of a
+/// first-order front end's bound +-sin(phi)^2 / f (`identify::FrontEnd`),
+/// the farther of the two per output.
+fn image_front(
+    knowns: &Knowns,
+    id: &Identified,
+    op: &Operating,
+    cal_hz: &[f64],
+    ratio: &Ratio,
+) -> Result<Ratio, Error> {
+    let gyro = id.gyro(&knowns.nominal);
+    let bound = id.loop_phase_deg.value.to_radians().sin().powi(2) / op.carrier_hz;
+    let [up, down] =
+        [bound, -bound].map(|a| predicted_ratio_lagged(knowns, &gyro, op, cal_hz, 0.0, Some(a)));
+    let (up, down) = (up?, down?);
+    let farther = |k: usize| {
+        let change = |r: &Ratio| (r.exact[k] / ratio.exact[k] - 1.0).abs();
+        if change(&up) >= change(&down) {
+            up.exact[k]
+        } else {
+            down.exact[k]
+        }
+    };
+    Ok(Ratio {
+        exact: std::array::from_fn(farther),
+        ..ratio.clone()
+    })
 }
 
 /// A datasheet sigma `u` (relative) through the exact theory: the ratio

@@ -88,33 +88,43 @@ pub fn predicted_ratio(
     op: &Operating,
     cal_hz: &[f64],
 ) -> Result<Ratio, Error> {
-    predicted_ratio_lagged(knowns, gyro, op, cal_hz, 0.0)
+    predicted_ratio_lagged(knowns, gyro, op, cal_hz, 0.0, None)
 }
 
 /// [`predicted_ratio`] with a residual loop phase error `lag_rad` left by
-/// the correction (the responses lag their references by that much more).
+/// the correction (the responses lag their references by that much more),
+/// and the front end at the images in the first-order form with the gain
+/// slope `linear_gain_per_hz` when given (`images::ImageFront`) instead of
+/// the group delay's turn.
 pub(super) fn predicted_ratio_lagged(
     knowns: &Knowns,
     gyro: &GyroParams,
     op: &Operating,
     cal_hz: &[f64],
     lag_rad: f64,
+    linear_gain_per_hz: Option<f64>,
 ) -> Result<Ratio, Error> {
+    let front = images::ImageFront {
+        delay_s: op.envelope_delay_s,
+        gain_per_hz: linear_gain_per_hz.unwrap_or(0.0),
+        linear: linear_gain_per_hz.is_some(),
+    };
     let clock = knowns.clock_hz;
     let per_lsb = knowns.force_full_scale.map(|f| f / 32768.0);
     let [dev_read, dev_cal] = devices(knowns, gyro, op)?;
     let rad = PI / 180.0;
     let rates = &knowns.rates_dps;
     // The sampled loop: the carrier's phasor and the DAC's images that the
-    // ADC aliases onto it (`images`; the images without the residual lag,
-    // a second-order change of a small term).
+    // ADC aliases onto it (`images`, through the front end's delay; the
+    // images without the residual lag, a second-order change of a small
+    // term).
     let add = |a: [f64; 2], b: [f64; 2]| [a[0] + b[0], a[1] + b[1]];
     let read_z: Vec<[f64; 2]> = rates
         .iter()
         .map(|r| {
             add(
                 theory::readout_z_lagged(&dev_read, r * rad, lag_rad),
-                images::readout_images(&dev_read, clock, r * rad),
+                images::readout_images(&dev_read, clock, r * rad, front),
             )
         })
         .collect();
@@ -128,7 +138,7 @@ pub(super) fn predicted_ratio_lagged(
             let lead = envelope_lead_rad(f, clock) + TAU * f * op.envelope_delay_s;
             add(
                 theory::calibration_z_lagged(&dev_cal, f, lead, sidebands, lag_rad),
-                images::calibration_images(&dev_cal, clock, f, lead, sidebands),
+                images::calibration_images(&dev_cal, clock, f, lead, sidebands, front),
             )
         })
         .collect();
