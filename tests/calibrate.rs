@@ -14,16 +14,22 @@
 //!   machine: free-running, the samples missed depend on the machine's load
 //!   (docs/real-board.md; the report of the serve work has the figures).
 //!
-//! Checks: the wire's identified f1, f2, Q1, Q2, loop phase, group delay
-//! and sf_selfcal (both outputs) agree with the in-process run's within 3
-//! combined sigma; each run's f and Q are within 3 sigma and 0.1% of the
-//! truth, its sf_selfcal within 3 sigma and 0.1% of the rate table.
+//! Checks: the wire's identified f1, f2, Q1, Q2, loop phase and group
+//! delay agree with the in-process run's within 3 combined sigma; each
+//! run's f and Q are within 3 sigma and 0.1% of the truth; each run's
+//! sf_selfcal is within 3 sigma (its own and the rate table's in
+//! quadrature) and 0.1% of the rate table at its own settings (the wire's
+//! carrier is a few NCO steps from the in-process run's, and the scale
+//! factors follow it), and the two errors agree within 3 combined sigma.
 
 mod common;
 #[path = "serve/served.rs"]
 mod served;
 
 use common::{gyrocal, json_object, stderr};
+use gyrocal_host::selfcal::Operating;
+use gyrocal_sim::field::scenario;
+use gyrocal_sim::serve::device;
 use serde_json::Value;
 use served::Served;
 use std::path::Path;
@@ -151,7 +157,17 @@ fn compare_over_the_wire(pace_r: u64) -> (f64, f64) {
             }
         }
     }
+    // Each run against the truth at its own settings: the wire's carrier
+    // is its own identification's, an NCO step (4.4e-4 Hz here) or a few
+    // from the in-process run's, and one step moves both outputs' true
+    // scale factors by 4.9e-4, more than their sigmas (the
+    // self-calibration follows its carrier; a truth at the other run's
+    // carrier does not).
+    let wire_truth = rate_table_at(&wire);
+    let local_table = rate_table_at(&local);
     for (k, sf_true) in pair(truth, "sf_true_per_dps").into_iter().enumerate() {
+        // The in-process run's truth is this very rate table.
+        assert_eq!(local_table.sf_per_dps[k], sf_true, "the rate table repeats");
         let sf = |v: &Value| {
             (
                 pair(v, "sf_selfcal_per_dps")[k],
@@ -159,26 +175,40 @@ fn compare_over_the_wire(pace_r: u64) -> (f64, f64) {
             )
         };
         let ((a, ra), (b, rb)) = (sf(&local), sf(&wire));
+        let wire_true = wire_truth.sf_per_dps[k];
         println!(
-            "sf_selfcal{} {a:>16.6} ±{:.4}% {b:>16.6} ±{:.4}% {:>16.6} (z LSB per deg/s)",
+            "sf_selfcal{} {a:>16.6} ±{:.4}% {b:>16.6} ±{:.4}% {sf_true:>16.6} {wire_true:>16.6} (z LSB per deg/s; truths at each run's settings)",
             k + 1,
             100.0 * ra,
             100.0 * rb,
-            sf_true
         );
-        assert!(
-            (a - b).abs() <= 3.0 * (ra * a).hypot(rb * b),
-            "output {}: {a} ± {ra}, {b} ± {rb}",
-            k + 1
+        // The truth is a measurement too: the rate table's own sigma (1.2e-3
+        // on output 1, whose scale factor is 13 times smaller than output
+        // 2's) in quadrature with each run's.
+        let truth_sd = pair(truth, "sf_true_uncertainty")[k];
+        assert_eq!(
+            pair(truth, "selfcal_error_uncertainty")[k],
+            ra.hypot(truth_sd),
+            "the in-process run's combined sigma"
         );
-        for (v, r) in [(a, ra), (b, rb)] {
-            let error = v / sf_true - 1.0;
+        let wire_truth_sd = wire_truth.uncertainty[k];
+        let errors = [
+            (a / sf_true - 1.0, ra.hypot(truth_sd)),
+            (b / wire_true - 1.0, rb.hypot(wire_truth_sd)),
+        ];
+        for (error, sd) in errors {
             assert!(
-                error.abs() <= 3.0 * r && error.abs() <= 1e-3,
-                "output {}: sf {v} ± {r}, truth {sf_true}",
+                error.abs() <= 3.0 * sd && error.abs() <= 1e-3,
+                "output {}: error {error:e} ± {sd:e} (in process {a} ± {ra}, over the wire {b} ± {rb})",
                 k + 1
             );
         }
+        let [(ea, sa), (eb, sb)] = errors;
+        assert!(
+            (ea - eb).abs() <= 3.0 * sa.hypot(sb),
+            "output {}: errors {ea:e} ± {sa:e} in process, {eb:e} ± {sb:e} over the wire",
+            k + 1
+        );
     }
     let (read, missed) = (
         number(&wire, &["samples", "read"]),
@@ -190,6 +220,29 @@ fn compare_over_the_wire(pace_r: u64) -> (f64, f64) {
     );
     assert_eq!(number(&local, &["samples", "missed"]), 0.0);
     (read, missed)
+}
+
+/// The rate table at the settings a run's JSON reports (`operating`), on
+/// the device at 45 deg C: the truth `gyrocal calibrate` gives in process,
+/// for a run that has none.
+fn rate_table_at(run: &Value) -> scenario::RateTable {
+    let file = device::parse("device.toml", DEVICE).unwrap();
+    let knowns = file.knowns().unwrap();
+    let at = file.at(Some(45.0)).unwrap();
+    let fe = file.front_end().unwrap();
+    let op = |key: &str| number(run, &["operating", key]);
+    let operating = Operating {
+        carrier_hz: op("carrier_hz"),
+        ref_lag_deg: op("ref_lag_deg"),
+        envelope_delay_s: op("envelope_delay_s"),
+        amplitude: (
+            run["operating"]["amplitude"][0].as_f64().unwrap(),
+            run["operating"]["amplitude"][1].as_f64().unwrap(),
+        ),
+    };
+    scenario::rate_table(&file.exp, &fe, &at, &knowns, &operating)
+        .unwrap()
+        .0
 }
 
 fn refused(args: &[&str], code: i32, says: &str) {

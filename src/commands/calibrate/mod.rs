@@ -7,8 +7,11 @@
 //!   `uio:///dev/uioN`, `mem:///dev/mem?base=0xADDR`), time measured by
 //!   SAMPLE_COUNT. Without it: the file's device on the in-process
 //!   simulated board (model engine, powered up), at `--temperature` when
-//!   the file has `[drift]`; the truth is then given too: the device, and
-//!   the rate table's scale factor at the cycle's settings.
+//!   the file has `[drift]`; the truth is then given too: the device, the
+//!   rate table's scale factor at the cycle's settings with its own
+//!   uncertainty, and the self-calibration's error against it with the
+//!   two sigmas in quadrature (`selfcal_error_uncertainty`, as in
+//!   `gyrocal field`).
 //! - The file's `[gyro]` is the datasheet the host starts from, `[drive]`
 //!   and `[experiment]` its settings (`serve::device::DeviceFile::knowns`).
 //! - Output: a table, or with `--json` one object on stdout: `identified`

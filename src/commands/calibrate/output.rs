@@ -41,6 +41,10 @@ pub fn json(o: &Outcome) -> Value {
     let cal = &o.cal;
     let truth = o.truth.as_ref().map(|t| {
         let d = &t.device;
+        // The two are independent measurements (as `field`'s).
+        let combined: [f64; 2] = std::array::from_fn(|k| {
+            cal.sf_selfcal_uncertainty.total[k].hypot(t.sf_true_uncertainty[k])
+        });
         json!({
             "temperature_c": d.temperature_c,
             "f1_hz": d.gyro.f1_hz,
@@ -53,6 +57,7 @@ pub fn json(o: &Outcome) -> Value {
             "sf_true_per_dps": t.sf_true_per_dps,
             "sf_true_uncertainty": t.sf_true_uncertainty,
             "selfcal_error": error(cal.sf_selfcal_per_dps, t.sf_true_per_dps),
+            "selfcal_error_uncertainty": combined,
             "clocks": t.clocks,
         })
     });
