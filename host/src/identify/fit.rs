@@ -98,6 +98,41 @@ impl FrontSlope {
     }
 }
 
+/// The model's shape at carrier `f` (`fit_mode`, without C) and its
+/// derivatives in fk and bk.
+fn shape(
+    fk: f64,
+    bk: f64,
+    f: f64,
+    clock_hz: Option<f64>,
+    pull: &dyn Fn(f64) -> C64,
+    front: FrontSlope,
+) -> (C64, C64, C64) {
+    let images = if clock_hz.is_some() { FIT_IMAGES } else { 0 };
+    let fs = clock_hz.unwrap_or(0.0);
+    let hold = clock_hz.map_or(1.0, |fs| hold_gain(f, fs));
+    let (mut g, mut dfk, mut dbk) = (C64::new(0.0, 0.0), C64::new(0.0, 0.0), C64::new(0.0, 0.0));
+    for j in -images..=images {
+        let v = f + f64::from(j) * fs;
+        // The front end acts on the analog response, each image at its own
+        // frequency v.
+        let (h, dh) = front.at(v, fk);
+        let w = hold * f / v;
+        let d = C64::new((fk - v) * (fk + v), v * bk) - pull(v);
+        g += h * w / d;
+        dfk += (dh - h * 2.0 * fk / d) * w / d;
+        dbk += -h * w * C64::new(0.0, v) / (d * d);
+    }
+    (g, dfk, dbk)
+}
+
+/// The fitted model's response at carrier `f` (without another mode's
+/// pull), as `fit_mode` fitted it.
+pub(super) fn response(m: &ModeFit, f: f64, clock_hz: f64) -> C64 {
+    let (fk, q) = (m.f_hz.value, m.q.value);
+    m.c * shape(fk, fk / q, f, Some(clock_hz), &no_pull, m.front).0
+}
+
 /// Gauss-Newton fit of the sampled response
 /// Y = C h(f) sum_j (f / (f + j fs)) / ((fk - v)(fk + v) + j v bk), v = f + j fs,
 /// h the DAC hold's gain sin(pi f / fs) / (pi f / fs) (`theory::hold_gain`;
@@ -128,27 +163,7 @@ pub(super) fn fit_mode(
     pull: &dyn Fn(f64) -> C64,
     front: FrontSlope,
 ) -> Result<ModeFit, &'static str> {
-    let images = if clock_hz.is_some() { FIT_IMAGES } else { 0 };
-    let fs = clock_hz.unwrap_or(0.0);
-    let den1 = |fk: f64, bk: f64, v: f64| C64::new((fk - v) * (fk + v), v * bk) - pull(v);
-    // The model's shape and its derivatives in fk and bk at f.
-    let shape = |fk: f64, bk: f64, f: f64| {
-        let (mut g, mut dfk, mut dbk) =
-            (C64::new(0.0, 0.0), C64::new(0.0, 0.0), C64::new(0.0, 0.0));
-        let hold = clock_hz.map_or(1.0, |fs| hold_gain(f, fs));
-        for j in -images..=images {
-            let v = f + f64::from(j) * fs;
-            // The front end acts on the analog response, each image at
-            // its own frequency v.
-            let (h, dh) = front.at(v, fk);
-            let w = hold * f / v;
-            let d = den1(fk, bk, v);
-            g += h * w / d;
-            dfk += (dh - h * 2.0 * fk / d) * w / d;
-            dbk += -h * w * C64::new(0.0, v) / (d * d);
-        }
-        (g, dfk, dbk)
-    };
+    let shape = |fk: f64, bk: f64, f: f64| shape(fk, bk, f, clock_hz, pull, front);
     // Best C for given (fk, bk) is linear: C = sum(Y conj(g)) / sum |g|^2,
     // g the model's shape.
     let best_c = |fk: f64, bk: f64| {
@@ -252,6 +267,11 @@ pub(super) fn fit_mode(
         gain_hz2: c.norm() * clock_hz.map_or(1.0, |fs| hold_gain(fk, fs)),
         scanned: false,
         sweep: points.to_vec(),
+        c,
+        front,
+        residual_sd: s2.sqrt(),
+        probe: vec![],
+        probed_delay_s: None,
     })
 }
 

@@ -4,8 +4,117 @@
 //! measurement at rest separates from the channels' gains.
 
 use super::fit::{self, FrontSlope};
-use super::{C64, Error, ModeFit, loop_phase};
-use std::f64::consts::TAU;
+use super::probe::Prober;
+use super::{C64, Error, Estimate, ModeFit, loop_phase};
+use crate::board::Board;
+use crate::knowns::{Knowns, TAU_MARGIN};
+use std::f64::consts::{PI, TAU};
+
+/// Bandwidths each side of a mode where identification measures once
+/// more when the two modes are not resolved (`probe`): the delay turns
+/// the phase between the two by 2 pi tau 16 bk, and the response there is
+/// 1/16 of the peak, so the delay comes out about as well as from modes
+/// 0.6 bandwidths apart (its sigma about sqrt 2 times the peak's relative
+/// noise over 2 pi bk).
+pub const PROBE_SPAN: f64 = 8.0;
+
+/// Measures `mode` (mode k, fitted alone) at `PROBE_SPAN` bandwidths each
+/// side, at the drive that puts its peak at the target (as its sweep did)
+/// and its own settling, into `mode.probe`, and the delay they give into
+/// `mode.probed_delay_s`; returns the clocks spent.
+pub(super) fn probe(
+    board: &mut dyn Board,
+    knowns: &Knowns,
+    k: usize,
+    mode: &mut ModeFit,
+) -> Result<u64, Error> {
+    let (fk, q) = (mode.f_hz.value, mode.q.value);
+    let bk = fk / q;
+    let max = [knowns.amplitude.0, knowns.amplitude.1][k].abs();
+    let mut prober = Prober::new(board, knowns, k, max / 8.0);
+    prober.tau_s = TAU_MARGIN / (PI * bk);
+    prober.set_amplitude_for_peak(mode.gain_hz2 / (fk * bk));
+    mode.probe = vec![
+        prober.measure(fk - PROBE_SPAN * bk)?,
+        prober.measure(fk + PROBE_SPAN * bk)?,
+    ];
+    mode.probed_delay_s = probed_delay(mode, knowns.clock_hz, &fit::no_pull);
+    Ok(prober.clocks)
+}
+
+/// The front end's delay `mode`'s probe points give (`mode` fitted with
+/// `pull`): the delay with which the fitted model turns from one probe
+/// point to the other as the measured responses do. The model's turn
+/// depends on the delay directly (2 pi tau (f+ - f-)) and through the
+/// DAC's images, which the delay turns by 2 pi tau fs and which at a few
+/// clocks per carrier are a good part of the response out there: 1.5 times
+/// the direct turn at 2.9 clocks per carrier and Q 2600, so that reading
+/// the delay off one fit and refitting with it diverges. The turn is linear
+/// in the delay but for the far images: Newton, twice. Each point's
+/// phase sigma is the residuals' sigma over its response; the images'
+/// weighting (the first-order form against the turn) is in the sigma too.
+/// None without probe points or when a fit fails.
+pub(super) fn probed_delay(
+    mode: &ModeFit,
+    clock_hz: f64,
+    pull: &dyn Fn(f64) -> C64,
+) -> Option<Estimate> {
+    let [(fa, ya), (fb, yb)] = <[(f64, C64); 2]>::try_from(mode.probe.as_slice()).ok()?;
+    let (fk, q) = (mode.f_hz.value, mode.q.value);
+    let bk = fk / q;
+    let turn = |delay_s: f64, linear: bool| {
+        let slope = FrontSlope {
+            delay_s,
+            linear,
+            ..mode.front
+        };
+        let m = fit::fit_mode(&mode.sweep, fk, bk, Some(clock_hz), pull, slope).ok()?;
+        let ra = ya / fit::response(&m, fa, clock_hz);
+        let rb = yb / fit::response(&m, fb, clock_hz);
+        Some(((rb / ra).arg(), m.residual_sd))
+    };
+    // Newton on the turn, with a step that turns the farthest image the
+    // fit carries by 0.01 rad (linear there to 5e-5); twice, as the
+    // images' turns are not linear over the whole move.
+    let step = 1e-2 / (TAU * f64::from(fit::FIT_IMAGES) * clock_hz);
+    let root = |linear: bool| {
+        let mut value = mode.front.delay_s;
+        let (mut per_s, mut noise) = (f64::NAN, f64::NAN);
+        for _ in 0..2 {
+            let ((r0, sd), (r1, _)) = (turn(value, linear)?, turn(value + step, linear)?);
+            per_s = (r1 - r0) / step;
+            noise = sd;
+            value -= r0 / per_s;
+        }
+        Some((
+            value,
+            (noise / ya.norm()).hypot(noise / yb.norm()) / per_s.abs(),
+        ))
+    };
+    // The images' weighting, which the fits' own term carries
+    // (`FrontEnd::moves`), moves this delay too: 0.2% to 1.3% of it on the
+    // pick-off (`the_probe_points_measure_the_delay`).
+    let ((value, noise), (other, _)) = (root(false)?, root(true)?);
+    let sd = noise.hypot(other - value);
+    (value.is_finite() && sd.is_finite()).then_some(Estimate {
+        value,
+        uncertainty: sd,
+    })
+}
+
+/// The inverse-variance mean of `delays`; None if there are none.
+pub(super) fn combined(delays: impl Iterator<Item = Estimate>) -> Option<Estimate> {
+    let (mut sum, mut weight) = (0.0, 0.0);
+    for d in delays {
+        let w = d.uncertainty.powi(-2);
+        sum += w * d.value;
+        weight += w;
+    }
+    (weight > 0.0 && weight.is_finite()).then(|| Estimate {
+        value: sum / weight,
+        uncertainty: weight.sqrt().recip(),
+    })
+}
 
 /// Rounds of refitting both modes with the delay their phases give
 /// (`FrontEnd::refit_both`): the delay moves the fitted phases only at
@@ -28,8 +137,9 @@ pub(crate) struct FrontEnd {
 
 impl FrontEnd {
     /// The front end the two modes' phases imply at `carrier_hz`: the
-    /// delay of `super::loop_phase` (measured, or a first-order front
-    /// end's when the modes are not resolved). A lag phi of a first-order
+    /// delay of `super::loop_phase` (measured: the line through the
+    /// modes' phases, or their probe points when the modes are not
+    /// resolved). A lag phi of a first-order
     /// front end (the pick-off, an RC) delays by sin(phi) cos(phi) / w
     /// and slopes the gain by +-sin(phi)^2 / f (`fit::FrontSlope`); the
     /// gain slope is bounded by that.
@@ -144,27 +254,49 @@ mod tests {
     use super::*;
     use crate::theory::hold_gain;
 
+    /// Modes (fk, q, clock) of the pick-off tests: Q 100 to 5e4, 2.9 to
+    /// 50 clocks per carrier.
+    const PICKOFF_MODES: [(f64, f64, f64); 5] = [
+        (2.6e4, 200.0, 3.5e5),
+        (7.7e5, 2600.0, 2.2e6),
+        (1e5, 100.0, 6e5),
+        (25.1e3, 3000.0, 1.2345e6),
+        (9.64e6, 5e4, 5e7),
+    ];
+
     /// A noise-free fine sweep of mode (fk, q) at clock `fs` seen through
     /// the simulator's pick-off (`frontend::PickoffPhase`: x cos phi -
     /// v sin phi / w_ref, referenced at fk, acting on every image at its
     /// own frequency), fitted with `slope`.
     fn fit_through_pickoff(fk: f64, q: f64, fs: f64, phi: f64, slope: FrontSlope) -> ModeFit {
         let bk = fk / q;
-        let c = C64::from_polar(2.0e9, -phi);
-        let pickoff = |v: f64| C64::new(phi.cos(), -phi.sin() * v / fk);
-        let y = |f: f64| {
-            let sum: C64 = (-fit::FIT_IMAGES..=fit::FIT_IMAGES)
-                .map(|j| f + f64::from(j) * fs)
-                .map(|v| (f / v) * pickoff(v) / C64::new((fk - v) * (fk + v), v * bk))
-                .sum();
-            c * sum * hold_gain(f, fs) / pickoff(fk)
-        };
+        let y = pickoff_response(fk, q, fs, phi);
         let points: Vec<(f64, C64)> = [-1.5, -0.75, 0.0, 0.75, 1.5, 1.5, 0.75, 0.0, -0.75, -1.5]
             .iter()
             .map(|s| fk + s * bk)
             .map(|f| (f, y(f)))
             .collect();
-        fit::fit_mode(&points, fk + 0.01 * bk, bk, Some(fs), &fit::no_pull, slope).unwrap()
+        let mut m =
+            fit::fit_mode(&points, fk + 0.01 * bk, bk, Some(fs), &fit::no_pull, slope).unwrap();
+        m.probe = [-PROBE_SPAN, PROBE_SPAN]
+            .map(|s| fk + s * bk)
+            .map(|f| (f, y(f)))
+            .to_vec();
+        m
+    }
+
+    /// The response of mode (fk, q) at clock `fs` through the pick-off.
+    fn pickoff_response(fk: f64, q: f64, fs: f64, phi: f64) -> impl Fn(f64) -> C64 {
+        let bk = fk / q;
+        let c = C64::from_polar(2.0e9, -phi);
+        let pickoff = move |v: f64| C64::new(phi.cos(), -phi.sin() * v / fk);
+        move |f: f64| {
+            let sum: C64 = (-fit::FIT_IMAGES..=fit::FIT_IMAGES)
+                .map(|j| f + f64::from(j) * fs)
+                .map(|v| (f / v) * pickoff(v) / C64::new((fk - v) * (fk + v), v * bk))
+                .sum();
+            c * sum * hold_gain(f, fs) / pickoff(fk)
+        }
     }
 
     /// The pick-off's delay is what biased Q: fitted alone, a mode seen
@@ -180,13 +312,7 @@ mod tests {
     #[test]
     fn the_front_ends_delay_is_in_the_model_and_what_it_leaves_within_its_terms() {
         let phi = 2f64.to_radians();
-        for (fk, q, fs) in [
-            (2.6e4, 200.0, 3.5e5),
-            (7.7e5, 2600.0, 2.2e6),
-            (1e5, 100.0, 6e5),
-            (25.1e3, 3000.0, 1.2345e6),
-            (9.64e6, 5e4, 5e7),
-        ] {
+        for (fk, q, fs) in PICKOFF_MODES {
             let alone = fit_through_pickoff(fk, q, fs, phi, FrontSlope::default());
             let bias = (alone.q.value - q) / phi;
             assert!(bias > 0.7, "{fk} Hz: Q alone only {bias} phi high");
@@ -211,6 +337,55 @@ mod tests {
                 (m.q.value - q).abs() < 0.03 * phi,
                 "{fk} Hz: Q {}",
                 m.q.value
+            );
+        }
+    }
+
+    /// Modes that are not resolved give no line to read the delay off:
+    /// their probe points at +-`PROBE_SPAN` bandwidths do. Through the
+    /// pick-off at 2 deg, on the five modes, the delay from a mode fitted
+    /// alone and from the fit with that delay in the model lie within
+    /// 1.3% of the pick-off's group delay sin(phi) cos(phi) / w (the
+    /// delay is solved for, not iterated: read off one fit and refitted
+    /// with, it had diverged at 2.9 clocks per carrier), and within the
+    /// images' term that the sigma carries.
+    #[test]
+    fn the_probe_points_measure_the_delay() {
+        let phi = 2f64.to_radians();
+        for (fk, q, fs) in PICKOFF_MODES {
+            let tau = phi.sin() * phi.cos() / (TAU * fk);
+            let alone = fit_through_pickoff(fk, q, fs, phi, FrontSlope::default());
+            let first = probed_delay(&alone, fs, &fit::no_pull).unwrap().value;
+            let slope = FrontSlope {
+                delay_s: first,
+                ..FrontSlope::default()
+            };
+            let again = probed_delay(
+                &fit_through_pickoff(fk, q, fs, phi, slope),
+                fs,
+                &fit::no_pull,
+            )
+            .unwrap()
+            .value;
+            let after = probed_delay(
+                &fit_through_pickoff(fk, q, fs, phi, slope),
+                fs,
+                &fit::no_pull,
+            )
+            .unwrap();
+            assert!(
+                (first / tau - 1.0).abs() < 0.02,
+                "{fk} Hz: alone {first:e} s, {tau:e}"
+            );
+            assert!(
+                (again / tau - 1.0).abs() < 0.02,
+                "{fk} Hz: {again:e} s, {tau:e}"
+            );
+            // Noise-free, its sigma is the images' term alone, which
+            // covers what the turn leaves.
+            assert!(
+                (after.value - tau).abs() <= 1.01 * after.uncertainty,
+                "{fk} Hz: {after:?}, {tau:e}"
             );
         }
     }

@@ -54,8 +54,10 @@
 //! 3. Gauss-Newton fit (`fit`) of the exact form above (4 real unknowns: C, fk, bk)
 //!    from the narrow-band solution, each mode alone.
 //! 4. Both fits again with the front end's group delay in the model
-//!    (`front`): the line through the two modes' phases gives it, and a
-//!    phase sloping across a resonance narrows it (2 deg of pick-off lag
+//!    (`front`): the line through the two modes' phases gives it (with
+//!    the modes not resolved, one more measurement `front::PROBE_SPAN`
+//!    bandwidths each side of each mode), and a phase sloping across a
+//!    resonance narrows it (2 deg of pick-off lag
 //!    had put Q 0.86 phi high on every device, and its misfit had doubled
 //!    fk's sigma). Uncertainties: the larger of the residuals' (variance
 //!    times the inverse normal matrix, propagated to Qk = fk / bk and
@@ -172,6 +174,22 @@ pub struct ModeFit {
     /// bound (`settling_residue`).
     #[serde(skip)]
     pub waited_s: f64,
+    /// C of the fitted form (ADC LSB per drive LSB, times Hz^2).
+    #[serde(skip)]
+    pub c: C64,
+    /// The front end's slope the fit took (`FrontEnd`).
+    #[serde(skip)]
+    pub(crate) front: fit::FrontSlope,
+    /// The residuals' sigma per real component (ADC LSB per drive LSB).
+    #[serde(skip)]
+    pub residual_sd: f64,
+    /// Responses at `front::PROBE_SPAN` bandwidths each side, measured
+    /// when the two modes are not resolved (carrier Hz, Y).
+    #[serde(skip)]
+    pub probe: Vec<(f64, C64)>,
+    /// The front end's delay those give against this fit's model (s).
+    #[serde(skip)]
+    pub probed_delay_s: Option<Estimate>,
 }
 
 /// The identified device.
@@ -183,8 +201,8 @@ pub struct Identified {
     /// the two modes' phases, evaluated there.
     pub loop_phase_deg: Estimate,
     /// Group delay of the loop (s): the slope of that line, d phi / d w
-    /// (with the modes not resolved, a first-order front end's at the
-    /// loop phase, +-100%). It delays the response's envelope against the
+    /// (with the modes not resolved, what the probe points each side of
+    /// them give, `front::probed_delay`). It delays the response's envelope against the
     /// references', which REF_PHASE (a carrier phase) cannot undo: the
     /// prediction carries it as an envelope lead
     /// (`selfcal::predicted_ratio`), and the fine fits and the images as
@@ -307,6 +325,8 @@ pub(crate) fn refit(
     })?;
     fit.waited_s = mode.waited_s;
     fit.scanned = mode.scanned;
+    fit.probe = mode.probe.clone();
+    fit.probed_delay_s = front::probed_delay(&fit, clock_hz, pull);
     Ok(fit)
 }
 
@@ -350,16 +370,16 @@ pub(crate) fn with_uncertainty(
 }
 
 /// The loop phase at `carrier_hz` and the group delay (module header):
-/// the line through the two modes' phases. With the modes closer than a
-/// tenth of a bandwidth the delay is not observable, and a first-order
-/// front end's is taken, sin(phi) cos(phi) / w at the lag phi, with all of
-/// itself as its sigma (`FrontEnd::of`).
+/// the line through the two modes' phases. With the modes not
+/// [`resolved`] that line has no slope: the delay is the one the modes'
+/// probe points give (`front::probed_delay`), and without them a
+/// first-order front end's, sin(phi) cos(phi) / w at the lag phi, with all
+/// of itself as its sigma.
 pub(crate) fn loop_phase(modes: &[ModeFit; 2], carrier_hz: f64) -> (Estimate, Estimate) {
     let [m1, m2] = modes;
     let (f1, f2) = (m1.f_hz.value, m2.f_hz.value);
     let (p1, p2) = (m1.phase_deg, m2.phase_deg);
-    // Modes closer than a tenth of a bandwidth: one frequency, one phase.
-    let resolvable = (f2 - f1).abs() > 0.1 * (f1 / m1.q.value).max(f2 / m2.q.value);
+    let resolvable = resolved(modes);
     let w2 = if resolvable {
         (carrier_hz - f1) / (f2 - f1)
     } else {
@@ -375,6 +395,8 @@ pub(crate) fn loop_phase(modes: &[ModeFit; 2], carrier_hz: f64) -> (Estimate, Es
             value: (p2.value - p1.value) * per_hz,
             uncertainty: p1.uncertainty.hypot(p2.uncertainty) * per_hz.abs(),
         }
+    } else if let Some(probed) = front::combined(modes.iter().filter_map(|m| m.probed_delay_s)) {
+        probed
     } else {
         let phi = loop_phase_deg.value.to_radians();
         let first_order = phi.sin() * phi.cos() / (TAU * 0.5 * (f1 + f2));
@@ -384,6 +406,15 @@ pub(crate) fn loop_phase(modes: &[ModeFit; 2], carrier_hz: f64) -> (Estimate, Es
         }
     };
     (loop_phase_deg, group_delay_s)
+}
+
+/// The two modes are resolved: farther apart than a tenth of a bandwidth.
+/// Closer, they are one frequency with one phase, and the line through
+/// their phases has no slope to give.
+pub(crate) fn resolved(modes: &[ModeFit; 2]) -> bool {
+    let [m1, m2] = modes;
+    let (f1, f2) = (m1.f_hz.value, m2.f_hz.value);
+    (f2 - f1).abs() > 0.1 * (f1 / m1.q.value).max(f2 / m2.q.value)
 }
 
 /// Identify both modes, starting from `guess` (the datasheet or the last
@@ -428,7 +459,14 @@ pub fn identify(
     let guess_f2 = m1.f_hz.value + (guess.f2_hz - guess.f1_hz) * (m1.f_hz.value / guess.f1_hz);
     let (m2, c2) = identify_mode(board, knowns, 1, guess_f2)?;
     let carrier = knowns.operating_carrier(m1.f_hz.value, m2.f_hz.value);
-    let modes = FrontEnd::refit_both(&[m1, m2], carrier, knowns.clock_hz)?;
+    let mut modes = [m1, m2];
+    let mut clocks = c1 + c2;
+    if !resolved(&modes) {
+        for (k, mode) in modes.iter_mut().enumerate() {
+            clocks += front::probe(board, knowns, k, mode)?;
+        }
+    }
+    let modes = FrontEnd::refit_both(&modes, carrier, knowns.clock_hz)?;
     let modes = FrontEnd::complete(&modes, carrier, knowns.clock_hz, [&fit::no_pull; 2])?;
     let (loop_phase_deg, group_delay_s) = loop_phase(&modes, carrier);
     Ok(Identified {
@@ -437,6 +475,6 @@ pub fn identify(
         group_delay_s,
         quadrature_dps: None,
         damping_coupling_dps: None,
-        clocks: c1 + c2,
+        clocks,
     })
 }
