@@ -179,6 +179,7 @@ fn rounding_moves_the_resonant_outputs_rate_table() {
             ref_lag_deg: 0.0,
             envelope_delay_s: 0.0,
             amplitude: knowns.amplitude,
+            fold_shift_hz: 0.0,
         };
         let sf0 = scenario::rate_table(&sc.exp, &fe, &at, &knowns, &op)
             .unwrap()
@@ -281,9 +282,13 @@ fn a_differential_drive_gain_is_measured_while_turning_and_corrected() {
 /// (`FieldStep::carrier_fold`, issue 20 section 3), and the step says so:
 /// every step whose profile RMS error on an output exceeds twice the
 /// quietest step's is one that reports a fold in the passband, and every
-/// such step ripples (measured on the paper device: 0.47 and 0.25 deg/s
-/// at 25 and 30 deg C, folds at 4.8 and 18.2 Hz; 0.07 to 0.08 elsewhere,
-/// no fold below 1 kHz).
+/// such step ripples. On the paper device the operating point moves the
+/// 25 deg C carrier 0.81 Hz out of its fold at 4.8 Hz (period 1250),
+/// which had rippled the rate by 0.46 / 0.19 deg/s; it is at the floor
+/// now (0.065 / 0.020). At 30 deg C the move out of the fold at 18.2 Hz
+/// (period 83) would change the scale factors by 45%, so the carrier
+/// stays, and that step ripples (0.25 / 0.14 deg/s) and says so
+/// (`gyrocal_host::selfcal::FOLD_SF_CHANGE`).
 fn assert_ripples_are_reported(report: &FieldReport) {
     for k in 0..2 {
         let rms = |s: &scenario::FieldStep| s.profile.as_ref().unwrap().selfcal_rms_error_dps[k];
@@ -320,6 +325,21 @@ fn paper_device_self_calibrates_over_ten_kelvin() {
     eprintln!("clocks {} wall {:.1} s", report.clocks, report.wall_s);
     assert_within_target(&report);
     assert_ripples_are_reported(&report);
+    // The carrier moved where that cleared its fold within the scale
+    // factors' allowance, and only there.
+    for s in &report.steps {
+        let shift = s.selfcal.operating.fold_shift_hz;
+        eprintln!("{} deg C: carrier moved {shift:+.4} Hz", s.temperature_c);
+        assert_eq!(
+            shift != 0.0,
+            s.temperature_c == 25.0,
+            "{} deg C",
+            s.temperature_c
+        );
+    }
+    let moved = &report.steps[0];
+    assert!((moved.selfcal.operating.fold_shift_hz - 0.81).abs() < 0.01);
+    assert!(!moved.carrier_fold.in_passband);
     // The baseline, beside it: a fixed carrier leaves the resonance within
     // a fraction of a kelvin (290 Hz/K against an 88 Hz half-bandwidth), so
     // 5 K away its scale factor is off by more than a factor of 2.

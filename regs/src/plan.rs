@@ -185,6 +185,46 @@ pub fn nearest_fold(carrier_hz: f64, clock_hz: f64) -> (u64, f64) {
         )
 }
 
+/// Folds closer to the carrier than this many Butterworth corners of the
+/// output filter put a ripple on the rate (at two corners the biquad and
+/// the RC pole still pass a fifth of it): [`fold_clear_carrier`] keeps the
+/// operating carrier out of them, and a field step whose carrier lands in
+/// one anyway says so.
+pub const FOLD_CLEAR_CORNERS: f64 = 2.0;
+
+/// The carrier on the NCO's grid (step f_clk / 2^32) nearest to
+/// `carrier_hz` whose [`nearest_fold`] lies at least `clear_hz` from it,
+/// within `max_shift_hz`: the grid points are tried outwards, nearest
+/// first. `None` when every point within reach folds closer.
+///
+/// A fold of period q moves q times as fast as the carrier (eps = f_clk
+/// |q r - n|), so a ripple at a few Hz goes out of a passband of some ten
+/// Hz for a shift of a fraction of a Hz: nothing beside a mode's bandwidth.
+///
+/// ```
+/// use gyrocal_regs::plan::{fold_clear_carrier, nearest_fold};
+/// // The paper device at 25 deg C folds 4.8 Hz from a 9.64 MHz carrier.
+/// let clock = 50e6;
+/// let moved = fold_clear_carrier(9_640_000.0039, clock, 40.0, 1.0).unwrap();
+/// assert!(nearest_fold(moved, clock).1 >= 40.0);
+/// assert!((moved - 9_640_000.0039).abs() < 0.1);
+/// ```
+pub fn fold_clear_carrier(
+    carrier_hz: f64,
+    clock_hz: f64,
+    clear_hz: f64,
+    max_shift_hz: f64,
+) -> Option<f64> {
+    let grid = clock_hz / 2f64.powi(32);
+    let nearest = (carrier_hz / grid).round();
+    let reach = (max_shift_hz / grid).floor().min(1e6) as i64;
+    (0..=reach)
+        .flat_map(|k| [k, -k])
+        .map(|k| (nearest + k as f64) * grid)
+        .filter(|f| (f - carrier_hz).abs() <= max_shift_hz && *f > 0.0 && *f < clock_hz / 2.0)
+        .find(|&f| nearest_fold(f, clock_hz).1 >= clear_hz)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -262,5 +302,35 @@ mod tests {
         assert!((eps - 4.8).abs() < 0.1, "{eps}");
         assert!(nearest_fold(9_642_892.004_9, clock).1 > 1000.0);
         assert_eq!(commensurate_period(9.64e6, 50e6), None); // 241/1250
+    }
+
+    /// The nearest clear point on the grid, whichever side, and none
+    /// within a reach too short: at 30 deg C the fold of period 83 moves
+    /// 83 Hz per Hz of carrier, so clearing 1 kHz from 18.2 Hz takes 11.8 Hz.
+    #[test]
+    fn the_nearest_clear_carrier_is_found_on_the_grid() {
+        let clock = 50e6;
+        let grid = clock / 2f64.powi(32);
+        let start = 9_638_553.997_5;
+        let moved = fold_clear_carrier(start, clock, 1000.0, 20.0).unwrap();
+        assert!(nearest_fold(moved, clock).1 >= 1000.0);
+        assert!(((moved / grid) - (moved / grid).round()).abs() < 1e-6);
+        assert!(
+            (moved - start).abs() > 11.0 && (moved - start).abs() < 12.5,
+            "{moved}"
+        );
+        // Every grid point nearer is folded.
+        let steps = ((moved - start).abs() / grid).floor() as i64;
+        for k in -steps + 1..steps {
+            let f = ((start / grid).round() + k as f64) * grid;
+            if (f - start).abs() < (moved - start).abs() {
+                assert!(nearest_fold(f, clock).1 < 1000.0, "{f}");
+            }
+        }
+        assert_eq!(fold_clear_carrier(start, clock, 1000.0, 5.0), None);
+        // A clear carrier stays where it is (to the grid).
+        let clear = 9_642_892.004_9;
+        let kept = fold_clear_carrier(clear, clock, 1000.0, 1.0).unwrap();
+        assert!((kept - clear).abs() <= grid / 2.0);
     }
 }

@@ -234,6 +234,20 @@ fn step_notes(s: &mut String, report: &FieldReport) {
             design.join(", ")
         );
     }
+    for st in report
+        .steps
+        .iter()
+        .filter(|st| st.selfcal.operating.fold_shift_hz != 0.0)
+    {
+        let _ = writeln!(
+            s,
+            "{:>8.2}  the carrier moved {:+.4} Hz to keep its folds out of the passband (nearest now {:.0} Hz away, period {} clocks)",
+            st.temperature_c,
+            st.selfcal.operating.fold_shift_hz,
+            st.carrier_fold.offset_hz,
+            st.carrier_fold.period
+        );
+    }
     for st in report.steps.iter().filter(|st| st.carrier_fold.in_passband) {
         let f = st.carrier_fold;
         let _ = writeln!(

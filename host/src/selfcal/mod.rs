@@ -69,12 +69,25 @@
 //! of the drives, which the prediction needs, is kept. Every window then
 //! watches the ADC_CLIP counts ([`crate::clip`]): a clipped window is an
 //! error, never a figure.
+//!
+//! # The carrier's folds
+//!
+//! A carrier near n / q of the clock shows the DAC and ADC only its q
+//! sample phases, drifting slowly: the carrier tables' quantization errors
+//! come back folded eps = f_clk |q f_c / f_clk - n| from the carrier, and
+//! inside the output's passband they ripple the rate
+//! (`gyrocal_regs::plan::nearest_fold`; on the paper device 0.46 deg/s RMS
+//! where the floor is 0.07). The fold moves q times as fast as the
+//! carrier, so the operating point moves the carrier along the NCO's grid
+//! to the nearest place whose folds lie `FOLD_CLEAR_CORNERS` Butterworth
+//! corners out, if that moves neither readout scale factor by more than
+//! `FOLD_SF_CHANGE` ([`Operating::fold_shift_hz`] says how far it moved).
 mod budget;
 mod predict;
 mod staircase;
 
 pub use budget::SfUncertainty;
-pub use predict::{Ratio, adc_peaks, predicted_ratio};
+pub use predict::{Ratio, adc_peaks, predicted_ratio, readout_sf};
 pub use staircase::{Staircase, staircase};
 
 use crate::board::Board;
@@ -84,6 +97,7 @@ use crate::drive_ratio::{self, CrossWindows, DriveRatio};
 use crate::error::Error;
 use crate::identify::{self, Estimate, Identified};
 use crate::knowns::Knowns;
+use gyrocal_regs::plan;
 use serde::Serialize;
 
 /// Amplitude time constants waited after leaving the identification (the
@@ -125,6 +139,10 @@ pub struct Operating {
     /// Drive amplitudes (fractions of full scale): the configured ones
     /// scaled so that no ADC is predicted above `ADC_OPERATING`.
     pub amplitude: (f64, f64),
+    /// How far the carrier was moved from its configured place against
+    /// the modes to keep the carrier tables' folds out of the passband
+    /// (Hz, on the NCO's grid; 0 when it was not: module header).
+    pub fold_shift_hz: f64,
 }
 
 /// One cycle's result.
@@ -166,19 +184,80 @@ pub struct SelfCal {
 pub fn operating(knowns: &Knowns, id: &Identified) -> Result<Operating, Error> {
     let asked = knowns.operating_carrier(id.modes[0].f_hz.value, id.modes[1].f_hz.value);
     let lag = id.loop_phase_deg.value;
-    let (_, real) = knowns.registers(asked, None, knowns.amplitude, lag)?;
-    let mut op = Operating {
-        carrier_hz: real.carrier_hz,
-        ref_lag_deg: lag,
-        envelope_delay_s: id.group_delay_s.value,
-        amplitude: knowns.amplitude,
+    let at = |carrier: f64| -> Result<Operating, Error> {
+        let (_, real) = knowns.registers(carrier, None, knowns.amplitude, lag)?;
+        Ok(Operating {
+            carrier_hz: real.carrier_hz,
+            ref_lag_deg: lag,
+            envelope_delay_s: id.group_delay_s.value,
+            amplitude: knowns.amplitude,
+            fold_shift_hz: 0.0,
+        })
     };
+    let mut op = at(asked)?;
+    if let Some(clear) = fold_clear(knowns, id, asked) {
+        let moved = at(clear)?;
+        let (before, after) = (
+            readout_sf(knowns, id, &op)?,
+            readout_sf(knowns, id, &moved)?,
+        );
+        if (0..2).all(|k| (after[k] / before[k] - 1.0).abs() <= FOLD_SF_CHANGE) {
+            op = Operating {
+                fold_shift_hz: moved.carrier_hz - op.carrier_hz,
+                ..moved
+            };
+        }
+    }
     let peak = adc_peaks(knowns, id, &op)?.into_iter().fold(0.0, f64::max);
     if peak > ADC_OPERATING {
         let s = ADC_OPERATING / peak;
         op.amplitude = (s * knowns.amplitude.0, s * knowns.amplitude.1);
     }
     Ok(op)
+}
+
+/// Farthest the carrier is looked for off its configured place to clear
+/// the folds, as a fraction of the nearer mode's bandwidth f / Q.
+pub const FOLD_SHIFT_BANDWIDTHS: f64 = 0.1;
+
+/// Largest change of either output's readout scale factor (predicted at
+/// the identified device, [`predict::readout_sf`]) a move that clears the
+/// folds may make. The truth and the prediction are both taken where the
+/// carrier is, so accuracy does not limit the move; the operating point
+/// the user chose does. The scale factors drift by more over the field
+/// scenarios' temperature steps (7% on the paper device). On the paper
+/// device the 0.8 Hz that clears the 25 deg C fold moves them by 3%; the
+/// 11.8 Hz for the 30 deg C fold would move them by 45%, and on the
+/// consumer device an 8.7 mHz move changed output 2's by a third (its
+/// readout term is the small real part of mode 1's response): those stay
+/// where they are, and their field steps report the fold.
+pub const FOLD_SF_CHANGE: f64 = 0.05;
+
+/// The carrier nearest to `asked` whose table folds lie at least
+/// `FOLD_CLEAR_CORNERS` Butterworth corners away
+/// (`gyrocal_regs::plan::fold_clear_carrier`), within
+/// `FOLD_SHIFT_BANDWIDTHS`; `None` when `asked` is clear or none is.
+fn fold_clear(knowns: &Knowns, id: &Identified, asked: f64) -> Option<f64> {
+    let clear = plan::FOLD_CLEAR_CORNERS * knowns.filter.butterworth_hz;
+    if plan::nearest_fold(asked, knowns.clock_hz).1 >= clear {
+        return None;
+    }
+    let nearer = id
+        .modes
+        .iter()
+        .min_by(|a, b| {
+            (a.f_hz.value - asked)
+                .abs()
+                .total_cmp(&(b.f_hz.value - asked).abs())
+        })
+        .expect("two modes");
+    let bandwidth = nearer.f_hz.value / nearer.q.value;
+    plan::fold_clear_carrier(
+        asked,
+        knowns.clock_hz,
+        clear,
+        FOLD_SHIFT_BANDWIDTHS * bandwidth,
+    )
 }
 
 /// One self-calibration cycle from a starting guess of the device. After

@@ -25,7 +25,11 @@ pub struct Ratio {
 
 /// The theory's device at `op` in readout and in calibration: the drive
 /// words' realized amplitudes as forces (design force per LSB).
-fn devices(knowns: &Knowns, gyro: &GyroParams, op: &Operating) -> Result<[Device; 2], Error> {
+pub(crate) fn devices(
+    knowns: &Knowns,
+    gyro: &GyroParams,
+    op: &Operating,
+) -> Result<[Device; 2], Error> {
     let (regs, _) = knowns.registers(op.carrier_hz, None, op.amplitude, 0.0)?;
     let amp = [regs.amp.0, regs.amp.1];
     let per_lsb = knowns.force_full_scale.map(|f| f / 32768.0);
@@ -45,6 +49,18 @@ fn devices(knowns: &Knowns, gyro: &GyroParams, op: &Operating) -> Result<[Device
         device(amp.map(readout_word)),
         device(amp.map(|a| calibration_word(a).abs())),
     ])
+}
+
+/// The readout scale factors at `op` (exact theory at the identified
+/// device, (m^2/s^2) / (rad/s) per output, a central difference at rest).
+pub fn readout_sf(knowns: &Knowns, id: &Identified, op: &Operating) -> Result<[f64; 2], Error> {
+    const STEP_RAD_S: f64 = 1e-3;
+    let [read, _] = devices(knowns, &id.gyro(&knowns.nominal), op)?;
+    let up = theory::readout_z(&read, STEP_RAD_S);
+    let down = theory::readout_z(&read, -STEP_RAD_S);
+    Ok(std::array::from_fn(|k| {
+        (up[k] - down[k]) / (2.0 * STEP_RAD_S)
+    }))
 }
 
 /// Each ADC's predicted peak over the cycle's readout rates and

@@ -192,9 +192,9 @@ pub struct CarrierFold {
 }
 
 /// Folds closer than this many Butterworth corners of the output filter
-/// are reported as a ripple (at two corners the biquad and the RC pole
-/// still pass a fifth of it).
-pub const FOLD_WARN: f64 = 2.0;
+/// are reported as a ripple; the host's operating point keeps its carrier
+/// out of them where it can (`gyrocal_host::selfcal`).
+pub use gyrocal_regs::plan::FOLD_CLEAR_CORNERS as FOLD_WARN;
 
 impl CarrierFold {
     fn of(carrier_hz: f64, knowns: &Knowns) -> Self {
