@@ -192,10 +192,17 @@ pub fn nearest_fold(carrier_hz: f64, clock_hz: f64) -> (u64, f64) {
 /// one anyway says so.
 pub const FOLD_CLEAR_CORNERS: f64 = 2.0;
 
+/// Most grid points a side [`fold_clear_carrier`] tries. At 50 MHz the
+/// grid is 12 mHz and 2048 points reach 24 Hz; at a 123 kHz clock
+/// (2.9e-5 Hz) a 20 Hz reach is tried in steps of 4.9 mHz, over which a
+/// fold of period 4096 moves 20 Hz.
+pub const FOLD_SEARCH_POINTS: i64 = 2048;
+
 /// The carrier on the NCO's grid (step f_clk / 2^32) nearest to
 /// `carrier_hz` whose [`nearest_fold`] lies at least `clear_hz` from it,
 /// within `max_shift_hz`: the grid points are tried outwards, nearest
-/// first. `None` when every point within reach folds closer.
+/// first, at most [`FOLD_SEARCH_POINTS`] a side (with more within reach,
+/// every m-th). `None` when every point tried folds closer.
 ///
 /// A fold of period q moves q times as fast as the carrier (eps = f_clk
 /// |q r - n|), so a ripple at a few Hz goes out of a passband of some ten
@@ -217,9 +224,12 @@ pub fn fold_clear_carrier(
 ) -> Option<f64> {
     let grid = clock_hz / 2f64.powi(32);
     let nearest = (carrier_hz / grid).round();
-    let reach = (max_shift_hz / grid).floor().min(1e6) as i64;
-    (0..=reach)
-        .flat_map(|k| [k, -k])
+    let reach = (max_shift_hz / grid).floor().clamp(0.0, 1e12) as i64;
+    // At most FOLD_SEARCH_POINTS points a side, each nearest_fold's 4096
+    // periods: a slow clock's fine grid is strided.
+    let stride = (reach / FOLD_SEARCH_POINTS).max(1);
+    (0..=reach / stride)
+        .flat_map(|k| [k * stride, -k * stride])
         .map(|k| (nearest + k as f64) * grid)
         .filter(|f| (f - carrier_hz).abs() <= max_shift_hz && *f > 0.0 && *f < clock_hz / 2.0)
         .find(|&f| nearest_fold(f, clock_hz).1 >= clear_hz)
