@@ -235,13 +235,10 @@ pub const FOLD_SF_CHANGE: f64 = 0.05;
 
 /// The carrier nearest to `asked` whose table folds lie at least
 /// `FOLD_CLEAR_CORNERS` Butterworth corners away
-/// (`gyrocal_regs::plan::fold_clear_carrier`), within
-/// `FOLD_SHIFT_BANDWIDTHS`; `None` when `asked` is clear or none is.
+/// (`gyrocal_regs::plan::fold_clear_carrier`; `asked` itself, to the
+/// grid, when it is clear), within `FOLD_SHIFT_BANDWIDTHS`; `None` when
+/// none is.
 fn fold_clear(knowns: &Knowns, id: &Identified, asked: f64) -> Option<f64> {
-    let clear = plan::FOLD_CLEAR_CORNERS * knowns.filter.butterworth_hz;
-    if plan::nearest_fold(asked, knowns.clock_hz).1 >= clear {
-        return None;
-    }
     let nearer = id
         .modes
         .iter()
@@ -255,7 +252,7 @@ fn fold_clear(knowns: &Knowns, id: &Identified, asked: f64) -> Option<f64> {
     plan::fold_clear_carrier(
         asked,
         knowns.clock_hz,
-        clear,
+        plan::FOLD_CLEAR_CORNERS * knowns.filter.butterworth_hz,
         FOLD_SHIFT_BANDWIDTHS * bandwidth,
     )
 }

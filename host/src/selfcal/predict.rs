@@ -25,11 +25,7 @@ pub struct Ratio {
 
 /// The theory's device at `op` in readout and in calibration: the drive
 /// words' realized amplitudes as forces (design force per LSB).
-pub(crate) fn devices(
-    knowns: &Knowns,
-    gyro: &GyroParams,
-    op: &Operating,
-) -> Result<[Device; 2], Error> {
+fn devices(knowns: &Knowns, gyro: &GyroParams, op: &Operating) -> Result<[Device; 2], Error> {
     let (regs, _) = knowns.registers(op.carrier_hz, None, op.amplitude, 0.0)?;
     let amp = [regs.amp.0, regs.amp.1];
     let per_lsb = knowns.force_full_scale.map(|f| f / 32768.0);
@@ -51,16 +47,12 @@ pub(crate) fn devices(
     ])
 }
 
-/// The readout scale factors at `op` (exact theory at the identified
-/// device, (m^2/s^2) / (rad/s) per output, a central difference at rest).
+/// The readout scale factors at `op`: the exact theory's small-signal
+/// slope (`theory::sf_read_per_rad_s`) at the identified device,
+/// (m^2/s^2) / (rad/s) per output.
 pub fn readout_sf(knowns: &Knowns, id: &Identified, op: &Operating) -> Result<[f64; 2], Error> {
-    const STEP_RAD_S: f64 = 1e-3;
     let [read, _] = devices(knowns, &id.gyro(&knowns.nominal), op)?;
-    let up = theory::readout_z(&read, STEP_RAD_S);
-    let down = theory::readout_z(&read, -STEP_RAD_S);
-    Ok(std::array::from_fn(|k| {
-        (up[k] - down[k]) / (2.0 * STEP_RAD_S)
-    }))
+    Ok(theory::sf_read_per_rad_s(&read))
 }
 
 /// Each ADC's predicted peak over the cycle's readout rates and

@@ -45,7 +45,7 @@ use gyrocal_host::drive_ratio;
 use gyrocal_host::identify::Estimate;
 use gyrocal_host::sampling::{Signal, mean_of_parts, part_means};
 use gyrocal_host::selfcal::{self, Operating, SelfCal};
-use gyrocal_regs::plan::nearest_fold;
+use gyrocal_regs::plan::{FOLD_CLEAR_CORNERS, nearest_fold};
 use rayon::prelude::*;
 use serde::Deserialize;
 use serde::Serialize;
@@ -187,14 +187,11 @@ pub struct CarrierFold {
     pub period: u64,
     /// The fold's distance from the carrier (Hz).
     pub offset_hz: f64,
-    /// Whether it lies within `FOLD_WARN` Butterworth corners.
+    /// Whether it lies within `FOLD_CLEAR_CORNERS` Butterworth corners
+    /// (`gyrocal_regs::plan`), which the host's operating point keeps its
+    /// carrier out of where it can (`gyrocal_host::selfcal`).
     pub in_passband: bool,
 }
-
-/// Folds closer than this many Butterworth corners of the output filter
-/// are reported as a ripple; the host's operating point keeps its carrier
-/// out of them where it can (`gyrocal_host::selfcal`).
-pub use gyrocal_regs::plan::FOLD_CLEAR_CORNERS as FOLD_WARN;
 
 impl CarrierFold {
     fn of(carrier_hz: f64, knowns: &Knowns) -> Self {
@@ -202,7 +199,7 @@ impl CarrierFold {
         Self {
             period,
             offset_hz,
-            in_passband: offset_hz < FOLD_WARN * knowns.filter.butterworth_hz,
+            in_passband: offset_hz < FOLD_CLEAR_CORNERS * knowns.filter.butterworth_hz,
         }
     }
 }
@@ -244,7 +241,7 @@ pub struct FieldStep {
     /// measurement, `selfcal.drive_ratio`, estimates).
     pub drive_gain_ratio_true: f64,
     /// The operating carrier's nearest fold on the clock
-    /// (`gyrocal_regs::plan::nearest_fold`): within `FOLD_WARN` Butterworth
+    /// (`gyrocal_regs::plan::nearest_fold`): within `FOLD_CLEAR_CORNERS` Butterworth
     /// corners of the carrier, the rate carries a ripple at that offset
     /// and its multiples, and the step's line says so.
     pub carrier_fold: CarrierFold,
