@@ -204,6 +204,10 @@ impl FrontEnd {
             ..self.slope
         };
         let per_unit = |step: FrontSlope, back: FrontSlope, size: f64, by: f64| {
+            if by == 0.0 {
+                // No sigma to carry (`complete`'s first pass): no fits.
+                return Ok([0.0; 3]);
+            }
             let (up, down) = (fitted(step)?, fitted(back)?);
             Ok::<_, Error>(std::array::from_fn(|i| {
                 ((up[i] - down[i]) / (2.0 * size) * by).abs()
@@ -231,12 +235,17 @@ impl FrontEnd {
         clock_hz: f64,
         pulls: [&dyn Fn(f64) -> C64; 2],
     ) -> Result<[ModeFit; 2], Error> {
+        let front = Self::of(modes, carrier_hz);
+        // The sweeps' part does not depend on the front end's sigmas: once
+        // for both passes.
+        let sweep =
+            [0, 1].map(|k| super::sweep_uncertainty(&modes[k], clock_hz, pulls[k], front.slope));
         let both = |front: &FrontEnd| {
-            let [m1, m2] = [0, 1]
-                .map(|k| super::with_uncertainty(modes[k].clone(), k, clock_hz, pulls[k], front));
+            let [m1, m2] = [0, 1].map(|k| {
+                super::with_uncertainty(modes[k].clone(), sweep[k], k, clock_hz, pulls[k], front)
+            });
             Ok::<_, Error>([m1?, m2?])
         };
-        let front = Self::of(modes, carrier_hz);
         let phases_only = both(&FrontEnd {
             delay_sd_s: 0.0,
             gain_bound_per_hz: 0.0,

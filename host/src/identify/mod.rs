@@ -330,41 +330,50 @@ pub(crate) fn refit(
     Ok(fit)
 }
 
-/// `fit` (fitted with `pull` and `front`, [`refit`]) with each
-/// uncertainty completed: the residuals' sigma takes every point's noise
-/// as alike, the jackknife over carriers (`fit::jackknife`) sees noise
+/// The part of `fit`'s uncertainties (fk Hz, Q, phase deg) that its sweep
+/// alone gives, whatever the front end's sigmas: the residuals' sigma
+/// takes every point's noise as alike, the jackknife over carriers
+/// (`fit::jackknife`, with the front end's `slope` the fit took) sees noise
 /// that differs from point to point and misfits that move with the
 /// carrier, and the larger of the two is taken; then in quadrature the
-/// waits' bounds (`settling_residue`, `REF_STEP_PULL`) and the front
-/// end's terms (`FrontEnd::moves`): its delay's sigma; its gain slope's
-/// bound, taken as one sigma (the first-order front ends sit at its ends,
-/// a pick-off at +a, a low-pass at -a, a pure delay at 0: a device's is
-/// not spread evenly between, and a / sqrt 3 left the pick-off's pull at
-/// 1.7 sigma); and what the images' weighting can move.
+/// waits' bounds (`settling_residue`, `REF_STEP_PULL`).
+pub(crate) fn sweep_uncertainty(
+    fit: &ModeFit,
+    clock_hz: f64,
+    pull: &dyn Fn(f64) -> C64,
+    slope: fit::FrontSlope,
+) -> [f64; 3] {
+    let jk = fit::jackknife(&fit.sweep, fit, Some(clock_hz), pull, slope);
+    let (bk, q) = (fit.f_hz.value / fit.q.value, fit.q.value);
+    let settle = settling_residue(bk, fit.waited_s);
+    let waits = REF_STEP_PULL.map(|p| settle + p * FILTER_SETTLE);
+    let waits = [waits[0] * bk, waits[1] * q, waits[2].to_degrees()];
+    let own = [fit.f_hz, fit.q, fit.phase_deg].map(|e| e.uncertainty);
+    std::array::from_fn(|i| own[i].max(jk[i]).hypot(waits[i]))
+}
+
+/// `fit` (fitted with `pull` and `front`, [`refit`]) with each
+/// uncertainty completed: its `sweep` part ([`sweep_uncertainty`]) and in
+/// quadrature the front end's terms (`FrontEnd::moves`): its delay's
+/// sigma; its gain slope's bound, taken as one sigma (the first-order
+/// front ends sit at its ends, a pick-off at +a, a low-pass at -a, a pure
+/// delay at 0: a device's is not spread evenly between, and a / sqrt 3
+/// left the pick-off's pull at 1.7 sigma); and what the images' weighting
+/// can move.
 pub(crate) fn with_uncertainty(
     mut fit: ModeFit,
+    sweep: [f64; 3],
     k: usize,
     clock_hz: f64,
     pull: &dyn Fn(f64) -> C64,
     front: &FrontEnd,
 ) -> Result<ModeFit, Error> {
-    let jk = fit::jackknife(&fit.sweep, &fit, Some(clock_hz), pull, front.slope);
     let [delay, gain, images] = front.moves(&fit, k, clock_hz, pull)?;
-    let (bk, q) = (fit.f_hz.value / fit.q.value, fit.q.value);
-    let settle = settling_residue(bk, fit.waited_s);
-    let waits = REF_STEP_PULL.map(|p| settle + p * FILTER_SETTLE);
-    let waits = [waits[0] * bk, waits[1] * q, waits[2].to_degrees()];
     for (i, e) in [&mut fit.f_hz, &mut fit.q, &mut fit.phase_deg]
         .into_iter()
         .enumerate()
     {
-        e.uncertainty = e
-            .uncertainty
-            .max(jk[i])
-            .hypot(waits[i])
-            .hypot(delay[i])
-            .hypot(gain[i])
-            .hypot(images[i]);
+        e.uncertainty = sweep[i].hypot(delay[i]).hypot(gain[i]).hypot(images[i]);
     }
     Ok(fit)
 }
