@@ -53,6 +53,14 @@ pub struct ImageFront {
 }
 
 impl ImageFront {
+    /// The gain at `shift_hz` from the carrier, relative to the carrier's:
+    /// 1 for the delay's turn; in the first-order form, what moves the
+    /// calibration's sidebands apart as well as the images
+    /// (`selfcal::predict`).
+    pub fn gain(self, shift_hz: f64) -> f64 {
+        self.at(shift_hz).0
+    }
+
     /// (gain, lag in rad) at an image `shift_hz` from the carrier.
     fn at(self, shift_hz: f64) -> (f64, f64) {
         let turn = TAU * self.delay_s * shift_hz;

@@ -101,9 +101,18 @@ pub fn predicted_ratio(
 
 /// [`predicted_ratio`] with a residual loop phase error `lag_rad` left by
 /// the correction (the responses lag their references by that much more),
-/// and the front end at the images in the first-order form with the gain
-/// slope `linear_gain_per_hz` when given (`images::ImageFront`) instead of
-/// the group delay's turn.
+/// and the front end in the first-order form with the gain slope
+/// `linear_gain_per_hz` when given (`images::ImageFront`) instead of the
+/// group delay's turn: at the images, and across the calibration's
+/// sidebands. There a slope a scales the sidebands at wb -+ Om by
+/// 1 -+ a f_cal, which turns the resonant part of each response, symmetric
+/// in the sidebands and far larger than the calibration signal
+/// (`theory::calibration_z_with_envelope_lead`), into signal: a relative
+/// change of the calibration scale factor proportional to a and
+/// independent of f_cal (the signal grows with f_cal as the asymmetry
+/// does). A pick-off lag of 8 deg (a = sin(phi)^2 / f) moved seed 2096's
+/// output 1 by -1.2e-3 at calibration frequencies 1.3 to 16 Hz alike
+/// (`tests/field_coverage.rs`).
 pub(super) fn predicted_ratio_lagged(
     knowns: &Knowns,
     gyro: &GyroParams,
@@ -140,7 +149,8 @@ pub(super) fn predicted_ratio_lagged(
     let cal_z: Vec<[f64; 2]> = cal_hz
         .iter()
         .map(|&f| {
-            let sidebands = [-1.0, 1.0].map(|s| hold_gain(op.carrier_hz + s * f, clock) / hold);
+            let sidebands = [-1.0, 1.0]
+                .map(|s| hold_gain(op.carrier_hz + s * f, clock) / hold * front.gain(s * f));
             // The response's envelope comes late by the group delay: the
             // references' envelope leads it by that much more.
             let lead = envelope_lead_rad(f, clock) + TAU * f * op.envelope_delay_s;
