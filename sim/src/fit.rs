@@ -27,7 +27,7 @@
 use crate::theory::{Device, calibration_z, readout_z};
 use serde::Serialize;
 
-pub use gyrocal_host::stats::{linear_fit, mean_and_standard_error};
+pub use gyrocal_host::stats::{coverage_factor, linear_fit, mean_and_standard_error};
 
 /// A fitted line and its slope's 1-sigma uncertainty.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -77,33 +77,6 @@ pub fn fit_batches(x: &[f64], batches: &[Vec<f64>]) -> Line {
         intercept,
         slope_uncertainty: mean_and_standard_error(&slopes).1,
     }
-}
-
-/// The factor that makes a standard deviation estimated with `dof`
-/// degrees of freedom cover what a normal's does at 3 sigma: the
-/// Student t quantile at 0.99865 over 3 (1.51 at 7 degrees of freedom,
-/// 1.20 at 15, 1 in the limit). Cornish-Fisher expansion of the t
-/// quantile to 1/dof^4, within 0.002 of it from 7 degrees of freedom
-/// (checked against the quantile integrated from the density); below 7 it
-/// underestimates it by a few percent (2.3% at 3; the runs have 7 or more).
-///
-/// ```
-/// use gyrocal_sim::fit::coverage_factor;
-/// assert!((coverage_factor(7) * 3.0 - 4.530).abs() < 0.003);
-/// assert!((coverage_factor(24) * 3.0 - 3.345).abs() < 0.001);
-/// ```
-pub fn coverage_factor(dof: u32) -> f64 {
-    let z = 3.0f64;
-    let n = f64::from(dof.max(1));
-    let q = z
-        + (z.powi(3) + z) / (4.0 * n)
-        + (5.0 * z.powi(5) + 16.0 * z.powi(3) + 3.0 * z) / (96.0 * n * n)
-        + (3.0 * z.powi(7) + 19.0 * z.powi(5) + 17.0 * z.powi(3) - 15.0 * z) / (384.0 * n.powi(3))
-        + (79.0 * z.powi(9) + 776.0 * z.powi(7) + 1482.0 * z.powi(5)
-            - 1920.0 * z.powi(3)
-            - 945.0 * z)
-            / (92160.0 * n.powi(4));
-    q / z
 }
 
 /// 1-sigma uncertainty of `a / b` for independent `a +- sa`, `b +- sb`.

@@ -19,7 +19,8 @@ use serde::Serialize;
 /// `drive_gain_ratio_uncertainty` in `drive_ratio`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct SfUncertainty {
-    /// The staircase slope's noise (`staircase`).
+    /// The staircase slope's noise (`staircase`), with the coverage
+    /// factor of its degrees of freedom.
     pub staircase: [f64; 2],
     /// The predicted ratio's, from the identified f1, f2, Q1, Q2,
     /// mode couplings, group delay and loop phase (each moved by its
