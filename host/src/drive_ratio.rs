@@ -76,7 +76,8 @@
 //!
 //! Each of the four windows is cut into `BATCHES` consecutive batches; the
 //! estimate is formed from each batch index alone and the spread of those
-//! `BATCHES` estimates gives the noise's standard error. The identified
+//! `BATCHES` estimates gives the noise's standard error, times the
+//! coverage factor of its `BATCHES - 1` degrees of freedom. The identified
 //! parameters' uncertainties enter through G_1 / G_2 (propagated by finite
 //! differences). A rate that drifts between the two signs cancels to first
 //! order (each of Q_1 and P_2 is the mean over both). A quadrature
@@ -90,7 +91,7 @@ use crate::identify::{self, Estimate, Identified};
 use crate::knowns::Knowns;
 use crate::sampling::average_z;
 use crate::selfcal::Operating;
-use crate::stats::mean_and_standard_error;
+use crate::stats::{coverage_factor, mean_and_standard_error};
 use gyrocal_regs::datapath::readout_word as signed_readout_word;
 use nalgebra::Complex;
 use serde::Serialize;
@@ -168,10 +169,17 @@ fn resonator_ratio(id: &Identified, carrier_hz: f64) -> (C64, f64) {
     (centre, propagated(id, |v| ratio(v).norm()))
 }
 
-/// Mean and standard error of `v`.
+/// Mean and standard error of `v`, times the coverage factor of its
+/// `v.len() - 1` degrees of freedom (1.51 for the `BATCHES` = 8 batches):
+/// a standard error from 7 degrees of freedom leaves 2% of Student t
+/// beyond 3 of its sigmas, not 0.27%.
 fn mean_and_error(v: &[f64]) -> Estimate {
-    let (value, uncertainty) = mean_and_standard_error(v);
-    Estimate { value, uncertainty }
+    let (value, se) = mean_and_standard_error(v);
+    let dof = u32::try_from(v.len() - 1).unwrap_or(u32::MAX);
+    Estimate {
+        value,
+        uncertainty: se * coverage_factor(dof),
+    }
 }
 
 /// `BATCHES` batch means of both outputs, `per_batch` z samples each,
