@@ -251,7 +251,10 @@ fn a_differential_drive_gain_is_measured_while_turning_and_corrected() {
             s.selfcal.sf_selfcal_uncertainty.drive_ratio[0],
             s.selfcal.sf_selfcal_uncertainty.drive_ratio[1],
         );
-        assert!(sigmas.abs() < 5.0, "{sigmas}");
+        // The promise of every sigma: the error within 3 of them. Here at
+        // most 2.5 (35 deg C), from a bias of some -8e-5 that falls as
+        // 1 / rate, not yet traced (docs/field.md).
+        assert!(sigmas.abs() < 3.0, "{sigmas}");
         assert!(m.phase_deg.value.abs() < 5.0 * m.phase_deg.uncertainty);
         // At the design ratio: the theory's error with the true gains.
         let op = &s.selfcal.operating;
