@@ -40,7 +40,7 @@ pub struct Staircase {
 /// Windows at `MIN_RIPPLE_PERIODS` leave few: three windows of two
 /// periods, 3 degrees of freedom and a factor of 3.0. Without it, a
 /// device of that kind (unseen, 118 kHz on a 1.37 MHz clock) read its
-/// output-2 staircase sigma anywhere from 0.7e-4 to 9.8e-4 over 16 noise
+/// output-2 staircase sigma anywhere from 0.7e-4 to 9.0e-4 over 16 noise
 /// seeds, and one of its 48 figures lay 4.3 sigma out.
 pub fn staircase(
     board: &mut dyn Board,
