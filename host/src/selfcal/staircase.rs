@@ -126,23 +126,9 @@ mod tests {
     use super::pooled_slope_uncertainty;
     use crate::sampling::mean_of_parts;
     use crate::stats::linear_fit;
-
-    /// Standard normal draws, reproducible: xorshift64* and Box-Muller.
-    struct Normal(u64);
-
-    impl Normal {
-        fn uniform(&mut self) -> f64 {
-            self.0 ^= self.0 >> 12;
-            self.0 ^= self.0 << 25;
-            self.0 ^= self.0 >> 27;
-            ((self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 + 0.5) / (1u64 << 53) as f64
-        }
-
-        fn draw(&mut self) -> f64 {
-            let (u, v) = (self.uniform(), self.uniform());
-            (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
-        }
-    }
+    use rand_distr::{Distribution, StandardNormal};
+    use rand_xoshiro::Xoshiro256PlusPlus;
+    use rand_xoshiro::rand_core::SeedableRng;
 
     /// Three windows of two ripple periods each (`MIN_RIPPLE_PERIODS`, as
     /// on a slow clock), period means with independent normal noise: the
@@ -156,7 +142,8 @@ mod tests {
     fn the_slope_sigma_covers_its_error_with_two_periods_a_window() {
         let x = [4.0, 6.0, 9.0].map(|f: f64| 360.0 * f);
         let sf = [-1265.7, -46.5];
-        let mut noise = Normal(0x9E37_79B9_7F4A_7C15);
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(1);
+        let mut draw = || -> f64 { StandardNormal.sample(&mut rng) };
         let trials = 4000;
         let (mut within_2, mut beyond_3) = (0usize, 0usize);
         for _ in 0..trials {
@@ -164,12 +151,7 @@ mod tests {
                 .iter()
                 .map(|xi| {
                     (0..2)
-                        .map(|_| {
-                            [
-                                sf[0] * xi + 30.0 * noise.draw(),
-                                sf[1] * xi + 300.0 * noise.draw(),
-                            ]
-                        })
+                        .map(|_| [sf[0] * xi + 30.0 * draw(), sf[1] * xi + 300.0 * draw()])
                         .collect()
                 })
                 .collect();
