@@ -289,7 +289,8 @@ fn accuracy_warnings(
     sim: &ScaleFactors,
     target: [f64; 2],
 ) -> Vec<String> {
-    let fixes = if plan.front_end.noise_lsb < 0.5 {
+    let dithered = crate::frontend::dithers(plan.front_end.noise_lsb, plan.front_end.adc_bits);
+    let fixes = if !dithered {
         "dither ([frontend] noise_lsb = 1) or more ADC bits ([frontend] adc_bits)"
     } else {
         "more ADC bits ([frontend] adc_bits) or longer first windows ([experiment] min_window_s)"
@@ -305,7 +306,7 @@ fn accuracy_warnings(
                 target,
                 exp.points.budget_s
             ));
-        } else if signal < 1.0 && plan.front_end.noise_lsb < 0.5 {
+        } else if signal < 1.0 && !dithered {
             lines.push(format!(
                 "output {}: its rate signal spans {signal:.2} ADC LSB over the points, below the ADC's resolution, and the ADCs are not dithered: each point's mean carries a static quantization bias that the uncertainty {reached:.2e} (target {:.2e}) cannot see; dither ([frontend] noise_lsb = 1, the default) or more ADC bits ([frontend] adc_bits) remove it",
                 k + 1,

@@ -12,7 +12,9 @@
 //! the truth is a measurement too), `selfcal_error` with its own 1-sigma
 //! `selfcal_error_uncertainty` (the two in quadrature), and
 //! `identified` (`f1_hz`, `f2_hz`, `q1`, `q2`, `loop_phase_deg`, each with
-//! an `_uncertainty` twin). `--out` writes field.json, field.csv and
+//! an `_uncertainty` twin), and `warnings`: inputs that no sigma covers,
+//! one line each, also printed first (ADC noise below half an ADC step,
+//! `gyrocal_sim::frontend::dithers`). `--out` writes field.json, field.csv and
 //! fig_field_error.png/.svg; with a `[profile]`, also the rate output
 //! over time, field_rate.csv and fig_field_rate.png/.svg.
 //!

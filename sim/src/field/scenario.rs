@@ -346,10 +346,29 @@ pub struct FieldReport {
     /// The steps (or their baselines) that failed, in the scenario's order;
     /// empty when every step finished.
     pub failed: Vec<StepFailure>,
+    /// Inputs that make a figure less than it says, one line each (also
+    /// printed when the run starts): ADCs the scenario leaves undithered.
+    pub warnings: Vec<String>,
     /// Clocks simulated, all steps.
     pub clocks: u64,
     /// Wall time (s).
     pub wall_s: f64,
+}
+
+/// The scenario's inputs that no sigma covers, one line each: ADC noise
+/// below half an ADC step ([`crate::frontend::dithers`]).
+pub fn warnings(exp: &Experiment) -> Vec<String> {
+    let fe = &exp.frontend;
+    let mut lines = vec![];
+    if !crate::frontend::dithers(fe.noise_lsb, fe.adc_bits) {
+        lines.push(format!(
+            "warning: [frontend] noise_lsb = {} is below half an ADC step ({} word LSB at adc_bits = {}): unless the device's own noise dithers the ADCs, an output far below their range carries a static quantization error that no sigma includes",
+            fe.noise_lsb,
+            0.5 * f64::from(1u32 << (16 - fe.adc_bits.min(16))),
+            fe.adc_bits
+        ));
+    }
+    lines
 }
 
 /// What a host programmed for `exp` would know: its `[datasheet]` over its
@@ -741,6 +760,8 @@ pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldRepor
     drift.validate()?;
     let start = Instant::now();
     let (fe, knowns) = build(exp)?;
+    let warnings = warnings(exp);
+    warnings.iter().for_each(|w| progress(w));
     let cycles = run_cycles(sc, &fe, &knowns, progress);
     let factory = cycles[0].as_ref().ok().map(|c| Factory {
         operating: c.cal.operating.clone(),
@@ -805,6 +826,7 @@ pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldRepor
         profile: sc.profile.clone(),
         steps,
         failed,
+        warnings,
         clocks,
         wall_s: start.elapsed().as_secs_f64(),
     })
@@ -928,4 +950,34 @@ fn step_line(st: &FieldStep) -> String {
         100.0 * e[0],
         100.0 * e[1],
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn paper() -> Scenario {
+        let text = include_str!("../../../tests/data/field_paper.toml");
+        parse("field_paper.toml", text).expect("the paper scenario parses")
+    }
+
+    #[test]
+    fn an_undithered_adc_is_named_in_one_line_and_a_dithered_one_is_not() {
+        let mut sc = paper();
+        assert!(warnings(&sc.exp).is_empty(), "{:?}", warnings(&sc.exp));
+        sc.exp.frontend.noise_lsb = 0.0;
+        let lines = warnings(&sc.exp);
+        assert_eq!(lines.len(), 1, "{lines:?}");
+        assert!(lines[0].contains("noise_lsb = 0 is below half an ADC step (0.5 word LSB"));
+        // The criterion is in ADC steps: 1 word LSB does not dither a 12-bit ADC.
+        sc.exp.frontend.noise_lsb = 1.0;
+        sc.exp.frontend.adc_bits = 12;
+        let lines = warnings(&sc.exp);
+        assert_eq!(lines.len(), 1, "{lines:?}");
+        assert!(
+            lines[0].contains("(8 word LSB at adc_bits = 12)"),
+            "{}",
+            lines[0]
+        );
+    }
 }
