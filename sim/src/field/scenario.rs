@@ -45,7 +45,9 @@ use gyrocal_host::drive_ratio;
 use gyrocal_host::identify::Estimate;
 use gyrocal_host::sampling::{Signal, mean_of_parts, part_means};
 use gyrocal_host::selfcal::{self, Operating, SelfCal};
-use gyrocal_regs::plan::{FOLD_CLEAR_CORNERS, nearest_fold};
+use gyrocal_regs::plan::{
+    FOLD_CLEAR_CORNERS, STATIC_FOLD_BEATS, STATIC_FOLD_PERIOD, nearest_fold, nearest_fold_within,
+};
 use rayon::prelude::*;
 use serde::Deserialize;
 use serde::Serialize;
@@ -191,16 +193,56 @@ pub struct CarrierFold {
     /// (`gyrocal_regs::plan`), which the host's operating point keeps its
     /// carrier out of where it can (`gyrocal_host::selfcal`).
     pub in_passband: bool,
+    /// A fold of period at most `STATIC_FOLD_PERIOD` clocks that beats
+    /// slower than once a measurement window (`min_window_s`), if any:
+    /// its error is the same in every batch of a window, so no sigma
+    /// sees it, and the step's figures may lie beyond their sigmas
+    /// (`gyrocal_regs::plan::STATIC_FOLD_PERIOD`).
+    pub static_fold: Option<StaticFold>,
+}
+
+/// A short-period fold slower than a measurement window.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct StaticFold {
+    /// The period q in clocks.
+    pub period: u64,
+    /// Its distance from the carrier (Hz).
+    pub offset_hz: f64,
 }
 
 impl CarrierFold {
     fn of(carrier_hz: f64, knowns: &Knowns) -> Self {
         let (period, offset_hz) = nearest_fold(carrier_hz, knowns.clock_hz);
+        let (short, short_hz) =
+            nearest_fold_within(carrier_hz, knowns.clock_hz, STATIC_FOLD_PERIOD);
         Self {
             period,
             offset_hz,
             in_passband: offset_hz < FOLD_CLEAR_CORNERS * knowns.filter.butterworth_hz,
+            static_fold: (short_hz * knowns.filter.min_window_s < STATIC_FOLD_BEATS).then_some(
+                StaticFold {
+                    period: short,
+                    offset_hz: short_hz,
+                },
+            ),
         }
+    }
+
+    /// One clause for the step's line: the static fold, else the one in
+    /// the passband, else nothing.
+    pub fn clause(&self) -> Option<String> {
+        if let Some(s) = self.static_fold {
+            return Some(format!(
+                "the carrier is {:.3} Hz from a fold of period {} clocks, slower than a window: its converters' and tables' errors are the same in every batch, so this step's figures may lie beyond their sigmas",
+                s.offset_hz, s.period
+            ));
+        }
+        self.in_passband.then(|| {
+            format!(
+                "the carrier folds {:.1} Hz from itself (period {} clocks): the rate may ripple at that offset",
+                self.offset_hz, self.period
+            )
+        })
     }
 }
 
@@ -935,15 +977,10 @@ fn step_line(st: &FieldStep) -> String {
         Some(b) => format!("baseline {:+.2}% / {:+.2}%", 100.0 * b[0], 100.0 * b[1]),
         None => "no baseline".to_string(),
     };
-    let f = st.carrier_fold;
-    let fold = if f.in_passband {
-        format!(
-            "; the carrier folds {:.1} Hz from itself (period {} clocks): the rate may ripple at that offset",
-            f.offset_hz, f.period
-        )
-    } else {
-        String::new()
-    };
+    let fold = st
+        .carrier_fold
+        .clause()
+        .map_or(String::new(), |c| format!("; {c}"));
     format!(
         "{} deg C: self-cal error {:+.4}% / {:+.4}%, {base}{fold}",
         st.temperature_c,
@@ -959,6 +996,34 @@ mod tests {
     fn paper() -> Scenario {
         let text = include_str!("../../../tests/data/field_paper.toml");
         parse("field_paper.toml", text).expect("the paper scenario parses")
+    }
+
+    #[test]
+    fn a_short_fold_slower_than_a_window_is_named_and_a_faster_one_is_not() {
+        // The unseen device's 25 deg C step: 15 kHz on 1.2 MHz, 0.4 s windows.
+        let mut k = knowns(&paper().exp).expect("knowns");
+        k.clock_hz = 1.2e6;
+        k.filter.min_window_s = 0.4;
+        let at = |carrier_hz: f64| CarrierFold::of(carrier_hz, &k);
+        let slow = at(15000.0005);
+        let s = slow
+            .static_fold
+            .expect("a fold 0.04 Hz off beats slower than 0.4 s");
+        assert_eq!(s.period, 80);
+        assert!((s.offset_hz - 0.04).abs() < 1e-6, "{}", s.offset_hz);
+        let line = slow.clause().expect("a clause");
+        assert!(line.contains("may lie beyond their sigmas"), "{line}");
+        // 2.4 Hz is 0.96 of a beat a window: named, though its figures
+        // were within their sigmas (the line errs on the side of saying
+        // it); 4 Hz, 1.6 beats a window, is not.
+        assert!(at(15000.03).static_fold.is_some());
+        assert_eq!(at(15000.05).static_fold, None);
+        assert_eq!(at(15011.25).static_fold, None);
+        // The paper's 30 deg C carrier (q = 83, 18.2 Hz, 0.1 s windows) ripples, but is not static.
+        let paper = knowns(&paper().exp).expect("knowns");
+        let f = CarrierFold::of(9638553.9975, &paper);
+        assert!(f.in_passband && f.static_fold.is_none(), "{f:?}");
+        assert!(f.clause().expect("a clause").contains("may ripple"));
     }
 
     #[test]
