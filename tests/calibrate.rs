@@ -240,6 +240,7 @@ fn rate_table_at(run: &Value) -> scenario::RateTable {
             run["operating"]["amplitude"][1].as_f64().unwrap(),
         ),
         fold_shift_hz: op("fold_shift_hz"),
+        static_fold: None,
     };
     scenario::rate_table(&file.exp, &fe, &at, &knowns, &operating)
         .unwrap()

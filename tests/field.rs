@@ -180,6 +180,7 @@ fn rounding_moves_the_resonant_outputs_rate_table() {
             envelope_delay_s: 0.0,
             amplitude: knowns.amplitude,
             fold_shift_hz: 0.0,
+            static_fold: None,
         };
         let sf0 = scenario::rate_table(&sc.exp, &fe, &at, &knowns, &op)
             .unwrap()

@@ -150,6 +150,40 @@ pub struct Operating {
     /// the modes to keep the carrier tables' folds out of the passband
     /// (Hz, on the NCO's grid; 0 when it was not: module header).
     pub fold_shift_hz: f64,
+    /// A fold of short period that beats slower than a window, left
+    /// where the carrier could not move off it ([`static_fold`]): the
+    /// figures of this operating point may lie beyond their sigmas.
+    pub static_fold: Option<StaticFold>,
+}
+
+/// A carrier fold of period at most `plan::STATIC_FOLD_PERIOD` clocks
+/// that beats less than `plan::STATIC_FOLD_BEATS` times a measurement
+/// window: its error is the same in every batch, so no sigma sees it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct StaticFold {
+    /// The period q in clocks (the carrier is near n / q of the clock).
+    pub period: u64,
+    /// Its distance from the carrier (Hz).
+    pub offset_hz: f64,
+}
+
+impl std::fmt::Display for StaticFold {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "the carrier is {:.3} Hz from a fold of period {} clocks, slower than a window: its converters' and tables' errors are the same in every batch, so the figures at this carrier may lie beyond their sigmas",
+            self.offset_hz, self.period
+        )
+    }
+}
+
+/// The static fold of `carrier_hz` under `knowns`' clock and window, if
+/// it has one.
+pub fn static_fold(knowns: &Knowns, carrier_hz: f64) -> Option<StaticFold> {
+    let (period, offset_hz) =
+        plan::nearest_fold_within(carrier_hz, knowns.clock_hz, plan::STATIC_FOLD_PERIOD);
+    (offset_hz * knowns.filter.min_window_s < plan::STATIC_FOLD_BEATS)
+        .then_some(StaticFold { period, offset_hz })
 }
 
 /// One cycle's result.
@@ -199,6 +233,7 @@ pub fn operating(knowns: &Knowns, id: &Identified) -> Result<Operating, Error> {
             envelope_delay_s: id.group_delay_s.value,
             amplitude: knowns.amplitude,
             fold_shift_hz: 0.0,
+            static_fold: static_fold(knowns, real.carrier_hz),
         })
     };
     let mut op = at(asked)?;

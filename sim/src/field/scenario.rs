@@ -45,9 +45,8 @@ use gyrocal_host::drive_ratio;
 use gyrocal_host::identify::Estimate;
 use gyrocal_host::sampling::{Signal, mean_of_parts, part_means};
 use gyrocal_host::selfcal::{self, Operating, SelfCal};
-use gyrocal_regs::plan::{
-    FOLD_CLEAR_CORNERS, STATIC_FOLD_BEATS, STATIC_FOLD_PERIOD, nearest_fold, nearest_fold_within,
-};
+use gyrocal_host::selfcal::{StaticFold, static_fold};
+use gyrocal_regs::plan::{FOLD_CLEAR_CORNERS, nearest_fold};
 use rayon::prelude::*;
 use serde::Deserialize;
 use serde::Serialize;
@@ -193,38 +192,21 @@ pub struct CarrierFold {
     /// (`gyrocal_regs::plan`), which the host's operating point keeps its
     /// carrier out of where it can (`gyrocal_host::selfcal`).
     pub in_passband: bool,
-    /// A fold of period at most `STATIC_FOLD_PERIOD` clocks that beats
-    /// slower than once a measurement window (`min_window_s`), if any:
-    /// its error is the same in every batch of a window, so no sigma
-    /// sees it, and the step's figures may lie beyond their sigmas
-    /// (`gyrocal_regs::plan::STATIC_FOLD_PERIOD`).
+    /// A fold of short period that beats slower than once a measurement
+    /// window, if any (`gyrocal_host::selfcal::static_fold`): its error is
+    /// the same in every batch of a window, so no sigma sees it, and the
+    /// step's figures may lie beyond their sigmas.
     pub static_fold: Option<StaticFold>,
-}
-
-/// A short-period fold slower than a measurement window.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub struct StaticFold {
-    /// The period q in clocks.
-    pub period: u64,
-    /// Its distance from the carrier (Hz).
-    pub offset_hz: f64,
 }
 
 impl CarrierFold {
     fn of(carrier_hz: f64, knowns: &Knowns) -> Self {
         let (period, offset_hz) = nearest_fold(carrier_hz, knowns.clock_hz);
-        let (short, short_hz) =
-            nearest_fold_within(carrier_hz, knowns.clock_hz, STATIC_FOLD_PERIOD);
         Self {
             period,
             offset_hz,
             in_passband: offset_hz < FOLD_CLEAR_CORNERS * knowns.filter.butterworth_hz,
-            static_fold: (short_hz * knowns.filter.min_window_s < STATIC_FOLD_BEATS).then_some(
-                StaticFold {
-                    period: short,
-                    offset_hz: short_hz,
-                },
-            ),
+            static_fold: static_fold(knowns, carrier_hz),
         }
     }
 
@@ -232,10 +214,7 @@ impl CarrierFold {
     /// the passband, else nothing.
     pub fn clause(&self) -> Option<String> {
         if let Some(s) = self.static_fold {
-            return Some(format!(
-                "the carrier is {:.3} Hz from a fold of period {} clocks, slower than a window: its converters' and tables' errors are the same in every batch, so this step's figures may lie beyond their sigmas",
-                s.offset_hz, s.period
-            ));
+            return Some(s.to_string());
         }
         self.in_passband.then(|| {
             format!(
@@ -1013,6 +992,10 @@ mod tests {
         assert!((s.offset_hz - 0.04).abs() < 1e-6, "{}", s.offset_hz);
         let line = slow.clause().expect("a clause");
         assert!(line.contains("may lie beyond their sigmas"), "{line}");
+        assert!(
+            line.contains("0.040 Hz from a fold of period 80 clocks"),
+            "{line}"
+        );
         // 2.4 Hz is 0.96 of a beat a window: named, though its figures
         // were within their sigmas (the line errs on the side of saying
         // it); 4 Hz, 1.6 beats a window, is not.

@@ -108,6 +108,9 @@ pub fn table(o: &Outcome) -> String {
         "operating: carrier {:.6} Hz, phase correction {:.5} deg",
         cal.operating.carrier_hz, cal.operating.ref_lag_deg
     );
+    if let Some(fold) = cal.operating.static_fold {
+        let _ = writeln!(s, "warning: {fold}");
+    }
     let _ = writeln!(
         s,
         "{:<32} {:>14} {:>14}",
