@@ -173,7 +173,7 @@ fn resonator_ratio(id: &Identified, carrier_hz: f64) -> (C64, f64) {
 /// `v.len() - 1` degrees of freedom (1.51 for the `BATCHES` = 8 batches):
 /// a standard error from 7 degrees of freedom leaves 2% of Student t
 /// beyond 3 of its sigmas, not 0.27%.
-fn mean_and_error(v: &[f64]) -> Estimate {
+pub(crate) fn mean_and_error(v: &[f64]) -> Estimate {
     let (value, se) = mean_and_standard_error(v);
     let dof = u32::try_from(v.len() - 1).unwrap_or(u32::MAX);
     Estimate {
