@@ -457,7 +457,8 @@ fn self_calibration_holds_with_brownian_noise() {
 /// 1.2 MHz clock. Left there, the converters' and tables' errors were the
 /// same in every batch: the couplings measured at rest came out
 /// -1.680 +- 0.020 and +0.693 +- 0.014 deg/s against a truth of 0 (84 and
-/// 50 sigma), and the self-cal errors -0.14% / -0.05%. Moved 0.031 Hz (the
+/// 50 sigma, before the couplings' coverage factor of 1.51), and the
+/// self-cal errors -0.14% / -0.05%. Moved 0.031 Hz (the
 /// fold then beats once a 0.4 s window; the scale factors change 5.7%,
 /// within `STATIC_FOLD_SF_CHANGE`), every figure lies within 3 sigma.
 #[test]
