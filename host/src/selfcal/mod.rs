@@ -303,7 +303,8 @@ pub const FOLD_SF_CHANGE: f64 = 0.05;
 /// [`FOLD_SF_CHANGE`] for a move off a static fold
 /// (`plan::STATIC_FOLD_BEATS`), where more is at stake than a ripple: on
 /// an unseen device (15 kHz on 1.2 MHz, carrier 0.004 Hz from a fold of
-/// period 80) the measured couplings were 84 and 50 of their sigmas off,
+/// period 80) the measured couplings were 84 and 50 of their sigmas off
+/// (before those carried their coverage factor; some 55 and 33 after),
 /// and the 0.031 Hz that gives the fold one beat a window moves the
 /// scale factors by 5.7%. The scale factors drift by 7% over the paper
 /// field's steps; a move that would change them by more than 10% is not
