@@ -61,8 +61,13 @@ pub struct FrontEnd {
 /// assert!(!dithers(1.0, 12) && dithers(8.0, 12)); // a 12-bit step is 16 word LSB
 /// ```
 pub fn dithers(noise_lsb: f64, adc_bits: u32) -> bool {
-    let step = f64::from(1u32 << (16 - adc_bits.min(16)));
-    noise_lsb >= 0.5 * step
+    noise_lsb >= dither_lsb(adc_bits)
+}
+
+/// The least noise (RMS, 16-bit word LSB) that dithers an ADC of
+/// `adc_bits` ([`dithers`]): half its step `2^(16 - adc_bits)`.
+pub fn dither_lsb(adc_bits: u32) -> f64 {
+    0.5 * f64::from(1u32 << (16 - adc_bits.min(16)))
 }
 
 /// Longest converter latency the ring buffers hold.

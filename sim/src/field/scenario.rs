@@ -44,8 +44,8 @@ use gyrocal_host::datasheet::Datasheet;
 use gyrocal_host::drive_ratio;
 use gyrocal_host::identify::Estimate;
 use gyrocal_host::sampling::{Signal, mean_of_parts, part_means};
+use gyrocal_host::selfcal::StaticFold;
 use gyrocal_host::selfcal::{self, Operating, SelfCal};
-use gyrocal_host::selfcal::{StaticFold, static_fold};
 use gyrocal_regs::plan::{FOLD_CLEAR_CORNERS, nearest_fold};
 use rayon::prelude::*;
 use serde::Deserialize;
@@ -193,20 +193,21 @@ pub struct CarrierFold {
     /// carrier out of where it can (`gyrocal_host::selfcal`).
     pub in_passband: bool,
     /// A fold of short period that beats slower than once a measurement
-    /// window, if any (`gyrocal_host::selfcal::static_fold`): its error is
-    /// the same in every batch of a window, so no sigma sees it, and the
+    /// window, if any: the operating point's own
+    /// (`gyrocal_host::selfcal::Operating::static_fold`). Its error is the
+    /// same in every batch of a window, so no sigma sees it, and the
     /// step's figures may lie beyond their sigmas.
     pub static_fold: Option<StaticFold>,
 }
 
 impl CarrierFold {
-    fn of(carrier_hz: f64, knowns: &Knowns) -> Self {
-        let (period, offset_hz) = nearest_fold(carrier_hz, knowns.clock_hz);
+    fn of(op: &Operating, knowns: &Knowns) -> Self {
+        let (period, offset_hz) = nearest_fold(op.carrier_hz, knowns.clock_hz);
         Self {
             period,
             offset_hz,
             in_passband: offset_hz < FOLD_CLEAR_CORNERS * knowns.filter.butterworth_hz,
-            static_fold: static_fold(knowns, carrier_hz),
+            static_fold: op.static_fold,
         }
     }
 
@@ -385,7 +386,7 @@ pub fn warnings(exp: &Experiment) -> Vec<String> {
         lines.push(format!(
             "warning: [frontend] noise_lsb = {} is below half an ADC step ({} word LSB at adc_bits = {}): unless the device's own noise dithers the ADCs, an output far below their range carries a static quantization error that no sigma includes",
             fe.noise_lsb,
-            0.5 * f64::from(1u32 << (16 - fe.adc_bits.min(16))),
+            crate::frontend::dither_lsb(fe.adc_bits),
             fe.adc_bits
         ));
     }
@@ -926,7 +927,7 @@ fn field_step(c: Cycle, baseline: Option<Baseline>, knowns: &Knowns) -> FieldSte
     FieldStep {
         temperature_c: c.at.temperature_c,
         drive_gain_ratio_true: c.at.drive_gain[1] / c.at.drive_gain[0],
-        carrier_fold: CarrierFold::of(c.cal.operating.carrier_hz, knowns),
+        carrier_fold: CarrierFold::of(&c.cal.operating, knowns),
         truth: c.at,
         sf_true_per_dps: sf_true,
         sf_true_uncertainty: c.truth.uncertainty,
@@ -971,10 +972,24 @@ fn step_line(st: &FieldStep) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use gyrocal_host::selfcal::static_fold;
 
     fn paper() -> Scenario {
         let text = include_str!("../../../tests/data/field_paper.toml");
         parse("field_paper.toml", text).expect("the paper scenario parses")
+    }
+
+    /// An operating point at `carrier_hz`, its static fold found as
+    /// `selfcal::operating` finds it.
+    fn operating_at(carrier_hz: f64, knowns: &Knowns) -> Operating {
+        Operating {
+            carrier_hz,
+            ref_lag_deg: 0.0,
+            envelope_delay_s: 0.0,
+            amplitude: knowns.amplitude,
+            fold_shift_hz: 0.0,
+            static_fold: static_fold(knowns, carrier_hz),
+        }
     }
 
     #[test]
@@ -983,7 +998,7 @@ mod tests {
         let mut k = knowns(&paper().exp).expect("knowns");
         k.clock_hz = 1.2e6;
         k.filter.min_window_s = 0.4;
-        let at = |carrier_hz: f64| CarrierFold::of(carrier_hz, &k);
+        let at = |carrier_hz: f64| CarrierFold::of(&operating_at(carrier_hz, &k), &k);
         let slow = at(15000.0005);
         let s = slow
             .static_fold
@@ -1004,7 +1019,7 @@ mod tests {
         assert_eq!(at(15011.25).static_fold, None);
         // The paper's 30 deg C carrier (q = 83, 18.2 Hz, 0.1 s windows) ripples, but is not static.
         let paper = knowns(&paper().exp).expect("knowns");
-        let f = CarrierFold::of(9638553.9975, &paper);
+        let f = CarrierFold::of(&operating_at(9638553.9975, &paper), &paper);
         assert!(f.in_passband && f.static_fold.is_none(), "{f:?}");
         assert!(f.clause().expect("a clause").contains("may ripple"));
     }
