@@ -27,6 +27,7 @@
 //! end; `exact` rounds `32767 sin` of the whole 32-bit phase.
 
 use gyrocal_hdl::model::carrier_nco::{table, table_sine};
+use gyrocal_hdl::model::sine_pair::sine_pair;
 use std::f64::consts::TAU;
 
 /// The averaging block (s): a 500 Hz output's time scale.
@@ -38,6 +39,7 @@ const SPAN_S: f64 = 0.2;
 #[derive(Clone, Copy)]
 enum Profile {
     Built,
+    Pair,
     Table {
         bits: u32,
         interpolated: u32,
@@ -50,6 +52,7 @@ impl Profile {
     fn name(self) -> String {
         match self {
             Profile::Built => "built (15/0, fill words)".into(),
+            Profile::Pair => "sine pair (15/3/2, ECP5)".into(),
             Profile::Table {
                 bits,
                 interpolated,
@@ -64,6 +67,7 @@ impl Profile {
     fn sine(self, phase: u32) -> f64 {
         match self {
             Profile::Built => f64::from(table_sine(table(), phase, 0)),
+            Profile::Pair => f64::from(sine_pair(phase).1),
             Profile::Exact => (32767.0 * (f64::from(phase) / 2f64.powi(32) * TAU).sin()).round(),
             Profile::Table {
                 bits,
@@ -155,6 +159,7 @@ fn main() {
         table(15, 3, 1),
         table(15, 3, 2),
         table(15, 3, 3),
+        Profile::Pair,
         Profile::Exact,
     ];
     for p in profiles {

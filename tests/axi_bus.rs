@@ -13,6 +13,7 @@
 
 use gyrocal_hdl::export;
 use gyrocal_hdl::host::register_map;
+use gyrocal_hdl::model::gyro_interface::CarrierProfile;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -68,11 +69,15 @@ fn require(tool: &str, package: &str) {
     );
 }
 
-fn run_cocotb(simulator: &str) {
+fn run_cocotb(simulator: &str, profile: CarrierProfile) {
     let python = python();
     let dir = tempfile::tempdir().unwrap();
-    let (program_file, vectors_file) = axi_vectors::write_inputs(dir.path());
-    let verilog = root().join("verilog-out").join(export::AXI_VERILOG_FILE);
+    let (program_file, vectors_file) = axi_vectors::write_inputs(dir.path(), profile);
+    let file = match profile {
+        CarrierProfile::Table => export::AXI_VERILOG_FILE,
+        CarrierProfile::Fine => export::FINE_AXI_VERILOG_FILE,
+    };
+    let verilog = root().join("verilog-out").join(file);
     let out = Command::new(&python)
         .arg(root().join("tests/axi/run.py"))
         .arg(simulator)
@@ -108,7 +113,7 @@ fn run_cocotb(simulator: &str) {
 #[test]
 fn third_party_axi_master_in_icarus() {
     require("iverilog", "iverilog");
-    run_cocotb("icarus");
+    run_cocotb("icarus", CarrierProfile::Table);
 }
 
 #[test]
@@ -116,7 +121,17 @@ fn third_party_axi_master_in_verilator() {
     require("verilator", "verilator");
     require("make", "make");
     require("g++", "g++");
-    run_cocotb("verilator");
+    run_cocotb("verilator", CarrierProfile::Table);
+}
+
+#[test]
+fn the_fine_core_behind_the_bus_in_verilator() {
+    // The ECP5 bus top (verilog-out/ecp5/gyro_interface_axi.v): the same
+    // cocotb cases, and the replay against the fine model's vectors.
+    require("verilator", "verilator");
+    require("make", "make");
+    require("g++", "g++");
+    run_cocotb("verilator", CarrierProfile::Fine);
 }
 
 #[test]

@@ -15,6 +15,7 @@
 //! FuseSoC, edalize and cocotb come from the venv of
 //! `scripts/ip/install-venv.sh` (tests/ip_tools).
 
+use gyrocal_hdl::model::gyro_interface::CarrierProfile;
 use gyrocal_verify::pnr::{ECP5_25F, ICE40_UP5K, pin_file};
 use gyrocal_verify::wrapper::{Core, Wrapper};
 use std::path::Path;
@@ -107,7 +108,7 @@ fn cocotb_tests() -> Vec<String> {
 #[test]
 fn sim_target_passes_every_cocotb_test_in_icarus() {
     let dir = tempfile::tempdir().unwrap();
-    let (program, vectors) = axi_vectors::write_inputs(dir.path());
+    let (program, vectors) = axi_vectors::write_inputs(dir.path(), CarrierProfile::Table);
     let build = dir.path().join("build");
     let env = |cmd: &mut std::process::Command| {
         cmd.env("GYRO_PROGRAM", &program)
@@ -184,5 +185,11 @@ fn synth_targets_use_the_generated_pnr_tops_and_pins() {
             );
             assert!(text.contains(&options), "{core}: {options}");
         }
+        // The ECP5 target builds the fine-carrier core, as RESOURCES.md's figures.
+        assert!(
+            text.contains("filesets: [rtl_ecp5, pnr_top, ecp5_pins]")
+                && text.contains("      - verilog-out/ecp5/"),
+            "{core}: synth_ecp5 must use verilog-out/ecp5/"
+        );
     }
 }

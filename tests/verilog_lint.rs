@@ -8,7 +8,7 @@
 //! `yosys`); without them the tests fail with that message, they are never
 //! skipped. About 15 s.
 
-use gyrocal_hdl::export::AXI_TOP_MODULE;
+use gyrocal_hdl::export::{AXI_TOP_MODULE, TOP_MODULE};
 use gyrocal_verify::{self as verify, lint, synthesis};
 
 fn verilator_present() {
@@ -38,6 +38,40 @@ fn exported_verilog_is_lint_clean_with_the_waivers() {
 }
 
 #[test]
+fn the_fine_core_is_lint_clean_with_the_waivers() {
+    // The ECP5 core: the core's waivers plus its own leaves' in
+    // ecp5/lint-waivers.vlt, each of which must still suppress a warning.
+    verilator_present();
+    let path = verify::committed_fine_verilog();
+    let report = lint::lint_files(
+        &[&path],
+        TOP_MODULE,
+        &[
+            &verify::committed_waivers(),
+            &verify::committed_fine_waivers(),
+        ],
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert!(
+        report.is_clean(),
+        "{}: {} warnings and {} errors left after the waivers; fix the design or, if benign, \
+         add a narrow waiver with its reason to verilog-out/ecp5/lint-waivers.vlt:\n{}",
+        path.display(),
+        report.warnings.len(),
+        report.errors.len(),
+        report.listing()
+    );
+    let uses = lint::waiver_usage_top(
+        &path,
+        TOP_MODULE,
+        &[&verify::committed_waivers()],
+        &verify::committed_fine_waivers(),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    assert_no_stale(&uses);
+}
+
+#[test]
 fn lint_without_waivers_does_find_warnings() {
     // The clean result above must come from the waivers, not from a lint that
     // sees nothing (wrong file, wrong top, warnings not parsed).
@@ -53,7 +87,11 @@ fn lint_without_waivers_does_find_warnings() {
 
 #[test]
 fn every_waiver_has_a_reason_and_is_narrow() {
-    for path in [verify::committed_waivers(), verify::committed_axi_waivers()] {
+    for path in [
+        verify::committed_waivers(),
+        verify::committed_axi_waivers(),
+        verify::committed_fine_waivers(),
+    ] {
         let text =
             std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         let waivers =

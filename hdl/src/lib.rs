@@ -9,6 +9,8 @@ pub mod cic_integrators;
 pub mod demod_mux;
 pub mod drive;
 pub mod export;
+pub mod fine_carrier_nco;
+pub mod fine_sine_table;
 /// The output filter's design, from the leaf crate `gyrocal-regs`.
 pub use gyrocal_regs::filter_design;
 pub mod gyro_interface;
@@ -25,6 +27,7 @@ pub mod rtl;
 /// The frequency plan (Hz to register values), from the leaf crate `gyrocal-regs`.
 pub use gyrocal_regs::plan as settings;
 pub mod sine;
+pub mod sine_pair;
 pub mod sine_table;
 pub mod table_sine;
 #[cfg(test)]

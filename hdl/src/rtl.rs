@@ -1,16 +1,34 @@
-//! The rust-hdl `GyroInterface` driven directly: the `rtl` engine's core.
+//! The rust-hdl `GyroInterface` (or `FineGyroInterface`, the ECP5 core)
+//! driven directly: the `rtl` engine's core.
 //!
 //! Same interface as the model (`crate::model::gyro_interface`): registers
 //! and ADC words in, ports out, one rising edge per `step`.
 
 use crate::drive::{prepare, tick};
-use crate::gyro_interface::GyroInterface;
-use crate::model::gyro_interface::{Outputs, Probes, Registers};
+use crate::gyro_interface::{FineGyroInterface, GyroInterface};
+use crate::model::gyro_interface::{CarrierProfile, Outputs, Probes, Registers};
 use crate::primitives::convert::{i128_to_signed, signed_to_i128, u128_to_bits};
+
+/// One of the two cores; both have the same ports.
+enum Design {
+    Table(Box<GyroInterface>),
+    Fine(Box<FineGyroInterface>),
+}
+
+/// `$body` with `$u` bound to the core, whichever it is (the two cores'
+/// ports have the same names and types).
+macro_rules! on_design {
+    ($design:expr, $u:ident => $body:expr) => {
+        match $design {
+            Design::Table($u) => $body,
+            Design::Fine($u) => $body,
+        }
+    };
+}
 
 /// rust-hdl's simulation of the datapath, stepped one clock at a time.
 pub struct RtlGyroInterface {
-    uut: Box<GyroInterface>,
+    uut: Design,
     applied: Option<Registers>,
 }
 
@@ -38,10 +56,10 @@ pub fn first_mismatch(
     adc: &[(i16, i16)],
     regs: &[Registers],
 ) -> Option<Mismatch> {
-    let mut model = crate::model::gyro_interface::GyroInterface::new();
+    let mut model = crate::model::gyro_interface::GyroInterface::with_profile(rtl.profile());
     let state = |rtl: &RtlGyroInterface, model: &crate::model::gyro_interface::GyroInterface| {
         (
-            (rtl.outputs(), probes(rtl.design())),
+            (rtl.outputs(), rtl.probes()),
             (model.outputs(), model.probes()),
         )
     };
@@ -80,38 +98,64 @@ impl RtlGyroInterface {
         Self::from_design(GyroInterface::new())
     }
 
-    /// A given (unconnected) design at power-up, connected and checked.
+    /// The core with this carrier profile at power-up, connected and checked.
+    pub fn with_profile(profile: CarrierProfile) -> Self {
+        match profile {
+            CarrierProfile::Table => Self::new(),
+            CarrierProfile::Fine => {
+                let mut uut = Box::new(FineGyroInterface::new());
+                prepare(uut.as_mut());
+                Self {
+                    uut: Design::Fine(uut),
+                    applied: None,
+                }
+            }
+        }
+    }
+
+    /// A given (unconnected) table design at power-up, connected and checked.
     pub fn from_design(design: GyroInterface) -> Self {
         let mut uut = Box::new(design);
         prepare(uut.as_mut());
-        Self { uut, applied: None }
+        Self {
+            uut: Design::Table(uut),
+            applied: None,
+        }
+    }
+
+    /// The core's carrier profile.
+    pub fn profile(&self) -> CarrierProfile {
+        match self.uut {
+            Design::Table(_) => CarrierProfile::Table,
+            Design::Fine(_) => CarrierProfile::Fine,
+        }
     }
 
     fn apply(&mut self, regs: &Registers) {
         if self.applied.as_ref() == Some(regs) {
             return;
         }
-        let u = &mut self.uut;
-        u.select.next = regs.select;
-        u.carrier_step.next = u128_to_bits(regs.carrier_step as u128);
-        u.ref_phase.next = u128_to_bits(regs.ref_phase as u128);
-        u.ref_delay.next = u128_to_bits(regs.ref_delay as u128);
-        u.mod_step.next = u128_to_bits(regs.mod_step as u128);
-        u.amp1.next = i128_to_signed(regs.amp.0 as i128);
-        u.amp2.next = i128_to_signed(regs.amp.1 as i128);
-        u.cic_decimation.next = u128_to_bits(regs.cic_decimation as u128);
-        u.cic_shift.next = u128_to_bits(regs.cic_shift as u128);
-        u.iir_k0.next = i128_to_signed(regs.iir.k0 as i128);
-        u.iir_k1.next = i128_to_signed(regs.iir.k1 as i128);
-        u.iir_k2.next = i128_to_signed(regs.iir.k2 as i128);
-        u.iir_alpha.next = i128_to_signed(regs.iir.alpha as i128);
+        on_design!(&mut self.uut, u => {
+            u.select.next = regs.select;
+            u.carrier_step.next = u128_to_bits(regs.carrier_step as u128);
+            u.ref_phase.next = u128_to_bits(regs.ref_phase as u128);
+            u.ref_delay.next = u128_to_bits(regs.ref_delay as u128);
+            u.mod_step.next = u128_to_bits(regs.mod_step as u128);
+            u.amp1.next = i128_to_signed(regs.amp.0 as i128);
+            u.amp2.next = i128_to_signed(regs.amp.1 as i128);
+            u.cic_decimation.next = u128_to_bits(regs.cic_decimation as u128);
+            u.cic_shift.next = u128_to_bits(regs.cic_shift as u128);
+            u.iir_k0.next = i128_to_signed(regs.iir.k0 as i128);
+            u.iir_k1.next = i128_to_signed(regs.iir.k1 as i128);
+            u.iir_k2.next = i128_to_signed(regs.iir.k2 as i128);
+            u.iir_alpha.next = i128_to_signed(regs.iir.alpha as i128);
+        });
         self.applied = Some(*regs);
     }
 
     /// The output ports during the current cycle.
     pub fn outputs(&self) -> Outputs {
-        let u = &self.uut;
-        Outputs {
+        on_design!(&self.uut, u => Outputs {
             dac: (
                 signed_to_i128(u.dac1.val()) as i16,
                 signed_to_i128(u.dac2.val()) as i16,
@@ -121,27 +165,24 @@ impl RtlGyroInterface {
                 signed_to_i128(u.z2.val()) as i64,
             ),
             z_valid: u.z_valid.val(),
-        }
+        })
     }
 
     /// One clock, like `model::gyro_interface::GyroInterface::step`.
     pub fn step(&mut self, adc: (i16, i16), regs: &Registers) -> Outputs {
         self.apply(regs);
-        self.uut.adc1.next = i128_to_signed(adc.0 as i128);
-        self.uut.adc2.next = i128_to_signed(adc.1 as i128);
-        tick(self.uut.as_mut());
+        on_design!(&mut self.uut, u => {
+            u.adc1.next = i128_to_signed(adc.0 as i128);
+            u.adc2.next = i128_to_signed(adc.1 as i128);
+            tick(u.as_mut());
+        });
         self.outputs()
     }
 
-    /// The design itself, for reading internal signals.
-    pub fn design(&self) -> &GyroInterface {
-        &self.uut
+    /// Internal signals during the current cycle, as in the model's `Probes`.
+    pub fn probes(&self) -> Probes {
+        on_design!(&self.uut, u => u.probes())
     }
-}
-
-/// Internal signals of the rust-hdl design, as in the model's `Probes`.
-pub fn probes(design: &GyroInterface) -> Probes {
-    design.probes()
 }
 
 #[cfg(test)]
@@ -184,6 +225,25 @@ mod tests {
                 None
             );
         }
+    }
+
+    #[test]
+    fn the_fine_core_matches_its_model_and_not_the_table_model() {
+        for calibration in [false, true] {
+            let (adc, regs) = stimulus(CYCLES, calibration);
+            let mut fine = RtlGyroInterface::with_profile(CarrierProfile::Fine);
+            assert_eq!(first_mismatch(&mut fine, &adc, &regs), None);
+        }
+        // Negative control: the fine core's carriers are not the table's,
+        // so against the table model the same comparison fails.
+        let (adc, regs) = stimulus(CYCLES, false);
+        let mut fine = RtlGyroInterface::with_profile(CarrierProfile::Fine);
+        let mut table = crate::model::gyro_interface::GyroInterface::new();
+        let differs = adc
+            .iter()
+            .zip(&regs)
+            .any(|(a, r)| fine.step(*a, r) != table.step(*a, r));
+        assert!(differs, "the fine core gave the table core's outputs");
     }
 
     #[test]

@@ -47,6 +47,76 @@ pub const FIFO_DEPTH: usize = 256;
 /// asserted equal to the fill plus the carrier and AM latencies).
 pub const DRIVE_START_CLOCKS: u64 = 8232;
 
+/// How the carrier NCO makes its sines: the two cores of the gateware,
+/// alike in every port, register and latency, different in their carriers.
+///
+/// ```
+/// use gyrocal_regs::datapath::CarrierProfile;
+/// assert_eq!("fine".parse::<CarrierProfile>(), Ok(CarrierProfile::Fine));
+/// assert_eq!(CarrierProfile::default().to_string(), "table");
+/// assert!("ecp5".parse::<CarrierProfile>().is_err());
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum CarrierProfile {
+    /// Integer words of a quarter-wave table filled at power-up, the phase
+    /// rounded to 2^15 a turn (`gyrocal_hdl::table_sine`): the core that
+    /// fits an iCE40 UltraPlus (`verilog-out/gyro_interface.v`).
+    #[default]
+    Table,
+    /// Quarter-LSB words in an initialized ROM, three more phase bits
+    /// interpolated, one rounding (`gyrocal_hdl::sine_pair`): block RAM with
+    /// contents and four multipliers, an ECP5 or larger part
+    /// (`verilog-out/ecp5/gyro_interface.v`). It removes the slow error a
+    /// carrier near a short fold of the clock leaves on the rate.
+    Fine,
+}
+
+impl CarrierProfile {
+    /// Both profiles.
+    pub const ALL: [CarrierProfile; 2] = [CarrierProfile::Table, CarrierProfile::Fine];
+
+    /// The name in configuration files.
+    pub fn name(self) -> &'static str {
+        match self {
+            CarrierProfile::Table => "table",
+            CarrierProfile::Fine => "fine",
+        }
+    }
+}
+
+impl std::fmt::Display for CarrierProfile {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A carrier profile name that is not one.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct UnknownCarrierProfile(pub String);
+
+impl std::fmt::Display for UnknownCarrierProfile {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "carrier profile {:?}: allowed \"table\" (the UP5K core) or \"fine\" (the ECP5 core)",
+            self.0
+        )
+    }
+}
+
+impl std::error::Error for UnknownCarrierProfile {}
+
+impl std::str::FromStr for CarrierProfile {
+    type Err = UnknownCarrierProfile;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        CarrierProfile::ALL
+            .into_iter()
+            .find(|p| p.name() == s)
+            .ok_or_else(|| UnknownCarrierProfile(s.to_owned()))
+    }
+}
+
 /// The AM mixer's Q1.15 product: `round(a b / 2^15)`, rounded half up,
 /// wrapped to 16 bits (the model of `gyrocal_hdl::q15_multiplier`).
 ///

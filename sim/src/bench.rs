@@ -95,7 +95,7 @@ fn measure<E: Engine>(
     let mut alone = vec![];
     let mut looped = vec![];
     for _ in 0..repetitions {
-        let mut engine = E::power_up()?;
+        let mut engine = E::power_up(exp.drive.carrier_profile)?;
         let start = Instant::now();
         let mut check = 0i64;
         for n in 0..clocks {

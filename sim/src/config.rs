@@ -53,6 +53,7 @@ use crate::noise::ThermalNoise;
 use crate::rate_drift::RateNoise;
 use gyrocal_hdl::cic_decimator::MAX_DECIMATION;
 use gyrocal_hdl::filter_design::{MAX_CUTOFF_RATIO, MIN_CUTOFF_RATIO, MIN_DECIMATION};
+use gyrocal_hdl::model::gyro_interface::CarrierProfile;
 use gyrocal_hdl::settings::{MAX_CAL_RATIO, MAX_REF_DELAY};
 use serde::{Deserialize, Serialize};
 
@@ -103,6 +104,36 @@ pub struct Drive {
     /// The same, channel 2 (N/kg).
     #[serde(default = "Drive::default_force")]
     pub force_full_scale2_n_per_kg: f64,
+    /// Which core's carriers: "table" (the UP5K core, the default) or
+    /// "fine" (the ECP5 core: interpolated carriers without the slow error
+    /// at a short fold of the clock). The model and rtl engines run both;
+    /// the verilator engine builds the table core.
+    #[serde(
+        default,
+        deserialize_with = "carrier_profile::deserialize",
+        serialize_with = "carrier_profile::serialize",
+        skip_serializing_if = "carrier_profile::is_default"
+    )]
+    pub carrier_profile: CarrierProfile,
+}
+
+/// `[drive] carrier_profile` through its name (`CarrierProfile`'s `FromStr`).
+mod carrier_profile {
+    use super::CarrierProfile;
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<CarrierProfile, D::Error> {
+        let name = String::deserialize(d)?;
+        name.parse().map_err(serde::de::Error::custom)
+    }
+
+    pub fn serialize<S: Serializer>(p: &CarrierProfile, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(p.name())
+    }
+
+    pub fn is_default(p: &CarrierProfile) -> bool {
+        *p == CarrierProfile::default()
+    }
 }
 
 impl Drive {
@@ -122,6 +153,7 @@ impl Drive {
             amplitude2: Self::default_amplitude(),
             force_full_scale1_n_per_kg: Self::default_force(),
             force_full_scale2_n_per_kg: Self::default_force(),
+            carrier_profile: CarrierProfile::default(),
         }
     }
     /// (amplitude1, amplitude2).

@@ -10,13 +10,16 @@
 //! All three give identical outputs on every cycle (tests prove it), so an
 //! experiment's results do not depend on the engine, only its speed does.
 
-use gyrocal_hdl::model::gyro_interface::{GyroInterface, Outputs, Probes, Registers};
+use gyrocal_hdl::model::gyro_interface::{
+    CarrierProfile, GyroInterface, Outputs, Probes, Registers,
+};
 use gyrocal_hdl::rtl::RtlGyroInterface;
 
 /// One clock at a time: inputs during a cycle in, outputs after the edge out.
 pub trait Engine {
-    /// A fresh instance at its power-up state.
-    fn power_up() -> Result<Self, String>
+    /// A fresh instance of the core with this carrier profile at its
+    /// power-up state.
+    fn power_up(profile: CarrierProfile) -> Result<Self, String>
     where
         Self: Sized;
     /// One rising edge with these inputs; returns the ports after it.
@@ -66,8 +69,8 @@ impl EngineKind {
 pub struct ModelEngine(GyroInterface);
 
 impl Engine for ModelEngine {
-    fn power_up() -> Result<Self, String> {
-        Ok(Self::default())
+    fn power_up(profile: CarrierProfile) -> Result<Self, String> {
+        Ok(Self(GyroInterface::with_profile(profile)))
     }
 
     #[inline(always)]
@@ -84,8 +87,8 @@ impl Engine for ModelEngine {
 pub struct RtlEngine(RtlGyroInterface);
 
 impl Engine for RtlEngine {
-    fn power_up() -> Result<Self, String> {
-        Ok(Self(RtlGyroInterface::new()))
+    fn power_up(profile: CarrierProfile) -> Result<Self, String> {
+        Ok(Self(RtlGyroInterface::with_profile(profile)))
     }
 
     fn step(&mut self, adc: (i16, i16), regs: &Registers) -> Outputs {
@@ -93,6 +96,6 @@ impl Engine for RtlEngine {
     }
 
     fn probes(&self) -> Probes {
-        self.0.design().probes()
+        self.0.probes()
     }
 }

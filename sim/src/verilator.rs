@@ -3,7 +3,7 @@
 //! of `verilator/wrapper.cpp`.
 
 use crate::engine::Engine;
-use gyrocal_hdl::model::gyro_interface::{Outputs, Probes, Registers};
+use gyrocal_hdl::model::gyro_interface::{CarrierProfile, Outputs, Probes, Registers};
 
 #[repr(C)]
 struct CRegisters {
@@ -76,7 +76,13 @@ impl Drop for VerilatorEngine {
 }
 
 impl Engine for VerilatorEngine {
-    fn power_up() -> Result<Self, String> {
+    fn power_up(profile: CarrierProfile) -> Result<Self, String> {
+        if profile != CarrierProfile::Table {
+            return Err(format!(
+                "[drive] carrier_profile = \"{profile}\": the verilator engine builds the table core \
+                 (verilog-out/gyro_interface.v) only; use the model or rtl engine"
+            ));
+        }
         // SAFETY: plain constructor; null means allocation failed.
         let model = unsafe { gyrocal_verilator_new() };
         if model.is_null() {

@@ -33,6 +33,11 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         if args.check {
             stale.push(path.display().to_string());
         } else {
+            if let Some(parent) = path.parent() {
+                std::fs::create_dir_all(parent).map_err(|e| {
+                    Failure::Run(format!("cannot create {}: {e}", parent.display()))
+                })?;
+            }
             gyrocal_verify::write_atomically(&path, &text)
                 .map_err(|e| Failure::Run(format!("cannot write {}: {e}", path.display())))?;
             println!("wrote {}", path.display());

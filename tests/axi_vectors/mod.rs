@@ -8,6 +8,7 @@
 use gyrocal_hdl::host::model::{BusInputs, BusOutputs, GyroInterfaceAxi};
 use gyrocal_hdl::host::register_map;
 use gyrocal_hdl::host::traffic::{Bias, traffic};
+use gyrocal_hdl::model::gyro_interface::CarrierProfile;
 use gyrocal_hdl::settings::{FrequencyPlan, registers};
 use std::path::Path;
 
@@ -75,7 +76,7 @@ fn output_line(o: &BusOutputs) -> String {
 
 /// Line n: the inputs of cycle n | the outputs before edge n + 1 (line 0:
 /// power-up outputs), as the model computes them.
-pub fn golden_vectors() -> String {
+pub fn golden_vectors(profile: CarrierProfile) -> String {
     let inputs = traffic(
         0x00a1_0b05,
         Bias {
@@ -85,7 +86,7 @@ pub fn golden_vectors() -> String {
         },
         REPLAY_CYCLES,
     );
-    let mut model = GyroInterfaceAxi::new();
+    let mut model = GyroInterfaceAxi::with_profile(profile);
     let mut text = String::new();
     let mut before = model.outputs();
     for i in &inputs {
@@ -96,9 +97,12 @@ pub fn golden_vectors() -> String {
 }
 
 /// Write [`program`] and [`golden_vectors`] into `dir`: (program file, vectors file).
-pub fn write_inputs(dir: &Path) -> (std::path::PathBuf, std::path::PathBuf) {
+pub fn write_inputs(
+    dir: &Path,
+    profile: CarrierProfile,
+) -> (std::path::PathBuf, std::path::PathBuf) {
     let (program_file, vectors_file) = (dir.join("program.txt"), dir.join("vectors.txt"));
     std::fs::write(&program_file, program()).unwrap();
-    std::fs::write(&vectors_file, golden_vectors()).unwrap();
+    std::fs::write(&vectors_file, golden_vectors(profile)).unwrap();
     (program_file, vectors_file)
 }

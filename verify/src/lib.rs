@@ -133,6 +133,12 @@ pub fn committed_verilog() -> PathBuf {
     verilog_out_dir().join(gyrocal_hdl::export::VERILOG_FILE)
 }
 
+/// The committed export of the fine-carrier (ECP5) core,
+/// `verilog-out/ecp5/gyro_interface.v`.
+pub fn committed_fine_verilog() -> PathBuf {
+    verilog_out_dir().join(gyrocal_hdl::export::FINE_VERILOG_FILE)
+}
+
 /// The committed Verilator waiver file, `verilog-out/lint-waivers.vlt`.
 pub fn committed_waivers() -> PathBuf {
     verilog_out_dir().join(lint::WAIVER_FILE)
@@ -146,6 +152,11 @@ pub fn committed_axi_verilog() -> PathBuf {
 /// The committed waivers of the bus wrapper, `verilog-out/lint-waivers-axi.vlt`.
 pub fn committed_axi_waivers() -> PathBuf {
     verilog_out_dir().join(lint::AXI_WAIVER_FILE)
+}
+
+/// The fine-carrier core's own waivers, `verilog-out/ecp5/lint-waivers.vlt`.
+pub fn committed_fine_waivers() -> PathBuf {
+    verilog_out_dir().join(lint::FINE_WAIVER_FILE)
 }
 
 /// The committed resource report, `verilog-out/RESOURCES.md`.

@@ -33,6 +33,9 @@ pub const WAIVER_FILE: &str = "lint-waivers.vlt";
 /// File name of the bus wrapper's own waivers inside `verilog-out/`, read
 /// after [`WAIVER_FILE`] when linting `gyro_interface_axi.v`.
 pub const AXI_WAIVER_FILE: &str = "lint-waivers-axi.vlt";
+/// The fine-carrier (ECP5) core's own waivers inside `verilog-out/`, read
+/// after [`WAIVER_FILE`] when linting `ecp5/gyro_interface.v`.
+pub const FINE_WAIVER_FILE: &str = "ecp5/lint-waivers.vlt";
 
 /// One Verilator warning.
 #[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]

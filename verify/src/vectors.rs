@@ -48,6 +48,7 @@
 
 use gyrocal_hdl::export::{PORTS, Port, PortDirection};
 use gyrocal_hdl::filter_design;
+use gyrocal_hdl::model::gyro_interface::CarrierProfile;
 use gyrocal_hdl::model::gyro_interface::{Outputs, Registers};
 use gyrocal_hdl::rtl::RtlGyroInterface;
 
@@ -116,9 +117,19 @@ pub fn golden_vectors(seed: u64) -> GoldenVectors {
     record(&stimulus(seed))
 }
 
+/// The standard vectors for `seed` on the core with this carrier profile.
+pub fn golden_vectors_for(profile: CarrierProfile, seed: u64) -> GoldenVectors {
+    record_with(profile, &stimulus(seed))
+}
+
 /// Run `stimulus` through rust-hdl's simulation of the design, from power-up.
 pub fn record(stimulus: &Stimulus) -> GoldenVectors {
-    let mut rtl = RtlGyroInterface::new();
+    record_with(CarrierProfile::Table, stimulus)
+}
+
+/// [`record`] on the core with this carrier profile.
+pub fn record_with(profile: CarrierProfile, stimulus: &Stimulus) -> GoldenVectors {
+    let mut rtl = RtlGyroInterface::with_profile(profile);
     let power_up = rtl.outputs();
     let cycles = stimulus
         .inputs

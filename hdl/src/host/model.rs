@@ -11,7 +11,7 @@ use super::register_map::{
 };
 use super::sample_fifo::FIFO_DEPTH;
 use super::{OKAY, SLVERR, Z_BITS};
-use crate::model::gyro_interface::{GyroInterface, Outputs};
+use crate::model::gyro_interface::{CarrierProfile, GyroInterface, Outputs};
 use std::collections::VecDeque;
 
 /// The input ports of `gyro_interface_axi` during one cycle.
@@ -231,8 +231,13 @@ fn response(result: bool) -> u8 {
 impl GyroInterfaceAxi {
     /// The bus top at power-up.
     pub fn new() -> Self {
+        Self::with_profile(CarrierProfile::Table)
+    }
+
+    /// The bus top around the core with this carrier profile, at power-up.
+    pub fn with_profile(profile: CarrierProfile) -> Self {
         Self {
-            core: GyroInterface::new(),
+            core: GyroInterface::with_profile(profile),
             bus: Wrapper::power_up(),
             fifo: Fifo::default(),
         }

@@ -8,11 +8,17 @@
 //! wrote them elsewhere, shows as a carrier mismatch. The model tracks only the fill's
 //! progress (`fill_request` for the modulation NCO, and when the lookups
 //! go live).
+//!
+//! With `CarrierProfile::Fine` it models `crate::fine_carrier_nco` instead:
+//! the sines are `super::sine_pair`'s, nothing is filled (no request to the
+//! modulation NCO), and the outputs go live at the same cycle.
 
 use super::sine::sine;
+use super::sine_pair::sine_pair;
 use crate::carrier_table_fill::{FILL_CLOCKS, REQUESTS, rom_entry_phase};
 use crate::quarter_wave::TABLE_ENTRIES;
 use crate::table_sine::LATENCY;
+use gyrocal_regs::datapath::CarrierProfile;
 use std::sync::OnceLock;
 
 /// The carriers' quarter-wave table: entry i is the sine at the centre of
@@ -69,21 +75,28 @@ pub struct CarrierNco {
     pipe: [Carriers; LATENCY],
     head: usize,
     table: &'static Table,
+    profile: CarrierProfile,
 }
 
 impl Default for CarrierNco {
     fn default() -> Self {
+        Self::new(CarrierProfile::Table)
+    }
+}
+
+impl CarrierNco {
+    /// The carrier NCO of the core with this profile, at power-up.
+    pub fn new(profile: CarrierProfile) -> Self {
         Self {
             phase: 0,
             count: 0,
             pipe: [Carriers::default(); LATENCY],
             head: 0,
             table: table(),
+            profile,
         }
     }
-}
 
-impl CarrierNco {
     /// The outputs during the current cycle.
     #[inline(always)]
     pub fn output(&self) -> Carriers {
@@ -95,7 +108,8 @@ impl CarrierNco {
     #[inline(always)]
     pub fn fill_request(&self) -> Option<u32> {
         let count = self.count as usize;
-        (count < REQUESTS).then(|| rom_entry_phase(count as i32 / 2 - 1))
+        (self.profile == CarrierProfile::Table && count < REQUESTS)
+            .then(|| rom_entry_phase(count as i32 / 2 - 1))
     }
 
     /// One clock with the given step and reference offset; outputs after the edge.
@@ -103,13 +117,27 @@ impl CarrierNco {
     pub fn step(&mut self, step: u32, ref_offset: u32) -> Carriers {
         let live = self.count as usize == FILL_CLOCKS;
         self.pipe[self.head] = if live {
-            let t = self.table;
             let reference = self.phase.wrapping_add(ref_offset);
-            Carriers {
-                drive_cos: table_sine(t, self.phase, 1),
-                drive_sin: table_sine(t, self.phase, 0),
-                ref_cos: table_sine(t, reference, 1),
-                ref_sin: table_sine(t, reference, 0),
+            match self.profile {
+                CarrierProfile::Table => {
+                    let t = self.table;
+                    Carriers {
+                        drive_cos: table_sine(t, self.phase, 1),
+                        drive_sin: table_sine(t, self.phase, 0),
+                        ref_cos: table_sine(t, reference, 1),
+                        ref_sin: table_sine(t, reference, 0),
+                    }
+                }
+                CarrierProfile::Fine => {
+                    let ((drive_cos, drive_sin), (ref_cos, ref_sin)) =
+                        (sine_pair(self.phase), sine_pair(reference));
+                    Carriers {
+                        drive_cos,
+                        drive_sin,
+                        ref_cos,
+                        ref_sin,
+                    }
+                }
             }
         } else {
             self.count += 1;

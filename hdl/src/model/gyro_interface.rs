@@ -9,6 +9,7 @@ use super::iir_lowpass::IirLowpass;
 use super::modulation_nco::ModulationNco;
 use super::reference_alignment::ReferenceAlignment;
 pub use gyrocal_regs::Registers;
+pub use gyrocal_regs::datapath::CarrierProfile;
 
 /// The output ports of `GyroInterface` during one cycle.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -49,9 +50,17 @@ pub struct GyroInterface {
 }
 
 impl GyroInterface {
-    /// The datapath at its power-up state.
+    /// The datapath at its power-up state (the table core).
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// The datapath of the core with this carrier profile, at power-up.
+    pub fn with_profile(profile: CarrierProfile) -> Self {
+        Self {
+            carrier_nco: CarrierNco::new(profile),
+            ..Self::default()
+        }
     }
 
     /// The output ports during the current cycle.
@@ -115,21 +124,54 @@ mod tests {
     #[test]
     fn the_drives_leave_zero_at_drive_start_clocks() {
         // Readout at full envelope: the DAC words are 0 while the carrier
-        // tables fill, and not during cycle DRIVE_START_CLOCKS.
+        // tables fill (or, on the fine core, for as long), and not during
+        // cycle DRIVE_START_CLOCKS.
         let regs = Registers {
             carrier_step: 0x1234_5679,
             amp: (20000, -20000),
             ..Default::default()
         };
-        let mut m = GyroInterface::new();
-        // `step` returns the outputs of the next cycle.
-        for cycle in 1..DRIVE_START_CLOCKS {
-            assert_eq!(m.step((0, 0), &regs).dac, (0, 0), "cycle {cycle}");
+        for profile in CarrierProfile::ALL {
+            let mut m = GyroInterface::with_profile(profile);
+            // `step` returns the outputs of the next cycle.
+            for cycle in 1..DRIVE_START_CLOCKS {
+                assert_eq!(
+                    m.step((0, 0), &regs).dac,
+                    (0, 0),
+                    "{profile}, cycle {cycle}"
+                );
+            }
+            let first = m.step((0, 0), &regs).dac;
+            assert!(
+                first.0 != 0 && first.1 != 0,
+                "{profile}, cycle {DRIVE_START_CLOCKS}: {first:?}"
+            );
         }
-        let first = m.step((0, 0), &regs).dac;
-        assert!(
-            first.0 != 0 && first.1 != 0,
-            "cycle {DRIVE_START_CLOCKS}: {first:?}"
-        );
+    }
+
+    #[test]
+    fn the_profiles_differ_only_in_the_carriers() {
+        // Same settings, same ADC words: the two cores' carriers differ by
+        // at most 4.2 + 1.02 LSB (their error bounds), which an envelope of
+        // 20000 / 32767 scales to 3.2 LSB; with the two products' roundings
+        // (0.5 each) the DAC words differ by at most 4. They do differ, and
+        // nothing else in the datapath sees the profile.
+        let regs = Registers {
+            carrier_step: 0x1234_5679,
+            amp: (20000, -20000),
+            ..Default::default()
+        };
+        let mut table = GyroInterface::with_profile(CarrierProfile::Table);
+        let mut fine = GyroInterface::with_profile(CarrierProfile::Fine);
+        let mut differ = 0;
+        for _ in 0..DRIVE_START_CLOCKS + 5000 {
+            let (a, b) = (table.step((0, 0), &regs).dac, fine.step((0, 0), &regs).dac);
+            assert!(
+                (a.0 - b.0).abs() <= 4 && (a.1 - b.1).abs() <= 4,
+                "{a:?} {b:?}"
+            );
+            differ += usize::from(a != b);
+        }
+        assert!(differ > 100, "the fine carriers never differed: {differ}");
     }
 }

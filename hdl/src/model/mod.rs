@@ -18,3 +18,4 @@ pub mod q15_multiplier;
 pub mod quarter_wave;
 pub mod reference_alignment;
 pub mod sine;
+pub mod sine_pair;

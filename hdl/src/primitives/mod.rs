@@ -6,6 +6,7 @@
 
 pub mod convert;
 mod digit_ram;
+mod fine_sine_rom;
 mod microcode_rom;
 pub mod pipelined_multiplier;
 mod quarter_sine_rom;
@@ -15,6 +16,7 @@ mod tapped_delay_line;
 mod word_ram;
 
 pub use digit_ram::DigitRam;
+pub use fine_sine_rom::FineSineRom;
 pub use microcode_rom::MicrocodeRom;
 pub use pipelined_multiplier::PipelinedMultiplier;
 pub use quarter_sine_rom::QuarterSineRom;

@@ -22,7 +22,7 @@ use crate::frontend::{Converters, FrontEnd, PickoffPhase};
 use crate::gyro::GyroModel;
 use crate::noise::ThermalNoise;
 use gyrocal_hdl::host::clip_counter::{ClipCount, clip_word};
-use gyrocal_hdl::model::gyro_interface::Outputs;
+use gyrocal_hdl::model::gyro_interface::{CarrierProfile, Outputs};
 pub use gyrocal_host::board::{Board, ZSample};
 use gyrocal_regs::map::{ADC_CLIP, BusError, RegisterAccess};
 
@@ -52,6 +52,7 @@ impl<E: Engine> SimBoard<E> {
         noise: &ThermalNoise,
         clock_hz: f64,
         phase_reference_hz: f64,
+        profile: CarrierProfile,
     ) -> Result<Self, String> {
         let mut fe = front_end.clone();
         for k in 0..2 {
@@ -65,7 +66,7 @@ impl<E: Engine> SimBoard<E> {
             Some(PickoffPhase::new(p, phase_reference_hz)?)
         };
         Ok(Self {
-            engine: E::power_up()?,
+            engine: E::power_up(profile)?,
             converters: Converters::new(&fe)?,
             gyro: GyroModel::new(&at.gyro, clock_hz)?.with_thermal_noise(noise)?,
             phase,

@@ -439,7 +439,14 @@ pub fn board_on<E: Engine>(
     at: &DeviceAt,
 ) -> Result<SimBoard<E>, String> {
     let reference = 0.5 * (exp.gyro.f1_hz + exp.gyro.f2_hz);
-    let mut board = SimBoard::new(at, fe, &exp.noise, exp.drive.clock_hz, reference)?;
+    let mut board = SimBoard::new(
+        at,
+        fe,
+        &exp.noise,
+        exp.drive.clock_hz,
+        reference,
+        exp.drive.carrier_profile,
+    )?;
     // As a host does: wait until the core has filled its carrier tables
     // (GYRO_DRIVE_START_CLOCKS in the C header) before using it.
     board
