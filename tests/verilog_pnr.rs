@@ -31,8 +31,9 @@ fn reports() -> &'static [PnrReport] {
     REPORTS
         .get_or_init(|| {
             let t = Instant::now();
-            let core = resources::pnr_core(&verify::verilog_out_dir());
-            let r = pnr::place_and_route_all(&core, &pnr::PARTS).map_err(|e| e.to_string());
+            let out = verify::verilog_out_dir();
+            let r = pnr::place_and_route_all(&|p| resources::pnr_core(&out, p), &pnr::PARTS)
+                .map_err(|e| e.to_string());
             for x in r.iter().flatten() {
                 eprintln!(
                     "{}: fits {}, Fmax {:?} MHz; synthesis {:.1?}, place and route {:.1?}",

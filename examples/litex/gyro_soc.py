@@ -38,7 +38,8 @@ from liteeth.phy.ecp5rgmii import LiteEthPHYRGMII
 from pmod_converters import PmodAD1DA2
 
 REPO = Path(__file__).resolve().parents[2]
-CORE_VERILOG = REPO / "verilog-out" / "gyro_interface_axi.v"
+# The ECP5 core: the fine carriers (interpolated sines from an initialized ROM).
+CORE_VERILOG = REPO / "verilog-out" / "ecp5" / "gyro_interface_axi.v"
 
 # Where the register map sits in the Etherbone (Wishbone byte) address space:
 # GYRO_BASE + GYRO_<NAME>_OFFSET. 256 bytes: the core's 8-bit byte address.

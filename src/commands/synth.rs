@@ -47,7 +47,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         .collect::<Result<Vec<_>, _>>()?;
     if !parts.is_empty() {
         eprintln!("placing and routing {} (minutes)", verilog.display());
-        let reports = pnr::place_and_route_all(&pnr_core(&args.out), &parts)
+        let reports = pnr::place_and_route_all(&|p| pnr_core(&args.out, p), &parts)
             .map_err(|e| Failure::Run(e.to_string()))?;
         print_pnr(&reports);
         return Ok(());

@@ -225,6 +225,17 @@ pub enum Outcome {
     DoesNotFit(String),
 }
 
+/// `path`'s file name, with its folder unless that is `verilog-out`.
+fn short_path(path: &Path) -> String {
+    let name = path
+        .file_name()
+        .map_or(String::new(), |n| n.to_string_lossy().into_owned());
+    match path.parent().and_then(|p| p.file_name()) {
+        Some(dir) if dir != "verilog-out" => format!("{}/{name}", dir.to_string_lossy()),
+        _ => name,
+    }
+}
+
 /// One part's place-and-route result.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PnrReport {
@@ -232,6 +243,9 @@ pub struct PnrReport {
     pub part: Part,
     /// The core's module name.
     pub core_module: String,
+    /// The core's Verilog files, by file name and the folder above it
+    /// (`ecp5/gyro_interface_axi.v`).
+    pub core_files: Vec<String>,
     /// The synthesis tool's version line.
     pub yosys_version: String,
     /// nextpnr's version line.
@@ -496,6 +510,7 @@ pub fn place_and_route(core: &Core, part: &Part) -> Result<PnrReport, VerifyErro
     Ok(PnrReport {
         part: *part,
         core_module: core.module.clone(),
+        core_files: core.verilog.iter().map(|f| short_path(f)).collect(),
         yosys_version,
         nextpnr_version,
         uses,
@@ -508,11 +523,14 @@ pub fn place_and_route(core: &Core, part: &Part) -> Result<PnrReport, VerifyErro
 }
 
 /// [`place_and_route`] on every part of `parts`, in parallel threads.
-pub fn place_and_route_all(core: &Core, parts: &[Part]) -> Result<Vec<PnrReport>, VerifyError> {
+pub fn place_and_route_all(
+    core_for: &(dyn Fn(&Part) -> Core + Sync),
+    parts: &[Part],
+) -> Result<Vec<PnrReport>, VerifyError> {
     std::thread::scope(|s| {
         let handles: Vec<_> = parts
             .iter()
-            .map(|p| s.spawn(move || place_and_route(core, p)))
+            .map(|p| s.spawn(move || place_and_route(&core_for(p), p)))
             .collect();
         handles
             .into_iter()

@@ -6,7 +6,9 @@
 //! (the file starts with it), `tests/verilog_pnr.rs` the second (the file
 //! ends with it).
 
-use crate::pnr::{Outcome, PARTS, PnrReport, SEED, nextpnr_args, place_and_route_all};
+use crate::pnr::{
+    Family, Outcome, PARTS, Part, PnrReport, SEED, nextpnr_args, place_and_route_all,
+};
 use crate::synthesis::{RESOURCES_FILE, SynthesisReport, resources_markdown, synthesize_all};
 use crate::targets;
 use crate::wrapper::Core;
@@ -15,12 +17,19 @@ use crate::{VerifyError, io_error};
 use std::fmt::Write as _;
 use std::path::Path;
 
-/// The core that `RESOURCES.md` places and routes, from the exported files
-/// in `verilog_out`: the bus-attached top `gyro_interface_axi`, which is
-/// what a user drops in and what the targets of issue 8 apply to (the
-/// Yosys section above still counts the bare `gyro_interface`).
-pub fn pnr_core(verilog_out: &Path) -> Core {
-    Core::gyro_interface_axi(verilog_out.join(gyrocal_hdl::export::AXI_VERILOG_FILE))
+/// The core that `RESOURCES.md` places and routes on `part`, from the
+/// exported files in `verilog_out`: the bus-attached top
+/// `gyro_interface_axi`, which is what a user drops in and what the targets
+/// of issue 8 apply to (the Yosys section above still counts the bare
+/// `gyro_interface`). An iCE40 gets the table core; an ECP5 the
+/// fine-carrier core of `ecp5/` (`CarrierProfile::Fine`), which needs
+/// block RAM with contents and multipliers the iCE40 UltraPlus lacks.
+pub fn pnr_core(verilog_out: &Path, part: &Part) -> Core {
+    let file = match part.family {
+        Family::Ice40 => gyrocal_hdl::export::AXI_VERILOG_FILE,
+        Family::Ecp5 => gyrocal_hdl::export::FINE_AXI_VERILOG_FILE,
+    };
+    Core::gyro_interface_axi(verilog_out.join(file))
 }
 
 /// Synthesize (Yosys's counts) and place and route ([`pnr_core`] on
@@ -30,11 +39,10 @@ pub fn pnr_core(verilog_out: &Path) -> Core {
 pub fn write_resources(
     verilog_out: &Path,
 ) -> Result<(Vec<SynthesisReport>, Vec<PnrReport>), VerifyError> {
-    let core = pnr_core(verilog_out);
     let verilog = verilog_out.join(gyrocal_hdl::export::VERILOG_FILE);
     let (yosys, pnr) = std::thread::scope(|s| {
         let yosys = s.spawn(|| synthesize_all(&verilog));
-        let pnr = place_and_route_all(&core, &PARTS);
+        let pnr = place_and_route_all(&|p| pnr_core(verilog_out, p), &PARTS);
         (yosys.join().expect("synthesis thread panicked"), pnr)
     });
     let (yosys, pnr) = (yosys?, pnr?);
@@ -72,7 +80,9 @@ pub fn pnr_section(reports: &[PnrReport]) -> String {
          registered LUT, into the pin `{FOLD_PIN}`, and `{CLOCK_PIN}` is the clock. Nothing can be\n\
          optimized away and every timed path runs from register to register. The counts\n\
          include the wrapper's {ffs} flip-flops and {luts} fold LUTs. Seed {SEED} on every part,\n\
-         `--timing-allow-fail` (a missed frequency is reported, not an error). Written by\n\
+         `--timing-allow-fail` (a missed frequency is reported, not an error). The iCE40 runs\n\
+         the table core (`gyro_interface_axi.v`), the ECP5 the fine-carrier core\n\
+         (`ecp5/gyro_interface_axi.v`, same ports and registers). Written by\n\
          `gyrocal synth`; the test `tests/verilog_pnr.rs` re-runs the flow and fails when\n\
          this section differs.\n\n"
     );
@@ -119,7 +129,9 @@ fn part_details(md: &mut String, r: &PnrReport) {
         .collect();
     let _ = write!(
         md,
-        "\n- Tools: {}; {}.\n- Synthesis: `{}`.\n- Place and route: `{} {}`.\n- Pins: {}.\n",
+        "\n- Core: `{}` in `{}`.\n- Tools: {}; {}.\n- Synthesis: `{}`.\n- Place and route: `{} {}`.\n- Pins: {}.\n",
+        r.core_module,
+        r.core_files.join("`, `"),
         r.yosys_version,
         r.nextpnr_version,
         r.part.synth_command(),

@@ -114,6 +114,7 @@ mod tests {
         PnrReport {
             part: ECP5_25F,
             core_module: "gyro_interface".into(),
+            core_files: vec!["gyro_interface.v".into()],
             yosys_version: "Yosys 0.70".into(),
             nextpnr_version: "nextpnr-0.11.1".into(),
             uses: vec![
