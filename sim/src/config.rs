@@ -839,6 +839,26 @@ mod tests {
     }
 
     #[test]
+    fn the_carrier_profile_defaults_to_the_table_round_trips_and_names_a_bad_value() {
+        let e = parse("c.toml", REQUIRED).unwrap();
+        assert_eq!(e.drive.carrier_profile, CarrierProfile::Table);
+        assert!(!toml::to_string(&e).unwrap().contains("carrier_profile"));
+        let fine = REQUIRED.replace("[drive]\n", "[drive]\ncarrier_profile = \"fine\"\n");
+        let e = parse("c.toml", &fine).unwrap();
+        assert_eq!(e.drive.carrier_profile, CarrierProfile::Fine);
+        assert_eq!(parse("c.toml", &toml::to_string(&e).unwrap()).unwrap(), e);
+        let bad = REQUIRED.replace("[drive]\n", "[drive]\ncarrier_profile = \"ecp5\"\n");
+        let err = parse("c.toml", &bad).unwrap_err();
+        assert!(!err.contains('\n'), "{err}");
+        assert!(
+            err.contains("\"ecp5\"")
+                && err.contains("allowed \"table\"")
+                && err.contains("\"fine\""),
+            "{err}"
+        );
+    }
+
+    #[test]
     fn a_missing_required_key_is_named() {
         let text = REQUIRED.replace("carrier_hz = 1.0123e6\n", "");
         let err = parse("c.toml", &text).unwrap_err();
