@@ -23,7 +23,7 @@
 //! Widths: outputs 16-bit, peak 32767. Phase during cycle n: the sum of
 //! the steps presented during cycles 0..n-1; outputs during cycle n belong
 //! to the phase of cycle n - 5 (`crate::sine_pair::LATENCY`). Resources:
-//! two `SinePair`s (18 ECP5 `DP16KD`, 4 `MULT18X18D`), 32 + 14 flip-flops
+//! two `SinePair`s (16 ECP5 `DP16KD`, 4 `MULT18X18D`), 32 + 14 flip-flops
 //! of phase and count.
 
 use crate::carrier_table_fill::FILL_CLOCKS;

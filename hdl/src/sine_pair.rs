@@ -24,8 +24,9 @@
 //! complement in [-32767, 32767] (`sum` bits 25:10). Gain: peak 32767.
 //! Error against `32767 sin(2 pi phase / 2^32)`: at most 1.02 LSB (the
 //! model's tests). Pipeline: 5 registers, as `crate::table_sine`, so the
-//! carriers keep their latency. Resources: one `FineSineRom` (nine ECP5
-//! `DP16KD`), two 18 x 18 multipliers (`MULT18X18D`), some 150 flip-flops.
+//! carriers keep their latency. Resources: one `FineSineRom` (eight ECP5
+//! `DP16KD`), two 18 x 18 multipliers (`MULT18X18D`), about 290 flip-flops
+//! of which the products' 72 sit in the multipliers' output registers.
 
 use crate::fine_sine_table::{SUBINTERVALS, TABLE_BITS, slope};
 use crate::primitives::convert::signed_bit_cast_exact;
@@ -69,20 +70,20 @@ pub struct SinePair {
     cos_quadrant: Signal<Local, Bits<2>>,
     quarter_turn: Constant<Bits<2>>,
     live_4: DFF<Bit>,
-    slope_01: Signal<Local, Signed<18>>,
-    slope_23: Signal<Local, Signed<18>>,
-    slope_45: Signal<Local, Signed<18>>,
-    slope_67: Signal<Local, Signed<18>>,
-    slope_0123: Signal<Local, Signed<18>>,
-    slope_4567: Signal<Local, Signed<18>>,
-    slope_0: Constant<Signed<18>>,
-    slope_1: Constant<Signed<18>>,
-    slope_2: Constant<Signed<18>>,
-    slope_3_: Constant<Signed<18>>,
-    slope_4: Constant<Signed<18>>,
-    slope_5: Constant<Signed<18>>,
-    slope_6: Constant<Signed<18>>,
-    slope_7: Constant<Signed<18>>,
+    slope_at_01: Signal<Local, Signed<18>>,
+    slope_at_23: Signal<Local, Signed<18>>,
+    slope_at_45: Signal<Local, Signed<18>>,
+    slope_at_67: Signal<Local, Signed<18>>,
+    slope_at_0123: Signal<Local, Signed<18>>,
+    slope_at_4567: Signal<Local, Signed<18>>,
+    slope_at_0: Constant<Signed<18>>,
+    slope_at_1: Constant<Signed<18>>,
+    slope_at_2: Constant<Signed<18>>,
+    slope_at_3: Constant<Signed<18>>,
+    slope_at_4: Constant<Signed<18>>,
+    slope_at_5: Constant<Signed<18>>,
+    slope_at_6: Constant<Signed<18>>,
+    slope_at_7: Constant<Signed<18>>,
 }
 
 /// Stages 4 and 5 of one output: which of `s`, `c`, `-s`, `-c` it is, the
@@ -218,20 +219,20 @@ impl SinePair {
             cos_quadrant: Default::default(),
             quarter_turn: Constant::new(1.into()),
             live_4: Default::default(),
-            slope_01: Default::default(),
-            slope_23: Default::default(),
-            slope_45: Default::default(),
-            slope_67: Default::default(),
-            slope_0123: Default::default(),
-            slope_4567: Default::default(),
-            slope_0: slope_constant(0),
-            slope_1: slope_constant(1),
-            slope_2: slope_constant(2),
-            slope_3_: slope_constant(3),
-            slope_4: slope_constant(4),
-            slope_5: slope_constant(5),
-            slope_6: slope_constant(6),
-            slope_7: slope_constant(7),
+            slope_at_01: Default::default(),
+            slope_at_23: Default::default(),
+            slope_at_45: Default::default(),
+            slope_at_67: Default::default(),
+            slope_at_0123: Default::default(),
+            slope_at_4567: Default::default(),
+            slope_at_0: slope_constant(0),
+            slope_at_1: slope_constant(1),
+            slope_at_2: slope_constant(2),
+            slope_at_3: slope_constant(3),
+            slope_at_4: slope_constant(4),
+            slope_at_5: slope_constant(5),
+            slope_at_6: slope_constant(6),
+            slope_at_7: slope_constant(7),
         }
     }
 }
@@ -283,25 +284,25 @@ impl Logic for SinePair {
         // Stage 3: the words registered (a block RAM's clock-to-out), the slope.
         self.sine_word_3.d.next = self.rom.word_a.val();
         self.cosine_word_3.d.next = self.rom.word_b.val();
-        self.slope_01.next = self.slope_0.val();
-        self.slope_23.next = self.slope_2.val();
-        self.slope_45.next = self.slope_4.val();
-        self.slope_67.next = self.slope_6.val();
+        self.slope_at_01.next = self.slope_at_0.val();
+        self.slope_at_23.next = self.slope_at_2.val();
+        self.slope_at_45.next = self.slope_at_4.val();
+        self.slope_at_67.next = self.slope_at_6.val();
         if self.sub_2.q.val().get_bit(0) {
-            self.slope_01.next = self.slope_1.val();
-            self.slope_23.next = self.slope_3_.val();
-            self.slope_45.next = self.slope_5.val();
-            self.slope_67.next = self.slope_7.val();
+            self.slope_at_01.next = self.slope_at_1.val();
+            self.slope_at_23.next = self.slope_at_3.val();
+            self.slope_at_45.next = self.slope_at_5.val();
+            self.slope_at_67.next = self.slope_at_7.val();
         }
-        self.slope_0123.next = self.slope_01.val();
-        self.slope_4567.next = self.slope_45.val();
+        self.slope_at_0123.next = self.slope_at_01.val();
+        self.slope_at_4567.next = self.slope_at_45.val();
         if self.sub_2.q.val().get_bit(1) {
-            self.slope_0123.next = self.slope_23.val();
-            self.slope_4567.next = self.slope_67.val();
+            self.slope_at_0123.next = self.slope_at_23.val();
+            self.slope_at_4567.next = self.slope_at_67.val();
         }
-        self.slope_3.d.next = self.slope_0123.val();
+        self.slope_3.d.next = self.slope_at_0123.val();
         if self.sub_2.q.val().get_bit(2) {
-            self.slope_3.d.next = self.slope_4567.val();
+            self.slope_3.d.next = self.slope_at_4567.val();
         }
         self.quadrant_3.d.next = self.quadrant_2.q.val();
         self.live_3.d.next = self.live_2.q.val();

@@ -2719,14 +2719,14 @@ module gyro_interface_axi__core__carrier_nco__drive(clock,phase,live,cos,sin);
 
     // Constant declarations
     localparam  quarter_turn = 2'b1;
-    localparam signed slope_0 = 18'b101010000000100100;
-    localparam signed slope_1 = 18'b110000010010101100;
-    localparam signed slope_2 = 18'b110110100100110100;
-    localparam signed slope_3_ = 18'b111100110110111100;
-    localparam signed slope_4 = 18'b11001001000100;
-    localparam signed slope_5 = 18'b1001011011001100;
-    localparam signed slope_6 = 18'b1111101101010100;
-    localparam signed slope_7 = 18'b10101111111011100;
+    localparam signed slope_at_0 = 18'b101010000000100100;
+    localparam signed slope_at_1 = 18'b110000010010101100;
+    localparam signed slope_at_2 = 18'b110110100100110100;
+    localparam signed slope_at_3 = 18'b111100110110111100;
+    localparam signed slope_at_4 = 18'b11001001000100;
+    localparam signed slope_at_5 = 18'b1001011011001100;
+    localparam signed slope_at_6 = 18'b1111101101010100;
+    localparam signed slope_at_7 = 18'b10101111111011100;
 
     // Stub signals
     reg  rom$clock;
@@ -2803,12 +2803,12 @@ module gyro_interface_axi__core__carrier_nco__drive(clock,phase,live,cos,sin);
 
     // Local signals
     reg  [1:0] cos_quadrant;
-    reg signed [17:0] slope_01;
-    reg signed [17:0] slope_23;
-    reg signed [17:0] slope_45;
-    reg signed [17:0] slope_67;
-    reg signed [17:0] slope_0123;
-    reg signed [17:0] slope_4567;
+    reg signed [17:0] slope_at_01;
+    reg signed [17:0] slope_at_23;
+    reg signed [17:0] slope_at_45;
+    reg signed [17:0] slope_at_67;
+    reg signed [17:0] slope_at_0123;
+    reg signed [17:0] slope_at_4567;
 
     // Sub module instances
     gyro_interface_axi__core__carrier_nco__drive__rom rom(
@@ -2968,25 +2968,25 @@ module gyro_interface_axi__core__carrier_nco__drive(clock,phase,live,cos,sin);
         live_2$d = live_1$q;
         sine_word_3$d = rom$word_a;
         cosine_word_3$d = rom$word_b;
-        slope_01 = slope_0;
-        slope_23 = slope_2;
-        slope_45 = slope_4;
-        slope_67 = slope_6;
+        slope_at_01 = slope_at_0;
+        slope_at_23 = slope_at_2;
+        slope_at_45 = slope_at_4;
+        slope_at_67 = slope_at_6;
         if (sub_2$q[32'h0]) begin
-            slope_01 = slope_1;
-            slope_23 = slope_3_;
-            slope_45 = slope_5;
-            slope_67 = slope_7;
+            slope_at_01 = slope_at_1;
+            slope_at_23 = slope_at_3;
+            slope_at_45 = slope_at_5;
+            slope_at_67 = slope_at_7;
         end
-        slope_0123 = slope_01;
-        slope_4567 = slope_45;
+        slope_at_0123 = slope_at_01;
+        slope_at_4567 = slope_at_45;
         if (sub_2$q[32'h1]) begin
-            slope_0123 = slope_23;
-            slope_4567 = slope_67;
+            slope_at_0123 = slope_at_23;
+            slope_at_4567 = slope_at_67;
         end
-        slope_3$d = slope_0123;
+        slope_3$d = slope_at_0123;
         if (sub_2$q[32'h2]) begin
-            slope_3$d = slope_4567;
+            slope_3$d = slope_at_4567;
         end
         quadrant_3$d = quadrant_2$q;
         live_3$d = live_2$q;
@@ -11922,14 +11922,14 @@ module gyro_interface_axi__core__carrier_nco__reference(clock,phase,live,cos,sin
 
     // Constant declarations
     localparam  quarter_turn = 2'b1;
-    localparam signed slope_0 = 18'b101010000000100100;
-    localparam signed slope_1 = 18'b110000010010101100;
-    localparam signed slope_2 = 18'b110110100100110100;
-    localparam signed slope_3_ = 18'b111100110110111100;
-    localparam signed slope_4 = 18'b11001001000100;
-    localparam signed slope_5 = 18'b1001011011001100;
-    localparam signed slope_6 = 18'b1111101101010100;
-    localparam signed slope_7 = 18'b10101111111011100;
+    localparam signed slope_at_0 = 18'b101010000000100100;
+    localparam signed slope_at_1 = 18'b110000010010101100;
+    localparam signed slope_at_2 = 18'b110110100100110100;
+    localparam signed slope_at_3 = 18'b111100110110111100;
+    localparam signed slope_at_4 = 18'b11001001000100;
+    localparam signed slope_at_5 = 18'b1001011011001100;
+    localparam signed slope_at_6 = 18'b1111101101010100;
+    localparam signed slope_at_7 = 18'b10101111111011100;
 
     // Stub signals
     reg  rom$clock;
@@ -12006,12 +12006,12 @@ module gyro_interface_axi__core__carrier_nco__reference(clock,phase,live,cos,sin
 
     // Local signals
     reg  [1:0] cos_quadrant;
-    reg signed [17:0] slope_01;
-    reg signed [17:0] slope_23;
-    reg signed [17:0] slope_45;
-    reg signed [17:0] slope_67;
-    reg signed [17:0] slope_0123;
-    reg signed [17:0] slope_4567;
+    reg signed [17:0] slope_at_01;
+    reg signed [17:0] slope_at_23;
+    reg signed [17:0] slope_at_45;
+    reg signed [17:0] slope_at_67;
+    reg signed [17:0] slope_at_0123;
+    reg signed [17:0] slope_at_4567;
 
     // Sub module instances
     gyro_interface_axi__core__carrier_nco__reference__rom rom(
@@ -12171,25 +12171,25 @@ module gyro_interface_axi__core__carrier_nco__reference(clock,phase,live,cos,sin
         live_2$d = live_1$q;
         sine_word_3$d = rom$word_a;
         cosine_word_3$d = rom$word_b;
-        slope_01 = slope_0;
-        slope_23 = slope_2;
-        slope_45 = slope_4;
-        slope_67 = slope_6;
+        slope_at_01 = slope_at_0;
+        slope_at_23 = slope_at_2;
+        slope_at_45 = slope_at_4;
+        slope_at_67 = slope_at_6;
         if (sub_2$q[32'h0]) begin
-            slope_01 = slope_1;
-            slope_23 = slope_3_;
-            slope_45 = slope_5;
-            slope_67 = slope_7;
+            slope_at_01 = slope_at_1;
+            slope_at_23 = slope_at_3;
+            slope_at_45 = slope_at_5;
+            slope_at_67 = slope_at_7;
         end
-        slope_0123 = slope_01;
-        slope_4567 = slope_45;
+        slope_at_0123 = slope_at_01;
+        slope_at_4567 = slope_at_45;
         if (sub_2$q[32'h1]) begin
-            slope_0123 = slope_23;
-            slope_4567 = slope_67;
+            slope_at_0123 = slope_at_23;
+            slope_at_4567 = slope_at_67;
         end
-        slope_3$d = slope_0123;
+        slope_3$d = slope_at_0123;
         if (sub_2$q[32'h2]) begin
-            slope_3$d = slope_4567;
+            slope_3$d = slope_at_4567;
         end
         quadrant_3$d = quadrant_2$q;
         live_3$d = live_2$q;

@@ -9,8 +9,8 @@
 //! `crate::sine_pair` reads an interval's sine (`addr_a = i`) and its
 //! cosine (`addr_b = ~i`) at once. The Verilog is one memory with an
 //! `initial` image and two registered reads, which Yosys maps to block RAM
-//! used as a true dual-port ROM: 8192 x 17 bits is nine ECP5 `DP16KD` (in
-//! 8K x 2 mode). An iCE40 UltraPlus cannot hold it (its SPRAMs have no
+//! used as a true dual-port ROM: 8192 x 17 bits is eight ECP5 `DP16KD`
+//! of 1K x 18, as placed (`verilog-out/RESOURCES.md`). An iCE40 UltraPlus cannot hold it (its SPRAMs have no
 //! initial contents, and 139 kbit is more than its 30 `SB_RAM40_4K`):
 //! this ROM belongs to the ECP5 carrier profile only. The read registers
 //! power up at 0, so the block simulates from time zero without X.
