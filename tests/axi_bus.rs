@@ -73,11 +73,9 @@ fn run_cocotb(simulator: &str, profile: CarrierProfile) {
     let python = python();
     let dir = tempfile::tempdir().unwrap();
     let (program_file, vectors_file) = axi_vectors::write_inputs(dir.path(), profile);
-    let file = match profile {
-        CarrierProfile::Table => export::AXI_VERILOG_FILE,
-        CarrierProfile::Fine => export::FINE_AXI_VERILOG_FILE,
-    };
-    let verilog = root().join("verilog-out").join(file);
+    let verilog = root()
+        .join("verilog-out")
+        .join(export::axi_verilog_file(profile));
     let out = Command::new(&python)
         .arg(root().join("tests/axi/run.py"))
         .arg(simulator)

@@ -32,23 +32,28 @@ fn golden() -> &'static GoldenVectors {
     })
 }
 
-/// The committed export, after checking that it is what the design exports
-/// now (the vectors come from the current design).
+/// The committed export of the core with this carrier profile, after
+/// checking that it is what the design exports now (the vectors come from
+/// the current design).
+fn committed(profile: CarrierProfile) -> Result<PathBuf, String> {
+    let path = verify::verilog_out_dir().join(gyrocal_hdl::export::verilog_file(profile));
+    let committed =
+        std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    if committed != gyrocal_hdl::export::verilog_for(profile) {
+        return Err(format!(
+            "{} is not what the design exports now: regenerate it (`cargo run --release -- export`) \
+             before replaying",
+            path.display()
+        ));
+    }
+    Ok(path)
+}
+
+/// The committed table-core export, checked once per test process.
 fn committed_verilog() -> PathBuf {
     static CHECKED: OnceLock<Result<PathBuf, String>> = OnceLock::new();
     CHECKED
-        .get_or_init(|| {
-            let path = verify::committed_verilog();
-            let committed = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
-            if committed != gyrocal_hdl::export::verilog() {
-                return Err(format!(
-                    "{} is not what the design exports now: regenerate it (`cargo run --release -- export`) \
-                     before replaying",
-                    path.display()
-                ));
-            }
-            Ok(path)
-        })
+        .get_or_init(|| committed(CarrierProfile::Table))
         .clone()
         .unwrap_or_else(|e| panic!("{e}"))
 }
@@ -57,19 +62,6 @@ fn committed_verilog() -> PathBuf {
 fn fine_golden() -> &'static GoldenVectors {
     static VECTORS: OnceLock<GoldenVectors> = OnceLock::new();
     VECTORS.get_or_init(|| vectors::golden_vectors_for(CarrierProfile::Fine, vectors::DEFAULT_SEED))
-}
-
-/// The committed fine-carrier export, checked as [`committed_verilog`].
-fn committed_fine_verilog() -> PathBuf {
-    let path = verify::committed_fine_verilog();
-    let committed =
-        std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    assert!(
-        committed == gyrocal_hdl::export::fine_verilog(),
-        "{} is not what the design exports now: regenerate it (`cargo run --release -- export`)",
-        path.display()
-    );
-    path
 }
 
 fn require_icarus() {
@@ -174,7 +166,7 @@ fn the_fine_core_replays_in_icarus_and_verilator() {
     require_icarus();
     require_verilator();
     let v = fine_golden();
-    let verilog = committed_fine_verilog();
+    let verilog = committed(CarrierProfile::Fine).unwrap_or_else(|e| panic!("{e}"));
     expect_pass(&compile(Simulator::Icarus, &verilog), v);
     let tb = compile(Simulator::Verilator, &verilog);
     expect_pass(&tb, v);

@@ -8,6 +8,7 @@
 //! a test fails when the committed files differ from what this code writes.
 
 use crate::gyro_interface::GyroInterface;
+use gyrocal_regs::datapath::CarrierProfile;
 use regex::Regex;
 use rust_hdl::prelude::{Block, generate_verilog};
 
@@ -28,6 +29,33 @@ pub const AXI_VERILOG_FILE: &str = "gyro_interface_axi.v";
 /// The bus-attached top around the fine-carrier core inside `verilog-out/`:
 /// module `gyro_interface_axi`, as [`AXI_VERILOG_FILE`], for ECP5 and larger parts.
 pub const FINE_AXI_VERILOG_FILE: &str = "ecp5/gyro_interface_axi.v";
+/// The core's Verilog inside `verilog-out/` for a carrier profile:
+/// [`VERILOG_FILE`] or [`FINE_VERILOG_FILE`].
+pub fn verilog_file(profile: CarrierProfile) -> &'static str {
+    match profile {
+        CarrierProfile::Table => VERILOG_FILE,
+        CarrierProfile::Fine => FINE_VERILOG_FILE,
+    }
+}
+
+/// The bus top's Verilog inside `verilog-out/` for a carrier profile:
+/// [`AXI_VERILOG_FILE`] or [`FINE_AXI_VERILOG_FILE`].
+pub fn axi_verilog_file(profile: CarrierProfile) -> &'static str {
+    match profile {
+        CarrierProfile::Table => AXI_VERILOG_FILE,
+        CarrierProfile::Fine => FINE_AXI_VERILOG_FILE,
+    }
+}
+
+/// The exported Verilog of the core with this carrier profile:
+/// [`verilog`] or [`fine_verilog`].
+pub fn verilog_for(profile: CarrierProfile) -> String {
+    match profile {
+        CarrierProfile::Table => verilog(),
+        CarrierProfile::Fine => fine_verilog(),
+    }
+}
+
 /// File name of the register map inside `verilog-out/`.
 pub const REGISTERS_FILE: &str = "REGISTERS.md";
 /// File name of the register map's C header inside `verilog-out/`.

@@ -136,7 +136,9 @@ pub fn committed_verilog() -> PathBuf {
 /// The committed export of the fine-carrier (ECP5) core,
 /// `verilog-out/ecp5/gyro_interface.v`.
 pub fn committed_fine_verilog() -> PathBuf {
-    verilog_out_dir().join(gyrocal_hdl::export::FINE_VERILOG_FILE)
+    verilog_out_dir().join(gyrocal_hdl::export::verilog_file(
+        gyrocal_hdl::model::gyro_interface::CarrierProfile::Fine,
+    ))
 }
 
 /// The committed Verilator waiver file, `verilog-out/lint-waivers.vlt`.

@@ -14,6 +14,7 @@ use crate::targets;
 use crate::wrapper::Core;
 use crate::wrapper::{CLOCK_PIN, FOLD_FAN_IN, FOLD_PIN, SETTINGS_PIN, WRAPPER_MODULE};
 use crate::{VerifyError, io_error};
+use gyrocal_hdl::model::gyro_interface::CarrierProfile;
 use std::fmt::Write as _;
 use std::path::Path;
 
@@ -25,11 +26,11 @@ use std::path::Path;
 /// fine-carrier core of `ecp5/` (`CarrierProfile::Fine`), which needs
 /// block RAM with contents and multipliers the iCE40 UltraPlus lacks.
 pub fn pnr_core(verilog_out: &Path, part: &Part) -> Core {
-    let file = match part.family {
-        Family::Ice40 => gyrocal_hdl::export::AXI_VERILOG_FILE,
-        Family::Ecp5 => gyrocal_hdl::export::FINE_AXI_VERILOG_FILE,
+    let profile = match part.family {
+        Family::Ice40 => CarrierProfile::Table,
+        Family::Ecp5 => CarrierProfile::Fine,
     };
-    Core::gyro_interface_axi(verilog_out.join(file))
+    Core::gyro_interface_axi(verilog_out.join(gyrocal_hdl::export::axi_verilog_file(profile)))
 }
 
 /// Synthesize (Yosys's counts) and place and route ([`pnr_core`] on
