@@ -25,9 +25,18 @@
 //! interpolated to first order (`+ delta * d_phase * cos`, the cosine
 //! word of the same table), one rounding to the integer output at the
 //! end; `exact` rounds `32767 sin` of the whole 32-bit phase.
+//!
+//! The last rows are the DAC words themselves, F x carrier as the cores'
+//! mixers make them at the default envelope F = 0.9 (29490), scaled back by
+//! 32768 / F: the table core rounds its 16-bit carrier and then the
+//! product (`gyrocal_hdl::am_mixer::AmMixer`), the fine core rounds the
+//! pair's quarter-LSB carrier times F once (`FineAmMixer`). A second
+//! rounding at the carrier rate is a slow error of its own at a fold.
 
+use gyrocal_hdl::model::am_mixer::carrier_product;
 use gyrocal_hdl::model::carrier_nco::{table, table_sine};
 use gyrocal_hdl::model::sine_pair::sine_pair;
+use gyrocal_regs::datapath::CarrierProfile;
 use std::f64::consts::TAU;
 
 /// The averaging block (s): a 500 Hz output's time scale.
@@ -46,6 +55,8 @@ enum Profile {
         fraction: i32,
     },
     Exact,
+    /// The DAC word at envelope `F` of a core, scaled back by 32768 / F.
+    Dac(CarrierProfile, i16),
 }
 
 impl Profile {
@@ -61,13 +72,22 @@ impl Profile {
                 format!("{bits}/{interpolated}/{fraction}")
             }
             Profile::Exact => "exact (32-bit phase)".into(),
+            Profile::Dac(core, f) => format!("{core} core, DAC word at F = {f}"),
         }
     }
 
     fn sine(self, phase: u32) -> f64 {
         match self {
             Profile::Built => f64::from(table_sine(table(), phase, 0)),
-            Profile::Pair => f64::from(sine_pair(phase).1),
+            // The pair's output is in quarter LSB.
+            Profile::Pair => f64::from(sine_pair(phase).1) / 4.0,
+            Profile::Dac(core, f) => {
+                let carrier = match core {
+                    CarrierProfile::Table => i32::from(table_sine(table(), phase, 0)),
+                    CarrierProfile::Fine => sine_pair(phase).1,
+                };
+                f64::from(carrier_product(core, f, carrier)) * 32768.0 / f64::from(f)
+            }
             Profile::Exact => (32767.0 * (f64::from(phase) / 2f64.powi(32) * TAU).sin()).round(),
             Profile::Table {
                 bits,
@@ -161,6 +181,8 @@ fn main() {
         table(15, 3, 3),
         Profile::Pair,
         Profile::Exact,
+        Profile::Dac(CarrierProfile::Table, 29490),
+        Profile::Dac(CarrierProfile::Fine, 29490),
     ];
     for p in profiles {
         println!("{:>28}  {:.4}", p.name(), slow_error(p, step, clock_hz));

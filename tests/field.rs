@@ -498,16 +498,20 @@ fn a_carrier_on_a_static_fold_moves_off_it() {
 /// The ECP5 core's carriers (`[drive] carrier_profile = "fine"`) on the
 /// paper device at 25 and 30 deg C, beside the table core's. At 30 deg C
 /// the carrier lies 18.2 Hz from a fold of period 83 that the host cannot
-/// leave; the table's words and phase rounding come back as a slow error
-/// of 0.0336 LSB there, the fine pair's as 0.0073
-/// (`examples/carrier_profiles.rs`). So output 1's excess over the floor
-/// (the moved 25 deg C step; excess = sqrt(rms^2 - floor^2), the ripple
-/// adding in quadrature to the noise) must shrink to well under half, and
-/// its RMS come within twice the floor, the goal of docs/field.md. Output 2
-/// keeps a second source that exact carriers leave too (0.074 deg/s with
-/// an exact sine, docs/field.md), so it must only improve.
+/// leave. On the table core the carriers' words and phase rounding, and
+/// the mixer's second rounding of F x carrier, come back as a slow error
+/// of the DAC words of 0.042 LSB there; on the fine core, whose mixer
+/// rounds F times the quarter-LSB pair once, 0.0076
+/// (`examples/carrier_profiles.rs`, the DAC rows). So each output's
+/// excess over its floor (the moved 25 deg C step; excess = sqrt(rms^2 -
+/// floor^2), the ripple adding in quadrature to the noise) must shrink to
+/// under half of the table core's, and both outputs' RMS come within
+/// twice the floor: issue 20's goal. Measured: excess ratios 0.13 and
+/// 0.14, 1.11 and 1.42 times the floor; with the pair rounded to whole LSB
+/// before the mixer (a second rounding) output 2 was 3.9 times, which this
+/// test fails.
 #[test]
-fn the_fine_carriers_remove_most_of_the_30_deg_c_ripple() {
+fn the_fine_core_keeps_the_30_deg_c_rate_within_twice_its_floor() {
     use gyrocal_hdl::model::gyro_interface::CarrierProfile;
     let path = "tests/data/field_paper.toml";
     let text = std::fs::read_to_string(path).unwrap();
@@ -532,14 +536,14 @@ fn the_fine_carriers_remove_most_of_the_30_deg_c_ripple() {
         (r[k].powi(2) - floor[k].powi(2)).max(0.0).sqrt()
     };
     let (table, fine) = (rms[0], rms[1]);
-    let ratio = excess(fine, 0) / excess(table, 0);
-    eprintln!("output 1 excess, fine over table: {ratio:.2}");
-    assert!(ratio < 0.5, "output 1 excess ratio {ratio:.2}");
-    assert!(fine.1[0] <= 2.0 * fine.0[0], "output 1: {:?}", fine);
-    assert!(
-        fine.1[1] < table.1[1],
-        "output 2: fine {:?}, table {:?}",
-        fine,
-        table
-    );
+    for k in 0..2 {
+        let ratio = excess(fine, k) / excess(table, k);
+        let floors = fine.1[k] / fine.0[k];
+        eprintln!(
+            "output {}: excess, fine over table {ratio:.2}; fine at 30 deg C {floors:.2} times its floor",
+            k + 1
+        );
+        assert!(ratio < 0.5, "output {} excess ratio {ratio:.2}", k + 1);
+        assert!(floors <= 2.0, "output {}: {fine:?}", k + 1);
+    }
 }

@@ -36,7 +36,19 @@
 //! clocks (product, hold, product, and a clock's wait when the other
 //! channel has the multiplier), the same for drives and references.
 //! Resources: 5 16x16 multipliers.
+//!
+//! Two mixers share this file (`am_mixer!` below). `AmMixer`, the table
+//! core's, is the above. `FineAmMixer`, the fine core's, takes the carriers
+//! of `crate::sine_pair` in quarter LSB (18 bits, peak 4 x 32767) and its
+//! four carrier products are `CarrierMultiplier`s: dac1 = round(round(F1
+//! A1 / 2^15) cos4 / 2^17), the carrier never rounded to an integer on its
+//! own. Same ports otherwise, same latencies; 1 16x16 and 4 16x18
+//! multipliers. Why: a second rounding at the carrier rate has a pattern
+//! that a fold of the clock turns into a slow error of drive and reference
+//! (docs/field.md, "One rounding").
 
+use crate::carrier_multiplier::CarrierMultiplier;
+use crate::fine_sine_table::OUTPUT_BITS;
 use crate::q15_multiplier::Q15Multiplier;
 use rust_hdl::prelude::*;
 
@@ -49,121 +61,148 @@ pub const AMPLITUDE_LATENCY: usize = 2 * crate::q15_multiplier::LATENCY + 2;
 /// The `turn` during which the envelope product of channel 1 leaves the
 /// multiplier: it entered on turn 0, `LATENCY` toggles earlier.
 const CHANNEL1_OUT_TURN: bool = crate::q15_multiplier::LATENCY % 2 == 1;
+// Both mixers' carrier products have the same latency.
+const _: () = assert!(crate::carrier_multiplier::LATENCY == crate::q15_multiplier::LATENCY);
 
-/// Two AM drive channels with reference copies.
-#[derive(LogicBlock)]
-pub struct AmMixer {
-    /// The clock.
-    pub clock: Signal<In, Clock>,
-    /// Drive amplitude F1 of mode 1, Q1.15.
-    pub amp1: Signal<In, Signed<16>>,
-    /// Drive amplitude F2 of mode 2, Q1.15.
-    pub amp2: Signal<In, Signed<16>>,
-    /// Amplitude factor A1 from the modulation NCO.
-    pub am1: Signal<In, Signed<16>>,
-    /// Amplitude factor A2 from the modulation NCO.
-    pub am2: Signal<In, Signed<16>>,
-    /// In-phase drive carrier.
-    pub drive_cos: Signal<In, Signed<16>>,
-    /// Quadrature drive carrier.
-    pub drive_sin: Signal<In, Signed<16>>,
-    /// In-phase reference carrier.
-    pub ref_cos: Signal<In, Signed<16>>,
-    /// Quadrature reference carrier.
-    pub ref_sin: Signal<In, Signed<16>>,
-    /// DAC word of drive 1: F1 A1 cos.
-    pub dac1: Signal<Out, Signed<16>>,
-    /// DAC word of drive 2: F2 A2 sin.
-    pub dac2: Signal<Out, Signed<16>>,
-    /// Reference copy of drive 1, from the reference carrier.
-    pub ref1: Signal<Out, Signed<16>>,
-    /// Reference copy of drive 2, from the reference carrier.
-    pub ref2: Signal<Out, Signed<16>>,
-    envelope: Q15Multiplier,
-    turn: DFF<Bit>,
-    fa1: DFF<Signed<16>>,
-    fa2: DFF<Signed<16>>,
-    channel1_out_turn: Constant<Bit>,
-    drive1: Q15Multiplier,
-    drive2: Q15Multiplier,
-    reference1: Q15Multiplier,
-    reference2: Q15Multiplier,
-}
-
-impl AmMixer {
-    /// The two AM channels.
-    pub fn new() -> Self {
-        Self {
-            clock: Default::default(),
-            amp1: Default::default(),
-            amp2: Default::default(),
-            am1: Default::default(),
-            am2: Default::default(),
-            drive_cos: Default::default(),
-            drive_sin: Default::default(),
-            ref_cos: Default::default(),
-            ref_sin: Default::default(),
-            dac1: Default::default(),
-            dac2: Default::default(),
-            ref1: Default::default(),
-            ref2: Default::default(),
-            envelope: Q15Multiplier::new(),
-            turn: Default::default(),
-            fa1: Default::default(),
-            fa2: Default::default(),
-            channel1_out_turn: Constant::new(CHANNEL1_OUT_TURN),
-            drive1: Q15Multiplier::new(),
-            drive2: Q15Multiplier::new(),
-            reference1: Q15Multiplier::new(),
-            reference2: Q15Multiplier::new(),
+/// Declares a pair of AM channels whose carrier products are `$product`
+/// (ports `a`, `b`, `y`, latency `q15_multiplier::LATENCY`) on carriers of
+/// `$carrier_bits`: the struct, its constructor and its wiring, written
+/// once for both cores.
+macro_rules! am_mixer {
+    ($(#[$meta:meta])* $name:ident, $product:ident, $carrier_bits:tt) => {
+        $(#[$meta])*
+        #[derive(LogicBlock)]
+        pub struct $name {
+            /// The clock.
+            pub clock: Signal<In, Clock>,
+            /// Drive amplitude F1 of mode 1, Q1.15.
+            pub amp1: Signal<In, Signed<16>>,
+            /// Drive amplitude F2 of mode 2, Q1.15.
+            pub amp2: Signal<In, Signed<16>>,
+            /// Amplitude factor A1 from the modulation NCO.
+            pub am1: Signal<In, Signed<16>>,
+            /// Amplitude factor A2 from the modulation NCO.
+            pub am2: Signal<In, Signed<16>>,
+            /// In-phase drive carrier.
+            pub drive_cos: Signal<In, Signed<$carrier_bits>>,
+            /// Quadrature drive carrier.
+            pub drive_sin: Signal<In, Signed<$carrier_bits>>,
+            /// In-phase reference carrier.
+            pub ref_cos: Signal<In, Signed<$carrier_bits>>,
+            /// Quadrature reference carrier.
+            pub ref_sin: Signal<In, Signed<$carrier_bits>>,
+            /// DAC word of drive 1: F1 A1 cos.
+            pub dac1: Signal<Out, Signed<16>>,
+            /// DAC word of drive 2: F2 A2 sin.
+            pub dac2: Signal<Out, Signed<16>>,
+            /// Reference copy of drive 1, from the reference carrier.
+            pub ref1: Signal<Out, Signed<16>>,
+            /// Reference copy of drive 2, from the reference carrier.
+            pub ref2: Signal<Out, Signed<16>>,
+            envelope: Q15Multiplier,
+            turn: DFF<Bit>,
+            fa1: DFF<Signed<16>>,
+            fa2: DFF<Signed<16>>,
+            channel1_out_turn: Constant<Bit>,
+            drive1: $product,
+            drive2: $product,
+            reference1: $product,
+            reference2: $product,
         }
-    }
-}
 
-impl Default for AmMixer {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl Logic for AmMixer {
-    #[hdl_gen]
-    fn update(&mut self) {
-        dff_setup!(self, clock, turn, fa1, fa2);
-        self.envelope.clock.next = self.clock.val();
-        self.drive1.clock.next = self.clock.val();
-        self.drive2.clock.next = self.clock.val();
-        self.reference1.clock.next = self.clock.val();
-        self.reference2.clock.next = self.clock.val();
-        // One envelope multiplier, channel 1 on turn 0, channel 2 on turn 1.
-        self.turn.d.next = !self.turn.q.val();
-        self.envelope.a.next = self.amp1.val();
-        self.envelope.b.next = self.am1.val();
-        if self.turn.q.val() {
-            self.envelope.a.next = self.amp2.val();
-            self.envelope.b.next = self.am2.val();
+        impl $name {
+            /// The two AM channels.
+            pub fn new() -> Self {
+                Self {
+                    clock: Default::default(),
+                    amp1: Default::default(),
+                    amp2: Default::default(),
+                    am1: Default::default(),
+                    am2: Default::default(),
+                    drive_cos: Default::default(),
+                    drive_sin: Default::default(),
+                    ref_cos: Default::default(),
+                    ref_sin: Default::default(),
+                    dac1: Default::default(),
+                    dac2: Default::default(),
+                    ref1: Default::default(),
+                    ref2: Default::default(),
+                    envelope: Q15Multiplier::new(),
+                    turn: Default::default(),
+                    fa1: Default::default(),
+                    fa2: Default::default(),
+                    channel1_out_turn: Constant::new(CHANNEL1_OUT_TURN),
+                    drive1: $product::new(),
+                    drive2: $product::new(),
+                    reference1: $product::new(),
+                    reference2: $product::new(),
+                }
+            }
         }
-        if self.turn.q.val() == self.channel1_out_turn.val() {
-            self.fa1.d.next = self.envelope.y.val();
-        } else {
-            self.fa2.d.next = self.envelope.y.val();
+
+        impl Default for $name {
+            fn default() -> Self {
+                Self::new()
+            }
         }
-        self.drive1.a.next = self.fa1.q.val();
-        self.drive1.b.next = self.drive_cos.val();
-        self.drive2.a.next = self.fa2.q.val();
-        self.drive2.b.next = self.drive_sin.val();
-        self.reference1.a.next = self.fa1.q.val();
-        self.reference1.b.next = self.ref_cos.val();
-        self.reference2.a.next = self.fa2.q.val();
-        self.reference2.b.next = self.ref_sin.val();
-        self.dac1.next = self.drive1.y.val();
-        self.dac2.next = self.drive2.y.val();
-        self.ref1.next = self.reference1.y.val();
-        self.ref2.next = self.reference2.y.val();
-    }
+
+        impl Logic for $name {
+            #[hdl_gen]
+            fn update(&mut self) {
+                dff_setup!(self, clock, turn, fa1, fa2);
+                self.envelope.clock.next = self.clock.val();
+                self.drive1.clock.next = self.clock.val();
+                self.drive2.clock.next = self.clock.val();
+                self.reference1.clock.next = self.clock.val();
+                self.reference2.clock.next = self.clock.val();
+                // One envelope multiplier, channel 1 on turn 0, channel 2 on turn 1.
+                self.turn.d.next = !self.turn.q.val();
+                self.envelope.a.next = self.amp1.val();
+                self.envelope.b.next = self.am1.val();
+                if self.turn.q.val() {
+                    self.envelope.a.next = self.amp2.val();
+                    self.envelope.b.next = self.am2.val();
+                }
+                if self.turn.q.val() == self.channel1_out_turn.val() {
+                    self.fa1.d.next = self.envelope.y.val();
+                } else {
+                    self.fa2.d.next = self.envelope.y.val();
+                }
+                self.drive1.a.next = self.fa1.q.val();
+                self.drive1.b.next = self.drive_cos.val();
+                self.drive2.a.next = self.fa2.q.val();
+                self.drive2.b.next = self.drive_sin.val();
+                self.reference1.a.next = self.fa1.q.val();
+                self.reference1.b.next = self.ref_cos.val();
+                self.reference2.a.next = self.fa2.q.val();
+                self.reference2.b.next = self.ref_sin.val();
+                self.dac1.next = self.drive1.y.val();
+                self.dac2.next = self.drive2.y.val();
+                self.ref1.next = self.reference1.y.val();
+                self.ref2.next = self.reference2.y.val();
+            }
+        }
+
+        crate::impl_clocked!($name);
+    };
 }
 
-crate::impl_clocked!(AmMixer);
+am_mixer!(
+    /// Two AM drive channels with reference copies: the table core's,
+    /// 16-bit carriers (`Q15Multiplier`, two roundings).
+    AmMixer,
+    Q15Multiplier,
+    16
+);
+
+am_mixer!(
+    /// Two AM drive channels with reference copies: the fine core's,
+    /// quarter-LSB carriers of `crate::sine_pair` (`CarrierMultiplier`,
+    /// one rounding of F A x carrier).
+    FineAmMixer,
+    CarrierMultiplier,
+    OUTPUT_BITS
+);
 
 /// Mutation hooks for the negative control in `crate::rtl` (tests only).
 #[cfg(test)]
@@ -178,14 +217,18 @@ impl AmMixer {
 mod tests {
     use super::*;
     use crate::drive::{prepare, tick};
+    use crate::fine_sine_table::OUTPUT_PEAK;
     use crate::model::am_mixer::{AmMixer as Model, Drives};
     use crate::model::carrier_nco::Carriers;
     use crate::primitives::convert::{i128_to_signed, signed_to_i128};
     use crate::test_util::{sample16, word16};
+    use gyrocal_regs::datapath::CarrierProfile;
     use proptest::prelude::*;
 
-    fn carriers() -> impl Strategy<Value = Carriers> {
-        (sample16(), sample16(), sample16(), sample16()).prop_map(|(a, b, c, d)| Carriers {
+    /// Four carrier words within +-`peak`, its extremes and 0 included.
+    fn carriers(peak: i32) -> impl Strategy<Value = Carriers> {
+        let word = prop_oneof![Just(peak), Just(-peak), Just(0), -peak..=peak];
+        (word.clone(), word.clone(), word.clone(), word).prop_map(|(a, b, c, d)| Carriers {
             drive_cos: a,
             drive_sin: b,
             ref_cos: c,
@@ -193,62 +236,89 @@ mod tests {
         })
     }
 
-    proptest! {
-        #![proptest_config(ProptestConfig::with_cases(8))]
-        #[test]
-        fn rtl_matches_model_including_full_scale_words(
-            cycles in prop::collection::vec(((word16(), word16()), (sample16(), sample16()), carriers()), 400),
-        ) {
-            let mut uut = AmMixer::new();
-            prepare(&mut uut);
-            let mut model = Model::default();
-            for (n, &(amp, am, c)) in cycles.iter().enumerate() {
-                let s = |x: i16| i128_to_signed(x as i128);
-                uut.amp1.next = s(amp.0);
-                uut.amp2.next = s(amp.1);
-                uut.am1.next = s(am.0);
-                uut.am2.next = s(am.1);
-                uut.drive_cos.next = s(c.drive_cos);
-                uut.drive_sin.next = s(c.drive_sin);
-                uut.ref_cos.next = s(c.ref_cos);
-                uut.ref_sin.next = s(c.ref_sin);
-                tick(&mut uut);
-                let v = |x: Signed<16>| signed_to_i128(x) as i16;
-                let hw = Drives {
-                    dac1: v(uut.dac1.val()),
-                    dac2: v(uut.dac2.val()),
-                    ref1: v(uut.ref1.val()),
-                    ref2: v(uut.ref2.val()),
-                };
-                prop_assert_eq!(hw, model.step(amp, am, c), "cycle {}", n);
+    /// The RTL mixer `$mixer` against the model of `$profile`, cycle by
+    /// cycle, on random envelopes and carriers within +-`$peak`.
+    macro_rules! rtl_matches_model {
+        ($test:ident, $mixer:ident, $profile:expr, $peak:expr) => {
+            proptest! {
+                #![proptest_config(ProptestConfig::with_cases(8))]
+                #[test]
+                fn $test(
+                    cycles in prop::collection::vec(((word16(), word16()), (sample16(), sample16()), carriers($peak)), 400),
+                ) {
+                    let mut uut = $mixer::new();
+                    prepare(&mut uut);
+                    let mut model = Model::new($profile);
+                    for (n, &(amp, am, c)) in cycles.iter().enumerate() {
+                        let s = |x: i16| i128_to_signed(x as i128);
+                        let w = |x: i32| i128_to_signed(x as i128);
+                        uut.amp1.next = s(amp.0);
+                        uut.amp2.next = s(amp.1);
+                        uut.am1.next = s(am.0);
+                        uut.am2.next = s(am.1);
+                        uut.drive_cos.next = w(c.drive_cos);
+                        uut.drive_sin.next = w(c.drive_sin);
+                        uut.ref_cos.next = w(c.ref_cos);
+                        uut.ref_sin.next = w(c.ref_sin);
+                        tick(&mut uut);
+                        let v = |x: Signed<16>| signed_to_i128(x) as i16;
+                        let hw = Drives {
+                            dac1: v(uut.dac1.val()),
+                            dac2: v(uut.dac2.val()),
+                            ref1: v(uut.ref1.val()),
+                            ref2: v(uut.ref2.val()),
+                        };
+                        prop_assert_eq!(hw, model.step(amp, am, c), "cycle {}", n);
+                    }
+                }
             }
-        }
+        };
     }
+
+    rtl_matches_model!(
+        rtl_matches_model_including_full_scale_words,
+        AmMixer,
+        CarrierProfile::Table,
+        32767
+    );
+    rtl_matches_model!(
+        the_fine_mixer_matches_its_model_including_full_scale_words,
+        FineAmMixer,
+        CarrierProfile::Fine,
+        OUTPUT_PEAK
+    );
 
     #[test]
     fn every_register_value_gives_an_in_range_drive() {
-        // Drive word = round(round(F A / 2^15) c / 2^15) for all F (any
-        // 16-bit value) and A, c within +-32767 (the NCO outputs): sweep F
-        // over all 65536 values against the extreme A and c.
-        let mut model = Model::default();
-        let extremes = [-32767i16, -1, 0, 1, 32767];
-        for f in i16::MIN..=i16::MAX {
-            for &a in &extremes {
-                for &c in &[-32767i16, 32767] {
-                    let exact = |x: i64, y: i64| (x * y + (1 << 14)).div_euclid(1 << 15);
-                    let want = exact(exact(f as i64, a as i64), c as i64);
-                    assert!((-32767..=32767).contains(&want));
-                    let carriers = Carriers {
-                        drive_cos: c,
-                        drive_sin: c,
-                        ref_cos: c,
-                        ref_sin: c,
-                    };
-                    let mut out = Drives::default();
-                    for _ in 0..AMPLITUDE_LATENCY {
-                        out = model.step((f, f), (a, a), carriers);
+        // Drive word = round(round(F A / 2^15) c / 2^(15 + f)) for all F
+        // (any 16-bit value) and A within +-32767, c within +-32767 x 2^f
+        // (the NCO outputs; f = 0 on the table core, 2 on the fine one):
+        // sweep F over all 65536 values against the extreme A and c.
+        for profile in CarrierProfile::ALL {
+            let f = crate::model::am_mixer::carrier_fraction_bits(profile);
+            let peak = 32767i64 << f;
+            let mut model = Model::new(profile);
+            let extremes = [-32767i16, -1, 0, 1, 32767];
+            for f_word in i16::MIN..=i16::MAX {
+                for &a in &extremes {
+                    for c in [-peak, peak] {
+                        let exact =
+                            |x: i64, y: i64, s: u32| (x * y + (1 << (s - 1))).div_euclid(1 << s);
+                        let want = exact(exact(f_word.into(), a.into(), 15), c, 15 + f);
+                        assert!((-32767..=32767).contains(&want));
+                        let c = c as i32;
+                        let carriers = Carriers {
+                            drive_cos: c,
+                            drive_sin: c,
+                            ref_cos: c,
+                            ref_sin: c,
+                        };
+                        let mut out = Drives::default();
+                        for _ in 0..AMPLITUDE_LATENCY {
+                            out = model.step((f_word, f_word), (a, a), carriers);
+                        }
+                        assert_eq!(out.dac1 as i64, want, "{profile}: F {f_word} A {a} c {c}");
                     }
-                    assert_eq!(out.dac1 as i64, want, "F {f} A {a} c {c}");
                 }
             }
         }

@@ -213,7 +213,7 @@ mod tests {
                 }
                 tick(&mut uut);
                 source.advance(requested);
-                let v = |x: Signed<16>| signed_to_i128(x) as i16;
+                let v = |x: Signed<16>| signed_to_i128(x) as i32;
                 let hw = Carriers {
                     drive_cos: v(uut.drive_cos.val()),
                     drive_sin: v(uut.drive_sin.val()),

@@ -13,20 +13,22 @@
 //! `crate::carrier_nco::CarrierNco`, so that the core around it
 //! (`crate::gyro_interface`), the register map and the host are the same
 //! for both parts; only the sines differ (`crate::sine_pair`: error at most
-//! 1.02 LSB against 4.2; spurs 107 dBc down against 90, measured below;
-//! no slow error at a short fold of the clock). The
+//! 0.65 LSB against 4.2, in quarter LSB for `crate::am_mixer::FineAmMixer`
+//! to round once; spurs 107 dBc down against 90, measured below; no slow
+//! error at a short fold of the clock). The
 //! ROM needs no fill: `filling` stays low and `fill_phase` 0, and the
 //! modulation NCO keeps its sine generator. The outputs still wait for
 //! cycle `FILL_CLOCKS` (a 14-bit counter), so the DAC words leave 0 at
 //! `DRIVE_START_CLOCKS` on both cores. `fill_word` is unused.
 //!
-//! Widths: outputs 16-bit, peak 32767. Phase during cycle n: the sum of
+//! Widths: outputs 18-bit, quarter LSB, peak 4 x 32767. Phase during cycle n: the sum of
 //! the steps presented during cycles 0..n-1; outputs during cycle n belong
 //! to the phase of cycle n - 5 (`crate::sine_pair::LATENCY`). Resources:
 //! two `SinePair`s (16 ECP5 `DP16KD`, 4 `MULT18X18D`), 32 + 14 flip-flops
 //! of phase and count.
 
 use crate::carrier_table_fill::FILL_CLOCKS;
+use crate::fine_sine_table::OUTPUT_BITS;
 use crate::sine_pair::SinePair;
 use rust_hdl::prelude::*;
 
@@ -53,14 +55,14 @@ pub struct FineCarrierNco {
     pub filling: Signal<Out, Bit>,
     /// Always 0.
     pub fill_phase: Signal<Out, Bits<32>>,
-    /// 32767 cos(phase): in-phase drive carrier (mode 1).
-    pub drive_cos: Signal<Out, Signed<16>>,
-    /// 32767 sin(phase): quadrature drive carrier (mode 2).
-    pub drive_sin: Signal<Out, Signed<16>>,
+    /// 4 x 32767 cos(phase): in-phase drive carrier (mode 1).
+    pub drive_cos: Signal<Out, Signed<OUTPUT_BITS>>,
+    /// 4 x 32767 sin(phase): quadrature drive carrier (mode 2).
+    pub drive_sin: Signal<Out, Signed<OUTPUT_BITS>>,
     /// 32767 cos(phase + ref_offset).
-    pub ref_cos: Signal<Out, Signed<16>>,
+    pub ref_cos: Signal<Out, Signed<OUTPUT_BITS>>,
     /// 32767 sin(phase + ref_offset).
-    pub ref_sin: Signal<Out, Signed<16>>,
+    pub ref_sin: Signal<Out, Signed<OUTPUT_BITS>>,
     phase: DFF<Bits<32>>,
     count: DFF<Bits<COUNT_BITS>>,
     live: Signal<Local, Bit>,
@@ -154,7 +156,7 @@ mod tests {
             assert!(!uut.filling.val());
             assert_eq!(model.fill_request(), None);
             tick(&mut uut);
-            let v = |x: Signed<16>| signed_to_i128(x) as i16;
+            let v = |x: Signed<OUTPUT_BITS>| signed_to_i128(x) as i32;
             let hw = Carriers {
                 drive_cos: v(uut.drive_cos.val()),
                 drive_sin: v(uut.drive_sin.val()),
@@ -170,8 +172,10 @@ mod tests {
         // The table core's test (`crate::carrier_nco`) at the same
         // carriers: the phase truncated below 18 bits bounds the largest
         // spur near -6.02 x 18 + 3.9 = -104 dBc (Nicholas and Samueli),
-        // the 16-bit output's rounding spreads about -98 dBc of noise over
-        // the band; 95 dBc leaves room for the window's leakage.
+        // the 18-bit (quarter-LSB) output's rounding spreads about -110
+        // dBc of noise over the band; 95 dBc leaves room for the window's
+        // leakage. Measured 108.2 to 108.3 dBc (107.1 to 108.2 when the
+        // outputs were rounded to whole LSB).
         use crate::test_util::sfdr_dbc;
         for carrier_hz in [9.64e6, 9.640_125e6, 9.6513e6] {
             let step = (carrier_hz / 50e6 * 2f64.powi(32)).round() as u32;

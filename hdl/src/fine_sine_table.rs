@@ -13,9 +13,10 @@
 //! table phases, drifting slowly, and the words' rounding comes back as a
 //! slow error of the carrier's amplitude and phase: the rate ripple of
 //! docs/field.md. Words a quarter LSB fine, three phase bits interpolated
-//! and one rounding at the end make the output a function of 18 phase bits
-//! rounded once, and that error averages away
-//! (`examples/carrier_profiles.rs` measures it).
+//! and one rounding at the end, to a quarter LSB, make the output a
+//! function of 18 phase bits rounded once, and that error averages away
+//! (`examples/carrier_profiles.rs` measures it). The AM mixer multiplies
+//! the quarter-LSB output, so the DAC word is rounded only once.
 //!
 //! Widths: `word[i]` lies in [0, 131068] (17 unsigned bits; 4 x 32767 =
 //! 131068 < 2^17); `slope[s]` lies in [-90076, 90076] (18 signed bits). A
@@ -47,9 +48,20 @@ pub const SLOPE_FRACTION_BITS: u32 = 30;
 pub const SUM_GUARD_BITS: u32 = 8;
 /// The product's arithmetic right shift (floor) to the sum's scale.
 pub const PRODUCT_SHIFT: u32 = SLOPE_FRACTION_BITS - SUM_GUARD_BITS;
-/// Fraction bits of the sum below the output's LSB: the final rounding
-/// shifts by this many.
+/// Fraction bits of the sum below the word's unit (32767 at the peak).
 pub const SUM_FRACTION_BITS: u32 = WORD_FRACTION_BITS + SUM_GUARD_BITS;
+/// Fraction bits of an output word: the pair's outputs are four times the
+/// sine, 32767 x 4 at the peak, like the table words. The AM mixer
+/// (`crate::am_mixer::FineAmMixer`) rounds its product once, to the DAC's
+/// 16 bits; a carrier rounded to an integer first would add a second
+/// rounding, whose pattern a fold turns into a slow error (docs/field.md).
+pub const OUTPUT_FRACTION_BITS: u32 = 2;
+/// Output width (signed): |output| <= 4 x 32767 < 2^17.
+pub const OUTPUT_BITS: usize = 18;
+/// The final rounding's shift: `SUM_FRACTION_BITS - OUTPUT_FRACTION_BITS`.
+pub const OUTPUT_SHIFT: u32 = SUM_FRACTION_BITS - OUTPUT_FRACTION_BITS;
+/// An output word's peak, 4 x 32767.
+pub const OUTPUT_PEAK: i32 = crate::sine_table::PEAK << OUTPUT_FRACTION_BITS;
 
 const _: () = assert!(4 * 32767 < 1 << WORD_BITS);
 

@@ -38,9 +38,11 @@
 //! Two cores share this file (`datapath!` below): `GyroInterface`, the
 //! table core above, and `FineGyroInterface`, whose carrier NCO is
 //! `crate::fine_carrier_nco` (interpolated sines from an initialized ROM
-//! and four multipliers: an ECP5 or larger part). Their ports, registers,
-//! latencies and power-up timing are the same; only the carrier words differ
-//! (`gyrocal_regs::datapath::CarrierProfile`).
+//! and four multipliers: an ECP5 or larger part) and whose mixer is
+//! `crate::am_mixer::FineAmMixer` (the carriers in quarter LSB, one
+//! rounding to the DAC word). Their ports, registers, latencies and
+//! power-up timing are the same; only the carrier words and their product's
+//! rounding differ (`gyrocal_regs::datapath::CarrierProfile`).
 //!
 //! Latencies (clocks): carrier phase to DAC word 8 (the sum of
 //! `carrier_nco::LATENCY` and `am_mixer::CARRIER_LATENCY`), ADC word to
@@ -50,7 +52,7 @@
 //! DAC word 7 or 8 (`am_mixer::AMPLITUDE_LATENCY`, the shared envelope
 //! multiplier's turn).
 
-use crate::am_mixer::AmMixer;
+use crate::am_mixer::{AmMixer, FineAmMixer};
 
 /// Clocks from power-up until the DAC words can leave 0: the carrier table
 /// fill (`carrier_table_fill::FILL_CLOCKS`), the carrier lookup and the AM
@@ -69,11 +71,12 @@ use crate::modulation_nco::ModulationNco;
 use crate::reference_alignment::{DELAY_BITS, ReferenceAlignment};
 use rust_hdl::prelude::*;
 
-/// Declares a datapath top with the given carrier NCO: the struct, its
+/// Declares a datapath top with the given carrier NCO and mixer: the struct, its
 /// constructor, its wiring (`update`) and its probes, written once for
-/// both cores. The carrier NCOs have the same ports.
+/// both cores. The carrier NCOs have the same ports, and so have the
+/// mixers, but for the carriers' width (16 bits or 18 in quarter LSB).
 macro_rules! datapath {
-    ($(#[$meta:meta])* $name:ident, $carrier:ident) => {
+    ($(#[$meta:meta])* $name:ident, $carrier:ident, $mixer:ident) => {
         $(#[$meta])*
         #[derive(LogicBlock)]
         pub struct $name {
@@ -121,7 +124,7 @@ macro_rules! datapath {
             pub iir_alpha: Signal<In, Signed<32>>,
             carrier_nco: $carrier,
             modulation_nco: ModulationNco,
-            am_mixer: AmMixer,
+            am_mixer: $mixer,
             reference_alignment: ReferenceAlignment,
             demod_mux: DemodMux,
             cic: CicDecimator,
@@ -155,7 +158,7 @@ macro_rules! datapath {
                     iir_alpha: Default::default(),
                     carrier_nco: $carrier::new(),
                     modulation_nco: ModulationNco::new(),
-                    am_mixer: AmMixer::new(),
+                    am_mixer: $mixer::new(),
                     reference_alignment: ReferenceAlignment::new(),
                     demod_mux: DemodMux::new(),
                     cic: CicDecimator::new(),
@@ -254,7 +257,8 @@ datapath!(
     /// The reconfigurable phase-readout and self-calibration datapath: the
     /// table core (`crate::carrier_nco`), which fits an iCE40 UltraPlus.
     GyroInterface,
-    CarrierNco
+    CarrierNco,
+    AmMixer
 );
 
 datapath!(
@@ -262,7 +266,8 @@ datapath!(
     /// (`crate::fine_carrier_nco`): the ECP5 core. Ports, registers and
     /// latencies are `GyroInterface`'s; only the carrier sines differ.
     FineGyroInterface,
-    FineCarrierNco
+    FineCarrierNco,
+    FineAmMixer
 );
 
 /// One-constant changes to the hardware, for the negative control of the

@@ -1,6 +1,7 @@
 //! gyrocal-hdl: the synthesizable datapath of the gyrocal interface.
 
 pub mod am_mixer;
+pub mod carrier_multiplier;
 pub mod carrier_nco;
 pub mod carrier_table_fill;
 pub mod cic_decimator;

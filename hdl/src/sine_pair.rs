@@ -1,11 +1,12 @@
 //! Cosine and sine of one phase from the fine table: three phase bits
-//! interpolated, one multiplier per output, one rounding at the end. The
-//! ECP5 carrier profile (`crate::fine_sine_table` says why).
+//! interpolated, one multiplier per output, one rounding at the end, to a
+//! quarter LSB. The ECP5 carrier profile (`crate::fine_sine_table` says
+//! why).
 //!
 //! ```text
 //!  clock:   1 address          2 ROM read      3 words, slope     4 products, bases       5 output
 //!  phase[29:17] ─► [i, ~i] ─► FineSineRom ─► [a, b] ─┬─► b x k ─► [p_s] ─┐
-//!                                                   ├─► a x k ─► [p_c] ─┼─► base ± (p >> 22) ─► [>> 10] ─► sin, cos
+//!                                                   ├─► a x k ─► [p_c] ─┼─► base ± (p >> 22) ─► [>> 8] ─► sin, cos
 //!  phase[16:14] ─► [s] ──────► [s] ─► slope[s] ─► [k]     bases ─► [base] ┘
 //!  phase[31:30] ─► [q] ──────► [q] ──────────► [q] ─► (which word, sign) ─► [pick, add]
 //!  live ─────────► [live] ───► [live] ───────► [live] ─────────────────► [live] ─► (else 0)
@@ -13,22 +14,22 @@
 //!
 //! The arithmetic is `crate::model::sine_pair`'s, which its header derives:
 //! each output is `s`, `c`, `-s` or `-c` of the phase within its quadrant,
-//! `(base ± t) >> 10`, with `base = 256 w + 512` or `511 - 256 w` (`w` the
+//! `(base ± t) >> 8`, with `base = 256 w + 128` or `127 - 256 w` (`w` the
 //! output's own word) and `t` the other word times the slope, floored to
 //! 2^-8 quarter LSB. The sine output takes the quadrant `q`, the cosine
 //! `q + 1`.
 //!
 //! Widths: words 17 bits unsigned (18 signed at the multipliers), slopes
 //! 18 signed, products 36, `t` 14 signed (|t| <= 2815), sums 27 signed
-//! (|sum| < 256 x 131068 + 512 + 2815 < 2^25), outputs 16-bit two's
-//! complement in [-32767, 32767] (`sum` bits 25:10). Gain: peak 32767.
-//! Error against `32767 sin(2 pi phase / 2^32)`: at most 1.02 LSB (the
-//! model's tests). Pipeline: 5 registers, as `crate::table_sine`, so the
+//! (|sum| < 256 x 131068 + 128 + 2815 < 2^25), outputs 18-bit two's
+//! complement in [-131068, 131068] (`sum` bits 25:8, quarter LSB). Gain:
+//! peak 4 x 32767. Error against `32767 sin(2 pi phase / 2^32)`: at most
+//! 0.65 LSB (the model's tests). Pipeline: 5 registers, as `crate::table_sine`, so the
 //! carriers keep their latency. Resources: one `FineSineRom` (eight ECP5
 //! `DP16KD`), two 18 x 18 multipliers (`MULT18X18D`), about 290 flip-flops
 //! of which the products' 72 sit in the multipliers' output registers.
 
-use crate::fine_sine_table::{SUBINTERVALS, TABLE_BITS, slope};
+use crate::fine_sine_table::{OUTPUT_BITS, SUBINTERVALS, TABLE_BITS, slope};
 use crate::primitives::convert::signed_bit_cast_exact;
 use crate::primitives::{FineSineRom, RegisteredMultiplier};
 use rust_hdl::prelude::*;
@@ -45,10 +46,10 @@ pub struct SinePair {
     pub phase: Signal<In, Bits<32>>,
     /// The lookup started now reaches the outputs (else they give 0 for it).
     pub live: Signal<In, Bit>,
-    /// 32767 cos(phase), `LATENCY` clocks after `phase`.
-    pub cos: Signal<Out, Signed<16>>,
-    /// 32767 sin(phase), `LATENCY` clocks after `phase`.
-    pub sin: Signal<Out, Signed<16>>,
+    /// 4 x 32767 cos(phase) (quarter LSB), `LATENCY` clocks after `phase`.
+    pub cos: Signal<Out, Signed<OUTPUT_BITS>>,
+    /// 4 x 32767 sin(phase) (quarter LSB), `LATENCY` clocks after `phase`.
+    pub sin: Signal<Out, Signed<OUTPUT_BITS>>,
     rom: FineSineRom,
     quadrant_1: DFF<Bits<2>>,
     sub_1: DFF<Bits<3>>,
@@ -104,12 +105,12 @@ pub struct OutputPart {
     pub cosine_cross: Signal<In, Signed<36>>,
     /// The lookup is live (stage 4).
     pub live: Signal<In, Bit>,
-    /// The output (stage 5, registered).
-    pub value: Signal<Out, Signed<16>>,
+    /// The output in quarter LSB (stage 5, registered).
+    pub value: Signal<Out, Signed<OUTPUT_BITS>>,
     base_4: DFF<Signed<27>>,
     sine_type_4: DFF<Bit>,
     add_4: DFF<Bit>,
-    value_5: DFF<Signed<16>>,
+    value_5: DFF<Signed<OUTPUT_BITS>>,
     own: Signal<Local, Bits<27>>,
     scaled: Signal<Local, Signed<27>>,
     cross_bits: Signal<Local, Signed<14>>,
@@ -118,13 +119,13 @@ pub struct OutputPart {
     half: Constant<Signed<27>>,
     half_less_one: Constant<Signed<27>>,
     guard: Constant<Bits<27>>,
-    zero: Constant<Signed<16>>,
+    zero: Constant<Signed<OUTPUT_BITS>>,
 }
 
 impl OutputPart {
     fn new() -> Self {
-        use crate::fine_sine_table::{SUM_FRACTION_BITS, SUM_GUARD_BITS};
-        let half = 1i64 << (SUM_FRACTION_BITS - 1);
+        use crate::fine_sine_table::{OUTPUT_SHIFT, SUM_GUARD_BITS};
+        let half = 1i64 << (OUTPUT_SHIFT - 1);
         Self {
             clock: Default::default(),
             quadrant: Default::default(),
@@ -156,7 +157,7 @@ impl Logic for OutputPart {
     fn update(&mut self) {
         dff_setup!(self, clock, base_4, sine_type_4, add_4, value_5);
         // Stage 4: the output's own word, scaled to the sum (x 256), and
-        // the base: 256 w + 512, or its one's complement plus 512.
+        // the base: 256 w + 128, or its one's complement plus 128.
         // (The words are never negative: their low 17 bits zero-extended.)
         self.own.next = bit_cast::<27, 17>(unsigned_cast(self.cosine_word.val().get_bits::<17>(0)));
         if !self.quadrant.val().get_bit(0) {
@@ -171,7 +172,8 @@ impl Logic for OutputPart {
         self.sine_type_4.d.next = !self.quadrant.val().get_bit(0);
         self.add_4.d.next = (!self.quadrant.val().get_bit(0)) ^ self.quadrant.val().get_bit(1);
         // Stage 5: the cross term (the product floored to 2^-8 quarter
-        // LSB, bits 35:22) added or subtracted, the sum's bits 25:10 out.
+        // LSB, bits 35:22) added or subtracted, the sum's bits 25:8 out
+        // (`fine_sine_table::OUTPUT_SHIFT`).
         self.cross_bits.next = self.cosine_cross.val().get_bits::<14>(22);
         if self.sine_type_4.q.val() {
             self.cross_bits.next = self.sine_cross.val().get_bits::<14>(22);
@@ -183,7 +185,7 @@ impl Logic for OutputPart {
         }
         self.value_5.d.next = self.zero.val();
         if self.live.val() {
-            self.value_5.d.next = self.sum.val().get_bits::<16>(10);
+            self.value_5.d.next = self.sum.val().get_bits::<OUTPUT_BITS>(8);
         }
         self.value.next = self.value_5.q.val();
     }
@@ -371,7 +373,7 @@ mod tests {
 
     /// The model's outputs after each edge: the lookup of 5 edges before,
     /// or 0 for one that was not live.
-    fn expected(stimulus: &[(u32, bool)]) -> Vec<(i16, i16)> {
+    fn expected(stimulus: &[(u32, bool)]) -> Vec<(i32, i32)> {
         (0..stimulus.len())
             .map(|n| match n.checked_sub(LATENCY - 1) {
                 Some(k) if stimulus[k].1 => sine_pair(stimulus[k].0),
@@ -390,7 +392,7 @@ mod tests {
             uut.phase.next = u64::from(phase).into();
             uut.live.next = live;
             tick(&mut uut);
-            let v = |x: Signed<16>| signed_to_i128(x) as i16;
+            let v = |x: Signed<OUTPUT_BITS>| signed_to_i128(x) as i32;
             assert_eq!((v(uut.cos.val()), v(uut.sin.val())), want[n], "edge {n}");
         }
     }
@@ -410,7 +412,8 @@ mod tests {
             .collect();
         let inputs = [("phase", 32, false), ("live", 1, false)];
         for (output, pick) in [("cos", 0usize), ("sin", 1)] {
-            let got = crate::test_util::icarus_clocked(&verilog, &inputs, (output, 16), &steps);
+            let got =
+                crate::test_util::icarus_clocked(&verilog, &inputs, (output, OUTPUT_BITS), &steps);
             assert_eq!(got.len(), want.len());
             for (n, (g, w)) in got.iter().zip(&want).enumerate() {
                 let w = if pick == 0 { w.0 } else { w.1 };

@@ -64,8 +64,10 @@ pub enum CarrierProfile {
     #[default]
     Table,
     /// Quarter-LSB words in an initialized ROM, three more phase bits
-    /// interpolated, one rounding (`gyrocal_hdl::sine_pair`): block RAM with
-    /// contents and four multipliers, an ECP5 or larger part
+    /// interpolated, carriers kept to a quarter LSB (`gyrocal_hdl::sine_pair`)
+    /// and F A x carrier rounded once to the DAC word
+    /// (`gyrocal_hdl::am_mixer::FineAmMixer`): block RAM with contents and
+    /// four more multipliers, an ECP5 or larger part
     /// (`verilog-out/ecp5/gyro_interface.v`). It removes the slow error a
     /// carrier near a short fold of the clock leaves on the rate.
     Fine,

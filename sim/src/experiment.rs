@@ -92,6 +92,8 @@ use crate::theory::{self, Device};
 use gyrocal_hdl::cic_decimator::OUTPUT_FRACTION_BITS;
 use gyrocal_hdl::filter_design::FilterDesign;
 use gyrocal_hdl::gyro_interface::DRIVE_START_CLOCKS;
+use gyrocal_hdl::model::am_mixer::{carrier_fraction_bits, carrier_product};
+use gyrocal_hdl::model::gyro_interface::CarrierProfile;
 use gyrocal_hdl::model::gyro_interface::{Outputs, Probes, Registers};
 use gyrocal_hdl::model::q15_multiplier::q15_product;
 use gyrocal_hdl::settings::{self, FrequencyPlan};
@@ -306,51 +308,65 @@ pub use crate::theory::envelope_lead_rad;
 /// average of its output times the exact sine (a carrier whose frequency
 /// is not a small-integer fraction of the clock visits the phases
 /// uniformly), over 2^16 phases spread evenly over every table interval.
-fn table_gain(sine: impl Fn(u32) -> i16) -> f64 {
+fn table_gain(sine: impl Fn(u32) -> f64) -> f64 {
     const PHASES: u64 = 1 << 16;
     let sum: f64 = (0..PHASES)
         .map(|i| {
             let phase = ((i << 32) / PHASES) as u32 + (1 << 15);
-            f64::from(sine(phase)) * (f64::from(phase) * TAU / 2f64.powi(32)).sin()
+            sine(phase) * (f64::from(phase) * TAU / 2f64.powi(32)).sin()
         })
         .sum();
     2.0 * sum / PHASES as f64 / f64::from(PEAK)
 }
 
-/// The carriers' 8192-word table at a 32-bit phase (drive cos and sin
-/// share its gain: a quarter turn is a whole number of its intervals).
-fn carrier_sine(phase: u32) -> i16 {
-    let table = gyrocal_hdl::model::carrier_nco::table();
-    gyrocal_hdl::model::carrier_nco::table_sine(table, phase, 0)
+/// The carrier word of the core with this profile at a 32-bit phase, in
+/// `Carriers`' scale (drive cos and sin share its gain: a quarter turn is a
+/// whole number of the table's intervals, and the pair's cosine is its
+/// sine a quarter turn on).
+fn carrier_word(profile: CarrierProfile, phase: u32) -> i32 {
+    match profile {
+        CarrierProfile::Table => {
+            let table = gyrocal_hdl::model::carrier_nco::table();
+            gyrocal_hdl::model::carrier_nco::table_sine(table, phase, 0).into()
+        }
+        CarrierProfile::Fine => gyrocal_hdl::model::sine_pair::sine_pair(phase).1,
+    }
 }
 
 /// Fundamental amplitude (LSB) of the drive and reference words per
-/// channel, as the AM mixer realizes them, rounding included: each word is
-/// a Q15 product rounded half up (`q15_product`), and the rounding error
+/// channel, as the AM mixer of the core with `profile` realizes them,
+/// rounding included: each word is the core's carrier product rounded half
+/// up (`carrier_product`: E times the table core's integer carrier over
+/// 2^15, or times the fine core's quarter-LSB carrier over 2^17), and the
+/// rounding error
 /// is a deterministic function of the table values that correlates with
 /// the sine (neglecting it left 2.3e-7 of the amplitude in readout and
 /// 5.3e-7 in calibration at amplitude 0.9; z carries the amplitude twice,
 /// so 1.1e-6 of the calibration scale factor, 4 to 6 of its sigmas on
 /// resonant outputs).
 /// - Readout: the envelope is one integer E = q15(amp, PEAK) (29490 for
-///   amplitude 0.9), and the word q15(E, carrier), whose fundamental is
+///   amplitude 0.9), and the word carrier_product(E, carrier), whose fundamental is
 ///   averaged over the carrier's phases (`table_gain`).
 /// - Calibration: the envelope q15(amp, am) follows the modulation table;
 ///   its fundamental is averaged over the modulation phases, and the
 ///   carrier product's rounding, a different integer envelope at every
 ///   step, averages out (below 1e-8 over the thousands of envelope values
 ///   of a period), so the carrier enters with its table's gain.
-fn realized_words(amp: (i16, i16), mode: Mode) -> [f64; 2] {
+fn realized_words(amp: (i16, i16), mode: Mode, profile: CarrierProfile) -> [f64; 2] {
     let peak = f64::from(PEAK);
+    let carrier_lsb = f64::from(1 << carrier_fraction_bits(profile));
     [amp.0, amp.1].map(|a| {
         let words = match mode {
             Mode::Readout => {
                 let envelope = q15_product(a, PEAK as i16);
-                peak * table_gain(|p| q15_product(envelope, carrier_sine(p)))
+                let word = |p| carrier_product(profile, envelope, carrier_word(profile, p));
+                peak * table_gain(|p| f64::from(word(p)))
             }
             Mode::Calibration => {
                 let modulation = |p| q15_product(a, gyrocal_hdl::model::sine::sine(p, 0));
-                peak * table_gain(modulation) * peak * table_gain(carrier_sine) / 32768.0
+                let carrier = |p| f64::from(carrier_word(profile, p)) / carrier_lsb;
+                peak * table_gain(|p| f64::from(modulation(p))) * peak * table_gain(carrier)
+                    / 32768.0
             }
         };
         words.abs()
@@ -383,8 +399,9 @@ pub fn plan(exp: &Experiment) -> Result<Plan, String> {
     };
     let (readout_regs, realized) = settings::registers(&base).map_err(|e| e.to_string())?;
     let filter = realized.filter.clone();
-    let drive_words = realized_words(readout_regs.amp, Mode::Readout);
-    let cal_drive_words = realized_words(readout_regs.amp, Mode::Calibration);
+    let profile = exp.drive.carrier_profile;
+    let drive_words = realized_words(readout_regs.amp, Mode::Readout, profile);
+    let cal_drive_words = realized_words(readout_regs.amp, Mode::Calibration, profile);
     if drive_words.iter().any(|&w| w < 1.0) {
         return Err("[drive] amplitude1, amplitude2: both drives need at least one DAC LSB".into());
     }

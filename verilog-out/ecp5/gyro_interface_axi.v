@@ -1470,10 +1470,10 @@ module gyro_interface_axi__core(clock,adc1,adc2,dac1,dac2,z1,z2,z_valid,select,c
     reg signed [15:0] carrier_nco$fill_word;
     wire  carrier_nco$filling;
     wire  [31:0] carrier_nco$fill_phase;
-    wire signed [15:0] carrier_nco$drive_cos;
-    wire signed [15:0] carrier_nco$drive_sin;
-    wire signed [15:0] carrier_nco$ref_cos;
-    wire signed [15:0] carrier_nco$ref_sin;
+    wire signed [17:0] carrier_nco$drive_cos;
+    wire signed [17:0] carrier_nco$drive_sin;
+    wire signed [17:0] carrier_nco$ref_cos;
+    wire signed [17:0] carrier_nco$ref_sin;
     reg  modulation_nco$clock;
     reg  [47:0] modulation_nco$step;
     reg  modulation_nco$select;
@@ -1487,10 +1487,10 @@ module gyro_interface_axi__core(clock,adc1,adc2,dac1,dac2,z1,z2,z_valid,select,c
     reg signed [15:0] am_mixer$amp2;
     reg signed [15:0] am_mixer$am1;
     reg signed [15:0] am_mixer$am2;
-    reg signed [15:0] am_mixer$drive_cos;
-    reg signed [15:0] am_mixer$drive_sin;
-    reg signed [15:0] am_mixer$ref_cos;
-    reg signed [15:0] am_mixer$ref_sin;
+    reg signed [17:0] am_mixer$drive_cos;
+    reg signed [17:0] am_mixer$drive_sin;
+    reg signed [17:0] am_mixer$ref_cos;
+    reg signed [17:0] am_mixer$ref_sin;
     wire signed [15:0] am_mixer$dac1;
     wire signed [15:0] am_mixer$dac2;
     wire signed [15:0] am_mixer$ref1;
@@ -1670,10 +1670,10 @@ module gyro_interface_axi__core__am_mixer(clock,amp1,amp2,am1,am2,drive_cos,driv
     input wire signed [15:0] amp2;
     input wire signed [15:0] am1;
     input wire signed [15:0] am2;
-    input wire signed [15:0] drive_cos;
-    input wire signed [15:0] drive_sin;
-    input wire signed [15:0] ref_cos;
-    input wire signed [15:0] ref_sin;
+    input wire signed [17:0] drive_cos;
+    input wire signed [17:0] drive_sin;
+    input wire signed [17:0] ref_cos;
+    input wire signed [17:0] ref_sin;
     output reg signed [15:0] dac1;
     output reg signed [15:0] dac2;
     output reg signed [15:0] ref1;
@@ -1698,19 +1698,19 @@ module gyro_interface_axi__core__am_mixer(clock,amp1,amp2,am1,am2,drive_cos,driv
     reg  fa2$clock;
     reg  drive1$clock;
     reg signed [15:0] drive1$a;
-    reg signed [15:0] drive1$b;
+    reg signed [17:0] drive1$b;
     wire signed [15:0] drive1$y;
     reg  drive2$clock;
     reg signed [15:0] drive2$a;
-    reg signed [15:0] drive2$b;
+    reg signed [17:0] drive2$b;
     wire signed [15:0] drive2$y;
     reg  reference1$clock;
     reg signed [15:0] reference1$a;
-    reg signed [15:0] reference1$b;
+    reg signed [17:0] reference1$b;
     wire signed [15:0] reference1$y;
     reg  reference2$clock;
     reg signed [15:0] reference2$a;
-    reg signed [15:0] reference2$b;
+    reg signed [17:0] reference2$b;
     wire signed [15:0] reference2$y;
 
     // Sub module instances
@@ -1808,29 +1808,29 @@ module gyro_interface_axi__core__am_mixer__drive1(clock,a,b,y);
     // Module arguments
     input wire  clock;
     input wire signed [15:0] a;
-    input wire signed [15:0] b;
+    input wire signed [17:0] b;
     output reg signed [15:0] y;
 
     // Constant declarations
-    localparam signed half_lsb = 32'h4000;
+    localparam signed half_lsb = 34'h10000;
 
     // Stub signals
     reg signed [15:0] a_in$d;
     wire signed [15:0] a_in$q;
     reg  a_in$clock;
-    reg signed [15:0] b_in$d;
-    wire signed [15:0] b_in$q;
+    reg signed [17:0] b_in$d;
+    wire signed [17:0] b_in$q;
     reg  b_in$clock;
     reg  product$clock;
     reg signed [15:0] product$a;
-    reg signed [15:0] product$b;
-    wire signed [31:0] product$p;
+    reg signed [17:0] product$b;
+    wire signed [33:0] product$p;
     reg signed [15:0] y_out$d;
     wire signed [15:0] y_out$q;
     reg  y_out$clock;
 
     // Local signals
-    reg signed [31:0] rounded;
+    reg signed [33:0] rounded;
 
     // Sub module instances
     gyro_interface_axi__core__am_mixer__drive1__a_in a_in(
@@ -1869,7 +1869,7 @@ module gyro_interface_axi__core__am_mixer__drive1(clock,a,b,y);
         product$a = a_in$q;
         product$b = b_in$q;
         rounded = product$p + half_lsb;
-        y_out$d = rounded[(32'hf)+:(16)];
+        y_out$d = rounded[(32'h11)+:(16)];
         y = y_out$q;
     end
 
@@ -1898,13 +1898,13 @@ endmodule // gyro_interface_axi__core__am_mixer__drive1__a_in
 module gyro_interface_axi__core__am_mixer__drive1__b_in(d,q,clock);
 
     // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
+    input wire signed [17:0] d;
+    output reg signed [17:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 16'h0;
+       q = 18'h0;
     end
 
     always @(posedge clock) begin
@@ -1919,8 +1919,8 @@ module gyro_interface_axi__core__am_mixer__drive1__product(clock,a,b,p);
     // Module arguments
     input wire  clock;
     input wire signed [15:0] a;
-    input wire signed [15:0] b;
-    output reg signed [31:0] p;
+    input wire signed [17:0] b;
+    output reg signed [33:0] p;
 
     // Update code (custom)
     initial p = 0;
@@ -1955,29 +1955,29 @@ module gyro_interface_axi__core__am_mixer__drive2(clock,a,b,y);
     // Module arguments
     input wire  clock;
     input wire signed [15:0] a;
-    input wire signed [15:0] b;
+    input wire signed [17:0] b;
     output reg signed [15:0] y;
 
     // Constant declarations
-    localparam signed half_lsb = 32'h4000;
+    localparam signed half_lsb = 34'h10000;
 
     // Stub signals
     reg signed [15:0] a_in$d;
     wire signed [15:0] a_in$q;
     reg  a_in$clock;
-    reg signed [15:0] b_in$d;
-    wire signed [15:0] b_in$q;
+    reg signed [17:0] b_in$d;
+    wire signed [17:0] b_in$q;
     reg  b_in$clock;
     reg  product$clock;
     reg signed [15:0] product$a;
-    reg signed [15:0] product$b;
-    wire signed [31:0] product$p;
+    reg signed [17:0] product$b;
+    wire signed [33:0] product$p;
     reg signed [15:0] y_out$d;
     wire signed [15:0] y_out$q;
     reg  y_out$clock;
 
     // Local signals
-    reg signed [31:0] rounded;
+    reg signed [33:0] rounded;
 
     // Sub module instances
     gyro_interface_axi__core__am_mixer__drive2__a_in a_in(
@@ -2016,7 +2016,7 @@ module gyro_interface_axi__core__am_mixer__drive2(clock,a,b,y);
         product$a = a_in$q;
         product$b = b_in$q;
         rounded = product$p + half_lsb;
-        y_out$d = rounded[(32'hf)+:(16)];
+        y_out$d = rounded[(32'h11)+:(16)];
         y = y_out$q;
     end
 
@@ -2045,13 +2045,13 @@ endmodule // gyro_interface_axi__core__am_mixer__drive2__a_in
 module gyro_interface_axi__core__am_mixer__drive2__b_in(d,q,clock);
 
     // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
+    input wire signed [17:0] d;
+    output reg signed [17:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 16'h0;
+       q = 18'h0;
     end
 
     always @(posedge clock) begin
@@ -2066,8 +2066,8 @@ module gyro_interface_axi__core__am_mixer__drive2__product(clock,a,b,p);
     // Module arguments
     input wire  clock;
     input wire signed [15:0] a;
-    input wire signed [15:0] b;
-    output reg signed [31:0] p;
+    input wire signed [17:0] b;
+    output reg signed [33:0] p;
 
     // Update code (custom)
     initial p = 0;
@@ -2287,29 +2287,29 @@ module gyro_interface_axi__core__am_mixer__reference1(clock,a,b,y);
     // Module arguments
     input wire  clock;
     input wire signed [15:0] a;
-    input wire signed [15:0] b;
+    input wire signed [17:0] b;
     output reg signed [15:0] y;
 
     // Constant declarations
-    localparam signed half_lsb = 32'h4000;
+    localparam signed half_lsb = 34'h10000;
 
     // Stub signals
     reg signed [15:0] a_in$d;
     wire signed [15:0] a_in$q;
     reg  a_in$clock;
-    reg signed [15:0] b_in$d;
-    wire signed [15:0] b_in$q;
+    reg signed [17:0] b_in$d;
+    wire signed [17:0] b_in$q;
     reg  b_in$clock;
     reg  product$clock;
     reg signed [15:0] product$a;
-    reg signed [15:0] product$b;
-    wire signed [31:0] product$p;
+    reg signed [17:0] product$b;
+    wire signed [33:0] product$p;
     reg signed [15:0] y_out$d;
     wire signed [15:0] y_out$q;
     reg  y_out$clock;
 
     // Local signals
-    reg signed [31:0] rounded;
+    reg signed [33:0] rounded;
 
     // Sub module instances
     gyro_interface_axi__core__am_mixer__reference1__a_in a_in(
@@ -2348,7 +2348,7 @@ module gyro_interface_axi__core__am_mixer__reference1(clock,a,b,y);
         product$a = a_in$q;
         product$b = b_in$q;
         rounded = product$p + half_lsb;
-        y_out$d = rounded[(32'hf)+:(16)];
+        y_out$d = rounded[(32'h11)+:(16)];
         y = y_out$q;
     end
 
@@ -2377,13 +2377,13 @@ endmodule // gyro_interface_axi__core__am_mixer__reference1__a_in
 module gyro_interface_axi__core__am_mixer__reference1__b_in(d,q,clock);
 
     // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
+    input wire signed [17:0] d;
+    output reg signed [17:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 16'h0;
+       q = 18'h0;
     end
 
     always @(posedge clock) begin
@@ -2398,8 +2398,8 @@ module gyro_interface_axi__core__am_mixer__reference1__product(clock,a,b,p);
     // Module arguments
     input wire  clock;
     input wire signed [15:0] a;
-    input wire signed [15:0] b;
-    output reg signed [31:0] p;
+    input wire signed [17:0] b;
+    output reg signed [33:0] p;
 
     // Update code (custom)
     initial p = 0;
@@ -2434,29 +2434,29 @@ module gyro_interface_axi__core__am_mixer__reference2(clock,a,b,y);
     // Module arguments
     input wire  clock;
     input wire signed [15:0] a;
-    input wire signed [15:0] b;
+    input wire signed [17:0] b;
     output reg signed [15:0] y;
 
     // Constant declarations
-    localparam signed half_lsb = 32'h4000;
+    localparam signed half_lsb = 34'h10000;
 
     // Stub signals
     reg signed [15:0] a_in$d;
     wire signed [15:0] a_in$q;
     reg  a_in$clock;
-    reg signed [15:0] b_in$d;
-    wire signed [15:0] b_in$q;
+    reg signed [17:0] b_in$d;
+    wire signed [17:0] b_in$q;
     reg  b_in$clock;
     reg  product$clock;
     reg signed [15:0] product$a;
-    reg signed [15:0] product$b;
-    wire signed [31:0] product$p;
+    reg signed [17:0] product$b;
+    wire signed [33:0] product$p;
     reg signed [15:0] y_out$d;
     wire signed [15:0] y_out$q;
     reg  y_out$clock;
 
     // Local signals
-    reg signed [31:0] rounded;
+    reg signed [33:0] rounded;
 
     // Sub module instances
     gyro_interface_axi__core__am_mixer__reference2__a_in a_in(
@@ -2495,7 +2495,7 @@ module gyro_interface_axi__core__am_mixer__reference2(clock,a,b,y);
         product$a = a_in$q;
         product$b = b_in$q;
         rounded = product$p + half_lsb;
-        y_out$d = rounded[(32'hf)+:(16)];
+        y_out$d = rounded[(32'h11)+:(16)];
         y = y_out$q;
     end
 
@@ -2524,13 +2524,13 @@ endmodule // gyro_interface_axi__core__am_mixer__reference2__a_in
 module gyro_interface_axi__core__am_mixer__reference2__b_in(d,q,clock);
 
     // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
+    input wire signed [17:0] d;
+    output reg signed [17:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 16'h0;
+       q = 18'h0;
     end
 
     always @(posedge clock) begin
@@ -2545,8 +2545,8 @@ module gyro_interface_axi__core__am_mixer__reference2__product(clock,a,b,p);
     // Module arguments
     input wire  clock;
     input wire signed [15:0] a;
-    input wire signed [15:0] b;
-    output reg signed [31:0] p;
+    input wire signed [17:0] b;
+    output reg signed [33:0] p;
 
     // Update code (custom)
     initial p = 0;
@@ -2604,10 +2604,10 @@ module gyro_interface_axi__core__carrier_nco(clock,step,ref_offset,fill_word,fil
     input wire signed [15:0] fill_word;
     output reg  filling;
     output reg  [31:0] fill_phase;
-    output reg signed [15:0] drive_cos;
-    output reg signed [15:0] drive_sin;
-    output reg signed [15:0] ref_cos;
-    output reg signed [15:0] ref_sin;
+    output reg signed [17:0] drive_cos;
+    output reg signed [17:0] drive_sin;
+    output reg signed [17:0] ref_cos;
+    output reg signed [17:0] ref_sin;
 
     // Constant declarations
     localparam  last = 14'b10000000100000;
@@ -2622,13 +2622,13 @@ module gyro_interface_axi__core__carrier_nco(clock,step,ref_offset,fill_word,fil
     reg  drive$clock;
     reg  [31:0] drive$phase;
     reg  drive$live;
-    wire signed [15:0] drive$cos;
-    wire signed [15:0] drive$sin;
+    wire signed [17:0] drive$cos;
+    wire signed [17:0] drive$sin;
     reg  reference$clock;
     reg  [31:0] reference$phase;
     reg  reference$live;
-    wire signed [15:0] reference$cos;
-    wire signed [15:0] reference$sin;
+    wire signed [17:0] reference$cos;
+    wire signed [17:0] reference$sin;
 
     // Local signals
     reg  live;
@@ -2714,8 +2714,8 @@ module gyro_interface_axi__core__carrier_nco__drive(clock,phase,live,cos,sin);
     input wire  clock;
     input wire  [31:0] phase;
     input wire  live;
-    output reg signed [15:0] cos;
-    output reg signed [15:0] sin;
+    output reg signed [17:0] cos;
+    output reg signed [17:0] sin;
 
     // Constant declarations
     localparam  quarter_turn = 2'b1;
@@ -2788,7 +2788,7 @@ module gyro_interface_axi__core__carrier_nco__drive(clock,phase,live,cos,sin);
     reg signed [35:0] sin_part$sine_cross;
     reg signed [35:0] sin_part$cosine_cross;
     reg  sin_part$live;
-    wire signed [15:0] sin_part$value;
+    wire signed [17:0] sin_part$value;
     reg  cos_part$clock;
     reg  [1:0] cos_part$quadrant;
     reg signed [17:0] cos_part$sine_word;
@@ -2796,7 +2796,7 @@ module gyro_interface_axi__core__carrier_nco__drive(clock,phase,live,cos,sin);
     reg signed [35:0] cos_part$sine_cross;
     reg signed [35:0] cos_part$cosine_cross;
     reg  cos_part$live;
-    wire signed [15:0] cos_part$value;
+    wire signed [17:0] cos_part$value;
     reg  live_4$d;
     wire  live_4$q;
     reg  live_4$clock;
@@ -3025,13 +3025,13 @@ module gyro_interface_axi__core__carrier_nco__drive__cos_part(clock,quadrant,sin
     input wire signed [35:0] sine_cross;
     input wire signed [35:0] cosine_cross;
     input wire  live;
-    output reg signed [15:0] value;
+    output reg signed [17:0] value;
 
     // Constant declarations
-    localparam signed half = 27'h200;
-    localparam signed half_less_one = 27'h1ff;
+    localparam signed half = 27'h80;
+    localparam signed half_less_one = 27'h7f;
     localparam  guard = 27'h8;
-    localparam signed zero = 16'h0;
+    localparam signed zero = 18'b0;
 
     // Stub signals
     reg signed [26:0] base_4$d;
@@ -3043,8 +3043,8 @@ module gyro_interface_axi__core__carrier_nco__drive__cos_part(clock,quadrant,sin
     reg  add_4$d;
     wire  add_4$q;
     reg  add_4$clock;
-    reg signed [15:0] value_5$d;
-    wire signed [15:0] value_5$q;
+    reg signed [17:0] value_5$d;
+    wire signed [17:0] value_5$q;
     reg  value_5$clock;
 
     // Local signals
@@ -3108,7 +3108,7 @@ module gyro_interface_axi__core__carrier_nco__drive__cos_part(clock,quadrant,sin
         end
         value_5$d = zero;
         if (live) begin
-            value_5$d = sum[(32'ha)+:(16)];
+            value_5$d = sum[(32'h8)+:(18)];
         end
         value = value_5$q;
     end
@@ -3176,13 +3176,13 @@ endmodule // gyro_interface_axi__core__carrier_nco__drive__cos_part__sine_type_4
 module gyro_interface_axi__core__carrier_nco__drive__cos_part__value_5(d,q,clock);
 
     // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
+    input wire signed [17:0] d;
+    output reg signed [17:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 16'h0;
+       q = 18'h0;
     end
 
     always @(posedge clock) begin
@@ -11632,13 +11632,13 @@ module gyro_interface_axi__core__carrier_nco__drive__sin_part(clock,quadrant,sin
     input wire signed [35:0] sine_cross;
     input wire signed [35:0] cosine_cross;
     input wire  live;
-    output reg signed [15:0] value;
+    output reg signed [17:0] value;
 
     // Constant declarations
-    localparam signed half = 27'h200;
-    localparam signed half_less_one = 27'h1ff;
+    localparam signed half = 27'h80;
+    localparam signed half_less_one = 27'h7f;
     localparam  guard = 27'h8;
-    localparam signed zero = 16'h0;
+    localparam signed zero = 18'b0;
 
     // Stub signals
     reg signed [26:0] base_4$d;
@@ -11650,8 +11650,8 @@ module gyro_interface_axi__core__carrier_nco__drive__sin_part(clock,quadrant,sin
     reg  add_4$d;
     wire  add_4$q;
     reg  add_4$clock;
-    reg signed [15:0] value_5$d;
-    wire signed [15:0] value_5$q;
+    reg signed [17:0] value_5$d;
+    wire signed [17:0] value_5$q;
     reg  value_5$clock;
 
     // Local signals
@@ -11715,7 +11715,7 @@ module gyro_interface_axi__core__carrier_nco__drive__sin_part(clock,quadrant,sin
         end
         value_5$d = zero;
         if (live) begin
-            value_5$d = sum[(32'ha)+:(16)];
+            value_5$d = sum[(32'h8)+:(18)];
         end
         value = value_5$q;
     end
@@ -11783,13 +11783,13 @@ endmodule // gyro_interface_axi__core__carrier_nco__drive__sin_part__sine_type_4
 module gyro_interface_axi__core__carrier_nco__drive__sin_part__value_5(d,q,clock);
 
     // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
+    input wire signed [17:0] d;
+    output reg signed [17:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 16'h0;
+       q = 18'h0;
     end
 
     always @(posedge clock) begin
@@ -11917,8 +11917,8 @@ module gyro_interface_axi__core__carrier_nco__reference(clock,phase,live,cos,sin
     input wire  clock;
     input wire  [31:0] phase;
     input wire  live;
-    output reg signed [15:0] cos;
-    output reg signed [15:0] sin;
+    output reg signed [17:0] cos;
+    output reg signed [17:0] sin;
 
     // Constant declarations
     localparam  quarter_turn = 2'b1;
@@ -11991,7 +11991,7 @@ module gyro_interface_axi__core__carrier_nco__reference(clock,phase,live,cos,sin
     reg signed [35:0] sin_part$sine_cross;
     reg signed [35:0] sin_part$cosine_cross;
     reg  sin_part$live;
-    wire signed [15:0] sin_part$value;
+    wire signed [17:0] sin_part$value;
     reg  cos_part$clock;
     reg  [1:0] cos_part$quadrant;
     reg signed [17:0] cos_part$sine_word;
@@ -11999,7 +11999,7 @@ module gyro_interface_axi__core__carrier_nco__reference(clock,phase,live,cos,sin
     reg signed [35:0] cos_part$sine_cross;
     reg signed [35:0] cos_part$cosine_cross;
     reg  cos_part$live;
-    wire signed [15:0] cos_part$value;
+    wire signed [17:0] cos_part$value;
     reg  live_4$d;
     wire  live_4$q;
     reg  live_4$clock;
@@ -12228,13 +12228,13 @@ module gyro_interface_axi__core__carrier_nco__reference__cos_part(clock,quadrant
     input wire signed [35:0] sine_cross;
     input wire signed [35:0] cosine_cross;
     input wire  live;
-    output reg signed [15:0] value;
+    output reg signed [17:0] value;
 
     // Constant declarations
-    localparam signed half = 27'h200;
-    localparam signed half_less_one = 27'h1ff;
+    localparam signed half = 27'h80;
+    localparam signed half_less_one = 27'h7f;
     localparam  guard = 27'h8;
-    localparam signed zero = 16'h0;
+    localparam signed zero = 18'b0;
 
     // Stub signals
     reg signed [26:0] base_4$d;
@@ -12246,8 +12246,8 @@ module gyro_interface_axi__core__carrier_nco__reference__cos_part(clock,quadrant
     reg  add_4$d;
     wire  add_4$q;
     reg  add_4$clock;
-    reg signed [15:0] value_5$d;
-    wire signed [15:0] value_5$q;
+    reg signed [17:0] value_5$d;
+    wire signed [17:0] value_5$q;
     reg  value_5$clock;
 
     // Local signals
@@ -12311,7 +12311,7 @@ module gyro_interface_axi__core__carrier_nco__reference__cos_part(clock,quadrant
         end
         value_5$d = zero;
         if (live) begin
-            value_5$d = sum[(32'ha)+:(16)];
+            value_5$d = sum[(32'h8)+:(18)];
         end
         value = value_5$q;
     end
@@ -12379,13 +12379,13 @@ endmodule // gyro_interface_axi__core__carrier_nco__reference__cos_part__sine_ty
 module gyro_interface_axi__core__carrier_nco__reference__cos_part__value_5(d,q,clock);
 
     // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
+    input wire signed [17:0] d;
+    output reg signed [17:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 16'h0;
+       q = 18'h0;
     end
 
     always @(posedge clock) begin
@@ -20835,13 +20835,13 @@ module gyro_interface_axi__core__carrier_nco__reference__sin_part(clock,quadrant
     input wire signed [35:0] sine_cross;
     input wire signed [35:0] cosine_cross;
     input wire  live;
-    output reg signed [15:0] value;
+    output reg signed [17:0] value;
 
     // Constant declarations
-    localparam signed half = 27'h200;
-    localparam signed half_less_one = 27'h1ff;
+    localparam signed half = 27'h80;
+    localparam signed half_less_one = 27'h7f;
     localparam  guard = 27'h8;
-    localparam signed zero = 16'h0;
+    localparam signed zero = 18'b0;
 
     // Stub signals
     reg signed [26:0] base_4$d;
@@ -20853,8 +20853,8 @@ module gyro_interface_axi__core__carrier_nco__reference__sin_part(clock,quadrant
     reg  add_4$d;
     wire  add_4$q;
     reg  add_4$clock;
-    reg signed [15:0] value_5$d;
-    wire signed [15:0] value_5$q;
+    reg signed [17:0] value_5$d;
+    wire signed [17:0] value_5$q;
     reg  value_5$clock;
 
     // Local signals
@@ -20918,7 +20918,7 @@ module gyro_interface_axi__core__carrier_nco__reference__sin_part(clock,quadrant
         end
         value_5$d = zero;
         if (live) begin
-            value_5$d = sum[(32'ha)+:(16)];
+            value_5$d = sum[(32'h8)+:(18)];
         end
         value = value_5$q;
     end
@@ -20986,13 +20986,13 @@ endmodule // gyro_interface_axi__core__carrier_nco__reference__sin_part__sine_ty
 module gyro_interface_axi__core__carrier_nco__reference__sin_part__value_5(d,q,clock);
 
     // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
+    input wire signed [17:0] d;
+    output reg signed [17:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 16'h0;
+       q = 18'h0;
     end
 
     always @(posedge clock) begin

@@ -52,17 +52,19 @@ pub fn table_sine(table: &Table, phase: u32, advance: u8) -> i16 {
     super::quarter_wave::lookup(phase, advance, |index| table[index])
 }
 
-/// Outputs of the carrier NCO during one cycle.
+/// Outputs of the carrier NCO during one cycle: 16-bit words (peak
+/// 32767) from the table core, 18-bit quarter-LSB words (peak 4 x 32767)
+/// from the fine core.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Carriers {
     /// In-phase drive carrier.
-    pub drive_cos: i16,
+    pub drive_cos: i32,
     /// Quadrature drive carrier.
-    pub drive_sin: i16,
+    pub drive_sin: i32,
     /// In-phase reference carrier.
-    pub ref_cos: i16,
+    pub ref_cos: i32,
     /// Quadrature reference carrier.
-    pub ref_sin: i16,
+    pub ref_sin: i32,
 }
 
 /// Cycle-true model of the carrier NCO.
@@ -122,10 +124,10 @@ impl CarrierNco {
                 CarrierProfile::Table => {
                     let t = self.table;
                     Carriers {
-                        drive_cos: table_sine(t, self.phase, 1),
-                        drive_sin: table_sine(t, self.phase, 0),
-                        ref_cos: table_sine(t, reference, 1),
-                        ref_sin: table_sine(t, reference, 0),
+                        drive_cos: table_sine(t, self.phase, 1).into(),
+                        drive_sin: table_sine(t, self.phase, 0).into(),
+                        ref_cos: table_sine(t, reference, 1).into(),
+                        ref_sin: table_sine(t, reference, 0).into(),
                     }
                 }
                 CarrierProfile::Fine => {
@@ -198,7 +200,7 @@ mod tests {
         // Cycle FILL_CLOCKS + 5: the phase of cycle FILL_CLOCKS.
         let phase = step.wrapping_mul(FILL_CLOCKS as u32);
         let first = nco.step(step, 0);
-        assert_eq!(first.drive_sin, table_sine(table(), phase, 0));
-        assert_eq!(first.drive_cos, table_sine(table(), phase, 1));
+        assert_eq!(first.drive_sin, i32::from(table_sine(table(), phase, 0)));
+        assert_eq!(first.drive_cos, i32::from(table_sine(table(), phase, 1)));
     }
 }

@@ -59,6 +59,7 @@ impl GyroInterface {
     pub fn with_profile(profile: CarrierProfile) -> Self {
         Self {
             carrier_nco: CarrierNco::new(profile),
+            am_mixer: AmMixer::new(profile),
             ..Self::default()
         }
     }
@@ -152,8 +153,8 @@ mod tests {
     #[test]
     fn the_profiles_differ_only_in_the_carriers() {
         // Same settings, same ADC words: the two cores' carriers differ by
-        // at most 4.2 + 1.02 LSB (their error bounds), which an envelope of
-        // 20000 / 32767 scales to 3.2 LSB; with the two products' roundings
+        // at most 4.2 + 0.65 LSB (their error bounds), which an envelope of
+        // 20000 / 32767 scales to 3.0 LSB; with the two products' roundings
         // (0.5 each) the DAC words differ by at most 4. They do differ, and
         // nothing else in the datapath sees the profile.
         let regs = Registers {

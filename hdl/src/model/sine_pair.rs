@@ -1,6 +1,6 @@
 //! Bit-true model of `crate::sine_pair::SinePair`: the cosine and sine of
 //! one phase from the fine table (`crate::fine_sine_table`), three phase
-//! bits interpolated, one rounding.
+//! bits interpolated, one rounding, to a quarter LSB.
 //!
 //! For a phase with quadrant `q` (bits 31:30), interval `i` (29:17) and
 //! sub-interval `s` (16:14), let `a = word[i]` and `b = word[8191 - i]`
@@ -12,9 +12,12 @@
 //!
 //! ```text
 //!   t_s = floor(b k / 2^22), t_c = floor(a k / 2^22)       (2^-8 quarter LSB)
-//!    s: (256 a + 512 + t_s) >> 10       -s: (511 - 256 a - t_s) >> 10
-//!    c: (256 b + 512 - t_c) >> 10       -c: (511 - 256 b + t_c) >> 10
+//!    s: (256 a + 128 + t_s) >> 8        -s: (127 - 256 a - t_s) >> 8
+//!    c: (256 b + 128 - t_c) >> 8        -c: (127 - 256 b + t_c) >> 8
 //! ```
+//!
+//! in quarter LSB: an output is `4 x 32767` at the peak (18 signed bits),
+//! and the AM mixer rounds its product with it once, to the DAC's LSB.
 //!
 //! The negative forms are the positive ones' one's complement plus the
 //! same rounding constant, so `-s` is exactly the negation of `s` (the
@@ -22,7 +25,7 @@
 //! output is the sine output a quarter turn on.
 
 use crate::fine_sine_table::{
-    PRODUCT_SHIFT, SUBINTERVALS, SUM_FRACTION_BITS, SUM_GUARD_BITS, TABLE_ENTRIES, slope, words,
+    OUTPUT_SHIFT, PRODUCT_SHIFT, SUBINTERVALS, SUM_GUARD_BITS, TABLE_ENTRIES, slope, words,
 };
 use std::sync::OnceLock;
 
@@ -40,10 +43,10 @@ fn tables() -> &'static Tables {
     })
 }
 
-/// `(32767 cos, 32767 sin)` of a 32-bit phase (2^32 = one turn), as
-/// `SinePair` computes them.
+/// `(4 x 32767 cos, 4 x 32767 sin)` of a 32-bit phase (2^32 = one turn),
+/// in quarter LSB, as `SinePair` computes them.
 #[inline(always)]
-pub fn sine_pair(phase: u32) -> (i16, i16) {
+pub fn sine_pair(phase: u32) -> (i32, i32) {
     let t = tables();
     let quadrant = phase >> 30;
     let i = (phase >> 17) as usize & (TABLE_ENTRIES - 1);
@@ -54,7 +57,7 @@ pub fn sine_pair(phase: u32) -> (i16, i16) {
     );
     let k = i64::from(t.slopes[s]);
     let (t_s, t_c) = ((b * k) >> PRODUCT_SHIFT, (a * k) >> PRODUCT_SHIFT);
-    let half = 1i64 << (SUM_FRACTION_BITS - 1);
+    let half = 1i64 << (OUTPUT_SHIFT - 1);
     let output = |q: u32| {
         let sine_type = q & 1 == 0;
         let negative = q & 2 != 0;
@@ -70,7 +73,7 @@ pub fn sine_pair(phase: u32) -> (i16, i16) {
         } else {
             base - cross
         };
-        (sum >> SUM_FRACTION_BITS) as i16
+        (sum >> OUTPUT_SHIFT) as i32
     };
     (output((quadrant + 1) & 3), output(quadrant))
 }
@@ -85,31 +88,37 @@ mod tests {
         (32767.0 * angle.cos(), 32767.0 * angle.sin())
     }
 
+    /// An output word in LSB of 32767.
+    fn lsb(word: i32) -> f64 {
+        f64::from(word) / 4.0
+    }
+
     #[test]
-    fn error_against_the_exact_sine_is_at_most_1_02_lsb() {
-        // The final rounding, 0.5 LSB; the phase bits below the
+    fn error_against_the_exact_sine_is_at_most_0_65_lsb() {
+        // The final rounding, half a quarter LSB: 0.125 LSB; the phase bits below the
         // interpolated ones, at most half a sub-interval (D / 16 rad) from
         // its centre: 32767 pi / 2^18 = 0.393 LSB; the word's rounding,
         // half a quarter LSB: 0.125 LSB; the products' floor, 2^-8 quarter
         // LSB: 0.001; the cross word's rounding times the slope (at most
         // 7 D / 16 = 8.4e-5 rad) and the curvature (7 D / 16)^2 / 2 x 32767:
-        // 1.2e-4 together. Sum 1.02 LSB (the built carriers: 4.2).
+        // 1.2e-4 together. Sum 0.644 LSB (the built carriers: 4.2; this
+        // pair rounded to whole LSB: 1.02).
         let mut worst = 0.0f64;
         for k in 0u32..(1 << 22) {
             let phase = k.wrapping_mul(0x9e37_79b9);
             let (c, s) = sine_pair(phase);
             let (ec, es) = exact(phase);
-            worst = worst.max((f64::from(c) - ec).abs().max((f64::from(s) - es).abs()));
+            worst = worst.max((lsb(c) - ec).abs().max((lsb(s) - es).abs()));
         }
         eprintln!("worst error {worst:.4} LSB");
-        assert!(worst <= 1.02, "worst error {worst} LSB");
+        assert!(worst <= 0.65, "worst error {worst} LSB");
     }
 
     #[test]
-    fn every_sub_interval_centre_is_within_0_63_lsb_of_the_exact_sine() {
+    fn every_sub_interval_centre_is_within_0_26_lsb_of_the_exact_sine() {
         // At a sub-interval's centre the phase truncation is gone: the
-        // final rounding (0.5), the word's (0.125) and the products'
-        // (0.001) and the curvature (1.2e-4) remain. Every interval and
+        // final rounding (0.125), the word's (0.125) and the products'
+        // (0.001) and the curvature (1.2e-4) remain: 0.251. Every interval and
         // sub-interval of all four quadrants.
         for i in 0..TABLE_ENTRIES as u32 {
             for s in 0..SUBINTERVALS as u32 {
@@ -118,7 +127,7 @@ mod tests {
                     let (c, sn) = sine_pair(phase);
                     let (ec, es) = exact(phase);
                     assert!(
-                        (f64::from(c) - ec).abs() <= 0.63 && (f64::from(sn) - es).abs() <= 0.63,
+                        (lsb(c) - ec).abs() <= 0.26 && (lsb(sn) - es).abs() <= 0.26,
                         "phase {phase:#x}: ({c}, {sn}) against ({ec:.3}, {es:.3})"
                     );
                 }
@@ -133,7 +142,8 @@ mod tests {
             let (c, s) = sine_pair(phase);
             assert_eq!(sine_pair(phase.wrapping_add(1 << 31)), (-c, -s));
             assert_eq!(sine_pair(phase.wrapping_add(1 << 30)).1, c);
-            assert!((-32767..=32767).contains(&c) && (-32767..=32767).contains(&s));
+            let peak = crate::fine_sine_table::OUTPUT_PEAK;
+            assert!((-peak..=peak).contains(&c) && (-peak..=peak).contains(&s));
         }
     }
 }
