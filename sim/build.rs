@@ -1,9 +1,34 @@
-//! With the `verilator` feature: compile verilog-out/gyro_interface.v with
-//! Verilator and the C ABI wrapper of `verilator/wrapper.cpp` into a static
-//! library for the `verilator` engine. Without it: nothing.
+//! With the `verilator` feature: compile verilog-out/gyro_interface.v (the
+//! table core) and verilog-out/ecp5/gyro_interface.v (the fine core) with
+//! Verilator, each with the C ABI wrapper of `verilator/wrapper.cpp`, into
+//! static libraries for the `verilator` engine. Without it: nothing.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
+
+/// One core to Verilate: its Verilog, the class prefix Verilator gives it
+/// (the two files share the module name `gyro_interface`), and the prefix of
+/// the C functions `verilator/wrapper.cpp` exports for it.
+struct Core {
+    verilog: &'static str,
+    class: &'static str,
+    functions: &'static str,
+}
+
+/// The table core, then the fine (ECP5) core; `src/verilator.rs` declares
+/// both sets of functions.
+const CORES: [Core; 2] = [
+    Core {
+        verilog: "../verilog-out/gyro_interface.v",
+        class: "Vgyro_interface",
+        functions: "gyrocal_verilator",
+    },
+    Core {
+        verilog: "../verilog-out/ecp5/gyro_interface.v",
+        class: "Vgyro_interface_fine",
+        functions: "gyrocal_verilator_fine",
+    },
+];
 
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
@@ -11,15 +36,67 @@ fn main() {
         return;
     }
     let manifest = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").unwrap());
-    let verilog = manifest.join("../verilog-out/gyro_interface.v");
     let wrapper = manifest.join("verilator/wrapper.cpp");
     let probes = manifest.join("verilator/probes.vlt");
-    for f in [&verilog, &wrapper, &probes] {
+    for f in [&wrapper, &probes] {
         println!("cargo:rerun-if-changed={}", f.display());
     }
-    let out = PathBuf::from(std::env::var("OUT_DIR").unwrap()).join("verilated");
-    let _ = std::fs::remove_dir_all(&out);
     let root = tool_output("verilator", &["--getenv", "VERILATOR_ROOT"]);
+    let include = Path::new(root.trim()).join("include");
+    let out_dir = PathBuf::from(std::env::var("OUT_DIR").unwrap());
+    for core in &CORES {
+        let verilog = manifest.join(core.verilog);
+        println!("cargo:rerun-if-changed={}", verilog.display());
+        let out = out_dir.join(format!("verilated-{}", core.class));
+        verilate(&verilog, &probes, core.class, &out);
+        let mut build = cc::Build::new();
+        for object in verilated_objects(&out, core.class) {
+            build.object(object);
+        }
+        build
+            .cpp(true)
+            .std("c++17")
+            .opt_level(2)
+            .flag_if_supported("-Wno-unused-parameter")
+            .include(&out)
+            .include(&include)
+            .include(include.join("vltstd"))
+            .define("GYROCAL_VMODEL", core.class)
+            .define("GYROCAL_VMODEL_H", format!("\"{}.h\"", core.class).as_str())
+            .define(
+                "GYROCAL_VROOT",
+                format!("{}___024root", core.class).as_str(),
+            )
+            .define(
+                "GYROCAL_VROOT_H",
+                format!("\"{}___024root.h\"", core.class).as_str(),
+            )
+            .define(
+                "GYROCAL_FN(name)",
+                format!("{}_##name", core.functions).as_str(),
+            )
+            .define(
+                "GYROCAL_HANDLE",
+                format!("{}_handle", core.functions).as_str(),
+            )
+            .file(&wrapper)
+            .compile(core.functions);
+    }
+    // The Verilator runtime once, after both models (a static library
+    // resolves only what the libraries before it left open).
+    let runtime = out_dir.join(format!("verilated-{}", CORES[0].class));
+    cc::Build::new()
+        .object(runtime.join("verilated.o"))
+        .object(runtime.join("verilated_threads.o"))
+        .compile("gyrocal_verilated_runtime");
+    println!("cargo:rustc-link-lib=dylib=pthread");
+    println!("cargo:rustc-link-lib=dylib=atomic");
+}
+
+/// Verilate `verilog` into `out` as class `class`, and build its objects
+/// (and the runtime's `verilated.o`, `verilated_threads.o`).
+fn verilate(verilog: &Path, probes: &Path, class: &str, out: &Path) {
+    let _ = std::fs::remove_dir_all(out);
     run(Command::new("verilator")
         .args([
             "--cc",
@@ -36,37 +113,20 @@ fn main() {
             "-Wno-style",
             "--top-module",
             "gyro_interface",
+            "--prefix",
+            class,
         ])
         .args(["-CFLAGS", "-O2 -fPIC", "-j", "2", "--Mdir"])
-        .arg(&out)
-        .arg(&verilog)
-        .arg(&probes));
-    run(Command::new("make").arg("-C").arg(&out).args([
+        .arg(out)
+        .arg(verilog)
+        .arg(probes));
+    run(Command::new("make").arg("-C").arg(out).args([
         "-f",
-        "Vgyro_interface.mk",
+        &format!("{class}.mk"),
         "OPT_FAST=-O2 -fPIC",
         "verilated.o",
         "verilated_threads.o",
     ]));
-    let include = Path::new(root.trim()).join("include");
-    let mut build = cc::Build::new();
-    for object in verilated_objects(&out) {
-        build.object(object);
-    }
-    build
-        .cpp(true)
-        .std("c++17")
-        .opt_level(2)
-        .flag_if_supported("-Wno-unused-parameter")
-        .include(&out)
-        .include(&include)
-        .include(include.join("vltstd"))
-        .file(&wrapper)
-        .object(out.join("verilated.o"))
-        .object(out.join("verilated_threads.o"))
-        .compile("gyrocal_verilator");
-    println!("cargo:rustc-link-lib=dylib=pthread");
-    println!("cargo:rustc-link-lib=dylib=atomic");
 }
 
 fn tool_output(tool: &str, args: &[&str]) -> String {
@@ -86,10 +146,10 @@ fn run(cmd: &mut Command) {
 }
 
 /// The model's object files: Verilator compiles a small design into one
-/// `Vgyro_interface__ALL.o`, and a larger one (split output, parallel
-/// build) into one object per C++ file, archived as `__ALL.a`.
-fn verilated_objects(out: &Path) -> Vec<PathBuf> {
-    let all = out.join("Vgyro_interface__ALL.o");
+/// `{class}__ALL.o`, and a larger one (split output, parallel build) into
+/// one object per C++ file, archived as `__ALL.a`.
+fn verilated_objects(out: &Path, class: &str) -> Vec<PathBuf> {
+    let all = out.join(format!("{class}__ALL.o"));
     if all.exists() {
         return vec![all];
     }
@@ -98,7 +158,7 @@ fn verilated_objects(out: &Path) -> Vec<PathBuf> {
         .filter_map(|entry| entry.ok().map(|e| e.path()))
         .filter(|path| {
             let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
-            name.starts_with("Vgyro_interface") && name.ends_with(".o")
+            name.starts_with(class) && name.ends_with(".o")
         })
         .collect();
     objects.sort();

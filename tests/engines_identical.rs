@@ -13,6 +13,7 @@ fn verilator_engine_is_built() {
 
 #[cfg(feature = "verilator")]
 mod with_verilator {
+    use gyrocal_hdl::model::gyro_interface::{CarrierProfile, Outputs};
     use gyrocal_sim::cosim::CoSim;
     use gyrocal_sim::engine::{Engine, EngineKind, ModelEngine};
     use gyrocal_sim::experiment::{self, Experiment, Plan};
@@ -52,22 +53,35 @@ mod with_verilator {
         let plan = experiment::plan(&exp).unwrap();
         let mut compared = 0u64;
         for point in [1, 3] {
-            let mut model = cosim::<ModelEngine>(&exp, &plan, point);
-            let mut verilated = cosim::<VerilatorEngine>(&exp, &plan, point);
-            for n in 1..=5_000_000u64 {
-                let (a, b) = (model.step(), verilated.step());
-                assert_eq!(a, b, "point {point}, clock {n}");
-                if n % 997 == 0 {
-                    assert_eq!(
-                        model.engine().probes(),
-                        verilated.engine().probes(),
-                        "probes, clock {n}"
-                    );
-                }
-                compared += 1;
-            }
+            same_on_every_clock(&exp, &plan, point, 5_000_000, |_| compared += 1);
         }
         assert_eq!(compared, 10_000_000);
+    }
+
+    /// The model and Verilator engines side by side from power-up at
+    /// `point` for `clocks`: every port on every clock, the internal probes
+    /// every 997 clocks. `each` sees the ports of every clock.
+    fn same_on_every_clock(
+        exp: &Experiment,
+        plan: &Plan,
+        point: usize,
+        clocks: u64,
+        mut each: impl FnMut(&Outputs),
+    ) {
+        let mut model = cosim::<ModelEngine>(exp, plan, point);
+        let mut verilated = cosim::<VerilatorEngine>(exp, plan, point);
+        for n in 1..=clocks {
+            let (a, b) = (model.step(), verilated.step());
+            assert_eq!(a, b, "point {point}, clock {n}");
+            if n % 997 == 0 {
+                assert_eq!(
+                    model.engine().probes(),
+                    verilated.engine().probes(),
+                    "probes, clock {n}"
+                );
+            }
+            each(&a);
+        }
     }
 
     #[test]
@@ -77,21 +91,7 @@ mod with_verilator {
         // calibration window is 8 periods of its 2 f_cal ripple). One round
         // of windows: a budget too small for a second one, so that the
         // engines' different speeds cannot change the plan.
-        let mut exp = small_device();
-        exp.gyro.q1 = 150.0;
-        exp.gyro.q2 = 150.0;
-        // The least decimation the filter takes; cut-offs within f_z / 5
-        // and calibration ripples (2 f_cal) sampled 20 times per period.
-        exp.filter.decimation = Some(gyrocal_hdl::filter_design::MIN_DECIMATION);
-        exp.filter.butterworth_hz = Some(5e3);
-        exp.filter.rc_hz = Some(10e3);
-        exp.points.cal_freqs_hz = vec![700.0, 1400.0];
-        exp.points.min_window_s = Some(5e-4);
-        exp.points.budget_s = 1e-6;
-        let reports: Vec<_> = [EngineKind::Model, EngineKind::Verilator, EngineKind::Rtl]
-            .into_iter()
-            .map(|engine| gyrocal_sim::report::run(&exp, engine, &|_| {}).unwrap())
-            .collect();
+        let reports = on_all_three_engines(&tiny_device());
         // 107,923 clocks measured: at R = 166 the calibration ripple allows
         // at most ~1.5 kHz, and windows of 8 ripple periods at 700 Hz are
         // longer than the 2 kHz ones at R = 16 were (under 80,000 then);
@@ -105,6 +105,36 @@ mod with_verilator {
             "{} clocks",
             reports[0].timing.cycles
         );
+        assert_identical(&reports);
+    }
+
+    /// The tiny device of the test above.
+    fn tiny_device() -> Experiment {
+        let mut exp = small_device();
+        exp.gyro.q1 = 150.0;
+        exp.gyro.q2 = 150.0;
+        // The least decimation the filter takes; cut-offs within f_z / 5
+        // and calibration ripples (2 f_cal) sampled 20 times per period.
+        exp.filter.decimation = Some(gyrocal_hdl::filter_design::MIN_DECIMATION);
+        exp.filter.butterworth_hz = Some(5e3);
+        exp.filter.rc_hz = Some(10e3);
+        exp.points.cal_freqs_hz = vec![700.0, 1400.0];
+        exp.points.min_window_s = Some(5e-4);
+        exp.points.budget_s = 1e-6;
+        exp
+    }
+
+    /// `exp` on the model, Verilator and rtl engines, in that order.
+    fn on_all_three_engines(exp: &Experiment) -> Vec<gyrocal_sim::report::Report> {
+        [EngineKind::Model, EngineKind::Verilator, EngineKind::Rtl]
+            .into_iter()
+            .map(|engine| gyrocal_sim::report::run(exp, engine, &|_| {}).unwrap())
+            .collect()
+    }
+
+    /// Every point's z, batches and trace, and the figures, the same on
+    /// every engine; and not vacuous.
+    fn assert_identical(reports: &[gyrocal_sim::report::Report]) {
         for r in &reports[1..] {
             assert_eq!(r.points.len(), reports[0].points.len());
             for (p, q) in r.points.iter().zip(&reports[0].points) {
@@ -123,5 +153,31 @@ mod with_verilator {
         }
         // Not vacuous: the outputs moved with rate and calibration frequency.
         assert!(reports[0].sf_read_per_dps[0] != 0.0 && reports[0].sf_cal_per_dps[1] != 0.0);
+    }
+
+    #[test]
+    fn the_fine_core_is_one_design_on_all_three_engines() {
+        // `[drive] carrier_profile = "fine"`: the model, the exported
+        // verilog-out/ecp5/gyro_interface.v in Verilator and rust-hdl's
+        // FineGyroInterface. Every port on every clock of 1 M clocks of
+        // readout and 1 M of calibration with the gyroscope in the loop
+        // (probes every 997), then the tiny experiment on all three.
+        let mut exp = small_device();
+        exp.drive.carrier_profile = CarrierProfile::Fine;
+        let plan = experiment::plan(&exp).unwrap();
+        let mut table = cosim::<ModelEngine>(&small_device(), &plan, 1);
+        let mut differ = 0u64;
+        same_on_every_clock(&exp, &plan, 1, 1_000_000, |a| {
+            differ += u64::from(table.step() != *a)
+        });
+        same_on_every_clock(&exp, &plan, 3, 1_000_000, |_| {});
+        // Not the table core under another name.
+        assert!(
+            differ > 1000,
+            "the fine core's ports differed from the table core's on {differ} clocks"
+        );
+        let mut tiny = tiny_device();
+        tiny.drive.carrier_profile = CarrierProfile::Fine;
+        assert_identical(&on_all_three_engines(&tiny));
     }
 }

@@ -1,6 +1,8 @@
-//! The `verilator` engine: verilog-out/gyro_interface.v compiled by
-//! Verilator (see build.rs) and stepped one clock per call through the C ABI
-//! of `verilator/wrapper.cpp`.
+//! The `verilator` engine: verilog-out/gyro_interface.v (the table core)
+//! or verilog-out/ecp5/gyro_interface.v (the fine core, `[drive]
+//! carrier_profile = "fine"`) compiled by Verilator (see build.rs) and
+//! stepped one clock per call through the C ABI of `verilator/wrapper.cpp`,
+//! compiled once per core.
 
 use crate::engine::Engine;
 use gyrocal_hdl::model::gyro_interface::{CarrierProfile, Outputs, Probes, Registers};
@@ -51,17 +53,58 @@ struct CModel {
     _private: [u8; 0],
 }
 
-unsafe extern "C" {
-    fn gyrocal_verilator_new() -> *mut CModel;
-    fn gyrocal_verilator_free(model: *mut CModel);
-    fn gyrocal_verilator_set_registers(model: *mut CModel, regs: *const CRegisters);
-    fn gyrocal_verilator_step(model: *mut CModel, adc1: i16, adc2: i16, out: *mut COutputs);
-    fn gyrocal_verilator_probes(model: *const CModel, probes: *mut CProbes);
+/// Declares one core's C functions (`wrapper.cpp` compiled with its
+/// prefix) and the table of them the engine calls through.
+macro_rules! core_api {
+    ($api:ident, $new:ident, $free:ident, $set:ident, $step:ident, $probes:ident) => {
+        unsafe extern "C" {
+            fn $new() -> *mut CModel;
+            fn $free(model: *mut CModel);
+            fn $set(model: *mut CModel, regs: *const CRegisters);
+            fn $step(model: *mut CModel, adc1: i16, adc2: i16, out: *mut COutputs);
+            fn $probes(model: *const CModel, probes: *mut CProbes);
+        }
+
+        static $api: Api = Api {
+            new: $new,
+            free: $free,
+            set_registers: $set,
+            step: $step,
+            probes: $probes,
+        };
+    };
 }
 
-/// The Verilated `gyro_interface`, one instance per engine.
+/// One Verilated core's functions.
+struct Api {
+    new: unsafe extern "C" fn() -> *mut CModel,
+    free: unsafe extern "C" fn(*mut CModel),
+    set_registers: unsafe extern "C" fn(*mut CModel, *const CRegisters),
+    step: unsafe extern "C" fn(*mut CModel, i16, i16, *mut COutputs),
+    probes: unsafe extern "C" fn(*const CModel, *mut CProbes),
+}
+
+core_api!(
+    TABLE,
+    gyrocal_verilator_new,
+    gyrocal_verilator_free,
+    gyrocal_verilator_set_registers,
+    gyrocal_verilator_step,
+    gyrocal_verilator_probes
+);
+core_api!(
+    FINE,
+    gyrocal_verilator_fine_new,
+    gyrocal_verilator_fine_free,
+    gyrocal_verilator_fine_set_registers,
+    gyrocal_verilator_fine_step,
+    gyrocal_verilator_fine_probes
+);
+
+/// The Verilated `gyro_interface` of one core, one instance per engine.
 pub struct VerilatorEngine {
     model: *mut CModel,
+    api: &'static Api,
     applied: Option<Registers>,
 }
 
@@ -71,25 +114,24 @@ unsafe impl Send for VerilatorEngine {}
 impl Drop for VerilatorEngine {
     fn drop(&mut self) {
         // SAFETY: `model` came from gyrocal_verilator_new and is freed once.
-        unsafe { gyrocal_verilator_free(self.model) }
+        unsafe { (self.api.free)(self.model) }
     }
 }
 
 impl Engine for VerilatorEngine {
     fn power_up(profile: CarrierProfile) -> Result<Self, String> {
-        if profile != CarrierProfile::Table {
-            return Err(format!(
-                "[drive] carrier_profile = \"{profile}\": the verilator engine builds the table core \
-                 (verilog-out/gyro_interface.v) only; use the model or rtl engine"
-            ));
-        }
+        let api = match profile {
+            CarrierProfile::Table => &TABLE,
+            CarrierProfile::Fine => &FINE,
+        };
         // SAFETY: plain constructor; null means allocation failed.
-        let model = unsafe { gyrocal_verilator_new() };
+        let model = unsafe { (api.new)() };
         if model.is_null() {
             return Err("cannot create the Verilated model".into());
         }
         Ok(Self {
             model,
+            api,
             applied: None,
         })
     }
@@ -113,12 +155,12 @@ impl Engine for VerilatorEngine {
                 cic_shift: regs.cic_shift,
             };
             // SAFETY: valid model pointer and a live struct.
-            unsafe { gyrocal_verilator_set_registers(self.model, &c) };
+            unsafe { (self.api.set_registers)(self.model, &c) };
             self.applied = Some(*regs);
         }
         let mut out = COutputs::default();
         // SAFETY: valid model pointer and a live output struct.
-        unsafe { gyrocal_verilator_step(self.model, adc.0, adc.1, &mut out) };
+        unsafe { (self.api.step)(self.model, adc.0, adc.1, &mut out) };
         Outputs {
             dac: (out.dac1, out.dac2),
             z: (out.z1, out.z2),
@@ -129,7 +171,7 @@ impl Engine for VerilatorEngine {
     fn probes(&self) -> Probes {
         let mut p = CProbes::default();
         // SAFETY: valid model pointer and a live output struct.
-        unsafe { gyrocal_verilator_probes(self.model, &mut p) };
+        unsafe { (self.api.probes)(self.model, &mut p) };
         Probes {
             reference: (p.ref1, p.ref2),
             w: (p.w1, p.w2),

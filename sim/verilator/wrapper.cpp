@@ -2,11 +2,24 @@
 // engine. One call steps one clock: inputs set, clock low and settle, clock
 // high (the rising edge), outputs read. Signed ports are returned
 // sign-extended.
+//
+// Compiled once per core (build.rs): the two cores' Verilog files have the
+// same module name, so each is Verilated with its own `--prefix`, and this
+// file names the model's classes and its own functions from the macros
+//   GYROCAL_VMODEL        the model class (Vgyro_interface, Vgyro_interface_fine)
+//   GYROCAL_VMODEL_H      its header, GYROCAL_VROOT_H the root's header
+//   GYROCAL_VROOT         the root class
+//   GYROCAL_FN(name)      this file's C functions, gyrocal_verilator[_fine]_name
+//   GYROCAL_HANDLE        the handle struct, one name per core
 #include <cstdint>
 #include <memory>
 #include "verilated.h"
-#include "Vgyro_interface.h"
-#include "Vgyro_interface___024root.h"
+#include GYROCAL_VMODEL_H
+#include GYROCAL_VROOT_H
+
+#define GyrocalVerilator GYROCAL_HANDLE
+#define Vgyro_interface GYROCAL_VMODEL
+#define Vgyro_interface___024root GYROCAL_VROOT
 
 extern "C" {
 
@@ -42,7 +55,7 @@ static inline int64_t sign_extend(uint64_t v, int bits) {
     return static_cast<int64_t>(v << (64 - bits)) >> (64 - bits);
 }
 
-GyrocalVerilator* gyrocal_verilator_new() {
+GyrocalVerilator* GYROCAL_FN(new)() {
     auto* g = new GyrocalVerilator;
     g->context = std::make_unique<VerilatedContext>();
     g->model = std::make_unique<Vgyro_interface>(g->context.get());
@@ -51,14 +64,14 @@ GyrocalVerilator* gyrocal_verilator_new() {
     return g;
 }
 
-void gyrocal_verilator_free(GyrocalVerilator* g) {
+void GYROCAL_FN(free)(GyrocalVerilator* g) {
     if (g) {
         g->model->final();
         delete g;
     }
 }
 
-void gyrocal_verilator_set_registers(GyrocalVerilator* g, const GyrocalRegisters* r) {
+void GYROCAL_FN(set_registers)(GyrocalVerilator* g, const GyrocalRegisters* r) {
     Vgyro_interface* m = g->model.get();
     m->select = r->select;
     m->carrier_step = r->carrier_step;
@@ -75,7 +88,7 @@ void gyrocal_verilator_set_registers(GyrocalVerilator* g, const GyrocalRegisters
     m->iir_alpha = static_cast<uint32_t>(r->iir_alpha);
 }
 
-void gyrocal_verilator_outputs(const GyrocalVerilator* g, GyrocalOutputs* out) {
+void GYROCAL_FN(outputs)(const GyrocalVerilator* g, GyrocalOutputs* out) {
     const Vgyro_interface* m = g->model.get();
     out->dac1 = static_cast<int16_t>(m->dac1);
     out->dac2 = static_cast<int16_t>(m->dac2);
@@ -84,7 +97,7 @@ void gyrocal_verilator_outputs(const GyrocalVerilator* g, GyrocalOutputs* out) {
     out->z_valid = m->z_valid;
 }
 
-void gyrocal_verilator_step(GyrocalVerilator* g, int16_t adc1, int16_t adc2, GyrocalOutputs* out) {
+void GYROCAL_FN(step)(GyrocalVerilator* g, int16_t adc1, int16_t adc2, GyrocalOutputs* out) {
     Vgyro_interface* m = g->model.get();
     m->adc1 = static_cast<uint16_t>(adc1);
     m->adc2 = static_cast<uint16_t>(adc2);
@@ -92,10 +105,10 @@ void gyrocal_verilator_step(GyrocalVerilator* g, int16_t adc1, int16_t adc2, Gyr
     m->eval();
     m->clock = 1;
     m->eval();
-    gyrocal_verilator_outputs(g, out);
+    GYROCAL_FN(outputs)(g, out);
 }
 
-void gyrocal_verilator_probes(const GyrocalVerilator* g, GyrocalProbes* p) {
+void GYROCAL_FN(probes)(const GyrocalVerilator* g, GyrocalProbes* p) {
     const Vgyro_interface___024root* r = g->model->rootp;
     p->ref1 = static_cast<int16_t>(r->gyro_interface__DOT__am_mixer__DOT__reference1__DOT__y_out__024q);
     p->ref2 = static_cast<int16_t>(r->gyro_interface__DOT__am_mixer__DOT__reference2__DOT__y_out__024q);
