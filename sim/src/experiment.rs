@@ -1182,4 +1182,56 @@ mod tests {
             "{within} of 400 within 1 sigma"
         );
     }
+    #[test]
+    fn the_realized_words_are_what_each_core_puts_out() {
+        // The readout drive word's fundamental, measured on the core's
+        // bit-true model over 2^24 clocks at the golden-ratio step (the
+        // carrier farthest from every fold: its phases fill the turn
+        // evenly soonest), against `realized_words` for the same core. The
+        // measurement's own rounding noise is 0.3 x sqrt(2 / 2^24) = 1e-4
+        // LSB; `realized_words` averages 2^16 phases, whose rounding
+        // pattern leaves it about 0.3 x sqrt(2 / 2^16) = 1.7e-3 LSB from the
+        // whole turn's average. 0.004 LSB bounds both (measured 0.0018 on
+        // the table core, 0.0009 on the fine). The cores' words differ by
+        // 0.009 LSB (3e-7: their carriers' gains and roundings), so the
+        // table core's words, which this crate used for both cores before,
+        // fail on the fine core.
+        use gyrocal_hdl::model::gyro_interface::{GyroInterface, Registers};
+        let amp = (29490, -20000);
+        let step = 0x61c8_8647_u32;
+        let mut measured = Vec::new();
+        for profile in CarrierProfile::ALL {
+            let mut core = GyroInterface::with_profile(profile);
+            let regs = Registers {
+                carrier_step: step,
+                amp,
+                ..Default::default()
+            };
+            for _ in 0..gyrocal_regs::datapath::DRIVE_START_CLOCKS + 64 {
+                core.step((0, 0), &regs);
+            }
+            let n = 1u32 << 24;
+            let (mut i, mut q) = (0.0, 0.0);
+            for k in 0..n {
+                let dac = f64::from(core.step((0, 0), &regs).dac.0);
+                let angle = f64::from(step.wrapping_mul(k)) * TAU / 2f64.powi(32);
+                i += dac * angle.cos();
+                q += dac * angle.sin();
+            }
+            let amplitude = 2.0 * i.hypot(q) / f64::from(n);
+            let want = realized_words(amp, Mode::Readout, profile)[0];
+            eprintln!("{profile}: measured {amplitude:.5} LSB, realized_words {want:.5}");
+            assert!(
+                (amplitude - want).abs() < 0.004,
+                "{profile}: {amplitude} against {want}"
+            );
+            measured.push(amplitude);
+        }
+        let table_words = realized_words(amp, Mode::Readout, CarrierProfile::Table)[0];
+        assert!(
+            (measured[1] - table_words).abs() > 0.004,
+            "the fine core's words {} are the table core's {table_words}",
+            measured[1]
+        );
+    }
 }
