@@ -34,7 +34,7 @@
 //! rounding at the carrier rate is a slow error of its own at a fold.
 
 use gyrocal_hdl::model::am_mixer::carrier_product;
-use gyrocal_hdl::model::carrier_nco::{table, table_sine};
+use gyrocal_hdl::model::carrier_nco::{carrier_word, table, table_sine};
 use gyrocal_hdl::model::sine_pair::sine_pair;
 use gyrocal_regs::datapath::CarrierProfile;
 use std::f64::consts::TAU;
@@ -82,10 +82,7 @@ impl Profile {
             // The pair's output is in quarter LSB.
             Profile::Pair => f64::from(sine_pair(phase).1) / 4.0,
             Profile::Dac(core, f) => {
-                let carrier = match core {
-                    CarrierProfile::Table => i32::from(table_sine(table(), phase, 0)),
-                    CarrierProfile::Fine => sine_pair(phase).1,
-                };
+                let carrier = carrier_word(core, phase);
                 f64::from(carrier_product(core, f, carrier)) * 32768.0 / f64::from(f)
             }
             Profile::Exact => (32767.0 * (f64::from(phase) / 2f64.powi(32) * TAU).sin()).round(),

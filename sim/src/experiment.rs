@@ -93,6 +93,7 @@ use gyrocal_hdl::cic_decimator::OUTPUT_FRACTION_BITS;
 use gyrocal_hdl::filter_design::FilterDesign;
 use gyrocal_hdl::gyro_interface::DRIVE_START_CLOCKS;
 use gyrocal_hdl::model::am_mixer::{carrier_fraction_bits, carrier_product};
+use gyrocal_hdl::model::carrier_nco::carrier_word;
 use gyrocal_hdl::model::gyro_interface::CarrierProfile;
 use gyrocal_hdl::model::gyro_interface::{Outputs, Probes, Registers};
 use gyrocal_hdl::model::q15_multiplier::q15_product;
@@ -319,27 +320,12 @@ fn table_gain(sine: impl Fn(u32) -> f64) -> f64 {
     2.0 * sum / PHASES as f64 / f64::from(PEAK)
 }
 
-/// The carrier word of the core with this profile at a 32-bit phase, in
-/// `Carriers`' scale (drive cos and sin share its gain: a quarter turn is a
-/// whole number of the table's intervals, and the pair's cosine is its
-/// sine a quarter turn on).
-fn carrier_word(profile: CarrierProfile, phase: u32) -> i32 {
-    match profile {
-        CarrierProfile::Table => {
-            let table = gyrocal_hdl::model::carrier_nco::table();
-            gyrocal_hdl::model::carrier_nco::table_sine(table, phase, 0).into()
-        }
-        CarrierProfile::Fine => gyrocal_hdl::model::sine_pair::sine_pair(phase).1,
-    }
-}
-
 /// Fundamental amplitude (LSB) of the drive and reference words per
 /// channel, as the AM mixer of the core with `profile` realizes them,
 /// rounding included: each word is the core's carrier product rounded half
 /// up (`carrier_product`: E times the table core's integer carrier over
 /// 2^15, or times the fine core's quarter-LSB carrier over 2^17), and the
-/// rounding error
-/// is a deterministic function of the table values that correlates with
+/// rounding error is a deterministic function of the table values that correlates with
 /// the sine (neglecting it left 2.3e-7 of the amplitude in readout and
 /// 5.3e-7 in calibration at amplitude 0.9; z carries the amplitude twice,
 /// so 1.1e-6 of the calibration scale factor, 4 to 6 of its sigmas on

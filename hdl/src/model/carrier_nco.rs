@@ -52,6 +52,17 @@ pub fn table_sine(table: &Table, phase: u32, advance: u8) -> i16 {
     super::quarter_wave::lookup(phase, advance, |index| table[index])
 }
 
+/// The drive sine word of the core with this profile at a 32-bit phase,
+/// in `Carriers`' scale: the table core's 16-bit word or the fine core's
+/// quarter-LSB one (`CarrierNco::step` makes the same words, four at a
+/// time). The cosine is the same word a quarter turn on.
+pub fn carrier_word(profile: CarrierProfile, phase: u32) -> i32 {
+    match profile {
+        CarrierProfile::Table => table_sine(table(), phase, 0).into(),
+        CarrierProfile::Fine => sine_pair(phase).1,
+    }
+}
+
 /// Outputs of the carrier NCO during one cycle: 16-bit words (peak
 /// 32767) from the table core, 18-bit quarter-LSB words (peak 4 x 32767)
 /// from the fine core.
