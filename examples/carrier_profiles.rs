@@ -27,14 +27,19 @@
 //! end; `exact` rounds `32767 sin` of the whole 32-bit phase.
 //!
 //! The last rows are the DAC words themselves, F x carrier as the cores'
-//! mixers make them at the default envelope F = 0.9 (29490), scaled back by
-//! 32768 / F: the table core rounds its 16-bit carrier and then the
-//! product (`gyrocal_hdl::am_mixer::AmMixer`), the fine core rounds the
-//! pair's quarter-LSB carrier times F once (`FineAmMixer`). A second
-//! rounding at the carrier rate is a slow error of its own at a fold.
+//! mixers make them clock by clock at the default envelope F = 0.9
+//! (29490), scaled back by 32768 / F (the model's
+//! `gyrocal_hdl::model::am_mixer::CarrierMultiplier`): the table core
+//! rounds its 16-bit carrier and then the product
+//! (`gyrocal_hdl::am_mixer::AmMixer`), a second rounding at the carrier
+//! rate, with a slow error of its own at a fold; the fine core rounds the
+//! pair's quarter-LSB carrier times F once and feeds that rounding's error
+//! back with zeros at the carrier (`FineAmMixer`), so only the pair's own
+//! error stays.
 
-use gyrocal_hdl::model::am_mixer::carrier_product;
+use gyrocal_hdl::model::am_mixer::{CarrierMultiplier, carrier_fraction_bits};
 use gyrocal_hdl::model::carrier_nco::{carrier_word, table, table_sine};
+use gyrocal_hdl::model::notch_coefficient::NotchCoefficient;
 use gyrocal_hdl::model::sine_pair::sine_pair;
 use gyrocal_regs::datapath::CarrierProfile;
 use std::f64::consts::TAU;
@@ -81,10 +86,7 @@ impl Profile {
             Profile::Built => f64::from(table_sine(table(), phase, 0)),
             // The pair's output is in quarter LSB.
             Profile::Pair => f64::from(sine_pair(phase).1) / 4.0,
-            Profile::Dac(core, f) => {
-                let carrier = carrier_word(core, phase);
-                f64::from(carrier_product(core, f, carrier)) * 32768.0 / f64::from(f)
-            }
+            Profile::Dac(..) => unreachable!("a core's DAC words are a stream: `Profile::words`"),
             Profile::Exact => (32767.0 * (f64::from(phase) / 2f64.powi(32) * TAU).sin()).round(),
             Profile::Table {
                 bits,
@@ -109,8 +111,35 @@ impl Profile {
     }
 }
 
+impl Profile {
+    /// The profile's sine at the phases `0, step, 2 step, ...`, called in
+    /// that order.
+    fn words(self, step: u32) -> Box<dyn FnMut(u32) -> f64> {
+        let Profile::Dac(core, f) = self else {
+            return Box::new(move |phase| self.sine(phase));
+        };
+        // The carrier product's words leave two edges after their factors:
+        // run the carriers two steps ahead of the phase asked for.
+        let mut product = CarrierMultiplier::new(carrier_fraction_bits(core));
+        let mut notch = NotchCoefficient::default();
+        let mut feed = move |phase: u32| {
+            let sin = carrier_word(core, phase);
+            let cos = carrier_word(core, phase.wrapping_add(1 << 30));
+            let k = notch.output();
+            notch.step(cos, sin);
+            product.step(f, sin, k)
+        };
+        feed(0);
+        feed(step);
+        Box::new(move |phase| {
+            f64::from(feed(phase.wrapping_add(step.wrapping_mul(2)))) * 32768.0 / f64::from(f)
+        })
+    }
+}
+
 /// RMS of the block means of the error's baseband about their mean (LSB).
 fn slow_error(profile: Profile, step: u32, clock_hz: f64) -> f64 {
+    let mut sine = profile.words(step);
     let block = (BLOCK_S * clock_hz).round() as usize;
     let blocks = (SPAN_S / BLOCK_S) as usize;
     let mut means = Vec::with_capacity(blocks);
@@ -119,7 +148,7 @@ fn slow_error(profile: Profile, step: u32, clock_hz: f64) -> f64 {
         let (mut i, mut q) = (0.0, 0.0);
         for _ in 0..block {
             let angle = f64::from(phase) / 2f64.powi(32) * TAU;
-            let error = profile.sine(phase) - 32767.0 * angle.sin();
+            let error = sine(phase) - 32767.0 * angle.sin();
             i += error * angle.sin();
             q += error * angle.cos();
             phase = phase.wrapping_add(step);

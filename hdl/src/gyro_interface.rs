@@ -40,7 +40,8 @@
 //! `crate::fine_carrier_nco` (interpolated sines from an initialized ROM
 //! and four multipliers: an ECP5 or larger part) and whose mixer is
 //! `crate::am_mixer::FineAmMixer` (the carriers in quarter LSB, one
-//! rounding to the DAC word). Their ports, registers, latencies and
+//! rounding to the DAC word, its error fed back away from the carrier).
+//! Their ports, registers, latencies and
 //! power-up timing are the same; only the carrier words and their product's
 //! rounding differ (`gyrocal_regs::datapath::CarrierProfile`).
 //!

@@ -20,6 +20,7 @@ pub mod iir_lowpass;
 pub mod iir_program;
 pub mod model;
 pub mod modulation_nco;
+pub mod notch_coefficient;
 pub mod primitives;
 pub mod q15_multiplier;
 pub mod quarter_wave;
@@ -30,6 +31,7 @@ pub use gyrocal_regs::plan as settings;
 pub mod sine;
 pub mod sine_pair;
 pub mod sine_table;
+pub mod small_multiplier;
 pub mod table_sine;
 #[cfg(test)]
 pub(crate) mod test_util;

@@ -346,7 +346,7 @@ fn realized_words(amp: (i16, i16), mode: Mode, profile: CarrierProfile) -> [f64;
             Mode::Readout => {
                 let envelope = q15_product(a, PEAK as i16);
                 let word = |p| carrier_product(profile, envelope, carrier_word(profile, p));
-                peak * table_gain(|p| f64::from(word(p)))
+                peak * table_gain(word)
             }
             Mode::Calibration => {
                 let modulation = |p| q15_product(a, gyrocal_hdl::model::sine::sine(p, 0));

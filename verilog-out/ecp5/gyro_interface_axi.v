@@ -1699,19 +1699,27 @@ module gyro_interface_axi__core__am_mixer(clock,amp1,amp2,am1,am2,drive_cos,driv
     reg  drive1$clock;
     reg signed [15:0] drive1$a;
     reg signed [17:0] drive1$b;
+    reg signed [8:0] drive1$k;
     wire signed [15:0] drive1$y;
     reg  drive2$clock;
     reg signed [15:0] drive2$a;
     reg signed [17:0] drive2$b;
+    reg signed [8:0] drive2$k;
     wire signed [15:0] drive2$y;
     reg  reference1$clock;
     reg signed [15:0] reference1$a;
     reg signed [17:0] reference1$b;
+    reg signed [8:0] reference1$k;
     wire signed [15:0] reference1$y;
     reg  reference2$clock;
     reg signed [15:0] reference2$a;
     reg signed [17:0] reference2$b;
+    reg signed [8:0] reference2$k;
     wire signed [15:0] reference2$y;
+    reg  notch$clock;
+    reg signed [17:0] notch$cos;
+    reg signed [17:0] notch$sin;
+    wire signed [8:0] notch$k;
 
     // Sub module instances
     gyro_interface_axi__core__am_mixer__envelope envelope(
@@ -1739,25 +1747,35 @@ module gyro_interface_axi__core__am_mixer(clock,amp1,amp2,am1,am2,drive_cos,driv
         .clock(drive1$clock),
         .a(drive1$a),
         .b(drive1$b),
+        .k(drive1$k),
         .y(drive1$y)
     );
     gyro_interface_axi__core__am_mixer__drive2 drive2(
         .clock(drive2$clock),
         .a(drive2$a),
         .b(drive2$b),
+        .k(drive2$k),
         .y(drive2$y)
     );
     gyro_interface_axi__core__am_mixer__reference1 reference1(
         .clock(reference1$clock),
         .a(reference1$a),
         .b(reference1$b),
+        .k(reference1$k),
         .y(reference1$y)
     );
     gyro_interface_axi__core__am_mixer__reference2 reference2(
         .clock(reference2$clock),
         .a(reference2$a),
         .b(reference2$b),
+        .k(reference2$k),
         .y(reference2$y)
+    );
+    gyro_interface_axi__core__am_mixer__notch notch(
+        .clock(notch$clock),
+        .cos(notch$cos),
+        .sin(notch$sin),
+        .k(notch$k)
     );
 
     // Update code
@@ -1798,56 +1816,112 @@ module gyro_interface_axi__core__am_mixer(clock,amp1,amp2,am1,am2,drive_cos,driv
         dac2 = drive2$y;
         ref1 = reference1$y;
         ref2 = reference2$y;
+        notch$clock = clock;
+        notch$cos = drive_cos;
+        notch$sin = drive_sin;
+        drive1$k = notch$k;
+        drive2$k = notch$k;
+        reference1$k = notch$k;
+        reference2$k = notch$k;
     end
 
 endmodule // gyro_interface_axi__core__am_mixer
 
 
-module gyro_interface_axi__core__am_mixer__drive1(clock,a,b,y);
+module gyro_interface_axi__core__am_mixer__drive1(clock,a,b,k,y);
 
     // Module arguments
     input wire  clock;
     input wire signed [15:0] a;
     input wire signed [17:0] b;
+    input wire signed [8:0] k;
     output reg signed [15:0] y;
 
     // Constant declarations
-    localparam signed half_lsb = 34'h10000;
+    localparam signed half_lsb = 19'b10000000000000000;
+    localparam  sign_of_residue = 17'b10000000000000000;
+    localparam  offset_flip = 19'b10000000000000000;
+    localparam signed word_max = 17'b111111111111111;
+    localparam signed word_min = 17'b11000000000000001;
+    localparam signed y_max = 16'h7fff;
+    localparam signed y_min = 16'h8001;
 
     // Stub signals
-    reg signed [15:0] a_in$d;
-    wire signed [15:0] a_in$q;
-    reg  a_in$clock;
-    reg signed [17:0] b_in$d;
-    wire signed [17:0] b_in$q;
-    reg  b_in$clock;
     reg  product$clock;
     reg signed [15:0] product$a;
     reg signed [17:0] product$b;
     wire signed [33:0] product$p;
+    reg  feedback$clock;
+    reg signed [8:0] feedback$a;
+    reg signed [8:0] feedback$b;
+    wire signed [17:0] feedback$p;
+    reg signed [16:0] residue_1$d;
+    wire signed [16:0] residue_1$q;
+    reg  residue_1$clock;
+    reg signed [16:0] residue_2$d;
+    wire signed [16:0] residue_2$q;
+    reg  residue_2$clock;
+    reg signed [16:0] residue_3$d;
+    wire signed [16:0] residue_3$q;
+    reg  residue_3$clock;
+    reg  [18:0] offset$d;
+    wire  [18:0] offset$q;
+    reg  offset$clock;
+    reg signed [16:0] word$d;
+    wire signed [16:0] word$q;
+    reg  word$clock;
     reg signed [15:0] y_out$d;
     wire signed [15:0] y_out$q;
     reg  y_out$clock;
 
     // Local signals
+    reg signed [8:0] residue_top;
+    reg signed [18:0] residue_3_wide;
+    reg signed [18:0] offset_next;
+    reg signed [18:0] offset_value;
+    reg signed [33:0] feedback_wide;
+    reg signed [33:0] feedback_scaled;
+    reg signed [33:0] offset_wide;
     reg signed [33:0] rounded;
+    reg  [16:0] low_bits;
 
     // Sub module instances
-    gyro_interface_axi__core__am_mixer__drive1__a_in a_in(
-        .d(a_in$d),
-        .q(a_in$q),
-        .clock(a_in$clock)
-    );
-    gyro_interface_axi__core__am_mixer__drive1__b_in b_in(
-        .d(b_in$d),
-        .q(b_in$q),
-        .clock(b_in$clock)
-    );
     gyro_interface_axi__core__am_mixer__drive1__product product(
         .clock(product$clock),
         .a(product$a),
         .b(product$b),
         .p(product$p)
+    );
+    gyro_interface_axi__core__am_mixer__drive1__feedback feedback(
+        .clock(feedback$clock),
+        .a(feedback$a),
+        .b(feedback$b),
+        .p(feedback$p)
+    );
+    gyro_interface_axi__core__am_mixer__drive1__residue_1 residue_1(
+        .d(residue_1$d),
+        .q(residue_1$q),
+        .clock(residue_1$clock)
+    );
+    gyro_interface_axi__core__am_mixer__drive1__residue_2 residue_2(
+        .d(residue_2$d),
+        .q(residue_2$q),
+        .clock(residue_2$clock)
+    );
+    gyro_interface_axi__core__am_mixer__drive1__residue_3 residue_3(
+        .d(residue_3$d),
+        .q(residue_3$q),
+        .clock(residue_3$clock)
+    );
+    gyro_interface_axi__core__am_mixer__drive1__offset offset(
+        .d(offset$d),
+        .q(offset$q),
+        .clock(offset$clock)
+    );
+    gyro_interface_axi__core__am_mixer__drive1__word word(
+        .d(word$d),
+        .q(word$q),
+        .clock(word$clock)
     );
     gyro_interface_axi__core__am_mixer__drive1__y_out y_out(
         .d(y_out$d),
@@ -1857,45 +1931,141 @@ module gyro_interface_axi__core__am_mixer__drive1(clock,a,b,y);
 
     // Update code
     always @(*) begin
-        a_in$clock = clock;
-        b_in$clock = clock;
+        residue_1$clock = clock;
+        residue_2$clock = clock;
+        residue_3$clock = clock;
+        offset$clock = clock;
+        word$clock = clock;
         y_out$clock = clock;
-        a_in$d = a_in$q;
-        b_in$d = b_in$q;
+        residue_1$d = residue_1$q;
+        residue_2$d = residue_2$q;
+        residue_3$d = residue_3$q;
+        offset$d = offset$q;
+        word$d = word$q;
         y_out$d = y_out$q;
-        a_in$d = a;
-        b_in$d = b;
         product$clock = clock;
-        product$a = a_in$q;
-        product$b = b_in$q;
-        rounded = product$p + half_lsb;
-        y_out$d = rounded[(32'h11)+:(16)];
+        product$a = a;
+        product$b = b;
+        feedback$clock = clock;
+        residue_top = residue_1$q[(32'h8)+:(9)];
+        feedback$a = k;
+        feedback$b = residue_top;
+        residue_3_wide = $signed(residue_3$q);
+        offset_next = half_lsb - residue_3_wide;
+        offset$d = $unsigned(offset_next) ^ offset_flip;
+        offset_value = $signed(offset$q ^ offset_flip);
+        feedback_wide = $signed(feedback$p);
+        feedback_scaled = $signed($unsigned(feedback_wide) << 32'h3);
+        offset_wide = $signed(offset_value);
+        rounded = (product$p + feedback_scaled) + offset_wide;
+        low_bits = $unsigned(rounded[(32'h0)+:(17)]);
+        residue_1$d = $signed(low_bits ^ sign_of_residue);
+        residue_2$d = residue_1$q;
+        residue_3$d = residue_2$q;
+        word$d = rounded[(32'h11)+:(17)];
+        y_out$d = word$q[(32'h0)+:(16)];
+        if (word$q > word_max) begin
+            y_out$d = y_max;
+        end
+        if (word$q < word_min) begin
+            y_out$d = y_min;
+        end
         y = y_out$q;
     end
 
 endmodule // gyro_interface_axi__core__am_mixer__drive1
 
 
-module gyro_interface_axi__core__am_mixer__drive1__a_in(d,q,clock);
+module gyro_interface_axi__core__am_mixer__drive1__feedback(clock,a,b,p);
 
     // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
     input wire  clock;
+    input wire signed [8:0] a;
+    input wire signed [8:0] b;
+    output reg signed [17:0] p;
 
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
+    // Constant declarations
+    localparam signed zero = 18'b0;
+
+    // Stub signals
+    reg signed [17:0] product$d;
+    wire signed [17:0] product$q;
+    reg  product$clock;
+
+    // Local signals
+    reg signed [17:0] wide;
+    reg  [8:0] bits;
+    reg signed [17:0] pp0;
+    reg signed [17:0] pp1;
+    reg signed [17:0] pp2;
+    reg signed [17:0] pp3;
+    reg signed [17:0] pp4;
+    reg signed [17:0] pp5;
+    reg signed [17:0] pp6;
+    reg signed [17:0] pp7;
+    reg signed [17:0] pp8;
+    reg signed [17:0] low;
+    reg signed [17:0] high;
+
+    // Sub module instances
+    gyro_interface_axi__core__am_mixer__drive1__feedback__product product(
+        .d(product$d),
+        .q(product$q),
+        .clock(product$clock)
+    );
+
+    // Update code
+    always @(*) begin
+        product$clock = clock;
+        product$d = product$q;
+        wide = $signed(a);
+        bits = $unsigned(b);
+        pp0 = zero;
+        if (bits[32'h0]) begin
+            pp0 = wide;
+        end
+        pp1 = zero;
+        if (bits[32'h1]) begin
+            pp1 = $signed($unsigned(wide) << 32'h1);
+        end
+        pp2 = zero;
+        if (bits[32'h2]) begin
+            pp2 = $signed($unsigned(wide) << 32'h2);
+        end
+        pp3 = zero;
+        if (bits[32'h3]) begin
+            pp3 = $signed($unsigned(wide) << 32'h3);
+        end
+        pp4 = zero;
+        if (bits[32'h4]) begin
+            pp4 = $signed($unsigned(wide) << 32'h4);
+        end
+        pp5 = zero;
+        if (bits[32'h5]) begin
+            pp5 = $signed($unsigned(wide) << 32'h5);
+        end
+        pp6 = zero;
+        if (bits[32'h6]) begin
+            pp6 = $signed($unsigned(wide) << 32'h6);
+        end
+        pp7 = zero;
+        if (bits[32'h7]) begin
+            pp7 = $signed($unsigned(wide) << 32'h7);
+        end
+        pp8 = zero;
+        if (bits[32'h8]) begin
+            pp8 = $signed($unsigned(wide) << 32'h8);
+        end
+        low = (pp0 + pp1) + (pp2 + pp3);
+        high = (pp4 + pp5) + (pp6 + pp7);
+        product$d = (low + high) - pp8;
+        p = product$q;
     end
 
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__am_mixer__drive1__a_in
+endmodule // gyro_interface_axi__core__am_mixer__drive1__feedback
 
 
-module gyro_interface_axi__core__am_mixer__drive1__b_in(d,q,clock);
+module gyro_interface_axi__core__am_mixer__drive1__feedback__product(d,q,clock);
 
     // Module arguments
     input wire signed [17:0] d;
@@ -1911,7 +2081,26 @@ module gyro_interface_axi__core__am_mixer__drive1__b_in(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__am_mixer__drive1__b_in
+endmodule // gyro_interface_axi__core__am_mixer__drive1__feedback__product
+
+
+module gyro_interface_axi__core__am_mixer__drive1__offset(d,q,clock);
+
+    // Module arguments
+    input wire  [18:0] d;
+    output reg  [18:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 19'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__drive1__offset
 
 
 module gyro_interface_axi__core__am_mixer__drive1__product(clock,a,b,p);
@@ -1929,6 +2118,82 @@ module gyro_interface_axi__core__am_mixer__drive1__product(clock,a,b,p);
        p <= a * b;
     end
 endmodule // gyro_interface_axi__core__am_mixer__drive1__product
+
+
+module gyro_interface_axi__core__am_mixer__drive1__residue_1(d,q,clock);
+
+    // Module arguments
+    input wire signed [16:0] d;
+    output reg signed [16:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 17'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__drive1__residue_1
+
+
+module gyro_interface_axi__core__am_mixer__drive1__residue_2(d,q,clock);
+
+    // Module arguments
+    input wire signed [16:0] d;
+    output reg signed [16:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 17'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__drive1__residue_2
+
+
+module gyro_interface_axi__core__am_mixer__drive1__residue_3(d,q,clock);
+
+    // Module arguments
+    input wire signed [16:0] d;
+    output reg signed [16:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 17'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__drive1__residue_3
+
+
+module gyro_interface_axi__core__am_mixer__drive1__word(d,q,clock);
+
+    // Module arguments
+    input wire signed [16:0] d;
+    output reg signed [16:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 17'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__drive1__word
 
 
 module gyro_interface_axi__core__am_mixer__drive1__y_out(d,q,clock);
@@ -1950,51 +2215,100 @@ module gyro_interface_axi__core__am_mixer__drive1__y_out(d,q,clock);
 endmodule // gyro_interface_axi__core__am_mixer__drive1__y_out
 
 
-module gyro_interface_axi__core__am_mixer__drive2(clock,a,b,y);
+module gyro_interface_axi__core__am_mixer__drive2(clock,a,b,k,y);
 
     // Module arguments
     input wire  clock;
     input wire signed [15:0] a;
     input wire signed [17:0] b;
+    input wire signed [8:0] k;
     output reg signed [15:0] y;
 
     // Constant declarations
-    localparam signed half_lsb = 34'h10000;
+    localparam signed half_lsb = 19'b10000000000000000;
+    localparam  sign_of_residue = 17'b10000000000000000;
+    localparam  offset_flip = 19'b10000000000000000;
+    localparam signed word_max = 17'b111111111111111;
+    localparam signed word_min = 17'b11000000000000001;
+    localparam signed y_max = 16'h7fff;
+    localparam signed y_min = 16'h8001;
 
     // Stub signals
-    reg signed [15:0] a_in$d;
-    wire signed [15:0] a_in$q;
-    reg  a_in$clock;
-    reg signed [17:0] b_in$d;
-    wire signed [17:0] b_in$q;
-    reg  b_in$clock;
     reg  product$clock;
     reg signed [15:0] product$a;
     reg signed [17:0] product$b;
     wire signed [33:0] product$p;
+    reg  feedback$clock;
+    reg signed [8:0] feedback$a;
+    reg signed [8:0] feedback$b;
+    wire signed [17:0] feedback$p;
+    reg signed [16:0] residue_1$d;
+    wire signed [16:0] residue_1$q;
+    reg  residue_1$clock;
+    reg signed [16:0] residue_2$d;
+    wire signed [16:0] residue_2$q;
+    reg  residue_2$clock;
+    reg signed [16:0] residue_3$d;
+    wire signed [16:0] residue_3$q;
+    reg  residue_3$clock;
+    reg  [18:0] offset$d;
+    wire  [18:0] offset$q;
+    reg  offset$clock;
+    reg signed [16:0] word$d;
+    wire signed [16:0] word$q;
+    reg  word$clock;
     reg signed [15:0] y_out$d;
     wire signed [15:0] y_out$q;
     reg  y_out$clock;
 
     // Local signals
+    reg signed [8:0] residue_top;
+    reg signed [18:0] residue_3_wide;
+    reg signed [18:0] offset_next;
+    reg signed [18:0] offset_value;
+    reg signed [33:0] feedback_wide;
+    reg signed [33:0] feedback_scaled;
+    reg signed [33:0] offset_wide;
     reg signed [33:0] rounded;
+    reg  [16:0] low_bits;
 
     // Sub module instances
-    gyro_interface_axi__core__am_mixer__drive2__a_in a_in(
-        .d(a_in$d),
-        .q(a_in$q),
-        .clock(a_in$clock)
-    );
-    gyro_interface_axi__core__am_mixer__drive2__b_in b_in(
-        .d(b_in$d),
-        .q(b_in$q),
-        .clock(b_in$clock)
-    );
     gyro_interface_axi__core__am_mixer__drive2__product product(
         .clock(product$clock),
         .a(product$a),
         .b(product$b),
         .p(product$p)
+    );
+    gyro_interface_axi__core__am_mixer__drive2__feedback feedback(
+        .clock(feedback$clock),
+        .a(feedback$a),
+        .b(feedback$b),
+        .p(feedback$p)
+    );
+    gyro_interface_axi__core__am_mixer__drive2__residue_1 residue_1(
+        .d(residue_1$d),
+        .q(residue_1$q),
+        .clock(residue_1$clock)
+    );
+    gyro_interface_axi__core__am_mixer__drive2__residue_2 residue_2(
+        .d(residue_2$d),
+        .q(residue_2$q),
+        .clock(residue_2$clock)
+    );
+    gyro_interface_axi__core__am_mixer__drive2__residue_3 residue_3(
+        .d(residue_3$d),
+        .q(residue_3$q),
+        .clock(residue_3$clock)
+    );
+    gyro_interface_axi__core__am_mixer__drive2__offset offset(
+        .d(offset$d),
+        .q(offset$q),
+        .clock(offset$clock)
+    );
+    gyro_interface_axi__core__am_mixer__drive2__word word(
+        .d(word$d),
+        .q(word$q),
+        .clock(word$clock)
     );
     gyro_interface_axi__core__am_mixer__drive2__y_out y_out(
         .d(y_out$d),
@@ -2004,45 +2318,141 @@ module gyro_interface_axi__core__am_mixer__drive2(clock,a,b,y);
 
     // Update code
     always @(*) begin
-        a_in$clock = clock;
-        b_in$clock = clock;
+        residue_1$clock = clock;
+        residue_2$clock = clock;
+        residue_3$clock = clock;
+        offset$clock = clock;
+        word$clock = clock;
         y_out$clock = clock;
-        a_in$d = a_in$q;
-        b_in$d = b_in$q;
+        residue_1$d = residue_1$q;
+        residue_2$d = residue_2$q;
+        residue_3$d = residue_3$q;
+        offset$d = offset$q;
+        word$d = word$q;
         y_out$d = y_out$q;
-        a_in$d = a;
-        b_in$d = b;
         product$clock = clock;
-        product$a = a_in$q;
-        product$b = b_in$q;
-        rounded = product$p + half_lsb;
-        y_out$d = rounded[(32'h11)+:(16)];
+        product$a = a;
+        product$b = b;
+        feedback$clock = clock;
+        residue_top = residue_1$q[(32'h8)+:(9)];
+        feedback$a = k;
+        feedback$b = residue_top;
+        residue_3_wide = $signed(residue_3$q);
+        offset_next = half_lsb - residue_3_wide;
+        offset$d = $unsigned(offset_next) ^ offset_flip;
+        offset_value = $signed(offset$q ^ offset_flip);
+        feedback_wide = $signed(feedback$p);
+        feedback_scaled = $signed($unsigned(feedback_wide) << 32'h3);
+        offset_wide = $signed(offset_value);
+        rounded = (product$p + feedback_scaled) + offset_wide;
+        low_bits = $unsigned(rounded[(32'h0)+:(17)]);
+        residue_1$d = $signed(low_bits ^ sign_of_residue);
+        residue_2$d = residue_1$q;
+        residue_3$d = residue_2$q;
+        word$d = rounded[(32'h11)+:(17)];
+        y_out$d = word$q[(32'h0)+:(16)];
+        if (word$q > word_max) begin
+            y_out$d = y_max;
+        end
+        if (word$q < word_min) begin
+            y_out$d = y_min;
+        end
         y = y_out$q;
     end
 
 endmodule // gyro_interface_axi__core__am_mixer__drive2
 
 
-module gyro_interface_axi__core__am_mixer__drive2__a_in(d,q,clock);
+module gyro_interface_axi__core__am_mixer__drive2__feedback(clock,a,b,p);
 
     // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
     input wire  clock;
+    input wire signed [8:0] a;
+    input wire signed [8:0] b;
+    output reg signed [17:0] p;
 
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
+    // Constant declarations
+    localparam signed zero = 18'b0;
+
+    // Stub signals
+    reg signed [17:0] product$d;
+    wire signed [17:0] product$q;
+    reg  product$clock;
+
+    // Local signals
+    reg signed [17:0] wide;
+    reg  [8:0] bits;
+    reg signed [17:0] pp0;
+    reg signed [17:0] pp1;
+    reg signed [17:0] pp2;
+    reg signed [17:0] pp3;
+    reg signed [17:0] pp4;
+    reg signed [17:0] pp5;
+    reg signed [17:0] pp6;
+    reg signed [17:0] pp7;
+    reg signed [17:0] pp8;
+    reg signed [17:0] low;
+    reg signed [17:0] high;
+
+    // Sub module instances
+    gyro_interface_axi__core__am_mixer__drive2__feedback__product product(
+        .d(product$d),
+        .q(product$q),
+        .clock(product$clock)
+    );
+
+    // Update code
+    always @(*) begin
+        product$clock = clock;
+        product$d = product$q;
+        wide = $signed(a);
+        bits = $unsigned(b);
+        pp0 = zero;
+        if (bits[32'h0]) begin
+            pp0 = wide;
+        end
+        pp1 = zero;
+        if (bits[32'h1]) begin
+            pp1 = $signed($unsigned(wide) << 32'h1);
+        end
+        pp2 = zero;
+        if (bits[32'h2]) begin
+            pp2 = $signed($unsigned(wide) << 32'h2);
+        end
+        pp3 = zero;
+        if (bits[32'h3]) begin
+            pp3 = $signed($unsigned(wide) << 32'h3);
+        end
+        pp4 = zero;
+        if (bits[32'h4]) begin
+            pp4 = $signed($unsigned(wide) << 32'h4);
+        end
+        pp5 = zero;
+        if (bits[32'h5]) begin
+            pp5 = $signed($unsigned(wide) << 32'h5);
+        end
+        pp6 = zero;
+        if (bits[32'h6]) begin
+            pp6 = $signed($unsigned(wide) << 32'h6);
+        end
+        pp7 = zero;
+        if (bits[32'h7]) begin
+            pp7 = $signed($unsigned(wide) << 32'h7);
+        end
+        pp8 = zero;
+        if (bits[32'h8]) begin
+            pp8 = $signed($unsigned(wide) << 32'h8);
+        end
+        low = (pp0 + pp1) + (pp2 + pp3);
+        high = (pp4 + pp5) + (pp6 + pp7);
+        product$d = (low + high) - pp8;
+        p = product$q;
     end
 
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__am_mixer__drive2__a_in
+endmodule // gyro_interface_axi__core__am_mixer__drive2__feedback
 
 
-module gyro_interface_axi__core__am_mixer__drive2__b_in(d,q,clock);
+module gyro_interface_axi__core__am_mixer__drive2__feedback__product(d,q,clock);
 
     // Module arguments
     input wire signed [17:0] d;
@@ -2058,7 +2468,26 @@ module gyro_interface_axi__core__am_mixer__drive2__b_in(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__am_mixer__drive2__b_in
+endmodule // gyro_interface_axi__core__am_mixer__drive2__feedback__product
+
+
+module gyro_interface_axi__core__am_mixer__drive2__offset(d,q,clock);
+
+    // Module arguments
+    input wire  [18:0] d;
+    output reg  [18:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 19'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__drive2__offset
 
 
 module gyro_interface_axi__core__am_mixer__drive2__product(clock,a,b,p);
@@ -2076,6 +2505,82 @@ module gyro_interface_axi__core__am_mixer__drive2__product(clock,a,b,p);
        p <= a * b;
     end
 endmodule // gyro_interface_axi__core__am_mixer__drive2__product
+
+
+module gyro_interface_axi__core__am_mixer__drive2__residue_1(d,q,clock);
+
+    // Module arguments
+    input wire signed [16:0] d;
+    output reg signed [16:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 17'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__drive2__residue_1
+
+
+module gyro_interface_axi__core__am_mixer__drive2__residue_2(d,q,clock);
+
+    // Module arguments
+    input wire signed [16:0] d;
+    output reg signed [16:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 17'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__drive2__residue_2
+
+
+module gyro_interface_axi__core__am_mixer__drive2__residue_3(d,q,clock);
+
+    // Module arguments
+    input wire signed [16:0] d;
+    output reg signed [16:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 17'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__drive2__residue_3
+
+
+module gyro_interface_axi__core__am_mixer__drive2__word(d,q,clock);
+
+    // Module arguments
+    input wire signed [16:0] d;
+    output reg signed [16:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 17'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__drive2__word
 
 
 module gyro_interface_axi__core__am_mixer__drive2__y_out(d,q,clock);
@@ -2282,99 +2787,247 @@ module gyro_interface_axi__core__am_mixer__fa2(d,q,clock);
 endmodule // gyro_interface_axi__core__am_mixer__fa2
 
 
-module gyro_interface_axi__core__am_mixer__reference1(clock,a,b,y);
+module gyro_interface_axi__core__am_mixer__notch(clock,cos,sin,k);
 
     // Module arguments
     input wire  clock;
-    input wire signed [15:0] a;
-    input wire signed [17:0] b;
-    output reg signed [15:0] y;
+    input wire signed [17:0] cos;
+    input wire signed [17:0] sin;
+    output reg signed [8:0] k;
 
     // Constant declarations
-    localparam signed half_lsb = 34'h10000;
+    localparam signed zero = 37'h0;
+    localparam signed half = 37'h8000000;
+    localparam  snapshot = 5'b0;
+    localparam  sign_step = 5'b1;
+    localparam  k_step = 5'b10011;
 
     // Stub signals
-    reg signed [15:0] a_in$d;
-    wire signed [15:0] a_in$q;
-    reg  a_in$clock;
-    reg signed [17:0] b_in$d;
-    wire signed [17:0] b_in$q;
-    reg  b_in$clock;
-    reg  product$clock;
-    reg signed [15:0] product$a;
-    reg signed [17:0] product$b;
-    wire signed [33:0] product$p;
-    reg signed [15:0] y_out$d;
-    wire signed [15:0] y_out$q;
-    reg  y_out$clock;
+    reg  [4:0] count$d;
+    wire  [4:0] count$q;
+    reg  count$clock;
+    reg signed [17:0] cos_1$d;
+    wire signed [17:0] cos_1$q;
+    reg  cos_1$clock;
+    reg signed [17:0] cos_2$d;
+    wire signed [17:0] cos_2$q;
+    reg  cos_2$clock;
+    reg signed [17:0] sin_1$d;
+    wire signed [17:0] sin_1$q;
+    reg  sin_1$clock;
+    reg signed [17:0] sin_2$d;
+    wire signed [17:0] sin_2$q;
+    reg  sin_2$clock;
+    reg signed [17:0] hold_c$d;
+    wire signed [17:0] hold_c$q;
+    reg  hold_c$clock;
+    reg signed [17:0] hold_s$d;
+    wire signed [17:0] hold_s$q;
+    reg  hold_s$clock;
+    reg  [17:0] bits_c$d;
+    wire  [17:0] bits_c$q;
+    reg  bits_c$clock;
+    reg  [17:0] bits_s$d;
+    wire  [17:0] bits_s$q;
+    reg  bits_s$clock;
+    reg signed [36:0] acc$d;
+    wire signed [36:0] acc$q;
+    reg  acc$clock;
+    reg signed [8:0] k_out$d;
+    wire signed [8:0] k_out$q;
+    reg  k_out$clock;
 
     // Local signals
-    reg signed [33:0] rounded;
+    reg signed [36:0] rounded;
+    reg signed [36:0] doubled;
+    reg signed [36:0] cos_wide;
+    reg signed [36:0] sin_wide;
+    reg signed [36:0] cos_term;
+    reg signed [36:0] sin_term;
 
     // Sub module instances
-    gyro_interface_axi__core__am_mixer__reference1__a_in a_in(
-        .d(a_in$d),
-        .q(a_in$q),
-        .clock(a_in$clock)
+    gyro_interface_axi__core__am_mixer__notch__count count(
+        .d(count$d),
+        .q(count$q),
+        .clock(count$clock)
     );
-    gyro_interface_axi__core__am_mixer__reference1__b_in b_in(
-        .d(b_in$d),
-        .q(b_in$q),
-        .clock(b_in$clock)
+    gyro_interface_axi__core__am_mixer__notch__cos_1 cos_1(
+        .d(cos_1$d),
+        .q(cos_1$q),
+        .clock(cos_1$clock)
     );
-    gyro_interface_axi__core__am_mixer__reference1__product product(
-        .clock(product$clock),
-        .a(product$a),
-        .b(product$b),
-        .p(product$p)
+    gyro_interface_axi__core__am_mixer__notch__cos_2 cos_2(
+        .d(cos_2$d),
+        .q(cos_2$q),
+        .clock(cos_2$clock)
     );
-    gyro_interface_axi__core__am_mixer__reference1__y_out y_out(
-        .d(y_out$d),
-        .q(y_out$q),
-        .clock(y_out$clock)
+    gyro_interface_axi__core__am_mixer__notch__sin_1 sin_1(
+        .d(sin_1$d),
+        .q(sin_1$q),
+        .clock(sin_1$clock)
+    );
+    gyro_interface_axi__core__am_mixer__notch__sin_2 sin_2(
+        .d(sin_2$d),
+        .q(sin_2$q),
+        .clock(sin_2$clock)
+    );
+    gyro_interface_axi__core__am_mixer__notch__hold_c hold_c(
+        .d(hold_c$d),
+        .q(hold_c$q),
+        .clock(hold_c$clock)
+    );
+    gyro_interface_axi__core__am_mixer__notch__hold_s hold_s(
+        .d(hold_s$d),
+        .q(hold_s$q),
+        .clock(hold_s$clock)
+    );
+    gyro_interface_axi__core__am_mixer__notch__bits_c bits_c(
+        .d(bits_c$d),
+        .q(bits_c$q),
+        .clock(bits_c$clock)
+    );
+    gyro_interface_axi__core__am_mixer__notch__bits_s bits_s(
+        .d(bits_s$d),
+        .q(bits_s$q),
+        .clock(bits_s$clock)
+    );
+    gyro_interface_axi__core__am_mixer__notch__acc acc(
+        .d(acc$d),
+        .q(acc$q),
+        .clock(acc$clock)
+    );
+    gyro_interface_axi__core__am_mixer__notch__k_out k_out(
+        .d(k_out$d),
+        .q(k_out$q),
+        .clock(k_out$clock)
     );
 
     // Update code
     always @(*) begin
-        a_in$clock = clock;
-        b_in$clock = clock;
-        y_out$clock = clock;
-        a_in$d = a_in$q;
-        b_in$d = b_in$q;
-        y_out$d = y_out$q;
-        a_in$d = a;
-        b_in$d = b;
-        product$clock = clock;
-        product$a = a_in$q;
-        product$b = b_in$q;
-        rounded = product$p + half_lsb;
-        y_out$d = rounded[(32'h11)+:(16)];
-        y = y_out$q;
+        count$clock = clock;
+        cos_1$clock = clock;
+        cos_2$clock = clock;
+        sin_1$clock = clock;
+        sin_2$clock = clock;
+        hold_c$clock = clock;
+        hold_s$clock = clock;
+        bits_c$clock = clock;
+        bits_s$clock = clock;
+        acc$clock = clock;
+        k_out$clock = clock;
+        count$d = count$q;
+        cos_1$d = cos_1$q;
+        cos_2$d = cos_2$q;
+        sin_1$d = sin_1$q;
+        sin_2$d = sin_2$q;
+        hold_c$d = hold_c$q;
+        hold_s$d = hold_s$q;
+        bits_c$d = bits_c$q;
+        bits_s$d = bits_s$q;
+        acc$d = acc$q;
+        k_out$d = k_out$q;
+        count$d = count$q + 32'h1;
+        cos_1$d = cos;
+        cos_2$d = cos_1$q;
+        sin_1$d = sin;
+        sin_2$d = sin_1$q;
+        doubled = $signed($unsigned(acc$q) << 32'h1);
+        cos_wide = $signed(hold_c$q);
+        sin_wide = $signed(hold_s$q);
+        cos_term = zero;
+        if (bits_c$q[32'h11]) begin
+            cos_term = cos_wide;
+            if (count$q == sign_step) begin
+                cos_term = zero - cos_wide;
+            end
+        end
+        sin_term = zero;
+        if (bits_s$q[32'h11]) begin
+            sin_term = sin_wide;
+            if (count$q == sign_step) begin
+                sin_term = zero - sin_wide;
+            end
+        end
+        if (count$q < k_step) begin
+            acc$d = (doubled + cos_term) + sin_term;
+            bits_c$d = bits_c$q << 32'h1;
+            bits_s$d = bits_s$q << 32'h1;
+        end
+        if (count$q == snapshot) begin
+            hold_c$d = cos;
+            hold_s$d = sin;
+            bits_c$d = $unsigned(cos_2$q);
+            bits_s$d = $unsigned(sin_2$q);
+            acc$d = zero;
+        end
+        rounded = acc$q + half;
+        if (count$q == k_step) begin
+            k_out$d = rounded[(32'h1c)+:(9)];
+        end
+        k = k_out$q;
     end
 
-endmodule // gyro_interface_axi__core__am_mixer__reference1
+endmodule // gyro_interface_axi__core__am_mixer__notch
 
 
-module gyro_interface_axi__core__am_mixer__reference1__a_in(d,q,clock);
+module gyro_interface_axi__core__am_mixer__notch__acc(d,q,clock);
 
     // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
+    input wire signed [36:0] d;
+    output reg signed [36:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 16'h0;
+       q = 37'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__am_mixer__reference1__a_in
+endmodule // gyro_interface_axi__core__am_mixer__notch__acc
 
 
-module gyro_interface_axi__core__am_mixer__reference1__b_in(d,q,clock);
+module gyro_interface_axi__core__am_mixer__notch__bits_c(d,q,clock);
+
+    // Module arguments
+    input wire  [17:0] d;
+    output reg  [17:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 18'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__notch__bits_c
+
+
+module gyro_interface_axi__core__am_mixer__notch__bits_s(d,q,clock);
+
+    // Module arguments
+    input wire  [17:0] d;
+    output reg  [17:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 18'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__notch__bits_s
+
+
+module gyro_interface_axi__core__am_mixer__notch__cos_1(d,q,clock);
 
     // Module arguments
     input wire signed [17:0] d;
@@ -2390,7 +3043,415 @@ module gyro_interface_axi__core__am_mixer__reference1__b_in(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__am_mixer__reference1__b_in
+endmodule // gyro_interface_axi__core__am_mixer__notch__cos_1
+
+
+module gyro_interface_axi__core__am_mixer__notch__cos_2(d,q,clock);
+
+    // Module arguments
+    input wire signed [17:0] d;
+    output reg signed [17:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 18'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__notch__cos_2
+
+
+module gyro_interface_axi__core__am_mixer__notch__count(d,q,clock);
+
+    // Module arguments
+    input wire  [4:0] d;
+    output reg  [4:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 5'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__notch__count
+
+
+module gyro_interface_axi__core__am_mixer__notch__hold_c(d,q,clock);
+
+    // Module arguments
+    input wire signed [17:0] d;
+    output reg signed [17:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 18'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__notch__hold_c
+
+
+module gyro_interface_axi__core__am_mixer__notch__hold_s(d,q,clock);
+
+    // Module arguments
+    input wire signed [17:0] d;
+    output reg signed [17:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 18'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__notch__hold_s
+
+
+module gyro_interface_axi__core__am_mixer__notch__k_out(d,q,clock);
+
+    // Module arguments
+    input wire signed [8:0] d;
+    output reg signed [8:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 9'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__notch__k_out
+
+
+module gyro_interface_axi__core__am_mixer__notch__sin_1(d,q,clock);
+
+    // Module arguments
+    input wire signed [17:0] d;
+    output reg signed [17:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 18'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__notch__sin_1
+
+
+module gyro_interface_axi__core__am_mixer__notch__sin_2(d,q,clock);
+
+    // Module arguments
+    input wire signed [17:0] d;
+    output reg signed [17:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 18'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__notch__sin_2
+
+
+module gyro_interface_axi__core__am_mixer__reference1(clock,a,b,k,y);
+
+    // Module arguments
+    input wire  clock;
+    input wire signed [15:0] a;
+    input wire signed [17:0] b;
+    input wire signed [8:0] k;
+    output reg signed [15:0] y;
+
+    // Constant declarations
+    localparam signed half_lsb = 19'b10000000000000000;
+    localparam  sign_of_residue = 17'b10000000000000000;
+    localparam  offset_flip = 19'b10000000000000000;
+    localparam signed word_max = 17'b111111111111111;
+    localparam signed word_min = 17'b11000000000000001;
+    localparam signed y_max = 16'h7fff;
+    localparam signed y_min = 16'h8001;
+
+    // Stub signals
+    reg  product$clock;
+    reg signed [15:0] product$a;
+    reg signed [17:0] product$b;
+    wire signed [33:0] product$p;
+    reg  feedback$clock;
+    reg signed [8:0] feedback$a;
+    reg signed [8:0] feedback$b;
+    wire signed [17:0] feedback$p;
+    reg signed [16:0] residue_1$d;
+    wire signed [16:0] residue_1$q;
+    reg  residue_1$clock;
+    reg signed [16:0] residue_2$d;
+    wire signed [16:0] residue_2$q;
+    reg  residue_2$clock;
+    reg signed [16:0] residue_3$d;
+    wire signed [16:0] residue_3$q;
+    reg  residue_3$clock;
+    reg  [18:0] offset$d;
+    wire  [18:0] offset$q;
+    reg  offset$clock;
+    reg signed [16:0] word$d;
+    wire signed [16:0] word$q;
+    reg  word$clock;
+    reg signed [15:0] y_out$d;
+    wire signed [15:0] y_out$q;
+    reg  y_out$clock;
+
+    // Local signals
+    reg signed [8:0] residue_top;
+    reg signed [18:0] residue_3_wide;
+    reg signed [18:0] offset_next;
+    reg signed [18:0] offset_value;
+    reg signed [33:0] feedback_wide;
+    reg signed [33:0] feedback_scaled;
+    reg signed [33:0] offset_wide;
+    reg signed [33:0] rounded;
+    reg  [16:0] low_bits;
+
+    // Sub module instances
+    gyro_interface_axi__core__am_mixer__reference1__product product(
+        .clock(product$clock),
+        .a(product$a),
+        .b(product$b),
+        .p(product$p)
+    );
+    gyro_interface_axi__core__am_mixer__reference1__feedback feedback(
+        .clock(feedback$clock),
+        .a(feedback$a),
+        .b(feedback$b),
+        .p(feedback$p)
+    );
+    gyro_interface_axi__core__am_mixer__reference1__residue_1 residue_1(
+        .d(residue_1$d),
+        .q(residue_1$q),
+        .clock(residue_1$clock)
+    );
+    gyro_interface_axi__core__am_mixer__reference1__residue_2 residue_2(
+        .d(residue_2$d),
+        .q(residue_2$q),
+        .clock(residue_2$clock)
+    );
+    gyro_interface_axi__core__am_mixer__reference1__residue_3 residue_3(
+        .d(residue_3$d),
+        .q(residue_3$q),
+        .clock(residue_3$clock)
+    );
+    gyro_interface_axi__core__am_mixer__reference1__offset offset(
+        .d(offset$d),
+        .q(offset$q),
+        .clock(offset$clock)
+    );
+    gyro_interface_axi__core__am_mixer__reference1__word word(
+        .d(word$d),
+        .q(word$q),
+        .clock(word$clock)
+    );
+    gyro_interface_axi__core__am_mixer__reference1__y_out y_out(
+        .d(y_out$d),
+        .q(y_out$q),
+        .clock(y_out$clock)
+    );
+
+    // Update code
+    always @(*) begin
+        residue_1$clock = clock;
+        residue_2$clock = clock;
+        residue_3$clock = clock;
+        offset$clock = clock;
+        word$clock = clock;
+        y_out$clock = clock;
+        residue_1$d = residue_1$q;
+        residue_2$d = residue_2$q;
+        residue_3$d = residue_3$q;
+        offset$d = offset$q;
+        word$d = word$q;
+        y_out$d = y_out$q;
+        product$clock = clock;
+        product$a = a;
+        product$b = b;
+        feedback$clock = clock;
+        residue_top = residue_1$q[(32'h8)+:(9)];
+        feedback$a = k;
+        feedback$b = residue_top;
+        residue_3_wide = $signed(residue_3$q);
+        offset_next = half_lsb - residue_3_wide;
+        offset$d = $unsigned(offset_next) ^ offset_flip;
+        offset_value = $signed(offset$q ^ offset_flip);
+        feedback_wide = $signed(feedback$p);
+        feedback_scaled = $signed($unsigned(feedback_wide) << 32'h3);
+        offset_wide = $signed(offset_value);
+        rounded = (product$p + feedback_scaled) + offset_wide;
+        low_bits = $unsigned(rounded[(32'h0)+:(17)]);
+        residue_1$d = $signed(low_bits ^ sign_of_residue);
+        residue_2$d = residue_1$q;
+        residue_3$d = residue_2$q;
+        word$d = rounded[(32'h11)+:(17)];
+        y_out$d = word$q[(32'h0)+:(16)];
+        if (word$q > word_max) begin
+            y_out$d = y_max;
+        end
+        if (word$q < word_min) begin
+            y_out$d = y_min;
+        end
+        y = y_out$q;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__reference1
+
+
+module gyro_interface_axi__core__am_mixer__reference1__feedback(clock,a,b,p);
+
+    // Module arguments
+    input wire  clock;
+    input wire signed [8:0] a;
+    input wire signed [8:0] b;
+    output reg signed [17:0] p;
+
+    // Constant declarations
+    localparam signed zero = 18'b0;
+
+    // Stub signals
+    reg signed [17:0] product$d;
+    wire signed [17:0] product$q;
+    reg  product$clock;
+
+    // Local signals
+    reg signed [17:0] wide;
+    reg  [8:0] bits;
+    reg signed [17:0] pp0;
+    reg signed [17:0] pp1;
+    reg signed [17:0] pp2;
+    reg signed [17:0] pp3;
+    reg signed [17:0] pp4;
+    reg signed [17:0] pp5;
+    reg signed [17:0] pp6;
+    reg signed [17:0] pp7;
+    reg signed [17:0] pp8;
+    reg signed [17:0] low;
+    reg signed [17:0] high;
+
+    // Sub module instances
+    gyro_interface_axi__core__am_mixer__reference1__feedback__product product(
+        .d(product$d),
+        .q(product$q),
+        .clock(product$clock)
+    );
+
+    // Update code
+    always @(*) begin
+        product$clock = clock;
+        product$d = product$q;
+        wide = $signed(a);
+        bits = $unsigned(b);
+        pp0 = zero;
+        if (bits[32'h0]) begin
+            pp0 = wide;
+        end
+        pp1 = zero;
+        if (bits[32'h1]) begin
+            pp1 = $signed($unsigned(wide) << 32'h1);
+        end
+        pp2 = zero;
+        if (bits[32'h2]) begin
+            pp2 = $signed($unsigned(wide) << 32'h2);
+        end
+        pp3 = zero;
+        if (bits[32'h3]) begin
+            pp3 = $signed($unsigned(wide) << 32'h3);
+        end
+        pp4 = zero;
+        if (bits[32'h4]) begin
+            pp4 = $signed($unsigned(wide) << 32'h4);
+        end
+        pp5 = zero;
+        if (bits[32'h5]) begin
+            pp5 = $signed($unsigned(wide) << 32'h5);
+        end
+        pp6 = zero;
+        if (bits[32'h6]) begin
+            pp6 = $signed($unsigned(wide) << 32'h6);
+        end
+        pp7 = zero;
+        if (bits[32'h7]) begin
+            pp7 = $signed($unsigned(wide) << 32'h7);
+        end
+        pp8 = zero;
+        if (bits[32'h8]) begin
+            pp8 = $signed($unsigned(wide) << 32'h8);
+        end
+        low = (pp0 + pp1) + (pp2 + pp3);
+        high = (pp4 + pp5) + (pp6 + pp7);
+        product$d = (low + high) - pp8;
+        p = product$q;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__reference1__feedback
+
+
+module gyro_interface_axi__core__am_mixer__reference1__feedback__product(d,q,clock);
+
+    // Module arguments
+    input wire signed [17:0] d;
+    output reg signed [17:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 18'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__reference1__feedback__product
+
+
+module gyro_interface_axi__core__am_mixer__reference1__offset(d,q,clock);
+
+    // Module arguments
+    input wire  [18:0] d;
+    output reg  [18:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 19'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__reference1__offset
 
 
 module gyro_interface_axi__core__am_mixer__reference1__product(clock,a,b,p);
@@ -2408,6 +3469,82 @@ module gyro_interface_axi__core__am_mixer__reference1__product(clock,a,b,p);
        p <= a * b;
     end
 endmodule // gyro_interface_axi__core__am_mixer__reference1__product
+
+
+module gyro_interface_axi__core__am_mixer__reference1__residue_1(d,q,clock);
+
+    // Module arguments
+    input wire signed [16:0] d;
+    output reg signed [16:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 17'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__reference1__residue_1
+
+
+module gyro_interface_axi__core__am_mixer__reference1__residue_2(d,q,clock);
+
+    // Module arguments
+    input wire signed [16:0] d;
+    output reg signed [16:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 17'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__reference1__residue_2
+
+
+module gyro_interface_axi__core__am_mixer__reference1__residue_3(d,q,clock);
+
+    // Module arguments
+    input wire signed [16:0] d;
+    output reg signed [16:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 17'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__reference1__residue_3
+
+
+module gyro_interface_axi__core__am_mixer__reference1__word(d,q,clock);
+
+    // Module arguments
+    input wire signed [16:0] d;
+    output reg signed [16:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 17'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__reference1__word
 
 
 module gyro_interface_axi__core__am_mixer__reference1__y_out(d,q,clock);
@@ -2429,51 +3566,100 @@ module gyro_interface_axi__core__am_mixer__reference1__y_out(d,q,clock);
 endmodule // gyro_interface_axi__core__am_mixer__reference1__y_out
 
 
-module gyro_interface_axi__core__am_mixer__reference2(clock,a,b,y);
+module gyro_interface_axi__core__am_mixer__reference2(clock,a,b,k,y);
 
     // Module arguments
     input wire  clock;
     input wire signed [15:0] a;
     input wire signed [17:0] b;
+    input wire signed [8:0] k;
     output reg signed [15:0] y;
 
     // Constant declarations
-    localparam signed half_lsb = 34'h10000;
+    localparam signed half_lsb = 19'b10000000000000000;
+    localparam  sign_of_residue = 17'b10000000000000000;
+    localparam  offset_flip = 19'b10000000000000000;
+    localparam signed word_max = 17'b111111111111111;
+    localparam signed word_min = 17'b11000000000000001;
+    localparam signed y_max = 16'h7fff;
+    localparam signed y_min = 16'h8001;
 
     // Stub signals
-    reg signed [15:0] a_in$d;
-    wire signed [15:0] a_in$q;
-    reg  a_in$clock;
-    reg signed [17:0] b_in$d;
-    wire signed [17:0] b_in$q;
-    reg  b_in$clock;
     reg  product$clock;
     reg signed [15:0] product$a;
     reg signed [17:0] product$b;
     wire signed [33:0] product$p;
+    reg  feedback$clock;
+    reg signed [8:0] feedback$a;
+    reg signed [8:0] feedback$b;
+    wire signed [17:0] feedback$p;
+    reg signed [16:0] residue_1$d;
+    wire signed [16:0] residue_1$q;
+    reg  residue_1$clock;
+    reg signed [16:0] residue_2$d;
+    wire signed [16:0] residue_2$q;
+    reg  residue_2$clock;
+    reg signed [16:0] residue_3$d;
+    wire signed [16:0] residue_3$q;
+    reg  residue_3$clock;
+    reg  [18:0] offset$d;
+    wire  [18:0] offset$q;
+    reg  offset$clock;
+    reg signed [16:0] word$d;
+    wire signed [16:0] word$q;
+    reg  word$clock;
     reg signed [15:0] y_out$d;
     wire signed [15:0] y_out$q;
     reg  y_out$clock;
 
     // Local signals
+    reg signed [8:0] residue_top;
+    reg signed [18:0] residue_3_wide;
+    reg signed [18:0] offset_next;
+    reg signed [18:0] offset_value;
+    reg signed [33:0] feedback_wide;
+    reg signed [33:0] feedback_scaled;
+    reg signed [33:0] offset_wide;
     reg signed [33:0] rounded;
+    reg  [16:0] low_bits;
 
     // Sub module instances
-    gyro_interface_axi__core__am_mixer__reference2__a_in a_in(
-        .d(a_in$d),
-        .q(a_in$q),
-        .clock(a_in$clock)
-    );
-    gyro_interface_axi__core__am_mixer__reference2__b_in b_in(
-        .d(b_in$d),
-        .q(b_in$q),
-        .clock(b_in$clock)
-    );
     gyro_interface_axi__core__am_mixer__reference2__product product(
         .clock(product$clock),
         .a(product$a),
         .b(product$b),
         .p(product$p)
+    );
+    gyro_interface_axi__core__am_mixer__reference2__feedback feedback(
+        .clock(feedback$clock),
+        .a(feedback$a),
+        .b(feedback$b),
+        .p(feedback$p)
+    );
+    gyro_interface_axi__core__am_mixer__reference2__residue_1 residue_1(
+        .d(residue_1$d),
+        .q(residue_1$q),
+        .clock(residue_1$clock)
+    );
+    gyro_interface_axi__core__am_mixer__reference2__residue_2 residue_2(
+        .d(residue_2$d),
+        .q(residue_2$q),
+        .clock(residue_2$clock)
+    );
+    gyro_interface_axi__core__am_mixer__reference2__residue_3 residue_3(
+        .d(residue_3$d),
+        .q(residue_3$q),
+        .clock(residue_3$clock)
+    );
+    gyro_interface_axi__core__am_mixer__reference2__offset offset(
+        .d(offset$d),
+        .q(offset$q),
+        .clock(offset$clock)
+    );
+    gyro_interface_axi__core__am_mixer__reference2__word word(
+        .d(word$d),
+        .q(word$q),
+        .clock(word$clock)
     );
     gyro_interface_axi__core__am_mixer__reference2__y_out y_out(
         .d(y_out$d),
@@ -2483,45 +3669,141 @@ module gyro_interface_axi__core__am_mixer__reference2(clock,a,b,y);
 
     // Update code
     always @(*) begin
-        a_in$clock = clock;
-        b_in$clock = clock;
+        residue_1$clock = clock;
+        residue_2$clock = clock;
+        residue_3$clock = clock;
+        offset$clock = clock;
+        word$clock = clock;
         y_out$clock = clock;
-        a_in$d = a_in$q;
-        b_in$d = b_in$q;
+        residue_1$d = residue_1$q;
+        residue_2$d = residue_2$q;
+        residue_3$d = residue_3$q;
+        offset$d = offset$q;
+        word$d = word$q;
         y_out$d = y_out$q;
-        a_in$d = a;
-        b_in$d = b;
         product$clock = clock;
-        product$a = a_in$q;
-        product$b = b_in$q;
-        rounded = product$p + half_lsb;
-        y_out$d = rounded[(32'h11)+:(16)];
+        product$a = a;
+        product$b = b;
+        feedback$clock = clock;
+        residue_top = residue_1$q[(32'h8)+:(9)];
+        feedback$a = k;
+        feedback$b = residue_top;
+        residue_3_wide = $signed(residue_3$q);
+        offset_next = half_lsb - residue_3_wide;
+        offset$d = $unsigned(offset_next) ^ offset_flip;
+        offset_value = $signed(offset$q ^ offset_flip);
+        feedback_wide = $signed(feedback$p);
+        feedback_scaled = $signed($unsigned(feedback_wide) << 32'h3);
+        offset_wide = $signed(offset_value);
+        rounded = (product$p + feedback_scaled) + offset_wide;
+        low_bits = $unsigned(rounded[(32'h0)+:(17)]);
+        residue_1$d = $signed(low_bits ^ sign_of_residue);
+        residue_2$d = residue_1$q;
+        residue_3$d = residue_2$q;
+        word$d = rounded[(32'h11)+:(17)];
+        y_out$d = word$q[(32'h0)+:(16)];
+        if (word$q > word_max) begin
+            y_out$d = y_max;
+        end
+        if (word$q < word_min) begin
+            y_out$d = y_min;
+        end
         y = y_out$q;
     end
 
 endmodule // gyro_interface_axi__core__am_mixer__reference2
 
 
-module gyro_interface_axi__core__am_mixer__reference2__a_in(d,q,clock);
+module gyro_interface_axi__core__am_mixer__reference2__feedback(clock,a,b,p);
 
     // Module arguments
-    input wire signed [15:0] d;
-    output reg signed [15:0] q;
     input wire  clock;
+    input wire signed [8:0] a;
+    input wire signed [8:0] b;
+    output reg signed [17:0] p;
 
-    // Update code (custom)
-    initial begin
-       q = 16'h0;
+    // Constant declarations
+    localparam signed zero = 18'b0;
+
+    // Stub signals
+    reg signed [17:0] product$d;
+    wire signed [17:0] product$q;
+    reg  product$clock;
+
+    // Local signals
+    reg signed [17:0] wide;
+    reg  [8:0] bits;
+    reg signed [17:0] pp0;
+    reg signed [17:0] pp1;
+    reg signed [17:0] pp2;
+    reg signed [17:0] pp3;
+    reg signed [17:0] pp4;
+    reg signed [17:0] pp5;
+    reg signed [17:0] pp6;
+    reg signed [17:0] pp7;
+    reg signed [17:0] pp8;
+    reg signed [17:0] low;
+    reg signed [17:0] high;
+
+    // Sub module instances
+    gyro_interface_axi__core__am_mixer__reference2__feedback__product product(
+        .d(product$d),
+        .q(product$q),
+        .clock(product$clock)
+    );
+
+    // Update code
+    always @(*) begin
+        product$clock = clock;
+        product$d = product$q;
+        wide = $signed(a);
+        bits = $unsigned(b);
+        pp0 = zero;
+        if (bits[32'h0]) begin
+            pp0 = wide;
+        end
+        pp1 = zero;
+        if (bits[32'h1]) begin
+            pp1 = $signed($unsigned(wide) << 32'h1);
+        end
+        pp2 = zero;
+        if (bits[32'h2]) begin
+            pp2 = $signed($unsigned(wide) << 32'h2);
+        end
+        pp3 = zero;
+        if (bits[32'h3]) begin
+            pp3 = $signed($unsigned(wide) << 32'h3);
+        end
+        pp4 = zero;
+        if (bits[32'h4]) begin
+            pp4 = $signed($unsigned(wide) << 32'h4);
+        end
+        pp5 = zero;
+        if (bits[32'h5]) begin
+            pp5 = $signed($unsigned(wide) << 32'h5);
+        end
+        pp6 = zero;
+        if (bits[32'h6]) begin
+            pp6 = $signed($unsigned(wide) << 32'h6);
+        end
+        pp7 = zero;
+        if (bits[32'h7]) begin
+            pp7 = $signed($unsigned(wide) << 32'h7);
+        end
+        pp8 = zero;
+        if (bits[32'h8]) begin
+            pp8 = $signed($unsigned(wide) << 32'h8);
+        end
+        low = (pp0 + pp1) + (pp2 + pp3);
+        high = (pp4 + pp5) + (pp6 + pp7);
+        product$d = (low + high) - pp8;
+        p = product$q;
     end
 
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__am_mixer__reference2__a_in
+endmodule // gyro_interface_axi__core__am_mixer__reference2__feedback
 
 
-module gyro_interface_axi__core__am_mixer__reference2__b_in(d,q,clock);
+module gyro_interface_axi__core__am_mixer__reference2__feedback__product(d,q,clock);
 
     // Module arguments
     input wire signed [17:0] d;
@@ -2537,7 +3819,26 @@ module gyro_interface_axi__core__am_mixer__reference2__b_in(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__am_mixer__reference2__b_in
+endmodule // gyro_interface_axi__core__am_mixer__reference2__feedback__product
+
+
+module gyro_interface_axi__core__am_mixer__reference2__offset(d,q,clock);
+
+    // Module arguments
+    input wire  [18:0] d;
+    output reg  [18:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 19'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__reference2__offset
 
 
 module gyro_interface_axi__core__am_mixer__reference2__product(clock,a,b,p);
@@ -2555,6 +3856,82 @@ module gyro_interface_axi__core__am_mixer__reference2__product(clock,a,b,p);
        p <= a * b;
     end
 endmodule // gyro_interface_axi__core__am_mixer__reference2__product
+
+
+module gyro_interface_axi__core__am_mixer__reference2__residue_1(d,q,clock);
+
+    // Module arguments
+    input wire signed [16:0] d;
+    output reg signed [16:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 17'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__reference2__residue_1
+
+
+module gyro_interface_axi__core__am_mixer__reference2__residue_2(d,q,clock);
+
+    // Module arguments
+    input wire signed [16:0] d;
+    output reg signed [16:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 17'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__reference2__residue_2
+
+
+module gyro_interface_axi__core__am_mixer__reference2__residue_3(d,q,clock);
+
+    // Module arguments
+    input wire signed [16:0] d;
+    output reg signed [16:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 17'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__reference2__residue_3
+
+
+module gyro_interface_axi__core__am_mixer__reference2__word(d,q,clock);
+
+    // Module arguments
+    input wire signed [16:0] d;
+    output reg signed [16:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 17'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__am_mixer__reference2__word
 
 
 module gyro_interface_axi__core__am_mixer__reference2__y_out(d,q,clock);

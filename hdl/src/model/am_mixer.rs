@@ -2,7 +2,10 @@
 //! `crate::am_mixer::FineAmMixer`.
 
 use super::carrier_nco::Carriers;
+use super::notch_coefficient::NotchCoefficient;
 use super::q15_multiplier::Q15Multiplier;
+use crate::carrier_multiplier::{FEEDBACK_SCALE, RESIDUE_DROP, SHIFT, WORD_LIMIT};
+use crate::fine_sine_table::OUTPUT_FRACTION_BITS;
 use crate::q15_multiplier::LATENCY;
 use gyrocal_regs::datapath::CarrierProfile;
 
@@ -19,26 +22,49 @@ pub struct Drives {
     pub ref2: i16,
 }
 
-/// Cycle-true model of a carrier product, `crate::q15_multiplier` (16-bit
-/// carriers) or `crate::carrier_multiplier` (quarter-LSB carriers): the
-/// factor, product and rounding registers, `round(a c / 2^shift)` rounded
-/// half up.
+/// Cycle-true model of a carrier product: `crate::q15_multiplier` (the
+/// table core's 16-bit carriers: factor, product and rounding registers),
+/// `round(a c / 2^15)` rounded half up; or `crate::carrier_multiplier`
+/// (the fine core's quarter-LSB carriers: product, rounding and
+/// saturation registers), `a c / 2^17` rounded half up with its rounding
+/// error fed back through `1 - k z^-2 + z^-4` (`k` from
+/// `crate::notch_coefficient`).
 #[derive(Clone, Copy, Debug)]
 pub struct CarrierMultiplier {
     factors: (i16, i32),
     product: i64,
+    /// The fine core's error feedback: `k` times the residue of two
+    /// cycles back without its low `RESIDUE_DROP` bits (the feedback
+    /// product's register), ...
+    feedback: i64,
+    /// ... the residues u - 2^17 y of the last three cycles, newest
+    /// first, ...
+    residues: [i32; 3],
+    /// ... 2^16 minus the residue of four cycles back ...
+    offset: i32,
+    /// ... and the word before saturation.
+    word: i64,
     y: i16,
-    shift: u32,
+    shaped: bool,
 }
 
 impl CarrierMultiplier {
-    /// The product for carriers with `fraction_bits` below the LSB.
+    /// The product for carriers with `fraction_bits` below the LSB: the
+    /// table core's (0) or the fine core's (`OUTPUT_FRACTION_BITS`).
     pub fn new(fraction_bits: u32) -> Self {
+        assert!(
+            fraction_bits == 0 || fraction_bits == OUTPUT_FRACTION_BITS,
+            "carrier fraction bits {fraction_bits}: the cores have 0 or {OUTPUT_FRACTION_BITS}"
+        );
         Self {
             factors: (0, 0),
             product: 0,
+            feedback: 0,
+            residues: [0; 3],
+            offset: 1 << (SHIFT - 1),
+            word: 0,
             y: 0,
-            shift: 15 + fraction_bits,
+            shaped: fraction_bits != 0,
         }
     }
 
@@ -48,19 +74,35 @@ impl CarrierMultiplier {
         self.y
     }
 
-    /// One clock; returns `y` after the edge.
+    /// One clock with the notch coefficient `k` (unused by the table
+    /// core's product); returns `y` after the edge.
     #[inline(always)]
-    pub fn step(&mut self, a: i16, c: i32) -> i16 {
-        // The two cores' shifts as constants: with a shift by a variable the
-        // model engine ran 1.5% slower (`gyrocal bench --engines model`).
-        self.y = match self.shift {
-            15 => round_product(self.product, 15),
-            17 => round_product(self.product, 17),
-            shift => round_product(self.product, shift),
-        };
-        self.product = i64::from(self.factors.0) * i64::from(self.factors.1);
-        self.factors = (a, c);
+    pub fn step(&mut self, a: i16, c: i32, k: i32) -> i16 {
+        if self.shaped {
+            self.shape(k);
+            self.product = i64::from(a) * i64::from(c);
+        } else {
+            self.y = round_product(self.product, 15);
+            self.product = i64::from(self.factors.0) * i64::from(self.factors.1);
+            self.factors = (a, c);
+        }
         self.y
+    }
+
+    /// The fine core's rounding and saturation stages and its feedback
+    /// registers.
+    #[inline(always)]
+    fn shape(&mut self, k: i32) {
+        self.y = self.word.clamp(-WORD_LIMIT, WORD_LIMIT) as i16;
+        // rounded = u + 2^16 = p + 8 k (r[n-2] >> 8) + 2^16 - r[n-4].
+        let rounded = self.product + (self.feedback << FEEDBACK_SCALE) + i64::from(self.offset);
+        self.word = rounded >> SHIFT;
+        // r = u - 2^17 round(u / 2^17): the low 17 bits of u, signed.
+        let low = (rounded as i32) & ((1 << SHIFT) - 1);
+        let residue = ((low ^ (1 << (SHIFT - 1))) << (32 - SHIFT)) >> (32 - SHIFT);
+        self.feedback = i64::from(k) * i64::from(self.residues[0] >> RESIDUE_DROP);
+        self.offset = (1 << (SHIFT - 1)) - self.residues[2];
+        self.residues = [residue, self.residues[0], self.residues[1]];
     }
 }
 
@@ -72,13 +114,17 @@ fn round_product(p: i64, shift: u32) -> i16 {
 }
 
 /// The DAC or reference word of the core with this profile for the
-/// envelope F A `a` and the carrier word `c` (`Carriers`' scale): the
-/// carrier product's output, without its pipeline.
-pub fn carrier_product(profile: CarrierProfile, a: i16, c: i32) -> i16 {
-    round_product(
-        i64::from(a) * i64::from(c),
-        15 + carrier_fraction_bits(profile),
-    )
+/// envelope F A `a` and the carrier word `c` (`Carriers`' scale), as the
+/// carrier sees it, without the pipeline: on the table core the word
+/// itself, `a c / 2^15` rounded half up; on the fine core the exact `a c /
+/// 2^17`, since its rounding error is fed back with zeros at the carrier
+/// and none of it stays at the carrier's frequency.
+pub fn carrier_product(profile: CarrierProfile, a: i16, c: i32) -> f64 {
+    let p = i64::from(a) * i64::from(c);
+    match profile {
+        CarrierProfile::Table => f64::from(round_product(p, 15)),
+        CarrierProfile::Fine => p as f64 / f64::from(1 << SHIFT),
+    }
 }
 
 /// Fraction bits of the carrier words a core's mixer takes.
@@ -100,6 +146,8 @@ pub struct AmMixer {
     drive2: CarrierMultiplier,
     reference1: CarrierMultiplier,
     reference2: CarrierMultiplier,
+    /// The fine core's notch coefficient (`None` on the table core).
+    notch: Option<NotchCoefficient>,
 }
 
 impl Default for AmMixer {
@@ -120,6 +168,10 @@ impl AmMixer {
             drive2: product,
             reference1: product,
             reference2: product,
+            notch: match profile {
+                CarrierProfile::Table => None,
+                CarrierProfile::Fine => Some(NotchCoefficient::default()),
+            },
         }
     }
 
@@ -151,10 +203,18 @@ impl AmMixer {
             self.envelope.step(amp.0, am.0);
         }
         self.turn = !self.turn;
-        self.drive1.step(fa1, carriers.drive_cos);
-        self.drive2.step(fa2, carriers.drive_sin);
-        self.reference1.step(fa1, carriers.ref_cos);
-        self.reference2.step(fa2, carriers.ref_sin);
+        let k = match &mut self.notch {
+            Some(notch) => {
+                let k = notch.output();
+                notch.step(carriers.drive_cos, carriers.drive_sin);
+                k
+            }
+            None => 0,
+        };
+        self.drive1.step(fa1, carriers.drive_cos, k);
+        self.drive2.step(fa2, carriers.drive_sin, k);
+        self.reference1.step(fa1, carriers.ref_cos, k);
+        self.reference2.step(fa2, carriers.ref_sin, k);
         self.output()
     }
 }

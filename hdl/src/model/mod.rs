@@ -14,6 +14,7 @@ pub mod demod_mux;
 pub mod gyro_interface;
 pub mod iir_lowpass;
 pub mod modulation_nco;
+pub mod notch_coefficient;
 pub mod q15_multiplier;
 pub mod quarter_wave;
 pub mod reference_alignment;
