@@ -322,14 +322,16 @@ fn table_gain(sine: impl Fn(u32) -> f64) -> f64 {
 
 /// Fundamental amplitude (LSB) of the drive and reference words per
 /// channel, as the AM mixer of the core with `profile` realizes them,
-/// rounding included: each word is the core's carrier product rounded half
-/// up (`carrier_product`: E times the table core's integer carrier over
-/// 2^15, or times the fine core's quarter-LSB carrier over 2^17), and the
-/// rounding error is a deterministic function of the table values that correlates with
-/// the sine (neglecting it left 2.3e-7 of the amplitude in readout and
+/// rounding included (`carrier_product`). On the table core each word is E
+/// times the integer carrier over 2^15, rounded half up, and that rounding
+/// error is a deterministic function of the table values that correlates
+/// with the sine (neglecting it left 2.3e-7 of the amplitude in readout and
 /// 5.3e-7 in calibration at amplitude 0.9; z carries the amplitude twice,
 /// so 1.1e-6 of the calibration scale factor, 4 to 6 of its sigmas on
-/// resonant outputs).
+/// resonant outputs). On the fine core the word is E times the quarter-LSB
+/// carrier over 2^17, and its rounding error is fed back with zeros at the
+/// carrier, so the exact product is what the carrier sees (the test below
+/// measures both cores' words).
 /// - Readout: the envelope is one integer E = q15(amp, PEAK) (29490 for
 ///   amplitude 0.9), and the word carrier_product(E, carrier), whose fundamental is
 ///   averaged over the carrier's phases (`table_gain`).
