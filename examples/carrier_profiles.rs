@@ -109,9 +109,7 @@ impl Profile {
             }
         }
     }
-}
 
-impl Profile {
     /// The profile's sine at the phases `0, step, 2 step, ...`, called in
     /// that order.
     fn words(self, step: u32) -> Box<dyn FnMut(u32) -> f64> {
