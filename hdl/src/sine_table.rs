@@ -14,8 +14,10 @@
 //! at the quadrant edges. Every value lies in [0, 32767], a 16-bit signed
 //! word; 4096 x 16 bits is 16 iCE40 `SB_RAM40_4K` or 4 ECP5 `DP16KD`.
 
-/// Address bits of the quarter-wave table (4096 entries).
-pub const ADDRESS_BITS: usize = 12;
+/// Address bits of the quarter-wave table (4096 entries); defined in the
+/// leaf crate, whose host code computes the calibration envelope's
+/// fundamental from the same words.
+pub const ADDRESS_BITS: usize = gyrocal_regs::datapath::MODULATION_TABLE_BITS;
 /// Number of entries in the quarter-wave table.
 pub const ENTRIES: usize = 1 << ADDRESS_BITS;
 /// Peak amplitude of every sine/cosine in the datapath: full scale of a
@@ -27,10 +29,10 @@ pub fn step_radians() -> f64 {
     std::f64::consts::FRAC_PI_2 / ENTRIES as f64
 }
 
-/// `value[i]`, the sine at the centre of interval i of the first quadrant.
+/// `value[i]`, the sine at the centre of interval i of the first quadrant
+/// (`gyrocal_regs::datapath::modulation_word`).
 pub fn value(i: usize) -> i32 {
-    let d = step_radians();
-    (PEAK as f64 * ((i as f64 + 0.5) * d).sin()).round() as i32
+    gyrocal_regs::datapath::modulation_word(i)
 }
 
 /// The whole table, `value[0..4096]`.
