@@ -244,14 +244,25 @@ fn step_notes(s: &mut String, report: &FieldReport) {
         .iter()
         .filter(|st| st.selfcal.operating.fold_shift_hz != 0.0)
     {
-        let _ = writeln!(
-            s,
-            "{:>8.2}  the carrier moved {:+.4} Hz to keep its folds out of the passband (nearest now {:.0} Hz away, period {} clocks)",
-            st.temperature_c,
-            st.selfcal.operating.fold_shift_hz,
-            st.carrier_fold.offset_hz,
-            st.carrier_fold.period
-        );
+        let f = &st.carrier_fold;
+        let (t, shift) = (st.temperature_c, st.selfcal.operating.fold_shift_hz);
+        // A move that could not clear the passband only made the fold
+        // beat faster (`gyrocal_regs::plan::SETTLED_FOLD_BEATS`).
+        let _ = if f.in_passband {
+            writeln!(
+                s,
+                "{t:>8.2}  the carrier moved {shift:+.4} Hz so that its nearest fold (period {} clocks, now {:.1} Hz away) beats {:.1} times a measurement window; clearing the passband would have moved the scale factors too far",
+                f.period,
+                f.offset_hz,
+                f.offset_hz * report.knowns.filter.min_window_s
+            )
+        } else {
+            writeln!(
+                s,
+                "{t:>8.2}  the carrier moved {shift:+.4} Hz to keep its folds out of the passband (nearest now {:.0} Hz away, period {} clocks)",
+                f.offset_hz, f.period
+            )
+        };
     }
     for st in &report.steps {
         if let Some(clause) = st.carrier_fold.clause() {

@@ -87,8 +87,10 @@
 //! than once a measurement window is worse: its error is the same in every
 //! batch, so it biases the figures where no sigma sees it. Where the
 //! passband cannot be cleared, the operating point still moves the carrier
-//! so that the short folds beat at least `plan::STATIC_FOLD_BEATS` times a
-//! window, within the same reach and `STATIC_FOLD_SF_CHANGE`.
+//! so that the short folds beat at least `plan::SETTLED_FOLD_BEATS` times a
+//! window (a beat's residual in a window's mean falls as the beats grow),
+//! or, if that move is too far, `plan::STATIC_FOLD_BEATS` times, within
+//! the same reach and `STATIC_FOLD_SF_CHANGE`.
 mod budget;
 mod predict;
 mod staircase;
@@ -238,13 +240,19 @@ pub fn operating(knowns: &Knowns, id: &Identified) -> Result<Operating, Error> {
     };
     let mut op = at(asked)?;
     // The passband clear of every fold, else the short folds beating
-    // within a window; the first move the allowance admits.
+    // `SETTLED_FOLD_BEATS` times a window, else once; the first move the
+    // allowance admits.
     let bandwidth = nearer_bandwidth(id, asked);
     let clears = [
         (
             plan::FOLD_CLEAR_CORNERS * knowns.filter.butterworth_hz,
             plan::MAX_FOLD_PERIOD,
             FOLD_SF_CHANGE,
+        ),
+        (
+            plan::SETTLED_FOLD_BEATS / knowns.filter.min_window_s,
+            plan::STATIC_FOLD_PERIOD,
+            STATIC_FOLD_SF_CHANGE,
         ),
         (
             plan::STATIC_FOLD_BEATS / knowns.filter.min_window_s,
@@ -296,8 +304,9 @@ pub const FOLD_SHIFT_BANDWIDTHS: f64 = 0.1;
 /// device the 0.8 Hz that clears the 25 deg C fold moves them by 3%; the
 /// 11.8 Hz for the 30 deg C fold would move them by 45%, and on the
 /// consumer device an 8.7 mHz move changed output 2's by a third (its
-/// readout term is the small real part of mode 1's response): those stay
-/// where they are, and their field steps report the fold.
+/// readout term is the small real part of mode 1's response): those do
+/// not clear their fold (at most they move by the static fold's rule,
+/// `plan::SETTLED_FOLD_BEATS`), and their field steps report it.
 pub const FOLD_SF_CHANGE: f64 = 0.05;
 
 /// [`FOLD_SF_CHANGE`] for a move off a static fold
