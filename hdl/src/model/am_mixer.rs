@@ -82,7 +82,7 @@ impl CarrierMultiplier {
             self.shape(k);
             self.product = i64::from(a) * i64::from(c);
         } else {
-            self.y = round_product(self.product, 15);
+            self.y = round_product(self.product);
             self.product = i64::from(self.factors.0) * i64::from(self.factors.1);
             self.factors = (a, c);
         }
@@ -106,11 +106,12 @@ impl CarrierMultiplier {
     }
 }
 
-/// `round(p / 2^shift)`, rounded half up: |p| < 2^33 and the result
-/// within 16 bits for every product of the mixers (`crate::am_mixer`).
+/// `round(p / 2^15)`, rounded half up, the table core's one shift: |p| <
+/// 2^33 and the result within 16 bits for every product of the mixers
+/// (`crate::am_mixer`).
 #[inline(always)]
-fn round_product(p: i64, shift: u32) -> i16 {
-    ((p + (1 << (shift - 1))) >> shift) as i16
+fn round_product(p: i64) -> i16 {
+    ((p + (1 << 14)) >> 15) as i16
 }
 
 /// The DAC or reference word of the core with this profile for the
@@ -122,7 +123,7 @@ fn round_product(p: i64, shift: u32) -> i16 {
 pub fn carrier_product(profile: CarrierProfile, a: i16, c: i32) -> f64 {
     let p = i64::from(a) * i64::from(c);
     match profile {
-        CarrierProfile::Table => f64::from(round_product(p, 15)),
+        CarrierProfile::Table => f64::from(round_product(p)),
         CarrierProfile::Fine => p as f64 / f64::from(1 << SHIFT),
     }
 }
