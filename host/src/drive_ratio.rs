@@ -221,8 +221,8 @@ impl CrossWindows {
         for (s, sign) in [1.0, -1.0].into_iter().enumerate() {
             let amps = (DRIVE1_FRACTION * op.amplitude.0, sign * op.amplitude.1);
             let (regs, _) = knowns.registers(op.carrier_hz, None, amps, op.ref_lag_deg)?;
-            w1 = signed_readout_word(regs.amp.0);
-            words[s] = signed_readout_word(regs.amp.1);
+            w1 = signed_readout_word(knowns.carrier_profile, regs.amp.0);
+            words[s] = signed_readout_word(knowns.carrier_profile, regs.amp.1);
             let mut pair = vec![];
             for quarter in [0u32, 1 << 30] {
                 let mut rotated = regs;

@@ -18,7 +18,7 @@
 
 use crate::board::{Board, ZSample};
 use crate::theory::hold_gain;
-use gyrocal_regs::datapath::readout_word;
+use gyrocal_regs::datapath::{CarrierProfile, readout_word};
 use gyrocal_regs::filter_design::cic_bit_growth;
 use gyrocal_regs::map::{
     BusError, RegisterAccess, RegisterBank, SAMPLE_COUNT, Z1_HI, Z1_LO, Z2_HI, Z2_LO,
@@ -69,7 +69,8 @@ impl Lorentzian {
         std::array::from_fn(|m| {
             let (fk, bk, c) = self.modes[m];
             let y = hold_gain(f, self.clock_hz) * c / C64::new((fk - f) * (fk + f), f * bk);
-            let w = readout_word(amps[m]);
+            // Exact products, as the fine core's words are.
+            let w = readout_word(CarrierProfile::Fine, amps[m]);
             self.state = self.state.wrapping_mul(6364136223846793005).wrapping_add(1);
             let n = ((self.state >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 2.0 * self.noise;
             dc / 2.0 * w * w * (y * C64::from_polar(1.0, -theta)).re + n

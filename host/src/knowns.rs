@@ -6,6 +6,7 @@
 use crate::device::GyroParams;
 use crate::error::Error;
 use gyrocal_regs::Registers;
+use gyrocal_regs::datapath::CarrierProfile;
 use gyrocal_regs::plan::{self, FrequencyPlan, Realized};
 use serde::Serialize;
 use std::f64::consts::{PI, TAU};
@@ -60,6 +61,15 @@ pub struct Knowns {
     pub rates_dps: Vec<f64>,
     /// Calibration frequencies of the staircase (Hz).
     pub cal_freqs_hz: Vec<f64>,
+    /// The core the board carries (`[drive] carrier_profile`): how it
+    /// forms its drive and reference words, which the predictions take
+    /// at their realized amplitudes (`gyrocal_regs::datapath::readout_word`).
+    #[serde(serialize_with = "profile_name")]
+    pub carrier_profile: CarrierProfile,
+}
+
+fn profile_name<S: serde::Serializer>(p: &CarrierProfile, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_str(p.name())
 }
 
 /// REF_PHASE word of a phase in degrees (2^32 = 360 deg), wrapping.

@@ -40,6 +40,8 @@ fn knowns(datasheet: GyroParams) -> Knowns {
         rates_dps: vec![1.0, 20.0],
         cal_freqs_hz: vec![10.0, 15.0],
         nominal: datasheet,
+        // The fake board's words are the exact product.
+        carrier_profile: gyrocal_regs::datapath::CarrierProfile::Fine,
     }
 }
 

@@ -8,6 +8,8 @@
 //! fill time), `gyrocal-hdl` asserts at compile time that it equals the
 //! constant here.
 
+use std::sync::OnceLock;
+
 /// Number of CIC integrator and comb stages.
 pub const CIC_STAGES: u32 = 4;
 /// log2 of the largest CIC decimation.
@@ -133,12 +135,120 @@ pub fn q15_product(a: i16, b: i16) -> i16 {
 }
 
 /// Fundamental amplitude (LSB) of a readout drive word for a Q1.15
-/// amplitude `amp`, with its sign: the envelope `amp x PEAK / 2^15`
-/// rounded as the AM mixer rounds it, times the carrier table's amplitude
-/// `PEAK / 2^15` (the table's own fundamental gain, 1 - 1.3e-7, is below
-/// anything the host resolves). In readout the modulation factor is PEAK.
-pub fn readout_word(amp: i16) -> f64 {
-    f64::from(q15_product(amp, PEAK as i16)) * f64::from(PEAK) / 32768.0
+/// amplitude `amp` on the core with `profile`, with its sign: the envelope
+/// E = `amp x PEAK / 2^15` rounded as the AM mixer rounds it, then the
+/// carrier's product as that core forms it (`carrier_fundamental`). In
+/// readout the modulation factor is PEAK.
+///
+/// ```
+/// use gyrocal_regs::datapath::{CarrierProfile, readout_word};
+/// // 0.9 of full scale: E = 29490 times the carrier's PEAK / 2^15.
+/// assert_eq!(readout_word(CarrierProfile::Fine, 29491), 29490.0 * 32767.0 / 32768.0);
+/// let table = readout_word(CarrierProfile::Table, 29491);
+/// assert!((table / (29490.0 * 32767.0 / 32768.0) - 1.0).abs() < 1e-6);
+/// ```
+pub fn readout_word(profile: CarrierProfile, amp: i16) -> f64 {
+    carrier_fundamental(profile, q15_product(amp, PEAK as i16))
+}
+
+/// Fundamental amplitude (LSB) of the drive word `E x carrier` for a held
+/// envelope word E on the core with `profile`: on the fine core the exact
+/// product E x PEAK / 2^15 (its rounding error is fed back with zeros at
+/// the carrier, `gyrocal_hdl::carrier_multiplier`); on the table core the
+/// fundamental of the words `round(E c / 2^15)` over the carrier table's
+/// 32768 phases a turn (`table_product_fundamental`), which a carrier away
+/// from short folds visits evenly.
+///
+/// A rounded sine of small amplitude has a fundamental off its own: on the
+/// table core +3.0e-5 at E = 260, +1.0e-4 at E = 100 and +5e-4 at E = 37,
+/// 1.4e-6 at 3686 and 1e-7 at 29490. An unseen device with Q 1e5 on a
+/// 16.3 MHz clock, driven at E = 65, read its self-calibrated scale factors
+/// +2.3e-4 off on the table core over four seeds (1.7 to 2.0 sigma, every
+/// seed) and +0.8e-5 on the fine core, before the host counted it.
+pub fn carrier_fundamental(profile: CarrierProfile, envelope: i16) -> f64 {
+    match profile {
+        CarrierProfile::Fine => f64::from(envelope) * f64::from(PEAK) / 32768.0,
+        CarrierProfile::Table => table_product_fundamental(i32::from(envelope)),
+    }
+}
+
+/// Intervals a quadrant of the table core's carrier table: 8192 words,
+/// each a quarter of a modulation-ROM step from a ROM centre
+/// (`gyrocal_hdl::carrier_table_fill`, whose model
+/// `gyrocal_hdl::model::carrier_nco::table` the hdl crate checks against
+/// [`carrier_table_word`]).
+pub const CARRIER_TABLE_ENTRIES: usize = 2 * MODULATION_TABLE_ENTRIES;
+
+/// The table core's carrier word `i` (first quadrant, 0..8192), as its
+/// power-up fill writes it: the modulation ROM's words at the ROM centres
+/// j = i / 2 and j -+ 1 (even i: j - 1, odd: j + 1), weights 3 : 1, rounded
+/// half to even. Outside 0..4096 the ROM's sine runs on: -word(0) below,
+/// word(4095) above (the quadrant's mirror).
+pub fn carrier_table_word(i: usize) -> i32 {
+    let rom = |k: i64| match k {
+        -1 => -modulation_word(0),
+        k if k >= MODULATION_TABLE_ENTRIES as i64 => modulation_word(MODULATION_TABLE_ENTRIES - 1),
+        k => modulation_word(k as usize),
+    };
+    let j = (i / 2) as i64;
+    let (near, far) = if i.is_multiple_of(2) {
+        (rom(j), rom(j - 1))
+    } else {
+        (rom(j), rom(j + 1))
+    };
+    let sum = 3 * near + far;
+    (sum + 1 + ((sum >> 2) & 1)) >> 2
+}
+
+/// The table core's carrier words over a turn, 4 x 8192 (mirrored in odd
+/// quadrants, negated in the second half), and the sine at each interval's
+/// centre, built once per process.
+fn carrier_turn() -> &'static [(i32, f64)] {
+    static TURN: OnceLock<Vec<(i32, f64)>> = OnceLock::new();
+    TURN.get_or_init(|| {
+        let n = 4 * CARRIER_TABLE_ENTRIES;
+        (0..n)
+            .map(|p| {
+                let (q, i) = (p / CARRIER_TABLE_ENTRIES, p % CARRIER_TABLE_ENTRIES);
+                let w = carrier_table_word(if q % 2 == 0 {
+                    i
+                } else {
+                    CARRIER_TABLE_ENTRIES - 1 - i
+                });
+                let theta = std::f64::consts::TAU * (p as f64 + 0.5) / n as f64;
+                (if q >= 2 { -w } else { w }, theta.sin())
+            })
+            .collect()
+    })
+}
+
+/// Fundamental (LSB) of the table core's words `round(E c / 2^15)`, rounded
+/// half up, over the carrier's turn.
+fn table_product_fundamental(envelope: i32) -> f64 {
+    let turn = carrier_turn();
+    let sum: f64 = turn
+        .iter()
+        .map(|&(c, sin)| f64::from((envelope * c + (1 << 14)) >> 15) * sin)
+        .sum();
+    2.0 * sum / turn.len() as f64
+}
+
+/// Envelopes up to which the calibration word sums the table core's
+/// products exactly ([`carrier_fundamental`]); above it, E x PEAK / 2^15,
+/// which is within 1.4e-6 of the fundamental there (3686: 1.4e-6; 29490:
+/// 1e-7), and the larger envelopes of a calibration period average their
+/// differences further.
+pub const EXACT_ENVELOPES: i32 = 4096;
+
+/// [`carrier_fundamental`] of the table core for every envelope 0..=4096,
+/// built once per process (0.1 s).
+fn small_envelopes() -> &'static [f64] {
+    static SMALL: OnceLock<Vec<f64>> = OnceLock::new();
+    SMALL.get_or_init(|| {
+        (0..=EXACT_ENVELOPES)
+            .map(table_product_fundamental)
+            .collect()
+    })
 }
 
 /// Address bits of the modulation sine's quarter-wave ROM: 4096 words a
@@ -161,10 +271,12 @@ pub fn modulation_word(i: usize) -> i32 {
 }
 
 /// Fundamental amplitude (LSB) of a calibration drive word's envelope
-/// crest for a Q1.15 amplitude `amp`, with its sign: the fundamental of
-/// the envelope words `round(amp x A / 2^15)` (`q15_product`) over the
-/// modulation sine's words A, which a calibration period visits evenly,
-/// times the carrier's amplitude `PEAK / 2^15`.
+/// crest for a Q1.15 amplitude `amp` on the core with `profile`, with its
+/// sign: the fundamental of the envelope words E = `round(amp x A / 2^15)`
+/// (`q15_product`) over the modulation sine's words A, which a calibration
+/// period visits evenly, each envelope times the carrier as that core
+/// forms its product ([`carrier_fundamental`]: the carrier turns some
+/// 1e5 times for every envelope step).
 ///
 /// The envelope's rounding does not average out of its fundamental: a
 /// rounded sine of small amplitude has a fundamental off its own. At the
@@ -180,13 +292,13 @@ pub fn modulation_word(i: usize) -> i32 {
 /// At amp 29490 (0.9 of full scale) the difference is 3e-7.
 ///
 /// ```
-/// use gyrocal_regs::datapath::{PEAK, calibration_word};
+/// use gyrocal_regs::datapath::{CarrierProfile::Fine, PEAK, calibration_word};
 /// let crest = |amp: i16| f64::from(amp) * f64::from(PEAK) / 32768.0 * f64::from(PEAK) / 32768.0;
-/// assert!((calibration_word(29490) / crest(29490) - 1.0).abs() < 1e-6);
-/// assert!(calibration_word(260) / crest(260) - 1.0 > 3e-5);
-/// assert_eq!(calibration_word(-260), -calibration_word(260));
+/// assert!((calibration_word(Fine, 29490) / crest(29490) - 1.0).abs() < 1e-6);
+/// assert!(calibration_word(Fine, 260) / crest(260) - 1.0 > 3e-5);
+/// assert!((calibration_word(Fine, -260) + calibration_word(Fine, 260)).abs() < 1e-9);
 /// ```
-pub fn calibration_word(amp: i16) -> f64 {
+pub fn calibration_word(profile: CarrierProfile, amp: i16) -> f64 {
     let n = 4 * MODULATION_TABLE_ENTRIES;
     let words: Vec<i16> = (0..MODULATION_TABLE_ENTRIES)
         .map(|i| modulation_word(i) as i16)
@@ -204,8 +316,21 @@ pub fn calibration_word(amp: i16) -> f64 {
             }];
             let a = if q >= 2 { -w } else { w };
             let theta = std::f64::consts::TAU * (p as f64 + 0.5) / n as f64;
-            f64::from(q15_product(amp, a)) * theta.sin()
+            envelope_fundamental(profile, q15_product(amp, a)) * theta.sin()
         })
         .sum();
-    2.0 * sum / n as f64 * f64::from(PEAK) / 32768.0
+    2.0 * sum / n as f64
+}
+
+/// [`carrier_fundamental`], from the table core's table of small envelopes
+/// where it has one ([`EXACT_ENVELOPES`]).
+fn envelope_fundamental(profile: CarrierProfile, envelope: i16) -> f64 {
+    let e = i32::from(envelope);
+    match profile {
+        CarrierProfile::Table if e.abs() <= EXACT_ENVELOPES => {
+            // Odd in E: the turn holds c and -c alike.
+            small_envelopes()[e.unsigned_abs() as usize] * f64::from(e.signum())
+        }
+        _ => f64::from(e) * f64::from(PEAK) / 32768.0,
+    }
 }

@@ -165,7 +165,94 @@ impl CarrierNco {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::am_mixer::carrier_product;
     use crate::sine_table::PEAK;
+    use gyrocal_regs::datapath::{
+        CarrierProfile::{Fine, Table},
+        calibration_word, carrier_table_word, q15_product, readout_word,
+    };
+
+    /// The host computes the table core's words without the gateware
+    /// (`gyrocal_regs::datapath::carrier_table_word`): every one is the
+    /// word this model's fill derives from the ROM's model.
+    #[test]
+    fn the_hosts_carrier_table_is_the_fill_s() {
+        for (i, &v) in table().iter().enumerate() {
+            assert_eq!(carrier_table_word(i), i32::from(v), "entry {i}");
+        }
+    }
+
+    /// The fundamental of the words `E x carrier` over 2^16 carrier phases,
+    /// two in each of the table's intervals, through this model's words
+    /// and the mixer model's rounding.
+    fn model_fundamental(profile: CarrierProfile, envelope: i16) -> f64 {
+        const PHASES: u64 = 1 << 16;
+        let sum: f64 = (0..PHASES)
+            .map(|i| {
+                let phase = ((i << 32) / PHASES) as u32 + (1 << 15);
+                let theta = f64::from(phase) * std::f64::consts::TAU / 2f64.powi(32);
+                carrier_product(profile, envelope, carrier_word(profile, phase)) * theta.sin()
+            })
+            .sum();
+        2.0 * sum / PHASES as f64
+    }
+
+    /// The host's drive words (`readout_word`, `calibration_word`) against
+    /// the model's on both cores, at the small drives where the table
+    /// core's rounding moves a fundamental (1e-4 at E = 100) and at 0.9 of
+    /// full scale. The host sums the same words at each interval's centre,
+    /// the model at its quarter points: a sine's difference of (pi /
+    /// 32768)^2 / 2 = 5e-9. On the fine core the host takes the carrier's
+    /// amplitude as PEAK; its interpolated words (within 0.65 of a quarter
+    /// LSB) have a fundamental 4e-8 off that (measured). Asserted within
+    /// 1e-7; the table core's rounding is 2e-4 at amp 65. The calibration word is
+    /// each envelope's fundamental through the mixer, over the modulation
+    /// ROM's turn (the carrier turns 1e5 times an envelope step at a
+    /// calibration frequency), from the ROM model's words; the table core
+    /// beyond 4096 takes E x PEAK / 2^15 (`EXACT_ENVELOPES`, within 1.4e-6).
+    #[test]
+    fn the_hosts_drive_words_are_the_models() {
+        let crest = f64::from(PEAK) / 32768.0;
+        for profile in [Table, Fine] {
+            for amp in [37i16, 65, 260, 1000, 29491] {
+                let e = q15_product(amp, PEAK as i16);
+                let (host, model) = (readout_word(profile, amp), model_fundamental(profile, e));
+                assert!(
+                    (host / model - 1.0).abs() < 1e-7,
+                    "{profile} readout, amp {amp}: {host} vs {model}"
+                );
+            }
+            for amp in [37i16, 65, 260] {
+                let mut cache = std::collections::HashMap::new();
+                let n = 4 * crate::sine_table::ENTRIES;
+                let sum: f64 = (0..n)
+                    .map(|p| {
+                        let phase = ((p as u64) << 32) / n as u64 + (1 << 16);
+                        let a = crate::model::sine::sine(phase as u32, 0);
+                        let e = q15_product(amp, a);
+                        let f = *cache
+                            .entry(e)
+                            .or_insert_with(|| model_fundamental(profile, e));
+                        f * (phase as f64 * std::f64::consts::TAU / 2f64.powi(32)).sin()
+                    })
+                    .sum();
+                let model = 2.0 * sum / n as f64;
+                let host = calibration_word(profile, amp);
+                assert!(
+                    (host / model - 1.0).abs() < 1e-7,
+                    "{profile} calibration, amp {amp}: {host} vs {model}"
+                );
+                // What the table core's rounding is worth here, for the record.
+                let ideal = calibration_word(Fine, amp);
+                eprintln!(
+                    "{profile} amp {amp}: calibration word over the exact product's {:+.2e}; readout {:+.2e}",
+                    host / ideal - 1.0,
+                    readout_word(profile, amp) / (f64::from(q15_product(amp, PEAK as i16)) * crest)
+                        - 1.0
+                );
+            }
+        }
+    }
 
     #[test]
     fn table_words_are_within_1_lsb_of_the_centre_sines() {

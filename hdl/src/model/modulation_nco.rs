@@ -58,7 +58,7 @@ impl ModulationNco {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use gyrocal_regs::datapath::{calibration_word, q15_product};
+    use gyrocal_regs::datapath::{CarrierProfile, calibration_word, q15_product};
     use std::f64::consts::TAU;
 
     /// The host predicts the calibration signal from
@@ -92,7 +92,7 @@ mod tests {
                     sums[k][1] += e * theta.sin();
                 }
             }
-            let expected = calibration_word(amp).abs();
+            let expected = calibration_word(CarrierProfile::Fine, amp).abs();
             for (k, [c, s]) in sums.into_iter().enumerate() {
                 let fundamental = 2.0 * c.hypot(s) / period as f64 * f64::from(PEAK) / 32768.0;
                 let error = fundamental / expected - 1.0;

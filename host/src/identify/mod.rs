@@ -86,6 +86,7 @@ use crate::device::GyroParams;
 use crate::error::Error;
 use crate::knowns::{FILTER_SETTLE, Knowns, TAU_MARGIN};
 pub(crate) use front::FrontEnd;
+use gyrocal_regs::datapath::CarrierProfile;
 use nalgebra::Complex;
 use probe::Prober;
 use serde::Serialize;
@@ -135,9 +136,10 @@ pub const SCAN_SPAN: f64 = 0.05;
 pub const SCAN_POINTS: usize = 21;
 
 /// Fundamental amplitude (LSB) of a readout drive word for a Q1.15
-/// amplitude (`gyrocal_regs::datapath::readout_word`), unsigned.
-pub fn readout_word(amp: i16) -> f64 {
-    gyrocal_regs::datapath::readout_word(amp).abs()
+/// amplitude on the core with `profile`
+/// (`gyrocal_regs::datapath::readout_word`), unsigned.
+pub fn readout_word(profile: CarrierProfile, amp: i16) -> f64 {
+    gyrocal_regs::datapath::readout_word(profile, amp).abs()
 }
 
 /// A value and its 1-sigma uncertainty.
@@ -435,6 +437,7 @@ pub(crate) fn resolved(modes: &[ModeFit; 2]) -> bool {
 /// ```
 /// use gyrocal_host::{GyroParams, identify, fake::Lorentzian};
 /// use gyrocal_host::knowns::{Derived, Knowns};
+/// use gyrocal_regs::datapath::CarrierProfile;
 /// use nalgebra::Complex;
 /// let c = Complex::from_polar(2.0e9, -3f64.to_radians());
 /// let (f1, f2) = (9.64e6, 9.64025e6);
@@ -447,7 +450,7 @@ pub(crate) fn resolved(modes: &[ModeFit; 2]) -> bool {
 ///     filter: Derived { decimation: 1000, butterworth_hz: 500.0, rc_hz: 2000.0,
 ///         min_window_s: 0.05 },
 ///     carrier_hz: 1.003 * f1, rates_dps: vec![1.0, 20.0], cal_freqs_hz: vec![10.0, 15.0],
-///     nominal: datasheet.clone(),
+///     nominal: datasheet.clone(), carrier_profile: CarrierProfile::Fine,
 /// };
 /// let id = identify::identify(&mut board, &knowns, &datasheet).unwrap();
 /// let mode1 = &id.modes[0];

@@ -107,7 +107,7 @@ impl<'a> Prober<'a> {
         let clipped = self.clip_count()?;
         self.clocks += settle + filter + 2 * SAMPLES_PER_PHASE * u64::from(r);
         let amp_word = [regs.amp.0, regs.amp.1][self.k];
-        let w = readout_word(amp_word);
+        let w = readout_word(kn.carrier_profile, amp_word);
         let y = C64::new(zi, zq) * (2.0 / (real.filter.dc_gain * w * w));
         Ok(Seen {
             carrier_hz: real.carrier_hz,

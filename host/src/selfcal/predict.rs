@@ -42,8 +42,8 @@ fn devices(knowns: &Knowns, gyro: &GyroParams, op: &Operating) -> Result<[Device
         f2_force: words[1] * per_lsb[1],
     };
     Ok([
-        device(amp.map(readout_word)),
-        device(amp.map(|a| calibration_word(a).abs())),
+        device(amp.map(|a| readout_word(knowns.carrier_profile, a))),
+        device(amp.map(|a| calibration_word(knowns.carrier_profile, a).abs())),
     ])
 }
 

@@ -416,6 +416,7 @@ pub fn knowns(exp: &Experiment) -> Result<Knowns, String> {
         carrier_hz: exp.drive.carrier_hz,
         rates_dps: exp.points.readout_rates_dps.clone(),
         cal_freqs_hz: exp.points.cal_freqs_hz.clone(),
+        carrier_profile: exp.drive.carrier_profile,
     })
 }
 
