@@ -167,7 +167,7 @@ pub fn readout_word(profile: CarrierProfile, amp: i16) -> f64 {
 /// seed) and +0.8e-5 on the fine core, before the host counted it.
 pub fn carrier_fundamental(profile: CarrierProfile, envelope: i16) -> f64 {
     match profile {
-        CarrierProfile::Fine => f64::from(envelope) * f64::from(PEAK) / 32768.0,
+        CarrierProfile::Fine => exact_product(envelope),
         CarrierProfile::Table => table_product_fundamental(i32::from(envelope)),
     }
 }
@@ -200,26 +200,35 @@ pub fn carrier_table_word(i: usize) -> i32 {
     (sum + 1 + ((sum >> 2) & 1)) >> 2
 }
 
-/// The table core's carrier words over a turn, 4 x 8192 (mirrored in odd
-/// quadrants, negated in the second half), and the sine at each interval's
-/// centre, built once per process.
+/// A quarter-wave table's words over a whole turn, 4 x `entries` samples:
+/// quadrant q reads `word(i)`, mirrored (`entries - 1 - i`) in odd
+/// quadrants and negated in the second half, as the gateware's lookups do
+/// (`gyrocal_hdl::quarter_wave`); each with the sine at its interval's
+/// centre, (p + 1/2) / (4 entries) of a turn.
+fn quarter_wave_turn(entries: usize, word: impl Fn(usize) -> i32) -> Vec<(i32, f64)> {
+    let n = 4 * entries;
+    (0..n)
+        .map(|p| {
+            let (q, i) = (p / entries, p % entries);
+            let w = word(if q % 2 == 0 { i } else { entries - 1 - i });
+            let theta = std::f64::consts::TAU * (p as f64 + 0.5) / n as f64;
+            (if q >= 2 { -w } else { w }, theta.sin())
+        })
+        .collect()
+}
+
+/// The table core's carrier words over a turn (`quarter_wave_turn`),
+/// built once per process.
 fn carrier_turn() -> &'static [(i32, f64)] {
     static TURN: OnceLock<Vec<(i32, f64)>> = OnceLock::new();
-    TURN.get_or_init(|| {
-        let n = 4 * CARRIER_TABLE_ENTRIES;
-        (0..n)
-            .map(|p| {
-                let (q, i) = (p / CARRIER_TABLE_ENTRIES, p % CARRIER_TABLE_ENTRIES);
-                let w = carrier_table_word(if q % 2 == 0 {
-                    i
-                } else {
-                    CARRIER_TABLE_ENTRIES - 1 - i
-                });
-                let theta = std::f64::consts::TAU * (p as f64 + 0.5) / n as f64;
-                (if q >= 2 { -w } else { w }, theta.sin())
-            })
-            .collect()
-    })
+    TURN.get_or_init(|| quarter_wave_turn(CARRIER_TABLE_ENTRIES, carrier_table_word))
+}
+
+/// The modulation sine's words over a turn (`quarter_wave_turn`), built
+/// once per process.
+fn modulation_turn() -> &'static [(i32, f64)] {
+    static TURN: OnceLock<Vec<(i32, f64)>> = OnceLock::new();
+    TURN.get_or_init(|| quarter_wave_turn(MODULATION_TABLE_ENTRIES, modulation_word))
 }
 
 /// Fundamental (LSB) of the table core's words `round(E c / 2^15)`, rounded
@@ -299,27 +308,12 @@ pub fn modulation_word(i: usize) -> i32 {
 /// assert!((calibration_word(Fine, -260) + calibration_word(Fine, 260)).abs() < 1e-9);
 /// ```
 pub fn calibration_word(profile: CarrierProfile, amp: i16) -> f64 {
-    let n = 4 * MODULATION_TABLE_ENTRIES;
-    let words: Vec<i16> = (0..MODULATION_TABLE_ENTRIES)
-        .map(|i| modulation_word(i) as i16)
-        .collect();
-    // Sample p of the turn: quadrant q = p / 4096 reads word i, mirrored in
-    // odd quadrants, negated in the second half (as the ROM's lookup does);
-    // its interval's centre is (p + 1/2) / n of a turn.
-    let sum: f64 = (0..n)
-        .map(|p| {
-            let (q, i) = (p / MODULATION_TABLE_ENTRIES, p % MODULATION_TABLE_ENTRIES);
-            let w = words[if q % 2 == 0 {
-                i
-            } else {
-                MODULATION_TABLE_ENTRIES - 1 - i
-            }];
-            let a = if q >= 2 { -w } else { w };
-            let theta = std::f64::consts::TAU * (p as f64 + 0.5) / n as f64;
-            envelope_fundamental(profile, q15_product(amp, a)) * theta.sin()
-        })
+    let turn = modulation_turn();
+    let sum: f64 = turn
+        .iter()
+        .map(|&(a, sin)| envelope_fundamental(profile, q15_product(amp, a as i16)) * sin)
         .sum();
-    2.0 * sum / n as f64
+    2.0 * sum / turn.len() as f64
 }
 
 /// [`carrier_fundamental`], from the table core's table of small envelopes
@@ -331,6 +325,11 @@ fn envelope_fundamental(profile: CarrierProfile, envelope: i16) -> f64 {
             // Odd in E: the turn holds c and -c alike.
             small_envelopes()[e.unsigned_abs() as usize] * f64::from(e.signum())
         }
-        _ => f64::from(e) * f64::from(PEAK) / 32768.0,
+        _ => exact_product(envelope),
     }
+}
+
+/// E x PEAK / 2^15: the envelope times the carrier's amplitude, unrounded.
+fn exact_product(envelope: i16) -> f64 {
+    f64::from(envelope) * f64::from(PEAK) / 32768.0
 }
