@@ -242,6 +242,27 @@ fn table_product_fundamental(envelope: i32) -> f64 {
     2.0 * sum / turn.len() as f64
 }
 
+/// The table core's words `round(E c / 2^15)` (rounded half up) over the
+/// carrier's turn, one per interval of its N = 32768 (phase (p + 1/2) / N
+/// of a turn): the function of the phase whose harmonics the sampling
+/// folds (`gyrocal_host::selfcal::spurs`).
+///
+/// ```
+/// use gyrocal_regs::datapath::{CarrierProfile::Table, readout_word, table_product_turn};
+/// let words = table_product_turn(29490);
+/// let n = words.len() as f64;
+/// let sine: f64 = words.iter().enumerate()
+///     .map(|(p, &w)| w * (std::f64::consts::TAU * (p as f64 + 0.5) / n).sin())
+///     .sum();
+/// assert_eq!(2.0 * sine / n, readout_word(Table, 29491));
+/// ```
+pub fn table_product_turn(envelope: i32) -> Vec<f64> {
+    carrier_turn()
+        .iter()
+        .map(|&(c, _)| f64::from((envelope * c + (1 << 14)) >> 15))
+        .collect()
+}
+
 /// Envelopes up to which the calibration word sums the table core's
 /// products exactly ([`carrier_fundamental`]); above it, E x PEAK / 2^15,
 /// which is within 1.4e-6 of the fundamental there (3686: 1.4e-6; 29490:

@@ -93,10 +93,12 @@
 //! the same reach and `STATIC_FOLD_SF_CHANGE`.
 mod budget;
 mod predict;
+mod spurs;
 mod staircase;
 
 pub use budget::SfUncertainty;
 pub use predict::{Ratio, adc_peaks, predicted_ratio, readout_sf};
+pub use spurs::{NAMED_LINES, SPUR_BAND_CORNERS, SpurLine, Spurs, spurs};
 pub use staircase::{Staircase, staircase};
 
 use crate::board::Board;

@@ -25,7 +25,11 @@ pub struct Ratio {
 
 /// The theory's device at `op` in readout and in calibration: the drive
 /// words' realized amplitudes as forces (design force per LSB).
-fn devices(knowns: &Knowns, gyro: &GyroParams, op: &Operating) -> Result<[Device; 2], Error> {
+pub(super) fn devices(
+    knowns: &Knowns,
+    gyro: &GyroParams,
+    op: &Operating,
+) -> Result<[Device; 2], Error> {
     let (regs, _) = knowns.registers(op.carrier_hz, None, op.amplitude, 0.0)?;
     let amp = [regs.amp.0, regs.amp.1];
     let per_lsb = knowns.force_full_scale.map(|f| f / 32768.0);

@@ -1,0 +1,284 @@
+//! The table core's carrier spurs in the rate's passband: which of the
+//! carrier words' harmonics the sampling folds next to the carrier at an
+//! operating point, and the rate ripple each can put on an output.
+//!
+//! A table-core word is `round(E T(phase) / 2^15)`, T the 8192-word
+//! quarter-wave table: a function of the phase, held over each of the
+//! turn's N = 32768 intervals (`datapath::table_product_turn`). With D_m
+//! the transform of those N words, the held words' harmonic m + kN is
+//! (-1)^k D_m sinc(pi (m + kN) / N) for m < N; only odd harmonics exist
+//! (the turn's second half is its first negated). Harmonic m is sampled at m times the carrier's step, so it lands Omega from the
+//! carrier when m step = +-step + Omega (mod 2^32). That is the fold of
+//! `plan::nearest_fold` seen harmonic by harmonic: near n / q of the clock
+//! the harmonics kq +- 1 land k eps from the carrier.
+//!
+//! Each line ripples the demodulated output at Omega. Against a reference
+//! R and an ADC signal H(f_c) D, whose product's full magnitude is M = |H
+//! D R| / 2 (in-phase and quadrature: the line turns through both), a
+//! reference line rho R ripples z by rho M and a drive line rho D by rho M
+//! |H(f_c + Omega) / H(f_c)|, both through the output filter's gain at
+//! Omega. Drive and reference read the table a `REF_PHASE` apart, so
+//! their lines' phases are unrelated: the sum of the two amplitudes is
+//! the bound. M and the readout scale factor come from the exact theory
+//! at the identified device, so the ripple is in deg/s.
+
+use super::Operating;
+use super::predict::devices;
+use crate::error::Error;
+use crate::identify::Identified;
+use crate::knowns::Knowns;
+use crate::theory::{self, Device};
+use gyrocal_regs::datapath::{CarrierProfile, PEAK, q15_product, table_product_turn};
+use rustfft::{FftPlanner, num_complex::Complex};
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::f64::consts::{FRAC_PI_2, PI};
+
+/// Phase intervals a turn of the table core's carrier.
+const TURN: u64 = 32768;
+
+/// Butterworth corners out to which lines count: the biquad and the RC
+/// pole pass less than 1 / 100 of a line beyond.
+pub const SPUR_BAND_CORNERS: f64 = 10.0;
+
+/// Images m + kN of each odd harmonic m < N looked at, k below this. The
+/// words' error other than the fundamental has a power P = mean(w^2) -
+/// 2 |D_1|^2 (0.19 LSB^2 at E = 29490, this module's test), and an image k
+/// keeps sinc^2 <= 1 / (pi k)^2 of its harmonic: all images beyond k =
+/// 1024 carry at most P / (1023 pi^2), 1.9e-5 LSB^2, spread over the
+/// whole band the clock folds, of which a passband of 1 kHz on 50 MHz
+/// takes 2e-5 on average: 2e-5 LSB RMS, 1.3e-9 of the fundamental.
+const IMAGES: u64 = 1024;
+
+/// Images kN -+ 1 of the fundamental looked at: the k-th is 1 / (N k) of
+/// it (the phase rounding's sawtooth), and those beyond k = 2^20 are below
+/// 3e-11 of it each.
+const FUNDAMENTAL_IMAGES: u64 = 1 << 20;
+
+/// One line next to the carrier.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct SpurLine {
+    /// Distance from the carrier (Hz, both sides folded together).
+    pub offset_hz: f64,
+    /// Bound on the ripple's amplitude per output at the filter's output
+    /// (deg/s, peak).
+    pub amplitude_dps: [f64; 2],
+}
+
+/// Lines the report names, largest first.
+pub const NAMED_LINES: usize = 8;
+
+/// The table core's spur lines in the passband at an operating point.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Spurs {
+    /// The lines, by offset (some thousands; not serialized).
+    #[serde(skip)]
+    pub lines: Vec<SpurLine>,
+    /// The `NAMED_LINES` largest (by the larger output's amplitude).
+    pub largest: Vec<SpurLine>,
+    /// Bound on the rate's RMS ripple per output from all of them (deg/s).
+    pub rms_dps: [f64; 2],
+}
+
+impl Spurs {
+    /// The RMS of the lines after averaging over records of `record_s`
+    /// seconds, each line's amplitude times |sinc(pi offset record_s)|.
+    pub fn rms_over_records_dps(&self, record_s: f64) -> [f64; 2] {
+        rms(self.lines.iter().map(|l| {
+            let x = PI * l.offset_hz * record_s;
+            let g = if x == 0.0 { 1.0 } else { (x.sin() / x).abs() };
+            l.amplitude_dps.map(|a| a * g)
+        }))
+    }
+}
+
+impl std::fmt::Display for Spurs {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "carrier table spurs in the passband: rate ripple at most {:.4} / {:.4} deg/s RMS",
+            self.rms_dps[0], self.rms_dps[1]
+        )?;
+        if let Some(l) = self.largest.first() {
+            write!(f, ", largest line {:.1} Hz from the carrier", l.offset_hz)?;
+        }
+        Ok(())
+    }
+}
+
+/// Root mean square of lines of these amplitudes at distinct offsets.
+fn rms(amplitudes: impl Iterator<Item = [f64; 2]>) -> [f64; 2] {
+    let s = amplitudes.fold([0.0; 2], |s, a| [s[0] + a[0] * a[0], s[1] + a[1] * a[1]]);
+    s.map(|v| (v / 2.0).sqrt())
+}
+
+/// The spur lines at `op` on the table core (`None` on the fine core,
+/// whose rounding error is fed back away from the carrier).
+pub fn spurs(knowns: &Knowns, id: &Identified, op: &Operating) -> Result<Option<Spurs>, Error> {
+    if knowns.carrier_profile != CarrierProfile::Table {
+        return Ok(None);
+    }
+    let (regs, _) = knowns.registers(op.carrier_hz, None, op.amplitude, op.ref_lag_deg)?;
+    let step = regs.carrier_step;
+    let band = SPUR_BAND_CORNERS * knowns.filter.butterworth_hz;
+    let per_step = knowns.clock_hz / 2f64.powi(32);
+    let envelopes = [regs.amp.0, regs.amp.1].map(|a| i32::from(q15_product(a, PEAK as i16)));
+    let spectra = envelopes.map(harmonics);
+    let fundamental = spectra.clone().map(|d| d[1] * sinc(1));
+    let [read, _] = devices(knowns, &id.gyro(&knowns.nominal), op)?;
+    let full = |dev: &Device| -> [f64; 2] {
+        let (i, q) = (
+            theory::readout_z_lagged(dev, 0.0, 0.0),
+            theory::readout_z_lagged(dev, 0.0, FRAC_PI_2),
+        );
+        [i[0].hypot(q[0]), i[1].hypot(q[1])]
+    };
+    let m_full = full(&read);
+    let sf_dps = theory::sf_read_per_rad_s(&read).map(|s| (s * PI / 180.0).abs());
+    let filter = |omega: f64| {
+        let b = omega / knowns.filter.butterworth_hz;
+        let r = omega / knowns.filter.rc_hz;
+        1.0 / ((1.0 + b.powi(4)) * (1.0 + r * r)).sqrt()
+    };
+    // Lines by |offset| in NCO steps: the two sides of a fold and the
+    // drive's and reference's lines at one offset add.
+    let mut lines: BTreeMap<u32, [f64; 2]> = BTreeMap::new();
+    for (m, side) in candidates(step, (band / per_step) as u32) {
+        let omega = f64::from(side) * per_step;
+        let m_moved = full(&Device {
+            carrier_hz: op.carrier_hz + omega,
+            ..read.clone()
+        });
+        let g = filter(omega.abs());
+        let amp: [f64; 2] = std::array::from_fn(|k| {
+            let rho = spectra[k][(m % TURN) as usize] * sinc(m) / fundamental[k];
+            m_full[k] * rho * (1.0 + m_moved[k] / m_full[k]) * g / sf_dps[k]
+        });
+        let entry = lines.entry(side.unsigned_abs()).or_insert([0.0; 2]);
+        entry[0] += amp[0];
+        entry[1] += amp[1];
+    }
+    let lines: Vec<SpurLine> = lines
+        .into_iter()
+        .map(|(s, amplitude_dps)| SpurLine {
+            offset_hz: f64::from(s) * per_step,
+            amplitude_dps,
+        })
+        .collect();
+    let rms_dps = rms(lines.iter().map(|l| l.amplitude_dps));
+    let mut largest = lines.clone();
+    largest.sort_by(|a, b| peak(b).total_cmp(&peak(a)));
+    largest.truncate(NAMED_LINES);
+    Ok(Some(Spurs {
+        lines,
+        largest,
+        rms_dps,
+    }))
+}
+
+/// A line's larger amplitude of the two outputs.
+fn peak(l: &SpurLine) -> f64 {
+    l.amplitude_dps[0].max(l.amplitude_dps[1])
+}
+
+/// |D_m| for m < N of the table core's words for envelope `e`
+/// (`datapath::table_product_turn`), by one transform.
+fn harmonics(e: i32) -> Vec<f64> {
+    let mut words: Vec<Complex<f64>> = table_product_turn(e)
+        .into_iter()
+        .map(|w| Complex::new(w, 0.0))
+        .collect();
+    FftPlanner::new()
+        .plan_fft_forward(words.len())
+        .process(&mut words);
+    let n = words.len() as f64;
+    words.iter().map(|c| c.norm() / n).collect()
+}
+
+/// |sinc(pi m / N)|: a held word's harmonic m against its sample's.
+fn sinc(m: u64) -> f64 {
+    let x = PI * m as f64 / TURN as f64;
+    (x.sin() / x).abs()
+}
+
+/// Harmonics m >= 2 (the fundamental's images to `FUNDAMENTAL_IMAGES`,
+/// the others' to `IMAGES`) that the carrier step `step` samples within
+/// `reach` steps of +-step, each with its signed offset from the carrier
+/// (NCO steps; the line at -step + delta is the carrier's at -delta).
+fn candidates(step: u32, reach: u32) -> Vec<(u64, i32)> {
+    let near = |m: u64| -> Option<i32> {
+        let nu = (m as u32).wrapping_mul(step);
+        let above = nu.wrapping_sub(step) as i32;
+        let below = nu.wrapping_add(step) as i32;
+        if above.unsigned_abs() <= reach {
+            Some(above)
+        } else if below.unsigned_abs() <= reach {
+            Some(-below)
+        } else {
+            None
+        }
+    };
+    let fundamental = (1..FUNDAMENTAL_IMAGES).flat_map(|k| [k * TURN - 1, k * TURN + 1]);
+    // Odd harmonics only: the turn's second half is the first negated.
+    let others = (3..TURN - 1)
+        .step_by(2)
+        .flat_map(|m0| (0..IMAGES).map(move |k| m0 + k * TURN));
+    fundamental
+        .chain(others)
+        .filter_map(|m| near(m).map(|s| (m, s)))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use gyrocal_regs::plan::nearest_fold;
+
+    /// `IMAGES`' premise: the words' power outside the fundamental, P =
+    /// mean(w^2) - 2 |D_1|^2, at the envelopes the field scenarios drive
+    /// (0.9 of full scale and the smallest, 65). The table's own words
+    /// carry 0.37 LSB RMS against the centre sines (`carrier_table_fill`)
+    /// and the product's rounding 0.29 (1 / 12 LSB^2): P is at most their
+    /// powers' sum, 0.22 LSB^2. Measured 0.19 and 0.08.
+    #[test]
+    fn the_words_error_power_is_what_the_image_count_assumes() {
+        for e in [29490, 65] {
+            let words = table_product_turn(e);
+            let n = words.len() as f64;
+            let power = words.iter().map(|w| w * w).sum::<f64>() / n;
+            let d1 = harmonics(e)[1];
+            let p = power - 2.0 * d1 * d1;
+            eprintln!("E = {e}: P = {p:.4} LSB^2");
+            assert!((0.0..0.22).contains(&p), "E = {e}: P = {p}");
+        }
+    }
+
+    /// A carrier near n / q of the clock: harmonics kq -+ 1 land k eps
+    /// from it (`plan::nearest_fold`), the odd ones among them (for q odd,
+    /// even k) are the candidates. The paper device's 30 deg C carrier on
+    /// 50 MHz, near 16 / 83.
+    #[test]
+    fn a_folds_harmonics_land_at_multiples_of_its_offset() {
+        let clock = 50e6;
+        let step = (9_638_553.73 / clock * 2f64.powi(32)).round() as u32;
+        let carrier = f64::from(step) * clock / 2f64.powi(32);
+        let (q, eps) = nearest_fold(carrier, clock);
+        assert_eq!(q, 83);
+        let per_step = clock / 2f64.powi(32);
+        let found = candidates(step, (1000.0 / per_step) as u32);
+        for k in 1..=12u64 {
+            for m in [k * q - 1, k * q + 1].into_iter().filter(|m| m % 2 == 1) {
+                let omega = found
+                    .iter()
+                    .find(|c| c.0 == m)
+                    .map(|c| f64::from(c.1.unsigned_abs()) * per_step);
+                let expected = k as f64 * eps;
+                assert_eq!(
+                    omega.map(|o| (o - expected).abs() < 1e-3),
+                    (expected <= 1000.0).then_some(true),
+                    "harmonic {m}: {omega:?} Hz, expected {expected} Hz"
+                );
+            }
+        }
+    }
+}
