@@ -29,6 +29,8 @@
 //! has a baseline (its baseline fields are null).
 
 use crate::Failure;
+use gyrocal_host::selfcal::Spurs;
+use gyrocal_sim::field::profile::RateTrace;
 use gyrocal_sim::field::scenario::{self, FAILED_CYCLE, FieldReport};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -271,6 +273,16 @@ fn step_notes(s: &mut String, report: &FieldReport) {
     }
 }
 
+/// A table-core step's spur bound (`Spurs`' line), and over the
+/// profile's records where there is one.
+fn spur_line(s: &mut String, t: f64, sp: &Spurs, trace: Option<&RateTrace>) {
+    let records = trace
+        .and_then(|tr| tr.spur_bound_dps)
+        .map(|r| format!("; over the profile's records {:.4} / {:.4}", r[0], r[1]))
+        .unwrap_or_default();
+    let _ = writeln!(s, "{t:>8.2}  {sp}{records}");
+}
+
 /// The human-readable table.
 pub fn summary(report: &FieldReport) -> String {
     let mut s = String::new();
@@ -341,6 +353,11 @@ pub fn summary(report: &FieldReport) -> String {
                 "{:>8.2}  rate profile RMS error, settled records (deg/s): self-cal {:.4} / {:.4}, baseline {:.4e} / {:.4e}",
                 st.temperature_c, a[0], a[1], b[0], b[1]
             );
+        }
+    }
+    for st in &report.steps {
+        if let Some(sp) = &st.carrier_spurs {
+            spur_line(&mut s, st.temperature_c, sp, st.profile.as_ref());
         }
     }
     for f in &report.failed {

@@ -231,6 +231,15 @@ pub fn run_profile(
     })
 }
 
+/// The record length of a trace from its records' mid times (s): their
+/// spacing, 0 for fewer than two records.
+pub fn record_spacing_s(time_s: &[f64]) -> f64 {
+    match time_s {
+        [a, b, ..] => b - a,
+        _ => 0.0,
+    }
+}
+
 /// The rate output of one step under the profile, self-calibrated and
 /// factory baseline, beside the truth.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -253,6 +262,11 @@ pub struct RateTrace {
     /// RMS of baseline_rate - true_rate over the settled records (deg/s);
     /// null without a baseline.
     pub baseline_rms_error_dps: Option<[f64; 2]>,
+    /// On the table core, the bound on the rate's RMS ripple from the
+    /// carrier's spurs (`gyrocal_host::selfcal::spurs`) over these
+    /// records (each line through its record's average): against
+    /// `selfcal_rms_error_dps`, how much of it the carrier tables can be.
+    pub spur_bound_dps: Option<[f64; 2]>,
 }
 
 #[cfg(test)]

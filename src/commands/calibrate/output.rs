@@ -76,6 +76,7 @@ pub fn json(o: &Outcome) -> Value {
         "clocks": cal.clocks,
         "wall_s": o.wall_s,
         "samples": {"read": o.samples.read, "missed": o.samples.missed},
+        "carrier_spurs": o.spurs,
         "truth": truth,
     })
 }
@@ -110,6 +111,9 @@ pub fn table(o: &Outcome) -> String {
     );
     if let Some(fold) = cal.operating.static_fold {
         let _ = writeln!(s, "warning: {fold}");
+    }
+    if let Some(sp) = &o.spurs {
+        let _ = writeln!(s, "{sp}");
     }
     let _ = writeln!(
         s,
