@@ -182,6 +182,7 @@ fn rounding_moves_the_resonant_outputs_rate_table() {
             amplitude: knowns.amplitude,
             fold_shift_hz: 0.0,
             static_fold: None,
+            spur_move: None,
         };
         let sf0 = scenario::rate_table(&sc.exp, &fe, &at, &knowns, &op)
             .unwrap()
@@ -285,40 +286,40 @@ fn a_differential_drive_gain_is_measured_while_turning_and_corrected() {
     assert_within_target(&report);
 }
 
-/// The calibrated rate ripples where the carrier folds in the passband
-/// (`FieldStep::carrier_fold`, issue 20 section 3), and the step says so:
-/// every step whose profile RMS error on an output exceeds twice the
-/// quietest step's is one that reports a fold in the passband, and every
-/// such step ripples. On the paper device the operating point moves the
-/// 25 deg C carrier 0.81 Hz out of its fold at 4.8 Hz (period 1250),
-/// which had rippled the rate by 0.46 / 0.19 deg/s; it is at the floor
-/// now (0.065 / 0.020). At 30 deg C the move out of the fold at 18.2 Hz
-/// (period 83) would change the scale factors by 45%
-/// (`gyrocal_host::selfcal::FOLD_SF_CHANGE`), so the carrier moves only
-/// 0.27 Hz, until the fold beats four times a window
-/// (`gyrocal_regs::plan::SETTLED_FOLD_BEATS`, 40.4 Hz), and that step
-/// ripples (0.158 / 0.088 deg/s on the table core; 0.251 / 0.140 with the
-/// carrier at 18.2 Hz) and says so.
-fn assert_ripples_are_reported(report: &FieldReport) {
+/// Issue 20 section 3's goal: at every step the calibrated rate's RMS
+/// error under the profile is within twice the quietest step's, on both
+/// outputs. The paper device's carrier folds in the passband at two
+/// steps. At 25 deg C the operating point moves the carrier 0.81 Hz out of
+/// its fold at 4.8 Hz (period 1250), which had rippled the rate by 0.46 /
+/// 0.19 deg/s; it is at the floor now (0.065 / 0.020). At 30 deg C the
+/// move out of the fold at 18.2 Hz (period 83) would change the scale
+/// factors by 45% (`gyrocal_host::selfcal::FOLD_SF_CHANGE`), so on the
+/// table core the carrier moves -1.09 Hz, to where the bound on its
+/// table spurs' ripple is lowest within the allowance (the fold 109 Hz
+/// away, most of its lines through the filter's skirt), and the rate is
+/// at 0.049 / 0.031 deg/s: 0.75 and 1.57 times the quietest step's. It
+/// was 0.158 / 0.088 with the carrier moved only until the fold beat four
+/// times a window, and 0.251 / 0.140 with the carrier at 18.2 Hz. The
+/// largest ratio over the five steps is 1.59 on output 1 (35 deg C
+/// against 30) and 1.57 on output 2. A step whose fold lies in the band
+/// still names it (`carrier_fold`).
+fn assert_every_step_within_twice_the_floor(report: &FieldReport) {
     for k in 0..2 {
         let rms = |s: &scenario::FieldStep| s.profile.as_ref().unwrap().selfcal_rms_error_dps[k];
         let floor = report.steps.iter().map(rms).fold(f64::INFINITY, f64::min);
         for s in &report.steps {
             let f = s.carrier_fold;
             eprintln!(
-                "{} deg C output {}: rate RMS error {:.3} deg/s (floor {floor:.3}), fold {:.1} Hz (period {})",
+                "{} deg C output {}: rate RMS error {:.3} deg/s ({:.2} times the floor {floor:.3}), fold {:.1} Hz (period {})",
                 s.temperature_c,
                 k + 1,
                 rms(s),
+                rms(s) / floor,
                 f.offset_hz,
                 f.period
             );
-            assert_eq!(
-                rms(s) > 2.0 * floor,
-                f.in_passband,
-                "{} deg C",
-                s.temperature_c
-            );
+            assert!(rms(s) <= 2.0 * floor, "{} deg C", s.temperature_c);
+            assert_eq!(f.clause().is_some(), f.in_passband);
         }
     }
 }
@@ -334,10 +335,10 @@ fn paper_device_self_calibrates_over_ten_kelvin() {
     }
     eprintln!("clocks {} wall {:.1} s", report.clocks, report.wall_s);
     assert_within_target(&report);
-    assert_ripples_are_reported(&report);
+    assert_every_step_within_twice_the_floor(&report);
     // The carrier moved where that cleared its fold within the scale
-    // factors' allowance (25 deg C), or gave the fold of period 83 its
-    // four beats a window (30 deg C), and only there.
+    // factors' allowance (25 deg C), or where its spur bound is lowest
+    // (30 deg C), and only there.
     let window = report.knowns.filter.min_window_s;
     for s in &report.steps {
         let shift = s.selfcal.operating.fold_shift_hz;
@@ -355,9 +356,13 @@ fn paper_device_self_calibrates_over_ten_kelvin() {
         .find(|s| s.temperature_c == 30.0)
         .unwrap();
     let beats = beaten.carrier_fold.offset_hz * window;
-    eprintln!("30 deg C: the fold beats {beats:.2} times a window");
-    let settled = gyrocal_regs::plan::SETTLED_FOLD_BEATS;
-    assert!((settled..1.5 * settled).contains(&beats), "{beats}");
+    let spur_move = beaten.selfcal.operating.spur_move.expect("a spur move");
+    eprintln!("30 deg C: the fold beats {beats:.2} times a window, {spur_move:?}");
+    assert!(beats >= gyrocal_regs::plan::SETTLED_FOLD_BEATS, "{beats}");
+    for k in 0..2 {
+        let gain = spur_move.from_dps[k] / spur_move.to_dps[k];
+        assert!(gain >= selfcal::SPUR_MOVE_GAIN, "output {}: {gain}", k + 1);
+    }
     let moved = &report.steps[0];
     assert!((moved.selfcal.operating.fold_shift_hz - 0.81).abs() < 0.01);
     assert!(!moved.carrier_fold.in_passband);
@@ -553,29 +558,29 @@ fn assert_the_spur_bound_holds(report: &FieldReport, t: f64, quiet: f64, tight: 
     }
 }
 
-/// The ECP5 core's carriers (`[drive] carrier_profile = "fine"`) on the
-/// paper device at 25 and 30 deg C, beside the table core's. At 30 deg C
-/// the carrier lies in the band of a fold of period 83 that the host
-/// cannot leave (18.2 Hz from it, 40.4 Hz since the host gives it four
-/// beats a window). On the table core the carriers' words and phase rounding, and
-/// the mixer's second rounding of F x carrier, come back as a slow error
-/// of the DAC words of 0.042 LSB there; on the fine core, whose mixer
-/// rounds F times the quarter-LSB pair once and feeds that error back
-/// away from the carrier, 0.0055 (`examples/carrier_profiles.rs`, the DAC
-/// rows). So each output's
-/// excess over its floor (the moved 25 deg C step; excess = sqrt(rms^2 -
-/// floor^2), the ripple adding in quadrature to the noise) must shrink to
-/// under half of the table core's, and both outputs' RMS come within
-/// twice the floor: issue 20's goal. Measured: excess ratios 0.22 and
-/// 0.24, 1.11 and 1.44 times the floor (at 18.2 Hz: 0.11, 0.17, 1.07 and
-/// 1.56; with one rounding and no feedback 0.13, 0.14, 1.11 and 1.42);
-/// with the pair rounded to whole LSB before the mixer (a second
-/// rounding) output 2 was 3.9 times, which this test fails.
+/// Both cores on the paper device at 25 and 30 deg C. At 30 deg C the
+/// carrier lies in the band of a fold of period 83 that the host cannot
+/// leave (18.2 Hz from it). On the table core the carriers' words and
+/// phase rounding, and the mixer's second rounding of F x carrier, come
+/// back as a slow error of the DAC words of 0.042 LSB there; the host
+/// moves that carrier to where its spur bound is lowest (the fold 109 Hz
+/// away, `gyrocal_host::selfcal::SpurMove`). The fine core (the ECP5's,
+/// `[drive] carrier_profile = "fine"`) rounds F times the quarter-LSB pair
+/// once and feeds that error back away from the carrier (0.0055 LSB,
+/// `examples/carrier_profiles.rs`, the DAC rows); it has no spur bound and
+/// moves its carrier only until the fold beats four times a window (40.4
+/// Hz). Issue 20's goal: both outputs' RMS within twice the floor (the
+/// moved 25 deg C step). Measured: table 0.75 and 1.57 times (2.4 and 4.4
+/// before the spur move), fine 1.11 and 1.44 (at 18.2 Hz 1.07 and 1.56;
+/// with one rounding and no feedback 1.11 and 1.42); with the fine core's
+/// pair rounded to whole LSB before the mixer (a second rounding) output
+/// 2 was 3.9 times, which this test fails. On the table core the spur
+/// bound must cover the excess over the floor (0 and 0.023 deg/s, bound
+/// 0.111 and 0.072 over the records).
 #[test]
-fn the_fine_core_keeps_the_30_deg_c_rate_within_twice_its_floor() {
+fn both_cores_keep_the_30_deg_c_rate_within_twice_its_floor() {
     let path = "tests/data/field_paper.toml";
     let text = std::fs::read_to_string(path).unwrap();
-    let mut rms = Vec::new();
     for profile in CarrierProfile::ALL {
         let mut sc = scenario::parse(path, &text).unwrap();
         sc.drift.temperatures_c = vec![25.0, 30.0];
@@ -585,31 +590,18 @@ fn the_fine_core_keeps_the_30_deg_c_rate_within_twice_its_floor() {
             let s = report.steps.iter().find(|s| s.temperature_c == t).unwrap();
             s.profile.as_ref().unwrap().selfcal_rms_error_dps
         };
-        eprintln!(
-            "{profile}: rate RMS error 25 deg C {:?}, 30 deg C {:?} (deg/s)",
-            at(25.0),
-            at(30.0)
-        );
-        rms.push((at(25.0), at(30.0)));
+        let (floor, hot) = (at(25.0), at(30.0));
+        eprintln!("{profile}: rate RMS error 25 deg C {floor:?}, 30 deg C {hot:?} (deg/s)");
+        for k in 0..2 {
+            let times = hot[k] / floor[k];
+            eprintln!("{profile} output {}: {times:.2} times the floor", k + 1);
+            assert!(times <= 2.0, "{profile} output {}: {times:.2}", k + 1);
+        }
         if profile == CarrierProfile::Table {
-            assert_the_spur_bound_holds(&report, 30.0, 25.0, &[0, 1]);
+            assert_the_spur_bound_holds(&report, 30.0, 25.0, &[]);
         } else {
             assert!(report.steps.iter().all(|s| s.carrier_spurs.is_none()));
         }
-    }
-    let excess_of = |(floor, r): ([f64; 2], [f64; 2]), k: usize| {
-        (r[k].powi(2) - floor[k].powi(2)).max(0.0).sqrt()
-    };
-    let (table, fine) = (rms[0], rms[1]);
-    for k in 0..2 {
-        let ratio = excess_of(fine, k) / excess_of(table, k);
-        let floors = fine.1[k] / fine.0[k];
-        eprintln!(
-            "output {}: excess, fine over table {ratio:.2}; fine at 30 deg C {floors:.2} times its floor",
-            k + 1
-        );
-        assert!(ratio < 0.5, "output {} excess ratio {ratio:.2}", k + 1);
-        assert!(floors <= 2.0, "output {}: {fine:?}", k + 1);
     }
 }
 

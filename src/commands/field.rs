@@ -250,7 +250,13 @@ fn step_notes(s: &mut String, report: &FieldReport) {
         let (t, shift) = (st.temperature_c, st.selfcal.operating.fold_shift_hz);
         // A move that could not clear the passband only made the fold
         // beat faster (`gyrocal_regs::plan::SETTLED_FOLD_BEATS`).
-        let _ = if f.in_passband {
+        let _ = if let Some(m) = st.selfcal.operating.spur_move {
+            writeln!(
+                s,
+                "{t:>8.2}  the carrier moved {shift:+.4} Hz to where its table spurs bound the rate ripple lowest within the allowance: {:.4} / {:.4} deg/s RMS, from {:.4} / {:.4} (nearest fold period {} clocks, now {:.1} Hz away); clearing the passband would have moved the scale factors too far",
+                m.to_dps[0], m.to_dps[1], m.from_dps[0], m.from_dps[1], f.period, f.offset_hz
+            )
+        } else if f.in_passband {
             writeln!(
                 s,
                 "{t:>8.2}  the carrier moved {shift:+.4} Hz so that its nearest fold (period {} clocks, now {:.1} Hz away) beats {:.1} times a measurement window; clearing the passband would have moved the scale factors too far",

@@ -31,8 +31,9 @@ use crate::theory::{self, Device};
 use gyrocal_regs::datapath::{CarrierProfile, PEAK, q15_product, table_product_turn};
 use rustfft::{FftPlanner, num_complex::Complex};
 use serde::Serialize;
-use std::collections::BTreeMap;
+use std::collections::HashMap;
 use std::f64::consts::{FRAC_PI_2, PI};
+use std::sync::{Arc, Mutex, OnceLock};
 
 /// Phase intervals a turn of the table core's carrier.
 const TURN: u64 = 32768;
@@ -64,6 +65,14 @@ pub struct SpurLine {
     /// (deg/s, peak).
     pub amplitude_dps: [f64; 2],
 }
+
+/// Points a mode bandwidth f / Q at which the drive lines' response is
+/// taken from the exact theory and interpolated between (a field step on
+/// a slow clock has some 1e5 lines). A Lorentzian's magnitude at its peak
+/// bends as 1 - x^2 / 2, x the detuning in half-bandwidths: points 2 / 32
+/// of a half-bandwidth apart interpolate within (2 / 32)^2 / 8 = 4.9e-4
+/// (this module's test measures it).
+const RESPONSE_GRID: f64 = 32.0;
 
 /// Lines the report names, largest first.
 pub const NAMED_LINES: usize = 8;
@@ -115,6 +124,30 @@ fn rms(amplitudes: impl Iterator<Item = [f64; 2]>) -> [f64; 2] {
 /// The spur lines at `op` on the table core (`None` on the fine core,
 /// whose rounding error is fed back away from the carrier).
 pub fn spurs(knowns: &Knowns, id: &Identified, op: &Operating) -> Result<Option<Spurs>, Error> {
+    let Some(lines) = spur_lines(knowns, id, op, FULL)? else {
+        return Ok(None);
+    };
+    let rms_dps = rms(lines.iter().map(|l| l.amplitude_dps));
+    let mut largest: Vec<SpurLine> = lines.clone();
+    if largest.len() > NAMED_LINES {
+        largest.select_nth_unstable_by(NAMED_LINES, |a, b| peak(b).total_cmp(&peak(a)));
+        largest.truncate(NAMED_LINES);
+    }
+    largest.sort_by(|a, b| peak(b).total_cmp(&peak(a)));
+    Ok(Some(Spurs {
+        lines,
+        largest,
+        rms_dps,
+    }))
+}
+
+/// The lines of [`spurs`] to `depth`, by offset.
+fn spur_lines(
+    knowns: &Knowns,
+    id: &Identified,
+    op: &Operating,
+    depth: Depth,
+) -> Result<Option<Vec<SpurLine>>, Error> {
     if knowns.carrier_profile != CarrierProfile::Table {
         return Ok(None);
     }
@@ -124,15 +157,8 @@ pub fn spurs(knowns: &Knowns, id: &Identified, op: &Operating) -> Result<Option<
     let per_step = knowns.clock_hz / 2f64.powi(32);
     let envelopes = [regs.amp.0, regs.amp.1].map(|a| i32::from(q15_product(a, PEAK as i16)));
     let spectra = envelopes.map(harmonics);
-    let fundamental = spectra.clone().map(|d| d[1] * sinc(1));
+    let fundamental = [0, 1].map(|k| spectra[k][1] * sinc(1));
     let [read, _] = devices(knowns, &id.gyro(&knowns.nominal), op)?;
-    let full = |dev: &Device| -> [f64; 2] {
-        let (i, q) = (
-            theory::readout_z_lagged(dev, 0.0, 0.0),
-            theory::readout_z_lagged(dev, 0.0, FRAC_PI_2),
-        );
-        [i[0].hypot(q[0]), i[1].hypot(q[1])]
-    };
     let m_full = full(&read);
     let sf_dps = theory::sf_read_per_rad_s(&read).map(|s| (s * PI / 180.0).abs());
     let filter = |omega: f64| {
@@ -140,40 +166,63 @@ pub fn spurs(knowns: &Knowns, id: &Identified, op: &Operating) -> Result<Option<
         let r = omega / knowns.filter.rc_hz;
         1.0 / ((1.0 + b.powi(4)) * (1.0 + r * r)).sqrt()
     };
-    // Lines by |offset| in NCO steps: the two sides of a fold and the
-    // drive's and reference's lines at one offset add.
-    let mut lines: BTreeMap<u32, [f64; 2]> = BTreeMap::new();
-    for (m, side) in candidates(step, (band / per_step) as u32) {
-        let omega = f64::from(side) * per_step;
-        let m_moved = full(&Device {
-            carrier_hz: op.carrier_hz + omega,
-            ..read.clone()
-        });
-        let g = filter(omega.abs());
-        let amp: [f64; 2] = std::array::from_fn(|k| {
-            let rho = spectra[k][(m % TURN) as usize] * sinc(m) / fundamental[k];
-            m_full[k] * rho * (1.0 + m_moved[k] / m_full[k]) * g / sf_dps[k]
-        });
-        let entry = lines.entry(side.unsigned_abs()).or_insert([0.0; 2]);
-        entry[0] += amp[0];
-        entry[1] += amp[1];
-    }
-    let lines: Vec<SpurLine> = lines
+    // The drive lines' response |H(f_c + Omega)| in the full magnitude,
+    // on a grid of RESPONSE_GRID points a mode bandwidth, interpolated.
+    let spacing = (read.f1_hz / read.q1).min(read.f2_hz / read.q2) / RESPONSE_GRID;
+    let mut grid: HashMap<i64, [f64; 2]> = HashMap::new();
+    let mut at_grid = |i: i64| -> [f64; 2] {
+        *grid.entry(i).or_insert_with(|| {
+            full(&Device {
+                carrier_hz: op.carrier_hz + i as f64 * spacing,
+                ..read.clone()
+            })
+        })
+    };
+    let mut found: Vec<(u32, [f64; 2])> = candidates(step, (band / per_step) as u32, depth)
         .into_iter()
-        .map(|(s, amplitude_dps)| SpurLine {
-            offset_hz: f64::from(s) * per_step,
-            amplitude_dps,
+        .map(|(m, side)| {
+            let omega = f64::from(side) * per_step;
+            let x = omega / spacing;
+            let i = x.floor() as i64;
+            let (lo, hi, w) = (at_grid(i), at_grid(i + 1), x - x.floor());
+            let m_moved: [f64; 2] = std::array::from_fn(|k| lo[k] + w * (hi[k] - lo[k]));
+            let g = filter(omega.abs());
+            let amp = std::array::from_fn(|k| {
+                let rho = spectra[k][(m % TURN) as usize] * sinc(m) / fundamental[k];
+                m_full[k] * rho * (1.0 + m_moved[k] / m_full[k]) * g / sf_dps[k]
+            });
+            (side.unsigned_abs(), amp)
         })
         .collect();
-    let rms_dps = rms(lines.iter().map(|l| l.amplitude_dps));
-    let mut largest = lines.clone();
-    largest.sort_by(|a, b| peak(b).total_cmp(&peak(a)));
-    largest.truncate(NAMED_LINES);
-    Ok(Some(Spurs {
-        lines,
-        largest,
-        rms_dps,
-    }))
+    // Lines by |offset| in NCO steps: the two sides of a fold and the
+    // drive's and reference's lines at one offset add.
+    found.sort_unstable_by_key(|f| f.0);
+    let mut lines: Vec<SpurLine> = Vec::new();
+    for (s, amp) in found {
+        let offset_hz = f64::from(s) * per_step;
+        match lines.last_mut() {
+            Some(l) if l.offset_hz == offset_hz => {
+                l.amplitude_dps[0] += amp[0];
+                l.amplitude_dps[1] += amp[1];
+            }
+            _ => lines.push(SpurLine {
+                offset_hz,
+                amplitude_dps: amp,
+            }),
+        }
+    }
+    Ok(Some(lines))
+}
+
+/// The bound of [`spurs`] alone, its RMS per output (deg/s), over the
+/// images `depth` counts.
+pub fn spur_rms(
+    knowns: &Knowns,
+    id: &Identified,
+    op: &Operating,
+    depth: Depth,
+) -> Result<Option<[f64; 2]>, Error> {
+    Ok(spur_lines(knowns, id, op, depth)?.map(|lines| rms(lines.iter().map(|l| l.amplitude_dps))))
 }
 
 /// A line's larger amplitude of the two outputs.
@@ -181,9 +230,25 @@ fn peak(l: &SpurLine) -> f64 {
     l.amplitude_dps[0].max(l.amplitude_dps[1])
 }
 
+/// The demodulated outputs' full magnitude at rest (in-phase and
+/// quadrature), per output, from the exact theory.
+fn full(dev: &Device) -> [f64; 2] {
+    let (i, q) = (
+        theory::readout_z_lagged(dev, 0.0, 0.0),
+        theory::readout_z_lagged(dev, 0.0, FRAC_PI_2),
+    );
+    [i[0].hypot(q[0]), i[1].hypot(q[1])]
+}
+
 /// |D_m| for m < N of the table core's words for envelope `e`
-/// (`datapath::table_product_turn`), by one transform.
-fn harmonics(e: i32) -> Vec<f64> {
+/// (`datapath::table_product_turn`), by one transform, kept for the
+/// process (a drive's envelope is one of a few).
+fn harmonics(e: i32) -> Arc<Vec<f64>> {
+    static KEPT: OnceLock<Mutex<HashMap<i32, Arc<Vec<f64>>>>> = OnceLock::new();
+    let kept = KEPT.get_or_init(Default::default);
+    if let Some(h) = kept.lock().expect("not poisoned").get(&e) {
+        return h.clone();
+    }
     let mut words: Vec<Complex<f64>> = table_product_turn(e)
         .into_iter()
         .map(|w| Complex::new(w, 0.0))
@@ -192,7 +257,9 @@ fn harmonics(e: i32) -> Vec<f64> {
         .plan_fft_forward(words.len())
         .process(&mut words);
     let n = words.len() as f64;
-    words.iter().map(|c| c.norm() / n).collect()
+    let h = Arc::new(words.iter().map(|c| c.norm() / n).collect());
+    kept.lock().expect("not poisoned").insert(e, Arc::clone(&h));
+    h
 }
 
 /// |sinc(pi m / N)|: a held word's harmonic m against its sample's.
@@ -201,11 +268,26 @@ fn sinc(m: u64) -> f64 {
     (x.sin() / x).abs()
 }
 
-/// Harmonics m >= 2 (the fundamental's images to `FUNDAMENTAL_IMAGES`,
-/// the others' to `IMAGES`) that the carrier step `step` samples within
-/// `reach` steps of +-step, each with its signed offset from the carrier
-/// (NCO steps; the line at -step + delta is the carrier's at -delta).
-fn candidates(step: u32, reach: u32) -> Vec<(u64, i32)> {
+/// How many images [`candidates`] looks at: (the fundamental's, the
+/// other harmonics').
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Depth(u64, u64);
+
+/// The whole bound: `FUNDAMENTAL_IMAGES` and `IMAGES`.
+pub const FULL: Depth = Depth(FUNDAMENTAL_IMAGES, IMAGES);
+
+/// The ranking of carriers in a search (`selfcal::operating`): the
+/// fundamental's first 4096 images (the k-th 1 / (N k) of it) and the
+/// others' first four, 1 / 100 of the full enumeration's work. The
+/// images left out are those the full bound's constants bound as small;
+/// the carrier chosen is then reported with the full bound.
+pub const SEARCH: Depth = Depth(1 << 12, 4);
+
+/// Harmonics m >= 2 (the fundamental's images to `depth.0`, the others'
+/// to `depth.1`) that the carrier step `step` samples within `reach`
+/// steps of +-step, each with its signed offset from the carrier (NCO
+/// steps; the line at -step + delta is the carrier's at -delta).
+fn candidates(step: u32, reach: u32, depth: Depth) -> Vec<(u64, i32)> {
     let near = |m: u64| -> Option<i32> {
         let nu = (m as u32).wrapping_mul(step);
         let above = nu.wrapping_sub(step) as i32;
@@ -218,11 +300,11 @@ fn candidates(step: u32, reach: u32) -> Vec<(u64, i32)> {
             None
         }
     };
-    let fundamental = (1..FUNDAMENTAL_IMAGES).flat_map(|k| [k * TURN - 1, k * TURN + 1]);
+    let fundamental = (1..depth.0).flat_map(|k| [k * TURN - 1, k * TURN + 1]);
     // Odd harmonics only: the turn's second half is the first negated.
     let others = (3..TURN - 1)
         .step_by(2)
-        .flat_map(|m0| (0..IMAGES).map(move |k| m0 + k * TURN));
+        .flat_map(move |m0| (0..depth.1).map(move |k| m0 + k * TURN));
     fundamental
         .chain(others)
         .filter_map(|m| near(m).map(|s| (m, s)))
@@ -253,6 +335,46 @@ mod tests {
         }
     }
 
+    /// `RESPONSE_GRID`'s premise: between grid points 1 / 32 of a mode
+    /// bandwidth apart, the full magnitude interpolates within 5e-4, on
+    /// the paper device driven at mode 1 (output 1 on its resonance,
+    /// output 2 250 Hz off it), over two bandwidths either side.
+    #[test]
+    fn the_response_interpolates_within_5e_4_between_grid_points() {
+        let dev = Device {
+            f1_hz: 9.64e6,
+            f2_hz: 9.640_25e6,
+            q1: 55000.0,
+            q2: 55000.0,
+            angular_gain: 0.6,
+            quadrature_dps: 0.0,
+            damping_coupling_dps: 0.0,
+            carrier_hz: 9.64e6,
+            f1_force: 1.0,
+            f2_force: 1.0,
+        };
+        let spacing = dev.f1_hz / dev.q1 / RESPONSE_GRID;
+        let at = |x: f64| {
+            full(&Device {
+                carrier_hz: dev.carrier_hz + x * spacing,
+                ..dev.clone()
+            })
+        };
+        let mut worst = 0.0f64;
+        for i in -64..64 {
+            let (lo, hi) = (at(f64::from(i)), at(f64::from(i + 1)));
+            for w in [0.25, 0.5, 0.75] {
+                let exact = at(f64::from(i) + w);
+                for k in 0..2 {
+                    let lerp = lo[k] + w * (hi[k] - lo[k]);
+                    worst = worst.max((lerp / exact[k] - 1.0).abs());
+                }
+            }
+        }
+        eprintln!("worst interpolation error {worst:.2e}");
+        assert!(worst < 5e-4, "{worst}");
+    }
+
     /// A carrier near n / q of the clock: harmonics kq -+ 1 land k eps
     /// from it (`plan::nearest_fold`), the odd ones among them (for q odd,
     /// even k) are the candidates. The paper device's 30 deg C carrier on
@@ -265,7 +387,7 @@ mod tests {
         let (q, eps) = nearest_fold(carrier, clock);
         assert_eq!(q, 83);
         let per_step = clock / 2f64.powi(32);
-        let found = candidates(step, (1000.0 / per_step) as u32);
+        let found = candidates(step, (1000.0 / per_step) as u32, FULL);
         for k in 1..=12u64 {
             for m in [k * q - 1, k * q + 1].into_iter().filter(|m| m % 2 == 1) {
                 let omega = found

@@ -1011,6 +1011,7 @@ mod tests {
             amplitude: knowns.amplitude,
             fold_shift_hz: 0.0,
             static_fold: static_fold(knowns, carrier_hz),
+            spur_move: None,
         }
     }
 
