@@ -319,12 +319,12 @@ pub fn operating(knowns: &Knowns, id: &Identified) -> Result<Operating, Error> {
     Ok(op)
 }
 
-/// Carriers tried a side of the asked one by [`quietest_spurs`], evenly
+/// Carriers tried a side of the asked one by `quietest_spurs`, evenly
 /// over the fold move's reach.
 pub const SPUR_SEARCH_POINTS: u32 = 32;
 
 /// Least factor by which a move must lower the larger output's spur
-/// bound, relative to its own, for [`quietest_spurs`] to take it: the
+/// bound, relative to its own, for `quietest_spurs` to take it: the
 /// bound is an amplitude sum (`spurs`), and a smaller gain may be none.
 pub const SPUR_MOVE_GAIN: f64 = 1.5;
 

@@ -268,7 +268,7 @@ fn sinc(m: u64) -> f64 {
     (x.sin() / x).abs()
 }
 
-/// How many images [`candidates`] looks at: (the fundamental's, the
+/// How many images `candidates` looks at: (the fundamental's, the
 /// other harmonics').
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Depth(u64, u64);
