@@ -7,8 +7,9 @@
 //! turn's N = 32768 intervals (`datapath::table_product_turn`). With D_m
 //! the transform of those N words, the held words' harmonic m + kN is
 //! (-1)^k D_m sinc(pi (m + kN) / N) for m < N; only odd harmonics exist
-//! (the turn's second half is its first negated). Harmonic m is sampled at m times the carrier's step, so it lands Omega from the
-//! carrier when m step = +-step + Omega (mod 2^32). That is the fold of
+//! (the turn's second half is its first negated). Harmonic m is sampled
+//! at m times the carrier's step, so it lands Omega from the carrier when
+//! m step = +-step + Omega (mod 2^32). That is the fold of
 //! `plan::nearest_fold` seen harmonic by harmonic: near n / q of the clock
 //! the harmonics kq +- 1 land k eps from the carrier.
 //!
