@@ -251,10 +251,16 @@ fn step_notes(s: &mut String, report: &FieldReport) {
         // A move that could not clear the passband only made the fold
         // beat faster (`gyrocal_regs::plan::SETTLED_FOLD_BEATS`).
         let _ = if let Some(m) = st.selfcal.operating.spur_move {
+            // The bound where it moved is the cycle's own.
+            let to = st
+                .selfcal
+                .carrier_spurs
+                .as_ref()
+                .map_or([f64::NAN; 2], |sp| sp.rms_dps);
             writeln!(
                 s,
                 "{t:>8.2}  the carrier moved {shift:+.4} Hz to where its table spurs bound the rate ripple lowest within the allowance: {:.4} / {:.4} deg/s RMS, from {:.4} / {:.4} (nearest fold period {} clocks, now {:.1} Hz away); clearing the passband would have moved the scale factors too far",
-                m.to_dps[0], m.to_dps[1], m.from_dps[0], m.from_dps[1], f.period, f.offset_hz
+                to[0], to[1], m.from_dps[0], m.from_dps[1], f.period, f.offset_hz
             )
         } else if f.in_passband {
             writeln!(
@@ -362,7 +368,7 @@ pub fn summary(report: &FieldReport) -> String {
         }
     }
     for st in &report.steps {
-        if let Some(sp) = &st.carrier_spurs {
+        if let Some(sp) = &st.selfcal.carrier_spurs {
             spur_line(&mut s, st.temperature_c, sp, st.profile.as_ref());
         }
     }

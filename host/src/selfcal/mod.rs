@@ -177,13 +177,13 @@ pub struct Operating {
 }
 
 /// A table-core carrier moved to lower its spur bound (`operating`).
+/// The bound where it moved is the cycle's own
+/// ([`SelfCal::carrier_spurs`]).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct SpurMove {
     /// The bound on the rate's RMS ripple per output where the carrier
     /// was asked (deg/s).
     pub from_dps: [f64; 2],
-    /// The bound where it moved (deg/s).
-    pub to_dps: [f64; 2],
 }
 
 /// A carrier fold of period at most `plan::STATIC_FOLD_PERIOD` clocks
@@ -244,6 +244,10 @@ pub struct SelfCal {
     pub sf_design_ratio_per_dps: [f64; 2],
     /// Relative 1-sigma uncertainty of `sf_selfcal_per_dps`, by source.
     pub sf_selfcal_uncertainty: SfUncertainty,
+    /// On the table core, the carrier words' harmonics that the clock
+    /// folds into the passband at `operating` and the bound on the rate
+    /// ripple they make ([`spurs()`]); `None` on the fine core.
+    pub carrier_spurs: Option<Spurs>,
     /// Clocks of the whole cycle.
     pub clocks: u64,
 }
@@ -380,16 +384,16 @@ fn quietest_spurs(
             }
         }
     }
-    // The move's bounds in full, as the step reports them.
+    // The bound where the carrier was asked, in full, as the step reports
+    // it (the cycle computes the one where it moved, `self_calibrate`).
     let Some((_, moved)) = best else {
         return Ok(None);
     };
-    let full = |op: &Operating| spur_rms(knowns, id, op, FULL).map(|r| r.unwrap_or_default());
-    let spur_move = Some(SpurMove {
-        from_dps: full(asked)?,
-        to_dps: full(&moved)?,
-    });
-    Ok(Some(Operating { spur_move, ..moved }))
+    let from_dps = spur_rms(knowns, id, asked, FULL)?.unwrap_or_default();
+    Ok(Some(Operating {
+        spur_move: Some(SpurMove { from_dps }),
+        ..moved
+    }))
 }
 
 /// Farthest the carrier is looked for off its configured place to clear
@@ -497,6 +501,7 @@ pub fn self_calibrate(
         drive_ratio: None,
         sf_design_ratio_per_dps: sf_selfcal_per_dps,
         sf_selfcal_uncertainty: uncertainty,
+        carrier_spurs: None,
     };
     if at_rest.relative.uncertainty < AT_REST_RATIO_SIGMA {
         // The coupling's estimate carried (r + 1/r) / 2 of the ratio r
@@ -510,6 +515,7 @@ pub fn self_calibrate(
         }
         apply_drive_ratio(knowns, &mut cal, at_rest)?;
     }
+    cal.carrier_spurs = spurs(knowns, &cal.identified, &cal.operating)?;
     Ok(cal)
 }
 

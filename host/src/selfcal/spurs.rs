@@ -129,12 +129,15 @@ pub fn spurs(knowns: &Knowns, id: &Identified, op: &Operating) -> Result<Option<
         return Ok(None);
     };
     let rms_dps = rms(lines.iter().map(|l| l.amplitude_dps));
-    let mut largest: Vec<SpurLine> = lines.clone();
-    if largest.len() > NAMED_LINES {
-        largest.select_nth_unstable_by(NAMED_LINES, |a, b| peak(b).total_cmp(&peak(a)));
-        largest.truncate(NAMED_LINES);
+    // The largest by index: the lines themselves stay in offset order.
+    let by_peak = |a: &usize, b: &usize| peak(&lines[*b]).total_cmp(&peak(&lines[*a]));
+    let mut order: Vec<usize> = (0..lines.len()).collect();
+    if order.len() > NAMED_LINES {
+        order.select_nth_unstable_by(NAMED_LINES, by_peak);
+        order.truncate(NAMED_LINES);
     }
-    largest.sort_by(|a, b| peak(b).total_cmp(&peak(a)));
+    order.sort_by(by_peak);
+    let largest = order.into_iter().map(|i| lines[i]).collect();
     Ok(Some(Spurs {
         lines,
         largest,

@@ -45,7 +45,7 @@ use gyrocal_host::drive_ratio;
 use gyrocal_host::identify::Estimate;
 use gyrocal_host::sampling::{Signal, mean_of_parts, part_means};
 use gyrocal_host::selfcal::StaticFold;
-use gyrocal_host::selfcal::{self, Operating, SelfCal, Spurs};
+use gyrocal_host::selfcal::{self, Operating, SelfCal};
 use gyrocal_regs::plan::{FOLD_CLEAR_CORNERS, nearest_fold};
 use rayon::prelude::*;
 use serde::Deserialize;
@@ -267,11 +267,6 @@ pub struct FieldStep {
     /// corners of the carrier, the rate carries a ripple at that offset
     /// and its multiples, and the step's line says so.
     pub carrier_fold: CarrierFold,
-    /// On the table core, the carrier words' harmonics that the clock
-    /// folds into the passband at the operating point and the bound on
-    /// the rate ripple they make (`gyrocal_host::selfcal::spurs`); null on
-    /// the fine core.
-    pub carrier_spurs: Option<Spurs>,
     /// Identified parameters (JSON: f1_hz, ..., with `_uncertainty` twins).
     pub identified: IdentifiedJson,
     /// The whole cycle's result.
@@ -914,11 +909,6 @@ fn baseline_of<'a>(
 /// factory calibration and the step's measurements at its settings exist.
 fn field_step(c: Cycle, baseline: Option<Baseline>, knowns: &Knowns) -> FieldStep {
     let sf_true = c.truth.sf_per_dps;
-    // A bound the host could not form (its theory at the operating point
-    // failed) is left out; the cycle's own figures stand.
-    let spurs = selfcal::spurs(knowns, &c.cal.identified, &c.cal.operating)
-        .ok()
-        .flatten();
     let trace = c.readout.as_ref().map(|(null, run)| {
         let selfcal_rate = profile::calibrated(&run.z, *null, c.cal.sf_selfcal_per_dps);
         let base = baseline.as_ref().map(|b| {
@@ -940,7 +930,9 @@ fn field_step(c: Cycle, baseline: Option<Baseline>, knowns: &Knowns) -> FieldSte
             selfcal_rate_dps: selfcal_rate,
             baseline_rate_dps: base.map(|b| b.0),
             null_selfcal_z: *null,
-            spur_bound_dps: spurs
+            spur_bound_dps: c
+                .cal
+                .carrier_spurs
                 .as_ref()
                 .map(|sp| sp.rms_over_records_dps(profile::record_spacing_s(&run.time_s))),
         }
@@ -949,7 +941,6 @@ fn field_step(c: Cycle, baseline: Option<Baseline>, knowns: &Knowns) -> FieldSte
         temperature_c: c.at.temperature_c,
         drive_gain_ratio_true: c.at.drive_gain[1] / c.at.drive_gain[0],
         carrier_fold: CarrierFold::of(&c.cal.operating, knowns),
-        carrier_spurs: spurs,
         truth: c.at,
         sf_true_per_dps: sf_true,
         sf_true_uncertainty: c.truth.uncertainty,

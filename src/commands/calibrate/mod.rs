@@ -27,7 +27,7 @@ pub mod watch;
 
 use super::experiment::read_config;
 use crate::Failure;
-use gyrocal_host::selfcal::{self, SelfCal, Spurs};
+use gyrocal_host::selfcal::{self, SelfCal};
 use gyrocal_host::{Board, Knowns, transport};
 use gyrocal_sim::drift::DeviceAt;
 use gyrocal_sim::field::board::SimBoard;
@@ -81,9 +81,6 @@ pub struct Outcome {
     pub wall_s: f64,
     /// The truth, in process.
     pub truth: Option<Truth>,
-    /// On the table core, the bound on the rate ripple from the carrier's
-    /// folded harmonics at the operating point (`selfcal::spurs`).
-    pub spurs: Option<Spurs>,
 }
 
 /// Calibrate and print.
@@ -132,20 +129,11 @@ fn over_the_wire(url: &str, knowns: &Knowns, temperature: Option<f64>) -> Result
     let (cal, samples, wall_s) = cycle(board.as_mut(), knowns)?;
     Ok(Outcome {
         board: url.into(),
-        spurs: table_spurs(knowns, &cal),
         cal,
         samples,
         wall_s,
         truth: None,
     })
-}
-
-/// The spur bound at the cycle's operating point; a bound the theory
-/// could not form is left out, the cycle's figures stand.
-fn table_spurs(knowns: &Knowns, cal: &SelfCal) -> Option<Spurs> {
-    selfcal::spurs(knowns, &cal.identified, &cal.operating)
-        .ok()
-        .flatten()
 }
 
 fn in_process(
@@ -165,7 +153,6 @@ fn in_process(
         scenario::rate_table(&file.exp, &fe, &at, knowns, &cal.operating).map_err(Failure::Run)?;
     Ok(Outcome {
         board: "in-process".into(),
-        spurs: table_spurs(knowns, &cal),
         cal,
         samples,
         wall_s,

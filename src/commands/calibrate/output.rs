@@ -76,7 +76,7 @@ pub fn json(o: &Outcome) -> Value {
         "clocks": cal.clocks,
         "wall_s": o.wall_s,
         "samples": {"read": o.samples.read, "missed": o.samples.missed},
-        "carrier_spurs": o.spurs,
+        "carrier_spurs": cal.carrier_spurs,
         "truth": truth,
     })
 }
@@ -112,7 +112,7 @@ pub fn table(o: &Outcome) -> String {
     if let Some(fold) = cal.operating.static_fold {
         let _ = writeln!(s, "warning: {fold}");
     }
-    if let Some(sp) = &o.spurs {
+    if let Some(sp) = &cal.carrier_spurs {
         let _ = writeln!(s, "{sp}");
     }
     let _ = writeln!(
