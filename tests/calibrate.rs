@@ -242,6 +242,7 @@ fn rate_table_at(run: &Value) -> scenario::RateTable {
         fold_shift_hz: op("fold_shift_hz"),
         static_fold: None,
         spur_move: None,
+        scaled_drives: None,
     };
     scenario::rate_table(&file.exp, &fe, &at, &knowns, &operating)
         .unwrap()

@@ -183,6 +183,7 @@ fn rounding_moves_the_resonant_outputs_rate_table() {
             fold_shift_hz: 0.0,
             static_fold: None,
             spur_move: None,
+            scaled_drives: None,
         };
         let sf0 = scenario::rate_table(&sc.exp, &fe, &at, &knowns, &op)
             .unwrap()
@@ -684,4 +685,69 @@ fn the_table_core_bounds_the_ripple_of_a_fold_of_period_10001() {
     eprintln!("largest line {largest:?}");
     assert!((largest.offset_hz - 4.8).abs() < 0.1, "{largest:?}");
     assert_the_spur_bound_holds(&report, 25.0, 30.0, &[0]);
+}
+
+/// The paper device behind a front end set for a carrier 1 kHz above its
+/// resonance (a datasheet 0.01% high, the configured carrier on it): at
+/// the identified resonance the configured drives would peak the ADCs
+/// some 10 times over full scale, so the operating point scales them to
+/// 9.2% (measured 0.0922 and 0.0919 of the configured). Each step says so
+/// (`Operating::scaled_drives`), and at 30 deg C the spur move is judged
+/// at the drive the carrier runs with: the bound where it was asked and
+/// the cycle's own where it moved (both at the scaled drive) must show
+/// the move's gain. Measured: 5.35 / 3.14 to 2.13 / 1.00 deg/s RMS (+1.09
+/// Hz). Judged at the configured drive (mutant
+/// `spur-bound-at-the-configured-drive`), the move went -1.09 Hz as on
+/// the paper device and reported 0.77 / 0.39 where it was asked, while
+/// the cycle's own bound where it moved was 1.78 / 1.33: no gain at all.
+#[test]
+fn a_drive_scaled_for_the_adcs_is_said_and_the_spur_move_is_judged_at_it() {
+    let path = "tests/data/field_paper.toml";
+    let text = std::fs::read_to_string(path)
+        .unwrap()
+        .replace("carrier_hz = 9.64e6", "carrier_hz = 9.641e6")
+        .replace(
+            "[drive]",
+            "[datasheet]\nf1_hz = 9.641e6\nf2_hz = 9.64125e6\nq1 = 55000\nq2 = 55000\nangular_gain = 0.6\nangular_gain_uncertainty = 0.0\n\n[drive]",
+        );
+    let mut sc = scenario::parse(path, &text).unwrap();
+    sc.drift.temperatures_c = vec![25.0, 30.0];
+    sc.profile = None;
+    let report = finished(&sc);
+    for st in &report.steps {
+        let scaled = st.selfcal.operating.scaled_drives.expect("scaled drives");
+        assert!(
+            scaled.fraction < selfcal::DRIVE_BIT_LOST && scaled.table_core,
+            "{}: {scaled:?}",
+            st.temperature_c
+        );
+        assert_eq!(scaled.amplitude, st.selfcal.operating.amplitude);
+    }
+    let step = report
+        .steps
+        .iter()
+        .find(|s| s.temperature_c == 30.0)
+        .unwrap();
+    let from = step
+        .selfcal
+        .operating
+        .spur_move
+        .expect("a spur move")
+        .from_dps;
+    let to = step
+        .selfcal
+        .carrier_spurs
+        .as_ref()
+        .expect("a bound")
+        .rms_dps;
+    eprintln!("30 deg C: spur bound {from:?} to {to:?}");
+    for k in 0..2 {
+        assert!(
+            from[k] >= selfcal::SPUR_MOVE_GAIN * to[k],
+            "output {}: {} to {}",
+            k + 1,
+            from[k],
+            to[k]
+        );
+    }
 }

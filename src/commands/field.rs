@@ -29,7 +29,7 @@
 //! has a baseline (its baseline fields are null).
 
 use crate::Failure;
-use gyrocal_host::selfcal::Spurs;
+use gyrocal_host::selfcal::{self, Spurs};
 use gyrocal_sim::field::profile::RateTrace;
 use gyrocal_sim::field::scenario::{self, FAILED_CYCLE, FieldReport};
 use std::fmt::Write as _;
@@ -210,9 +210,10 @@ fn write_results(
     Ok(written)
 }
 
-/// Per step: the quadrature coupling the cycle measured, a drive-gain
-/// ratio taken as the design's with no sigma, and a carrier that folds in
-/// the output's passband (the rate ripples there).
+/// Per step: the quadrature coupling the cycle measured, drives scaled
+/// down for the ADCs, a drive-gain ratio taken as the design's with no
+/// sigma, and a carrier that folds in the output's passband (the rate
+/// ripples there).
 fn step_notes(s: &mut String, report: &FieldReport) {
     for st in &report.steps {
         let i = &st.identified;
@@ -227,6 +228,12 @@ fn step_notes(s: &mut String, report: &FieldReport) {
             i.damping_coupling_dps_uncertainty,
             st.truth.gyro.damping_coupling_dps
         );
+    }
+    for st in &report.steps {
+        let scaled = st.selfcal.operating.scaled_drives;
+        if let Some(d) = scaled.filter(|d| d.fraction < selfcal::DRIVE_BIT_LOST) {
+            let _ = writeln!(s, "{:>8.2}  {d}", st.temperature_c);
+        }
     }
     let design: Vec<String> = report
         .steps

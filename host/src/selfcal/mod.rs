@@ -120,6 +120,7 @@ use crate::drive_ratio::{self, CrossWindows, DriveRatio};
 use crate::error::Error;
 use crate::identify::{self, Estimate, Identified};
 use crate::knowns::Knowns;
+use gyrocal_regs::datapath::CarrierProfile;
 use gyrocal_regs::plan;
 use serde::Serialize;
 
@@ -162,6 +163,9 @@ pub struct Operating {
     /// Drive amplitudes (fractions of full scale): the configured ones
     /// scaled so that no ADC is predicted above `ADC_OPERATING`.
     pub amplitude: (f64, f64),
+    /// Where that scaled them down, by how much ([`ScaledDrives`]'s line
+    /// says what it costs).
+    pub scaled_drives: Option<ScaledDrives>,
     /// How far the carrier was moved from its configured place against
     /// the modes to keep the carrier tables' folds out of the passband
     /// (Hz, on the NCO's grid; 0 when it was not: module header).
@@ -204,6 +208,53 @@ impl std::fmt::Display for StaticFold {
             "the carrier is {:.3} Hz from a fold of period {} clocks, slower than a window: its converters' and tables' errors are the same in every batch, so the figures at this carrier may lie beyond their sigmas",
             self.offset_hz, self.period
         )
+    }
+}
+
+/// The configured drives scaled down so that no ADC is predicted above
+/// `ADC_OPERATING` of full scale ([`Operating::scaled_drives`]).
+///
+/// On an unseen device (3.3 MHz, Q 40000, table core, 27.3 MHz clock)
+/// whose front end was set 0.2% off its resonance, the drives ran at
+/// 0.66% of the configured ones: the table words lost 7.2 bits, a fold of
+/// period 91 in the passband rippled the rate by 281 deg/s RMS (bound 564),
+/// and the scale factors' sigma was 0.31%. With the ADC gain 150 times
+/// lower the drives ran at 99%, and the same step gave 1.6 deg/s (bound
+/// 2.1) and 0.016%; on the fine core 0.38 deg/s and 0.010%.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct ScaledDrives {
+    /// The drives' amplitudes (fractions of full scale).
+    pub amplitude: (f64, f64),
+    /// Their fraction of the configured ones (`[drive] amplitude1/2`).
+    pub fraction: f64,
+    /// On the table core: the carrier words' rounding error is fixed in
+    /// LSB, so its spur bound (`spurs`) grows as the drive shrinks.
+    pub table_core: bool,
+}
+
+/// Scale below which the drive words have lost a bit: the reports name
+/// such a scaling (`ScaledDrives`'s line), and on the table core what it
+/// costs.
+pub const DRIVE_BIT_LOST: f64 = 0.5;
+
+impl std::fmt::Display for ScaledDrives {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "the drives run at {:.4} / {:.4} of full scale, {:.3}% of [drive] amplitude1/2, so that no ADC is predicted above {:.0}% of full scale",
+            self.amplitude.0,
+            self.amplitude.1,
+            100.0 * self.fraction,
+            100.0 * ADC_OPERATING
+        )?;
+        if self.table_core && self.fraction < DRIVE_BIT_LOST {
+            write!(
+                f,
+                "; the table core's carrier words lose {:.1} bits and its spurs grow as much (a lower ADC or drive gain lets the drive rise; the fine core shapes its rounding away from the carrier)",
+                -self.fraction.log2()
+            )?;
+        }
+        Ok(())
     }
 }
 
@@ -269,6 +320,7 @@ pub fn operating(knowns: &Knowns, id: &Identified) -> Result<Operating, Error> {
             fold_shift_hz: 0.0,
             static_fold: static_fold(knowns, real.carrier_hz),
             spur_move: None,
+            scaled_drives: None,
         })
     };
     let mut op = at(asked)?;
@@ -315,12 +367,32 @@ pub fn operating(knowns: &Knowns, id: &Identified) -> Result<Operating, Error> {
             ..m
         };
     }
+    within_adc(knowns, id, op)
+}
+
+/// `op` with the configured drives scaled by one factor so that no ADC
+/// peak is predicted above `ADC_OPERATING` (module header), or as they
+/// are where none is.
+fn within_adc(knowns: &Knowns, id: &Identified, op: Operating) -> Result<Operating, Error> {
     let peak = adc_peaks(knowns, id, &op)?.into_iter().fold(0.0, f64::max);
-    if peak > ADC_OPERATING {
-        let s = ADC_OPERATING / peak;
-        op.amplitude = (s * knowns.amplitude.0, s * knowns.amplitude.1);
+    if peak <= ADC_OPERATING {
+        return Ok(Operating {
+            amplitude: knowns.amplitude,
+            scaled_drives: None,
+            ..op
+        });
     }
-    Ok(op)
+    let fraction = ADC_OPERATING / peak;
+    let amplitude = (fraction * knowns.amplitude.0, fraction * knowns.amplitude.1);
+    Ok(Operating {
+        amplitude,
+        scaled_drives: Some(ScaledDrives {
+            amplitude,
+            fraction,
+            table_core: knowns.carrier_profile == CarrierProfile::Table,
+        }),
+        ..op
+    })
 }
 
 /// Carriers tried a side of the asked one by `quietest_spurs`, evenly
@@ -358,7 +430,14 @@ fn quietest_spurs(
     at: &dyn Fn(f64) -> Result<Operating, Error>,
     admitted: &dyn Fn(&Operating, f64) -> Result<bool, Error>,
 ) -> Result<Option<Operating>, Error> {
-    let Some(here) = spur_rms(knowns, id, asked, SEARCH)? else {
+    // Each bound at the drives the carrier would run with: the table
+    // words' rounding error is fixed in LSB, so a drive scaled down for
+    // the ADCs (`within_adc`) raises the bound as much.
+    let bound = |op: &Operating, depth: Depth| {
+        let driven = within_adc(knowns, id, op.clone())?;
+        spur_rms(knowns, id, &driven, depth)
+    };
+    let Some(here) = bound(asked, SEARCH)? else {
         return Ok(None);
     };
     let settled = plan::SETTLED_FOLD_BEATS / knowns.filter.min_window_s;
@@ -375,7 +454,7 @@ fn quietest_spurs(
             if eps < settled || !admitted(&moved, FOLD_SF_CHANGE)? {
                 continue;
             }
-            let Some(there) = spur_rms(knowns, id, &moved, SEARCH)? else {
+            let Some(there) = bound(&moved, SEARCH)? else {
                 continue;
             };
             let score = (0..2).map(|k| there[k] / here[k]).fold(0.0, f64::max);
@@ -389,7 +468,7 @@ fn quietest_spurs(
     let Some((_, moved)) = best else {
         return Ok(None);
     };
-    let from_dps = spur_rms(knowns, id, asked, FULL)?.unwrap_or_default();
+    let from_dps = bound(asked, FULL)?.unwrap_or_default();
     Ok(Some(Operating {
         spur_move: Some(SpurMove { from_dps }),
         ..moved
@@ -611,4 +690,32 @@ pub fn apply_drive_ratio(
     cal.ratio = ratio;
     cal.drive_ratio = Some(measured);
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The scaled drives' line names the table words' lost bits only on
+    /// the table core, and only once a bit is lost.
+    #[test]
+    fn the_scaled_drives_line_names_the_table_cores_lost_bits() {
+        let line = |fraction: f64, table_core: bool| {
+            let amplitude = (0.9 * fraction, 0.9 * fraction);
+            ScaledDrives {
+                amplitude,
+                fraction,
+                table_core,
+            }
+            .to_string()
+        };
+        let small = line(1.0 / 150.0, true);
+        assert!(
+            small.contains("0.0060 / 0.0060 of full scale, 0.667%"),
+            "{small}"
+        );
+        assert!(small.contains("lose 7.2 bits"), "{small}");
+        assert!(!line(1.0 / 150.0, false).contains("bits"));
+        assert!(!line(0.6, true).contains("bits"));
+    }
 }

@@ -1003,6 +1003,7 @@ mod tests {
             fold_shift_hz: 0.0,
             static_fold: static_fold(knowns, carrier_hz),
             spur_move: None,
+            scaled_drives: None,
         }
     }
 

@@ -4,6 +4,7 @@
 
 use super::Outcome;
 use gyrocal_host::identify::Estimate;
+use gyrocal_host::selfcal;
 use serde_json::{Map, Value, json};
 use std::fmt::Write as _;
 
@@ -109,6 +110,10 @@ pub fn table(o: &Outcome) -> String {
         "operating: carrier {:.6} Hz, phase correction {:.5} deg",
         cal.operating.carrier_hz, cal.operating.ref_lag_deg
     );
+    let scaled = cal.operating.scaled_drives;
+    if let Some(d) = scaled.filter(|d| d.fraction < selfcal::DRIVE_BIT_LOST) {
+        let _ = writeln!(s, "{d}");
+    }
     if let Some(fold) = cal.operating.static_fold {
         let _ = writeln!(s, "warning: {fold}");
     }
