@@ -66,7 +66,11 @@ fn run_file(name: &str, text: &str) -> Report {
 
 fn assert_on_theory(name: &str, r: &Report) {
     for k in 0..2 {
-        let (m, x, s) = (r.ratio[k], r.theory.ratio[k], r.ratio_uncertainty[k]);
+        let (m, x, s) = (
+            r.scale_factors.ratio[k],
+            r.theory.ratio[k],
+            r.scale_factors.ratio_uncertainty[k],
+        );
         eprintln!(
             "{name}, output {}: ratio {m:.6} +- {s:.1e}, exact {x:.6}, error {:+.4}% ({:+.2} sigma)",
             k + 1,
@@ -75,7 +79,11 @@ fn assert_on_theory(name: &str, r: &Report) {
         );
     }
     for k in 0..2 {
-        let (m, x, s) = (r.ratio[k], r.theory.ratio[k], r.ratio_uncertainty[k]);
+        let (m, x, s) = (
+            r.scale_factors.ratio[k],
+            r.theory.ratio[k],
+            r.scale_factors.ratio_uncertainty[k],
+        );
         assert!(
             (m - x).abs() <= 3.0 * s,
             "{name}, output {}: {m} vs {x}, sigma {s}",

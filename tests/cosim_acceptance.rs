@@ -58,7 +58,7 @@ fn assert_ratios_match_theory(r: &Report, what: &str) {
         eprintln!(
             "{what}, output {}: ratio {:.6} exact {:.6} error {:+.4}%",
             k + 1,
-            r.ratio[k],
+            r.scale_factors.ratio[k],
             r.theory.ratio[k],
             100.0 * r.ratio_error[k]
         );
@@ -114,11 +114,11 @@ fn matched_modes_give_minus_two_lambda() {
             "closed form {}",
             closed_form.ratio[k]
         );
-        let error = r.ratio[k] / target - 1.0;
+        let error = r.scale_factors.ratio[k] / target - 1.0;
         eprintln!(
             "matched, output {}: ratio {:.6} vs -2 lambda: {:+.4}%",
             k + 1,
-            r.ratio[k],
+            r.scale_factors.ratio[k],
             100.0 * error
         );
         assert!(
@@ -202,8 +202,9 @@ fn the_papers_device_at_full_scale() {
     // coverage factor of its 7 degrees of freedom (1.51) plus systematic
     // terms (`gyrocal_sim::budget`), 4.85e-5 x 1.51 on this run.
     let error = r.ratio_error[1];
-    let spread =
-        r.uncertainty_budget.ratio[1].statistical / coverage_factor(BATCHES - 1) / r.ratio[1].abs();
+    let spread = r.uncertainty_budget.ratio[1].statistical
+        / coverage_factor(BATCHES - 1)
+        / r.scale_factors.ratio[1].abs();
     eprintln!("paper's device: detuned ratio error {error:+.2e}, batch spread {spread:.2e}");
     assert!(spread < 5e-5, "batch spread {spread:.2e}");
     assert!(error.abs() < 1e-4, "detuned ratio error {error:+.2e}");

@@ -59,7 +59,11 @@ fn check(name: &str, text: &str) {
     );
     let mut sigmas_from_uncoupled = 0.0f64;
     for (k, &w) in without.iter().enumerate() {
-        let (m, x, s) = (r.ratio[k], r.theory.ratio[k], r.ratio_uncertainty[k]);
+        let (m, x, s) = (
+            r.scale_factors.ratio[k],
+            r.theory.ratio[k],
+            r.scale_factors.ratio_uncertainty[k],
+        );
         eprintln!(
             "{name}, output {}: ratio {m:.6} +- {s:.1e}, exact {x:.6} (error {:+.4}%, {:+.2} sigma); \
              exact without the coupling {:.6}: the coupling moves it by {:+.3}%",

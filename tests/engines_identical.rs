@@ -143,16 +143,23 @@ mod with_verilator {
                 assert_eq!(p.trace, q.trace, "{}", r.timing.engine);
             }
             assert_eq!(
-                (r.sf_read_per_dps, r.sf_cal_per_dps, r.ratio),
                 (
-                    reports[0].sf_read_per_dps,
-                    reports[0].sf_cal_per_dps,
-                    reports[0].ratio
+                    r.scale_factors.sf_read_per_dps,
+                    r.scale_factors.sf_cal_per_dps,
+                    r.scale_factors.ratio
+                ),
+                (
+                    reports[0].scale_factors.sf_read_per_dps,
+                    reports[0].scale_factors.sf_cal_per_dps,
+                    reports[0].scale_factors.ratio
                 )
             );
         }
         // Not vacuous: the outputs moved with rate and calibration frequency.
-        assert!(reports[0].sf_read_per_dps[0] != 0.0 && reports[0].sf_cal_per_dps[1] != 0.0);
+        assert!(
+            reports[0].scale_factors.sf_read_per_dps[0] != 0.0
+                && reports[0].scale_factors.sf_cal_per_dps[1] != 0.0
+        );
     }
 
     #[test]

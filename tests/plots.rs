@@ -325,12 +325,12 @@ fn flat_outputs_still_draw() {
         p.z = [1e-12, -2e-12];
         p.z_theory = [1e-12, -2e-12];
     }
-    flat.sf_read_per_dps = [0.0; 2];
-    flat.sf_cal_per_dps = [0.0; 2];
+    flat.scale_factors.sf_read_per_dps = [0.0; 2];
+    flat.scale_factors.sf_cal_per_dps = [0.0; 2];
     flat.theory.sf_read_per_dps = [0.0; 2];
     flat.theory.sf_cal_per_dps = [0.0; 2];
-    flat.intercept_read = [1e-12, -2e-12];
-    flat.intercept_cal = [1e-12, -2e-12];
+    flat.scale_factors.intercept_read = [1e-12, -2e-12];
+    flat.scale_factors.intercept_cal = [1e-12, -2e-12];
     let dir = tempfile::tempdir().expect("temp dir");
     plots::write_figures(&flat, dir.path()).expect("flat figures");
 }

@@ -126,22 +126,42 @@ fn errors(r: &Report) -> [(f64, f64); 6] {
     let pair = |m: [f64; 2], x: [f64; 2], s: [f64; 2], k: usize| (m[k] - x[k], s[k]);
     let t = &r.theory;
     [
-        pair(r.ratio, t.ratio, r.ratio_uncertainty, 0),
-        pair(r.ratio, t.ratio, r.ratio_uncertainty, 1),
         pair(
-            r.sf_read_per_dps,
-            t.sf_read_per_dps,
-            r.sf_read_uncertainty,
+            r.scale_factors.ratio,
+            t.ratio,
+            r.scale_factors.ratio_uncertainty,
             0,
         ),
         pair(
-            r.sf_read_per_dps,
-            t.sf_read_per_dps,
-            r.sf_read_uncertainty,
+            r.scale_factors.ratio,
+            t.ratio,
+            r.scale_factors.ratio_uncertainty,
             1,
         ),
-        pair(r.sf_cal_per_dps, t.sf_cal_per_dps, r.sf_cal_uncertainty, 0),
-        pair(r.sf_cal_per_dps, t.sf_cal_per_dps, r.sf_cal_uncertainty, 1),
+        pair(
+            r.scale_factors.sf_read_per_dps,
+            t.sf_read_per_dps,
+            r.scale_factors.sf_read_uncertainty,
+            0,
+        ),
+        pair(
+            r.scale_factors.sf_read_per_dps,
+            t.sf_read_per_dps,
+            r.scale_factors.sf_read_uncertainty,
+            1,
+        ),
+        pair(
+            r.scale_factors.sf_cal_per_dps,
+            t.sf_cal_per_dps,
+            r.scale_factors.sf_cal_uncertainty,
+            0,
+        ),
+        pair(
+            r.scale_factors.sf_cal_per_dps,
+            t.sf_cal_per_dps,
+            r.scale_factors.sf_cal_uncertainty,
+            1,
+        ),
     ]
 }
 
@@ -311,9 +331,9 @@ fn survey() {
             "clock": d.clock_hz, "lambda": d.lambda, "rates": d.rates_dps, "cals": d.cal_hz,
             "cycles": r.timing.cycles, "wall_s": r.timing.wall_s, "rounds": r.timing.rounds,
             "warnings": r.warnings,
-            "ratio": misses(r.ratio, r.ratio_uncertainty, r.theory.ratio),
-            "sf_read": misses(r.sf_read_per_dps, r.sf_read_uncertainty, r.theory.sf_read_per_dps),
-            "sf_cal": misses(r.sf_cal_per_dps, r.sf_cal_uncertainty, r.theory.sf_cal_per_dps),
+            "ratio": misses(r.scale_factors.ratio, r.scale_factors.ratio_uncertainty, r.theory.ratio),
+            "sf_read": misses(r.scale_factors.sf_read_per_dps, r.scale_factors.sf_read_uncertainty, r.theory.sf_read_per_dps),
+            "sf_cal": misses(r.scale_factors.sf_cal_per_dps, r.scale_factors.sf_cal_uncertainty, r.theory.sf_cal_per_dps),
             "budget": r.uncertainty_budget, "images": r.theory.images,
         });
         eprintln!("{line}");

@@ -91,19 +91,13 @@ pub struct Theory {
 /// Everything `gyrocal run --json` prints and `results.json` holds.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Report {
-    /// Simulated readout scale factor [output 1, output 2], (m^2/s^2) per deg/s.
-    pub sf_read_per_dps: [f64; 2],
-    /// Its 1-sigma uncertainty against the exact theory, all sources
+    /// The simulated scale factors, their ratio and the fits' intercepts
+    /// (JSON: at the top level, `sf_read_per_dps` ... `intercept_cal`),
+    /// in (m^2/s^2) per deg/s (calibration: per deg/s of virtual rate 360
+    /// f_cal); each 1-sigma against the exact theory, all sources
     /// (`uncertainty_budget`).
-    pub sf_read_uncertainty: [f64; 2],
-    /// Simulated calibration scale factor, per deg/s of virtual rate 360 f_cal.
-    pub sf_cal_per_dps: [f64; 2],
-    /// Its 1-sigma uncertainty.
-    pub sf_cal_uncertainty: [f64; 2],
-    /// Simulated ratio sf_read / sf_cal.
-    pub ratio: [f64; 2],
-    /// Its 1-sigma uncertainty.
-    pub ratio_uncertainty: [f64; 2],
+    #[serde(flatten)]
+    pub scale_factors: ScaleFactors,
     /// The ratio's target uncertainty, tolerance x max(|ratio|, 0.5).
     pub ratio_target_uncertainty: [f64; 2],
     /// The 1-sigma terms of each figure by source, whose root sum of
@@ -120,10 +114,6 @@ pub struct Report {
     pub sf_cal_lsb_per_dps: [f64; 2],
     /// Its 1-sigma uncertainty.
     pub sf_cal_lsb_uncertainty: [f64; 2],
-    /// Intercepts of the simulated readout and calibration fits.
-    pub intercept_read: [f64; 2],
-    /// Intercepts of the simulated calibration fits.
-    pub intercept_cal: [f64; 2],
     /// The exact theory at the same points, and closed forms.
     pub theory: Theory,
     /// Relative error of the simulated ratio against the exact fitted one.
@@ -214,8 +204,6 @@ impl Report {
         ));
         let theory_device = plan.theory_device(exp);
         Report {
-            intercept_read: sim.intercept_read,
-            intercept_cal: sim.intercept_cal,
             ratio_error: std::array::from_fn(|k| rel(sim.ratio[k], exact.ratio[k])),
             predicted_sf_read_per_dps: predicted,
             predicted_sf_read_eq56_per_dps: predicted_eq56,
@@ -223,12 +211,6 @@ impl Report {
             prediction_error_eq56: std::array::from_fn(|k| {
                 rel(predicted_eq56[k], sim.sf_read_per_dps[k])
             }),
-            sf_read_per_dps: sim.sf_read_per_dps,
-            sf_read_uncertainty: sim.sf_read_uncertainty,
-            sf_cal_per_dps: sim.sf_cal_per_dps,
-            sf_cal_uncertainty: sim.sf_cal_uncertainty,
-            ratio: sim.ratio,
-            ratio_uncertainty: sim.ratio_uncertainty,
             ratio_target_uncertainty: target,
             uncertainty_budget,
             sf_read_lsb_per_dps: in_lsb(sim.sf_read_per_dps, read_per_lsb),
@@ -274,6 +256,7 @@ impl Report {
             points,
             timing: measured.timing,
             warnings,
+            scale_factors: sim,
         }
     }
 }

@@ -312,14 +312,14 @@ pub fn summary(report: &Report) -> String {
         |name: &str, v: [f64; 2]| format!("{name:<32}{:>+17.4e}{:9}  {:>+17.4e}\n", v[0], "", v[1]);
     s.push_str(&row(
         "sf_read (m^2/s^2 per deg/s)",
-        report.sf_read_per_dps,
-        report.sf_read_uncertainty,
+        report.scale_factors.sf_read_per_dps,
+        report.scale_factors.sf_read_uncertainty,
     ));
     s.push_str(&exact("  exact theory, same fit", t.sf_read_per_dps));
     s.push_str(&row(
         "sf_cal (per deg/s virtual)",
-        report.sf_cal_per_dps,
-        report.sf_cal_uncertainty,
+        report.scale_factors.sf_cal_per_dps,
+        report.scale_factors.sf_cal_uncertainty,
     ));
     s.push_str(&exact("  exact theory, same fit", t.sf_cal_per_dps));
     s.push_str(&row(
@@ -336,8 +336,14 @@ pub fn summary(report: &Report) -> String {
     s.push_str(&format!(
         "{:<32}{:>26}  {:>26}\n",
         "ratio sf_read / sf_cal",
-        ratio(report.ratio[0], report.ratio_uncertainty[0]),
-        ratio(report.ratio[1], report.ratio_uncertainty[1])
+        ratio(
+            report.scale_factors.ratio[0],
+            report.scale_factors.ratio_uncertainty[0]
+        ),
+        ratio(
+            report.scale_factors.ratio[1],
+            report.scale_factors.ratio_uncertainty[1]
+        )
     ));
     let plain =
         |name: &str, v: [f64; 2]| format!("{name:<32}{:>+17.6}{:9}  {:>+17.6}\n", v[0], "", v[1]);
@@ -348,7 +354,7 @@ pub fn summary(report: &Report) -> String {
         // The relative error over the relative sigma: the sign of the
         // error column beside it.
         std::array::from_fn(|k| {
-            report.ratio_error[k] / (report.ratio_uncertainty[k] / t.ratio[k].abs())
+            report.ratio_error[k] / (report.scale_factors.ratio_uncertainty[k] / t.ratio[k].abs())
         });
     s.push_str(&format!(
         "{:<32}{:>+16.4}% {:>+5.1}s  {:>+16.4}% {:>+5.1}s\n",

@@ -47,7 +47,7 @@ pub fn paper_table(report: &Report) -> String {
         "115 uV/deg/s",
         format!(
             "{:+.5e} +- {:.1e}",
-            report.sf_read_per_dps[d], report.sf_read_uncertainty[d]
+            report.scale_factors.sf_read_per_dps[d], report.scale_factors.sf_read_uncertainty[d]
         ),
         format!("{:+.5e}", t.sf_read_per_dps[d]),
     ));
@@ -56,7 +56,7 @@ pub fn paper_table(report: &Report) -> String {
         "73 uV/deg/s",
         format!(
             "{:+.5e} +- {:.1e}",
-            report.sf_cal_per_dps[d], report.sf_cal_uncertainty[d]
+            report.scale_factors.sf_cal_per_dps[d], report.scale_factors.sf_cal_uncertainty[d]
         ),
         format!("{:+.5e}", t.sf_cal_per_dps[d]),
     ));
@@ -65,7 +65,7 @@ pub fn paper_table(report: &Report) -> String {
         "1.53",
         format!(
             "{:.5} +- {:.1e}",
-            report.ratio[d], report.ratio_uncertainty[d]
+            report.scale_factors.ratio[d], report.scale_factors.ratio_uncertainty[d]
         ),
         format!("{:.5}", t.ratio[d]),
     ));
@@ -109,7 +109,7 @@ pub fn paper_table(report: &Report) -> String {
         "\nsimulated ratio against the exact theory at the same points: {:+.4}% (output {}), 1 sigma {:.4}%; {} clocks in {:.2} s wall\n",
         100.0 * report.ratio_error[d],
         d + 1,
-        100.0 * report.ratio_uncertainty[d] / report.ratio[d].abs(),
+        100.0 * report.scale_factors.ratio_uncertainty[d] / report.scale_factors.ratio[d].abs(),
         report.timing.cycles,
         report.timing.wall_s
     ));

@@ -24,8 +24,8 @@ pub(super) fn draw_calibration<DB: DrawingBackend>(
             fmt_num(freqs[0], 4),
             fmt_num(freqs[freqs.len() - 1], 4),
             r.timing.engine,
-            fmt_num(r.ratio[0], 4),
-            fmt_num(r.ratio[1], 4),
+            fmt_num(r.scale_factors.ratio[0], 4),
+            fmt_num(r.scale_factors.ratio[1], 4),
         ),
     )?;
     let panels = body.split_evenly((1, 2));
@@ -41,7 +41,10 @@ pub(super) fn draw_calibration<DB: DrawingBackend>(
                 .iter()
                 .map(|p| (p.rate_dps, p.z_theory[k]))
                 .collect(),
-            fit: (r.sf_cal_per_dps[k], r.intercept_cal[k]),
+            fit: (
+                r.scale_factors.sf_cal_per_dps[k],
+                r.scale_factors.intercept_cal[k],
+            ),
             theory_slope: r.theory.sf_cal_per_dps[k],
         };
         draw_line_panel(area, &panel)?;

@@ -48,10 +48,10 @@ impl<'a> Data<'a> {
             }
         }
         let scalars = [
-            report.sf_read_per_dps,
-            report.sf_cal_per_dps,
-            report.intercept_read,
-            report.intercept_cal,
+            report.scale_factors.sf_read_per_dps,
+            report.scale_factors.sf_cal_per_dps,
+            report.scale_factors.intercept_read,
+            report.scale_factors.intercept_cal,
             report.theory.sf_read_per_dps,
             report.theory.sf_cal_per_dps,
         ];

@@ -36,7 +36,10 @@ pub(super) fn draw_readout<DB: DrawingBackend>(
                 .iter()
                 .map(|p| (p.rate_dps, p.z_theory[k]))
                 .collect(),
-            fit: (r.sf_read_per_dps[k], r.intercept_read[k]),
+            fit: (
+                r.scale_factors.sf_read_per_dps[k],
+                r.scale_factors.intercept_read[k],
+            ),
             theory_slope: r.theory.sf_read_per_dps[k],
         };
         draw_line_panel(area, &panel)?;

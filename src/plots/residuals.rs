@@ -62,14 +62,14 @@ pub(super) fn draw_residuals<DB: DrawingBackend>(
             "readout",
             "rotation rate Ω (°/s)",
             &data.readout,
-            r.sf_read_per_dps,
+            r.scale_factors.sf_read_per_dps,
             r.theory.sf_read_per_dps,
         ),
         (
             "calibration",
             "virtual rate 360·f_cal (°/s)",
             &data.cal,
-            r.sf_cal_per_dps,
+            r.scale_factors.sf_cal_per_dps,
             r.theory.sf_cal_per_dps,
         ),
     ];
