@@ -1,0 +1,83 @@
+#!/usr/bin/env bash
+# The model engine's speed side by side: this tree's gyrocal against the
+# one built at a base revision (default 4afc731, issue 23's baseline), on
+# one core, runs alternated so that both see the same machine, then the
+# medians of each and their ratio (this tree over the base).
+#
+# Usage: scripts/bench-against.sh [BASE_REV] [ROUNDS] [CPU]
+#   BASE_REV  a revision to build and compare with (default 4afc731)
+#   ROUNDS    alternations (default 3); each runs both binaries'
+#             `gyrocal bench --engines model --repetitions 3 --no-reproduce`
+#   CPU       the core both run on (default the last one)
+#
+# The base is built once in a git worktree under target/bench-base/REV
+# with its own target directory, and only its binary is kept there; the
+# first call takes some minutes. Only the timings go to stdout; builds and
+# progress go to stderr.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+base_rev=${1:-4afc731}
+rounds=${2:-3}
+cpu=${3:-$(($(nproc) - 1))}
+if ! [[ "$rounds" =~ ^[1-9][0-9]*$ ]]; then
+  echo "error: ROUNDS = $rounds: allowed a whole number >= 1" >&2
+  exit 2
+fi
+if ! [[ "$cpu" =~ ^[0-9]+$ ]] || ((cpu >= $(nproc))); then
+  echo "error: CPU = $cpu: allowed 0..$(($(nproc) - 1))" >&2
+  exit 2
+fi
+base_sha=$(git rev-parse --verify --quiet "$base_rev^{commit}") || {
+  echo "error: BASE_REV = $base_rev: not a revision of this repository" >&2
+  exit 2
+}
+
+base_dir=target/bench-base/${base_sha:0:12}
+if [ ! -x "$base_dir/gyrocal" ]; then
+  echo "building the base $base_rev ($base_sha) in $base_dir" >&2
+  tree="$base_dir/tree"
+  rm -rf "$tree"
+  git worktree prune
+  git worktree add --detach --force "$tree" "$base_sha" >&2
+  (cd "$tree" && CARGO_TARGET_DIR="$PWD/../target" cargo build --release --quiet --bin gyrocal) >&2
+  cp "$base_dir/target/release/gyrocal" "$base_dir/gyrocal.tmp"
+  mv "$base_dir/gyrocal.tmp" "$base_dir/gyrocal"
+  # Only the binary is kept: the tree and its build are gigabytes.
+  git worktree remove --force "$tree"
+  rm -rf "$base_dir/target"
+fi
+echo "building this tree" >&2
+cargo build --release --quiet --bin gyrocal >&2
+head_bin=target/release/gyrocal
+base_bin=$base_dir/gyrocal
+
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+run() { # name binary round
+  echo "round $3: $1" >&2
+  taskset -c "$cpu" env RAYON_NUM_THREADS=1 "$2" bench --engines model \
+    --repetitions 3 --no-reproduce --json >"$out/$1.$3.json"
+}
+for r in $(seq 1 "$rounds"); do
+  run base "$base_bin" "$r"
+  run head "$head_bin" "$r"
+done
+
+python3 - "$out" "$rounds" "$base_rev" "$(git rev-parse --short HEAD)" <<'EOF'
+import json, statistics, sys
+out, rounds, base_rev, head_rev = sys.argv[1], int(sys.argv[2]), sys.argv[3], sys.argv[4]
+def speeds(name):
+    s = {False: [], True: []}
+    for r in range(1, rounds + 1):
+        for m in json.load(open(f"{out}/{name}.{r}.json"))["measurements"]:
+            s[m["with_gyro"]].extend(m["samples"])
+    return s
+base, head = speeds("base"), speeds("head")
+print(f"model engine, one core, {rounds} alternated rounds of 3 repetitions (M clocks/s)")
+print(f"{'setting':<20} {'base ' + base_rev:>26} {'this tree ' + head_rev:>26} {'ratio':>7}")
+cell = lambda v: f"{statistics.median(v) / 1e6:.2f} ({min(v) / 1e6:.1f}..{max(v) / 1e6:.1f})"
+for gyro, label in [(False, "datapath alone"), (True, "with the gyroscope")]:
+    b, h = statistics.median(base[gyro]), statistics.median(head[gyro])
+    print(f"{label:<20} {cell(base[gyro]):>26} {cell(head[gyro]):>26} {h / b:>7.3f}")
+EOF
