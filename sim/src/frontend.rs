@@ -17,6 +17,7 @@
 //! drops the LSBs of the word (truncation, as a narrower DAC wired to the
 //! top bits does).
 
+use crate::error::ModelError;
 use rand_distr::{Distribution, StandardNormal};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use rand_xoshiro::rand_core::SeedableRng;
@@ -89,18 +90,19 @@ pub struct Converters {
 
 impl Converters {
     /// Converters at rest (all words zero).
-    pub fn new(config: &FrontEnd) -> Result<Self, String> {
+    pub fn new(config: &FrontEnd) -> Result<Self, ModelError> {
         for (name, v) in [
             ("dac_latency", config.dac_latency),
             ("adc_latency", config.adc_latency),
         ] {
             if v > MAX_LATENCY {
-                return Err(format!("{name} = {v}: allowed 0..={MAX_LATENCY} clocks"));
+                let rule = format!("allowed 0..={MAX_LATENCY} clocks");
+                return Err(ModelError::parameter(name, v, rule));
             }
         }
         for (name, v) in [("dac_bits", config.dac_bits), ("adc_bits", config.adc_bits)] {
             if !(1..=16).contains(&v) {
-                return Err(format!("{name} = {v}: allowed 1..=16"));
+                return Err(ModelError::parameter(name, v, "allowed 1..=16"));
             }
         }
         for (name, v) in [
@@ -110,11 +112,15 @@ impl Converters {
             ("ADC gain of channel 2", config.adc_per_meter[1]),
         ] {
             if !(v.is_finite() && v > 0.0) {
-                return Err(format!("{name} = {v}: must be a positive number"));
+                return Err(ModelError::parameter(name, v, "must be a positive number"));
             }
         }
         if !(config.noise_lsb.is_finite() && config.noise_lsb >= 0.0) {
-            return Err(format!("noise_lsb = {}: must be >= 0", config.noise_lsb));
+            return Err(ModelError::parameter(
+                "noise_lsb",
+                config.noise_lsb,
+                "must be >= 0",
+            ));
         }
         Ok(Self {
             config: config.clone(),
@@ -196,15 +202,21 @@ pub struct PickoffPhase {
 
 impl PickoffPhase {
     /// A lag of `phase_deg` (|phase| <= 180) at `reference_hz` (> 0).
-    pub fn new(phase_deg: f64, reference_hz: f64) -> Result<Self, String> {
+    pub fn new(phase_deg: f64, reference_hz: f64) -> Result<Self, ModelError> {
         if !(phase_deg.is_finite() && phase_deg.abs() <= 180.0) {
-            return Err(format!(
-                "front-end phase = {phase_deg} deg: allowed -180..=180"
+            let value = format!("{phase_deg} deg");
+            return Err(ModelError::parameter(
+                "front-end phase",
+                value,
+                "allowed -180..=180",
             ));
         }
         if !(reference_hz.is_finite() && reference_hz > 0.0) {
-            return Err(format!(
-                "front-end phase reference = {reference_hz} Hz: must be a positive number"
+            let value = format!("{reference_hz} Hz");
+            return Err(ModelError::parameter(
+                "front-end phase reference",
+                value,
+                "must be a positive number",
             ));
         }
         let phi = phase_deg.to_radians();
@@ -355,17 +367,12 @@ mod tests {
     fn bad_settings_name_the_setting() {
         let mut fe = front_end();
         fe.adc_latency = 40;
-        assert!(
-            Converters::new(&fe)
-                .unwrap_err()
-                .starts_with("adc_latency = 40")
-        );
+        let e = Converters::new(&fe).unwrap_err();
+        assert_eq!(e.to_string(), "adc_latency = 40: allowed 0..=31 clocks");
+        assert!(matches!(e, ModelError::Parameter { name, .. } if name == "adc_latency"));
         let mut fe = front_end();
         fe.dac_bits = 0;
-        assert!(
-            Converters::new(&fe)
-                .unwrap_err()
-                .starts_with("dac_bits = 0")
-        );
+        let e = Converters::new(&fe).unwrap_err();
+        assert_eq!(e.to_string(), "dac_bits = 0: allowed 1..=16");
     }
 }

@@ -51,6 +51,7 @@
 //! the matrices at each rate change. Off (the default), `step` is the
 //! noiseless update, result for result.
 
+use crate::error::ModelError;
 use crate::noise::{self, Mat4, StateNoise, ThermalNoise};
 use nalgebra::SMatrix;
 use std::f64::consts::TAU;
@@ -85,11 +86,15 @@ pub struct GyroModel {
     thermal: Option<(ThermalNoise, StateNoise)>,
 }
 
-fn check(name: &str, value: f64, ok: bool, allowed: &str) -> Result<(), String> {
+fn check(name: &str, value: f64, ok: bool, allowed: &str) -> Result<(), ModelError> {
     if value.is_finite() && ok {
         Ok(())
     } else {
-        Err(format!("{name} = {value}: must be {allowed}"))
+        Err(ModelError::parameter(
+            name,
+            value,
+            format!("must be {allowed}"),
+        ))
     }
 }
 
@@ -100,7 +105,7 @@ impl GyroModel {
     /// both mode frequencies are finite and in (0, clock_hz/2), both Q are finite
     /// and > 0, the angular gain is finite and both couplings are in range
     /// ([`GyroParams::check_couplings`]).
-    pub fn new(params: &GyroParams, clock_hz: f64) -> Result<GyroModel, String> {
+    pub fn new(params: &GyroParams, clock_hz: f64) -> Result<GyroModel, ModelError> {
         check("clock_hz", clock_hz, clock_hz > 0.0, "finite and > 0 Hz")?;
         let nyq = clock_hz / 2.0;
         let allowed_f = format!("finite and in (0, clock_hz/2 = {nyq} Hz)");
@@ -119,7 +124,7 @@ impl GyroModel {
         check("q1", params.q1, params.q1 > 0.0, "finite and > 0")?;
         check("q2", params.q2, params.q2 > 0.0, "finite and > 0")?;
         check("angular_gain", params.angular_gain, true, "finite")?;
-        params.check_couplings().map_err(|e| e.to_string())?;
+        params.check_couplings()?;
         let w1 = std::f64::consts::TAU * params.f1_hz;
         let w2 = std::f64::consts::TAU * params.f2_hz;
         let wr = 0.5 * (w1 + w2);
@@ -219,7 +224,7 @@ impl GyroModel {
     /// Adds the thermomechanical force noise of `noise` (seeded; its
     /// temperature 0 K leaves the model noiseless). Errors (one line, naming
     /// the field) on a mass or temperature out of range.
-    pub fn with_thermal_noise(mut self, noise: &ThermalNoise) -> Result<Self, String> {
+    pub fn with_thermal_noise(mut self, noise: &ThermalNoise) -> Result<Self, ModelError> {
         noise.validate()?;
         self.thermal = if noise.is_on() {
             let qd = self.thermal_covariance(noise, self.omz);

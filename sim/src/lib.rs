@@ -2,7 +2,8 @@
 //!
 //! Read in order: `gyro` (the two-mode resonator, discretized exactly),
 //! `theory` (exact steady state and the paper's equations), `frontend`
-//! (DACs and ADCs), `engine` (the three simulators of the datapath),
+//! (DACs and ADCs), `error` (those leaf models' typed errors), `engine`
+//! (the three simulators of the datapath),
 //! `cosim` (the closed loop), `experiment` (readout sweep and calibration
 //! staircase), `fit` (scale factors); `field` (the simulated board and the drifting
 //! device) and `serve` (that board on the wire, over Etherbone).
@@ -18,6 +19,7 @@ pub mod datasheet;
 pub mod drift;
 pub mod edf;
 pub mod engine;
+pub mod error;
 pub mod experiment;
 pub mod field;
 pub mod fit;

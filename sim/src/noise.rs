@@ -49,6 +49,7 @@
 //! xoshiro256++ generator: the same seed gives the same run on every
 //! machine.
 
+use crate::error::ModelError;
 use nalgebra::SMatrix;
 use rand_distr::{Distribution, StandardNormal};
 use rand_xoshiro::Xoshiro256PlusPlus;
@@ -92,17 +93,20 @@ impl Default for ThermalNoise {
 
 impl ThermalNoise {
     /// Checks the fields; the error is one line naming the field.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), ModelError> {
         if !(self.mass_kg.is_finite() && self.mass_kg > 0.0) {
-            return Err(format!(
-                "mass_kg = {}: must be finite and > 0 kg",
-                self.mass_kg
+            return Err(ModelError::parameter(
+                "mass_kg",
+                self.mass_kg,
+                "must be finite and > 0 kg",
             ));
         }
         let t = self.temperature_k;
         if !(t.is_finite() && (0.0..=MAX_TEMPERATURE_K).contains(&t)) {
-            return Err(format!(
-                "temperature_k = {t}: allowed 0..={MAX_TEMPERATURE_K} K"
+            return Err(ModelError::parameter(
+                "temperature_k",
+                t,
+                format!("allowed 0..={MAX_TEMPERATURE_K} K"),
             ));
         }
         Ok(())
@@ -182,7 +186,7 @@ pub(crate) struct StateNoise {
 
 impl StateNoise {
     /// Noise with covariance `qd` (positive definite), seeded.
-    pub(crate) fn new(qd: &Mat4, seed: u64) -> Result<Self, String> {
+    pub(crate) fn new(qd: &Mat4, seed: u64) -> Result<Self, ModelError> {
         let mut noise = Self {
             factor: [[0.0; 4]; 4],
             rng: Xoshiro256PlusPlus::seed_from_u64(seed),
@@ -192,10 +196,10 @@ impl StateNoise {
     }
 
     /// Replaces the covariance (the generator runs on).
-    pub(crate) fn set_covariance(&mut self, qd: &Mat4) -> Result<(), String> {
+    pub(crate) fn set_covariance(&mut self, qd: &Mat4) -> Result<(), ModelError> {
         let l = qd
             .cholesky()
-            .ok_or("thermal noise: the state covariance is not positive definite")?
+            .ok_or(ModelError::CovarianceNotPositiveDefinite)?
             .l();
         for i in 0..4 {
             for j in 0..4 {
@@ -333,16 +337,14 @@ mod tests {
             mass_kg: 0.0,
             ..ThermalNoise::default()
         };
-        assert!(bad.validate().unwrap_err().starts_with("mass_kg = 0"));
+        let e = bad.validate().unwrap_err();
+        assert_eq!(e.to_string(), "mass_kg = 0: must be finite and > 0 kg");
         let bad = ThermalNoise {
             temperature_k: -1.0,
             ..ThermalNoise::default()
         };
-        assert!(
-            bad.validate()
-                .unwrap_err()
-                .starts_with("temperature_k = -1")
-        );
+        let e = bad.validate().unwrap_err().to_string();
+        assert!(e.starts_with("temperature_k = -1: allowed 0..="), "{e}");
         assert!(ThermalNoise::default().validate().is_ok());
         assert!(!ThermalNoise::default().is_on());
     }

@@ -496,7 +496,7 @@ fn new_validates_every_field() {
         assert!(GyroModel::new(p, clock).is_ok(), "{p:?}");
     }
     for (field, p, clock) in bad {
-        let err = GyroModel::new(&p, clock).expect_err(field);
+        let err = GyroModel::new(&p, clock).expect_err(field).to_string();
         assert!(err.starts_with(field), "{field}: message {err:?}");
         assert!(!err.contains('\n'), "one line: {err:?}");
     }

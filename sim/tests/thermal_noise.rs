@@ -321,7 +321,7 @@ fn bad_noise_settings_are_refused_in_one_line() {
             },
         ),
     ] {
-        let err = g().with_thermal_noise(&n).unwrap_err();
+        let err = g().with_thermal_noise(&n).unwrap_err().to_string();
         assert!(err.starts_with(field) && !err.contains('\n'), "{err}");
     }
 }
