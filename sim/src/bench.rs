@@ -162,7 +162,10 @@ pub fn run(
             }
             #[cfg(not(feature = "verilator"))]
             EngineKind::Verilator => {
-                return Err("engine \"verilator\": this build has no Verilator engine (rebuild with --features verilator)".into());
+                return Err(format!(
+                    "engine \"verilator\": {}",
+                    crate::error::EngineError::NotBuilt
+                ));
             }
         };
         measurements.extend(m);

@@ -10,6 +10,7 @@
 //! All three give identical outputs on every cycle (tests prove it), so an
 //! experiment's results do not depend on the engine, only its speed does.
 
+use crate::error::EngineError;
 use gyrocal_hdl::model::gyro_interface::{
     CarrierProfile, GyroInterface, Outputs, Probes, Registers,
 };
@@ -19,7 +20,7 @@ use gyrocal_hdl::rtl::RtlGyroInterface;
 pub trait Engine {
     /// A fresh instance of the core with this carrier profile at its
     /// power-up state.
-    fn power_up(profile: CarrierProfile) -> Result<Self, String>
+    fn power_up(profile: CarrierProfile) -> Result<Self, EngineError>
     where
         Self: Sized;
     /// One rising edge with these inputs; returns the ports after it.
@@ -54,12 +55,12 @@ impl EngineKind {
     }
 
     /// Parse a command-line name.
-    pub fn parse(name: &str) -> Result<Self, String> {
+    pub fn parse(name: &str) -> Result<Self, EngineError> {
         match name {
             "model" => Ok(EngineKind::Model),
             "rtl" => Ok(EngineKind::Rtl),
             "verilator" => Ok(EngineKind::Verilator),
-            _ => Err(format!("engine {name:?}: allowed model, verilator, rtl")),
+            _ => Err(EngineError::Unknown(name.into())),
         }
     }
 }
@@ -69,7 +70,7 @@ impl EngineKind {
 pub struct ModelEngine(GyroInterface);
 
 impl Engine for ModelEngine {
-    fn power_up(profile: CarrierProfile) -> Result<Self, String> {
+    fn power_up(profile: CarrierProfile) -> Result<Self, EngineError> {
         Ok(Self(GyroInterface::with_profile(profile)))
     }
 
@@ -87,7 +88,7 @@ impl Engine for ModelEngine {
 pub struct RtlEngine(RtlGyroInterface);
 
 impl Engine for RtlEngine {
-    fn power_up(profile: CarrierProfile) -> Result<Self, String> {
+    fn power_up(profile: CarrierProfile) -> Result<Self, EngineError> {
         Ok(Self(RtlGyroInterface::with_profile(profile)))
     }
 
@@ -97,5 +98,20 @@ impl Engine for RtlEngine {
 
     fn probes(&self) -> Probes {
         self.0.probes()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_parse_and_a_wrong_one_is_named_with_the_allowed() {
+        for kind in EngineKind::ALL {
+            assert_eq!(EngineKind::parse(kind.name()), Ok(kind));
+        }
+        let e = EngineKind::parse("fast").unwrap_err();
+        assert_eq!(e, EngineError::Unknown("fast".into()));
+        assert_eq!(e.to_string(), "engine \"fast\": allowed model, verilator, rtl");
     }
 }

@@ -49,3 +49,23 @@ impl From<ModelError> for String {
         e.to_string()
     }
 }
+
+/// What choosing or starting an engine refuses.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum EngineError {
+    /// A name that is no engine.
+    #[error("engine {0:?}: allowed model, verilator, rtl")]
+    Unknown(String),
+    /// The Verilator engine, in a build without it.
+    #[error("this build has no Verilator engine (rebuild with --features verilator)")]
+    NotBuilt,
+    /// The Verilated model could not be allocated.
+    #[error("cannot create the Verilated model")]
+    NotCreated,
+}
+
+impl From<EngineError> for String {
+    fn from(e: EngineError) -> Self {
+        e.to_string()
+    }
+}

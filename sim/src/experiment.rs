@@ -1055,7 +1055,10 @@ fn run_verilator(
     _: u32,
     _: &(dyn Fn(Tick) + Sync),
 ) -> Result<PointResult, String> {
-    Err("engine = \"verilator\": this build has no Verilator engine (rebuild with --features verilator)".into())
+    Err(format!(
+        "engine = \"verilator\": {}",
+        crate::error::EngineError::NotBuilt
+    ))
 }
 
 /// Simulate the first clocks of one point with an observer, up to the
@@ -1095,11 +1098,14 @@ pub fn observe_point_on(
         EngineKind::Model => observe_point::<ModelEngine>(exp, plan, point, observer),
         EngineKind::Rtl => observe_point::<RtlEngine>(exp, plan, point, observer),
         #[cfg(feature = "verilator")]
-        EngineKind::Verilator => observe_point::<crate::verilator::VerilatorEngine>(exp, plan, point, observer),
+        EngineKind::Verilator => {
+            observe_point::<crate::verilator::VerilatorEngine>(exp, plan, point, observer)
+        }
         #[cfg(not(feature = "verilator"))]
-        EngineKind::Verilator => Err(
-            "engine = \"verilator\": this build has no Verilator engine (rebuild with --features verilator)".into(),
-        ),
+        EngineKind::Verilator => Err(format!(
+            "engine = \"verilator\": {}",
+            crate::error::EngineError::NotBuilt
+        )),
     }
 }
 

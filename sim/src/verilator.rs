@@ -5,6 +5,7 @@
 //! compiled once per core.
 
 use crate::engine::Engine;
+use crate::error::EngineError;
 use gyrocal_hdl::model::gyro_interface::{CarrierProfile, Outputs, Probes, Registers};
 
 #[repr(C)]
@@ -119,7 +120,7 @@ impl Drop for VerilatorEngine {
 }
 
 impl Engine for VerilatorEngine {
-    fn power_up(profile: CarrierProfile) -> Result<Self, String> {
+    fn power_up(profile: CarrierProfile) -> Result<Self, EngineError> {
         let api = match profile {
             CarrierProfile::Table => &TABLE,
             CarrierProfile::Fine => &FINE,
@@ -127,7 +128,7 @@ impl Engine for VerilatorEngine {
         // SAFETY: plain constructor; null means allocation failed.
         let model = unsafe { (api.new)() };
         if model.is_null() {
-            return Err("cannot create the Verilated model".into());
+            return Err(EngineError::NotCreated);
         }
         Ok(Self {
             model,

@@ -89,10 +89,10 @@ impl RunOptions {
         let engine =
             EngineKind::parse(&self.engine).map_err(|e| Failure::Input(format!("--{e}")))?;
         if engine == EngineKind::Verilator && !cfg!(feature = "verilator") {
-            return Err(Failure::Input(
-                "--engine verilator: this build has no Verilator engine (build with --features verilator)"
-                    .into(),
-            ));
+            return Err(Failure::Input(format!(
+                "--engine verilator: {}",
+                gyrocal_sim::error::EngineError::NotBuilt
+            )));
         }
         let vcd = match &self.vcd {
             None => None,

@@ -98,10 +98,10 @@ fn engine(name: &str) -> Result<EngineKind, Failure> {
         Ok(EngineKind::Rtl) | Err(_) => Err(Failure::Input(format!(
             "--engine {name:?}: allowed model, verilator"
         ))),
-        Ok(EngineKind::Verilator) if !cfg!(feature = "verilator") => Err(Failure::Input(
-            "--engine verilator: this build has no Verilator engine (build with --features verilator)"
-                .into(),
-        )),
+        Ok(EngineKind::Verilator) if !cfg!(feature = "verilator") => Err(Failure::Input(format!(
+            "--engine verilator: {}",
+            gyrocal_sim::error::EngineError::NotBuilt
+        ))),
         Ok(kind) => Ok(kind),
     }
 }
