@@ -112,6 +112,9 @@ mod tests {
         }
         let e = EngineKind::parse("fast").unwrap_err();
         assert_eq!(e, EngineError::Unknown("fast".into()));
-        assert_eq!(e.to_string(), "engine \"fast\": allowed model, verilator, rtl");
+        assert_eq!(
+            e.to_string(),
+            "engine \"fast\": allowed model, verilator, rtl"
+        );
     }
 }
