@@ -717,7 +717,7 @@ fn a_drive_scaled_for_the_adcs_is_said_and_the_spur_move_is_judged_at_it() {
     for st in &report.steps {
         let scaled = st.selfcal.operating.scaled_drives.expect("scaled drives");
         assert!(
-            scaled.fraction < selfcal::DRIVE_BIT_LOST && scaled.table_core,
+            scaled.is_said() && scaled.table_core,
             "{}: {scaled:?}",
             st.temperature_c
         );

@@ -29,7 +29,7 @@
 //! has a baseline (its baseline fields are null).
 
 use crate::Failure;
-use gyrocal_host::selfcal::{self, Spurs};
+use gyrocal_host::selfcal::{ScaledDrives, Spurs};
 use gyrocal_sim::field::profile::RateTrace;
 use gyrocal_sim::field::scenario::{self, FAILED_CYCLE, FieldReport};
 use std::fmt::Write as _;
@@ -231,7 +231,7 @@ fn step_notes(s: &mut String, report: &FieldReport) {
     }
     for st in &report.steps {
         let scaled = st.selfcal.operating.scaled_drives;
-        if let Some(d) = scaled.filter(|d| d.fraction < selfcal::DRIVE_BIT_LOST) {
+        if let Some(d) = scaled.filter(ScaledDrives::is_said) {
             let _ = writeln!(s, "{:>8.2}  {d}", st.temperature_c);
         }
     }

@@ -66,9 +66,12 @@
 //! peak over every readout rate and calibration frequency of its plan
 //! (exact theory, [`predict::adc_peaks`]) and scales both drives by one
 //! factor so that no peak exceeds `ADC_OPERATING` of full scale; the ratio
-//! of the drives, which the prediction needs, is kept. Every window then
-//! watches the ADC_CLIP counts ([`crate::clip`]): a clipped window is an
-//! error, never a figure.
+//! of the drives, which the prediction needs, is kept
+//! ([`Operating::scaled_drives`]; below half the configured drives the
+//! reports say so in one line, [`ScaledDrives`]). The carrier search
+//! judges each carrier's spur bound at the drive it would run with. Every
+//! window then watches the ADC_CLIP counts ([`crate::clip`]): a clipped
+//! window is an error, never a figure.
 //!
 //! # The carrier's folds
 //!
@@ -237,6 +240,14 @@ pub struct ScaledDrives {
 /// costs.
 pub const DRIVE_BIT_LOST: f64 = 0.5;
 
+impl ScaledDrives {
+    /// Whether the reports name this scaling in a line: below
+    /// `DRIVE_BIT_LOST` of the configured drives.
+    pub fn is_said(&self) -> bool {
+        self.fraction < DRIVE_BIT_LOST
+    }
+}
+
 impl std::fmt::Display for ScaledDrives {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
@@ -247,7 +258,7 @@ impl std::fmt::Display for ScaledDrives {
             100.0 * self.fraction,
             100.0 * ADC_OPERATING
         )?;
-        if self.table_core && self.fraction < DRIVE_BIT_LOST {
+        if self.table_core && self.is_said() {
             write!(
                 f,
                 "; the table core's carrier words lose {:.1} bits and its spurs grow as much (a lower ADC or drive gain lets the drive rise; the fine core shapes its rounding away from the carrier)",

@@ -4,7 +4,7 @@
 
 use super::Outcome;
 use gyrocal_host::identify::Estimate;
-use gyrocal_host::selfcal;
+use gyrocal_host::selfcal::ScaledDrives;
 use serde_json::{Map, Value, json};
 use std::fmt::Write as _;
 
@@ -111,7 +111,7 @@ pub fn table(o: &Outcome) -> String {
         cal.operating.carrier_hz, cal.operating.ref_lag_deg
     );
     let scaled = cal.operating.scaled_drives;
-    if let Some(d) = scaled.filter(|d| d.fraction < selfcal::DRIVE_BIT_LOST) {
+    if let Some(d) = scaled.filter(ScaledDrives::is_said) {
         let _ = writeln!(s, "{d}");
     }
     if let Some(fold) = cal.operating.static_fold {
