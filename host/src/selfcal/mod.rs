@@ -444,11 +444,9 @@ fn quietest_spurs(
     // Each bound at the drives the carrier would run with: the table
     // words' rounding error is fixed in LSB, so a drive scaled down for
     // the ADCs (`within_adc`) raises the bound as much.
-    let bound = |op: &Operating, depth: Depth| {
-        let driven = within_adc(knowns, id, op.clone())?;
-        spur_rms(knowns, id, &driven, depth)
-    };
-    let Some(here) = bound(asked, SEARCH)? else {
+    let driven = |op: &Operating| within_adc(knowns, id, op.clone());
+    let asked_driven = driven(asked)?;
+    let Some(here) = spur_rms(knowns, id, &asked_driven, SEARCH)? else {
         return Ok(None);
     };
     let settled = plan::SETTLED_FOLD_BEATS / knowns.filter.min_window_s;
@@ -465,7 +463,7 @@ fn quietest_spurs(
             if eps < settled || !admitted(&moved, FOLD_SF_CHANGE)? {
                 continue;
             }
-            let Some(there) = bound(&moved, SEARCH)? else {
+            let Some(there) = spur_rms(knowns, id, &driven(&moved)?, SEARCH)? else {
                 continue;
             };
             let score = (0..2).map(|k| there[k] / here[k]).fold(0.0, f64::max);
@@ -479,7 +477,7 @@ fn quietest_spurs(
     let Some((_, moved)) = best else {
         return Ok(None);
     };
-    let from_dps = bound(asked, FULL)?.unwrap_or_default();
+    let from_dps = spur_rms(knowns, id, &asked_driven, FULL)?.unwrap_or_default();
     Ok(Some(Operating {
         spur_move: Some(SpurMove { from_dps }),
         ..moved
