@@ -300,25 +300,17 @@ fn bad_boards_are_one_line_errors() {
 }
 
 /// A device whose front end was set for a carrier 1 kHz above its
-/// resonance (the paper's, behind a `[datasheet]` 0.01% high with the
-/// carrier configured on it; `tests/field.rs`
+/// resonance (`tests/data/field_paper_scaled_drives.toml`: the paper's,
+/// behind a `[datasheet]` 0.01% high with the carrier configured on it;
+/// `tests/field.rs`
 /// `a_drive_scaled_for_the_adcs_is_said_and_the_spur_move_is_judged_at_it`
 /// has the figures): `gyrocal calibrate` runs the drives at 9.2% of the
 /// configured ones and says so in one line, with the table words' lost
 /// bits (3.4).
 #[test]
 fn calibrate_says_when_the_drives_were_scaled_for_the_adcs() {
-    let text = std::fs::read_to_string("tests/data/field_paper.toml")
-        .unwrap()
-        .replace("carrier_hz = 9.64e6", "carrier_hz = 9.641e6")
-        .replace(
-            "[drive]",
-            "[datasheet]\nf1_hz = 9.641e6\nf2_hz = 9.64125e6\nq1 = 55000\nq2 = 55000\nangular_gain = 0.6\nangular_gain_uncertainty = 0.0\n\n[drive]",
-        );
-    let dir = tempfile::tempdir().unwrap();
-    let config = dir.path().join("device.toml");
-    std::fs::write(&config, text).unwrap();
-    let o = gyrocal(&["calibrate", "--config", config.to_str().unwrap()]);
+    let config = "tests/data/field_paper_scaled_drives.toml";
+    let o = gyrocal(&["calibrate", "--config", config]);
     assert!(o.status.success(), "{}", stderr(&o));
     let out = String::from_utf8(o.stdout).unwrap();
     let line = out

@@ -688,7 +688,8 @@ fn the_table_core_bounds_the_ripple_of_a_fold_of_period_10001() {
 }
 
 /// The paper device behind a front end set for a carrier 1 kHz above its
-/// resonance (a datasheet 0.01% high, the configured carrier on it): at
+/// resonance (`tests/data/field_paper_scaled_drives.toml`: a datasheet
+/// 0.01% high, the configured carrier on it): at
 /// the identified resonance the configured drives would peak the ADCs
 /// some 10 times over full scale, so the operating point scales them to
 /// 9.2% (measured 0.0922 and 0.0919 of the configured). Each step says so
@@ -702,18 +703,9 @@ fn the_table_core_bounds_the_ripple_of_a_fold_of_period_10001() {
 /// the cycle's own bound where it moved was 1.78 / 1.33: no gain at all.
 #[test]
 fn a_drive_scaled_for_the_adcs_is_said_and_the_spur_move_is_judged_at_it() {
-    let path = "tests/data/field_paper.toml";
-    let text = std::fs::read_to_string(path)
-        .unwrap()
-        .replace("carrier_hz = 9.64e6", "carrier_hz = 9.641e6")
-        .replace(
-            "[drive]",
-            "[datasheet]\nf1_hz = 9.641e6\nf2_hz = 9.64125e6\nq1 = 55000\nq2 = 55000\nangular_gain = 0.6\nangular_gain_uncertainty = 0.0\n\n[drive]",
-        );
-    let mut sc = scenario::parse(path, &text).unwrap();
-    sc.drift.temperatures_c = vec![25.0, 30.0];
-    sc.profile = None;
-    let report = finished(&sc);
+    let path = "tests/data/field_paper_scaled_drives.toml";
+    let text = std::fs::read_to_string(path).unwrap();
+    let report = finished(&scenario::parse(path, &text).unwrap());
     for st in &report.steps {
         let scaled = st.selfcal.operating.scaled_drives.expect("scaled drives");
         assert!(

@@ -1055,10 +1055,16 @@ fn run_verilator(
     _: u32,
     _: &(dyn Fn(Tick) + Sync),
 ) -> Result<PointResult, String> {
-    Err(format!(
+    Err(verilator_not_built())
+}
+
+/// The one line for the Verilator engine in a build without it.
+#[cfg(not(feature = "verilator"))]
+fn verilator_not_built() -> String {
+    format!(
         "engine = \"verilator\": {}",
         crate::error::EngineError::NotBuilt
-    ))
+    )
 }
 
 /// Simulate the first clocks of one point with an observer, up to the
@@ -1102,10 +1108,7 @@ pub fn observe_point_on(
             observe_point::<crate::verilator::VerilatorEngine>(exp, plan, point, observer)
         }
         #[cfg(not(feature = "verilator"))]
-        EngineKind::Verilator => Err(format!(
-            "engine = \"verilator\": {}",
-            crate::error::EngineError::NotBuilt
-        )),
+        EngineKind::Verilator => Err(verilator_not_built()),
     }
 }
 
