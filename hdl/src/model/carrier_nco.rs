@@ -16,7 +16,7 @@
 use super::sine::sine;
 use super::sine_pair::sine_pair;
 use crate::carrier_table_fill::{FILL_CLOCKS, REQUESTS, rom_entry_phase};
-use crate::quarter_wave::TABLE_ENTRIES;
+use crate::quarter_wave::{PHASE_BELOW_INDEX, TABLE_ENTRIES};
 use crate::table_sine::LATENCY;
 use gyrocal_regs::datapath::CarrierProfile;
 use std::sync::OnceLock;
@@ -29,6 +29,33 @@ pub type Table = [i16; TABLE_ENTRIES];
 pub fn table() -> &'static Table {
     static TABLE: OnceLock<Box<Table>> = OnceLock::new();
     TABLE.get_or_init(|| Box::new(std::array::from_fn(entry)))
+}
+
+/// The carriers' table unfolded to a whole turn: word `j` is
+/// `table_sine(table(), j << PHASE_BELOW_INDEX, 0)`. The word of a phase
+/// depends only on its top `32 - PHASE_BELOW_INDEX` bits, so a lookup
+/// (`turn_sine`) is one read instead of the quadrant's mirror and sign
+/// around one: the
+/// model's shortcut, not the hardware's (which stores the quarter), equal
+/// word for word (a test reads every phase interval both ways).
+pub type Turn = [i16; 4 * TABLE_ENTRIES];
+
+/// The unfolded table, built once per process from `table()`.
+pub fn turn() -> &'static Turn {
+    static TURN: OnceLock<Box<Turn>> = OnceLock::new();
+    TURN.get_or_init(|| {
+        let t = table();
+        Box::new(std::array::from_fn(|j| {
+            table_sine(t, (j << PHASE_BELOW_INDEX) as u32, 0)
+        }))
+    })
+}
+
+/// `table_sine(table(), phase, advance)` read from the unfolded table.
+#[inline(always)]
+pub fn turn_sine(turn: &Turn, phase: u32, advance: u8) -> i16 {
+    let j = (phase >> PHASE_BELOW_INDEX) as usize + usize::from(advance) * TABLE_ENTRIES;
+    turn[j & (4 * TABLE_ENTRIES - 1)]
 }
 
 /// Carrier table entry `i`: a quarter of a ROM step from ROM centre i / 2,
@@ -87,7 +114,7 @@ pub struct CarrierNco {
     /// Outputs in flight; `pipe[head]` is the current output.
     pipe: [Carriers; LATENCY],
     head: usize,
-    table: &'static Table,
+    turn: &'static Turn,
     profile: CarrierProfile,
 }
 
@@ -105,7 +132,7 @@ impl CarrierNco {
             count: 0,
             pipe: [Carriers::default(); LATENCY],
             head: 0,
-            table: table(),
+            turn: turn(),
             profile,
         }
     }
@@ -133,12 +160,12 @@ impl CarrierNco {
             let reference = self.phase.wrapping_add(ref_offset);
             match self.profile {
                 CarrierProfile::Table => {
-                    let t = self.table;
+                    let t = self.turn;
                     Carriers {
-                        drive_cos: table_sine(t, self.phase, 1).into(),
-                        drive_sin: table_sine(t, self.phase, 0).into(),
-                        ref_cos: table_sine(t, reference, 1).into(),
-                        ref_sin: table_sine(t, reference, 0).into(),
+                        drive_cos: turn_sine(t, self.phase, 1).into(),
+                        drive_sin: turn_sine(t, self.phase, 0).into(),
+                        ref_cos: turn_sine(t, reference, 1).into(),
+                        ref_sin: turn_sine(t, reference, 0).into(),
                     }
                 }
                 CarrierProfile::Fine => {
@@ -156,7 +183,11 @@ impl CarrierNco {
             self.count += 1;
             Carriers::default()
         };
-        self.head = (self.head + 1) % LATENCY;
+        self.head = if self.head + 1 == LATENCY {
+            0
+        } else {
+            self.head + 1
+        };
         self.phase = self.phase.wrapping_add(step);
         self.output()
     }
@@ -171,6 +202,25 @@ mod tests {
         CarrierProfile::{Fine, Table},
         calibration_word, carrier_table_word, q15_product, readout_word,
     };
+
+    /// The unfolded table reads, at every phase interval of a turn and
+    /// every advance, the word the quarter table's lookup gives.
+    #[test]
+    fn the_unfolded_table_is_the_quarter_tables_lookup() {
+        let (quarter, whole) = (table(), turn());
+        for j in 0..4 * TABLE_ENTRIES as u32 {
+            for low in [0, 1, (1 << PHASE_BELOW_INDEX) - 1] {
+                let phase = (j << PHASE_BELOW_INDEX) | low;
+                for advance in 0..4 {
+                    assert_eq!(
+                        turn_sine(whole, phase, advance),
+                        table_sine(quarter, phase, advance),
+                        "phase {phase:#x}, advance {advance}"
+                    );
+                }
+            }
+        }
+    }
 
     /// The host computes the table core's words without the gateware
     /// (`gyrocal_regs::datapath::carrier_table_word`): every one is the

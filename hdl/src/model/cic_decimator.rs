@@ -63,6 +63,18 @@ impl CicDecimator {
         (self.y, self.valid)
     }
 
+    /// Edges from now until the one after which the output is next valid:
+    /// the running schedule's last edge, or the counter's run to 0 and the
+    /// schedule that sample starts. Exact with the decimation held.
+    #[inline(always)]
+    pub fn edges_to_valid(&self) -> u64 {
+        if self.busy > 0 {
+            self.busy as u64
+        } else {
+            u64::from(self.count) + SAMPLE_TO_OUTPUT as u64
+        }
+    }
+
     /// One clock with inputs `x = (x1, x2)`, decimation R (13-bit word) and
     /// output shift.
     #[inline(always)]

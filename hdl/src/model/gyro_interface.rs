@@ -94,33 +94,172 @@ impl GyroInterface {
     #[inline(always)]
     pub fn step(&mut self, adc: (i16, i16), regs: &Registers) -> Outputs {
         let regs = &regs.at_ports();
+        let drives = self.am_mixer.output();
+        self.step_drives(regs);
+        self.step_readout(adc, (drives.ref1, drives.ref2), regs);
+        self.outputs()
+    }
+
+    /// `clocks` clocks with `regs` held, in blocks of `BLOCK`: the same
+    /// clocks as `step` that many times, with `analog` closing the loop.
+    /// The DAC words do not depend on the ADC words (no path in the
+    /// datapath leads from the demodulators back to the drives), so the
+    /// drive half can run ahead. Per block, in passes:
+    ///
+    /// ```text
+    /// 1. the drive half's words of the next block, each clock beside one
+    ///    `analog.advance` with this block's DAC word (integer work beside
+    ///    the gyroscope's floating-point recursion, which would otherwise
+    ///    wait on its own latency);
+    /// 2. `analog.convert`: this block's ADC words;
+    /// 3. the readout half on them.
+    /// ```
+    ///
+    /// `on_z(i, z)` is called when clock `i` (from 0) publishes z. Returns
+    /// the outputs after the last edge.
+    #[inline(always)]
+    pub fn run<A, Z>(
+        &mut self,
+        regs: &Registers,
+        clocks: u64,
+        analog: &mut A,
+        mut on_z: Z,
+    ) -> Outputs
+    where
+        A: AnalogSide,
+        Z: FnMut(u64, (i64, i64)),
+    {
+        let regs = &regs.at_ports();
+        let block = |done: u64| (clocks - done).min(BLOCK as u64) as usize;
+        let mut this = DriveBlock::default();
+        let mut next = DriveBlock::default();
+        let mut adc = [(0i16, 0i16); BLOCK];
+        let mut n = block(0);
+        for i in 0..n {
+            self.drive_into(&mut this, i, regs);
+        }
+        let mut done = 0u64;
+        while n > 0 {
+            let ahead = block(done + n as u64);
+            // Only the last block is short: the next one is never longer.
+            for (i, &dac) in this.dac[..ahead].iter().enumerate() {
+                self.drive_into(&mut next, i, regs);
+                analog.advance(dac);
+            }
+            for &dac in &this.dac[ahead..n] {
+                analog.advance(dac);
+            }
+            analog.convert(&mut adc[..n]);
+            for (i, (&a, &r)) in adc[..n].iter().zip(&this.references[..n]).enumerate() {
+                self.step_readout(a, r, regs);
+                let (z1, z2, valid) = self.iir.output();
+                if valid {
+                    on_z(done + i as u64, (z1, z2));
+                }
+            }
+            done += n as u64;
+            n = ahead;
+            std::mem::swap(&mut this, &mut next);
+        }
+        self.outputs()
+    }
+
+    /// The drive words during the current cycle into clock `i` of a
+    /// block, then the drive half's edge.
+    #[inline(always)]
+    fn drive_into(&mut self, block: &mut DriveBlock, i: usize, regs: &Registers) {
+        let drives = self.am_mixer.output();
+        block.dac[i] = (drives.dac1, drives.dac2);
+        block.references[i] = (drives.ref1, drives.ref2);
+        self.step_drives(regs);
+    }
+
+    /// Edges from now none of which can publish z, with the registers
+    /// held. With the IIR idle and no CIC sample waiting for it, the next
+    /// CIC sample is valid after `CicDecimator::edges_to_valid` edges, the
+    /// idle IIR takes it at the next edge and publishes z
+    /// `crate::iir_lowpass::LATENCY` edges after the strobe: the z comes
+    /// at edge `edges_to_valid + LATENCY`, so that many minus one are
+    /// quiet. 0 while the IIR runs or a sample waits (it may drop it).
+    pub fn quiet_clocks(&self) -> u64 {
+        if !self.iir.idle() || self.cic.output().1 {
+            0
+        } else {
+            self.cic.edges_to_valid() + crate::iir_lowpass::LATENCY as u64 - 1
+        }
+    }
+
+    /// The drive half of one clock (carrier NCO, modulation NCO, AM
+    /// mixers): nothing in it reads the ADC words.
+    #[inline(always)]
+    fn step_drives(&mut self, regs: &Registers) {
         // Read every block's current outputs before any register moves.
         let carriers = self.carrier_nco.output();
         let am = self.modulation_nco.output();
-        let drives = self.am_mixer.output();
-        let aligned = self.reference_alignment.output();
-        let w = self.demod_mux.output();
-        let (cic, cic_valid) = self.cic.output();
-
         let fill = self.carrier_nco.fill_request();
         self.carrier_nco.step(regs.carrier_step, regs.ref_phase);
         self.modulation_nco.step(regs.mod_step, regs.select, fill);
         self.am_mixer.step(regs.amp, am, carriers);
+    }
+
+    /// The readout half of one clock (reference alignment, demodulators,
+    /// CIC, IIR) with the ADC words and the reference copies of the
+    /// drives during the current cycle.
+    #[inline(always)]
+    fn step_readout(&mut self, adc: (i16, i16), references: (i16, i16), regs: &Registers) {
+        let aligned = self.reference_alignment.output();
+        let w = self.demod_mux.output();
+        let (cic, cic_valid) = self.cic.output();
         self.reference_alignment
-            .step(drives.ref1, drives.ref2, regs.ref_delay);
+            .step(references.0, references.1, regs.ref_delay);
         self.demod_mux.step(adc, aligned, regs.select);
         let r = regs.cic_decimation as u32;
         let shift = regs.cic_shift as u32;
         self.cic.step(w, r, shift);
         self.iir.step(cic, cic_valid, &regs.iir);
-        self.outputs()
     }
 }
+
+/// A converter word per channel (DAC or ADC; channel 1, channel 2).
+pub type Words = (i16, i16);
+
+/// What closes `GyroInterface::run`'s loop: the DACs, the sensor and the
+/// ADCs, a clock at a time on the DAC side and a block at a time on the
+/// ADC side.
+pub trait AnalogSide {
+    /// One clock with the DAC words during it: the ADCs sample at its
+    /// start, then the sensor advances under the words' forces.
+    fn advance(&mut self, dac: Words);
+    /// The ADC words during the clocks advanced since the last call, in
+    /// order (`adc.len()` of them).
+    fn convert(&mut self, adc: &mut [Words]);
+}
+
+/// The drive half's words over a block.
+#[derive(Clone, Copy)]
+struct DriveBlock {
+    dac: [Words; BLOCK],
+    references: [Words; BLOCK],
+}
+
+impl Default for DriveBlock {
+    fn default() -> Self {
+        Self {
+            dac: [(0, 0); BLOCK],
+            references: [(0, 0); BLOCK],
+        }
+    }
+}
+
+/// Clocks per block of `GyroInterface::run`: its three buffers (12 bytes a
+/// clock) stay in the first-level cache.
+pub const BLOCK: usize = 256;
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::gyro_interface::DRIVE_START_CLOCKS;
+    use crate::test_util::Rng;
 
     #[test]
     fn the_drives_leave_zero_at_drive_start_clocks() {
@@ -174,5 +313,160 @@ mod tests {
             differ += usize::from(a != b);
         }
         assert!(differ > 100, "the fine carriers never differed: {differ}");
+    }
+
+    /// Registers of one run: readout or calibration, a filter designed
+    /// for a decimation from the shortest to the longest, now and then
+    /// with a decimation too short for the IIR (which then drops CIC
+    /// samples), any reference delay.
+    fn run_registers(rng: &mut Rng) -> Registers {
+        let designed = [166u32, 200, 397, 1000, 4096][rng.range(0, 4) as usize];
+        let fz = 1e6 / f64::from(designed);
+        let design = gyrocal_regs::filter_design::design(1e6, designed, fz / 40.0, fz / 20.0)
+            .expect("a valid design");
+        let decimation = if rng.range(0, 5) == 0 {
+            rng.range(2, 165) as u32
+        } else {
+            designed
+        };
+        Registers {
+            select: rng.range(0, 1) == 1,
+            carrier_step: rng.next_u64() as u32,
+            ref_phase: rng.next_u64() as u32,
+            ref_delay: rng.range(0, 63) as u8,
+            mod_step: rng.next_u64() & ((1 << Registers::MOD_STEP_BITS) - 1),
+            amp: (rng.word16(), rng.word16()),
+            cic_decimation: decimation as u16,
+            cic_shift: design.cic_shift as u8,
+            iir: design.coefficients,
+        }
+    }
+
+    /// The ADC words a run sees: `analog_word` of each clock's DAC words.
+    struct Hashed<'a> {
+        word: Box<dyn FnMut(Words) -> Words + 'a>,
+        pending: Vec<Words>,
+    }
+
+    impl AnalogSide for Hashed<'_> {
+        fn advance(&mut self, dac: Words) {
+            let w = (self.word)(dac);
+            self.pending.push(w);
+        }
+        fn convert(&mut self, adc: &mut [Words]) {
+            assert_eq!(adc.len(), self.pending.len(), "a block converted whole");
+            adc.copy_from_slice(&self.pending);
+            self.pending.clear();
+        }
+    }
+
+    fn analog(count: &mut u64) -> Hashed<'_> {
+        Hashed {
+            word: Box::new(analog_word(count)),
+            pending: vec![],
+        }
+    }
+
+    /// The ADC word of one clock: a hash of the DAC words and a counter,
+    /// so that a word taken at the wrong cycle shows.
+    fn analog_word(count: &mut u64) -> impl FnMut((i16, i16)) -> (i16, i16) + '_ {
+        move |dac| {
+            *count += 1;
+            let key = *count ^ (dac.0 as u16 as u64) << 32 ^ (dac.1 as u16 as u64) << 48;
+            let h = key.wrapping_mul(0x9e37_79b9_7f4a_7c15);
+            ((h >> 48) as i16, (h >> 32) as i16)
+        }
+    }
+
+    /// `run` plays the clocks `step` plays, on both cores: runs of every
+    /// length around a block's (1, BLOCK - 1, BLOCK, BLOCK + 1, long),
+    /// with the registers changed between them, give the same z at the
+    /// same clocks and the same ports and internal signals after.
+    #[test]
+    fn a_run_is_step_clock_by_clock() {
+        let lengths = [
+            1,
+            BLOCK as u64 - 1,
+            BLOCK as u64,
+            BLOCK as u64 + 1,
+            3,
+            20_000,
+            777,
+        ];
+        for profile in CarrierProfile::ALL {
+            let mut rng = Rng::new(11);
+            let (mut blocked, mut stepped) = (
+                GyroInterface::with_profile(profile),
+                GyroInterface::with_profile(profile),
+            );
+            let (mut count_b, mut count_s) = (0, 0);
+            let mut clock = 0u64;
+            for (run, &clocks) in lengths.iter().cycle().take(40).enumerate() {
+                let regs = run_registers(&mut rng);
+                let mut z_blocked = vec![];
+                let out = blocked.run(&regs, clocks, &mut analog(&mut count_b), |i, z| {
+                    z_blocked.push((clock + i, z))
+                });
+                let mut z_stepped = vec![];
+                let mut feed = analog_word(&mut count_s);
+                let mut o = stepped.outputs();
+                for i in 0..clocks {
+                    o = stepped.step(feed(o.dac), &regs);
+                    if o.z_valid {
+                        z_stepped.push((clock + i, o.z));
+                    }
+                }
+                assert_eq!(
+                    z_blocked, z_stepped,
+                    "{profile}, run {run} of {clocks} clocks"
+                );
+                assert_eq!(out, o, "{profile}, run {run}");
+                assert_eq!(blocked.probes(), stepped.probes(), "{profile}, run {run}");
+                clock += clocks;
+            }
+            assert!(clock > 100_000);
+        }
+    }
+
+    /// `quiet_clocks` is exact where it is not 0: from any cycle of runs
+    /// with changing registers, the next z comes at the edge after the
+    /// quiet ones; and it is known on most cycles.
+    #[test]
+    fn the_next_z_comes_right_after_the_quiet_clocks() {
+        let mut rng = Rng::new(5);
+        let mut model = GyroInterface::new();
+        let mut count = 0;
+        let mut known = 0;
+        for run in 0..20 {
+            let regs = run_registers(&mut rng);
+            for cycle in 0..2000 {
+                let quiet = model.quiet_clocks();
+                let mut ahead = model.clone();
+                let mut c = count;
+                let mut feed = analog_word(&mut c);
+                let mut o = ahead.outputs();
+                let mut edges = 0;
+                loop {
+                    o = ahead.step(feed(o.dac), &regs);
+                    edges += 1;
+                    if o.z_valid {
+                        break;
+                    }
+                    // A CIC schedule, the longest decimation and the IIR.
+                    assert!(edges < 10_000, "run {run}, cycle {cycle}: no z");
+                }
+                if quiet > 0 {
+                    assert_eq!(edges, quiet + 1, "run {run}, cycle {cycle}");
+                    known += 1;
+                }
+                let o = model.outputs();
+                model.step(analog_word(&mut count)(o.dac), &regs);
+            }
+        }
+        assert!(
+            known > 10_000,
+            "quiet_clocks was 0 in {} of 40000 cycles",
+            40_000 - known
+        );
     }
 }

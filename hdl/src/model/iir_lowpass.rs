@@ -93,6 +93,14 @@ impl IirLowpass {
         self.pc != 0
     }
 
+    /// True while no schedule runs and none is about to leave its
+    /// pipeline: an edge can publish z only after the filter accepts a
+    /// sample.
+    #[inline(always)]
+    pub fn idle(&self) -> bool {
+        self.pc == 0 && self.rom_q == 0 && self.word == 0
+    }
+
     /// The input digit `select` (channel * 3 + digit) as stored in RAM.
     #[inline(always)]
     fn input_digit(&self, select: u8) -> i64 {
@@ -108,7 +116,7 @@ impl IirLowpass {
     /// `(z1, z2, z_valid)` after the edge.
     #[inline(always)]
     pub fn step(&mut self, x: (i64, i64), x_valid: bool, k: &Coefficients) -> (i64, i64, bool) {
-        if self.pc == 0 && self.rom_q == 0 && self.word == 0 && !x_valid {
+        if self.idle() && !x_valid {
             // Idle: word 0 does nothing that a schedule reads back.
             self.z_valid = false;
             return self.output();
