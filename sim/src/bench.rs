@@ -1,14 +1,16 @@
 //! Side-by-side speed of the engines, in one process, on the same stimulus.
 //!
-//! For each engine: clocks per second stepping the datapath alone (ADC
+//! For each engine: clocks per second running the datapath alone (ADC
 //! words from a precomputed table) and inside the closed loop with the
 //! gyroscope model (`CoSim`), each repeated and reported as the median with
-//! its spread. Stimulus: the paper's device, calibration at 12 Hz (every
+//! its spread. Both run as the experiments do, through `Engine::run` (the
+//! model engine in blocks, the others clock by clock). Stimulus: the paper's device, calibration at 12 Hz (every
 //! block busy). Optionally, the whole `reproduce` experiment, timed wall to
 //! wall on all cores, with the process's peak resident memory.
 
 use crate::engine::{Engine, EngineKind, ModelEngine, RtlEngine};
 use crate::experiment::{self, Experiment, Plan};
+use gyrocal_hdl::model::gyro_interface::{AnalogSide, Words};
 use serde::Serialize;
 use std::hint::black_box;
 use std::time::Instant;
@@ -64,6 +66,29 @@ fn median(v: &[f64]) -> f64 {
     }
 }
 
+/// The datapath alone's analog side: the ADC words of a table, in turn;
+/// the DAC words summed so that they are computed.
+struct Replay<'a> {
+    words: &'a [Words],
+    next: usize,
+    check: i64,
+}
+
+impl AnalogSide for Replay<'_> {
+    #[inline(always)]
+    fn advance(&mut self, dac: Words) {
+        self.check = self.check.wrapping_add(i64::from(dac.0));
+    }
+
+    #[inline(always)]
+    fn convert(&mut self, adc: &mut [Words]) {
+        for a in adc {
+            *a = self.words[self.next];
+            self.next = (self.next + 1) % self.words.len();
+        }
+    }
+}
+
 fn stimulus_plan() -> (Experiment, Plan) {
     let mut exp = Experiment::paper();
     exp.points.cal_freqs_hz = vec![12.0, 13.0];
@@ -98,17 +123,22 @@ fn measure<E: Engine>(
         let mut engine = E::power_up(exp.drive.carrier_profile)?;
         let start = Instant::now();
         let mut check = 0i64;
-        for n in 0..clocks {
-            let o = engine.step(adc[(n % adc.len() as u64) as usize], black_box(&point.regs));
-            check = check.wrapping_add(o.z.0 ^ o.dac.0 as i64);
-        }
-        black_box(check);
+        let mut table = Replay {
+            words: &adc,
+            next: 0,
+            check: 0,
+        };
+        let mut z_sum = 0i64;
+        let sum = |n: u64, z: (i64, i64)| z_sum = z_sum.wrapping_add(z.0 ^ n as i64);
+        engine.run((0, 0), black_box(&point.regs), clocks, &mut table, sum);
+        check = check.wrapping_add(table.check);
+        black_box((check, z_sum));
         alone.push(clocks as f64 / start.elapsed().as_secs_f64());
         let mut sim = experiment::point_loop::<E>(&exp, &plan, point)?;
         let start = Instant::now();
-        for _ in 0..clocks {
-            black_box(sim.step());
-        }
+        let mut check = 0i64;
+        sim.run(clocks, |n, z| check = check.wrapping_add(z.0 ^ n as i64));
+        black_box(check);
         looped.push(clocks as f64 / start.elapsed().as_secs_f64());
     }
     let make = |with_gyro: bool, samples: Vec<f64>| Measurement {

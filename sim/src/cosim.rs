@@ -1,5 +1,5 @@
-//! The closed loop: datapath engine, DACs, gyroscope, ADCs, one clock at a
-//! time.
+//! The closed loop: datapath engine, DACs, gyroscope, ADCs
+//! (`crate::analog`).
 //!
 //! Per clock n (the gyroscope at time nT, the engine's ports during cycle n):
 //!
@@ -9,6 +9,11 @@
 //!  2. the engine takes the ADC words and plays the rising edge n + 1;
 //!  3. the gyroscope advances to (n+1)T under the held force.
 //! ```
+//!
+//! `CoSim::step` plays one clock so; `CoSim::run` plays many with the
+//! registers held, which the model engine does in blocks (the drive half
+//! ahead of the gyroscope, `gyrocal_hdl::model::gyro_interface`'s `run`):
+//! the same clocks, 1.3 to 1.4 times as fast.
 //!
 //! The demodulation references are lined up from the converter latencies by
 //! `gyrocal_hdl::settings` (ref_delay = L_dac + L_adc, ref_phase =
@@ -22,6 +27,7 @@
 //! clock). `CoSim` implements `RegisterAccess`, reads included: the z
 //! snapshot is latched by a SAMPLE_COUNT read, as in the hardware.
 
+use crate::analog::{Analog, Watched};
 use crate::engine::Engine;
 use crate::frontend::Converters;
 use crate::gyro::GyroModel;
@@ -29,13 +35,12 @@ use gyrocal_hdl::host::register_map::{
     self, BusError, RegisterAccess, RegisterBank, SAMPLE_COUNT, STREAM_OVERFLOW, Z1_HI, Z1_LO,
     Z2_HI, Z2_LO,
 };
-use gyrocal_hdl::model::gyro_interface::{Outputs, Registers};
+use gyrocal_hdl::model::gyro_interface::{Outputs, Registers, Words};
 
 /// Engine, converters and gyroscope in a loop.
 pub struct CoSim<E: Engine> {
     engine: E,
-    converters: Converters,
-    gyro: GyroModel,
+    analog: Analog,
     host: HostRegisters,
     outputs: Outputs,
     adc: (i16, i16),
@@ -49,8 +54,7 @@ impl<E: Engine> CoSim<E> {
     pub fn new(engine: E, converters: Converters, gyro: GyroModel, regs: Registers) -> Self {
         let mut sim = Self {
             engine,
-            converters,
-            gyro,
+            analog: Analog::new(converters, gyro, None),
             host: HostRegisters::power_up(),
             outputs: Outputs::default(),
             adc: (0, 0),
@@ -64,15 +68,42 @@ impl<E: Engine> CoSim<E> {
     /// One clock; returns the engine's ports after the edge.
     #[inline(always)]
     pub fn step(&mut self) -> Outputs {
-        let (adc, force) = self
-            .converters
-            .step(self.outputs.dac, (self.gyro.x1(), self.gyro.x2()));
-        self.adc = adc;
-        self.outputs = self.engine.step(adc, self.host.registers());
-        self.gyro.step(force.0, force.1);
+        self.adc = self.analog.step(self.outputs.dac);
+        self.outputs = self.engine.step(self.adc, self.host.registers());
         self.cycle += 1;
         self.samples = self.samples.wrapping_add(self.outputs.z_valid as u32);
         self.outputs
+    }
+
+    /// `clocks` clocks with the registers and the rate held, in the
+    /// engine's blocks (`Engine::run`): the same clocks as `step` that
+    /// many times. `on_z(cycle, z)` gets each z the engine publishes, with
+    /// the cycle `step` would have returned it at.
+    #[inline(always)]
+    pub fn run(&mut self, clocks: u64, mut on_z: impl FnMut(u64, (i64, i64))) {
+        if clocks == 0 {
+            return;
+        }
+        let mut last_adc = self.adc;
+        let mut analog = Watched {
+            analog: &mut self.analog,
+            watch: |adc: &[Words]| last_adc = adc[adc.len() - 1],
+        };
+        let first = self.cycle + 1;
+        let mut samples = self.samples;
+        self.outputs = self.engine.run(
+            self.outputs.dac,
+            self.host.registers(),
+            clocks,
+            &mut analog,
+            |i, z| {
+                samples = samples.wrapping_add(1);
+                on_z(first + i, z);
+            },
+        );
+        self.samples = samples;
+        self.adc = last_adc;
+        self.cycle += clocks;
     }
 
     /// The ADC words the last clock's edge captured.
@@ -98,7 +129,7 @@ impl<E: Engine> CoSim<E> {
 
     /// Change the rotation rate (rad/s) from the next clock on.
     pub fn set_rate(&mut self, omz_rad_s: f64) {
-        self.gyro.set_rate(omz_rad_s);
+        self.analog.gyro.set_rate(omz_rad_s);
     }
 
     /// The engine (for internal signals).
@@ -108,7 +139,7 @@ impl<E: Engine> CoSim<E> {
 
     /// The gyroscope.
     pub fn gyro(&self) -> &GyroModel {
-        &self.gyro
+        &self.analog.gyro
     }
 }
 
@@ -244,5 +275,47 @@ mod tests {
             last_z, sim.outputs.z,
             "z moved on after the snapshot (else the test proves nothing)"
         );
+    }
+
+    /// `run` plays the clocks `step` plays: on a calibration and a
+    /// readout point at a rate (ADC noise on), runs of lengths around the
+    /// engine's block give every z at the cycle `step` gives it, and leave
+    /// the same ports, ADC words, sample count and gyroscope state.
+    #[test]
+    fn a_run_is_the_steps_it_replaces() {
+        let exp = Experiment::paper();
+        let plan = plan(&exp).unwrap();
+        use crate::experiment::Mode;
+        for mode in [Mode::Calibration, Mode::Readout] {
+            let point = plan.points.iter().find(|p| p.mode == mode).unwrap();
+            let mut blocked = point_loop::<ModelEngine>(&exp, &plan, point).unwrap();
+            let mut stepped = point_loop::<ModelEngine>(&exp, &plan, point).unwrap();
+            for sim in [&mut blocked, &mut stepped] {
+                sim.set_rate(0.3);
+            }
+            for clocks in [1u64, 255, 256, 257, 100_000, 7, 30_001] {
+                let mut z_blocked = vec![];
+                blocked.run(clocks, |n, z| z_blocked.push((n, z)));
+                let mut z_stepped = vec![];
+                for _ in 0..clocks {
+                    let o = stepped.step();
+                    if o.z_valid {
+                        z_stepped.push((stepped.cycle(), o.z));
+                    }
+                }
+                assert_eq!(z_blocked, z_stepped, "{:?}, {clocks} clocks", point.mode);
+                assert_eq!(blocked.outputs, stepped.outputs);
+                assert_eq!(blocked.last_adc(), stepped.last_adc());
+                assert_eq!(blocked.samples, stepped.samples);
+                assert_eq!(blocked.cycle(), stepped.cycle());
+                assert_eq!(blocked.gyro().state(), stepped.gyro().state());
+            }
+            assert!(
+                blocked.samples > 10,
+                "{:?}: {} samples",
+                point.mode,
+                blocked.samples
+            );
+        }
     }
 }

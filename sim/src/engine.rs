@@ -12,7 +12,7 @@
 
 use crate::error::EngineError;
 use gyrocal_hdl::model::gyro_interface::{
-    CarrierProfile, GyroInterface, Outputs, Probes, Registers,
+    AnalogSide, CarrierProfile, GyroInterface, Outputs, Probes, Registers, Words,
 };
 use gyrocal_hdl::rtl::RtlGyroInterface;
 
@@ -27,6 +27,48 @@ pub trait Engine {
     fn step(&mut self, adc: (i16, i16), regs: &Registers) -> Outputs;
     /// Internal signals during the current cycle (for waveforms).
     fn probes(&self) -> Probes;
+
+    /// Edges from now none of which can publish z with the registers held
+    /// (a lower bound, 0 when unknown): a loop may play them in one
+    /// `run` while it waits for the next sample.
+    fn quiet_clocks(&self) -> u64 {
+        0
+    }
+
+    /// `clocks` rising edges with the registers held, in a loop closed by
+    /// `analog` (the converters and the gyroscope); `dac` are the DAC
+    /// words during the first cycle. `on_z(i, z)` is called when edge `i`
+    /// (from 0) publishes z. Returns the ports after the last edge
+    /// (`clocks` > 0). Clock by clock here; the model engine plays it in
+    /// blocks (`GyroInterface::run`).
+    #[inline(always)]
+    fn run<A, Z>(
+        &mut self,
+        mut dac: Words,
+        regs: &Registers,
+        clocks: u64,
+        analog: &mut A,
+        mut on_z: Z,
+    ) -> Outputs
+    where
+        A: AnalogSide,
+        Z: FnMut(u64, (i64, i64)),
+        Self: Sized,
+    {
+        assert!(clocks > 0, "Engine::run: no clock to play");
+        let mut out = Outputs::default();
+        for i in 0..clocks {
+            let mut adc = [(0, 0)];
+            analog.advance(dac);
+            analog.convert(&mut adc);
+            out = self.step(adc[0], regs);
+            dac = out.dac;
+            if out.z_valid {
+                on_z(i, out.z);
+            }
+        }
+        out
+    }
 }
 
 /// Which simulator runs the datapath.
@@ -81,6 +123,27 @@ impl Engine for ModelEngine {
 
     fn probes(&self) -> Probes {
         self.0.probes()
+    }
+
+    fn quiet_clocks(&self) -> u64 {
+        self.0.quiet_clocks()
+    }
+
+    #[inline(always)]
+    fn run<A, Z>(
+        &mut self,
+        _dac: Words,
+        regs: &Registers,
+        clocks: u64,
+        analog: &mut A,
+        on_z: Z,
+    ) -> Outputs
+    where
+        A: AnalogSide,
+        Z: FnMut(u64, (i64, i64)),
+    {
+        assert!(clocks > 0, "Engine::run: no clock to play");
+        self.0.run(regs, clocks, analog, on_z)
     }
 }
 

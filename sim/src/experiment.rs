@@ -717,19 +717,11 @@ fn advance<E: Engine>(
     progress: &(dyn Fn(Tick) + Sync),
 ) {
     const CHUNK: u64 = 1 << 20;
-    let mut done = 0;
-    for n in sim.cycle() + 1..=end {
-        let o = sim.step();
-        if o.z_valid {
-            samples.push(n, o.z);
-        }
-        done += 1;
-        if done == CHUNK {
-            progress(Tick::Clocks(done));
-            done = 0;
-        }
+    while sim.cycle() < end {
+        let clocks = (end - sim.cycle()).min(CHUNK);
+        sim.run(clocks, |n, z| samples.push(n, z));
+        progress(Tick::Clocks(clocks));
     }
-    progress(Tick::Clocks(done));
 }
 
 /// Calibration batches (consecutive, `per_period` to a ripple period, whole

@@ -80,7 +80,8 @@ pub struct Converters {
     config: FrontEnd,
     dac_ring: [(i16, i16); MAX_LATENCY as usize + 1],
     adc_ring: [(i16, i16); MAX_LATENCY as usize + 1],
-    head: usize,
+    dac_head: usize,
+    adc_head: usize,
     dac_mask: i16,
     adc_step_inv: f64,
     /// Lowest and highest ADC code, -2^(bits-1) and 2^(bits-1) - 1.
@@ -126,7 +127,8 @@ impl Converters {
             config: config.clone(),
             dac_ring: [(0, 0); MAX_LATENCY as usize + 1],
             adc_ring: [(0, 0); MAX_LATENCY as usize + 1],
-            head: 0,
+            dac_head: 0,
+            adc_head: 0,
             dac_mask: !((1i32 << (16 - config.dac_bits)) - 1) as i16,
             adc_step_inv: 1.0 / f64::from(1u32 << (16 - config.adc_bits)),
             adc_code_range: (
@@ -142,12 +144,27 @@ impl Converters {
         &self.config
     }
 
-    /// One ADC conversion of the displacement `x` (m) on `channel` (0, 1).
+    /// Standard normal draws for `clocks` clocks into `out` (cleared
+    /// first), both channels' of a clock in turn, the order `step` draws
+    /// them; false (and nothing drawn) without noise.
+    pub fn draw_noise(&mut self, clocks: usize, out: &mut Vec<f64>) -> bool {
+        out.clear();
+        match &mut self.noise {
+            Some(g) => {
+                out.extend((0..2 * clocks).map(|_| g.sample()));
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// One ADC conversion of the displacement `x` (m) on `channel` (0, 1)
+    /// with the standard normal draw `g` (when there is noise).
     #[inline(always)]
-    fn convert(&mut self, channel: usize, x: f64) -> i16 {
+    fn convert(&self, channel: usize, x: f64, g: f64) -> i16 {
         let mut v = x * self.config.adc_per_meter[channel];
-        if let Some(g) = &mut self.noise {
-            v += self.config.noise_lsb * g.sample();
+        if self.noise.is_some() {
+            v += self.config.noise_lsb * g;
         }
         // Round half away from zero by truncating v +- 1/2, saturate to the
         // converter's codes, then left-justify in the 16-bit word. Clamping
@@ -155,9 +172,12 @@ impl Converters {
         // keeps the work to a few branch-free instructions, where
         // f64::round is a library call.
         let steps = v * self.adc_step_inv;
-        let code = (steps + 0.5f64.copysign(steps))
+        let clamped = (steps + 0.5f64.copysign(steps))
             .max(self.adc_code_range.0)
-            .min(self.adc_code_range.1) as i32;
+            .min(self.adc_code_range.1);
+        // SAFETY: `max` and `min` leave a number within the code range
+        // (a NaN becomes the lowest code), which every i32 holds.
+        let code: i32 = unsafe { clamped.to_int_unchecked() };
         (code << (16 - self.config.adc_bits)) as i16
     }
 
@@ -167,18 +187,46 @@ impl Converters {
     /// DACs apply over this clock period.
     #[inline(always)]
     pub fn step(&mut self, dac: (i16, i16), x: (f64, f64)) -> ((i16, i16), (f64, f64)) {
-        let sample = (self.convert(0, x.0), self.convert(1, x.1));
+        let g = match &mut self.noise {
+            Some(g) => (g.sample(), g.sample()),
+            None => (0.0, 0.0),
+        };
+        self.step_with(dac, x, g)
+    }
+
+    /// `step` with the clock's standard normal draws `g` given (from
+    /// `draw_noise`; ignored without noise).
+    #[inline(always)]
+    pub fn step_with(
+        &mut self,
+        dac: (i16, i16),
+        x: (f64, f64),
+        g: (f64, f64),
+    ) -> ((i16, i16), (f64, f64)) {
+        (self.adc_step(x, g), self.dac_step(dac))
+    }
+
+    /// The ADC half of `step_with`: the words presented during this cycle.
+    #[inline(always)]
+    pub fn adc_step(&mut self, x: (f64, f64), g: (f64, f64)) -> (i16, i16) {
+        let sample = (self.convert(0, x.0, g.0), self.convert(1, x.1, g.1));
+        let n = self.adc_ring.len();
+        self.adc_head = (self.adc_head + 1) % n;
+        self.adc_ring[self.adc_head] = sample;
+        self.adc_ring[(self.adc_head + n - self.config.adc_latency as usize) % n]
+    }
+
+    /// The DAC half of `step_with`: the forces held over this clock.
+    #[inline(always)]
+    pub fn dac_step(&mut self, dac: (i16, i16)) -> (f64, f64) {
         let n = self.dac_ring.len();
-        self.head = (self.head + 1) % n;
-        self.dac_ring[self.head] = (dac.0 & self.dac_mask, dac.1 & self.dac_mask);
-        self.adc_ring[self.head] = sample;
-        let held = self.dac_ring[(self.head + n - self.config.dac_latency as usize) % n];
-        let adc = self.adc_ring[(self.head + n - self.config.adc_latency as usize) % n];
-        let force = (
+        self.dac_head = (self.dac_head + 1) % n;
+        self.dac_ring[self.dac_head] = (dac.0 & self.dac_mask, dac.1 & self.dac_mask);
+        let held = self.dac_ring[(self.dac_head + n - self.config.dac_latency as usize) % n];
+        (
             held.0 as f64 * self.config.force_per_lsb[0],
             held.1 as f64 * self.config.force_per_lsb[1],
-        );
-        (adc, force)
+        )
     }
 }
 

@@ -346,6 +346,7 @@ impl GyroModel {
     }
 
     /// State `[x1, v1, x2, v2]` at the current clock edge (m, m/s, m, m/s).
+    #[inline(always)]
     pub fn state(&self) -> [f64; 4] {
         [
             self.s[0],

@@ -9,6 +9,7 @@
 //! device) and `serve` (that board on the wire, over Etherbone).
 
 pub mod allan;
+pub mod analog;
 /// Exact window means (`gyrocal_host::average`).
 pub use gyrocal_host::average;
 pub mod bench;

@@ -402,15 +402,14 @@ pub fn run_noisy(
     let mut n = 0u64;
     while n < end {
         let stop = (n + CHUNK).min(end);
-        for _ in n..stop {
-            let o = sim.step();
-            if o.z_valid && sim.cycle() > settle {
-                let z = [o.z.0 as f64, o.z.1 as f64];
+        sim.run(stop - n, |cycle, z| {
+            if cycle > settle {
+                let z = [z.0 as f64, z.1 as f64];
                 for k in 0..2 {
                     blocks[k].push(rate_dps + (z[k] * per_lsb[k] - z_theory[k]) / sf[k]);
                 }
             }
-        }
+        });
         progress(stop - n);
         n = stop;
     }

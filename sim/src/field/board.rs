@@ -15,6 +15,7 @@
 //! table of the simulation harness, which host code (that sees a
 //! `&mut dyn Board`) cannot reach.
 
+use crate::analog::{Analog, Watched};
 use crate::cosim::HostRegisters;
 use crate::drift::DeviceAt;
 use crate::engine::{Engine, ModelEngine};
@@ -22,7 +23,7 @@ use crate::frontend::{Converters, FrontEnd, PickoffPhase};
 use crate::gyro::GyroModel;
 use crate::noise::ThermalNoise;
 use gyrocal_hdl::host::clip_counter::{ClipCount, clip_word};
-use gyrocal_hdl::model::gyro_interface::{CarrierProfile, Outputs};
+use gyrocal_hdl::model::gyro_interface::{CarrierProfile, Outputs, Words};
 pub use gyrocal_host::board::{Board, ZSample};
 use gyrocal_regs::map::{ADC_CLIP, BusError, RegisterAccess};
 
@@ -31,9 +32,7 @@ use gyrocal_regs::map::{ADC_CLIP, BusError, RegisterAccess};
 /// the register map.
 pub struct SimBoard<E: Engine = ModelEngine> {
     engine: E,
-    converters: Converters,
-    gyro: GyroModel,
-    phase: Option<PickoffPhase>,
+    analog: Analog,
     host: HostRegisters,
     outputs: Outputs,
     samples: u32,
@@ -67,9 +66,11 @@ impl<E: Engine> SimBoard<E> {
         };
         Ok(Self {
             engine: E::power_up(profile)?,
-            converters: Converters::new(&fe)?,
-            gyro: GyroModel::new(&at.gyro, clock_hz)?.with_thermal_noise(noise)?,
-            phase,
+            analog: Analog::new(
+                Converters::new(&fe)?,
+                GyroModel::new(&at.gyro, clock_hz)?.with_thermal_noise(noise)?,
+                phase,
+            ),
             host: HostRegisters::power_up(),
             outputs: Outputs::default(),
             samples: 0,
@@ -80,7 +81,7 @@ impl<E: Engine> SimBoard<E> {
 
     /// The rate table: rotation rate (rad/s) from the next clock on.
     pub fn set_rate(&mut self, omz_rad_s: f64) {
-        self.gyro.set_rate(omz_rad_s);
+        self.analog.gyro.set_rate(omz_rad_s);
     }
 
     /// Clocks played since power-up.
@@ -90,36 +91,59 @@ impl<E: Engine> SimBoard<E> {
 
     #[inline(always)]
     fn step(&mut self) {
-        let x = match &self.phase {
-            None => (self.gyro.x1(), self.gyro.x2()),
-            Some(p) => {
-                let s = self.gyro.state();
-                (p.apply(s[0], s[1]), p.apply(s[2], s[3]))
-            }
-        };
-        let (adc, force) = self.converters.step(self.outputs.dac, x);
+        let adc = self.analog.step(self.outputs.dac);
         self.clip[0].step(adc.0, false);
         self.clip[1].step(adc.1, false);
         self.outputs = self.engine.step(adc, self.host.registers());
-        self.gyro.step(force.0, force.1);
         self.samples = self.samples.wrapping_add(self.outputs.z_valid as u32);
         self.cycle += 1;
+    }
+
+    /// `step` `clocks` times, in the engine's blocks (`Engine::run`).
+    fn run(&mut self, clocks: u64) {
+        if clocks == 0 {
+            return;
+        }
+        let Self {
+            engine,
+            analog,
+            host,
+            outputs,
+            samples,
+            cycle,
+            clip,
+        } = self;
+        let mut analog = Watched {
+            analog,
+            watch: |adc: &[Words]| {
+                for a in adc {
+                    clip[0].step(a.0, false);
+                    clip[1].step(a.1, false);
+                }
+            },
+        };
+        let on_z = |_, _| *samples = samples.wrapping_add(1);
+        *outputs = engine.run(outputs.dac, host.registers(), clocks, &mut analog, on_z);
+        *cycle += clocks;
     }
 }
 
 impl<E: Engine> Board for SimBoard<E> {
     fn wait_clocks(&mut self, clocks: u64) -> Result<(), BusError> {
-        for _ in 0..clocks {
-            self.step();
-        }
+        self.run(clocks);
         Ok(())
     }
 
-    /// Steps the clock until the count moves past `after` (at most R
-    /// clocks when `after` is the current count), then reads the snapshot.
+    /// Plays the clock until the count moves past `after` (at most R
+    /// clocks when `after` is the current count), then reads the snapshot:
+    /// the edges that cannot publish (`Engine::quiet_clocks`) in one run,
+    /// the rest one at a time.
     fn next_sample(&mut self, after: u32) -> Result<ZSample, BusError> {
         while self.samples == after {
-            self.step();
+            match self.engine.quiet_clocks() {
+                0 => self.step(),
+                quiet => self.run(quiet),
+            }
         }
         self.read_z()
     }
@@ -141,5 +165,69 @@ impl<E: Engine> RegisterAccess for SimBoard<E> {
             return Ok(word);
         }
         self.host.read(offset, self.outputs.z, self.samples)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::Experiment;
+    use crate::field::scenario;
+
+    /// The paper's board in readout at 50 deg/s, ADC noise on, with a
+    /// front-end phase lag (the path `run` takes through `PickoffPhase`)
+    /// and ADC 1's gain 4 times too high, so that it clips.
+    fn readout_board() -> SimBoard {
+        let exp = Experiment::paper();
+        let (fe, knowns) = scenario::build(&exp).unwrap();
+        let (regs, _) = knowns
+            .registers(exp.drive.carrier_hz, None, knowns.amplitude, 0.0)
+            .unwrap();
+        let at = DeviceAt {
+            temperature_c: 25.0,
+            delta_k: 0.0,
+            gyro: exp.gyro.clone(),
+            adc_gain: [4.0, 1.0],
+            drive_gain: [1.0; 2],
+            front_end_phase_deg: 3.0,
+        };
+        let mut board = scenario::board_at(&exp, &fe, &at).unwrap();
+        board.program(&regs).unwrap();
+        board.set_rate(50f64.to_radians());
+        board
+    }
+
+    /// `wait_clocks` and `next_sample` (which play the engine's blocks)
+    /// leave the board where `step` one clock at a time does: the same
+    /// samples with the same counts, the same clip counts, the same
+    /// gyroscope state and clock, over waits of odd lengths.
+    #[test]
+    fn waits_and_samples_play_the_clocks_one_by_one() {
+        let (mut blocked, mut stepped) = (readout_board(), readout_board());
+        let mut after = (0, 0);
+        for (k, wait) in [0u64, 1, 255, 256, 257, 10_000, 3, 40_000]
+            .iter()
+            .cycle()
+            .take(40)
+            .enumerate()
+        {
+            blocked.wait_clocks(*wait).unwrap();
+            for _ in 0..*wait {
+                stepped.step();
+            }
+            let a = blocked.next_sample(after.0).unwrap();
+            while stepped.samples == after.1 {
+                stepped.step();
+            }
+            let b = stepped.read_z().unwrap();
+            assert_eq!(a, b, "sample {k}");
+            assert_eq!(blocked.cycle(), stepped.cycle(), "sample {k}");
+            after = (a.count, b.count);
+        }
+        assert!(after.0 > 100, "{} samples", after.0);
+        assert_eq!(blocked.analog.gyro.state(), stepped.analog.gyro.state());
+        let clip = blocked.read_register(ADC_CLIP.offset).unwrap();
+        assert_ne!(clip, 0, "ADC 1 never clipped");
+        assert_eq!(Ok(clip), stepped.read_register(ADC_CLIP.offset));
     }
 }

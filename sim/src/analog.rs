@@ -1,0 +1,114 @@
+//! The analog side of the loop, what lies between the FPGA's DAC and ADC
+//! pins: the DACs, the gyroscope, an unmodelled pick-off phase lag and
+//! the ADCs. The co-simulation (`crate::cosim`) and the simulated board
+//! (`crate::field::board`) both close their engine over one.
+//!
+//! Per clock n: the ADCs sample x(nT) (through the phase lag, when there
+//! is one), the converters return the ADC words of cycle n and the force
+//! the DACs hold over [nT, (n+1)T), the gyroscope advances to (n+1)T under
+//! it. Nothing here reads the engine's state, so a block of clocks can be
+//! played at once (`Analog::run`) once the engine has given the block's
+//! DAC words (`crate::engine::Engine::run`).
+
+use crate::frontend::{Converters, PickoffPhase};
+use crate::gyro::GyroModel;
+use gyrocal_hdl::model::gyro_interface::{AnalogSide, BLOCK, Words};
+
+/// DACs, gyroscope, pick-off phase lag and ADCs.
+#[derive(Clone, Debug)]
+pub struct Analog {
+    /// The converters.
+    pub converters: Converters,
+    /// The gyroscope.
+    pub gyro: GyroModel,
+    /// The pick-off's phase lag (`None`: none).
+    pub phase: Option<PickoffPhase>,
+    /// The ADC noise of a block, in the order `step` draws it.
+    noise: Vec<f64>,
+    /// What the ADCs see at each edge advanced and not yet converted.
+    pending: Vec<(f64, f64)>,
+}
+
+impl Analog {
+    /// The analog side at rest.
+    pub fn new(converters: Converters, gyro: GyroModel, phase: Option<PickoffPhase>) -> Self {
+        Self {
+            converters,
+            gyro,
+            phase,
+            noise: vec![],
+            pending: Vec::with_capacity(BLOCK),
+        }
+    }
+
+    /// The displacements the ADCs see at the current clock edge (m).
+    #[inline(always)]
+    fn sensed(&self) -> (f64, f64) {
+        match &self.phase {
+            None => (self.gyro.x1(), self.gyro.x2()),
+            Some(p) => {
+                let s = self.gyro.state();
+                (p.apply(s[0], s[1]), p.apply(s[2], s[3]))
+            }
+        }
+    }
+
+    /// One clock: the DAC words during it in, the ADC words during it out.
+    #[inline(always)]
+    pub fn step(&mut self, dac: Words) -> Words {
+        let (adc, force) = self.converters.step(dac, self.sensed());
+        self.gyro.step(force.0, force.1);
+        adc
+    }
+}
+
+/// The block schedule of `GyroInterface::run`: `advance` keeps what the
+/// ADCs see at each edge (the gyroscope's forces come from the DAC words
+/// alone), `convert` draws the block's ADC noise in the order `step`
+/// draws it and converts, so the words are `step`'s.
+impl AnalogSide for Analog {
+    #[inline(always)]
+    fn advance(&mut self, dac: Words) {
+        let x = self.sensed();
+        self.pending.push(x);
+        let force = self.converters.dac_step(dac);
+        self.gyro.step(force.0, force.1);
+    }
+
+    #[inline(always)]
+    fn convert(&mut self, adc: &mut [Words]) {
+        debug_assert_eq!(adc.len(), self.pending.len());
+        let mut noise = std::mem::take(&mut self.noise);
+        if !self.converters.draw_noise(adc.len(), &mut noise) {
+            noise.clear();
+            noise.resize(2 * adc.len(), 0.0);
+        }
+        for ((a, &x), g) in adc.iter_mut().zip(&self.pending).zip(noise.chunks_exact(2)) {
+            *a = self.converters.adc_step(x, (g[0], g[1]));
+        }
+        self.pending.clear();
+        self.noise = noise;
+    }
+}
+
+/// An analog side that shows each block's ADC words to `watch` once
+/// converted (the last word, the clip counters).
+pub struct Watched<'a, W: FnMut(&[Words])> {
+    /// The analog side.
+    pub analog: &'a mut Analog,
+    /// Sees the ADC words, in order.
+    pub watch: W,
+}
+
+impl<W: FnMut(&[Words])> AnalogSide for Watched<'_, W> {
+    #[inline(always)]
+    fn advance(&mut self, dac: Words) {
+        self.analog.advance(dac);
+    }
+
+    #[inline(always)]
+    fn convert(&mut self, adc: &mut [Words]) {
+        self.analog.convert(adc);
+        (self.watch)(adc);
+    }
+}
