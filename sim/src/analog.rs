@@ -6,9 +6,11 @@
 //! Per clock n: the ADCs sample x(nT) (through the phase lag, when there
 //! is one), the converters return the ADC words of cycle n and the force
 //! the DACs hold over [nT, (n+1)T), the gyroscope advances to (n+1)T under
-//! it. Nothing here reads the engine's state, so a block of clocks can be
-//! played at once (`Analog::run`) once the engine has given the block's
-//! DAC words (`crate::engine::Engine::run`).
+//! it (`Analog::step`). Nothing here reads the engine's state and the
+//! forces come from the DAC words alone, so the gyroscope can advance
+//! through a block of clocks before any of its ADC words is converted: the
+//! schedule `AnalogSide` gives the model engine's blocks
+//! (`crate::engine::Engine::run`).
 
 use crate::frontend::{Converters, PickoffPhase};
 use crate::gyro::GyroModel;

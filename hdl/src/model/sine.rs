@@ -62,7 +62,11 @@ impl Sine {
     #[inline(always)]
     pub fn step(&mut self, phase: u32, advance: u8) -> i16 {
         self.pipe[self.head] = sine_with(self.table, phase, advance);
-        self.head = (self.head + 1) % LATENCY;
+        self.head = if self.head + 1 == LATENCY {
+            0
+        } else {
+            self.head + 1
+        };
         self.pipe[self.head]
     }
 }
