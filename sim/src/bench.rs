@@ -4,9 +4,10 @@
 //! words from a precomputed table) and inside the closed loop with the
 //! gyroscope model (`CoSim`), each repeated and reported as the median with
 //! its spread. Both run as the experiments do, through `Engine::run` (the
-//! model engine in blocks, the others clock by clock). Stimulus: the paper's device, calibration at 12 Hz (every
-//! block busy). Optionally, the whole `reproduce` experiment, timed wall to
-//! wall on all cores, with the process's peak resident memory.
+//! model engine in blocks, the others clock by clock). Stimulus: the
+//! paper's device, calibration at 12 Hz (every block busy). Optionally, the
+//! whole `reproduce` experiment, timed wall to wall on all cores, with the
+//! process's peak resident memory.
 
 use crate::engine::{Engine, EngineKind, ModelEngine, RtlEngine};
 use crate::experiment::{self, Experiment, Plan};

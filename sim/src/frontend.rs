@@ -191,22 +191,11 @@ impl Converters {
             Some(g) => (g.sample(), g.sample()),
             None => (0.0, 0.0),
         };
-        self.step_with(dac, x, g)
-    }
-
-    /// `step` with the clock's standard normal draws `g` given (from
-    /// `draw_noise`; ignored without noise).
-    #[inline(always)]
-    pub fn step_with(
-        &mut self,
-        dac: (i16, i16),
-        x: (f64, f64),
-        g: (f64, f64),
-    ) -> ((i16, i16), (f64, f64)) {
         (self.adc_step(x, g), self.dac_step(dac))
     }
 
-    /// The ADC half of `step_with`: the words presented during this cycle.
+    /// The ADC half of `step`, with the clock's standard normal draws `g`
+    /// given (from `draw_noise`): the words presented during this cycle.
     #[inline(always)]
     pub fn adc_step(&mut self, x: (f64, f64), g: (f64, f64)) -> (i16, i16) {
         let sample = (self.convert(0, x.0, g.0), self.convert(1, x.1, g.1));
@@ -216,7 +205,7 @@ impl Converters {
         self.adc_ring[(self.adc_head + n - self.config.adc_latency as usize) % n]
     }
 
-    /// The DAC half of `step_with`: the forces held over this clock.
+    /// The DAC half of `step`: the forces held over this clock.
     #[inline(always)]
     pub fn dac_step(&mut self, dac: (i16, i16)) -> (f64, f64) {
         let n = self.dac_ring.len();

@@ -35,9 +35,9 @@ pub fn table() -> &'static Table {
 /// `table_sine(table(), j << PHASE_BELOW_INDEX, 0)`. The word of a phase
 /// depends only on its top `32 - PHASE_BELOW_INDEX` bits, so a lookup
 /// (`turn_sine`) is one read instead of the quadrant's mirror and sign
-/// around one: the
-/// model's shortcut, not the hardware's (which stores the quarter), equal
-/// word for word (a test reads every phase interval both ways).
+/// around one: the model's shortcut, not the hardware's (which stores the
+/// quarter), equal word for word (a test reads every phase interval both
+/// ways).
 pub type Turn = [i16; 4 * TABLE_ENTRIES];
 
 /// The unfolded table, built once per process from `table()`.
