@@ -3,7 +3,7 @@
 
 use super::carrier_nco::Carriers;
 use super::notch_coefficient::NotchCoefficient;
-use super::q15_multiplier::Q15Multiplier;
+use super::q15_multiplier::{Q15Multiplier, product_block};
 use crate::carrier_multiplier::{FEEDBACK_SCALE, RESIDUE_DROP, SHIFT, WORD_LIMIT};
 use crate::fine_sine_table::OUTPUT_FRACTION_BITS;
 use crate::q15_multiplier::LATENCY;
@@ -87,6 +87,17 @@ impl CarrierMultiplier {
             self.factors = (a, c);
         }
         self.y
+    }
+
+    /// The table core's `y` during the next `out.len()` cycles, then as
+    /// many edges with `input(k)` (a, c) at edge k: `output` and `step`
+    /// clock by clock (`super::q15_multiplier::product_block`).
+    #[inline(always)]
+    pub fn block(&mut self, out: &mut [i16], input: impl Fn(usize) -> (i16, i32)) {
+        debug_assert!(!self.shaped);
+        let registers = (&mut self.factors, &mut self.product, &mut self.y);
+        let multiply = |(a, c): (i16, i32)| i64::from(a) * i64::from(c);
+        product_block(registers, out, input, multiply, round_product);
     }
 
     /// The fine core's rounding and saturation stages and its feedback
@@ -217,5 +228,69 @@ impl AmMixer {
         self.reference1.step(fa1, carriers.ref_cos, k);
         self.reference2.step(fa2, carriers.ref_sin, k);
         self.output()
+    }
+
+    /// True when `block` may play the next clocks: the table core.
+    #[inline(always)]
+    pub fn blocks(&self) -> bool {
+        self.notch.is_none()
+    }
+
+    /// The outputs during the next `out.len()` cycles, then as many edges
+    /// with `amp` held, `am[k]` and `carriers[k]` the inputs during cycle
+    /// k: `output` and `step` clock by clock, where `blocks()`. In passes
+    /// over chunks of the block: the envelope multiplier, the latching of
+    /// F A by channel, then each carrier product.
+    #[inline(always)]
+    pub fn block(
+        &mut self,
+        amp: (i16, i16),
+        am: &[(i16, i16)],
+        carriers: &[Carriers],
+        out: &mut [Drives],
+    ) {
+        debug_assert!(self.blocks());
+        const CHUNK: usize = 64;
+        let mut envelope = [0i16; CHUNK];
+        let mut fa = [(0i16, 0i16); CHUNK];
+        let mut word = [0i16; CHUNK];
+        for ((out, am), carriers) in out
+            .chunks_mut(CHUNK)
+            .zip(am.chunks(CHUNK))
+            .zip(carriers.chunks(CHUNK))
+        {
+            let m = out.len();
+            let turn = self.turn;
+            let channel = |k: usize| turn ^ (k % 2 == 1);
+            self.envelope.block(&mut envelope[..m], |k| {
+                if channel(k) {
+                    (amp.1, am[k].1)
+                } else {
+                    (amp.0, am[k].0)
+                }
+            });
+            for (k, (f, &e)) in fa.iter_mut().zip(&envelope[..m]).enumerate() {
+                *f = self.fa;
+                if channel(k) == (LATENCY % 2 == 1) {
+                    self.fa.0 = e;
+                } else {
+                    self.fa.1 = e;
+                }
+            }
+            self.turn = channel(m);
+            let word = &mut word[..m];
+            self.drive1
+                .block(word, |k| (fa[k].0, carriers[k].drive_cos));
+            out.iter_mut().zip(&*word).for_each(|(o, &w)| o.dac1 = w);
+            self.drive2
+                .block(word, |k| (fa[k].1, carriers[k].drive_sin));
+            out.iter_mut().zip(&*word).for_each(|(o, &w)| o.dac2 = w);
+            self.reference1
+                .block(word, |k| (fa[k].0, carriers[k].ref_cos));
+            out.iter_mut().zip(&*word).for_each(|(o, &w)| o.ref1 = w);
+            self.reference2
+                .block(word, |k| (fa[k].1, carriers[k].ref_sin));
+            out.iter_mut().zip(&*word).for_each(|(o, &w)| o.ref2 = w);
+        }
     }
 }

@@ -13,6 +13,7 @@
 //! the sines are `super::sine_pair`'s, nothing is filled (no request to the
 //! modulation NCO), and the outputs go live at the same cycle.
 
+use super::delay_ring::DelayRing;
 use super::sine::sine;
 use super::sine_pair::sine_pair;
 use crate::carrier_table_fill::{FILL_CLOCKS, REQUESTS, rom_entry_phase};
@@ -111,9 +112,8 @@ pub struct CarrierNco {
     phase: u32,
     /// The fill counter: cycles since power-up, stopped at `FILL_CLOCKS`.
     count: u16,
-    /// Outputs in flight; `pipe[head]` is the current output.
-    pipe: [Carriers; LATENCY],
-    head: usize,
+    /// Outputs in flight.
+    pipe: DelayRing<Carriers, LATENCY>,
     turn: &'static Turn,
     profile: CarrierProfile,
 }
@@ -130,8 +130,7 @@ impl CarrierNco {
         Self {
             phase: 0,
             count: 0,
-            pipe: [Carriers::default(); LATENCY],
-            head: 0,
+            pipe: DelayRing::default(),
             turn: turn(),
             profile,
         }
@@ -140,7 +139,7 @@ impl CarrierNco {
     /// The outputs during the current cycle.
     #[inline(always)]
     pub fn output(&self) -> Carriers {
-        self.pipe[self.head]
+        self.pipe.output()
     }
 
     /// The phase the fill asks the modulation NCO's sine generator for
@@ -156,18 +155,10 @@ impl CarrierNco {
     #[inline(always)]
     pub fn step(&mut self, step: u32, ref_offset: u32) -> Carriers {
         let live = self.count as usize == FILL_CLOCKS;
-        self.pipe[self.head] = if live {
+        let entering = if live {
             let reference = self.phase.wrapping_add(ref_offset);
             match self.profile {
-                CarrierProfile::Table => {
-                    let t = self.turn;
-                    Carriers {
-                        drive_cos: turn_sine(t, self.phase, 1).into(),
-                        drive_sin: turn_sine(t, self.phase, 0).into(),
-                        ref_cos: turn_sine(t, reference, 1).into(),
-                        ref_sin: turn_sine(t, reference, 0).into(),
-                    }
-                }
+                CarrierProfile::Table => table_carriers(self.turn, self.phase, reference),
                 CarrierProfile::Fine => {
                     let ((drive_cos, drive_sin), (ref_cos, ref_sin)) =
                         (sine_pair(self.phase), sine_pair(reference));
@@ -183,13 +174,42 @@ impl CarrierNco {
             self.count += 1;
             Carriers::default()
         };
-        self.head = if self.head + 1 == LATENCY {
-            0
-        } else {
-            self.head + 1
-        };
         self.phase = self.phase.wrapping_add(step);
-        self.output()
+        self.pipe.step(entering)
+    }
+
+    /// True when `block` may play the next clocks: the table core, its
+    /// table filled.
+    #[inline(always)]
+    pub fn blocks(&self) -> bool {
+        self.profile == CarrierProfile::Table && self.count as usize == FILL_CLOCKS
+    }
+
+    /// The carriers during the next `out.len()` cycles, then as many edges
+    /// with `step` and `ref_offset` held: the same as `output` and `step`
+    /// clock by clock, where `blocks()`. The phase at edge k is the
+    /// arithmetic sequence `phase + k step`, so the lookups of a block
+    /// carry no dependence from clock to clock.
+    #[inline(always)]
+    pub fn block(&mut self, step: u32, ref_offset: u32, out: &mut [Carriers]) {
+        debug_assert!(self.blocks());
+        let (turn, phase) = (self.turn, self.phase);
+        self.pipe.block(out, |k| {
+            let drive = phase.wrapping_add(step.wrapping_mul(k as u32));
+            table_carriers(turn, drive, drive.wrapping_add(ref_offset))
+        });
+        self.phase = phase.wrapping_add(step.wrapping_mul(out.len() as u32));
+    }
+}
+
+/// The table core's four carrier words at the drive and reference phases.
+#[inline(always)]
+fn table_carriers(t: &Turn, drive: u32, reference: u32) -> Carriers {
+    Carriers {
+        drive_cos: turn_sine(t, drive, 1).into(),
+        drive_sin: turn_sine(t, drive, 0).into(),
+        ref_cos: turn_sine(t, reference, 1).into(),
+        ref_sin: turn_sine(t, reference, 0).into(),
     }
 }
 

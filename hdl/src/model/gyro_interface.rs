@@ -1,8 +1,8 @@
 //! Bit-true, cycle-true model of `crate::gyro_interface::GyroInterface`:
 //! the blocks' models wired as in the hardware. This is the `model` engine.
 
-use super::am_mixer::AmMixer;
-use super::carrier_nco::CarrierNco;
+use super::am_mixer::{AmMixer, Drives};
+use super::carrier_nco::{CarrierNco, Carriers};
 use super::cic_decimator::CicDecimator;
 use super::demod_mux::DemodMux;
 use super::iir_lowpass::IirLowpass;
@@ -104,19 +104,21 @@ impl GyroInterface {
     /// clocks as `step` that many times, with `analog` closing the loop.
     /// The DAC words do not depend on the ADC words (no path in the
     /// datapath leads from the demodulators back to the drives), so the
-    /// drive half can run ahead. Per block, in passes:
+    /// drive half can run ahead, and the readout half behind. Per block:
     ///
     /// ```text
-    /// 1. the drive half's words of the next block, each clock beside one
-    ///    `analog.advance` with this block's DAC word (integer work beside
-    ///    the gyroscope's floating-point recursion, which would otherwise
-    ///    wait on its own latency);
-    /// 2. `analog.convert`: this block's ADC words;
-    /// 3. the readout half on them.
+    /// 1. `analog.advance` with each of the block's DAC words, each clock
+    ///    beside one clock of the readout half on the block before
+    ///    (integer work beside the gyroscope's floating-point recursion,
+    ///    which would otherwise wait on its own latency);
+    /// 2. `analog.convert`: the block's ADC words, read out in step 1 of
+    ///    the next block (or after the last);
+    /// 3. the drive half of the next block, stage by stage
+    ///    (`drive_block`).
     /// ```
     ///
-    /// `on_z(i, z)` is called when clock `i` (from 0) publishes z. Returns
-    /// the outputs after the last edge.
+    /// `on_z(i, z)` is called when clock `i` (from 0) publishes z, in the
+    /// order of the clocks. Returns the outputs after the last edge.
     #[inline(always)]
     pub fn run<A, Z>(
         &mut self,
@@ -131,47 +133,78 @@ impl GyroInterface {
     {
         let regs = &regs.at_ports();
         let block = |done: u64| (clocks - done).min(BLOCK as u64) as usize;
-        let mut this = DriveBlock::default();
-        let mut next = DriveBlock::default();
+        let mut drives = [[Drives::default(); BLOCK]; 2];
+        let mut stages = DriveStages::default();
+        // The block converted and not yet read out: its ADC words, its
+        // length and first clock; its drive words are `drives[1 - this]`.
         let mut adc = [(0i16, 0i16); BLOCK];
+        let (mut waiting, mut first) = (0usize, 0u64);
+        let mut this = 0;
         let mut n = block(0);
-        for i in 0..n {
-            self.drive_into(&mut this, i, regs);
-        }
+        self.drive_block(&mut drives[this][..n], &mut stages, regs);
         let mut done = 0u64;
         while n > 0 {
-            let ahead = block(done + n as u64);
-            // Only the last block is short: the next one is never longer.
-            for (i, &dac) in this.dac[..ahead].iter().enumerate() {
-                self.drive_into(&mut next, i, regs);
-                analog.advance(dac);
-            }
-            for &dac in &this.dac[ahead..n] {
-                analog.advance(dac);
-            }
-            analog.convert(&mut adc[..n]);
-            for (i, (&a, &r)) in adc[..n].iter().zip(&this.references[..n]).enumerate() {
-                self.step_readout(a, r, regs);
-                let (z1, z2, valid) = self.iir.output();
-                if valid {
-                    on_z(done + i as u64, (z1, z2));
+            let [a, b] = &mut drives;
+            let (now, before) = if this == 0 { (a, b) } else { (b, a) };
+            let mut read = |gi: &mut Self, i: usize| {
+                if let Some(z) = gi.readout_clock(adc[i], before[i], regs) {
+                    on_z(first + i as u64, z);
+                }
+            };
+            for (i, d) in now[..n].iter().enumerate() {
+                analog.advance((d.dac1, d.dac2));
+                if i < waiting {
+                    read(self, i);
                 }
             }
+            // Only the last block is short: the one before is never shorter.
+            for i in n..waiting {
+                read(self, i);
+            }
+            analog.convert(&mut adc[..n]);
+            (waiting, first) = (n, done);
             done += n as u64;
-            n = ahead;
-            std::mem::swap(&mut this, &mut next);
+            n = block(done);
+            this = 1 - this;
+            self.drive_block(&mut drives[this][..n], &mut stages, regs);
+        }
+        for i in 0..waiting {
+            if let Some(z) = self.readout_clock(adc[i], drives[1 - this][i], regs) {
+                on_z(first + i as u64, z);
+            }
         }
         self.outputs()
     }
 
-    /// The drive words during the current cycle into clock `i` of a
-    /// block, then the drive half's edge.
+    /// The readout half of one clock of a run, with the ADC words and the
+    /// drive words during it; the z it publishes, if any.
     #[inline(always)]
-    fn drive_into(&mut self, block: &mut DriveBlock, i: usize, regs: &Registers) {
-        let drives = self.am_mixer.output();
-        block.dac[i] = (drives.dac1, drives.dac2);
-        block.references[i] = (drives.ref1, drives.ref2);
-        self.step_drives(regs);
+    fn readout_clock(&mut self, adc: Words, d: Drives, regs: &Registers) -> Option<(i64, i64)> {
+        self.step_readout(adc, (d.ref1, d.ref2), regs);
+        let (z1, z2, valid) = self.iir.output();
+        valid.then_some((z1, z2))
+    }
+
+    /// The drive words during the next `drives.len()` cycles, then the
+    /// drive half's edges: stage by stage over the block where every stage
+    /// can (`CarrierNco::blocks`: the table core after its fill), else
+    /// clock by clock.
+    #[inline(always)]
+    fn drive_block(&mut self, drives: &mut [Drives], stages: &mut DriveStages, regs: &Registers) {
+        let n = drives.len();
+        if self.carrier_nco.blocks() && self.am_mixer.blocks() {
+            let carriers = &mut stages.carriers[..n];
+            let am = &mut stages.am[..n];
+            self.carrier_nco
+                .block(regs.carrier_step, regs.ref_phase, carriers);
+            self.modulation_nco.block(regs.mod_step, regs.select, am);
+            self.am_mixer.block(regs.amp, am, carriers, drives);
+        } else {
+            for d in drives {
+                *d = self.am_mixer.output();
+                self.step_drives(regs);
+            }
+        }
     }
 
     /// Edges from now none of which can publish z, with the registers
@@ -235,18 +268,18 @@ pub trait AnalogSide {
     fn convert(&mut self, adc: &mut [Words]);
 }
 
-/// The drive half's words over a block.
-#[derive(Clone, Copy)]
-struct DriveBlock {
-    dac: [Words; BLOCK],
-    references: [Words; BLOCK],
+/// The drive half's stages' outputs over a block, on the way to the
+/// drive words (`GyroInterface::drive_block`).
+struct DriveStages {
+    carriers: [Carriers; BLOCK],
+    am: [(i16, i16); BLOCK],
 }
 
-impl Default for DriveBlock {
+impl Default for DriveStages {
     fn default() -> Self {
         Self {
-            dac: [(0, 0); BLOCK],
-            references: [(0, 0); BLOCK],
+            carriers: [Carriers::default(); BLOCK],
+            am: [(0, 0); BLOCK],
         }
     }
 }

@@ -10,6 +10,7 @@
 pub mod am_mixer;
 pub mod carrier_nco;
 pub mod cic_decimator;
+pub mod delay_ring;
 pub mod demod_mux;
 pub mod gyro_interface;
 pub mod iir_lowpass;

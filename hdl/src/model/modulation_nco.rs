@@ -53,6 +53,40 @@ impl ModulationNco {
         self.phase = (self.phase + step) & PHASE_MASK;
         self.am
     }
+
+    /// `(am1, am2)` during the next `out.len()` cycles, then as many edges
+    /// with `step` and `select` held and no fill request: the same as
+    /// `output` and `step(step, select, None)` clock by clock. The sine
+    /// generator's phases and advances at edge k are arithmetic on k
+    /// (`Sine::block`); then one pass latches the words as `step` does.
+    #[inline(always)]
+    pub fn block(&mut self, step: u64, select: bool, out: &mut [(i16, i16)]) {
+        const CHUNK: usize = 64;
+        let mut sines = [0i16; CHUNK];
+        for chunk in out.chunks_mut(CHUNK) {
+            let (phase, turn) = (self.phase, self.turn);
+            let sines = &mut sines[..chunk.len()];
+            self.sine.block(sines, |k| {
+                let phase = phase.wrapping_add(step.wrapping_mul(k as u64)) & PHASE_MASK;
+                let turn = turn ^ (k % 2 == 1);
+                ((phase >> 16) as u32, if turn { 0 } else { 1 })
+            });
+            let mut turn = turn;
+            for (o, &s) in chunk.iter_mut().zip(sines.iter()) {
+                *o = self.am;
+                if !select {
+                    self.am = (PEAK as i16, PEAK as i16);
+                } else if turn == (LATENCY % 2 == 1) {
+                    self.am.0 = s;
+                } else {
+                    self.am.1 = s;
+                }
+                turn = !turn;
+            }
+            self.turn = turn;
+            self.phase = phase.wrapping_add(step.wrapping_mul(chunk.len() as u64)) & PHASE_MASK;
+        }
+    }
 }
 
 #[cfg(test)]

@@ -5,6 +5,7 @@
 //! the power-up registers give (`crate::quarter_wave`): 0 during cycles
 //! 0..=4.
 
+use super::delay_ring::DelayRing;
 use crate::quarter_wave::LATENCY;
 use crate::sine_table;
 use std::sync::OnceLock;
@@ -34,17 +35,15 @@ fn sine_with(table: &Table, phase: u32, advance: u8) -> i16 {
 /// Cycle-true model of one `crate::sine::Sine`.
 #[derive(Clone, Debug)]
 pub struct Sine {
-    /// Values in flight; `pipe[head]` is the current output.
-    pipe: [i16; LATENCY],
-    head: usize,
+    /// Values in flight.
+    pipe: DelayRing<i16, LATENCY>,
     table: &'static Table,
 }
 
 impl Default for Sine {
     fn default() -> Self {
         Self {
-            pipe: [0; LATENCY],
-            head: 0,
+            pipe: DelayRing::default(),
             table: table(),
         }
     }
@@ -54,20 +53,26 @@ impl Sine {
     /// The output during the current cycle.
     #[inline(always)]
     pub fn output(&self) -> i16 {
-        self.pipe[self.head]
+        self.pipe.output()
     }
 
     /// Present `phase` and `advance` for one clock; returns the output
     /// after the edge.
     #[inline(always)]
     pub fn step(&mut self, phase: u32, advance: u8) -> i16 {
-        self.pipe[self.head] = sine_with(self.table, phase, advance);
-        self.head = if self.head + 1 == LATENCY {
-            0
-        } else {
-            self.head + 1
-        };
-        self.pipe[self.head]
+        self.pipe.step(sine_with(self.table, phase, advance))
+    }
+
+    /// The outputs during the next `out.len()` cycles, then as many edges
+    /// with `input(k)` (phase, advance) presented at edge k: `output` and
+    /// `step` clock by clock (`DelayRing::block`).
+    #[inline(always)]
+    pub fn block(&mut self, out: &mut [i16], input: impl Fn(usize) -> (u32, u8)) {
+        let table = self.table;
+        self.pipe.block(out, |k| {
+            let (phase, advance) = input(k);
+            sine_with(table, phase, advance)
+        });
     }
 }
 

@@ -1,0 +1,94 @@
+//! A pipeline of fixed latency as the models keep it: the values in
+//! flight in a ring, the current output at its head. The ROM sine
+//! (`super::sine`) and the carrier NCO (`super::carrier_nco`) compute a
+//! word from the phase at an edge and publish it `L` edges later; the
+//! stages between change nothing the ports show, so the model keeps the
+//! `L` words in flight instead of the stages' registers.
+
+/// `L` values in flight; `pipe[head]` is the output during the current
+/// cycle, the one that entered `L` edges ago.
+#[derive(Clone, Copy, Debug)]
+pub struct DelayRing<T, const L: usize> {
+    pipe: [T; L],
+    head: usize,
+}
+
+impl<T: Copy + Default, const L: usize> Default for DelayRing<T, L> {
+    fn default() -> Self {
+        Self {
+            pipe: [T::default(); L],
+            head: 0,
+        }
+    }
+}
+
+impl<T: Copy, const L: usize> DelayRing<T, L> {
+    /// The output during the current cycle.
+    #[inline(always)]
+    pub fn output(&self) -> T {
+        self.pipe[self.head]
+    }
+
+    /// One edge at which `value` enters; returns the output after it.
+    #[inline(always)]
+    pub fn step(&mut self, value: T) -> T {
+        self.pipe[self.head] = value;
+        self.head = if self.head + 1 == L { 0 } else { self.head + 1 };
+        self.output()
+    }
+
+    /// The outputs during the next `out.len()` cycles, then as many edges
+    /// with `entering(k)` entering at edge `k`: the same as `output` and
+    /// `step(entering(k))` for k = 0, 1, ... The outputs from cycle `L` on
+    /// are `entering(i - L)`, so a caller whose `entering` is arithmetic on
+    /// `k` gets a loop without a carried dependence.
+    #[inline(always)]
+    pub fn block(&mut self, out: &mut [T], entering: impl Fn(usize) -> T) {
+        let n = out.len();
+        let old = *self;
+        let in_flight = |i: usize| old.pipe[(old.head + i) % L];
+        for (i, o) in out.iter_mut().enumerate().take(L) {
+            *o = in_flight(i);
+        }
+        for (i, o) in out.iter_mut().enumerate().skip(L) {
+            *o = entering(i - L);
+        }
+        // After n edges the ring holds the outputs during cycles n..n + L.
+        for (j, p) in self.pipe.iter_mut().enumerate() {
+            let i = n + j;
+            *p = if i < L { in_flight(i) } else { entering(i - L) };
+        }
+        self.head = 0;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::test_util::Rng;
+
+    /// `block` over runs of 0 to 12 cycles, the ring's head anywhere,
+    /// against `output` and `step` cycle by cycle.
+    #[test]
+    fn a_block_is_its_steps() {
+        let mut rng = Rng::new(5);
+        let (mut ring, mut stepped) = (
+            DelayRing::<u32, 5>::default(),
+            DelayRing::<u32, 5>::default(),
+        );
+        let mut k0 = 0u32;
+        for _ in 0..200 {
+            let n = rng.range(0, 12) as usize;
+            let salt = rng.range(0, 1000) as u32;
+            let entering = |k: usize| (k as u32 + k0).wrapping_mul(2654435761) ^ salt;
+            let mut out = vec![0; n];
+            ring.block(&mut out, entering);
+            for (k, &o) in out.iter().enumerate() {
+                assert_eq!(o, stepped.output(), "cycle {k} of {n}");
+                stepped.step(entering(k));
+            }
+            assert_eq!(ring.output(), stepped.output());
+            k0 += n as u32;
+        }
+    }
+}
