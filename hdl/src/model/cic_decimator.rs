@@ -119,28 +119,62 @@ impl CicDecimator {
     /// last: the hardware's `integral` is the unsplit cascade's value of
     /// one clock earlier (`crate::cic_integrators`), so the newest input is
     /// not in it yet and stays pending.
+    ///
+    /// In chunks of at most `CHUNK` inputs: the cascade from zero in i64
+    /// (exact for any i32 input: the fourth stage stays within C(512, 4)
+    /// 2^31 < 2^62.4), then added to the held values moved on by the
+    /// chunk's edges, `integrator_power`. Every step is exact modulo
+    /// 2^128, as the wrapping i128 cascade clock by clock is.
     #[inline(never)]
     fn integrate_pending(&mut self) {
         let newest = self.pending.pop();
-        let [
-            [mut a1, mut a2, mut a3, mut a4],
-            [mut b1, mut b2, mut b3, mut b4],
-        ] = self.integrator;
-        for &(x1, x2) in &self.pending {
-            // Every stage takes its predecessor's value before the edge.
-            a4 = a4.wrapping_add(a3);
-            a3 = a3.wrapping_add(a2);
-            a2 = a2.wrapping_add(a1);
-            a1 = a1.wrapping_add(x1 as i128);
-            b4 = b4.wrapping_add(b3);
-            b3 = b3.wrapping_add(b2);
-            b2 = b2.wrapping_add(b1);
-            b1 = b1.wrapping_add(x2 as i128);
+        for chunk in self.pending.chunks(CHUNK) {
+            let [mut a1, mut a2, mut a3, mut a4] = [0i64; STAGES as usize];
+            let [mut b1, mut b2, mut b3, mut b4] = [0i64; STAGES as usize];
+            for &(x1, x2) in chunk {
+                // Every stage takes its predecessor's value before the edge.
+                a4 += a3;
+                a3 += a2;
+                a2 += a1;
+                a1 += i64::from(x1);
+                b4 += b3;
+                b3 += b2;
+                b2 += b1;
+                b1 += i64::from(x2);
+            }
+            let m = chunk.len() as i128;
+            integrator_power(&mut self.integrator[0], m, [a1, a2, a3, a4]);
+            integrator_power(&mut self.integrator[1], m, [b1, b2, b3, b4]);
         }
-        self.integrator = [[a1, a2, a3, a4], [b1, b2, b3, b4]];
         self.pending.clear();
         self.pending.extend(newest);
     }
+}
+
+/// Inputs per chunk of `CicDecimator::integrate_pending`.
+const CHUNK: usize = 512;
+
+/// One channel's integrators after `m` edges: an edge adds each stage's
+/// old value to the next (`I + N`, N the shift down the cascade), so `m`
+/// of them give `sum_j C(m, j) N^j` on the held values, plus `zero`, the
+/// cascade's values after the same inputs from zero.
+#[inline(always)]
+fn integrator_power(held: &mut [i128; STAGES as usize], m: i128, zero: [i64; STAGES as usize]) {
+    let [s1, s2, s3, s4] = *held;
+    let c2 = m * (m - 1) / 2;
+    let c3 = c2 * (m - 2) / 3;
+    let z = zero.map(i128::from);
+    *held = [
+        s1.wrapping_add(z[0]),
+        s2.wrapping_add(s1.wrapping_mul(m)).wrapping_add(z[1]),
+        s3.wrapping_add(s2.wrapping_mul(m))
+            .wrapping_add(s1.wrapping_mul(c2))
+            .wrapping_add(z[2]),
+        s4.wrapping_add(s3.wrapping_mul(m))
+            .wrapping_add(s2.wrapping_mul(c2))
+            .wrapping_add(s1.wrapping_mul(c3))
+            .wrapping_add(z[3]),
+    ];
 }
 
 #[cfg(test)]
@@ -188,6 +222,49 @@ mod tests {
                     round_half_up(x, shift),
                     "x {x}, shift {shift}"
                 );
+            }
+        }
+    }
+
+    /// The chunked integration against the cascade clock by clock in
+    /// wrapping i128, from held values anywhere in 128 bits, for runs
+    /// around the chunk's length and the longest decimation, with the
+    /// largest inputs (the i64 chunk's bound) and random ones.
+    #[test]
+    fn chunked_integration_is_the_cascade_clock_by_clock() {
+        let mut rng = crate::test_util::Rng::new(23);
+        for len in [0usize, 1, 2, 511, 512, 513, 1025, 8191] {
+            for fill in 0..4 {
+                let x = |i: usize, rng: &mut crate::test_util::Rng| match fill {
+                    0 => (i32::MIN, i32::MIN),
+                    1 => (i32::MAX, i32::MIN),
+                    _ => (
+                        rng.next_u64() as i32,
+                        (rng.next_u64() >> 7) as i32 ^ i as i32,
+                    ),
+                };
+                let inputs: Vec<(i32, i32)> = (0..len).map(|i| x(i, &mut rng)).collect();
+                let held: [[i128; 4]; 2] = std::array::from_fn(|_| {
+                    std::array::from_fn(|_| (rng.next_u64() as i128) << 64 | rng.next_u64() as i128)
+                });
+                let mut cic = CicDecimator {
+                    integrator: held,
+                    pending: inputs.clone(),
+                    ..Default::default()
+                };
+                cic.pending.push((7, 7));
+                cic.integrate_pending();
+                let mut want = held;
+                for &(x1, x2) in &inputs {
+                    for (s, x) in want.iter_mut().zip([x1, x2]) {
+                        s[3] = s[3].wrapping_add(s[2]);
+                        s[2] = s[2].wrapping_add(s[1]);
+                        s[1] = s[1].wrapping_add(s[0]);
+                        s[0] = s[0].wrapping_add(i128::from(x));
+                    }
+                }
+                assert_eq!(cic.integrator, want, "{len} inputs, fill {fill}");
+                assert_eq!(cic.pending, vec![(7, 7)], "the newest input stays pending");
             }
         }
     }
