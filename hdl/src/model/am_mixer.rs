@@ -3,7 +3,7 @@
 
 use super::carrier_nco::Carriers;
 use super::notch_coefficient::NotchCoefficient;
-use super::q15_multiplier::{Q15Multiplier, product_block};
+use super::q15_multiplier::Q15Multiplier;
 use crate::carrier_multiplier::{FEEDBACK_SCALE, RESIDUE_DROP, SHIFT, WORD_LIMIT};
 use crate::fine_sine_table::OUTPUT_FRACTION_BITS;
 use crate::q15_multiplier::LATENCY;
@@ -89,15 +89,40 @@ impl CarrierMultiplier {
         self.y
     }
 
-    /// The table core's `y` during the next `out.len()` cycles, then as
-    /// many edges with `input(k)` (a, c) at edge k: `output` and `step`
-    /// clock by clock (`super::q15_multiplier::product_block`).
+    /// The table core's `y` during cycle `k` < 3 of a block, from the
+    /// registers: the word, the rounded product, the rounded factors'
+    /// product.
     #[inline(always)]
-    pub fn block(&mut self, out: &mut [i16], input: impl Fn(usize) -> (i16, i32)) {
+    fn in_flight(&self, k: usize) -> i16 {
+        match k {
+            0 => self.y,
+            1 => round_product(self.product),
+            _ => round_product(i64::from(self.factors.0) * i64::from(self.factors.1)),
+        }
+    }
+
+    /// The table core's registers after `m` edges with `input(k)` (a, c)
+    /// at edge k: the word `m` cycles on (the product of the input at
+    /// edge m - 3 from m = 3 on), the product of the input before the
+    /// last, the last input. `AmMixer::block` computes the words of the
+    /// cycles between for the four products at once.
+    #[inline(always)]
+    fn skip(&mut self, m: usize, input: impl Fn(usize) -> (i16, i32)) {
         debug_assert!(!self.shaped);
-        let registers = (&mut self.factors, &mut self.product, &mut self.y);
-        let multiply = |(a, c): (i16, i32)| i64::from(a) * i64::from(c);
-        product_block(registers, out, input, multiply, round_product);
+        let product = |(a, c): (i16, i32)| i64::from(a) * i64::from(c);
+        if m == 0 {
+            return;
+        }
+        let y = match m {
+            1 | 2 => self.in_flight(m),
+            _ => round_product(product(input(m - 3))),
+        };
+        self.product = match m {
+            1 => product(self.factors),
+            _ => product(input(m - 2)),
+        };
+        self.factors = input(m - 1);
+        self.y = y;
     }
 
     /// The fine core's rounding and saturation stages and its feedback
@@ -230,6 +255,38 @@ impl AmMixer {
         self.output()
     }
 
+    /// The four carrier products of a block (`block`), the table core's:
+    /// the words in flight, then from cycle 3 on the four products of the
+    /// F A and the carriers of three cycles before, rounded together.
+    /// Table carriers are 16-bit words, so a product and its rounding
+    /// bias stay within i32 (2^30 + 2^14), which `round_product`'s i64
+    /// gives the same.
+    #[inline(always)]
+    fn products_block(&mut self, fa: &[(i16, i16)], carriers: &[Carriers], out: &mut [Drives]) {
+        let m = out.len();
+        for (k, o) in out.iter_mut().enumerate().take(3) {
+            *o = Drives {
+                dac1: self.drive1.in_flight(k),
+                dac2: self.drive2.in_flight(k),
+                ref1: self.reference1.in_flight(k),
+                ref2: self.reference2.in_flight(k),
+            };
+        }
+        let round = |a: i16, c: i32| ((i32::from(a) * c + (1 << 14)) >> 15) as i16;
+        for ((o, f), c) in out.iter_mut().skip(3).zip(fa).zip(carriers) {
+            *o = Drives {
+                dac1: round(f.0, c.drive_cos),
+                dac2: round(f.1, c.drive_sin),
+                ref1: round(f.0, c.ref_cos),
+                ref2: round(f.1, c.ref_sin),
+            };
+        }
+        self.drive1.skip(m, |k| (fa[k].0, carriers[k].drive_cos));
+        self.drive2.skip(m, |k| (fa[k].1, carriers[k].drive_sin));
+        self.reference1.skip(m, |k| (fa[k].0, carriers[k].ref_cos));
+        self.reference2.skip(m, |k| (fa[k].1, carriers[k].ref_sin));
+    }
+
     /// True when `block` may play the next clocks: the table core.
     #[inline(always)]
     pub fn blocks(&self) -> bool {
@@ -240,7 +297,7 @@ impl AmMixer {
     /// with `amp` held, `am[k]` and `carriers[k]` the inputs during cycle
     /// k: `output` and `step` clock by clock, where `blocks()`. In passes
     /// over chunks of the block: the envelope multiplier, the latching of
-    /// F A by channel, then each carrier product.
+    /// F A by channel, then the four carrier products together.
     #[inline(always)]
     pub fn block(
         &mut self,
@@ -253,7 +310,6 @@ impl AmMixer {
         const CHUNK: usize = 64;
         let mut envelope = [0i16; CHUNK];
         let mut fa = [(0i16, 0i16); CHUNK];
-        let mut word = [0i16; CHUNK];
         for ((out, am), carriers) in out
             .chunks_mut(CHUNK)
             .zip(am.chunks(CHUNK))
@@ -278,19 +334,7 @@ impl AmMixer {
                 }
             }
             self.turn = channel(m);
-            let word = &mut word[..m];
-            self.drive1
-                .block(word, |k| (fa[k].0, carriers[k].drive_cos));
-            out.iter_mut().zip(&*word).for_each(|(o, &w)| o.dac1 = w);
-            self.drive2
-                .block(word, |k| (fa[k].1, carriers[k].drive_sin));
-            out.iter_mut().zip(&*word).for_each(|(o, &w)| o.dac2 = w);
-            self.reference1
-                .block(word, |k| (fa[k].0, carriers[k].ref_cos));
-            out.iter_mut().zip(&*word).for_each(|(o, &w)| o.ref1 = w);
-            self.reference2
-                .block(word, |k| (fa[k].1, carriers[k].ref_sin));
-            out.iter_mut().zip(&*word).for_each(|(o, &w)| o.ref2 = w);
+            self.products_block(&fa[..m], carriers, out);
         }
     }
 }
