@@ -79,28 +79,51 @@ impl CicDecimator {
     /// output shift.
     #[inline(always)]
     pub fn step(&mut self, x: (i32, i32), decimation: u32, shift: u32) -> ((i64, i64), bool) {
-        self.valid = false;
-        if self.busy > 0 {
-            // Non-idle schedule state; its last clock publishes.
-            self.busy -= 1;
-            if self.busy == 0 {
-                self.y = self.result;
-                self.valid = true;
+        self.block(&[x], decimation, shift, &mut [((0, 0), false)]);
+        self.output()
+    }
+
+    /// `((y1, y2), valid)` during the next `out.len()` cycles, then as
+    /// many edges with `x[i]` the inputs during cycle i: `output` and
+    /// `step` clock by clock. The inputs join `pending` a slice at a time,
+    /// when the counter samples the integrators and at the block's end,
+    /// instead of one push a clock.
+    #[inline(always)]
+    pub fn block(
+        &mut self,
+        x: &[(i32, i32)],
+        decimation: u32,
+        shift: u32,
+        out: &mut [((i64, i64), bool)],
+    ) {
+        let mut joined = 0;
+        for (t, o) in out.iter_mut().enumerate() {
+            *o = (self.y, self.valid);
+            self.valid = false;
+            if self.busy > 0 {
+                // Non-idle schedule state; its last clock publishes.
+                self.busy -= 1;
+                if self.busy == 0 {
+                    self.y = self.result;
+                    self.valid = true;
+                }
+            } else if self.count == 0 {
+                // The inputs before this edge, as `step` would hold them.
+                self.pending.extend_from_slice(&x[joined..t]);
+                joined = t;
+                self.integrate_pending();
+                self.result = (self.comb_and_round(0, shift), self.comb_and_round(1, shift));
+                self.busy = SAMPLE_TO_OUTPUT - 1;
             }
-        } else if self.count == 0 {
-            self.integrate_pending();
-            self.result = (self.comb_and_round(0, shift), self.comb_and_round(1, shift));
-            self.busy = SAMPLE_TO_OUTPUT - 1;
+            // Counter: it runs whatever the schedule does.
+            self.count = if self.count == 0 {
+                decimation.wrapping_sub(1) & ((1 << DECIMATION_BITS) - 1)
+            } else {
+                self.count - 1
+            };
         }
-        // Counter: it runs whatever the schedule does.
-        self.count = if self.count == 0 {
-            decimation.wrapping_sub(1) & ((1 << DECIMATION_BITS) - 1)
-        } else {
-            self.count - 1
-        };
-        // Integrators: x enters at this edge (see `integrate_pending`).
-        self.pending.push(x);
-        (self.y, self.valid)
+        // Integrators: the inputs enter at these edges (`integrate_pending`).
+        self.pending.extend_from_slice(&x[joined..out.len()]);
     }
 
     /// The four combs of one channel on its sampled fourth integrator, then

@@ -30,4 +30,40 @@ impl DemodMux {
         };
         self.w
     }
+
+    /// `(w1, w2)` during the next `out.len()` cycles, then as many edges
+    /// with `adc[i]` and `aligned[i]` the inputs during cycle i: `output`
+    /// and `step` clock by clock. From cycle 2 on, w is the product of the
+    /// inputs of two cycles before.
+    #[inline(always)]
+    pub fn block(
+        &mut self,
+        adc: &[(i16, i16)],
+        aligned: &[(i16, i16)],
+        select: bool,
+        out: &mut [(i32, i32)],
+    ) {
+        let n = out.len();
+        if n == 0 {
+            return;
+        }
+        let reference = |a: (i16, i16)| if select { (a.1, a.0) } else { a };
+        let product =
+            |x: (i16, i16), r: (i16, i16)| (x.0 as i32 * r.0 as i32, x.1 as i32 * r.1 as i32);
+        let held = product(self.adc, self.reference);
+        out[0] = self.w;
+        if n > 1 {
+            out[1] = held;
+        }
+        for ((o, &x), &a) in out.iter_mut().skip(2).zip(adc).zip(aligned) {
+            *o = product(x, reference(a));
+        }
+        self.w = if n == 1 {
+            held
+        } else {
+            product(adc[n - 2], reference(aligned[n - 2]))
+        };
+        self.adc = adc[n - 1];
+        self.reference = reference(aligned[n - 1]);
+    }
 }

@@ -103,18 +103,18 @@ impl GyroInterface {
     /// `clocks` clocks with `regs` held, in blocks of `BLOCK`: the same
     /// clocks as `step` that many times, with `analog` closing the loop.
     /// The DAC words do not depend on the ADC words (no path in the
-    /// datapath leads from the demodulators back to the drives), so the
-    /// drive half can run ahead, and the readout half behind. Per block:
+    /// datapath leads from the demodulators back to the drives), and
+    /// nothing after the IIR's input feeds back either, so each half runs
+    /// a block at a time, stage by stage. Per block:
     ///
     /// ```text
     /// 1. `analog.advance` with each of the block's DAC words, each clock
-    ///    beside one clock of the readout half on the block before
-    ///    (integer work beside the gyroscope's floating-point recursion,
-    ///    which would otherwise wait on its own latency);
-    /// 2. `analog.convert`: the block's ADC words, read out in step 1 of
-    ///    the next block (or after the last);
-    /// 3. the drive half of the next block, stage by stage
-    ///    (`drive_block`).
+    ///    beside one clock of the IIR on the block before (integer work
+    ///    beside the gyroscope's floating-point recursion, which would
+    ///    otherwise wait on its own latency);
+    /// 2. `analog.convert`: the block's ADC words;
+    /// 3. the readout half up to the CIC on them (`readout_block`);
+    /// 4. the drive half of the next block (`drive_block`).
     /// ```
     ///
     /// `on_z(i, z)` is called when clock `i` (from 0) publishes z, in the
@@ -133,56 +133,51 @@ impl GyroInterface {
     {
         let regs = &regs.at_ports();
         let block = |done: u64| (clocks - done).min(BLOCK as u64) as usize;
-        let mut drives = [[Drives::default(); BLOCK]; 2];
+        let mut drives = [Drives::default(); BLOCK];
         let mut stages = DriveStages::default();
-        // The block converted and not yet read out: its ADC words, its
-        // length and first clock; its drive words are `drives[1 - this]`.
-        let mut adc = [(0i16, 0i16); BLOCK];
-        let (mut waiting, mut first) = (0usize, 0u64);
-        let mut this = 0;
+        let mut readout = ReadoutStages::default();
         let mut n = block(0);
-        self.drive_block(&mut drives[this][..n], &mut stages, regs);
+        self.drive_block(&mut drives[..n], &mut stages, regs);
         let mut done = 0u64;
         while n > 0 {
-            let [a, b] = &mut drives;
-            let (now, before) = if this == 0 { (a, b) } else { (b, a) };
-            let mut read = |gi: &mut Self, i: usize| {
-                if let Some(z) = gi.readout_clock(adc[i], before[i], regs) {
-                    on_z(first + i as u64, z);
-                }
-            };
-            for (i, d) in now[..n].iter().enumerate() {
-                analog.advance((d.dac1, d.dac2));
-                if i < waiting {
-                    read(self, i);
-                }
-            }
-            // Only the last block is short: the one before is never shorter.
-            for i in n..waiting {
-                read(self, i);
-            }
-            analog.convert(&mut adc[..n]);
-            (waiting, first) = (n, done);
+            analog.advance_block(drives[..n].iter().map(|d| (d.dac1, d.dac2)));
+            analog.convert(&mut readout.adc[..n]);
+            self.readout_block(&drives[..n], &mut readout, regs, |i, z| on_z(done + i, z));
             done += n as u64;
             n = block(done);
-            this = 1 - this;
-            self.drive_block(&mut drives[this][..n], &mut stages, regs);
-        }
-        for i in 0..waiting {
-            if let Some(z) = self.readout_clock(adc[i], drives[1 - this][i], regs) {
-                on_z(first + i as u64, z);
-            }
+            self.drive_block(&mut drives[..n], &mut stages, regs);
         }
         self.outputs()
     }
 
-    /// The readout half of one clock of a run, with the ADC words and the
-    /// drive words during it; the z it publishes, if any.
+    /// The readout half over a block, stage by stage, with the block's
+    /// drive words (their reference copies) and ADC words (`stages.adc`):
+    /// `on_z(i, z)` when clock `i` of the block publishes z. The IIR, idle
+    /// between samples, costs a test on those clocks.
     #[inline(always)]
-    fn readout_clock(&mut self, adc: Words, d: Drives, regs: &Registers) -> Option<(i64, i64)> {
-        self.step_readout(adc, (d.ref1, d.ref2), regs);
-        let (z1, z2, valid) = self.iir.output();
-        valid.then_some((z1, z2))
+    fn readout_block(
+        &mut self,
+        drives: &[Drives],
+        stages: &mut ReadoutStages,
+        regs: &Registers,
+        mut on_z: impl FnMut(u64, (i64, i64)),
+    ) {
+        let n = drives.len();
+        let (aligned, w) = (&mut stages.aligned[..n], &mut stages.w[..n]);
+        let references = |i: usize| (drives[i].ref1, drives[i].ref2);
+        self.reference_alignment
+            .block(references, regs.ref_delay, aligned);
+        self.demod_mux
+            .block(&stages.adc[..n], aligned, regs.select, w);
+        let (r, shift) = (regs.cic_decimation as u32, regs.cic_shift as u32);
+        let cic = &mut stages.cic[..n];
+        self.cic.block(w, r, shift, cic);
+        for (i, &(x, valid)) in cic.iter().enumerate() {
+            let (z1, z2, z_valid) = self.iir.step(x, valid, &regs.iir);
+            if z_valid {
+                on_z(i as u64, (z1, z2));
+            }
+        }
     }
 
     /// The drive words during the next `drives.len()` cycles, then the
@@ -263,6 +258,14 @@ pub trait AnalogSide {
     /// One clock with the DAC words during it: the ADCs sample at its
     /// start, then the sensor advances under the words' forces.
     fn advance(&mut self, dac: Words);
+    /// `advance` with each of these DAC words in turn: an analog side may
+    /// play them faster together.
+    #[inline(always)]
+    fn advance_block(&mut self, dac: impl Iterator<Item = Words>) {
+        for d in dac {
+            self.advance(d);
+        }
+    }
     /// The ADC words during the clocks advanced since the last call, in
     /// order (`adc.len()` of them).
     fn convert(&mut self, adc: &mut [Words]);
@@ -280,6 +283,26 @@ impl Default for DriveStages {
         Self {
             carriers: [Carriers::default(); BLOCK],
             am: [(0, 0); BLOCK],
+        }
+    }
+}
+
+/// The readout half's stages over a block, on the way from the ADC words
+/// to the IIR (`GyroInterface::readout_block`).
+struct ReadoutStages {
+    adc: [Words; BLOCK],
+    aligned: [Words; BLOCK],
+    w: [(i32, i32); BLOCK],
+    cic: [((i64, i64), bool); BLOCK],
+}
+
+impl Default for ReadoutStages {
+    fn default() -> Self {
+        Self {
+            adc: [(0, 0); BLOCK],
+            aligned: [(0, 0); BLOCK],
+            w: [(0, 0); BLOCK],
+            cic: [((0, 0), false); BLOCK],
         }
     }
 }

@@ -42,4 +42,41 @@ impl ReferenceAlignment {
         self.newest = (self.newest + 1) % TAPS;
         self.words[self.newest] = (ref1, ref2);
     }
+
+    /// `(aligned1, aligned2)` during the next `out.len()` cycles, then as
+    /// many edges with `refs(i)` the references during cycle i: `output`
+    /// and `step` clock by clock. The output after the edge of cycle t is
+    /// the reference of cycle t - delay (a delay of 0 included), from the
+    /// ring while that lies before the block.
+    #[inline(always)]
+    pub fn block(&mut self, refs: impl Fn(usize) -> (i16, i16), delay: u8, out: &mut [(i16, i16)]) {
+        let n = out.len();
+        if n == 0 {
+            return;
+        }
+        let d = delay as usize & (TAPS - 1);
+        // The reference of cycle i - TAPS <= j < 0 is in the ring.
+        let before = |j: usize| self.words[(self.newest + 1 + j) % TAPS];
+        let reference = |t: usize| {
+            if t >= d {
+                refs(t - d)
+            } else {
+                before(TAPS + t - d)
+            }
+        };
+        out[0] = self.aligned;
+        for (t, o) in out[1..].iter_mut().enumerate() {
+            *o = reference(t);
+        }
+        self.aligned = reference(n - 1);
+        let words: [(i16, i16); TAPS] = std::array::from_fn(|k| {
+            // Ring slot k after n edges holds the reference of cycle
+            // n - TAPS + ((k - newest') mod TAPS), newest' = newest + n.
+            let age = (k + 2 * TAPS - 1 - (self.newest + n) % TAPS) % TAPS;
+            let j = n + age;
+            if j >= TAPS { refs(j - TAPS) } else { before(j) }
+        });
+        self.words = words;
+        self.newest = (self.newest + n) % TAPS;
+    }
 }
