@@ -29,6 +29,8 @@ pub struct Analog {
     noise: Vec<f64>,
     /// What the ADCs see at each edge advanced and not yet converted.
     pending: Vec<(f64, f64)>,
+    /// The DAC forces of a block (`advance_block`).
+    forces: Vec<(f64, f64)>,
 }
 
 impl Analog {
@@ -40,19 +42,14 @@ impl Analog {
             phase,
             noise: vec![],
             pending: Vec::with_capacity(BLOCK),
+            forces: Vec::with_capacity(BLOCK),
         }
     }
 
     /// The displacements the ADCs see at the current clock edge (m).
     #[inline(always)]
     fn sensed(&self) -> (f64, f64) {
-        match &self.phase {
-            None => (self.gyro.x1(), self.gyro.x2()),
-            Some(p) => {
-                let s = self.gyro.state();
-                (p.apply(s[0], s[1]), p.apply(s[2], s[3]))
-            }
-        }
+        sense(self.phase, self.gyro.state())
     }
 
     /// One clock: the DAC words during it in, the ADC words during it out.
@@ -61,6 +58,16 @@ impl Analog {
         let (adc, force) = self.converters.step(dac, self.sensed());
         self.gyro.step(force.0, force.1);
         adc
+    }
+}
+
+/// The displacements the ADCs see from the gyroscope's state `[x1, v1,
+/// x2, v2]`, through the pick-off's phase lag if any.
+#[inline(always)]
+fn sense(phase: Option<PickoffPhase>, s: [f64; 4]) -> (f64, f64) {
+    match phase {
+        None => (s[0], s[2]),
+        Some(p) => (p.apply(s[0], s[1]), p.apply(s[2], s[3])),
     }
 }
 
@@ -75,6 +82,22 @@ impl AnalogSide for Analog {
         self.pending.push(x);
         let force = self.converters.dac_step(dac);
         self.gyro.step(force.0, force.1);
+    }
+
+    /// The DAC forces of the block in one pass, then the gyroscope's
+    /// clocks in another (`GyroModel::steps`).
+    #[inline(always)]
+    fn advance_block(&mut self, dac: impl Iterator<Item = Words>) {
+        let converters = &mut self.converters;
+        self.forces.clear();
+        self.forces.extend(dac.map(|d| converters.dac_step(d)));
+        let start = self.pending.len();
+        self.pending.resize(start + self.forces.len(), (0.0, 0.0));
+        let phase = self.phase;
+        self.gyro
+            .steps(&self.forces, &mut self.pending[start..], |s| {
+                sense(phase, s)
+            });
     }
 
     #[inline(always)]
@@ -106,6 +129,11 @@ impl<W: FnMut(&[Words])> AnalogSide for Watched<'_, W> {
     #[inline(always)]
     fn advance(&mut self, dac: Words) {
         self.analog.advance(dac);
+    }
+
+    #[inline(always)]
+    fn advance_block(&mut self, dac: impl Iterator<Item = Words>) {
+        self.analog.advance_block(dac);
     }
 
     #[inline(always)]

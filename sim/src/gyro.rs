@@ -41,7 +41,9 @@
 //! input column of the augmented matrix is scaled by `wr^2`, so every entry of
 //! the matrix handed to `exp` is of order `w T` (at most about pi) or smaller,
 //! instead of mixing 1, 6e7 and 1e-16. A step is then a plain 4x4 plus 4x2
-//! multiply on `[f64; 4]` arrays: no allocation, no nalgebra.
+//! multiply on `[f64; 4]` arrays: no allocation, no nalgebra. Steps go in
+//! pairs, the second from the state before the first through `Phi^2`
+//! ([`GyroModel::step`]), which halves the recursion's latency.
 //!
 //! # Brownian noise
 //!
@@ -58,11 +60,68 @@ use std::f64::consts::TAU;
 
 pub use gyrocal_host::device::{CouplingOutOfRange, GyroParams, MAX_COUPLING_DPS};
 
-/// Transition and input matrices of one clock period, as plain arrays.
+/// Transition and input matrices of one clock period, as plain arrays,
+/// and the transition over two (`Phi^2`, for `GyroModel::step`'s pairs).
 #[derive(Clone, Debug, PartialEq)]
 struct Discrete {
     phi: [[f64; 4]; 4],
     gamma: [[f64; 2]; 4],
+    phi2: [[f64; 4]; 4],
+}
+
+impl Discrete {
+    /// From one period's matrices.
+    fn new(phi: [[f64; 4]; 4], gamma: [[f64; 2]; 4]) -> Self {
+        let phi2 = std::array::from_fn(|i| {
+            std::array::from_fn(|j| (0..4).map(|k| phi[i][k] * phi[k][j]).sum())
+        });
+        Self { phi, gamma, phi2 }
+    }
+}
+
+/// The first clock of a pair before this step (its state and input
+/// term), if this step is a pair's second.
+type Half = Option<([f64; 4], [f64; 4])>;
+
+/// One clock of `GyroModel::step`'s pairs, from the state `s` with the
+/// input term `u`: the state after it, and the pair's half.
+#[inline(always)]
+fn pair_step(
+    d: &Discrete,
+    coupled: bool,
+    s: [f64; 4],
+    half: Half,
+    u: [f64; 4],
+) -> ([f64; 4], Half) {
+    match half {
+        None => {
+            let p = times(&d.phi, s, coupled);
+            (std::array::from_fn(|i| u[i] + p[i]), Some((s, u)))
+        }
+        Some((before, first)) => {
+            let carried = times(&d.phi, first, coupled);
+            let p = times(&d.phi2, before, coupled);
+            (std::array::from_fn(|i| (carried[i] + u[i]) + p[i]), None)
+        }
+    }
+}
+
+/// `m v`, with the products of exact zeros skipped when the modes are
+/// decoupled (the off-diagonal blocks are zero).
+#[inline(always)]
+fn times(m: &[[f64; 4]; 4], v: [f64; 4], coupled: bool) -> [f64; 4] {
+    if coupled {
+        std::array::from_fn(|i| {
+            (m[i][0] * v[0] + m[i][1] * v[1]) + (m[i][2] * v[2] + m[i][3] * v[3])
+        })
+    } else {
+        [
+            m[0][0] * v[0] + m[0][1] * v[1],
+            m[1][0] * v[0] + m[1][1] * v[1],
+            m[2][2] * v[2] + m[2][3] * v[3],
+            m[3][2] * v[2] + m[3][3] * v[3],
+        ]
+    }
 }
 
 /// The gyroscope, stepped once per clock with zero-order-held forces.
@@ -82,6 +141,9 @@ pub struct GyroModel {
     rest: Discrete,
     cur: Discrete,
     s: [f64; 4],
+    /// The first clock of a pair (`step`): the state before it and its
+    /// input term.
+    half: Half,
     /// Brownian noise source and its settings, when on.
     thermal: Option<(ThermalNoise, StateNoise)>,
 }
@@ -134,15 +196,10 @@ impl GyroModel {
             wr,
             omz: 0.0,
             coupled: params.coupled_at_rest(),
-            rest: Discrete {
-                phi: [[0.0; 4]; 4],
-                gamma: [[0.0; 2]; 4],
-            },
-            cur: Discrete {
-                phi: [[0.0; 4]; 4],
-                gamma: [[0.0; 2]; 4],
-            },
+            rest: Discrete::new([[0.0; 4]; 4], [[0.0; 2]; 4]),
+            cur: Discrete::new([[0.0; 4]; 4], [[0.0; 2]; 4]),
             s: [0.0; 4],
+            half: None,
             thermal: None,
         };
         let mut rest = model.discretize(0.0);
@@ -159,7 +216,7 @@ impl GyroModel {
                 rest.gamma[i + 2][0] = 0.0;
             }
         }
-        model.rest = rest;
+        model.rest = Discrete::new(rest.phi, rest.gamma);
         model.cur = model.rest.clone();
         Ok(model)
     }
@@ -251,20 +308,10 @@ impl GyroModel {
         let wr = self.wr;
         let e = (self.augmented(omz) * t).exp();
         let inv_wr2 = 1.0 / (wr * wr);
-        let mut d = Discrete {
-            phi: [[0.0; 4]; 4],
-            gamma: [[0.0; 2]; 4],
-        };
-        for i in 0..4 {
-            for j in 0..4 {
-                d.phi[i][j] = e[(i, j)];
-            }
-            for j in 0..2 {
-                // Gamma acts on the physical force f = wr^2 g.
-                d.gamma[i][j] = e[(i, 4 + j)] * inv_wr2;
-            }
-        }
-        d
+        let phi = std::array::from_fn(|i| std::array::from_fn(|j| e[(i, j)]));
+        // Gamma acts on the physical force f = wr^2 g.
+        let gamma = std::array::from_fn(|i| std::array::from_fn(|j| e[(i, 4 + j)] * inv_wr2));
+        Discrete::new(phi, gamma)
     }
 
     /// Sets the (piecewise constant) rotation rate `Omz` (rad/s) that applies from
@@ -281,6 +328,7 @@ impl GyroModel {
             return;
         }
         self.omz = omz_rad_s;
+        self.half = None;
         self.coupled = self.coupled_at(omz_rad_s);
         self.cur = if omz_rad_s == 0.0 {
             self.rest.clone()
@@ -304,33 +352,65 @@ impl GyroModel {
     /// 2x2 diagonal blocks are used (the others are exactly zero): about 1.3x
     /// faster, same result. A coupling keeps the full 4x4 step at rest.
     /// With thermal noise on, the clock's Brownian increment is added.
-    #[inline]
+    ///
+    /// Steps go in pairs, counted from the last change of state or rate:
+    /// with `u[n] = Gamma f[n]` (plus the increment),
+    ///
+    /// ```text
+    /// s[n+1] = Phi s[n] + u[n]                    (the pair's first clock)
+    /// s[n+2] = Phi^2 s[n] + (Phi u[n] + u[n+1])   (its second)
+    /// ```
+    ///
+    /// The same exact discretization, rounded otherwise: a state leads to
+    /// the next-but-one through one product instead of two, so the
+    /// recursion's latency, which bounds a co-simulation's clock, is
+    /// halved; the bracket and the first clock's state wait on no state.
+    /// Every caller steps the same sequence, so the states are the same
+    /// whoever plays the clocks.
+    #[inline(always)]
     pub fn step(&mut self, f1: f64, f2: f64) {
-        let p = &self.cur.phi;
+        let u = self.input(f1, f2);
+        (self.s, self.half) = pair_step(&self.cur, self.coupled, self.s, self.half, u);
+    }
+
+    /// `forces.len()` clocks of `step`, and `sense` of the state `[x1, v1,
+    /// x2, v2]` at each clock's edge, before its step, into `seen`. The
+    /// state stays in registers over the run instead of going through
+    /// memory at every clock, which would add a store and a load to the
+    /// recursion's latency.
+    #[inline(always)]
+    pub fn steps<X>(
+        &mut self,
+        forces: &[(f64, f64)],
+        seen: &mut [X],
+        sense: impl Fn([f64; 4]) -> X,
+    ) {
+        debug_assert_eq!(forces.len(), seen.len());
+        let (mut s, mut half) = (self.s, self.half);
+        for (&(f1, f2), x) in forces.iter().zip(seen) {
+            *x = sense([s[0], s[1] * self.wr, s[2], s[3] * self.wr]);
+            let u = self.input(f1, f2);
+            (s, half) = pair_step(&self.cur, self.coupled, s, half, u);
+        }
+        (self.s, self.half) = (s, half);
+    }
+
+    /// The input term of a clock, `Gamma f` plus the Brownian increment
+    /// when on.
+    #[inline(always)]
+    fn input(&mut self, f1: f64, f2: f64) -> [f64; 4] {
         let g = &self.cur.gamma;
-        let s = self.s;
-        // The input term does not depend on the state: adding it first keeps
-        // it off the critical (state-to-state) latency path.
-        self.s = if self.coupled {
-            let row = |i: usize| {
-                ((g[i][0] * f1 + g[i][1] * f2) + p[i][0] * s[0] + p[i][1] * s[1])
-                    + (p[i][2] * s[2] + p[i][3] * s[3])
-            };
-            [row(0), row(1), row(2), row(3)]
+        let mut u: [f64; 4] = if self.coupled {
+            std::array::from_fn(|i| g[i][0] * f1 + g[i][1] * f2)
         } else {
-            [
-                (g[0][0] * f1 + p[0][0] * s[0]) + p[0][1] * s[1],
-                (g[1][0] * f1 + p[1][0] * s[0]) + p[1][1] * s[1],
-                (g[2][1] * f2 + p[2][2] * s[2]) + p[2][3] * s[3],
-                (g[3][1] * f2 + p[3][2] * s[2]) + p[3][3] * s[3],
-            ]
+            [g[0][0] * f1, g[1][0] * f1, g[2][1] * f2, g[3][1] * f2]
         };
         if let Some((_, source)) = &mut self.thermal {
-            let w = source.sample();
-            for (s, w) in self.s.iter_mut().zip(w) {
-                *s += w;
+            for (u, w) in u.iter_mut().zip(source.sample()) {
+                *u += w;
             }
         }
+        u
     }
 
     /// Position of mode 1 at the current clock edge (m).
@@ -359,11 +439,13 @@ impl GyroModel {
     /// Sets the state `[x1, v1, x2, v2]` (m, m/s, m, m/s).
     pub fn set_state(&mut self, state: [f64; 4]) {
         self.s = [state[0], state[1] / self.wr, state[2], state[3] / self.wr];
+        self.half = None;
     }
 
     /// Zeroes the state (the rate is kept).
     pub fn reset(&mut self) {
         self.s = [0.0; 4];
+        self.half = None;
     }
 
     /// Current rotation rate `Omz` (rad/s).

@@ -528,3 +528,100 @@ fn state_round_trip_reset_and_rate_cache() {
     assert_eq!(g.state(), [0.0; 4]);
     assert_eq!(g.rate(), 0.0);
 }
+
+/// `steps` is `step` clock by clock, bit for bit: the state it senses at
+/// each edge and the state after the run, over runs of odd and even
+/// length (the pairs of `step` run across them), coupled and not, with
+/// thermal noise, the rate and the state changed between runs (which
+/// start a new pair in both).
+#[test]
+fn steps_are_the_steps_clock_by_clock() {
+    use gyrocal_sim::noise::ThermalNoise;
+    let noise = ThermalNoise {
+        mass_kg: 1.0e-9,
+        temperature_k: 300.0,
+        seed: 9,
+    };
+    let p = params(1.0e6, 1.0003e6, 3000.0, 2500.0, 0.8);
+    for omz in [0.0, 2.0] {
+        let mut a = GyroModel::new(&p, 10.0e6)
+            .expect("valid")
+            .with_thermal_noise(&noise)
+            .expect("valid noise");
+        a.set_rate(omz);
+        let mut b = a.clone();
+        let mut k = 0.0f64;
+        for (i, len) in [1usize, 2, 3, 256, 7, 1, 1, 100, 5].into_iter().enumerate() {
+            let forces: Vec<(f64, f64)> = (0..len)
+                .map(|_| {
+                    k += 1.0;
+                    ((0.37 * k).sin() * 1e3, (0.11 * k).cos() * 1e3)
+                })
+                .collect();
+            let mut seen = vec![[0.0; 4]; len];
+            a.steps(&forces, &mut seen, |s| s);
+            for (n, &(f1, f2)) in forces.iter().enumerate() {
+                assert_eq!(seen[n], b.state(), "rate {omz}, run {i}, clock {n}");
+                b.step(f1, f2);
+            }
+            assert_eq!(a.state(), b.state(), "rate {omz}, after run {i}");
+            match i {
+                3 => {
+                    a.set_rate(omz + 1.0);
+                    b.set_rate(omz + 1.0);
+                }
+                5 => {
+                    let s = a.state();
+                    a.set_state(s);
+                    b.set_state(s);
+                }
+                _ => {}
+            }
+        }
+        assert!(
+            a.state().iter().any(|&x| x != 0.0),
+            "the runs moved the state"
+        );
+    }
+}
+
+/// A change of rate or state between the two clocks of a pair starts a
+/// new pair: the model then goes on as a fresh one set to that state and
+/// rate, where the old pair's Phi^2 would carry the clock before the
+/// change across it (a relative error of the change itself: 2 lam Omz T =
+/// 8e-7 here for the rate).
+#[test]
+fn a_change_between_a_pairs_clocks_starts_a_new_pair() {
+    let p = params(1.0e6, 1.0003e6, 3000.0, 2500.0, 0.8);
+    let force = |n: usize| ((0.3 * n as f64).sin() * 1e3, 5e2);
+    let fresh = |rate: f64, state: [f64; 4]| {
+        let mut g = GyroModel::new(&p, 10.0e6).expect("valid");
+        g.set_rate(rate);
+        g.set_state(state);
+        g
+    };
+    let run = |g: &mut GyroModel| {
+        for n in 0..101 {
+            let (f1, f2) = force(n);
+            g.step(f1, f2);
+        }
+        g.state()
+    };
+    // A state set after a pair's first clock: bit for bit.
+    let mut a = GyroModel::new(&p, 10.0e6).expect("valid");
+    a.step(1e3, -2e3);
+    let x = [1e-9, -2e-4, 3e-9, 1e-4];
+    a.set_state(x);
+    assert_eq!(run(&mut a), run(&mut fresh(0.0, x)));
+    // A rate set after a pair's first clock: from the state then (which
+    // set_state takes back to within an ulp of the scaled velocities).
+    let mut c = GyroModel::new(&p, 10.0e6).expect("valid");
+    c.step(1e3, -2e3);
+    let s = c.state();
+    c.set_rate(5.0);
+    let (c, d) = (run(&mut c), run(&mut fresh(5.0, s)));
+    let norm = d.iter().map(|v| v * v).sum::<f64>().sqrt();
+    for i in 0..4 {
+        assert!((c[i] - d[i]).abs() <= 1e-12 * norm, "{c:?} vs {d:?}");
+    }
+}

@@ -1,7 +1,8 @@
-//! Without couplings the theory and the model are the uncoupled ones, bit
-//! for bit: every theory function and a model trajectory give exactly the
-//! f64 bits recorded in `data/uncoupled_bits.json` by the code of commit
-//! 4afc731, before the quadrature and damping couplings
+//! Without couplings the theory and the model are the uncoupled ones:
+//! every theory function gives exactly the f64 bits recorded in
+//! `data/uncoupled_bits.json` by the code of commit 4afc731, before the
+//! quadrature and damping couplings, and a model trajectory the recorded
+//! one to within the rounding of the pair step that came after
 //! (`data/uncoupled_bits_generator.rs` wrote it). Seven devices (the
 //! paper's at mode 1 and midway, matched, unequal Q with a negative split,
 //! consumer, low Q, 2 MHz high Q), rates -500..300 deg/s, calibration
@@ -70,7 +71,39 @@ fn zero_coupling_gives_the_uncoupled_bits() {
             .iter()
             .map(|b| u64::from_str_radix(b.as_str().expect("hex"), 16).expect("hex"))
             .collect();
-        let got: Vec<u64> = ours(dev, what, &args).iter().map(|x| x.to_bits()).collect();
+        let got = ours(dev, what, &args);
+        if what == "model_state" {
+            // The model now steps in pairs (`GyroModel::step`): the same
+            // exact discretization rounded otherwise, Phi^2 s[n] + (Phi
+            // u[n] + u[n+1]) where the recorded bits took Phi (Phi s[n] +
+            // u[n]) + u[n+1]. A clock's two roundings differ by a few ulp
+            // of the state's scale (each entry sums at most 8 products
+            // that the state bounds); the modes decay, so over the
+            // stimulus's 4000 clocks the trajectories part by at most
+            // 4000 x 8 ulp = 7.1e-12 of the state's norm. Asserted within
+            // 1e-11 of it; a coupling leaking in, or a step rounding from
+            // a wrong matrix, moves the state by far more.
+            let want: Vec<f64> = want.iter().map(|&b| f64::from_bits(b)).collect();
+            let norm = want.iter().map(|x| x * x).sum::<f64>().sqrt();
+            let apart = got
+                .iter()
+                .zip(&want)
+                .map(|(g, w)| (g - w).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            eprintln!(
+                "model state on device {}: {:.2e} of its norm from the recorded bits",
+                c["device"],
+                apart / norm
+            );
+            assert!(
+                apart <= 1e-11 * norm,
+                "{what}{args:?} on device {}: {got:?} vs {want:?}",
+                c["device"]
+            );
+            continue;
+        }
+        let got: Vec<u64> = got.iter().map(|x| x.to_bits()).collect();
         assert_eq!(got, want, "{what}{args:?} on device {}", c["device"]);
     }
 }
