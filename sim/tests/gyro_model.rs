@@ -615,7 +615,7 @@ fn a_change_between_a_pairs_clocks_starts_a_new_pair() {
     assert_eq!(run(&mut a), run(&mut fresh(0.0, x)));
     // A rate set after a pair's first clock: from the state then (which
     // set_state takes back to within an ulp of the scaled velocities).
-    let mut c = GyroModel::new(&p, 10.0e6).expect("valid");
+    let mut c = fresh(0.0, x);
     c.step(1e3, -2e3);
     let s = c.state();
     c.set_rate(5.0);
