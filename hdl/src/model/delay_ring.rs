@@ -53,6 +53,16 @@ impl<T: Copy, const L: usize> DelayRing<T, L> {
         for (i, o) in out.iter_mut().enumerate().skip(L) {
             *o = entering(i - L);
         }
+        self.skip(n, entering);
+    }
+
+    /// `n` edges with `entering(k)` entering at edge k, as `block` plays
+    /// them, without the outputs: only the last `L` values entering are
+    /// computed.
+    #[inline(always)]
+    pub fn skip(&mut self, n: usize, entering: impl Fn(usize) -> T) {
+        let old = *self;
+        let in_flight = |i: usize| old.pipe[(old.head + i) % L];
         // After n edges the ring holds the outputs during cycles n..n + L.
         for (j, p) in self.pipe.iter_mut().enumerate() {
             let i = n + j;

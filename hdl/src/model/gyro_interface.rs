@@ -371,10 +371,10 @@ mod tests {
         assert!(differ > 100, "the fine carriers never differed: {differ}");
     }
 
-    /// Registers of one run: readout or calibration, a filter designed
-    /// for a decimation from the shortest to the longest, now and then
-    /// with a decimation too short for the IIR (which then drops CIC
-    /// samples), any reference delay.
+    /// Registers of one run: readout or calibration (a modulation step of
+    /// any width), a filter designed for a decimation from the shortest
+    /// to the longest, now and then with a decimation too short for the
+    /// IIR (which then drops CIC samples), any reference delay.
     fn run_registers(rng: &mut Rng) -> Registers {
         let designed = [166u32, 200, 397, 1000, 4096][rng.range(0, 4) as usize];
         let fz = 1e6 / f64::from(designed);
@@ -390,7 +390,9 @@ mod tests {
             carrier_step: rng.next_u64() as u32,
             ref_phase: rng.next_u64() as u32,
             ref_delay: rng.range(0, 63) as u8,
-            mod_step: rng.next_u64() & ((1 << Registers::MOD_STEP_BITS) - 1),
+            // Any width: calibration frequencies (a ROM interval every
+            // few hundred clocks) as well as steps across the turn.
+            mod_step: rng.next_u64() & ((1 << rng.range(1, Registers::MOD_STEP_BITS as i64)) - 1),
             amp: (rng.word16(), rng.word16()),
             cic_decimation: decimation as u16,
             cic_shift: design.cic_shift as u8,

@@ -74,6 +74,24 @@ impl Sine {
             sine_with(table, phase, advance)
         });
     }
+
+    /// `block` where the caller knows the words: `word(k)` is the word
+    /// of the phase and advance presented at edge k.
+    #[inline(always)]
+    pub fn block_words(&mut self, out: &mut [i16], word: impl Fn(usize) -> i16) {
+        self.pipe.block(out, word);
+    }
+
+    /// `n` edges with `input(k)` presented at edge k, as `block` plays
+    /// them, without the outputs (`DelayRing::skip`).
+    #[inline(always)]
+    pub fn skip(&mut self, n: usize, input: impl Fn(usize) -> (u32, u8)) {
+        let table = self.table;
+        self.pipe.skip(n, |k| {
+            let (phase, advance) = input(k);
+            sine_with(table, phase, advance)
+        });
+    }
 }
 
 #[cfg(test)]
