@@ -87,7 +87,7 @@ impl AnalogSide for Analog {
     /// The DAC forces of the block in one pass, then the gyroscope's
     /// clocks in another (`GyroModel::steps`).
     #[inline(always)]
-    fn advance_block(&mut self, dac: impl Iterator<Item = Words>) {
+    fn advance_block(&mut self, dac: impl Iterator<Item = Words>, mut beside: impl FnMut(usize)) {
         let converters = &mut self.converters;
         self.forces.clear();
         self.forces.extend(dac.map(|d| converters.dac_step(d)));
@@ -95,7 +95,8 @@ impl AnalogSide for Analog {
         self.pending.resize(start + self.forces.len(), (0.0, 0.0));
         let phase = self.phase;
         self.gyro
-            .steps(&self.forces, &mut self.pending[start..], |s| {
+            .steps(&self.forces, &mut self.pending[start..], |t, s| {
+                beside(t);
                 sense(phase, s)
             });
     }
@@ -132,8 +133,8 @@ impl<W: FnMut(&[Words])> AnalogSide for Watched<'_, W> {
     }
 
     #[inline(always)]
-    fn advance_block(&mut self, dac: impl Iterator<Item = Words>) {
-        self.analog.advance_block(dac);
+    fn advance_block(&mut self, dac: impl Iterator<Item = Words>, beside: impl FnMut(usize)) {
+        self.analog.advance_block(dac, beside);
     }
 
     #[inline(always)]

@@ -383,12 +383,12 @@ impl GyroModel {
         &mut self,
         forces: &[(f64, f64)],
         seen: &mut [X],
-        sense: impl Fn([f64; 4]) -> X,
+        mut sense: impl FnMut(usize, [f64; 4]) -> X,
     ) {
         debug_assert_eq!(forces.len(), seen.len());
         let (mut s, mut half) = (self.s, self.half);
-        for (&(f1, f2), x) in forces.iter().zip(seen) {
-            *x = sense([s[0], s[1] * self.wr, s[2], s[3] * self.wr]);
+        for (t, (&(f1, f2), x)) in forces.iter().zip(seen).enumerate() {
+            *x = sense(t, [s[0], s[1] * self.wr, s[2], s[3] * self.wr]);
             let u = self.input(f1, f2);
             (s, half) = pair_step(&self.cur, self.coupled, s, half, u);
         }

@@ -559,7 +559,7 @@ fn steps_are_the_steps_clock_by_clock() {
                 })
                 .collect();
             let mut seen = vec![[0.0; 4]; len];
-            a.steps(&forces, &mut seen, |s| s);
+            a.steps(&forces, &mut seen, |_, s| s);
             for (n, &(f1, f2)) in forces.iter().enumerate() {
                 assert_eq!(seen[n], b.state(), "rate {omz}, run {i}, clock {n}");
                 b.step(f1, f2);

@@ -192,13 +192,32 @@ impl CarrierNco {
     /// carry no dependence from clock to clock.
     #[inline(always)]
     pub fn block(&mut self, step: u32, ref_offset: u32, out: &mut [Carriers]) {
+        let entering = self.entering(step, ref_offset);
+        self.pipe.block(out, entering);
+        self.phase = self.phase.wrapping_add(step.wrapping_mul(out.len() as u32));
+    }
+
+    /// The words entering the pipeline at edge k of the next clocks with
+    /// `step` and `ref_offset` held, where `blocks()`: the four table
+    /// words at `phase + k step`. A caller may look them up ahead, beside
+    /// other work, and play the block with them (`block_entered`).
+    #[inline(always)]
+    pub fn entering(&self, step: u32, ref_offset: u32) -> impl Fn(usize) -> Carriers + use<> {
         debug_assert!(self.blocks());
         let (turn, phase) = (self.turn, self.phase);
-        self.pipe.block(out, |k| {
+        move |k| {
             let drive = phase.wrapping_add(step.wrapping_mul(k as u32));
             table_carriers(turn, drive, drive.wrapping_add(ref_offset))
-        });
-        self.phase = phase.wrapping_add(step.wrapping_mul(out.len() as u32));
+        }
+    }
+
+    /// `block` with the words `entering` gives looked up ahead:
+    /// `entered[k]` for edge k, at least `out.len()` of them.
+    #[inline(always)]
+    pub fn block_entered(&mut self, step: u32, entered: &[Carriers], out: &mut [Carriers]) {
+        debug_assert!(self.blocks() && entered.len() >= out.len());
+        self.pipe.block(out, |k| entered[k]);
+        self.phase = self.phase.wrapping_add(step.wrapping_mul(out.len() as u32));
     }
 }
 

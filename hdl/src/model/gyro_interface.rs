@@ -140,7 +140,23 @@ impl GyroInterface {
         self.drive_block(&mut drives[..n], &mut stages, regs);
         let mut done = 0u64;
         while n > 0 {
-            analog.advance_block(drives[..n].iter().map(|d| (d.dac1, d.dac2)));
+            // The next block's carrier lookups, beside the analog side's
+            // clocks of this one (the next block is never longer).
+            let ahead = block(done + n as u64);
+            let dac = drives[..n].iter().map(|d| (d.dac1, d.dac2));
+            stages.entered_len = 0;
+            if self.carrier_nco.blocks() {
+                let entering = self.carrier_nco.entering(regs.carrier_step, regs.ref_phase);
+                let entered = &mut stages.entered;
+                analog.advance_block(dac, |t| {
+                    if t < ahead {
+                        entered[t] = entering(t);
+                    }
+                });
+                stages.entered_len = ahead;
+            } else {
+                analog.advance_block(dac, |_| {});
+            }
             analog.convert(&mut readout.adc[..n]);
             self.readout_block(&drives[..n], &mut readout, regs, |i, z| on_z(done + i, z));
             done += n as u64;
@@ -190,8 +206,14 @@ impl GyroInterface {
         if self.carrier_nco.blocks() && self.am_mixer.blocks() {
             let carriers = &mut stages.carriers[..n];
             let am = &mut stages.am[..n];
-            self.carrier_nco
-                .block(regs.carrier_step, regs.ref_phase, carriers);
+            if stages.entered_len >= n {
+                let entered = &stages.entered[..n];
+                self.carrier_nco
+                    .block_entered(regs.carrier_step, entered, carriers);
+            } else {
+                self.carrier_nco
+                    .block(regs.carrier_step, regs.ref_phase, carriers);
+            }
             self.modulation_nco.block(regs.mod_step, regs.select, am);
             self.am_mixer.block(regs.amp, am, carriers, drives);
         } else {
@@ -258,12 +280,16 @@ pub trait AnalogSide {
     /// One clock with the DAC words during it: the ADCs sample at its
     /// start, then the sensor advances under the words' forces.
     fn advance(&mut self, dac: Words);
-    /// `advance` with each of these DAC words in turn: an analog side may
-    /// play them faster together.
+    /// `advance` with each of these DAC words in turn, calling
+    /// `beside(t)` at clock t: an analog side may play them faster
+    /// together, and the caller's independent work in `beside` runs in
+    /// the same loop, where a core overlaps it with the analog side's
+    /// chains of dependent operations.
     #[inline(always)]
-    fn advance_block(&mut self, dac: impl Iterator<Item = Words>) {
-        for d in dac {
+    fn advance_block(&mut self, dac: impl Iterator<Item = Words>, mut beside: impl FnMut(usize)) {
+        for (t, d) in dac.enumerate() {
             self.advance(d);
+            beside(t);
         }
     }
     /// The ADC words during the clocks advanced since the last call, in
@@ -274,6 +300,10 @@ pub trait AnalogSide {
 /// The drive half's stages' outputs over a block, on the way to the
 /// drive words (`GyroInterface::drive_block`).
 struct DriveStages {
+    /// The carrier words entering the pipeline at the next block's edges,
+    /// looked up ahead (`entered_len` of them, 0 for none).
+    entered: [Carriers; BLOCK],
+    entered_len: usize,
     carriers: [Carriers; BLOCK],
     am: [(i16, i16); BLOCK],
 }
@@ -281,6 +311,8 @@ struct DriveStages {
 impl Default for DriveStages {
     fn default() -> Self {
         Self {
+            entered: [Carriers::default(); BLOCK],
+            entered_len: 0,
             carriers: [Carriers::default(); BLOCK],
             am: [(0, 0); BLOCK],
         }
