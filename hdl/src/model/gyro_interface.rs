@@ -108,12 +108,12 @@ impl GyroInterface {
     /// a block at a time, stage by stage. Per block:
     ///
     /// ```text
-    /// 1. `analog.advance` with each of the block's DAC words, each clock
-    ///    beside one clock of the IIR on the block before (integer work
-    ///    beside the gyroscope's floating-point recursion, which would
-    ///    otherwise wait on its own latency);
+    /// 1. `analog.advance_block` with the block's DAC words, the next
+    ///    block's carrier lookups beside its clocks (integer work beside
+    ///    the gyroscope's floating-point recursion, which would otherwise
+    ///    wait on its own latency);
     /// 2. `analog.convert`: the block's ADC words;
-    /// 3. the readout half up to the CIC on them (`readout_block`);
+    /// 3. the readout half on them (`readout_block`), z as it comes;
     /// 4. the drive half of the next block (`drive_block`).
     /// ```
     ///
