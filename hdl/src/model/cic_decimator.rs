@@ -79,26 +79,29 @@ impl CicDecimator {
     /// output shift.
     #[inline(always)]
     pub fn step(&mut self, x: (i32, i32), decimation: u32, shift: u32) -> ((i64, i64), bool) {
-        self.block(&[x], decimation, shift, &mut [((0, 0), false)]);
+        self.block(&[x], decimation, shift, |_, _| {});
         self.output()
     }
 
-    /// `((y1, y2), valid)` during the next `out.len()` cycles, then as
-    /// many edges with `x[i]` the inputs during cycle i: `output` and
-    /// `step` clock by clock. The inputs join `pending` a slice at a time,
-    /// when the counter samples the integrators and at the block's end,
-    /// instead of one push a clock.
+    /// `x.len()` clocks with `x[i]` the inputs during cycle i: `output`
+    /// and `step` clock by clock, the outputs told as events,
+    /// `on_valid(i, y)` for each cycle i of the block during which the
+    /// output is valid (it holds otherwise). The inputs join `pending` a
+    /// slice at a time, when the counter samples the integrators and at
+    /// the block's end, instead of one push a clock.
     #[inline(always)]
     pub fn block(
         &mut self,
         x: &[(i32, i32)],
         decimation: u32,
         shift: u32,
-        out: &mut [((i64, i64), bool)],
+        mut on_valid: impl FnMut(usize, (i64, i64)),
     ) {
         let mut joined = 0;
-        for (t, o) in out.iter_mut().enumerate() {
-            *o = (self.y, self.valid);
+        for t in 0..x.len() {
+            if self.valid {
+                on_valid(t, self.y);
+            }
             self.valid = false;
             if self.busy > 0 {
                 // Non-idle schedule state; its last clock publishes.
@@ -123,7 +126,7 @@ impl CicDecimator {
             };
         }
         // Integrators: the inputs enter at these edges (`integrate_pending`).
-        self.pending.extend_from_slice(&x[joined..out.len()]);
+        self.pending.extend_from_slice(&x[joined..]);
     }
 
     /// The four combs of one channel on its sampled fourth integrator, then

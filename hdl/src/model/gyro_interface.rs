@@ -168,8 +168,10 @@ impl GyroInterface {
 
     /// The readout half over a block, stage by stage, with the block's
     /// drive words (their reference copies) and ADC words (`stages.adc`):
-    /// `on_z(i, z)` when clock `i` of the block publishes z. The IIR, idle
-    /// between samples, costs a test on those clocks.
+    /// `on_z(i, z)` when clock `i` of the block publishes z. The CIC tells
+    /// its samples as events; the IIR steps through its schedules and
+    /// skips its idle clocks to the next sample (an idle step changes
+    /// nothing but clearing z_valid, so one stands for them all).
     #[inline(always)]
     fn readout_block(
         &mut self,
@@ -186,13 +188,28 @@ impl GyroInterface {
         self.demod_mux
             .block(&stages.adc[..n], aligned, regs.select, w);
         let (r, shift) = (regs.cic_decimation as u32, regs.cic_shift as u32);
-        let cic = &mut stages.cic[..n];
-        self.cic.block(w, r, shift, cic);
-        for (i, &(x, valid)) in cic.iter().enumerate() {
+        let samples = &mut stages.samples;
+        samples.clear();
+        self.cic.block(w, r, shift, |t, y| samples.push((t, y)));
+        let mut next = samples.iter().peekable();
+        let mut t = 0;
+        while t < n {
+            if self.iir.idle() {
+                // Idle until the next sample, if any in this block.
+                let at = next.peek().map_or(n, |&&(at, _)| at);
+                if at > t {
+                    self.iir.step((0, 0), false, &regs.iir);
+                    t = at;
+                    continue;
+                }
+            }
+            let sample = next.next_if(|&&(at, _)| at == t);
+            let (x, valid) = sample.map_or(((0, 0), false), |&(_, y)| (y, true));
             let (z1, z2, z_valid) = self.iir.step(x, valid, &regs.iir);
             if z_valid {
-                on_z(i as u64, (z1, z2));
+                on_z(t as u64, (z1, z2));
             }
+            t += 1;
         }
     }
 
@@ -325,7 +342,8 @@ struct ReadoutStages {
     adc: [Words; BLOCK],
     aligned: [Words; BLOCK],
     w: [(i32, i32); BLOCK],
-    cic: [((i64, i64), bool); BLOCK],
+    /// The CIC's samples over the block: cycle, words.
+    samples: Vec<(usize, (i64, i64))>,
 }
 
 impl Default for ReadoutStages {
@@ -334,7 +352,7 @@ impl Default for ReadoutStages {
             adc: [(0, 0); BLOCK],
             aligned: [(0, 0); BLOCK],
             w: [(0, 0); BLOCK],
-            cic: [((0, 0), false); BLOCK],
+            samples: Vec::with_capacity(BLOCK),
         }
     }
 }
