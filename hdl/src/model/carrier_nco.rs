@@ -193,8 +193,7 @@ impl CarrierNco {
     #[inline(always)]
     pub fn block(&mut self, step: u32, ref_offset: u32, out: &mut [Carriers]) {
         let entering = self.entering(step, ref_offset);
-        self.pipe.block(out, entering);
-        self.phase = self.phase.wrapping_add(step.wrapping_mul(out.len() as u32));
+        self.play(step, out, entering);
     }
 
     /// The words entering the pipeline at edge k of the next clocks with
@@ -216,7 +215,14 @@ impl CarrierNco {
     #[inline(always)]
     pub fn block_entered(&mut self, step: u32, entered: &[Carriers], out: &mut [Carriers]) {
         debug_assert!(self.blocks() && entered.len() >= out.len());
-        self.pipe.block(out, |k| entered[k]);
+        self.play(step, out, |k| entered[k]);
+    }
+
+    /// The block's pipeline with `entering(k)` entering at edge k, and the
+    /// phase moved on by its edges.
+    #[inline(always)]
+    fn play(&mut self, step: u32, out: &mut [Carriers], entering: impl Fn(usize) -> Carriers) {
+        self.pipe.block(out, entering);
         self.phase = self.phase.wrapping_add(step.wrapping_mul(out.len() as u32));
     }
 }

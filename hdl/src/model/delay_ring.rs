@@ -72,6 +72,19 @@ impl<T: Copy, const L: usize> DelayRing<T, L> {
     }
 }
 
+/// A word leaving a pipeline of `latency` edges that two channels share
+/// on alternate edges (channel 1 entering on turn false, as the envelope
+/// multiplier and the modulation sine are used), into its channel's half
+/// of `pair`, at an edge of `turn`.
+#[inline(always)]
+pub fn latch_alternate(pair: &mut (i16, i16), turn: bool, latency: usize, word: i16) {
+    if turn == (latency % 2 == 1) {
+        pair.0 = word;
+    } else {
+        pair.1 = word;
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

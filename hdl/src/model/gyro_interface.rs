@@ -137,15 +137,15 @@ impl GyroInterface {
         let mut stages = DriveStages::default();
         let mut readout = ReadoutStages::default();
         let mut n = block(0);
-        self.drive_block(&mut drives[..n], &mut stages, regs);
+        self.drive_block(&mut drives[..n], &mut stages, regs, false);
         let mut done = 0u64;
         while n > 0 {
             // The next block's carrier lookups, beside the analog side's
             // clocks of this one (the next block is never longer).
             let ahead = block(done + n as u64);
             let dac = drives[..n].iter().map(|d| (d.dac1, d.dac2));
-            stages.entered_len = 0;
-            if self.carrier_nco.blocks() {
+            let looked_up = self.carrier_nco.blocks();
+            if looked_up {
                 let entering = self.carrier_nco.entering(regs.carrier_step, regs.ref_phase);
                 let entered = &mut stages.entered;
                 analog.advance_block(dac, |t| {
@@ -153,7 +153,6 @@ impl GyroInterface {
                         entered[t] = entering(t);
                     }
                 });
-                stages.entered_len = ahead;
             } else {
                 analog.advance_block(dac, |_| {});
             }
@@ -161,7 +160,7 @@ impl GyroInterface {
             self.readout_block(&drives[..n], &mut readout, regs, |i, z| on_z(done + i, z));
             done += n as u64;
             n = block(done);
-            self.drive_block(&mut drives[..n], &mut stages, regs);
+            self.drive_block(&mut drives[..n], &mut stages, regs, looked_up);
         }
         self.outputs()
     }
@@ -216,14 +215,21 @@ impl GyroInterface {
     /// The drive words during the next `drives.len()` cycles, then the
     /// drive half's edges: stage by stage over the block where every stage
     /// can (`CarrierNco::blocks`: the table core after its fill), else
-    /// clock by clock.
+    /// clock by clock. `entered`: `stages.entered` holds the block's
+    /// carrier words, looked up ahead.
     #[inline(always)]
-    fn drive_block(&mut self, drives: &mut [Drives], stages: &mut DriveStages, regs: &Registers) {
+    fn drive_block(
+        &mut self,
+        drives: &mut [Drives],
+        stages: &mut DriveStages,
+        regs: &Registers,
+        entered: bool,
+    ) {
         let n = drives.len();
         if self.carrier_nco.blocks() && self.am_mixer.blocks() {
             let carriers = &mut stages.carriers[..n];
             let am = &mut stages.am[..n];
-            if stages.entered_len >= n {
+            if entered {
                 let entered = &stages.entered[..n];
                 self.carrier_nco
                     .block_entered(regs.carrier_step, entered, carriers);
@@ -318,9 +324,8 @@ pub trait AnalogSide {
 /// drive words (`GyroInterface::drive_block`).
 struct DriveStages {
     /// The carrier words entering the pipeline at the next block's edges,
-    /// looked up ahead (`entered_len` of them, 0 for none).
+    /// when looked up ahead.
     entered: [Carriers; BLOCK],
-    entered_len: usize,
     carriers: [Carriers; BLOCK],
     am: [(i16, i16); BLOCK],
 }
@@ -329,7 +334,6 @@ impl Default for DriveStages {
     fn default() -> Self {
         Self {
             entered: [Carriers::default(); BLOCK],
-            entered_len: 0,
             carriers: [Carriers::default(); BLOCK],
             am: [(0, 0); BLOCK],
         }

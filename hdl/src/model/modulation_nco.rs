@@ -1,5 +1,6 @@
 //! Bit-true model of `crate::modulation_nco::ModulationNco`.
 
+use super::delay_ring::latch_alternate;
 use super::sine::Sine;
 use crate::quarter_wave::PHASE_BELOW_INDEX;
 use crate::sine::LATENCY;
@@ -38,11 +39,8 @@ impl ModulationNco {
     pub fn step(&mut self, step: u64, select: bool, fill: Option<u32>) -> (i16, i16) {
         if !select {
             self.am = (PEAK as i16, PEAK as i16);
-        } else if self.turn == (LATENCY % 2 == 1) {
-            // The cosine asked for LATENCY toggles ago leaves the pipeline.
-            self.am.0 = self.sine.output();
         } else {
-            self.am.1 = self.sine.output();
+            latch(&mut self.am, self.turn, self.sine.output());
         }
         match fill {
             Some(phase) => self.sine.step(phase, 0),
@@ -91,14 +89,10 @@ impl ModulationNco {
                     }),
                     None => self.sine.block(sines, |k| input(base + k)),
                 }
-                let mut turn = turn0 ^ ((c * CHUNK) % 2 == 1);
+                let mut turn = turn0 ^ (base % 2 == 1);
                 for (o, &s) in chunk.iter_mut().zip(sines.iter()) {
                     *o = self.am;
-                    if turn == (LATENCY % 2 == 1) {
-                        self.am.0 = s;
-                    } else {
-                        self.am.1 = s;
-                    }
+                    latch(&mut self.am, turn, s);
                     turn = !turn;
                 }
             }
@@ -106,6 +100,14 @@ impl ModulationNco {
         self.turn = turn0 ^ (n % 2 == 1);
         self.phase = phase0.wrapping_add(step.wrapping_mul(n as u64)) & PHASE_MASK;
     }
+}
+
+/// The sine generator's word into the factor it belongs to, at an edge of
+/// `turn`: the cosine asked for on turn false into A1, the sine into A2
+/// (`latch_alternate`).
+#[inline(always)]
+fn latch(am: &mut (i16, i16), turn: bool, word: i16) {
+    latch_alternate(am, turn, LATENCY, word);
 }
 
 /// The ROM words at advances 0 and 1 for every edge base..base + m of a

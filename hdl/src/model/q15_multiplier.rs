@@ -21,8 +21,8 @@ impl Q15Multiplier {
     /// One clock; returns `y` after the edge.
     #[inline(always)]
     pub fn step(&mut self, a: i16, b: i16) -> i16 {
-        self.y = ((self.product.wrapping_add(1 << 14)) >> 15) as i16;
-        self.product = self.factors.0 as i32 * self.factors.1 as i32;
+        self.y = round(self.product);
+        self.product = multiply(self.factors);
         self.factors = (a, b);
         self.y
     }
@@ -32,14 +32,20 @@ impl Q15Multiplier {
     #[inline(always)]
     pub fn block(&mut self, out: &mut [i16], input: impl Fn(usize) -> (i16, i16)) {
         let registers = (&mut self.factors, &mut self.product, &mut self.y);
-        product_block(
-            registers,
-            out,
-            input,
-            |(a, b)| a as i32 * b as i32,
-            |p| ((p.wrapping_add(1 << 14)) >> 15) as i16,
-        );
+        product_block(registers, out, input, multiply, round);
     }
+}
+
+/// The product register's word.
+#[inline(always)]
+fn multiply((a, b): (i16, i16)) -> i32 {
+    a as i32 * b as i32
+}
+
+/// The rounding register's word: `round(p / 2^15)` half up, wrapped.
+#[inline(always)]
+fn round(p: i32) -> i16 {
+    ((p.wrapping_add(1 << 14)) >> 15) as i16
 }
 
 /// A product pipeline's three registers (factors, product, rounded word)
@@ -56,25 +62,55 @@ pub fn product_block<F: Copy, P: Copy>(
     multiply: impl Fn(F) -> P,
     round: impl Fn(P) -> i16,
 ) {
-    let n = out.len();
-    if n == 0 {
-        return;
-    }
-    let (f0, p0) = (*factors, *product);
-    // The product register during cycle k.
-    let product_at = |k: usize| match k {
-        0 => p0,
-        1 => multiply(f0),
-        _ => multiply(input(k - 2)),
-    };
-    out[0] = *y;
-    for (k, o) in out.iter_mut().enumerate().skip(1).take(2) {
-        *o = round(product_at(k - 1));
+    let held = (*factors, *product, *y);
+    for (k, o) in out.iter_mut().enumerate().take(3) {
+        *o = product_in_flight(held, k, &multiply, &round);
     }
     for (k, o) in out.iter_mut().enumerate().skip(3) {
         *o = round(multiply(input(k - 3)));
     }
-    *y = round(product_at(n - 1));
-    *product = product_at(n);
-    *factors = input(n - 1);
+    product_skip((factors, product, y), out.len(), input, multiply, round);
+}
+
+/// The word of a product pipeline during cycle `k` < 3 from its registers
+/// (factors, product, word): the word, the rounded product, the rounded
+/// factors' product.
+#[inline(always)]
+pub fn product_in_flight<F: Copy, P: Copy>(
+    (factors, product, y): (F, P, i16),
+    k: usize,
+    multiply: impl Fn(F) -> P,
+    round: impl Fn(P) -> i16,
+) -> i16 {
+    match k {
+        0 => y,
+        1 => round(product),
+        _ => round(multiply(factors)),
+    }
+}
+
+/// A product pipeline's registers after `m` edges with `input(k)` at edge
+/// k, as `product_block` leaves them: the word `m` cycles on, the product
+/// of the input before the last, the last input.
+#[inline(always)]
+pub fn product_skip<F: Copy, P: Copy>(
+    (factors, product, y): (&mut F, &mut P, &mut i16),
+    m: usize,
+    input: impl Fn(usize) -> F,
+    multiply: impl Fn(F) -> P,
+    round: impl Fn(P) -> i16,
+) {
+    if m == 0 {
+        return;
+    }
+    let word = match m {
+        1 | 2 => product_in_flight((*factors, *product, *y), m, &multiply, &round),
+        _ => round(multiply(input(m - 3))),
+    };
+    *product = match m {
+        1 => multiply(*factors),
+        _ => multiply(input(m - 2)),
+    };
+    *factors = input(m - 1);
+    *y = word;
 }

@@ -68,11 +68,8 @@ impl Sine {
     /// `step` clock by clock (`DelayRing::block`).
     #[inline(always)]
     pub fn block(&mut self, out: &mut [i16], input: impl Fn(usize) -> (u32, u8)) {
-        let table = self.table;
-        self.pipe.block(out, |k| {
-            let (phase, advance) = input(k);
-            sine_with(table, phase, advance)
-        });
+        let words = Self::words(self.table, input);
+        self.block_words(out, words);
     }
 
     /// `block` where the caller knows the words: `word(k)` is the word
@@ -86,11 +83,17 @@ impl Sine {
     /// them, without the outputs (`DelayRing::skip`).
     #[inline(always)]
     pub fn skip(&mut self, n: usize, input: impl Fn(usize) -> (u32, u8)) {
-        let table = self.table;
-        self.pipe.skip(n, |k| {
+        let words = Self::words(self.table, input);
+        self.pipe.skip(n, words);
+    }
+
+    /// The word of each edge's phase and advance, `input(k)`.
+    #[inline(always)]
+    fn words(table: &'static Table, input: impl Fn(usize) -> (u32, u8)) -> impl Fn(usize) -> i16 {
+        move |k| {
             let (phase, advance) = input(k);
             sine_with(table, phase, advance)
-        });
+        }
     }
 }
 
