@@ -66,16 +66,51 @@ pub use gyrocal_host::device::{CouplingOutOfRange, GyroParams, MAX_COUPLING_DPS}
 struct Discrete {
     phi: [[f64; 4]; 4],
     gamma: [[f64; 2]; 4],
-    phi2: [[f64; 4]; 4],
+    /// `Phi` and `Phi^2` by columns, the form a step uses.
+    phi_by: Columns,
+    phi2_by: Columns,
+    /// The columns of `Gamma`, and the one column `[g00, g10, g21, g31]`
+    /// of its diagonal blocks.
+    gamma_by: [[f64; 4]; 2],
+    gamma_diagonal: [f64; 4],
+}
+
+/// A 4x4 matrix by columns, and its two diagonal 2x2 blocks as two
+/// columns, `[m00, m10, m22, m32]` and `[m01, m11, m23, m33]`: a product
+/// is then four (or two) lanes wide, each lane the sum a row's dot
+/// product takes, in the same order.
+#[derive(Clone, Debug, PartialEq)]
+struct Columns {
+    full: [[f64; 4]; 4],
+    diagonal: [[f64; 4]; 2],
+}
+
+impl Columns {
+    fn new(m: &[[f64; 4]; 4]) -> Self {
+        Self {
+            full: std::array::from_fn(|j| std::array::from_fn(|i| m[i][j])),
+            diagonal: [
+                [m[0][0], m[1][0], m[2][2], m[3][2]],
+                [m[0][1], m[1][1], m[2][3], m[3][3]],
+            ],
+        }
+    }
 }
 
 impl Discrete {
     /// From one period's matrices.
     fn new(phi: [[f64; 4]; 4], gamma: [[f64; 2]; 4]) -> Self {
-        let phi2 = std::array::from_fn(|i| {
+        let phi2: [[f64; 4]; 4] = std::array::from_fn(|i| {
             std::array::from_fn(|j| (0..4).map(|k| phi[i][k] * phi[k][j]).sum())
         });
-        Self { phi, gamma, phi2 }
+        Self {
+            phi,
+            gamma,
+            phi_by: Columns::new(&phi),
+            phi2_by: Columns::new(&phi2),
+            gamma_by: std::array::from_fn(|j| std::array::from_fn(|i| gamma[i][j])),
+            gamma_diagonal: [gamma[0][0], gamma[1][0], gamma[2][1], gamma[3][1]],
+        }
     }
 }
 
@@ -95,32 +130,32 @@ fn pair_step(
 ) -> ([f64; 4], Half) {
     match half {
         None => {
-            let p = times(&d.phi, s, coupled);
+            let p = times(&d.phi_by, s, coupled);
             (std::array::from_fn(|i| u[i] + p[i]), Some((s, u)))
         }
         Some((before, first)) => {
-            let carried = times(&d.phi, first, coupled);
-            let p = times(&d.phi2, before, coupled);
+            let carried = times(&d.phi_by, first, coupled);
+            let p = times(&d.phi2_by, before, coupled);
             (std::array::from_fn(|i| (carried[i] + u[i]) + p[i]), None)
         }
     }
 }
 
 /// `m v`, with the products of exact zeros skipped when the modes are
-/// decoupled (the off-diagonal blocks are zero).
+/// decoupled (the off-diagonal blocks are zero). Each lane adds a row's
+/// products as `(m0 v0 + m1 v1) + (m2 v2 + m3 v3)`, and the lanes are
+/// independent, so a compiler can run them as one vector.
 #[inline(always)]
-fn times(m: &[[f64; 4]; 4], v: [f64; 4], coupled: bool) -> [f64; 4] {
+fn times(m: &Columns, v: [f64; 4], coupled: bool) -> [f64; 4] {
     if coupled {
+        let c = &m.full;
         std::array::from_fn(|i| {
-            (m[i][0] * v[0] + m[i][1] * v[1]) + (m[i][2] * v[2] + m[i][3] * v[3])
+            (c[0][i] * v[0] + c[1][i] * v[1]) + (c[2][i] * v[2] + c[3][i] * v[3])
         })
     } else {
-        [
-            m[0][0] * v[0] + m[0][1] * v[1],
-            m[1][0] * v[0] + m[1][1] * v[1],
-            m[2][2] * v[2] + m[2][3] * v[3],
-            m[3][2] * v[2] + m[3][3] * v[3],
-        ]
+        let [a, b] = &m.diagonal;
+        let (va, vb) = ([v[0], v[0], v[2], v[2]], [v[1], v[1], v[3], v[3]]);
+        std::array::from_fn(|i| a[i] * va[i] + b[i] * vb[i])
     }
 }
 
@@ -399,11 +434,13 @@ impl GyroModel {
     /// when on.
     #[inline(always)]
     fn input(&mut self, f1: f64, f2: f64) -> [f64; 4] {
-        let g = &self.cur.gamma;
+        let d = &self.cur;
         let mut u: [f64; 4] = if self.coupled {
-            std::array::from_fn(|i| g[i][0] * f1 + g[i][1] * f2)
+            let [g1, g2] = &d.gamma_by;
+            std::array::from_fn(|i| g1[i] * f1 + g2[i] * f2)
         } else {
-            [g[0][0] * f1, g[1][0] * f1, g[2][1] * f2, g[3][1] * f2]
+            let f = [f1, f1, f2, f2];
+            std::array::from_fn(|i| d.gamma_diagonal[i] * f[i])
         };
         if let Some((_, source)) = &mut self.thermal {
             for (u, w) in u.iter_mut().zip(source.sample()) {
