@@ -2,7 +2,10 @@
 # The model engine's speed side by side: this tree's gyrocal against the
 # one built at a base revision (default 4afc731, issue 23's baseline), on
 # one core, runs alternated so that both see the same machine, then the
-# medians of each and their ratio (this tree over the base).
+# medians of each and their ratio (this tree over the base). This tree runs
+# twice per round: as it chooses (the widest instruction set the processor
+# runs) and with GYROCAL_ISA=portable (the x86-64 baseline the base was
+# built for), so the gain of each change shows apart from the wider build.
 #
 # Usage: scripts/bench-against.sh [BASE_REV] [ROUNDS] [CPU]
 #   BASE_REV  a revision to build and compare with (default 4afc731)
@@ -54,14 +57,15 @@ base_bin=$base_dir/gyrocal
 
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
-run() { # name binary round
+run() { # name binary round [VAR=value...]
   echo "round $3: $1" >&2
-  taskset -c "$cpu" env RAYON_NUM_THREADS=1 "$2" bench --engines model \
+  taskset -c "$cpu" env RAYON_NUM_THREADS=1 "${@:4}" "$2" bench --engines model \
     --repetitions 3 --no-reproduce --json >"$out/$1.$3.json"
 }
 for r in $(seq 1 "$rounds"); do
   run base "$base_bin" "$r"
   run head "$head_bin" "$r"
+  run portable "$head_bin" "$r" GYROCAL_ISA=portable
 done
 
 python3 - "$out" "$rounds" "$base_rev" "$(git rev-parse --short HEAD)" <<'EOF'
@@ -73,11 +77,15 @@ def speeds(name):
         for m in json.load(open(f"{out}/{name}.{r}.json"))["measurements"]:
             s[m["with_gyro"]].extend(m["samples"])
     return s
-base, head = speeds("base"), speeds("head")
+base, head, portable = speeds("base"), speeds("head"), speeds("portable")
+isa = json.load(open(f"{out}/head.1.json"))["model_isa"]
 print(f"model engine, one core, {rounds} alternated rounds of 3 repetitions (M clocks/s)")
-print(f"{'setting':<20} {'base ' + base_rev:>26} {'this tree ' + head_rev:>26} {'ratio':>7}")
+print(f"this tree {head_rev} as it chooses ({isa}) and with GYROCAL_ISA=portable")
+print(f"{'setting':<20} {'base ' + base_rev:>24} {'portable':>24} {isa:>24} {'ratios':>13}")
 cell = lambda v: f"{statistics.median(v) / 1e6:.2f} ({min(v) / 1e6:.1f}..{max(v) / 1e6:.1f})"
 for gyro, label in [(False, "datapath alone"), (True, "with the gyroscope")]:
-    b, h = statistics.median(base[gyro]), statistics.median(head[gyro])
-    print(f"{label:<20} {cell(base[gyro]):>26} {cell(head[gyro]):>26} {h / b:>7.3f}")
+    b = statistics.median(base[gyro])
+    p, h = statistics.median(portable[gyro]), statistics.median(head[gyro])
+    cells = "".join(f"{cell(v):>24}" for v in (base[gyro], portable[gyro], head[gyro]))
+    print(f"{label:<20} {cells} {p / b:>6.3f} {h / b:>6.3f}")
 EOF

@@ -299,3 +299,40 @@ fn vcd_dump_reads_back_with_the_expected_signals_and_timing() {
     assert!(max_dac > 20_000 && max_dac <= 32767, "dac1 peak {max_dac}");
     assert!(x_values > 1000);
 }
+
+/// `GYROCAL_ISA` naming no instruction set stops any command in one line,
+/// exit 2, before it runs; naming each one this processor runs gives the
+/// same figures, word for word (the runs compiled for it change speed
+/// only).
+#[test]
+fn the_instruction_set_is_checked_and_changes_no_figure() {
+    use gyrocal_hdl::model::isa::Isa;
+    let with_isa = |isa: &str, args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_gyrocal"))
+            .env("GYROCAL_ISA", isa)
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    let run = ["run", "--config", SMALL, "--json", "--quiet"];
+    let o = with_isa("sse9", &run);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(o.stdout.is_empty());
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.starts_with("error: GYROCAL_ISA = \"sse9\": not an instruction set; allowed portable"),
+        "{err}"
+    );
+    // Everything but the wall times.
+    let figures = |isa: &Isa| {
+        let mut v = json_object(with_isa(isa.name(), &run));
+        v.as_object_mut().unwrap().remove("timing");
+        v
+    };
+    let isas = Isa::supported_all();
+    let first = figures(&isas[0]);
+    for isa in &isas[1..] {
+        assert_eq!(figures(isa), first, "{isa} against {}", isas[0]);
+    }
+}

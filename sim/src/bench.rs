@@ -12,6 +12,7 @@
 use crate::engine::{Engine, EngineKind, ModelEngine, RtlEngine};
 use crate::experiment::{self, Experiment, Plan};
 use gyrocal_hdl::model::gyro_interface::{AnalogSide, Words};
+use gyrocal_hdl::model::isa::Isa;
 use serde::Serialize;
 use std::hint::black_box;
 use std::time::Instant;
@@ -50,6 +51,9 @@ pub struct ReproduceTiming {
 pub struct BenchReport {
     /// Per engine and setting.
     pub measurements: Vec<Measurement>,
+    /// The instruction set the model engine's runs were compiled for
+    /// (`gyrocal_hdl::model::isa`).
+    pub model_isa: String,
     /// Median model speed over median Verilator speed, gyroscope in the loop.
     pub model_over_verilator_with_gyro: Option<f64>,
     /// The reproduce run, when asked.
@@ -224,6 +228,7 @@ pub fn run(
     };
     Ok(BenchReport {
         measurements,
+        model_isa: Isa::selected().name().into(),
         model_over_verilator_with_gyro,
         reproduce,
     })

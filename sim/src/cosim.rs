@@ -137,6 +137,11 @@ impl<E: Engine> CoSim<E> {
         &self.engine
     }
 
+    /// The engine, to set it up (`ModelEngine::set_isa`).
+    pub fn engine_mut(&mut self) -> &mut E {
+        &mut self.engine
+    }
+
     /// The gyroscope.
     pub fn gyro(&self) -> &GyroModel {
         &self.analog.gyro
@@ -220,6 +225,7 @@ mod tests {
     use crate::engine::ModelEngine;
     use crate::experiment::{Experiment, plan, point_loop};
     use gyrocal_hdl::host::register_map::{CIC_DECIMATION, ID, ID_WORD};
+    use gyrocal_hdl::model::isa::Isa;
 
     #[test]
     fn the_engine_is_programmed_through_the_register_map() {
@@ -280,15 +286,22 @@ mod tests {
     /// `run` plays the clocks `step` plays: on a calibration and a
     /// readout point at a rate (ADC noise on), runs of lengths around the
     /// engine's block give every z at the cycle `step` gives it, and leave
-    /// the same ports, ADC words, sample count and gyroscope state.
+    /// the same ports, ADC words, sample count and gyroscope state; with
+    /// the run compiled for every instruction set this processor runs
+    /// (the gyroscope's float products among what it compiles), while
+    /// `step` stays portable.
     #[test]
     fn a_run_is_the_steps_it_replaces() {
         let exp = Experiment::paper();
         let plan = plan(&exp).unwrap();
         use crate::experiment::Mode;
-        for mode in [Mode::Calibration, Mode::Readout] {
-            let point = plan.points.iter().find(|p| p.mode == mode).unwrap();
+        let modes = [Mode::Calibration, Mode::Readout];
+        let isas = Isa::supported_all();
+        for (mode, &isa) in modes.iter().flat_map(|m| isas.iter().map(move |i| (m, i))) {
+            let point = plan.points.iter().find(|p| p.mode == *mode).unwrap();
             let mut blocked = point_loop::<ModelEngine>(&exp, &plan, point).unwrap();
+            blocked.engine_mut().set_isa(isa);
+            assert_eq!(blocked.engine().isa(), isa);
             let mut stepped = point_loop::<ModelEngine>(&exp, &plan, point).unwrap();
             for sim in [&mut blocked, &mut stepped] {
                 sim.set_rate(0.3);
@@ -303,17 +316,16 @@ mod tests {
                         z_stepped.push((stepped.cycle(), o.z));
                     }
                 }
-                assert_eq!(z_blocked, z_stepped, "{:?}, {clocks} clocks", point.mode);
+                assert_eq!(z_blocked, z_stepped, "{mode:?} ({isa}), {clocks} clocks");
                 assert_eq!(blocked.outputs, stepped.outputs);
                 assert_eq!(blocked.last_adc(), stepped.last_adc());
                 assert_eq!(blocked.samples, stepped.samples);
                 assert_eq!(blocked.cycle(), stepped.cycle());
-                assert_eq!(blocked.gyro().state(), stepped.gyro().state());
+                assert_eq!(blocked.gyro().state(), stepped.gyro().state(), "{isa}");
             }
             assert!(
                 blocked.samples > 10,
-                "{:?}: {} samples",
-                point.mode,
+                "{mode:?}: {} samples",
                 blocked.samples
             );
         }

@@ -14,6 +14,7 @@ use crate::error::EngineError;
 use gyrocal_hdl::model::gyro_interface::{
     AnalogSide, CarrierProfile, GyroInterface, Outputs, Probes, Registers, Words,
 };
+use gyrocal_hdl::model::isa::Isa;
 use gyrocal_hdl::rtl::RtlGyroInterface;
 
 /// One clock at a time: inputs during a cycle in, outputs after the edge out.
@@ -108,25 +109,45 @@ impl EngineKind {
 }
 
 /// The bit-true model engine.
-#[derive(Clone, Debug, Default)]
-pub struct ModelEngine(GyroInterface);
+#[derive(Clone, Debug)]
+pub struct ModelEngine {
+    datapath: GyroInterface,
+    /// What its runs are compiled for (`Isa::selected` at power-up).
+    isa: Isa,
+}
+
+impl ModelEngine {
+    /// Runs compiled for `isa` from now on (the portable build if this
+    /// processor lacks it): the same results, at another speed.
+    pub fn set_isa(&mut self, isa: Isa) {
+        self.isa = isa;
+    }
+
+    /// What its runs are compiled for.
+    pub fn isa(&self) -> Isa {
+        self.isa
+    }
+}
 
 impl Engine for ModelEngine {
     fn power_up(profile: CarrierProfile) -> Result<Self, EngineError> {
-        Ok(Self(GyroInterface::with_profile(profile)))
+        Ok(Self {
+            datapath: GyroInterface::with_profile(profile),
+            isa: Isa::selected(),
+        })
     }
 
     #[inline(always)]
     fn step(&mut self, adc: (i16, i16), regs: &Registers) -> Outputs {
-        self.0.step(adc, regs)
+        self.datapath.step(adc, regs)
     }
 
     fn probes(&self) -> Probes {
-        self.0.probes()
+        self.datapath.probes()
     }
 
     fn quiet_clocks(&self) -> u64 {
-        self.0.quiet_clocks()
+        self.datapath.quiet_clocks()
     }
 
     #[inline(always)]
@@ -143,7 +164,7 @@ impl Engine for ModelEngine {
         Z: FnMut(u64, (i64, i64)),
     {
         assert!(clocks > 0, "Engine::run: no clock to play");
-        self.0.run(regs, clocks, analog, on_z)
+        self.datapath.run_on(self.isa, regs, clocks, analog, on_z)
     }
 }
 

@@ -60,6 +60,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         );
         return Ok(());
     }
+    println!("model engine compiled for {}", report.model_isa);
     println!(
         "{:<10} {:<14} {:>16} {:>24}",
         "engine", "gyro in loop", "median clocks/s", "min .. max"

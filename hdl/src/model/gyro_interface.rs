@@ -6,6 +6,7 @@ use super::carrier_nco::{CarrierNco, Carriers};
 use super::cic_decimator::CicDecimator;
 use super::demod_mux::DemodMux;
 use super::iir_lowpass::IirLowpass;
+use super::isa::Isa;
 use super::modulation_nco::ModulationNco;
 use super::reference_alignment::ReferenceAlignment;
 pub use gyrocal_regs::Registers;
@@ -119,8 +120,66 @@ impl GyroInterface {
     ///
     /// `on_z(i, z)` is called when clock `i` (from 0) publishes z, in the
     /// order of the clocks. Returns the outputs after the last edge.
+    ///
+    /// Compiled for the instruction set `Isa::selected` names (the widest
+    /// this processor runs, [`super::isa`]): the same results on every one.
     #[inline(always)]
-    pub fn run<A, Z>(
+    pub fn run<A, Z>(&mut self, regs: &Registers, clocks: u64, analog: &mut A, on_z: Z) -> Outputs
+    where
+        A: AnalogSide,
+        Z: FnMut(u64, (i64, i64)),
+    {
+        self.run_on(Isa::selected(), regs, clocks, analog, on_z)
+    }
+
+    /// `run` as compiled for `isa` ([`super::isa`]); the portable build
+    /// when this processor lacks `isa`. The same outputs and calls.
+    #[inline(always)]
+    pub fn run_on<A, Z>(
+        &mut self,
+        isa: Isa,
+        regs: &Registers,
+        clocks: u64,
+        analog: &mut A,
+        on_z: Z,
+    ) -> Outputs
+    where
+        A: AnalogSide,
+        Z: FnMut(u64, (i64, i64)),
+    {
+        #[cfg(target_arch = "x86_64")]
+        if isa == Isa::X86_64V3 && isa.supported() {
+            // SAFETY: the processor has every feature the function is
+            // compiled for (checked just above).
+            return unsafe { self.run_x86_64_v3(regs, clocks, analog, on_z) };
+        }
+        let _ = isa;
+        self.run_blocks(regs, clocks, analog, on_z)
+    }
+
+    /// `run_blocks` compiled for x86-64-v3.
+    ///
+    /// # Safety
+    /// The processor must have its features (`Isa::X86_64V3.supported()`).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,movbe")]
+    unsafe fn run_x86_64_v3<A, Z>(
+        &mut self,
+        regs: &Registers,
+        clocks: u64,
+        analog: &mut A,
+        on_z: Z,
+    ) -> Outputs
+    where
+        A: AnalogSide,
+        Z: FnMut(u64, (i64, i64)),
+    {
+        self.run_blocks(regs, clocks, analog, on_z)
+    }
+
+    /// `run`'s blocks, as its documentation says.
+    #[inline(always)]
+    fn run_blocks<A, Z>(
         &mut self,
         regs: &Registers,
         clocks: u64,
@@ -490,10 +549,11 @@ mod tests {
         }
     }
 
-    /// `run` plays the clocks `step` plays, on both cores: runs of every
-    /// length around a block's (1, BLOCK - 1, BLOCK, BLOCK + 1, long),
-    /// with the registers changed between them, give the same z at the
-    /// same clocks and the same ports and internal signals after.
+    /// `run` plays the clocks `step` plays, on both cores and compiled for
+    /// every instruction set this processor runs: runs of every length
+    /// around a block's (1, BLOCK - 1, BLOCK, BLOCK + 1, long), with the
+    /// registers changed between them, give the same z at the same clocks
+    /// and the same ports and internal signals after.
     #[test]
     fn a_run_is_step_clock_by_clock() {
         let lengths = [
@@ -505,7 +565,11 @@ mod tests {
             20_000,
             777,
         ];
-        for profile in CarrierProfile::ALL {
+        let isas = Isa::supported_all();
+        for (profile, isa) in CarrierProfile::ALL
+            .into_iter()
+            .flat_map(|p| isas.iter().map(move |&i| (p, i)))
+        {
             let mut rng = Rng::new(11);
             let (mut blocked, mut stepped) = (
                 GyroInterface::with_profile(profile),
@@ -516,7 +580,8 @@ mod tests {
             for (run, &clocks) in lengths.iter().cycle().take(40).enumerate() {
                 let regs = run_registers(&mut rng);
                 let mut z_blocked = vec![];
-                let out = blocked.run(&regs, clocks, &mut analog(&mut count_b), |i, z| {
+                let analog = &mut analog(&mut count_b);
+                let out = blocked.run_on(isa, &regs, clocks, analog, |i, z| {
                     z_blocked.push((clock + i, z))
                 });
                 let mut z_stepped = vec![];
@@ -530,10 +595,11 @@ mod tests {
                 }
                 assert_eq!(
                     z_blocked, z_stepped,
-                    "{profile}, run {run} of {clocks} clocks"
+                    "{profile} ({isa}), run {run} of {clocks} clocks"
                 );
-                assert_eq!(out, o, "{profile}, run {run}");
-                assert_eq!(blocked.probes(), stepped.probes(), "{profile}, run {run}");
+                assert_eq!(out, o, "{profile} ({isa}), run {run}");
+                let probes = (blocked.probes(), stepped.probes());
+                assert_eq!(probes.0, probes.1, "{profile} ({isa}), run {run}");
                 clock += clocks;
             }
             assert!(clock > 100_000);

@@ -14,6 +14,7 @@ pub mod delay_ring;
 pub mod demod_mux;
 pub mod gyro_interface;
 pub mod iir_lowpass;
+pub mod isa;
 pub mod modulation_nco;
 pub mod notch_coefficient;
 pub mod q15_multiplier;
