@@ -89,6 +89,12 @@ impl CicDecimator {
     /// output is valid (it holds otherwise). The inputs join `pending` a
     /// slice at a time, when the counter samples the integrators and at
     /// the block's end, instead of one push a clock.
+    ///
+    /// A clock does one of three things: a busy schedule counts down (its
+    /// last clock publishes), or the idle back-end samples at the counter's
+    /// 0, or nothing but the counter moves. So the block goes from event
+    /// to event, the clocks between them moving only the counter
+    /// (`counter_after`).
     #[inline(always)]
     pub fn block(
         &mut self,
@@ -97,19 +103,26 @@ impl CicDecimator {
         shift: u32,
         mut on_valid: impl FnMut(usize, (i64, i64)),
     ) {
+        let n = x.len();
+        let period = (decimation.wrapping_sub(1) & ((1 << DECIMATION_BITS) - 1)) + 1;
         let mut joined = 0;
-        for t in 0..x.len() {
+        let mut t = 0;
+        while t < n {
             if self.valid {
                 on_valid(t, self.y);
+                self.valid = false;
             }
-            self.valid = false;
             if self.busy > 0 {
-                // Non-idle schedule state; its last clock publishes.
-                self.busy -= 1;
+                // The schedule's clocks (or the block's rest); the last
+                // one publishes.
+                let d = self.busy.min(n - t);
+                self.busy -= d;
                 if self.busy == 0 {
                     self.y = self.result;
                     self.valid = true;
                 }
+                self.count = counter_after(self.count, d, period);
+                t += d;
             } else if self.count == 0 {
                 // The inputs before this edge, as `step` would hold them.
                 self.pending.extend_from_slice(&x[joined..t]);
@@ -117,13 +130,14 @@ impl CicDecimator {
                 self.integrate_pending();
                 self.result = (self.comb_and_round(0, shift), self.comb_and_round(1, shift));
                 self.busy = SAMPLE_TO_OUTPUT - 1;
-            }
-            // Counter: it runs whatever the schedule does.
-            self.count = if self.count == 0 {
-                decimation.wrapping_sub(1) & ((1 << DECIMATION_BITS) - 1)
+                self.count = period - 1;
+                t += 1;
             } else {
-                self.count - 1
-            };
+                // Idle until the counter's 0 (or the block's end).
+                let d = (self.count as usize).min(n - t);
+                self.count -= d as u32;
+                t += d;
+            }
         }
         // Integrators: the inputs enter at these edges (`integrate_pending`).
         self.pending.extend_from_slice(&x[joined..]);
@@ -179,6 +193,20 @@ impl CicDecimator {
 
 /// Inputs per chunk of `CicDecimator::integrate_pending`.
 const CHUNK: usize = 512;
+
+/// The decimation counter after `clocks` edges from `count`: each edge
+/// counts down, and reloads `period - 1` at 0 (`period` the decimation R,
+/// 2^13 for R = 0, as a 13-bit word's R - 1 wraps).
+#[inline(always)]
+fn counter_after(count: u32, clocks: usize, period: u32) -> u32 {
+    let count_down = count as usize;
+    if clocks <= count_down {
+        (count_down - clocks) as u32
+    } else {
+        let since_reload = (clocks - count_down - 1) % period as usize;
+        period - 1 - since_reload as u32
+    }
+}
 
 /// One channel's integrators after `m` edges: an edge adds each stage's
 /// old value to the next (`I + N`, N the shift down the cascade), so `m`
@@ -293,6 +321,74 @@ mod tests {
                 assert_eq!(cic.pending, vec![(7, 7)], "the newest input stays pending");
             }
         }
+    }
+
+    /// The counter after a jump is the counter after as many edges one
+    /// by one, for every period's edge cases (R = 1, a 13-bit word's 0
+    /// standing for 2^13) and jumps across several reloads.
+    #[test]
+    fn the_counter_jumps_as_it_counts() {
+        for period in [1u32, 2, 3, 7, 1000, 1 << DECIMATION_BITS] {
+            for start in [0, 1, period / 2, period - 1] {
+                let mut count = start;
+                for clocks in 0..3 * period as usize + 5 {
+                    assert_eq!(
+                        counter_after(start, clocks, period),
+                        count,
+                        "period {period}, from {start}, {clocks} clocks"
+                    );
+                    count = if count == 0 { period - 1 } else { count - 1 };
+                }
+            }
+        }
+    }
+
+    /// A block jumping from event to event is the clocks one by one
+    /// (`step`, a block of one): the same valid cycles and words, and the
+    /// same state after, over blocks of every length with decimations
+    /// longer and shorter than the schedule (strobes dropped), 1 and the
+    /// 13-bit word's 0, changed between blocks.
+    #[test]
+    fn a_block_is_its_clocks_one_by_one() {
+        let mut rng = crate::test_util::Rng::new(31);
+        let (mut blocked, mut stepped) = (CicDecimator::default(), CicDecimator::default());
+        let (mut events, mut steps) = (0, 0);
+        for run in 0..300 {
+            let decimation = match run % 6 {
+                0 => 0,
+                1 => 1,
+                2 => SAMPLE_TO_OUTPUT as u32 - 1,
+                3 => SAMPLE_TO_OUTPUT as u32 + 1,
+                _ => 2 + (rng.next_u64() % 200) as u32,
+            };
+            let shift = (rng.next_u64() % 41) as u32;
+            let n = (rng.next_u64() % 700) as usize;
+            let x: Vec<(i32, i32)> = (0..n)
+                .map(|_| (rng.next_u64() as i32 >> 8, rng.next_u64() as i32 >> 3))
+                .collect();
+            let mut told = vec![];
+            blocked.block(&x, decimation, shift, |t, y| told.push((t, y)));
+            let mut seen = vec![];
+            for (t, &xt) in x.iter().enumerate() {
+                if stepped.output().1 {
+                    seen.push((t, stepped.output().0));
+                }
+                stepped.step(xt, decimation, shift);
+            }
+            assert_eq!(told, seen, "run {run}: R {decimation}, {n} clocks");
+            assert_eq!(blocked.output(), stepped.output(), "run {run}");
+            assert_eq!(
+                blocked.edges_to_valid(),
+                stepped.edges_to_valid(),
+                "run {run}"
+            );
+            events += told.len();
+            steps += n;
+        }
+        assert!(
+            events > 200 && steps > 50_000,
+            "{events} events, {steps} clocks"
+        );
     }
 
     proptest! {
