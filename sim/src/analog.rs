@@ -109,9 +109,7 @@ impl AnalogSide for Analog {
             noise.clear();
             noise.resize(2 * adc.len(), 0.0);
         }
-        for ((a, &x), g) in adc.iter_mut().zip(&self.pending).zip(noise.chunks_exact(2)) {
-            *a = self.converters.adc_step(x, (g[0], g[1]));
-        }
+        self.converters.adc_block(&self.pending, &noise, adc);
         self.pending.clear();
         self.noise = noise;
     }

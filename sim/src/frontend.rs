@@ -205,6 +205,25 @@ impl Converters {
         self.adc_ring[(self.adc_head + n - self.config.adc_latency as usize) % n]
     }
 
+    /// `adc_step` over a block: the ADC words during the clocks whose
+    /// edges sampled `x`, with their draws `g` (two a clock, as
+    /// `draw_noise` gives them). The ring and its head stay in locals
+    /// over the block, so no store into the ring makes the compiler read
+    /// the latency and the gains again at every clock.
+    #[inline(always)]
+    pub fn adc_block(&mut self, x: &[(f64, f64)], g: &[f64], out: &mut [(i16, i16)]) {
+        debug_assert!(x.len() == out.len() && g.len() == 2 * out.len());
+        let n = self.adc_ring.len();
+        let back = n - self.config.adc_latency as usize;
+        let (mut ring, mut head) = (self.adc_ring, self.adc_head);
+        for ((o, &x), g) in out.iter_mut().zip(x).zip(g.chunks_exact(2)) {
+            head = (head + 1) % n;
+            ring[head] = (self.convert(0, x.0, g[0]), self.convert(1, x.1, g[1]));
+            *o = ring[(head + back) % n];
+        }
+        (self.adc_ring, self.adc_head) = (ring, head);
+    }
+
     /// The DAC half of `step`: the forces held over this clock.
     #[inline(always)]
     pub fn dac_step(&mut self, dac: (i16, i16)) -> (f64, f64) {
