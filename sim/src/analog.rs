@@ -88,9 +88,9 @@ impl AnalogSide for Analog {
     /// clocks in another (`GyroModel::steps`).
     #[inline(always)]
     fn advance_block(&mut self, dac: impl Iterator<Item = Words>, mut beside: impl FnMut(usize)) {
-        let converters = &mut self.converters;
-        self.forces.clear();
-        self.forces.extend(dac.map(|d| converters.dac_step(d)));
+        self.forces.resize(BLOCK, (0.0, 0.0));
+        let clocks = self.converters.dac_block(dac, &mut self.forces);
+        self.forces.truncate(clocks);
         let start = self.pending.len();
         self.pending.resize(start + self.forces.len(), (0.0, 0.0));
         let phase = self.phase;

@@ -224,6 +224,31 @@ impl Converters {
         (self.adc_ring, self.adc_head) = (ring, head);
     }
 
+    /// `dac_step` over a block: `forces[k]`, the forces held over clock k
+    /// of `dac`'s words, the ring in locals as in `adc_block`. Returns the
+    /// clocks played: `dac`'s words, at most `forces.len()`.
+    #[inline(always)]
+    pub fn dac_block(
+        &mut self,
+        dac: impl Iterator<Item = (i16, i16)>,
+        forces: &mut [(f64, f64)],
+    ) -> usize {
+        let mut clocks = 0;
+        let n = self.dac_ring.len();
+        let back = n - self.config.dac_latency as usize;
+        let (mask, gain) = (self.dac_mask, self.config.force_per_lsb);
+        let (mut ring, mut head) = (self.dac_ring, self.dac_head);
+        for (f, d) in forces.iter_mut().zip(dac) {
+            head = (head + 1) % n;
+            ring[head] = (d.0 & mask, d.1 & mask);
+            let held = ring[(head + back) % n];
+            *f = (held.0 as f64 * gain[0], held.1 as f64 * gain[1]);
+            clocks += 1;
+        }
+        (self.dac_ring, self.dac_head) = (ring, head);
+        clocks
+    }
+
     /// The DAC half of `step`: the forces held over this clock.
     #[inline(always)]
     pub fn dac_step(&mut self, dac: (i16, i16)) -> (f64, f64) {
