@@ -48,6 +48,7 @@
 //! assert!(d.decimation >= 166 && d.butterworth_hz < d.rc_hz);
 //! ```
 
+use crate::error::ConfigError;
 use crate::gyro::GyroParams;
 use crate::noise::ThermalNoise;
 use crate::rate_drift::RateNoise;
@@ -302,11 +303,17 @@ const Z_RATE_OVER_RC: f64 = 10.0;
 const FILTER_TIMES_PER_BATCH: f64 = 10.0;
 
 /// A numeric key with its range check.
-fn check(section: &str, key: &str, value: f64, ok: bool, allowed: &str) -> Result<(), String> {
+fn check(
+    section: &'static str,
+    key: &str,
+    value: f64,
+    ok: bool,
+    allowed: &str,
+) -> Result<(), ConfigError> {
     if value.is_finite() && ok {
         Ok(())
     } else {
-        Err(format!("[{section}] {key} = {value}: {allowed}"))
+        Err(ConfigError::key(section, key, value, allowed))
     }
 }
 
@@ -366,11 +373,9 @@ impl NoiseModel {
     }
 
     /// Every key's range; one line naming `[noise]` and the key.
-    pub fn validate(&self) -> Result<(), String> {
-        self.thermal()
-            .validate()
-            .map_err(|e| format!("[noise] {e}"))?;
-        self.rate().validate()
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        self.thermal().validate()?;
+        self.rate().validate().map_err(ConfigError::RateNoise)
     }
 }
 
@@ -402,8 +407,9 @@ pub(crate) fn parse_error(name: &str, text: &str, e: toml::de::Error) -> String 
 
 /// Parse a configuration file's text, checking every key and that the
 /// derived values exist. `name` labels error messages (the file path).
-pub fn parse(name: &str, text: &str) -> Result<Experiment, String> {
-    let e: Experiment = toml::from_str(text).map_err(|e| parse_error(name, text, e))?;
+pub fn parse(name: &str, text: &str) -> Result<Experiment, ConfigError> {
+    let e: Experiment =
+        toml::from_str(text).map_err(|e| ConfigError::Syntax(parse_error(name, text, e)))?;
     e.validate()?;
     e.derived()?;
     Ok(e)
@@ -488,16 +494,16 @@ impl Experiment {
     }
 
     /// Every key's own range, with the names of the configuration file.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), ConfigError> {
         self.validate_gyro()?;
         self.validate_drive()?;
         self.validate_frontend()?;
         self.validate_points()?;
-        self.datasheet.over(&self.gyro).map_err(|e| e.to_string())?;
-        self.noise.validate().map_err(|e| format!("[noise] {e}"))
+        self.datasheet.over(&self.gyro)?;
+        Ok(self.noise.validate()?)
     }
 
-    fn validate_gyro(&self) -> Result<(), String> {
+    fn validate_gyro(&self) -> Result<(), ConfigError> {
         let g = &self.gyro;
         let positive = "must be a positive number";
         let nyquist = self.drive.clock_hz / 2.0;
@@ -532,10 +538,10 @@ impl Experiment {
             true,
             "must be a finite number",
         )?;
-        g.check_couplings().map_err(|e| format!("[gyro] {e}"))
+        Ok(g.check_couplings()?)
     }
 
-    fn validate_drive(&self) -> Result<(), String> {
+    fn validate_drive(&self) -> Result<(), ConfigError> {
         let d = &self.drive;
         let nyquist = d.clock_hz / 2.0;
         let below = format!("must be above 0 and below clock_hz / 2 = {nyquist} Hz");
@@ -559,7 +565,7 @@ impl Experiment {
         Ok(())
     }
 
-    fn validate_frontend(&self) -> Result<(), String> {
+    fn validate_frontend(&self) -> Result<(), ConfigError> {
         let f = &self.frontend;
         let max = crate::frontend::MAX_LATENCY;
         for (key, v) in [
@@ -576,8 +582,11 @@ impl Experiment {
         }
         let delay = f.dac_latency + f.adc_latency;
         if delay > MAX_REF_DELAY {
-            return Err(format!(
-                "[frontend] dac_latency + adc_latency = {delay}: at most {MAX_REF_DELAY} clocks (the reference delay line)"
+            return Err(ConfigError::key(
+                "frontend",
+                "dac_latency + adc_latency",
+                delay,
+                format!("at most {MAX_REF_DELAY} clocks (the reference delay line)"),
             ));
         }
         let bits = format!("allowed 1..={MAX_CONVERTER_BITS}");
@@ -617,10 +626,11 @@ impl Experiment {
                 )?;
             }
             _ => {
-                return Err(
-                    "[frontend] adc_per_meter1 and adc_per_meter2: give both or neither (neither: set from adc_headroom)"
-                        .into(),
-                );
+                return Err(ConfigError::rule(
+                    "frontend",
+                    "adc_per_meter1 and adc_per_meter2",
+                    "give both or neither (neither: set from adc_headroom)",
+                ));
             }
         }
         check(
@@ -632,7 +642,7 @@ impl Experiment {
         )
     }
 
-    fn validate_points(&self) -> Result<(), String> {
+    fn validate_points(&self) -> Result<(), ConfigError> {
         let p = &self.points;
         check_list(
             "readout_rates_dps",
@@ -700,7 +710,7 @@ impl Experiment {
     ///
     /// An explicit value that conflicts with the others is refused with
     /// both values and what is allowed.
-    pub fn derived(&self) -> Result<Derived, String> {
+    pub fn derived(&self) -> Result<Derived, ConfigError> {
         let clock = self.drive.clock_hz;
         let band = self.signal_band_hz();
         let max_cal = self.points.cal_freqs_hz.iter().cloned().fold(0.0, f64::max);
@@ -709,13 +719,21 @@ impl Experiment {
         let decimation = match self.filter.decimation {
             Some(r) => {
                 if !(MIN_DECIMATION..=MAX_DECIMATION).contains(&r) {
-                    return Err(format!(
-                        "[filter] decimation = {r}: allowed {MIN_DECIMATION}..={MAX_DECIMATION}"
+                    return Err(ConfigError::key(
+                        "filter",
+                        "decimation",
+                        r,
+                        format!("allowed {MIN_DECIMATION}..={MAX_DECIMATION}"),
                     ));
                 }
                 if f64::from(r) > ripple_limit {
-                    return Err(format!(
-                        "[filter] decimation = {r}: the calibration ripple at 2 x {max_cal} Hz needs {SAMPLES_PER_RIPPLE} z samples per period, so decimation <= {ripple_limit} (clock_hz / (2 x {SAMPLES_PER_RIPPLE} x max cal_freqs_hz)); lower it or the calibration frequencies"
+                    return Err(ConfigError::key(
+                        "filter",
+                        "decimation",
+                        r,
+                        format!(
+                            "the calibration ripple at 2 x {max_cal} Hz needs {SAMPLES_PER_RIPPLE} z samples per period, so decimation <= {ripple_limit} (clock_hz / (2 x {SAMPLES_PER_RIPPLE} x max cal_freqs_hz)); lower it or the calibration frequencies"
+                        ),
                     ));
                 }
                 r
@@ -723,8 +741,12 @@ impl Experiment {
             None => {
                 if ripple_limit < f64::from(MIN_DECIMATION) {
                     let max = clock / (SAMPLES_PER_RIPPLE * 2.0 * f64::from(MIN_DECIMATION));
-                    return Err(format!(
-                        "[experiment] cal_freqs_hz contains {max_cal}: at most {max:.3} Hz on this clock (clock_hz / (2 x {SAMPLES_PER_RIPPLE} z samples per ripple period x decimation {MIN_DECIMATION}))"
+                    return Err(ConfigError::rule(
+                        "experiment",
+                        format!("cal_freqs_hz contains {max_cal}"),
+                        format!(
+                            "at most {max:.3} Hz on this clock (clock_hz / (2 x {SAMPLES_PER_RIPPLE} z samples per ripple period x decimation {MIN_DECIMATION}))"
+                        ),
                     ));
                 }
                 let fz_wanted = Z_RATE_OVER_RC * CUTOFF_STEP * CUTOFF_STEP * band;
@@ -742,7 +764,7 @@ impl Experiment {
                 "clock_hz / derived decimation {decimation} = {fz} Hz; set [filter] decimation to move it"
             ),
         };
-        let cutoff = |key: &str, given: Option<f64>, wanted: f64| -> Result<f64, String> {
+        let cutoff = |key: &str, given: Option<f64>, wanted: f64| -> Result<f64, ConfigError> {
             match given {
                 Some(v) => check(
                     "filter",
@@ -778,19 +800,21 @@ impl Experiment {
 }
 
 /// A list of values: not empty, each in range, at least 2 distinct.
-fn check_list(key: &str, v: &[f64], ok: &dyn Fn(f64) -> bool, allowed: &str) -> Result<(), String> {
+fn check_list(
+    key: &str,
+    v: &[f64],
+    ok: &dyn Fn(f64) -> bool,
+    allowed: &str,
+) -> Result<(), ConfigError> {
+    let rule = |what: String, rule: &str| Err(ConfigError::rule("experiment", what, rule));
     if v.is_empty() {
-        return Err(format!(
-            "[experiment] {key} is empty: give at least 2 distinct values"
-        ));
+        return rule(format!("{key} is empty"), "give at least 2 distinct values");
     }
     if let Some(x) = v.iter().find(|x| !(x.is_finite() && ok(**x))) {
-        return Err(format!("[experiment] {key} contains {x}: {allowed}"));
+        return rule(format!("{key} contains {x}"), allowed);
     }
     if v.iter().all(|x| *x == v[0]) {
-        return Err(format!(
-            "[experiment] {key}: give at least 2 distinct values for a slope"
-        ));
+        return rule(key.into(), "give at least 2 distinct values for a slope");
     }
     Ok(())
 }
@@ -848,7 +872,7 @@ mod tests {
         assert_eq!(e.drive.carrier_profile, CarrierProfile::Fine);
         assert_eq!(parse("c.toml", &toml::to_string(&e).unwrap()).unwrap(), e);
         let bad = REQUIRED.replace("[drive]\n", "[drive]\ncarrier_profile = \"ecp5\"\n");
-        let err = parse("c.toml", &bad).unwrap_err();
+        let err = parse("c.toml", &bad).unwrap_err().to_string();
         assert!(!err.contains('\n'), "{err}");
         assert!(
             err.contains("\"ecp5\"")
@@ -861,7 +885,7 @@ mod tests {
     #[test]
     fn a_missing_required_key_is_named() {
         let text = REQUIRED.replace("carrier_hz = 1.0123e6\n", "");
-        let err = parse("c.toml", &text).unwrap_err();
+        let err = parse("c.toml", &text).unwrap_err().to_string();
         assert!(err.contains("missing field `carrier_hz`"), "{err}");
     }
 
@@ -870,7 +894,7 @@ mod tests {
         // An RC cut-off above the derived z rate's range: the error names the
         // user's value, the derived decimation and the key that moves it.
         let text = REQUIRED.replace("[experiment]", "[filter]\nrc_hz = 1e6\n[experiment]");
-        let err = parse("c.toml", &text).unwrap_err();
+        let err = parse("c.toml", &text).unwrap_err().to_string();
         assert!(
             err.starts_with("[filter] rc_hz = 1000000: allowed"),
             "{err}"
@@ -879,6 +903,33 @@ mod tests {
             err.contains("derived decimation") && err.contains("[filter] decimation"),
             "{err}"
         );
+    }
+
+    /// The errors are typed: a caller tells a key out of range from a rule
+    /// over keys, a coupling or a file that does not parse, with the
+    /// section and key as data.
+    #[test]
+    fn errors_carry_the_section_and_key() {
+        let err = |text: &str| parse("c.toml", text).unwrap_err();
+        assert!(matches!(
+            err(&REQUIRED.replace("q1 = 5000", "q1 = -5.0")),
+            ConfigError::Key { section: "gyro", ref key, ref value, .. } if key == "q1" && value == "-5"
+        ));
+        assert!(matches!(
+            err(&format!("{REQUIRED}[frontend]\nadc_per_meter1 = 1e9\n")),
+            ConfigError::Rule {
+                section: "frontend",
+                ..
+            }
+        ));
+        assert!(matches!(
+            err(&REQUIRED.replace("q1 = 5000", "q1 = 5000\nquadrature_dps = 2e5")),
+            ConfigError::Coupling(_)
+        ));
+        assert!(matches!(
+            err(&REQUIRED.replace("[gyro]", "[gyro")),
+            ConfigError::Syntax(_)
+        ));
     }
 
     #[test]
@@ -931,7 +982,7 @@ mod tests {
             ),
         ];
         for (text, start) in cases {
-            let err = parse("c.toml", &text).unwrap_err();
+            let err = parse("c.toml", &text).unwrap_err().to_string();
             assert!(err.starts_with(start), "{text:?} gave {err:?}");
             assert!(!err.contains('\n'), "{err:?}");
         }

@@ -1,9 +1,11 @@
-//! Typed errors of the simulator's leaf models: the gyroscope, its
+//! Typed errors of the simulator's leaf models (the gyroscope, its
 //! thermal noise and the converters, the path a sample takes from the DAC
-//! to the ADC. Each message is one line naming what is wrong and what is
-//! allowed. The layers above still speak `String`: `From` turns a
-//! `ModelError` into its message, so `?` carries it up unchanged.
+//! to the ADC), of the engines and of a configuration file's checks. Each
+//! message is one line naming what is wrong and what is allowed. The
+//! layers above still speak `String`: `From` turns each into its message,
+//! so `?` carries it up unchanged.
 
+use gyrocal_host::datasheet::DatasheetError;
 use gyrocal_host::device::CouplingOutOfRange;
 
 /// What a leaf model refuses.
@@ -66,6 +68,85 @@ pub enum EngineError {
 
 impl From<EngineError> for String {
     fn from(e: EngineError) -> Self {
+        e.to_string()
+    }
+}
+
+/// What the checks of a configuration file refuse (`crate::config`):
+/// one line naming the section and the key.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ConfigError {
+    /// The file is no TOML, or a key is unknown or of the wrong type:
+    /// the file, the line and section where the parser stopped, and its
+    /// message.
+    #[error("{0}")]
+    Syntax(String),
+    /// A key outside its range: `[section] key = value: allowed`.
+    #[error("[{section}] {key} = {value}: {allowed}")]
+    Key {
+        /// The section, without brackets.
+        section: &'static str,
+        /// The key (or the keys' sum it checks).
+        key: String,
+        /// Its value as given.
+        value: String,
+        /// What is allowed.
+        allowed: String,
+    },
+    /// A rule over several keys or a list's values, `[section] what:
+    /// rule`.
+    #[error("[{section}] {what}: {rule}")]
+    Rule {
+        /// The section, without brackets.
+        section: &'static str,
+        /// What breaks it (the keys, or the list and its value).
+        what: String,
+        /// The rule.
+        rule: String,
+    },
+    /// A mode coupling of `[gyro]` beyond its range.
+    #[error("[gyro] {0}")]
+    Coupling(#[from] CouplingOutOfRange),
+    /// `[datasheet]` does not fit `[gyro]`.
+    #[error(transparent)]
+    Datasheet(#[from] DatasheetError),
+    /// A key of the Brownian noise in `[noise]`.
+    #[error("[noise] {0}")]
+    Thermal(#[from] ModelError),
+    /// A key of the rate noises in `[noise]` (their message names the
+    /// section).
+    #[error("{0}")]
+    RateNoise(String),
+}
+
+impl ConfigError {
+    /// `[section] key = value: allowed`.
+    pub fn key(
+        section: &'static str,
+        key: impl Into<String>,
+        value: impl ToString,
+        allowed: impl Into<String>,
+    ) -> Self {
+        Self::Key {
+            section,
+            key: key.into(),
+            value: value.to_string(),
+            allowed: allowed.into(),
+        }
+    }
+
+    /// `[section] what: rule`.
+    pub fn rule(section: &'static str, what: impl Into<String>, rule: impl Into<String>) -> Self {
+        Self::Rule {
+            section,
+            what: what.into(),
+            rule: rule.into(),
+        }
+    }
+}
+
+impl From<ConfigError> for String {
+    fn from(e: ConfigError) -> Self {
         e.to_string()
     }
 }

@@ -45,7 +45,7 @@ pub fn write_files(dir: &Path, files: Vec<(&str, String)>) -> Result<Vec<PathBuf
 /// `--config FILE` read and checked as the experiment `gyrocal run` runs.
 pub fn load_experiment(path: &Path) -> Result<Experiment, Failure> {
     let (name, text) = read_config(path)?;
-    gyrocal_sim::config::parse(&name, &text).map_err(Failure::Input)
+    gyrocal_sim::config::parse(&name, &text).map_err(|e| Failure::Input(e.to_string()))
 }
 
 /// Options every experiment command takes.

@@ -49,8 +49,8 @@ pub struct Setup {
 pub fn parse(name: &str, text: &str) -> Result<Setup, Error> {
     let file: SetupFile =
         toml::from_str(text).map_err(|e| Error::Input(config::parse_error(name, text, e)))?;
-    let input = |e: String| Error::Input(format!("{name}: {e}"));
-    file.noise.validate().map_err(input)?;
+    let input = |e: &dyn std::fmt::Display| Error::Input(format!("{name}: {e}"));
+    file.noise.validate().map_err(|e| input(&e))?;
     let exp = Experiment {
         gyro: file.gyro,
         drive: file.drive,
@@ -61,10 +61,10 @@ pub fn parse(name: &str, text: &str) -> Result<Setup, Error> {
         // The datasheet command measures the device; no host datasheet.
         datasheet: Default::default(),
     };
-    exp.validate().map_err(input)?;
-    exp.derived().map_err(input)?;
+    exp.validate().map_err(|e| input(&e))?;
+    exp.derived().map_err(|e| input(&e))?;
     if let Some(d) = &file.drift {
-        d.validate().map_err(input)?;
+        d.validate().map_err(|e| input(&e))?;
     }
     Ok(Setup {
         exp,
