@@ -375,7 +375,7 @@ impl NoiseModel {
     /// Every key's range; one line naming `[noise]` and the key.
     pub fn validate(&self) -> Result<(), ConfigError> {
         self.thermal().validate()?;
-        self.rate().validate().map_err(ConfigError::RateNoise)
+        self.rate().validate()
     }
 }
 

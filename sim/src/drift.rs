@@ -33,6 +33,7 @@
 //! quadrature_dps_per_k = 0          # deg/s per K
 //! ```
 
+use crate::error::ConfigError;
 use crate::gyro::{GyroParams, MAX_COUPLING_DPS};
 use serde::{Deserialize, Serialize};
 
@@ -112,11 +113,11 @@ pub fn kelvin(temperature_c: f64) -> f64 {
     temperature_c + 273.15
 }
 
-fn field_error(key: &str, value: impl std::fmt::Display, allowed: &str) -> String {
-    format!("[drift] {key} = {value}: {allowed}")
+fn field_error(key: &str, value: impl std::fmt::Display, allowed: &str) -> ConfigError {
+    ConfigError::key("drift", key, value, allowed)
 }
 
-fn check_ppm(key: &str, v: f64) -> Result<(), String> {
+fn check_ppm(key: &str, v: f64) -> Result<(), ConfigError> {
     if v.is_finite() && v.abs() <= MAX_PPM_PER_K {
         Ok(())
     } else {
@@ -132,12 +133,13 @@ impl Drift {
     /// Checks every key against its limits, and that every step keeps the
     /// gains and Q positive and the phase within +-MAX_PHASE_DEG. Errors are
     /// one line naming the key.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), ConfigError> {
         let t = &self.temperatures_c;
         if t.is_empty() || t.len() > MAX_STEPS {
-            return Err(format!(
-                "[drift] temperatures_c has {} steps: allowed 1..={MAX_STEPS}",
-                t.len()
+            return Err(ConfigError::rule(
+                "drift",
+                format!("temperatures_c has {} steps", t.len()),
+                format!("allowed 1..={MAX_STEPS}"),
             ));
         }
         let (lo, hi) = TEMPERATURE_RANGE_C;
@@ -145,8 +147,10 @@ impl Drift {
             .iter()
             .find(|v| !(v.is_finite() && (lo..=hi).contains(*v)))
         {
-            return Err(format!(
-                "[drift] temperatures_c contains {bad}: allowed {lo}..={hi} deg C"
+            return Err(ConfigError::rule(
+                "drift",
+                format!("temperatures_c contains {bad}"),
+                format!("allowed {lo}..={hi} deg C"),
             ));
         }
         check_ppm("tcf1_ppm_per_k", self.tcf1_ppm_per_k)?;
@@ -176,7 +180,7 @@ impl Drift {
     }
 
     /// Every step's multipliers stay positive and its phase in range.
-    fn check_steps(&self) -> Result<(), String> {
+    fn check_steps(&self) -> Result<(), ConfigError> {
         let coefficients = [
             ("tcf1_ppm_per_k", self.tcf1_ppm_per_k),
             ("tcf2_ppm_per_k", self.tcf2_ppm_per_k),
@@ -216,11 +220,14 @@ impl Drift {
     /// quadrature, frequencies and Q). Errors are one line naming the step
     /// and the coupling, its value there and what is allowed. Call after
     /// [`Drift::validate`] and the `[gyro]` checks.
-    pub fn validate_device(&self, nominal: &GyroParams) -> Result<(), String> {
+    pub fn validate_device(&self, nominal: &GyroParams) -> Result<(), ConfigError> {
         for &t in &self.temperatures_c {
             let gyro = self.at(nominal, t).gyro;
             gyro.check_couplings()
-                .map_err(|e| format!("[drift] at {t} deg C (temperatures_c) {e}"))?;
+                .map_err(|coupling| ConfigError::DriftCoupling {
+                    temperature_c: t,
+                    coupling,
+                })?;
         }
         Ok(())
     }
@@ -396,6 +403,17 @@ mod tests {
             ..paper()
         };
         let err = d.validate_device(&p).unwrap_err();
+        assert!(
+            matches!(
+                err,
+                ConfigError::DriftCoupling {
+                    temperature_c: 35.0,
+                    ..
+                }
+            ),
+            "{err:?}"
+        );
+        let err = err.to_string();
         assert!(
             err.starts_with("[drift] at 35 deg C (temperatures_c) quadrature_dps = 105000:"),
             "{err}"

@@ -113,10 +113,14 @@ pub enum ConfigError {
     /// A key of the Brownian noise in `[noise]`.
     #[error("[noise] {0}")]
     Thermal(#[from] ModelError),
-    /// A key of the rate noises in `[noise]` (their message names the
-    /// section).
-    #[error("{0}")]
-    RateNoise(String),
+    /// A coupling that a step of `[drift]` carries out of its range.
+    #[error("[drift] at {temperature_c} deg C (temperatures_c) {coupling}")]
+    DriftCoupling {
+        /// The step's temperature (deg C).
+        temperature_c: f64,
+        /// The coupling there.
+        coupling: CouplingOutOfRange,
+    },
 }
 
 impl ConfigError {

@@ -49,6 +49,7 @@
 //! `[noise] seed` and jumped by 2^128 steps, so they never overlap the
 //! Brownian force noise's stream of the same seed.
 
+use crate::error::ConfigError;
 use rand_distr::{Distribution, StandardNormal};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use rand_xoshiro::rand_core::SeedableRng;
@@ -91,7 +92,7 @@ pub struct RateNoise {
 impl RateNoise {
     /// Checks the three keys: finite, `0..=MAX_COEFFICIENT`; one line
     /// naming the key.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), ConfigError> {
         for (key, v) in [
             ("arw_deg_per_sqrt_h", self.arw_deg_per_sqrt_h),
             (
@@ -101,9 +102,8 @@ impl RateNoise {
             ("rrw_deg_per_h_per_sqrt_h", self.rrw_deg_per_h_per_sqrt_h),
         ] {
             if !(v.is_finite() && (0.0..=MAX_COEFFICIENT).contains(&v)) {
-                return Err(format!(
-                    "[noise] {key} = {v}: allowed 0..={MAX_COEFFICIENT}"
-                ));
+                let allowed = format!("allowed 0..={MAX_COEFFICIENT}");
+                return Err(ConfigError::key("noise", key, v, allowed));
             }
         }
         Ok(())
@@ -348,6 +348,7 @@ mod tests {
         assert!(
             bad.validate()
                 .unwrap_err()
+                .to_string()
                 .starts_with("[noise] rrw_deg_per_h_per_sqrt_h = -1")
         );
         assert!(!RateNoise::default().is_on());

@@ -1,6 +1,7 @@
 //! The `[drive_probe]` section of a field scenario.
 
 use crate::config::MAX_RATE_DPS;
+use crate::error::ConfigError;
 use serde::{Deserialize, Serialize};
 
 /// The `[drive_probe]` section of a field scenario: after each step's
@@ -20,14 +21,19 @@ pub struct DriveProbe {
 
 impl DriveProbe {
     /// Checks the rate; the error is one line naming the key.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), ConfigError> {
         let r = self.rate_dps;
         if r.is_finite() && r != 0.0 && r.abs() <= MAX_RATE_DPS {
             Ok(())
         } else {
-            Err(format!(
-                "[drive_probe] rate_dps = {r}: allowed non-zero, -{MAX_RATE_DPS}..={MAX_RATE_DPS} \
-                 deg/s (at rest the cross responses vanish)"
+            Err(ConfigError::key(
+                "drive_probe",
+                "rate_dps",
+                r,
+                format!(
+                    "allowed non-zero, -{MAX_RATE_DPS}..={MAX_RATE_DPS} deg/s \
+                     (at rest the cross responses vanish)"
+                ),
             ))
         }
     }

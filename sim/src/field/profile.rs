@@ -34,6 +34,7 @@
 
 use super::board::SimBoard;
 use crate::config::MAX_RATE_DPS;
+use crate::error::ConfigError;
 pub use gyrocal_host::rate::{calibrated, readout_null, rms_error};
 use serde::{Deserialize, Serialize};
 
@@ -66,14 +67,14 @@ pub struct Profile {
     pub settle_s: f64,
 }
 
-fn profile_error(key: &str, value: impl std::fmt::Display, allowed: &str) -> String {
-    format!("[profile] {key} = {value}: {allowed}")
+fn profile_error(key: &str, value: impl std::fmt::Display, allowed: &str) -> ConfigError {
+    ConfigError::key("profile", key, value, allowed)
 }
 
 impl Profile {
     /// Checks every key; errors are one line naming the key. `sample_s` is
     /// the board's z sample period (R / f_clk): a record holds at least one.
-    pub fn validate(&self, sample_s: f64) -> Result<(), String> {
+    pub fn validate(&self, sample_s: f64) -> Result<(), ConfigError> {
         let d = self.duration_s;
         if !(d.is_finite() && d > 0.0 && d <= MAX_DURATION_S) {
             return Err(profile_error(
