@@ -62,6 +62,18 @@ pub enum Failure {
     Run(String),
 }
 
+impl Failure {
+    /// Bad input, from any error's message.
+    pub fn input(e: impl ToString) -> Self {
+        Failure::Input(e.to_string())
+    }
+
+    /// A failed run, from any error's message.
+    pub fn run(e: impl ToString) -> Self {
+        Failure::Run(e.to_string())
+    }
+}
+
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,

@@ -7,6 +7,7 @@
 
 use gyrocal_host::datasheet::DatasheetError;
 use gyrocal_host::device::CouplingOutOfRange;
+use gyrocal_regs::PlanError;
 
 /// What a leaf model refuses.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -151,6 +152,36 @@ impl ConfigError {
 
 impl From<ConfigError> for String {
     fn from(e: ConfigError) -> Self {
+        e.to_string()
+    }
+}
+
+/// What planning or running an experiment's points refuses
+/// (`crate::experiment`).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum RunError {
+    /// The configuration's checks.
+    #[error(transparent)]
+    Config(#[from] ConfigError),
+    /// A frequency plan or filter the datapath cannot realize.
+    #[error(transparent)]
+    Plan(#[from] PlanError),
+    /// A model of the analog side.
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    /// An engine that does not start.
+    #[error(transparent)]
+    Engine(#[from] EngineError),
+    /// The Verilator engine, asked of a build without it.
+    #[error("engine = \"verilator\": {}", EngineError::NotBuilt)]
+    NoVerilator,
+    /// A drive amplitude that rounds to no DAC word.
+    #[error("[drive] amplitude1, amplitude2: both drives need at least one DAC LSB")]
+    DrivesBelowOneLsb,
+}
+
+impl From<RunError> for String {
+    fn from(e: RunError) -> Self {
         e.to_string()
     }
 }

@@ -80,6 +80,7 @@ use crate::config::Derived;
 pub use crate::config::Experiment;
 use crate::cosim::CoSim;
 use crate::engine::{Engine, EngineKind, ModelEngine, RtlEngine};
+use crate::error::RunError;
 use crate::fit::{
     Line, ScaleFactors, coverage_factor, fit_batches, linear_fit, mean_and_standard_error,
 };
@@ -367,7 +368,7 @@ fn span(v: &[f64]) -> f64 {
 }
 
 /// Plan an experiment: registers, ADC gains, settling, batches, targets.
-pub fn plan(exp: &Experiment) -> Result<Plan, String> {
+pub fn plan(exp: &Experiment) -> Result<Plan, RunError> {
     exp.validate()?;
     let derived = exp.derived()?;
     let rates = &exp.points.readout_rates_dps;
@@ -385,13 +386,13 @@ pub fn plan(exp: &Experiment) -> Result<Plan, String> {
         dac_latency: fe.dac_latency,
         adc_latency: fe.adc_latency,
     };
-    let (readout_regs, realized) = settings::registers(&base).map_err(|e| e.to_string())?;
+    let (readout_regs, realized) = settings::registers(&base)?;
     let filter = realized.filter.clone();
     let profile = exp.drive.carrier_profile;
     let drive_words = realized_words(readout_regs.amp, Mode::Readout, profile);
     let cal_drive_words = realized_words(readout_regs.amp, Mode::Calibration, profile);
     if drive_words.iter().any(|&w| w < 1.0) {
-        return Err("[drive] amplitude1, amplitude2: both drives need at least one DAC LSB".into());
+        return Err(RunError::DrivesBelowOneLsb);
     }
     let force_full_scale = exp.drive.force_full_scale();
     let force_per_lsb = [force_full_scale[0] / 32768.0, force_full_scale[1] / 32768.0];
@@ -452,8 +453,7 @@ pub fn plan(exp: &Experiment) -> Result<Plan, String> {
             };
             settings::registers(&p).map(|(r, real)| (r, real.cal_hz))
         })
-        .collect::<Result<_, _>>()
-        .map_err(|e| e.to_string())?;
+        .collect::<Result<_, _>>()?;
     // ADC gains: the largest sampled displacement of any point (the DAC's
     // images included, `crate::images`) at `adc_headroom`.
     let mut peak_x = [0.0f64; 2];
@@ -653,7 +653,7 @@ pub fn point_loop<E: Engine>(
     exp: &Experiment,
     plan: &Plan,
     point: &PointPlan,
-) -> Result<CoSim<E>, String> {
+) -> Result<CoSim<E>, RunError> {
     let gyro = GyroModel::new(&exp.gyro, exp.drive.clock_hz)?.with_thermal_noise(&exp.noise)?;
     let converters = Converters::new(&plan.front_end)?;
     let mut sim = CoSim::new(
@@ -769,7 +769,7 @@ pub fn run_point<E: Engine>(
     point: &PointPlan,
     units: u32,
     progress: &(dyn Fn(Tick) + Sync),
-) -> Result<PointResult, String> {
+) -> Result<PointResult, RunError> {
     let mut sim = point_loop::<E>(exp, plan, point)?;
     let r = plan.filter.decimation;
     let end = point.cycles_for(units, r);
@@ -951,7 +951,7 @@ pub fn run_points(
     plan: &Plan,
     engine: EngineKind,
     progress: &(dyn Fn(Tick) + Sync),
-) -> Result<Measured, String> {
+) -> Result<Measured, RunError> {
     let start = Instant::now();
     let r = plan.filter.decimation;
     let mut units: Vec<u32> = plan.points.iter().map(|p| p.units).collect();
@@ -1035,7 +1035,7 @@ fn run_verilator(
     point: &PointPlan,
     units: u32,
     progress: &(dyn Fn(Tick) + Sync),
-) -> Result<PointResult, String> {
+) -> Result<PointResult, RunError> {
     run_point::<crate::verilator::VerilatorEngine>(exp, plan, point, units, progress)
 }
 
@@ -1046,17 +1046,8 @@ fn run_verilator(
     _: &PointPlan,
     _: u32,
     _: &(dyn Fn(Tick) + Sync),
-) -> Result<PointResult, String> {
-    Err(verilator_not_built())
-}
-
-/// The one line for the Verilator engine in a build without it.
-#[cfg(not(feature = "verilator"))]
-fn verilator_not_built() -> String {
-    format!(
-        "engine = \"verilator\": {}",
-        crate::error::EngineError::NotBuilt
-    )
+) -> Result<PointResult, RunError> {
+    Err(RunError::NoVerilator)
 }
 
 /// Simulate the first clocks of one point with an observer, up to the
@@ -1067,7 +1058,7 @@ pub fn observe_point<E: Engine>(
     plan: &Plan,
     point: &PointPlan,
     observer: &mut dyn Observer,
-) -> Result<(), String> {
+) -> Result<(), RunError> {
     let mut sim = point_loop::<E>(exp, plan, point)?;
     for n in 1..=observer.last_cycle() {
         let o = sim.step();
@@ -1091,7 +1082,7 @@ pub fn observe_point_on(
     plan: &Plan,
     point: &PointPlan,
     observer: &mut dyn Observer,
-) -> Result<(), String> {
+) -> Result<(), RunError> {
     match kind {
         EngineKind::Model => observe_point::<ModelEngine>(exp, plan, point, observer),
         EngineKind::Rtl => observe_point::<RtlEngine>(exp, plan, point, observer),
@@ -1100,13 +1091,14 @@ pub fn observe_point_on(
             observe_point::<crate::verilator::VerilatorEngine>(exp, plan, point, observer)
         }
         #[cfg(not(feature = "verilator"))]
-        EngineKind::Verilator => Err(verilator_not_built()),
+        EngineKind::Verilator => Err(RunError::NoVerilator),
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::error::ConfigError;
     use rand_distr::{Distribution, StandardNormal};
     use rand_xoshiro::Xoshiro256PlusPlus;
     use rand_xoshiro::rand_core::SeedableRng;
@@ -1171,6 +1163,29 @@ mod tests {
             "{within} of 400 within 1 sigma"
         );
     }
+    /// `plan` tells its refusals apart: a drive that rounds to no DAC
+    /// word, a key out of range, a plan the datapath cannot realize.
+    #[test]
+    fn plan_errors_are_typed() {
+        let mut tiny = Experiment::paper();
+        tiny.drive.amplitude1 = 1e-6;
+        assert_eq!(plan(&tiny).unwrap_err(), RunError::DrivesBelowOneLsb);
+        let mut bad = Experiment::paper();
+        bad.gyro.q1 = -1.0;
+        assert!(matches!(
+            plan(&bad).unwrap_err(),
+            RunError::Config(ConfigError::Key {
+                section: "gyro",
+                ..
+            })
+        ));
+        let e = plan(&tiny).unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "[drive] amplitude1, amplitude2: both drives need at least one DAC LSB"
+        );
+    }
+
     #[test]
     fn the_realized_words_are_what_each_core_puts_out() {
         // The readout drive word's fundamental, measured on the core's

@@ -45,7 +45,7 @@ pub fn write_files(dir: &Path, files: Vec<(&str, String)>) -> Result<Vec<PathBuf
 /// `--config FILE` read and checked as the experiment `gyrocal run` runs.
 pub fn load_experiment(path: &Path) -> Result<Experiment, Failure> {
     let (name, text) = read_config(path)?;
-    gyrocal_sim::config::parse(&name, &text).map_err(|e| Failure::Input(e.to_string()))
+    gyrocal_sim::config::parse(&name, &text).map_err(Failure::input)
 }
 
 /// Options every experiment command takes.
@@ -145,7 +145,7 @@ pub fn execute(
     options: &RunOptions,
     checked: &Checked,
 ) -> Result<Report, Failure> {
-    let plan = experiment::plan(exp).map_err(Failure::Input)?;
+    let plan = experiment::plan(exp).map_err(Failure::input)?;
     for w in &plan.warnings {
         eprintln!("warning: {w}");
     }
@@ -171,7 +171,7 @@ pub fn execute(
         Tick::Planned(n) => bar.inc_length(n),
     };
     let measured =
-        experiment::run_points(exp, &plan, checked.engine, &tick).map_err(Failure::Run)?;
+        experiment::run_points(exp, &plan, checked.engine, &tick).map_err(Failure::run)?;
     bar.finish_and_clear();
     let report = Report::new(exp, &plan, measured);
     for w in report.warnings.iter().skip(plan.warnings.len()) {
@@ -232,7 +232,7 @@ fn write_vcd(
     .map_err(io)?;
     let result = experiment::observe_point_on(engine, exp, plan, point, &mut recorder);
     let finished = recorder.finish();
-    if let Err(e) = result.map_err(Failure::Run).and(finished.map_err(io)) {
+    if let Err(e) = result.map_err(Failure::run).and(finished.map_err(io)) {
         let _ = std::fs::remove_file(&tmp);
         return Err(e);
     }

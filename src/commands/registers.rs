@@ -158,7 +158,7 @@ fn c_header(config: &str, plan: &Plan, blocks: &[Block]) -> String {
 /// Print the words.
 pub fn run(args: &Args) -> Result<(), Failure> {
     let exp = super::experiment::load_experiment(&args.config)?;
-    let plan = experiment::plan(&exp).map_err(Failure::Input)?;
+    let plan = experiment::plan(&exp).map_err(Failure::input)?;
     let blocks = blocks(&plan);
     let out = match args.format {
         Format::Table => table(&plan, &blocks),
