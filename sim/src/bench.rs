@@ -10,6 +10,7 @@
 //! process's peak resident memory.
 
 use crate::engine::{Engine, EngineKind, ModelEngine, RtlEngine};
+use crate::error::RunError;
 use crate::experiment::{self, Experiment, Plan};
 use gyrocal_hdl::model::gyro_interface::{AnalogSide, Words};
 use gyrocal_hdl::model::isa::Isa;
@@ -105,7 +106,7 @@ fn measure<E: Engine>(
     name: &str,
     clocks: u64,
     repetitions: usize,
-) -> Result<[Measurement; 2], String> {
+) -> Result<[Measurement; 2], RunError> {
     let (exp, plan) = stimulus_plan();
     let point = plan
         .points
@@ -180,7 +181,7 @@ pub fn run(
     scale: f64,
     reproduce: bool,
     progress: &dyn Fn(&str),
-) -> Result<BenchReport, String> {
+) -> Result<BenchReport, RunError> {
     let mut measurements = vec![];
     for &kind in engines {
         let clocks = ((default_clocks(kind) as f64 * scale) as u64).max(1000);
@@ -196,12 +197,7 @@ pub fn run(
                 measure::<crate::verilator::VerilatorEngine>("verilator", clocks, repetitions)?
             }
             #[cfg(not(feature = "verilator"))]
-            EngineKind::Verilator => {
-                return Err(format!(
-                    "engine \"verilator\": {}",
-                    crate::error::EngineError::NotBuilt
-                ));
-            }
+            EngineKind::Verilator => return Err(RunError::NoVerilator),
         };
         measurements.extend(m);
     }

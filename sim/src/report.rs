@@ -5,6 +5,7 @@
 use crate::budget::{Budget, ImageShifts, budget};
 use crate::config::{Derived, Experiment};
 use crate::engine::EngineKind;
+use crate::error::RunError;
 use crate::experiment::{
     self, Measured, Mode, Plan, PointResult, Tick, Timing, exact_scale_factors,
     measured_scale_factors,
@@ -306,7 +307,7 @@ pub fn run(
     exp: &Experiment,
     engine: EngineKind,
     progress: &(dyn Fn(Tick) + Sync),
-) -> Result<Report, String> {
+) -> Result<Report, RunError> {
     let plan = experiment::plan(exp)?;
     let measured = experiment::run_points(exp, &plan, engine, progress)?;
     Ok(Report::new(exp, &plan, measured))

@@ -52,7 +52,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         !args.no_reproduce,
         &|m| eprintln!("{m}"),
     )
-    .map_err(Failure::Run)?;
+    .map_err(Failure::run)?;
     if args.json {
         println!(
             "{}",
