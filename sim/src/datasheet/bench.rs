@@ -42,7 +42,7 @@ impl Bench {
     /// Plans `exp` and the readout registers; `drift` sets the factory
     /// temperature's device.
     pub fn new(exp: &Experiment, drift: Option<&Drift>) -> Result<Self, Error> {
-        let (fe, knowns) = scenario::build(exp).map_err(Error::Input)?;
+        let (fe, knowns) = scenario::build(exp).map_err(|e| Error::Input(e.to_string()))?;
         let (regs, _) = knowns
             .registers(exp.drive.carrier_hz, None, knowns.amplitude, 0.0)
             .map_err(|e| Error::Input(e.to_string()))?;

@@ -33,6 +33,7 @@ use crate::config::Experiment;
 use crate::config::{Drive, Filter, Frontend, Points};
 use crate::drift::{DeviceAt, Drift};
 use crate::engine::Engine;
+use crate::error::{ConfigError, RunError};
 use crate::experiment;
 use crate::fit::{coverage_factor, linear_fit};
 use crate::frontend::FrontEnd;
@@ -163,7 +164,7 @@ pub const FACTORY_C: f64 = 25.0;
 impl Scenario {
     /// Checks the experiment (as `gyrocal run` does), the drift over the
     /// device, the profile and the drive probe: one line naming the key.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), ConfigError> {
         let exp = &self.exp;
         exp.validate()?;
         let derived = exp.derived()?;
@@ -397,8 +398,8 @@ pub fn warnings(exp: &Experiment) -> Vec<String> {
 /// `[gyro]` (the keys the datasheet leaves out), its drive, latencies,
 /// filter and points. The filter and first window are derived from the
 /// datasheet, as a host must.
-pub fn knowns(exp: &Experiment) -> Result<Knowns, String> {
-    let nominal = exp.datasheet.over(&exp.gyro).map_err(|e| e.to_string())?;
+pub fn knowns(exp: &Experiment) -> Result<Knowns, ConfigError> {
+    let nominal = exp.datasheet.over(&exp.gyro)?;
     let host_view = Experiment {
         gyro: nominal.gyro.clone(),
         ..exp.clone()
@@ -421,7 +422,7 @@ pub fn knowns(exp: &Experiment) -> Result<Knowns, String> {
 }
 
 /// The board as built and what the host knows, for `exp`.
-pub fn build(exp: &Experiment) -> Result<(FrontEnd, Knowns), String> {
+pub fn build(exp: &Experiment) -> Result<(FrontEnd, Knowns), RunError> {
     let plan = experiment::plan(exp)?;
     Ok((plan.front_end, knowns(exp)?))
 }

@@ -13,6 +13,7 @@
 use crate::config::{self, Experiment};
 use crate::drift::{DeviceAt, Drift, TEMPERATURE_RANGE_C};
 use crate::engine::Engine;
+use crate::error::ConfigError;
 use crate::field::board::SimBoard;
 use crate::field::scenario;
 use crate::frontend::FrontEnd;
@@ -50,7 +51,7 @@ pub fn parse(name: &str, text: &str) -> Result<DeviceFile, String> {
 
 impl DeviceFile {
     /// What a host programmed for this file knows (`scenario::knowns`).
-    pub fn knowns(&self) -> Result<Knowns, String> {
+    pub fn knowns(&self) -> Result<Knowns, ConfigError> {
         scenario::knowns(&self.exp)
     }
 

@@ -263,7 +263,10 @@ impl Sweep {
         let mut failed = vec![];
         let mut steps = vec![];
         let mut clocks = 0;
-        let started = sc.validate().and_then(|()| scenario::run(&sc, &|_| {}));
+        let started = sc
+            .validate()
+            .map_err(String::from)
+            .and_then(|()| scenario::run(&sc, &|_| {}));
         match started {
             Err(error) => failed.push(DeviceFailure {
                 temperature_c: None,

@@ -87,7 +87,7 @@ pub struct Outcome {
 pub fn run(args: &Args) -> Result<(), Failure> {
     let (name, text) = read_config(&args.config)?;
     let file = device::parse(&name, &text).map_err(Failure::Input)?;
-    let knowns = file.knowns().map_err(Failure::Input)?;
+    let knowns = file.knowns().map_err(Failure::input)?;
     let outcome = match &args.board {
         Some(url) => over_the_wire(url, &knowns, args.temperature)?,
         None => in_process(&file, &knowns, args.temperature)?,
