@@ -258,6 +258,11 @@ fn unwritable_folder_is_an_error_naming_it() {
     let target = file.join("figures");
     let e = plots::write_figures(small_report(), &target).expect_err("a file in the way");
     assert!(
+        matches!(&e, plots::PlotError::Write { path, .. } if *path == target),
+        "{e:?}"
+    );
+    let e = e.to_string();
+    assert!(
         e.contains(&target.display().to_string()),
         "error does not name {}: {e}",
         target.display()
@@ -270,7 +275,9 @@ fn occupied_file_name_is_an_error_naming_it() {
     let dir = tempfile::tempdir().expect("temp dir");
     let occupied = dir.path().join("fig5a_staircase.png");
     std::fs::create_dir(&occupied).expect("mkdir");
-    let e = plots::write_figures(small_report(), dir.path()).expect_err("a folder in the way");
+    let e = plots::write_figures(small_report(), dir.path())
+        .expect_err("a folder in the way")
+        .to_string();
     assert!(
         e.contains(&occupied.display().to_string()),
         "error does not name {}: {e}",
@@ -295,11 +302,15 @@ fn reports_that_cannot_be_drawn_are_errors() {
         p.trace.clear();
     }
     let e = plots::write_figures(&no_trace, dir.path()).expect_err("no traces");
+    assert!(matches!(e, plots::PlotError::Data(_)), "{e:?}");
+    let e = e.to_string();
     assert!(e.contains("trace"), "{e}");
 
     let mut nan = small_report().clone();
     nan.points[1].z[1] = f64::NAN;
-    let e = plots::write_figures(&nan, dir.path()).expect_err("NaN");
+    let e = plots::write_figures(&nan, dir.path())
+        .expect_err("NaN")
+        .to_string();
     assert!(e.contains("non-finite"), "{e}");
 
     let first_readout = small_report()
@@ -312,7 +323,9 @@ fn reports_that_cannot_be_drawn_are_errors() {
     one_point
         .points
         .retain(|p| p.mode != Mode::Readout || p.rate_dps == keep);
-    let e = plots::write_figures(&one_point, dir.path()).expect_err("one readout point");
+    let e = plots::write_figures(&one_point, dir.path())
+        .expect_err("one readout point")
+        .to_string();
     assert!(e.contains("readout"), "{e}");
     assert_eq!(std::fs::read_dir(dir.path()).expect("dir").count(), 0);
 }
@@ -448,7 +461,9 @@ fn an_allan_analysis_that_cannot_be_drawn_is_an_error() {
     let mut zero = synthetic_allan();
     zero.points[3].adev = 0.0;
     let dir = tempfile::tempdir().expect("temp dir");
-    let e = plots::write_allan_figure(&zero, "t", dir.path(), "a").expect_err("zero");
+    let e = plots::write_allan_figure(&zero, "t", dir.path(), "a")
+        .expect_err("zero")
+        .to_string();
     assert!(e.contains("positive") && !e.contains('\n'), "{e}");
     zero.points.truncate(1);
     assert!(plots::write_allan_figure(&zero, "t", dir.path(), "a").is_err());

@@ -206,7 +206,7 @@ fn write_outputs(report: &AllanReport, dir: &Path) -> Result<Vec<PathBuf>, Failu
             crate::plots::write_allan_figure_with_prediction(
                 analysis, &curve, &label, &title, dir, &name,
             )
-            .map_err(Failure::Run)?,
+            .map_err(Failure::run)?,
         );
     }
     Ok(written)

@@ -133,7 +133,7 @@ fn write_outputs(
         dir,
         vec![("datasheet.json", text), ("rate.csv", rate_csv(ds))],
     )?;
-    written.extend(crate::plots::write_datasheet_figures(ds, dir).map_err(Failure::Run)?);
+    written.extend(crate::plots::write_datasheet_figures(ds, dir).map_err(Failure::run)?);
     Ok(written)
 }
 

@@ -278,7 +278,7 @@ pub fn write_results(report: &Report, dir: &Path) -> Result<Vec<PathBuf>, Failur
         dir,
         vec![("results.json", json), ("points.csv", points_csv(report))],
     )?;
-    written.extend(crate::plots::write_figures(report, dir).map_err(Failure::Run)?);
+    written.extend(crate::plots::write_figures(report, dir).map_err(Failure::run)?);
     Ok(written)
 }
 

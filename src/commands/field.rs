@@ -201,11 +201,11 @@ fn write_results(
     let title = format!("Self-calibration in the field: {name}");
     written.extend(
         crate::plots::write_field_figure(report, &title, dir, "fig_field_error")
-            .map_err(Failure::Run)?,
+            .map_err(Failure::run)?,
     );
     written.extend(
         crate::plots::field_rate::write_field_rate_figure(report, &title, dir, "fig_field_rate")
-            .map_err(Failure::Run)?,
+            .map_err(Failure::run)?,
     );
     Ok(written)
 }

@@ -154,7 +154,7 @@ fn emit(report: &SweepReport, name: &str, out: &Output) -> Result<(), Failure> {
         let title = format!("Self-calibration over a production spread: {name}");
         written.extend(
             crate::plots::write_sweep_figure(report, &title, dir, "fig_sweep")
-                .map_err(Failure::Run)?,
+                .map_err(Failure::run)?,
         );
         for path in written {
             eprintln!("wrote {}", path.display());

@@ -6,6 +6,7 @@
 //! floor and the ranges, [`AllanFigure::with_prediction`] adds a predicted
 //! curve (the noise model's); drawing only draws them.
 
+use super::error::PlotError;
 use gyrocal_sim::allan::{AllanAnalysis, BIAS_INSTABILITY_FACTOR};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -57,22 +58,22 @@ fn log_range(values: impl IntoIterator<Item = f64>, pad: f64) -> (f64, f64) {
 impl AllanFigure {
     /// Checks `analysis` (at least two points, every tau and deviation
     /// finite and positive) and lays the figure out.
-    pub(super) fn new(analysis: &AllanAnalysis, title: &str) -> Result<Self, String> {
+    pub(super) fn new(analysis: &AllanAnalysis, title: &str) -> Result<Self, PlotError> {
         let pts = &analysis.points;
         if pts.len() < 2 {
-            return Err(format!(
+            return Err(PlotError::Data(format!(
                 "Allan figure: {} points, at least 2 are needed",
                 pts.len()
-            ));
+            )));
         }
         if let Some(p) = pts
             .iter()
             .find(|p| !(p.tau_s.is_finite() && p.tau_s > 0.0 && p.adev.is_finite() && p.adev > 0.0))
         {
-            return Err(format!(
+            return Err(PlotError::Data(format!(
                 "Allan figure: point at tau = {} s has deviation {}: a log axis needs finite, positive values",
                 p.tau_s, p.adev
-            ));
+            )));
         }
         let points: Vec<(f64, f64)> = pts.iter().map(|p| (p.tau_s, p.adev * PER_HOUR)).collect();
         let x = log_range(points.iter().map(|p| p.0), 0.15);
@@ -125,15 +126,15 @@ impl AllanFigure {
         mut self,
         curve: &[(f64, f64)],
         label: &str,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, PlotError> {
         if let Some(p) = curve
             .iter()
             .find(|p| !(p.0.is_finite() && p.0 > 0.0 && p.1.is_finite() && p.1 > 0.0))
         {
-            return Err(format!(
+            return Err(PlotError::Data(format!(
                 "Allan figure: predicted point ({}, {}): a log axis needs finite, positive values",
                 p.0, p.1
-            ));
+            )));
         }
         let curve: Vec<(f64, f64)> = curve.iter().map(|&(t, s)| (t, s * PER_HOUR)).collect();
         let ys = self.points.iter().chain(&curve).map(|p| p.1);
@@ -144,7 +145,7 @@ impl AllanFigure {
 }
 
 impl Plot for AllanFigure {
-    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), PlotError> {
         root.fill(&WHITE).map_err(err)?;
         let body = header(root, &self.title, &self.subtitle)?;
         let (x, y) = (self.x, self.y);

@@ -2,6 +2,7 @@
 //! rate 360 f_cal (f_cal on a top axis), fitted lines, theory, one panel
 //! per output (`line_panel`).
 
+use super::error::PlotError;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -13,7 +14,7 @@ use super::style::header;
 pub(super) fn draw_calibration<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     data: &Data,
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     let r = data.report;
     let freqs: Vec<f64> = data.cal.iter().map(|p| p.cal_hz).collect();
     let body = header(

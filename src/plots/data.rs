@@ -1,5 +1,6 @@
 //! The report of a run, checked and sorted for drawing.
 
+use super::error::PlotError;
 use gyrocal_sim::experiment::{Mode, PointResult};
 use gyrocal_sim::report::Report;
 
@@ -14,7 +15,7 @@ pub(super) struct Data<'a> {
 }
 
 impl<'a> Data<'a> {
-    pub(super) fn new(report: &'a Report) -> Result<Self, String> {
+    pub(super) fn new(report: &'a Report) -> Result<Self, PlotError> {
         let pick = |mode: Mode| -> Vec<&PointResult> {
             report.points.iter().filter(|p| p.mode == mode).collect()
         };
@@ -23,28 +24,28 @@ impl<'a> Data<'a> {
         cal.sort_by(|a, b| a.cal_hz.total_cmp(&b.cal_hz));
         for (what, points) in [("readout", &readout), ("calibration", &cal)] {
             if points.len() < 2 {
-                return Err(format!(
+                return Err(PlotError::Data(format!(
                     "figures: the report has {} {what} points, at least 2 are needed",
                     points.len()
-                ));
+                )));
             }
             for p in points.iter() {
                 let values = [p.rate_dps, p.z[0], p.z[1], p.z_theory[0], p.z_theory[1]];
                 if values.iter().any(|v| !v.is_finite()) {
-                    return Err(format!(
+                    return Err(PlotError::Data(format!(
                         "figures: {what} point at {} deg/s has a non-finite value (z {:?}, theory {:?})",
                         p.rate_dps, p.z, p.z_theory
-                    ));
+                    )));
                 }
             }
         }
         for p in &cal {
             if p.trace.len() < 2 || p.trace.iter().flatten().any(|v| !v.is_finite()) {
-                return Err(format!(
+                return Err(PlotError::Data(format!(
                     "figures: calibration point at {} Hz has no usable trace ({} samples; traces are not serialized, figures need the report of a run)",
                     p.cal_hz,
                     p.trace.len()
-                ));
+                )));
             }
         }
         let scalars = [
@@ -56,7 +57,9 @@ impl<'a> Data<'a> {
             report.theory.sf_cal_per_dps,
         ];
         if scalars.iter().flatten().any(|v| !v.is_finite()) {
-            return Err("figures: the report has a non-finite scale factor or intercept".into());
+            return Err(PlotError::Data(
+                "figures: the report has a non-finite scale factor or intercept".into(),
+            ));
         }
         Ok(Self {
             report,

@@ -12,6 +12,7 @@
 //! Each figure's data is laid out in `new` (checked: finite, and positive
 //! on log axes); drawing only draws.
 
+use super::error::PlotError;
 use super::format::{fmt_num, padded_range};
 use super::style::{GREY, LIGHT, OUT_COLOR, header, text_style};
 use super::{Plot, err};
@@ -43,7 +44,7 @@ fn log_range(values: impl IntoIterator<Item = f64>) -> (f64, f64) {
 }
 
 impl AdevFigure {
-    pub(super) fn new(ds: &Datasheet) -> Result<Self, String> {
+    pub(super) fn new(ds: &Datasheet) -> Result<Self, PlotError> {
         let bars: [Bars; 2] = std::array::from_fn(|k| {
             let a = &ds.outputs[k].adev;
             (0..a.tau_s.len())
@@ -56,10 +57,10 @@ impl AdevFigure {
                 || b.iter()
                     .any(|p| !(ok(p.0) && ok(p.1) && ok(p.2) && ok(p.3)))
             {
-                return Err(format!(
+                return Err(PlotError::Data(format!(
                     "datasheet Allan figure: output {} needs two or more finite, positive points",
                     k + 1
-                ));
+                )));
             }
         }
         let model = std::array::from_fn(|k| {
@@ -98,7 +99,7 @@ impl AdevFigure {
 }
 
 impl Plot for AdevFigure {
-    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), PlotError> {
         root.fill(&WHITE).map_err(err)?;
         let body = header(root, "Datasheet: Allan deviation", &self.subtitle)?;
         let mut chart = ChartBuilder::on(&body)
@@ -178,7 +179,7 @@ pub(super) struct XyFigure {
 
 impl XyFigure {
     /// The sweep's residuals.
-    pub(super) fn nonlinearity(ds: &Datasheet) -> Result<Self, String> {
+    pub(super) fn nonlinearity(ds: &Datasheet) -> Result<Self, PlotError> {
         let s = &ds.sweep;
         let series = std::array::from_fn(|k| {
             s.rates_dps
@@ -203,7 +204,7 @@ impl XyFigure {
     }
 
     /// Bias and scale-factor error against temperature.
-    pub(super) fn temperature(t: &Temperature) -> Result<Self, String> {
+    pub(super) fn temperature(t: &Temperature) -> Result<Self, PlotError> {
         let mut steps: Vec<_> = t.steps.iter().collect();
         steps.sort_by(|a, b| a.temperature_c.total_cmp(&b.temperature_c));
         let col = |f: &dyn Fn(usize, usize) -> f64| -> [Vec<(f64, f64)>; 2] {
@@ -236,24 +237,24 @@ impl XyFigure {
         })
     }
 
-    fn checked(self) -> Result<Self, String> {
+    fn checked(self) -> Result<Self, PlotError> {
         let bad = self
             .panels
             .iter()
             .flat_map(|p| p.1.iter().flatten())
             .find(|p| !(p.0.is_finite() && p.1.is_finite()));
         match bad {
-            Some(p) => Err(format!(
+            Some(p) => Err(PlotError::Data(format!(
                 "{}: point ({}, {}) is not finite",
                 self.title, p.0, p.1
-            )),
+            ))),
             None => Ok(self),
         }
     }
 }
 
 impl Plot for XyFigure {
-    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), PlotError> {
         root.fill(&WHITE).map_err(err)?;
         let body = header(root, &self.title, &self.subtitle)?;
         let areas = body.split_evenly((1, self.panels.len()));

@@ -7,6 +7,7 @@
 //! data ([`FieldPanel::new`]) is that, per step and output, apart from the
 //! drawing.
 
+use super::error::PlotError;
 use super::style::{GREY, OUT_COLOR, header, text_style};
 use super::{Plot, err};
 use gyrocal_sim::field::scenario::FieldReport;
@@ -26,9 +27,9 @@ pub(super) struct FieldPanel {
 }
 
 impl FieldPanel {
-    pub(super) fn new(report: &FieldReport, title: &str) -> Result<Self, String> {
+    pub(super) fn new(report: &FieldReport, title: &str) -> Result<Self, PlotError> {
         if report.steps.is_empty() {
-            return Err("field figure: no steps".into());
+            return Err(PlotError::Data("field figure: no steps".into()));
         }
         let mut steps: Vec<_> = report.steps.iter().collect();
         steps.sort_by(|a, b| a.temperature_c.total_cmp(&b.temperature_c));
@@ -52,7 +53,9 @@ impl FieldPanel {
         });
         let all = selfcal.iter().chain(&baseline).flatten();
         if all.clone().any(|p| !p.1.is_finite()) {
-            return Err("field figure: a scale factor is zero or not finite".into());
+            return Err(PlotError::Data(
+                "field figure: a scale factor is zero or not finite".into(),
+            ));
         }
         Ok(Self {
             selfcal,
@@ -82,7 +85,7 @@ impl FieldPanel {
 }
 
 impl Plot for FieldPanel {
-    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), PlotError> {
         root.fill(&WHITE).map_err(err)?;
         let body = header(
             root,

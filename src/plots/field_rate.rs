@@ -10,6 +10,7 @@
 //! records (`gyrocal_sim::field::profile`): the output's step responses
 //! run off the frame, clipped at its edge.
 
+use super::error::PlotError;
 use super::style::{GREY, header, text_style};
 use super::{Plot, err, write_plot};
 use gyrocal_sim::field::scenario::FieldReport;
@@ -42,17 +43,16 @@ pub(super) struct RatePanels {
 
 impl RatePanels {
     /// The error of each record, steps end to end; `None` without a profile.
-    pub(super) fn new(report: &FieldReport, title: &str) -> Result<Option<Self>, String> {
+    pub(super) fn new(report: &FieldReport, title: &str) -> Result<Option<Self>, PlotError> {
         let Some(profile) = &report.profile else {
             return Ok(None);
         };
         let duration = profile.duration_s;
         let mut panels: [[Vec<StepSeries>; 2]; 2] = Default::default();
         for (i, step) in report.steps.iter().enumerate() {
-            let trace = step
-                .profile
-                .as_ref()
-                .ok_or("field rate figure: a step has no profile")?;
+            let trace = step.profile.as_ref().ok_or_else(|| {
+                PlotError::Data("field rate figure: a step has no profile".into())
+            })?;
             let offset = i as f64 * duration;
             let rows = [
                 Some(&trace.selfcal_rate_dps),
@@ -70,7 +70,9 @@ impl RatePanels {
                         .map(|((t, r), truth)| (offset + t, r[k] - truth))
                         .collect();
                     if points.iter().any(|p| !p.1.is_finite()) {
-                        return Err("field rate figure: a rate is not finite".into());
+                        return Err(PlotError::Data(
+                            "field rate figure: a rate is not finite".into(),
+                        ));
                     }
                     panel.push(StepSeries {
                         temperature_c: step.temperature_c,
@@ -110,7 +112,7 @@ impl RatePanels {
         series: &[StepSeries],
         caption: &str,
         legend: bool,
-    ) -> Result<(), String> {
+    ) -> Result<(), PlotError> {
         let (lo, hi) = y_range(series);
         let pad = ((hi - lo) * 0.08)
             .max(hi.abs().max(lo.abs()) * 1e-3)
@@ -177,7 +179,7 @@ fn y_range(series: &[StepSeries]) -> (f64, f64) {
 }
 
 impl Plot for RatePanels {
-    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), PlotError> {
         root.fill(&WHITE).map_err(err)?;
         let body = header(
             root,
@@ -205,11 +207,11 @@ pub fn write_field_rate_figure(
     title: &str,
     dir: &Path,
     name: &str,
-) -> Result<Vec<PathBuf>, String> {
+) -> Result<Vec<PathBuf>, PlotError> {
     super::style::register_font()?;
     let Some(plot) = RatePanels::new(report, title)? else {
         return Ok(vec![]);
     };
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    std::fs::create_dir_all(dir).map_err(|e| PlotError::write(dir, e))?;
     write_plot(&plot, SIZE, dir, name)
 }

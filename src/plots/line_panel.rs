@@ -3,6 +3,7 @@
 //! rate. [`LinePanel::view`] computes what is shown (offsets, power of ten,
 //! ranges, legend corner); [`draw_line_panel`] only draws it.
 
+use super::error::PlotError;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -138,7 +139,7 @@ impl LinePanel {
 pub(super) fn draw_line_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     p: &LinePanel,
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     let k = p.k;
     let color = OUT_COLOR[k];
     let v = p.view();
@@ -224,7 +225,7 @@ fn intercept_notes<DB: DrawingBackend>(
     k: usize,
     v: &LineView,
     (xs, ys): (std::ops::Range<i32>, std::ops::Range<i32>),
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     let lower = matches!(
         v.corner,
         SeriesLabelPosition::LowerRight | SeriesLabelPosition::LowerLeft

@@ -40,6 +40,7 @@ mod allan;
 mod calibration;
 mod data;
 mod datasheet;
+pub mod error;
 mod field;
 pub(crate) mod field_rate;
 mod format;
@@ -50,6 +51,7 @@ mod staircase;
 mod style;
 mod sweep;
 
+pub use error::PlotError;
 use gyrocal_sim::allan::AllanAnalysis;
 use gyrocal_sim::report::Report;
 use plotters::coord::Shift;
@@ -94,7 +96,7 @@ impl Figure {
 
 /// Something that draws itself on a whole drawing area.
 trait Plot {
-    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String>;
+    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), PlotError>;
 }
 
 /// One figure of a run.
@@ -104,7 +106,7 @@ struct RunFigure<'a> {
 }
 
 impl Plot for RunFigure<'_> {
-    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), PlotError> {
         root.fill(&WHITE).map_err(err)?;
         match self.fig {
             Figure::Readout => readout::draw_readout(root, self.data),
@@ -120,10 +122,10 @@ impl Plot for RunFigure<'_> {
 /// names the file (or folder) at fault; the report is checked before any
 /// file is written, and a file that fails leaves the ones before it whole
 /// and no temporary file behind.
-pub fn write_figures(report: &Report, dir: &Path) -> Result<Vec<PathBuf>, String> {
+pub fn write_figures(report: &Report, dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
     style::register_font()?;
     let data = Data::new(report)?;
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    std::fs::create_dir_all(dir).map_err(|e| PlotError::write(dir, e))?;
     let mut written = vec![];
     for fig in Figure::ALL {
         let plot = RunFigure { fig, data: &data };
@@ -142,10 +144,10 @@ pub fn write_allan_figure(
     title: &str,
     dir: &Path,
     name: &str,
-) -> Result<Vec<PathBuf>, String> {
+) -> Result<Vec<PathBuf>, PlotError> {
     style::register_font()?;
     let plot = allan::AllanFigure::new(analysis, title)?;
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    std::fs::create_dir_all(dir).map_err(|e| PlotError::write(dir, e))?;
     write_plot(&plot, allan::SIZE, dir, name)
 }
 
@@ -159,10 +161,10 @@ pub fn write_allan_figure_with_prediction(
     title: &str,
     dir: &Path,
     name: &str,
-) -> Result<Vec<PathBuf>, String> {
+) -> Result<Vec<PathBuf>, PlotError> {
     style::register_font()?;
     let plot = allan::AllanFigure::new(analysis, title)?.with_prediction(prediction, label)?;
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    std::fs::create_dir_all(dir).map_err(|e| PlotError::write(dir, e))?;
     write_plot(&plot, allan::SIZE, dir, name)
 }
 
@@ -175,10 +177,10 @@ pub fn write_field_figure(
     title: &str,
     dir: &Path,
     name: &str,
-) -> Result<Vec<PathBuf>, String> {
+) -> Result<Vec<PathBuf>, PlotError> {
     style::register_font()?;
     let plot = field::FieldPanel::new(report, title)?;
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    std::fs::create_dir_all(dir).map_err(|e| PlotError::write(dir, e))?;
     write_plot(&plot, field::SIZE, dir, name)
 }
 
@@ -191,10 +193,10 @@ pub fn write_sweep_figure(
     title: &str,
     dir: &Path,
     name: &str,
-) -> Result<Vec<PathBuf>, String> {
+) -> Result<Vec<PathBuf>, PlotError> {
     style::register_font()?;
     let plot = sweep::SweepFigure::new(report, title)?;
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    std::fs::create_dir_all(dir).map_err(|e| PlotError::write(dir, e))?;
     write_plot(&plot, sweep::SIZE, dir, name)
 }
 
@@ -206,7 +208,7 @@ pub fn write_sweep_figure(
 pub fn write_datasheet_figures(
     ds: &gyrocal_sim::datasheet::Datasheet,
     dir: &Path,
-) -> Result<Vec<PathBuf>, String> {
+) -> Result<Vec<PathBuf>, PlotError> {
     style::register_font()?;
     let adev = datasheet::AdevFigure::new(ds)?;
     let nonlinearity = datasheet::XyFigure::nonlinearity(ds)?;
@@ -215,7 +217,7 @@ pub fn write_datasheet_figures(
         .as_ref()
         .map(datasheet::XyFigure::temperature)
         .transpose()?;
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    std::fs::create_dir_all(dir).map_err(|e| PlotError::write(dir, e))?;
     let mut written = write_plot(&adev, datasheet::SIZE, dir, "datasheet_adev")?;
     written.extend(write_plot(
         &nonlinearity,
@@ -240,51 +242,56 @@ fn write_plot<P: Plot>(
     size: (u32, u32),
     dir: &Path,
     name: &str,
-) -> Result<Vec<PathBuf>, String> {
+) -> Result<Vec<PathBuf>, PlotError> {
     let png_path = dir.join(format!("{name}.png"));
-    let png = render_png(plot, size)
-        .map_err(|e| format!("{}: drawing failed: {e}", png_path.display()))?;
+    let drawing = |path: &Path| {
+        let path = path.to_path_buf();
+        move |e| PlotError::Drawing {
+            path,
+            error: Box::new(e),
+        }
+    };
+    let png = render_png(plot, size).map_err(drawing(&png_path))?;
     write_atomic(&png_path, &png)?;
     let svg_path = dir.join(format!("{name}.svg"));
-    let svg = render_svg(plot, size)
-        .map_err(|e| format!("{}: drawing failed: {e}", svg_path.display()))?;
+    let svg = render_svg(plot, size).map_err(drawing(&svg_path))?;
     write_atomic(&svg_path, svg.as_bytes())?;
     Ok(vec![png_path, svg_path])
 }
 
 /// Write `bytes` atomically (`gyrocal_verify::write_atomically`),
 /// with the error as one line naming the file.
-fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
-    gyrocal_verify::write_atomically(path, bytes).map_err(|e| format!("{}: {e}", path.display()))
+fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), PlotError> {
+    gyrocal_verify::write_atomically(path, bytes).map_err(|e| PlotError::write(path, e))
 }
 
-fn render_png<P: Plot>(plot: &P, (w, h): (u32, u32)) -> Result<Vec<u8>, String> {
+fn render_png<P: Plot>(plot: &P, (w, h): (u32, u32)) -> Result<Vec<u8>, PlotError> {
     let mut rgb = vec![0u8; w as usize * h as usize * 3];
     {
         let root = BitMapBackend::with_buffer(&mut rgb, (w, h)).into_drawing_area();
         plot.draw_on(&root)?;
-        root.present().map_err(|e| e.to_string())?;
+        root.present().map_err(PlotError::backend)?;
     }
     let mut out = vec![];
     let mut encoder = png::Encoder::new(&mut out, w, h);
     encoder.set_color(png::ColorType::Rgb);
     encoder.set_depth(png::BitDepth::Eight);
-    let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
-    writer.write_image_data(&rgb).map_err(|e| e.to_string())?;
-    writer.finish().map_err(|e| e.to_string())?;
+    let mut writer = encoder.write_header().map_err(PlotError::backend)?;
+    writer.write_image_data(&rgb).map_err(PlotError::backend)?;
+    writer.finish().map_err(PlotError::backend)?;
     Ok(out)
 }
 
-fn render_svg<P: Plot>(plot: &P, size: (u32, u32)) -> Result<String, String> {
+fn render_svg<P: Plot>(plot: &P, size: (u32, u32)) -> Result<String, PlotError> {
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
         plot.draw_on(&root)?;
-        root.present().map_err(|e| e.to_string())?;
+        root.present().map_err(PlotError::backend)?;
     }
     Ok(svg)
 }
 
-fn err<E: std::fmt::Display>(e: E) -> String {
-    e.to_string()
+fn err<E: std::fmt::Display>(e: E) -> PlotError {
+    PlotError::backend(e)
 }

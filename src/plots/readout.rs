@@ -2,6 +2,7 @@
 //! rotation rate, their least-squares lines and the exact theory at the
 //! same rates, one panel per output (`line_panel`).
 
+use super::error::PlotError;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -12,7 +13,7 @@ use super::style::header;
 pub(super) fn draw_readout<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     data: &Data,
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     let r = data.report;
     let body = header(
         root,

@@ -3,6 +3,7 @@
 //! rates), less its mean (an offset error does not move the scale
 //! factor), readout and calibration side by side.
 
+use super::error::PlotError;
 use gyrocal_sim::experiment::PointResult;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -49,7 +50,7 @@ fn residual_panel(points: &[&PointResult], sf_theory: [f64; 2]) -> ResidualPanel
 pub(super) fn draw_residuals<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     data: &Data,
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     let r = data.report;
     let body = header(
         root,

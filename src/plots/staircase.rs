@@ -4,6 +4,7 @@
 //! averaged over one ripple period 1 / (2 f_cal), with the window means and
 //! the exact theory as horizontal segments. One column per output.
 
+use super::error::PlotError;
 use gyrocal_sim::experiment::PointResult;
 use plotters::coord::Shift;
 use plotters::coord::types::RangedCoordf64;
@@ -83,7 +84,7 @@ fn lay_out<'a>(cal: &[&'a PointResult]) -> (Vec<Step<'a>>, f64) {
 pub(super) fn draw_staircase<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     data: &Data,
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     let r = data.report;
     let (steps, end) = lay_out(&data.cal);
     let freqs: Vec<f64> = data.cal.iter().map(|p| p.cal_hz).collect();
@@ -121,7 +122,7 @@ fn staircase_axes<'a, DB: DrawingBackend>(
     (end, y_labels): (f64, usize),
     steps: &[Step],
     label_windows: bool,
-) -> Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>, String> {
+) -> Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>, PlotError> {
     let mut chart = ChartBuilder::on(area)
         .caption(caption, text_style(17))
         .margin(12)
@@ -190,7 +191,7 @@ fn staircase_raw<DB: DrawingBackend>(
     steps: &[Step],
     k: usize,
     end: f64,
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     let color = OUT_COLOR[k];
     let (exp, (y0, y1)) = raw_range(steps, k);
     let scale = 10f64.powi(-exp);
@@ -271,7 +272,7 @@ fn staircase_smooth<DB: DrawingBackend>(
     steps: &[Step],
     k: usize,
     end: f64,
-) -> Result<(), String> {
+) -> Result<(), PlotError> {
     let color = OUT_COLOR[k];
     let SmoothRange {
         exp,

@@ -1,6 +1,7 @@
 //! Shared look of the figures: the embedded font, colours, text styles,
 //! the title block and the choice of a free corner for a legend.
 
+use super::error::PlotError;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
@@ -20,11 +21,10 @@ pub(super) const LIGHT: RGBColor = RGBColor(225, 225, 225);
 /// Unit of a scale factor.
 pub(super) const SF_UNIT: &str = "(m²/s²)/(°/s)";
 
-pub(super) fn register_font() -> Result<(), String> {
-    static DONE: OnceLock<Result<(), String>> = OnceLock::new();
+pub(super) fn register_font() -> Result<(), PlotError> {
+    static DONE: OnceLock<Result<(), PlotError>> = OnceLock::new();
     DONE.get_or_init(|| {
-        plotters::style::register_font(FAMILY, FontStyle::Normal, FONT)
-            .map_err(|_| "assets/fonts/DejaVuSans-subset.ttf: not a usable font".to_string())
+        plotters::style::register_font(FAMILY, FontStyle::Normal, FONT).map_err(|_| PlotError::Font)
     })
     .clone()
 }
@@ -38,7 +38,7 @@ pub(super) fn header<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     title: &str,
     subtitle: &str,
-) -> Result<DrawingArea<DB, Shift>, String> {
+) -> Result<DrawingArea<DB, Shift>, PlotError> {
     let (top, body) = root.split_vertically(70);
     let (w, _) = top.dim_in_pixel();
     let centre = |size| {

@@ -9,6 +9,7 @@
 //! error and are not drawn; the subtitle counts them. The panels' data
 //! ([`SweepFigure::new`]) is computed apart from the drawing.
 
+use super::error::PlotError;
 use super::style::{GREY, OUT_COLOR, header, text_style};
 use super::{Plot, err};
 use gyrocal_sim::sweep::SweepReport;
@@ -29,7 +30,7 @@ pub(super) struct SweepFigure {
 }
 
 impl SweepFigure {
-    pub(super) fn new(report: &SweepReport, title: &str) -> Result<Self, String> {
+    pub(super) fn new(report: &SweepReport, title: &str) -> Result<Self, PlotError> {
         let points: [Vec<(f64, f64, f64)>; 2] = std::array::from_fn(|k| {
             report
                 .devices
@@ -45,14 +46,16 @@ impl SweepFigure {
                 .collect()
         });
         if points[0].is_empty() {
-            return Err("sweep figure: no device finished".into());
+            return Err(PlotError::Data("sweep figure: no device finished".into()));
         }
         if points
             .iter()
             .flatten()
             .any(|p| !(p.0.is_finite() && p.1 > 0.0 && p.2.is_finite()))
         {
-            return Err("sweep figure: an error, split or Q is not finite".into());
+            return Err(PlotError::Data(
+                "sweep figure: an error, split or Q is not finite".into(),
+            ));
         }
         let s = &report.summary;
         Ok(Self {
@@ -95,7 +98,7 @@ impl SweepFigure {
         }
     }
 
-    fn draw_cdf<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> Result<(), String> {
+    fn draw_cdf<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> Result<(), PlotError> {
         let (e0, e1) = self.error_range();
         let mut chart = ChartBuilder::on(area)
             .margin(15)
@@ -158,7 +161,7 @@ impl SweepFigure {
         x: fn(&(f64, f64, f64)) -> f64,
         x_desc: &str,
         log_x: bool,
-    ) -> Result<(), String> {
+    ) -> Result<(), PlotError> {
         let (e0, e1) = self.error_range();
         let (x0, x1) = self.x_range(x, log_x);
         let t = self.tolerance_percent;
@@ -211,7 +214,7 @@ impl SweepFigure {
 }
 
 impl Plot for SweepFigure {
-    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), PlotError> {
         root.fill(&WHITE).map_err(err)?;
         let body = header(root, &self.title, &self.subtitle)?;
         let panels = body.split_evenly((1, 3));
