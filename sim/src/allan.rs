@@ -41,6 +41,7 @@
 //! [`white_rate_edf`] (white rate noise, the angle random walk) and
 //! [`random_walk_rate_edf`].
 
+use crate::error::AllanError;
 use serde::Serialize;
 
 /// `sigma` of flicker rate noise over its coefficient, `sqrt(2 ln 2 / pi)`
@@ -103,20 +104,16 @@ pub fn octave_clusters(n: usize) -> Vec<usize> {
         .collect()
 }
 
-fn check_series(rate: &[f64], sample_rate_hz: f64) -> Result<(), String> {
+fn check_series(rate: &[f64], sample_rate_hz: f64) -> Result<(), AllanError> {
     if !(sample_rate_hz.is_finite() && sample_rate_hz > 0.0) {
-        return Err(format!(
-            "sample rate {sample_rate_hz} Hz: must be finite and > 0"
-        ));
+        return Err(AllanError::SampleRate(sample_rate_hz));
     }
     if rate.len() < 2 {
-        return Err(format!(
-            "{} rate samples: the Allan deviation needs at least 2",
-            rate.len()
-        ));
+        return Err(AllanError::TooFewSamples(rate.len()));
     }
-    if let Some(i) = rate.iter().position(|v| !v.is_finite()) {
-        return Err(format!("rate sample {i} is {}: must be finite", rate[i]));
+    if let Some(index) = rate.iter().position(|v| !v.is_finite()) {
+        let value = rate[index];
+        return Err(AllanError::NotFinite { index, value });
     }
     Ok(())
 }
@@ -127,14 +124,14 @@ pub fn overlapping_adev(
     rate: &[f64],
     sample_rate_hz: f64,
     clusters: &[usize],
-) -> Result<Vec<AllanPoint>, String> {
+) -> Result<Vec<AllanPoint>, AllanError> {
     check_series(rate, sample_rate_hz)?;
     let n = rate.len();
-    if let Some(m) = clusters.iter().find(|&&m| m == 0 || 2 * m > n) {
-        return Err(format!(
-            "cluster of {m} samples: allowed 1..={} for {n} samples",
-            n / 2
-        ));
+    if let Some(&cluster) = clusters.iter().find(|&&m| m == 0 || 2 * m > n) {
+        return Err(AllanError::Cluster {
+            cluster,
+            samples: n,
+        });
     }
     let tau0 = 1.0 / sample_rate_hz;
     let mean = rate.iter().sum::<f64>() / n as f64;
@@ -217,7 +214,7 @@ pub fn bias_instability(points: &[AllanPoint]) -> BiasInstability {
 /// The whole analysis of a rate series (deg/s) at `sample_rate_hz`, on
 /// octave-spaced taus. Errors (one line) on a non-finite sample or rate, or
 /// fewer than 2 samples.
-pub fn analyze(rate_dps: &[f64], sample_rate_hz: f64) -> Result<AllanAnalysis, String> {
+pub fn analyze(rate_dps: &[f64], sample_rate_hz: f64) -> Result<AllanAnalysis, AllanError> {
     check_series(rate_dps, sample_rate_hz)?;
     let points = overlapping_adev(rate_dps, sample_rate_hz, &octave_clusters(rate_dps.len()))?;
     Ok(AllanAnalysis {
@@ -250,15 +247,16 @@ pub struct ArwReading {
 /// The angle random walk of `rate` (deg/s at `sample_rate_hz`) read at the
 /// cluster nearest `tau_s`, with its degrees of freedom. Errors (one line)
 /// when the series is shorter than two such clusters.
-pub fn arw_at(rate: &[f64], sample_rate_hz: f64, tau_s: f64) -> Result<ArwReading, String> {
+pub fn arw_at(rate: &[f64], sample_rate_hz: f64, tau_s: f64) -> Result<ArwReading, AllanError> {
     check_series(rate, sample_rate_hz)?;
     let m = (tau_s * sample_rate_hz).round().max(1.0) as usize;
     if 2 * m > rate.len() {
-        return Err(format!(
-            "{} rate samples at {sample_rate_hz} Hz: reading tau = {tau_s} s needs at least {}",
-            rate.len(),
-            2 * m
-        ));
+        return Err(AllanError::TooShortForTau {
+            samples: rate.len(),
+            sample_rate_hz,
+            tau_s,
+            needed: 2 * m,
+        });
     }
     let point = overlapping_adev(rate, sample_rate_hz, &[m])?.remove(0);
     let edf = white_rate_edf(rate.len(), m);
@@ -324,18 +322,26 @@ mod tests {
     fn clusters_and_series_are_checked() {
         assert_eq!(octave_clusters(9), vec![1, 2, 4]);
         assert_eq!(octave_clusters(1), Vec::<usize>::new());
-        assert!(
-            overlapping_adev(&[1.0; 8], 1.0, &[5])
-                .unwrap_err()
-                .contains("1..=4")
+        let e = overlapping_adev(&[1.0; 8], 1.0, &[5]).unwrap_err();
+        assert_eq!(
+            e,
+            AllanError::Cluster {
+                cluster: 5,
+                samples: 8
+            }
         );
-        assert!(
-            analyze(&[1.0, f64::NAN], 1.0)
-                .unwrap_err()
-                .starts_with("rate sample 1")
+        assert!(e.to_string().contains("1..=4"), "{e}");
+        let e = analyze(&[1.0, f64::NAN], 1.0).unwrap_err();
+        assert!(matches!(e, AllanError::NotFinite { index: 1, .. }), "{e:?}");
+        assert!(e.to_string().starts_with("rate sample 1"), "{e}");
+        assert_eq!(
+            analyze(&[1.0, 2.0], 0.0).unwrap_err(),
+            AllanError::SampleRate(0.0)
         );
-        assert!(analyze(&[1.0, 2.0], 0.0).is_err());
-        assert!(analyze(&[1.0], 1.0).is_err());
+        assert_eq!(
+            analyze(&[1.0], 1.0).unwrap_err(),
+            AllanError::TooFewSamples(1)
+        );
     }
 
     #[test]
@@ -364,6 +370,7 @@ mod tests {
         assert!(
             arw_at(&rate[..99], fs, 1.0)
                 .unwrap_err()
+                .to_string()
                 .contains("at least 100")
         );
     }

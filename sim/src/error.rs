@@ -185,3 +185,63 @@ impl From<RunError> for String {
         e.to_string()
     }
 }
+
+/// What the Allan deviation and the noise fit of a rate series refuse
+/// (`crate::allan`, `crate::noise_terms`).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum AllanError {
+    /// A sample rate that is not a positive number.
+    #[error("sample rate {0} Hz: must be finite and > 0")]
+    SampleRate(f64),
+    /// Fewer than 2 samples.
+    #[error("{0} rate samples: the Allan deviation needs at least 2")]
+    TooFewSamples(usize),
+    /// A sample that is not finite.
+    #[error("rate sample {index} is {value}: must be finite")]
+    NotFinite {
+        /// Its index.
+        index: usize,
+        /// Its value.
+        value: f64,
+    },
+    /// A cluster of 0 samples or longer than half the series.
+    #[error("cluster of {cluster} samples: allowed 1..={} for {samples} samples", samples / 2)]
+    Cluster {
+        /// Samples per cluster.
+        cluster: usize,
+        /// Samples in the series.
+        samples: usize,
+    },
+    /// A series shorter than two clusters of the asked tau.
+    #[error(
+        "{samples} rate samples at {sample_rate_hz} Hz: reading tau = {tau_s} s needs at least {needed}"
+    )]
+    TooShortForTau {
+        /// Samples in the series.
+        samples: usize,
+        /// Their rate (Hz).
+        sample_rate_hz: f64,
+        /// The tau asked (s).
+        tau_s: f64,
+        /// Samples it needs.
+        needed: usize,
+    },
+    /// No Allan point at or above the fit's least tau.
+    #[error(
+        "no Allan point at tau >= {tau_min_s} s from {samples} samples at {sample_rate_hz} Hz: run longer"
+    )]
+    NothingToFit {
+        /// The fit's least tau (s).
+        tau_min_s: f64,
+        /// Samples in the series.
+        samples: usize,
+        /// Their rate (Hz).
+        sample_rate_hz: f64,
+    },
+}
+
+impl From<AllanError> for String {
+    fn from(e: AllanError) -> Self {
+        e.to_string()
+    }
+}

@@ -38,6 +38,7 @@
 
 use crate::allan::{self, AllanPoint};
 use crate::edf::{self, ONE_SIGMA};
+use crate::error::AllanError;
 use crate::rate_drift::FLICKER_ADEV_PER_B;
 use serde::Serialize;
 
@@ -245,7 +246,7 @@ fn coefficient_reading(c: f64, sd: f64, scale: f64, what: &str) -> Reading {
 
 /// Analyze a rate series (deg/s) at `fs` (Hz): octave taus, the fit over
 /// `tau >= tau_fit_min_s`, confidence intervals and the readings.
-pub fn analyze(rate: &[f64], fs: f64, tau_fit_min_s: f64) -> Result<NoiseAnalysis, String> {
+pub fn analyze(rate: &[f64], fs: f64, tau_fit_min_s: f64) -> Result<NoiseAnalysis, AllanError> {
     let n = rate.len();
     let raw = allan::overlapping_adev(rate, fs, &allan::octave_clusters(n))?;
     let fitted: Vec<&AllanPoint> = raw
@@ -253,9 +254,11 @@ pub fn analyze(rate: &[f64], fs: f64, tau_fit_min_s: f64) -> Result<NoiseAnalysi
         .filter(|p| p.tau_s >= tau_fit_min_s && p.adev > 0.0)
         .collect();
     if fitted.is_empty() {
-        return Err(format!(
-            "no Allan point at tau >= {tau_fit_min_s} s from {n} samples at {fs} Hz: run longer"
-        ));
+        return Err(AllanError::NothingToFit {
+            tau_min_s: tau_fit_min_s,
+            samples: n,
+            sample_rate_hz: fs,
+        });
     }
     let taus: Vec<f64> = fitted.iter().map(|p| p.tau_s).collect();
     let y: Vec<f64> = fitted.iter().map(|p| p.adev * p.adev).collect();

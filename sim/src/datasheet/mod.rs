@@ -226,7 +226,7 @@ pub fn run(
     let outputs = (0..2)
         .map(|k| {
             let a = noise_terms::analyze(&rate_dps[k], series.sample_rate_hz, fit_min_tau_s)
-                .map_err(Error::Run)?;
+                .map_err(|e| Error::Run(e.to_string()))?;
             Ok(sheet(k, &a, &sweep, &dynamics, temperature.as_ref()))
         })
         .collect::<Result<Vec<_>, Error>>()?;
