@@ -84,6 +84,7 @@
 use crate::allan::{self, AllanAnalysis, ArwReading};
 use crate::config::Experiment;
 use crate::engine::ModelEngine;
+use crate::error::{AllanError, RunError};
 use crate::experiment::{self, Mode, Plan, PointPlan, point_loop};
 use crate::noise::ThermalNoise;
 use serde::Serialize;
@@ -149,12 +150,12 @@ pub struct RateNoisePrediction {
 
 /// The readout point of `plan` at `rate_dps` (the readout registers and
 /// settling of the plan's readout sweep).
-fn readout_point(plan: &Plan, rate_dps: f64) -> Result<PointPlan, String> {
+fn readout_point(plan: &Plan, rate_dps: f64) -> Result<PointPlan, RateNoiseError> {
     let first = plan
         .points
         .iter()
         .find(|p| p.mode == Mode::Readout)
-        .ok_or("the plan has no readout point")?;
+        .ok_or(RateNoiseError::NoReadoutPoint)?;
     Ok(PointPlan {
         rate_dps,
         omz_rad_s: rate_dps.to_radians(),
@@ -165,7 +166,11 @@ fn readout_point(plan: &Plan, rate_dps: f64) -> Result<PointPlan, String> {
 /// Readout scale factors at `rate_dps` (z in m^2/s^2 per deg/s): the exact
 /// theory's central difference over +-1 deg/s (its quadratic term cancels;
 /// the cubic one is below 1e-9 of the slope at a readout's rates).
-fn local_scale_factors(exp: &Experiment, plan: &Plan, rate_dps: f64) -> Result<[f64; 2], String> {
+fn local_scale_factors(
+    exp: &Experiment,
+    plan: &Plan,
+    rate_dps: f64,
+) -> Result<[f64; 2], RateNoiseError> {
     let z = |r: f64| readout_point(plan, r).map(|p| plan.theory_z(exp, &p));
     let (up, down) = (z(rate_dps + 1.0)?, z(rate_dps - 1.0)?);
     Ok([(up[0] - down[0]) / 2.0, (up[1] - down[1]) / 2.0])
@@ -176,7 +181,7 @@ pub fn predict(
     exp: &Experiment,
     plan: &Plan,
     rate_dps: f64,
-) -> Result<RateNoisePrediction, String> {
+) -> Result<RateNoisePrediction, RateNoiseError> {
     let sf = local_scale_factors(exp, plan, rate_dps)?;
     let per_lsb = plan.z_per_lsb(Mode::Readout);
     let fe = &plan.front_end;
@@ -359,13 +364,34 @@ impl Blocks {
 }
 
 /// Checks a run length (s): one line naming what is allowed.
-pub fn check_seconds(seconds: f64) -> Result<(), String> {
+pub fn check_seconds(seconds: f64) -> Result<(), RateNoiseError> {
     if seconds.is_finite() && (MIN_SECONDS..=MAX_SECONDS).contains(&seconds) {
         Ok(())
     } else {
-        Err(format!(
-            "--seconds {seconds}: allowed {MIN_SECONDS} to {MAX_SECONDS} s of simulated time"
-        ))
+        Err(RateNoiseError::Seconds(seconds))
+    }
+}
+
+/// What predicting or running a readout's rate noise refuses.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum RateNoiseError {
+    /// A plan without a readout point.
+    #[error("the plan has no readout point")]
+    NoReadoutPoint,
+    /// A run length out of range (s).
+    #[error("--seconds {0}: allowed {MIN_SECONDS} to {MAX_SECONDS} s of simulated time")]
+    Seconds(f64),
+    /// Planning or running the point.
+    #[error(transparent)]
+    Run(#[from] RunError),
+    /// The rate series' Allan deviation.
+    #[error(transparent)]
+    Allan(#[from] AllanError),
+}
+
+impl From<RateNoiseError> for String {
+    fn from(e: RateNoiseError) -> Self {
+        e.to_string()
     }
 }
 
@@ -379,7 +405,7 @@ pub fn run_noisy(
     rate_dps: f64,
     seconds: f64,
     progress: &(dyn Fn(u64) + Sync),
-) -> Result<NoisyRun, String> {
+) -> Result<NoisyRun, RateNoiseError> {
     check_seconds(seconds)?;
     let start = Instant::now();
     let point = readout_point(plan, rate_dps)?;
@@ -432,7 +458,7 @@ pub fn run_noisy(
     })
 }
 
-fn output_run(series: &[f64], rate_hz: f64) -> Result<OutputRun, String> {
+fn output_run(series: &[f64], rate_hz: f64) -> Result<OutputRun, AllanError> {
     let mean_rate_dps = series.iter().sum::<f64>() / series.len().max(1) as f64;
     Ok(OutputRun {
         mean_rate_dps,
@@ -445,7 +471,7 @@ fn output_run(series: &[f64], rate_hz: f64) -> Result<OutputRun, String> {
 pub fn plan_and_predict(
     exp: &Experiment,
     rate_dps: f64,
-) -> Result<(Plan, RateNoisePrediction), String> {
+) -> Result<(Plan, RateNoisePrediction), RateNoiseError> {
     let plan = experiment::plan(exp)?;
     let prediction = predict(exp, &plan, rate_dps)?;
     Ok((plan, prediction))

@@ -75,7 +75,7 @@ impl AllanReport<'_> {
 /// Run the noisy readout and report its Allan deviation.
 pub fn run(args: &Args) -> Result<(), Failure> {
     let exp = super::experiment::load_experiment(&args.config)?;
-    rate_noise::check_seconds(args.seconds).map_err(Failure::Input)?;
+    rate_noise::check_seconds(args.seconds).map_err(Failure::input)?;
     let max_rate = gyrocal_sim::config::MAX_RATE_DPS;
     if !(args.rate_dps.is_finite() && args.rate_dps.abs() <= max_rate) {
         return Err(Failure::Input(format!(
@@ -87,7 +87,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         check_folder(dir)?;
     }
     let (plan, prediction) =
-        rate_noise::plan_and_predict(&exp, args.rate_dps).map_err(Failure::Input)?;
+        rate_noise::plan_and_predict(&exp, args.rate_dps).map_err(Failure::input)?;
     for w in &plan.warnings {
         eprintln!("warning: {w}");
     }
@@ -102,7 +102,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     );
     let tick = |n: u64| bar.inc(n);
     let run = rate_noise::run_noisy(&exp, &plan, args.rate_dps, args.seconds, &tick)
-        .map_err(Failure::Run)?;
+        .map_err(Failure::run)?;
     bar.finish_and_clear();
     let predicted_adev_dps = std::array::from_fn(|k| {
         run.outputs[k]

@@ -172,7 +172,7 @@ fn table(a: &NoiseAnalysis) -> AdevTable {
 
 /// Check the options against the setup; the full scale they give.
 fn full_scale(setup: &Setup, options: &Options) -> Result<f64, Error> {
-    crate::rate_noise::check_seconds(options.seconds).map_err(Error::Input)?;
+    crate::rate_noise::check_seconds(options.seconds).map_err(|e| Error::Input(e.to_string()))?;
     let max = crate::config::MAX_RATE_DPS;
     match options.full_scale_dps {
         Some(fs) if !(fs.is_finite() && fs > 0.0 && fs <= max) => Err(Error::Input(format!(
