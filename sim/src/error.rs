@@ -8,6 +8,7 @@
 use gyrocal_host::datasheet::DatasheetError;
 use gyrocal_host::device::CouplingOutOfRange;
 use gyrocal_regs::PlanError;
+use gyrocal_regs::map::BusError;
 
 /// What a leaf model refuses.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -242,6 +243,33 @@ pub enum AllanError {
 
 impl From<AllanError> for String {
     fn from(e: AllanError) -> Self {
+        e.to_string()
+    }
+}
+
+/// What a field scenario's step, or the scenario, fails on
+/// (`crate::field::scenario`).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum FieldError {
+    /// The scenario's configuration.
+    #[error(transparent)]
+    Config(#[from] ConfigError),
+    /// Planning the experiment, or building a board.
+    #[error(transparent)]
+    Run(#[from] RunError),
+    /// A host step (self-calibration, a measurement).
+    #[error(transparent)]
+    Host(#[from] gyrocal_host::Error),
+    /// The simulated board refused a register access.
+    #[error(transparent)]
+    Bus(#[from] BusError),
+    /// A baseline profile asked of a scenario without `[profile]`.
+    #[error("no profile")]
+    NoProfile,
+}
+
+impl From<FieldError> for String {
+    fn from(e: FieldError) -> Self {
         e.to_string()
     }
 }

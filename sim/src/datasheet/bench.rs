@@ -75,7 +75,7 @@ impl Bench {
             exp.noise.temperature_k = 0.0;
             fe.noise_lsb = 0.0;
         }
-        let mut board = scenario::board_at(&exp, &fe, at).map_err(Error::Run)?;
+        let mut board = scenario::board_at(&exp, &fe, at).map_err(|e| Error::Run(e.to_string()))?;
         board.program(&self.regs).map_err(run)?;
         board.set_rate(rate_dps.to_radians());
         Ok(board)

@@ -19,6 +19,7 @@ use crate::analog::{Analog, Watched};
 use crate::cosim::HostRegisters;
 use crate::drift::DeviceAt;
 use crate::engine::{Engine, ModelEngine};
+use crate::error::RunError;
 use crate::frontend::{Converters, FrontEnd, PickoffPhase};
 use crate::gyro::GyroModel;
 use crate::noise::ThermalNoise;
@@ -52,7 +53,7 @@ impl<E: Engine> SimBoard<E> {
         clock_hz: f64,
         phase_reference_hz: f64,
         profile: CarrierProfile,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, RunError> {
         let mut fe = front_end.clone();
         for k in 0..2 {
             fe.force_per_lsb[k] *= at.drive_gain[k];

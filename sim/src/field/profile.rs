@@ -198,7 +198,7 @@ pub fn run_profile(
     profile: &Profile,
     decimation: u32,
     clock_hz: f64,
-) -> Result<ProfileRun, String> {
+) -> Result<ProfileRun, gyrocal_host::Error> {
     let sample_s = f64::from(decimation) / clock_hz;
     let per_record = (profile.record_length_s() / sample_s).round().max(1.0) as usize;
     let records = ((profile.duration_s / (per_record as f64 * sample_s)).floor() as usize).max(1);
@@ -208,8 +208,7 @@ pub fn run_profile(
         let rate = profile.rate_dps_at((sample as f64 + 0.5) * sample_s);
         b.set_rate(rate.to_radians());
         applied.push(rate);
-    })
-    .map_err(|e| e.to_string())?;
+    })?;
     board.set_rate(0.0);
     let n = per_record as f64;
     let time_s: Vec<f64> = (0..records)

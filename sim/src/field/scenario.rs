@@ -33,7 +33,7 @@ use crate::config::Experiment;
 use crate::config::{Drive, Filter, Frontend, Points};
 use crate::drift::{DeviceAt, Drift};
 use crate::engine::Engine;
-use crate::error::{ConfigError, RunError};
+use crate::error::{ConfigError, FieldError, RunError};
 use crate::experiment;
 use crate::fit::{coverage_factor, linear_fit};
 use crate::frontend::FrontEnd;
@@ -428,7 +428,7 @@ pub fn build(exp: &Experiment) -> Result<(FrontEnd, Knowns), RunError> {
 }
 
 /// A fresh board at one step, on the model engine ([`board_on`]).
-pub fn board_at(exp: &Experiment, fe: &FrontEnd, at: &DeviceAt) -> Result<SimBoard, String> {
+pub fn board_at(exp: &Experiment, fe: &FrontEnd, at: &DeviceAt) -> Result<SimBoard, FieldError> {
     board_on(exp, fe, at)
 }
 
@@ -439,7 +439,7 @@ pub fn board_on<E: Engine>(
     exp: &Experiment,
     fe: &FrontEnd,
     at: &DeviceAt,
-) -> Result<SimBoard<E>, String> {
+) -> Result<SimBoard<E>, FieldError> {
     let reference = 0.5 * (exp.gyro.f1_hz + exp.gyro.f2_hz);
     let mut board = SimBoard::new(
         at,
@@ -451,9 +451,7 @@ pub fn board_on<E: Engine>(
     )?;
     // As a host does: wait until the core has filled its carrier tables
     // (GYRO_DRIVE_START_CLOCKS in the C header) before using it.
-    board
-        .wait_clocks(gyrocal_regs::datapath::DRIVE_START_CLOCKS)
-        .map_err(|e| e.to_string())?;
+    board.wait_clocks(gyrocal_regs::datapath::DRIVE_START_CLOCKS)?;
     Ok(board)
 }
 
@@ -466,21 +464,21 @@ fn settled_readout_board(
     knowns: &Knowns,
     op: &Operating,
     rate_dps: f64,
-) -> Result<SimBoard, String> {
+) -> Result<SimBoard, FieldError> {
     let mut board = board_at(exp, fe, at)?;
     program_readout(&mut board, knowns, op)?;
     board.set_rate(rate_dps.to_radians());
-    board
-        .wait_clocks(knowns.settle_clocks(TABLE_FIRST_TAUS))
-        .map_err(|e| e.to_string())?;
+    board.wait_clocks(knowns.settle_clocks(TABLE_FIRST_TAUS))?;
     Ok(board)
 }
 
-fn program_readout(board: &mut dyn Board, knowns: &Knowns, op: &Operating) -> Result<(), String> {
-    let (regs, _) = knowns
-        .registers(op.carrier_hz, None, op.amplitude, op.ref_lag_deg)
-        .map_err(|e| e.to_string())?;
-    board.program(&regs).map_err(|e| e.to_string())
+fn program_readout(
+    board: &mut dyn Board,
+    knowns: &Knowns,
+    op: &Operating,
+) -> Result<(), FieldError> {
+    let (regs, _) = knowns.registers(op.carrier_hz, None, op.amplitude, op.ref_lag_deg)?;
+    Ok(board.program(&regs)?)
 }
 
 /// Parts each rate-table window is cut into: the table's slope per part
@@ -510,7 +508,7 @@ fn table_point(
     knowns: &Knowns,
     op: &Operating,
     rate_dps: f64,
-) -> Result<(Vec<[f64; 2]>, u64), String> {
+) -> Result<(Vec<[f64; 2]>, u64), FieldError> {
     let mut board = settled_readout_board(exp, fe, at, knowns, op, rate_dps)?;
     let r = knowns.filter.decimation;
     let w = TABLE_WINDOWS;
@@ -522,8 +520,7 @@ fn table_point(
         length,
         TABLE_PARTS * w,
         Signal::Steady,
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     Ok((parts, board.cycle()))
 }
 
@@ -592,12 +589,12 @@ pub fn rate_table(
     at: &DeviceAt,
     knowns: &Knowns,
     op: &Operating,
-) -> Result<(RateTable, u64), String> {
+) -> Result<(RateTable, u64), FieldError> {
     let points: Vec<(Vec<[f64; 2]>, u64)> = knowns
         .rates_dps
         .par_iter()
         .map(|&rate| table_point(exp, fe, at, knowns, op, rate))
-        .collect::<Result<_, String>>()?;
+        .collect::<Result<_, FieldError>>()?;
     let parts: Vec<Vec<[f64; 2]>> = points.iter().map(|p| p.0.clone()).collect();
     let clocks = points.iter().map(|p| p.1).sum();
     Ok((RateTable::from_parts(&knowns.rates_dps, &parts), clocks))
@@ -621,28 +618,24 @@ struct Cycle {
 /// Self-calibrate a fresh board at `t`; with a profile, then switch to
 /// readout, measure the null at rest and run the profile on that board.
 /// The rate table at the cycle's settings follows (its rates in parallel).
-fn cycle_at(sc: &Scenario, fe: &FrontEnd, knowns: &Knowns, t: f64) -> Result<Cycle, String> {
+fn cycle_at(sc: &Scenario, fe: &FrontEnd, knowns: &Knowns, t: f64) -> Result<Cycle, FieldError> {
     let at = sc.drift.at(&sc.exp.gyro, t);
     let mut board = board_at(&sc.exp, fe, &at)?;
-    let e = |e: gyrocal_host::Error| e.to_string();
-    let mut cal = selfcal::self_calibrate(&mut board, knowns, &knowns.nominal).map_err(e)?;
+    let mut cal = selfcal::self_calibrate(&mut board, knowns, &knowns.nominal)?;
     if let Some(probe) = &sc.drive_probe {
         board.set_rate(probe.rate_dps.to_radians());
-        let measured =
-            drive_ratio::measure(&mut board, knowns, &cal.operating, &cal.identified).map_err(e)?;
+        let measured = drive_ratio::measure(&mut board, knowns, &cal.operating, &cal.identified)?;
         board.set_rate(0.0);
-        selfcal::apply_drive_ratio(knowns, &mut cal, measured).map_err(e)?;
+        selfcal::apply_drive_ratio(knowns, &mut cal, measured)?;
     }
     let readout = match &sc.profile {
         None => None,
         Some(p) => {
             program_readout(&mut board, knowns, &cal.operating)?;
-            board
-                .wait_clocks(knowns.settle_clocks(TABLE_FIRST_TAUS))
-                .map_err(|e| e.to_string())?;
+            board.wait_clocks(knowns.settle_clocks(TABLE_FIRST_TAUS))?;
             let r = knowns.filter.decimation;
             let length = (knowns.filter.min_window_s * knowns.clock_hz).ceil();
-            let null = profile::readout_null(&mut board, r, length).map_err(e)?;
+            let null = profile::readout_null(&mut board, r, length)?;
             Some((
                 null,
                 profile::run_profile(&mut board, p, r, knowns.clock_hz)?,
@@ -683,7 +676,7 @@ enum Done {
 
 /// Every step but the first (at T0 the factory's settings are its own)
 /// whose own cycle finished.
-fn jobs(cycles: &[Result<Cycle, String>], rates: usize, with_profile: bool) -> Vec<Job> {
+fn jobs(cycles: &[Result<Cycle, FieldError>], rates: usize, with_profile: bool) -> Vec<Job> {
     let mut jobs = vec![];
     for step in (1..cycles.len()).filter(|&i| cycles[i].is_ok()) {
         jobs.extend((0..rates).map(|rate| Job::Factory { step, rate }));
@@ -725,7 +718,7 @@ fn run_cycles(
     fe: &FrontEnd,
     knowns: &Knowns,
     progress: &(dyn Fn(&str) + Sync),
-) -> Vec<Result<Cycle, String>> {
+) -> Vec<Result<Cycle, FieldError>> {
     sc.drift
         .temperatures_c
         .par_iter()
@@ -751,13 +744,13 @@ fn run_jobs(
     fe: &FrontEnd,
     knowns: &Knowns,
     factory: &Operating,
-    cycles: &[Result<Cycle, String>],
+    cycles: &[Result<Cycle, FieldError>],
     jobs: &[Job],
-) -> Vec<Result<(Done, u64), String>> {
+) -> Vec<Result<(Done, u64), FieldError>> {
     let exp = &sc.exp;
     let rates = &knowns.rates_dps;
     jobs.par_iter()
-        .map(|job| -> Result<(Done, u64), String> {
+        .map(|job| -> Result<(Done, u64), FieldError> {
             let at = &cycles[job.step()].as_ref().map_err(Clone::clone)?.at;
             match *job {
                 Job::Factory { rate, .. } => {
@@ -765,7 +758,7 @@ fn run_jobs(
                     Ok((Done::Point(mean_of_parts(&parts)), n))
                 }
                 Job::BaselineProfile { .. } => {
-                    let p = sc.profile.as_ref().ok_or("no profile")?;
+                    let p = sc.profile.as_ref().ok_or(FieldError::NoProfile)?;
                     let mut board = settled_readout_board(exp, fe, at, knowns, factory, 0.0)?;
                     let r = knowns.filter.decimation;
                     let run = profile::run_profile(&mut board, p, r, knowns.clock_hz)?;
@@ -785,7 +778,7 @@ fn run_jobs(
 /// other steps stand; without the factory calibration (the first step
 /// failed) no step has a baseline. Only a scenario that cannot start (its
 /// board or the host's knowledge cannot be built) is an error.
-pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldReport, String> {
+pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldReport, FieldError> {
     let (exp, drift) = (&sc.exp, &sc.drift);
     exp.validate()?;
     drift.validate()?;
@@ -825,7 +818,7 @@ pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldRepor
                 failed.push(StepFailure {
                     temperature_c: t,
                     stage: FAILED_CYCLE,
-                    error,
+                    error: error.to_string(),
                 });
                 continue;
             }
@@ -836,7 +829,7 @@ pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldRepor
                     failed.push(StepFailure {
                         temperature_c: t,
                         stage: FAILED_BASELINE,
-                        error,
+                        error: error.to_string(),
                     })
                 })
                 .ok()
@@ -878,9 +871,9 @@ fn baseline_of<'a>(
     c: &Cycle,
     f: &Factory,
     jobs: &[Job],
-    done: &'a [Result<(Done, u64), String>],
+    done: &'a [Result<(Done, u64), FieldError>],
     rates: &[f64],
-) -> Result<Baseline<'a>, String> {
+) -> Result<Baseline<'a>, FieldError> {
     if i == 0 {
         return Ok(Baseline {
             sf_fixed: c.truth.sf_per_dps,

@@ -95,7 +95,7 @@ impl DeviceFile {
     /// A powered-up board on engine `E` holding the device at `at`
     /// (`scenario::board_on`: the drives have started).
     pub fn board<E: Engine>(&self, at: &DeviceAt) -> Result<SimBoard<E>, String> {
-        scenario::board_on(&self.exp, &self.front_end()?, at)
+        Ok(scenario::board_on(&self.exp, &self.front_end()?, at)?)
     }
 }
 

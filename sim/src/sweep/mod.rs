@@ -24,6 +24,7 @@
 pub mod spread;
 pub mod summary;
 
+use crate::error::FieldError;
 use crate::field::scenario::{self, IdentifiedJson, Scenario};
 use crate::gyro::GyroParams;
 use rayon::prelude::*;
@@ -265,13 +266,13 @@ impl Sweep {
         let mut clocks = 0;
         let started = sc
             .validate()
-            .map_err(String::from)
+            .map_err(FieldError::from)
             .and_then(|()| scenario::run(&sc, &|_| {}));
         match started {
             Err(error) => failed.push(DeviceFailure {
                 temperature_c: None,
                 stage: "device".into(),
-                error,
+                error: error.to_string(),
             }),
             Ok(report) => {
                 clocks = report.clocks;

@@ -150,7 +150,7 @@ fn in_process(
     eprintln!("rate table at the calibrated carrier and phase (the truth)");
     let fe = file.front_end().map_err(Failure::Run)?;
     let (table, clocks) =
-        scenario::rate_table(&file.exp, &fe, &at, knowns, &cal.operating).map_err(Failure::Run)?;
+        scenario::rate_table(&file.exp, &fe, &at, knowns, &cal.operating).map_err(Failure::run)?;
     Ok(Outcome {
         board: "in-process".into(),
         cal,
