@@ -48,12 +48,6 @@ impl ModelError {
     }
 }
 
-impl From<ModelError> for String {
-    fn from(e: ModelError) -> Self {
-        e.to_string()
-    }
-}
-
 /// What choosing or starting an engine refuses.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
 pub enum EngineError {
@@ -66,12 +60,6 @@ pub enum EngineError {
     /// The Verilated model could not be allocated.
     #[error("cannot create the Verilated model")]
     NotCreated,
-}
-
-impl From<EngineError> for String {
-    fn from(e: EngineError) -> Self {
-        e.to_string()
-    }
 }
 
 /// What the checks of a configuration file refuse (`crate::config`):
@@ -151,12 +139,6 @@ impl ConfigError {
     }
 }
 
-impl From<ConfigError> for String {
-    fn from(e: ConfigError) -> Self {
-        e.to_string()
-    }
-}
-
 /// What planning or running an experiment's points refuses
 /// (`crate::experiment`).
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -179,12 +161,6 @@ pub enum RunError {
     /// A drive amplitude that rounds to no DAC word.
     #[error("[drive] amplitude1, amplitude2: both drives need at least one DAC LSB")]
     DrivesBelowOneLsb,
-}
-
-impl From<RunError> for String {
-    fn from(e: RunError) -> Self {
-        e.to_string()
-    }
 }
 
 /// What the Allan deviation and the noise fit of a rate series refuse
@@ -241,12 +217,6 @@ pub enum AllanError {
     },
 }
 
-impl From<AllanError> for String {
-    fn from(e: AllanError) -> Self {
-        e.to_string()
-    }
-}
-
 /// What a field scenario's step, or the scenario, fails on
 /// (`crate::field::scenario`).
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -268,8 +238,23 @@ pub enum FieldError {
     NoProfile,
 }
 
-impl From<FieldError> for String {
-    fn from(e: FieldError) -> Self {
-        e.to_string()
-    }
+/// `From<E> for String` for each error: the layers above that still
+/// speak `String` take any of them with `?`, as its one-line message.
+macro_rules! into_message {
+    ($($error:ty),*) => {
+        $(impl From<$error> for String {
+            fn from(e: $error) -> Self {
+                e.to_string()
+            }
+        })*
+    };
 }
+
+into_message!(
+    ModelError,
+    EngineError,
+    ConfigError,
+    RunError,
+    AllanError,
+    FieldError
+);
