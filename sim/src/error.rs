@@ -1,9 +1,11 @@
-//! Typed errors of the simulator's leaf models (the gyroscope, its
-//! thermal noise and the converters, the path a sample takes from the DAC
-//! to the ADC), of the engines and of a configuration file's checks. Each
-//! message is one line naming what is wrong and what is allowed. The
-//! layers above still speak `String`: `From` turns each into its message,
-//! so `?` carries it up unchanged.
+//! Typed errors of the simulator, from the leaves up: the models of the
+//! analog side (`ModelError`: the gyroscope, its thermal noise, the
+//! converters), the engines (`EngineError`), a configuration file's
+//! checks (`ConfigError`), planning and running an experiment's points
+//! (`RunError`), the Allan deviation (`AllanError`) and the field
+//! scenario's steps (`FieldError`). Each message is one line naming what
+//! is wrong and what is allowed. The few layers that still speak `String`
+//! (the server's requests) take any of them with `?`, as its message.
 
 use gyrocal_host::datasheet::DatasheetError;
 use gyrocal_host::device::CouplingOutOfRange;
