@@ -147,6 +147,7 @@ impl Converters {
     /// Standard normal draws for `clocks` clocks into `out` (cleared
     /// first), both channels' of a clock in turn, the order `step` draws
     /// them; false (and nothing drawn) without noise.
+    #[inline(always)]
     pub fn draw_noise(&mut self, clocks: usize, out: &mut Vec<f64>) -> bool {
         out.clear();
         match &mut self.noise {
