@@ -78,10 +78,8 @@ pub const MAX_LATENCY: u32 = 31;
 #[derive(Clone, Debug)]
 pub struct Converters {
     config: FrontEnd,
-    dac_ring: [(i16, i16); MAX_LATENCY as usize + 1],
-    adc_ring: [(i16, i16); MAX_LATENCY as usize + 1],
-    dac_head: usize,
-    adc_head: usize,
+    dac_ring: LatencyRing,
+    adc_ring: LatencyRing,
     dac_mask: i16,
     adc_step_inv: f64,
     /// Lowest and highest ADC code, -2^(bits-1) and 2^(bits-1) - 1.
@@ -125,10 +123,8 @@ impl Converters {
         }
         Ok(Self {
             config: config.clone(),
-            dac_ring: [(0, 0); MAX_LATENCY as usize + 1],
-            adc_ring: [(0, 0); MAX_LATENCY as usize + 1],
-            dac_head: 0,
-            adc_head: 0,
+            dac_ring: LatencyRing::default(),
+            adc_ring: LatencyRing::default(),
             dac_mask: !((1i32 << (16 - config.dac_bits)) - 1) as i16,
             adc_step_inv: 1.0 / f64::from(1u32 << (16 - config.adc_bits)),
             adc_code_range: (
@@ -200,10 +196,7 @@ impl Converters {
     #[inline(always)]
     pub fn adc_step(&mut self, x: (f64, f64), g: (f64, f64)) -> (i16, i16) {
         let sample = (self.convert(0, x.0, g.0), self.convert(1, x.1, g.1));
-        let n = self.adc_ring.len();
-        self.adc_head = (self.adc_head + 1) % n;
-        self.adc_ring[self.adc_head] = sample;
-        self.adc_ring[(self.adc_head + n - self.config.adc_latency as usize) % n]
+        self.adc_ring.delay(sample, self.config.adc_latency)
     }
 
     /// `adc_step` over a block: the ADC words during the clocks whose
@@ -214,15 +207,12 @@ impl Converters {
     #[inline(always)]
     pub fn adc_block(&mut self, x: &[(f64, f64)], g: &[f64], out: &mut [(i16, i16)]) {
         debug_assert!(x.len() == out.len() && g.len() == 2 * out.len());
-        let n = self.adc_ring.len();
-        let back = n - self.config.adc_latency as usize;
-        let (mut ring, mut head) = (self.adc_ring, self.adc_head);
+        let (mut ring, latency) = (self.adc_ring, self.config.adc_latency);
         for ((o, &x), g) in out.iter_mut().zip(x).zip(g.chunks_exact(2)) {
-            head = (head + 1) % n;
-            ring[head] = (self.convert(0, x.0, g[0]), self.convert(1, x.1, g[1]));
-            *o = ring[(head + back) % n];
+            let sample = (self.convert(0, x.0, g[0]), self.convert(1, x.1, g[1]));
+            *o = ring.delay(sample, latency);
         }
-        (self.adc_ring, self.adc_head) = (ring, head);
+        self.adc_ring = ring;
     }
 
     /// `dac_step` over a block: `forces[k]`, the forces held over clock k
@@ -235,32 +225,55 @@ impl Converters {
         forces: &mut [(f64, f64)],
     ) -> usize {
         let mut clocks = 0;
-        let n = self.dac_ring.len();
-        let back = n - self.config.dac_latency as usize;
-        let (mask, gain) = (self.dac_mask, self.config.force_per_lsb);
-        let (mut ring, mut head) = (self.dac_ring, self.dac_head);
+        let (mut ring, latency) = (self.dac_ring, self.config.dac_latency);
         for (f, d) in forces.iter_mut().zip(dac) {
-            head = (head + 1) % n;
-            ring[head] = (d.0 & mask, d.1 & mask);
-            let held = ring[(head + back) % n];
-            *f = (held.0 as f64 * gain[0], held.1 as f64 * gain[1]);
+            *f = self.force(ring.delay(self.dac_word(d), latency));
             clocks += 1;
         }
-        (self.dac_ring, self.dac_head) = (ring, head);
+        self.dac_ring = ring;
         clocks
     }
 
     /// The DAC half of `step`: the forces held over this clock.
     #[inline(always)]
     pub fn dac_step(&mut self, dac: (i16, i16)) -> (f64, f64) {
-        let n = self.dac_ring.len();
-        self.dac_head = (self.dac_head + 1) % n;
-        self.dac_ring[self.dac_head] = (dac.0 & self.dac_mask, dac.1 & self.dac_mask);
-        let held = self.dac_ring[(self.dac_head + n - self.config.dac_latency as usize) % n];
-        (
-            held.0 as f64 * self.config.force_per_lsb[0],
-            held.1 as f64 * self.config.force_per_lsb[1],
-        )
+        let word = self.dac_word(dac);
+        let held = self.dac_ring.delay(word, self.config.dac_latency);
+        self.force(held)
+    }
+
+    /// The DAC's word: `dac` narrowed to its bits.
+    #[inline(always)]
+    fn dac_word(&self, dac: (i16, i16)) -> (i16, i16) {
+        (dac.0 & self.dac_mask, dac.1 & self.dac_mask)
+    }
+
+    /// The forces (N/kg) of the held DAC words.
+    #[inline(always)]
+    fn force(&self, held: (i16, i16)) -> (f64, f64) {
+        let gain = self.config.force_per_lsb;
+        (held.0 as f64 * gain[0], held.1 as f64 * gain[1])
+    }
+}
+
+/// A converter's latency: the words of the last `MAX_LATENCY + 1` clocks.
+/// Small and `Copy`, so a block can keep it in locals (`adc_block`,
+/// `dac_block`) while a clock's step updates it in place.
+#[derive(Clone, Copy, Debug, Default)]
+struct LatencyRing {
+    words: [(i16, i16); MAX_LATENCY as usize + 1],
+    head: usize,
+}
+
+impl LatencyRing {
+    /// Enters `word` and returns the one entered `latency` clocks ago
+    /// (`word` itself for 0).
+    #[inline(always)]
+    fn delay(&mut self, word: (i16, i16), latency: u32) -> (i16, i16) {
+        let n = self.words.len();
+        self.head = (self.head + 1) % n;
+        self.words[self.head] = word;
+        self.words[(self.head + n - latency as usize) % n]
     }
 }
 
