@@ -35,11 +35,6 @@ pub enum PlotError {
 }
 
 impl PlotError {
-    /// A backend's error, as its message.
-    pub fn backend(e: impl std::fmt::Display) -> Self {
-        PlotError::Backend(e.to_string())
-    }
-
     /// Writing `path` failed with `e`.
     pub fn write(path: &std::path::Path, e: impl std::fmt::Display) -> Self {
         PlotError::Write {

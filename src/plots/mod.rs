@@ -270,15 +270,15 @@ fn render_png<P: Plot>(plot: &P, (w, h): (u32, u32)) -> Result<Vec<u8>, PlotErro
     {
         let root = BitMapBackend::with_buffer(&mut rgb, (w, h)).into_drawing_area();
         plot.draw_on(&root)?;
-        root.present().map_err(PlotError::backend)?;
+        root.present().map_err(err)?;
     }
     let mut out = vec![];
     let mut encoder = png::Encoder::new(&mut out, w, h);
     encoder.set_color(png::ColorType::Rgb);
     encoder.set_depth(png::BitDepth::Eight);
-    let mut writer = encoder.write_header().map_err(PlotError::backend)?;
-    writer.write_image_data(&rgb).map_err(PlotError::backend)?;
-    writer.finish().map_err(PlotError::backend)?;
+    let mut writer = encoder.write_header().map_err(err)?;
+    writer.write_image_data(&rgb).map_err(err)?;
+    writer.finish().map_err(err)?;
     Ok(out)
 }
 
@@ -287,11 +287,12 @@ fn render_svg<P: Plot>(plot: &P, size: (u32, u32)) -> Result<String, PlotError> 
     {
         let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
         plot.draw_on(&root)?;
-        root.present().map_err(PlotError::backend)?;
+        root.present().map_err(err)?;
     }
     Ok(svg)
 }
 
+/// A drawing backend's or encoder's error, as its message.
 fn err<E: std::fmt::Display>(e: E) -> PlotError {
-    PlotError::backend(e)
+    PlotError::Backend(e.to_string())
 }
