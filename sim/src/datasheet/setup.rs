@@ -7,6 +7,7 @@
 use super::Error;
 use crate::config::{self, Drive, Experiment, Filter, Frontend, NoiseModel, Points};
 use crate::drift::Drift;
+use crate::error::ConfigError;
 use crate::gyro::GyroParams;
 use crate::rate_drift::RateNoise;
 use serde::Deserialize;
@@ -49,8 +50,8 @@ pub struct Setup {
 pub fn parse(name: &str, text: &str) -> Result<Setup, Error> {
     let file: SetupFile =
         toml::from_str(text).map_err(|e| Error::Input(config::parse_error(name, text, e)))?;
-    let input = |e: &dyn std::fmt::Display| Error::Input(format!("{name}: {e}"));
-    file.noise.validate().map_err(|e| input(&e))?;
+    let input = |e: ConfigError| Error::Input(format!("{name}: {e}"));
+    file.noise.validate().map_err(input)?;
     let exp = Experiment {
         gyro: file.gyro,
         drive: file.drive,
@@ -61,10 +62,10 @@ pub fn parse(name: &str, text: &str) -> Result<Setup, Error> {
         // The datasheet command measures the device; no host datasheet.
         datasheet: Default::default(),
     };
-    exp.validate().map_err(|e| input(&e))?;
-    exp.derived().map_err(|e| input(&e))?;
+    exp.validate().map_err(input)?;
+    exp.derived().map_err(input)?;
     if let Some(d) = &file.drift {
-        d.validate().map_err(|e| input(&e))?;
+        d.validate().map_err(input)?;
     }
     Ok(Setup {
         exp,
