@@ -92,6 +92,56 @@ fn a_coupled_device_self_calibrates_from_5_to_60_deg_c() {
     }
 }
 
+/// The coupling in deg/s is the stiffness the host measures turned with
+/// the datasheet's lambda (`gyrocal_host::identify::CouplingFigure`): a
+/// lambda 4% high puts the figure 4% low, 10 deg/s at 250, where the
+/// measurement's sigma is some 0.01 deg/s. With the datasheet saying 4%,
+/// the figure's sigma carries 4% of the value, and the error lies within 3
+/// of it (without that term it lay 900 of the measurement's sigmas off).
+/// The prediction turns the figure back with the same lambda, so lambda's
+/// error does not move it: the scale factors' budget moves the coupling by
+/// the measurement's sigma alone, which stays below 1 deg/s, while
+/// lambda's own term (4% of the ratio, `budget::angular_gain`) covers
+/// their error.
+#[test]
+fn a_datasheet_lambda_off_is_in_the_coupling_figures_sigma() {
+    let path = "tests/data/field_coupled.toml";
+    let text = std::fs::read_to_string(path).unwrap().replace(
+        "[datasheet]\n",
+        "[datasheet]\nangular_gain = 0.832\nangular_gain_uncertainty = 0.04\n",
+    );
+    let mut sc = scenario::parse(path, &text).unwrap();
+    sc.drift.temperatures_c = vec![25.0, 60.0];
+    let report = scenario::run(&sc, &|_| {}).unwrap();
+    assert!(report.failed.is_empty(), "{:?}", report.failed);
+    for s in &report.steps {
+        let id = &s.identified;
+        let figure = s.selfcal.identified.quadrature_dps.unwrap();
+        let truth = s.truth.gyro.quadrature_dps;
+        eprintln!(
+            "{} deg C: coupling {:.3} +- {:.3} deg/s (measurement {:.3}; true {truth:.3}), self-cal error {:+.4}% / {:+.4}% at {:.4}% / {:.4}%",
+            s.temperature_c,
+            id.quadrature_dps,
+            id.quadrature_dps_uncertainty,
+            figure.measurement_uncertainty,
+            100.0 * s.selfcal_error[0],
+            100.0 * s.selfcal_error[1],
+            100.0 * s.selfcal_error_uncertainty[0],
+            100.0 * s.selfcal_error_uncertainty[1],
+        );
+        assert!(
+            (id.quadrature_dps - truth).abs() <= 3.0 * id.quadrature_dps_uncertainty,
+            "{} deg C",
+            s.temperature_c
+        );
+        assert!(id.quadrature_dps_uncertainty >= 0.04 * id.quadrature_dps.abs());
+        assert!(figure.measurement_uncertainty < 1.0);
+        for k in 0..2 {
+            assert!(s.selfcal_error[k].abs() <= 3.0 * s.selfcal_error_uncertainty[k]);
+        }
+    }
+}
+
 /// While the coupled device turns (`[drive_probe]`, 200 deg/s), the
 /// measurement's identity picks up -(k - c) / (k + c), which moves its
 /// phase (about 50 deg here) but not its magnitude

@@ -35,7 +35,8 @@
 //! k / (2 lambda 2 pi f_1) rad/s = 180 k / (lambda f_1) deg/s and
 //! Omega_d = 180 Im / (lambda f_c) deg/s, with the datasheet's lambda. The
 //! prediction turns them back with the same lambda, so lambda's error
-//! does not enter.
+//! does not enter it; the figures in deg/s carry it
+//! ([`crate::identify::CouplingFigure`]).
 //!
 //! # Uncertainty
 //!

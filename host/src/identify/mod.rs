@@ -151,6 +151,55 @@ pub struct Estimate {
     pub uncertainty: f64,
 }
 
+/// A mode coupling measured at rest ([`crate::coupling`]), in deg/s at
+/// the datasheet's lambda: the host measures a stiffness (Hz^2) and turns
+/// it into deg/s with that lambda, so the figure is off by lambda's error
+/// against the device's coupling, while the prediction, which turns it
+/// back with the same lambda, does not see lambda at all.
+///
+/// ```
+/// use gyrocal_host::identify::{CouplingFigure, Estimate};
+/// // 3 deg/s measured to 0.02, lambda known to 2.5%: 0.075 from lambda.
+/// let c = CouplingFigure::new(Estimate { value: 3.0, uncertainty: 0.02 }, 0.025);
+/// assert!((c.uncertainty - 0.02f64.hypot(0.075)).abs() < 1e-15);
+/// assert_eq!(c.measurement_uncertainty, 0.02);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct CouplingFigure {
+    /// The coupling (deg/s).
+    pub value: f64,
+    /// Its 1-sigma against the device's coupling in deg/s: the
+    /// measurement's and lambda's (the datasheet's relative 1-sigma of
+    /// lambda times the value) in quadrature.
+    pub uncertainty: f64,
+    /// The measurement's 1-sigma alone (batch spread and the identified
+    /// resonators): what the prediction sees, and what the scale factor's
+    /// budget moves the coupling by (`selfcal::budget::identified`).
+    pub measurement_uncertainty: f64,
+}
+
+impl CouplingFigure {
+    /// The figure of `measured` (deg/s at the datasheet's lambda) for a
+    /// lambda of relative 1-sigma `angular_gain_relative`.
+    pub fn new(measured: Estimate, angular_gain_relative: f64) -> Self {
+        Self {
+            value: measured.value,
+            uncertainty: measured
+                .uncertainty
+                .hypot(measured.value * angular_gain_relative),
+            measurement_uncertainty: measured.uncertainty,
+        }
+    }
+
+    /// The measurement, without lambda's part.
+    pub fn measured(&self) -> Estimate {
+        Estimate {
+            value: self.value,
+            uncertainty: self.measurement_uncertainty,
+        }
+    }
+}
+
 /// One mode's fitted response.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ModeFit {
@@ -215,10 +264,10 @@ pub struct Identified {
     /// cross responses once the operating point is known
     /// ([`crate::coupling`]); `None` until then, when the datasheet's is
     /// used.
-    pub quadrature_dps: Option<Estimate>,
+    pub quadrature_dps: Option<CouplingFigure>,
     /// The damping coupling Omega_d (deg/s, the sign convention of
     /// `[gyro] damping_coupling_dps`), measured with it; `None` until then.
-    pub damping_coupling_dps: Option<Estimate>,
+    pub damping_coupling_dps: Option<CouplingFigure>,
     /// Clocks the identification took.
     pub clocks: u64,
 }

@@ -92,14 +92,16 @@ pub(super) fn identified(
         *[&mut g.f1_hz, &mut g.q1, &mut g.f2_hz, &mut g.q2][i] += sd;
         moved.push(predicted_ratio(knowns, &g, op, cal_hz)?);
     }
+    // The couplings by their measurement's sigma alone: the prediction
+    // turns them back into stiffness with the lambda that made the figure.
     if let Some(q) = id.quadrature_dps {
         let mut g = gyro.clone();
-        g.quadrature_dps += q.uncertainty;
+        g.quadrature_dps += q.measurement_uncertainty;
         moved.push(predicted_ratio(knowns, &g, op, cal_hz)?);
     }
     if let Some(d) = id.damping_coupling_dps {
         let mut g = gyro.clone();
-        g.damping_coupling_dps += d.uncertainty;
+        g.damping_coupling_dps += d.measurement_uncertainty;
         moved.push(predicted_ratio(knowns, &g, op, cal_hz)?);
     }
     if id.group_delay_s.uncertainty.is_finite() {

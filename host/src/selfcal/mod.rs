@@ -121,7 +121,7 @@ use crate::coupling;
 use crate::device::GyroParams;
 use crate::drive_ratio::{self, CrossWindows, DriveRatio};
 use crate::error::Error;
-use crate::identify::{self, Estimate, Identified};
+use crate::identify::{self, CouplingFigure, Estimate, Identified};
 use crate::knowns::Knowns;
 use gyrocal_regs::datapath::CarrierProfile;
 use gyrocal_regs::plan;
@@ -598,7 +598,11 @@ pub fn self_calibrate(
         let id = &mut cal.identified;
         for c in [&mut id.quadrature_dps, &mut id.damping_coupling_dps] {
             if let Some(c) = c.as_mut() {
-                c.value *= 2.0 / (r + 1.0 / r);
+                let measured = Estimate {
+                    value: c.value * 2.0 / (r + 1.0 / r),
+                    ..c.measured()
+                };
+                *c = CouplingFigure::new(measured, knowns.angular_gain_uncertainty);
             }
         }
         apply_drive_ratio(knowns, &mut cal, at_rest)?;
@@ -657,8 +661,10 @@ fn uncoupled(
         };
     }
     id = uncouple(&c)?;
-    id.quadrature_dps = Some(c.quadrature_dps);
-    id.damping_coupling_dps = Some(c.damping_dps);
+    // Figures in deg/s: lambda's 1-sigma is the datasheet's.
+    let figure = |e| CouplingFigure::new(e, knowns.angular_gain_uncertainty);
+    id.quadrature_dps = Some(figure(c.quadrature_dps));
+    id.damping_coupling_dps = Some(figure(c.damping_dps));
     Ok(id)
 }
 

@@ -43,7 +43,7 @@ use crate::sweep::spread::Spread;
 use gyrocal_host::Knowns;
 use gyrocal_host::datasheet::Datasheet;
 use gyrocal_host::drive_ratio;
-use gyrocal_host::identify::Estimate;
+use gyrocal_host::identify::{CouplingFigure, Estimate};
 use gyrocal_host::sampling::{Signal, mean_of_parts, part_means};
 use gyrocal_host::selfcal::StaticFold;
 use gyrocal_host::selfcal::{self, Operating, SelfCal};
@@ -328,8 +328,15 @@ impl From<&SelfCal> for IdentifiedJson {
             value: f64::NAN,
             uncertainty: f64::NAN,
         };
-        let quadrature = id.quadrature_dps.unwrap_or(none);
-        let damping = id.damping_coupling_dps.unwrap_or(none);
+        // The figures' sigmas, lambda's part in them (`CouplingFigure`).
+        let figure = |c: Option<CouplingFigure>| {
+            c.map_or(none, |c| Estimate {
+                value: c.value,
+                uncertainty: c.uncertainty,
+            })
+        };
+        let quadrature = figure(id.quadrature_dps);
+        let damping = figure(id.damping_coupling_dps);
         Self {
             f1_hz: m1.f_hz.value,
             f1_hz_uncertainty: m1.f_hz.uncertainty,
