@@ -36,8 +36,8 @@
 //!   device share its identification, so the 160 count as 40 to 160
 //!   trials: at 96% a binomial standard deviation of 1.5 to 3%.
 //! - Every t within 3. The pinned devices hold it (99.4% within 2, largest
-//!   |t| 2.22, RMS 0.77); seeds up to 2100 (85 devices, 340 figures) give
-//!   97.1% within 2 and one beyond 3 (0.9 are expected in 340 figures of
+//!   |t| 2.21, RMS 0.73); seeds up to 2100 (85 devices, 340 figures) give
+//!   97.6% within 2 and one beyond 3 (0.9 are expected in 340 figures of
 //!   honest normal sigmas): seed 2096 (Q 154, 3.8 clocks per carrier),
 //!   output 1 at 35 deg C, -0.049% +- 0.014% (-3.4 sigma). Single runs
 //!   at other front-end lags (-0.013, -0.019, -0.049, -0.045, -0.040% at
@@ -140,8 +140,15 @@ fn t_values(r: &FieldReport) -> Vec<f64> {
         .collect()
 }
 
+/// The identified parameters with a truth, as `identified_t` names them.
+const IDENTIFIED: [&str; 5] = ["f1", "f2", "Q1", "Q2", "quadrature"];
+
+/// Those whose coverage the test asserts (`identified_coverage`).
+const ASSERTED: [&str; 4] = ["f1", "f2", "Q1", "Q2"];
+
 /// The identified parameters that have a truth, as (name, t = error /
-/// sigma) for each step: f1, f2, Q1, Q2 against the device at that step.
+/// sigma) for each step: f1, f2, Q1, Q2 and the quadrature coupling
+/// against the device at that step.
 fn identified_t(r: &FieldReport) -> Vec<(&'static str, f64)> {
     r.steps
         .iter()
@@ -152,6 +159,10 @@ fn identified_t(r: &FieldReport) -> Vec<(&'static str, f64)> {
                 ("f2", (id.f2_hz - g.f2_hz) / id.f2_hz_uncertainty),
                 ("Q1", (id.q1 - g.q1) / id.q1_uncertainty),
                 ("Q2", (id.q2 - g.q2) / id.q2_uncertainty),
+                (
+                    "quadrature",
+                    (id.quadrature_dps - g.quadrature_dps) / id.quadrature_dps_uncertainty,
+                ),
             ]
         })
         .collect()
@@ -184,6 +195,14 @@ fn describe(d: &RandomDevice, r: &FieldReport) -> String {
                 s.selfcal_error[k] / s.selfcal_error_uncertainty[k]
             );
         }
+    }
+    for s in &r.steps {
+        line += &format!(
+            " quadrature {:.4} +- {:.4} (true {:.4})",
+            s.identified.quadrature_dps,
+            s.identified.quadrature_dps_uncertainty,
+            s.truth.gyro.quadrature_dps
+        );
     }
     for f in &r.failed {
         line += &format!(
@@ -249,17 +268,21 @@ fn self_calibrated_scale_factors_lie_within_their_sigmas_as_promised() {
 /// (`identify::FrontEnd`, now in the fit's model; with the modes not
 /// resolved it is measured at probe points 8 bandwidths each side, where
 /// a first-order front end's +-100% had put those Q sigmas 40 times their
-/// errors). Pinned now: 99.1% within 2, largest |t| 2.71, RMS t f1 0.62,
-/// f2 0.73, Q1 0.66, Q2 0.60.
+/// errors). Pinned now: 98.4% within 2, largest |t| 2.49, RMS t f1 0.64,
+/// f2 0.70, Q1 0.74, Q2 0.59.
 fn identified_coverage(id_t: &[(&'static str, f64)]) {
-    let all: Vec<f64> = id_t.iter().map(|p| p.1).collect();
+    let all: Vec<f64> = id_t
+        .iter()
+        .filter(|p| ASSERTED.contains(&p.0))
+        .map(|p| p.1)
+        .collect();
     let (in2, worst, rms) = coverage(&all);
     eprintln!(
         "identified f and Q, {} figures: {:.1}% within 2 sigma, largest |t| {worst:.2}, RMS t {rms:.2}",
         all.len(),
         100.0 * in2
     );
-    for name in ["f1", "f2", "Q1", "Q2"] {
+    for name in IDENTIFIED {
         let t: Vec<f64> = id_t.iter().filter(|p| p.0 == name).map(|p| p.1).collect();
         let (in2, worst, rms) = coverage(&t);
         eprintln!(
@@ -273,11 +296,49 @@ fn identified_coverage(id_t: &[(&'static str, f64)]) {
         100.0 * in2
     );
     assert!(worst <= 3.0, "an identified parameter at {worst:.2} sigma");
-    for name in ["f1", "f2", "Q1", "Q2"] {
+    for name in ASSERTED {
         let t: Vec<f64> = id_t.iter().filter(|p| p.0 == name).map(|p| p.1).collect();
         let rms = coverage(&t).2;
         assert!(rms >= 0.3, "{name}: RMS t {rms:.2}, its sigma inflated");
     }
+    quadrature_coverage(id_t);
+}
+
+/// The quadrature coupling measured at rest (`gyrocal_host::coupling`),
+/// of the half of the devices that carry one and of the half that do not:
+/// its sigma is the spread of 8 batch estimates times the coverage factor
+/// of their 7 degrees of freedom, and in deg/s lambda's 1-sigma
+/// (`CouplingFigure`; exact here). Asserted: 90% to 99.5% within 2 and an
+/// RMS t of at least 0.3, as for f and Q; not yet every t within 3.
+///
+/// Pinned: 96.2% of 80 within 2, RMS t 0.83, largest |t| 3.40: seed 2011
+/// (modes matched, 3.6 deg/s) at 25 deg C, 3.804 +- 0.062 deg/s. Seeds
+/// 2001..2100 (170 figures): 97.6% within 2, that one beyond 3, RMS t
+/// 0.75, where honest sigmas from 7 degrees of freedom give 0.78. On seed
+/// 2011 over 48 noise seeds the estimates scatter 1.21 and 1.27 times
+/// their batch standard errors at the two steps; two sets of windows
+/// measured in a row on one board differ by 1.25 times theirs (80 pairs,
+/// alike at 1/4, 1 and 4 LSB of ADC noise): a term proportional to the
+/// noise and common to a window's batches, which their spread cannot see.
+/// Almost all of it is in the estimate from output 2 (the cross response
+/// to drive 1 at 1/8 of its amplitude, twelve times the noise of output
+/// 1's estimate there), while z itself, 2^20 samples of the difference of
+/// two noise seeds, is white to within 6% over a batch's 64 samples. Not
+/// found yet: on that device a figure lies beyond 3 of its sigmas some 2%
+/// of the time instead of 0.27%.
+fn quadrature_coverage(id_t: &[(&'static str, f64)]) {
+    let t: Vec<f64> = id_t
+        .iter()
+        .filter(|p| p.0 == "quadrature")
+        .map(|p| p.1)
+        .collect();
+    let (in2, _, rms) = coverage(&t);
+    assert!(
+        (0.90..=0.995).contains(&in2),
+        "quadrature: {:.1}% within 2 sigma",
+        100.0 * in2
+    );
+    assert!(rms >= 0.3, "quadrature: RMS t {rms:.2}, its sigma inflated");
 }
 
 /// The front end's gain slope across the calibration's sidebands
@@ -324,15 +385,24 @@ fn explore() {
     let (a, b) = seeds.split_once("..").expect("GYROCAL_FIELD_SEEDS=A..B");
     let range = a.parse::<u64>().unwrap()..b.parse::<u64>().unwrap();
     let mut t = vec![];
+    let mut id_t = vec![];
     for (d, r) in range.filter_map(field) {
         println!("{}", describe(&d, &r));
         t.extend(t_values(&r));
+        id_t.extend(identified_t(&r));
     }
-    let n = t.len() as f64;
-    println!(
-        "{} figures: {:.1}% within 2 sigma, {} beyond 3",
-        t.len(),
-        100.0 * t.iter().filter(|x| x.abs() <= 2.0).count() as f64 / n,
-        t.iter().filter(|x| x.abs() > 3.0).count()
-    );
+    let line = |what: &str, t: &[f64]| {
+        let n = t.len() as f64;
+        println!(
+            "{what}, {} figures: {:.1}% within 2 sigma, {} beyond 3",
+            t.len(),
+            100.0 * t.iter().filter(|x| x.abs() <= 2.0).count() as f64 / n,
+            t.iter().filter(|x| x.abs() > 3.0).count()
+        );
+    };
+    line("self-calibrated scale factors", &t);
+    for name in IDENTIFIED {
+        let t: Vec<f64> = id_t.iter().filter(|p| p.0 == name).map(|p| p.1).collect();
+        line(name, &t);
+    }
 }
