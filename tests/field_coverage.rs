@@ -315,17 +315,17 @@ fn identified_coverage(id_t: &[(&'static str, f64)]) {
 /// (modes matched, 3.6 deg/s) at 25 deg C, 3.804 +- 0.062 deg/s. Seeds
 /// 2001..2100 (170 figures): 97.6% within 2, that one beyond 3, RMS t
 /// 0.75, where honest sigmas from 7 degrees of freedom give 0.78. On seed
-/// 2011 over 48 noise seeds the estimates scatter 1.21 and 1.27 times
-/// their batch standard errors at the two steps; two sets of windows
-/// measured in a row on one board differ by 1.25 times theirs (80 pairs,
-/// alike at 1/4, 1 and 4 LSB of ADC noise): a term proportional to the
-/// noise and common to a window's batches, which their spread cannot see.
-/// Almost all of it is in the estimate from output 2 (the cross response
-/// to drive 1 at 1/8 of its amplitude, twelve times the noise of output
-/// 1's estimate there), while z itself, 2^20 samples of the difference of
-/// two noise seeds, is white to within 6% over a batch's 64 samples. Not
-/// found yet: on that device a figure lies beyond 3 of its sigmas some 2%
-/// of the time instead of 0.27%.
+/// 2011, two sets of windows measured in a row on one board (150 noise
+/// seeds, both steps: 300 pairs) differ by 1.107 +- 0.045 times their
+/// batch standard errors: output 1's estimate 1.01, output 2's (the cross
+/// response to drive 1 at 1/8 of its amplitude, twelve times the noise of
+/// output 1's there) 1.12, the z windows themselves 0.99 to 1.13. That is
+/// about what z's own memory leaves: adjacent batches share the output
+/// filter's (lag-one correlation 0.65 at 8 z samples, none beyond 24), which
+/// makes the spread of 8 batches of 64 samples 1.05 times too narrow, and
+/// z is white beyond (2^20 samples of the difference of two noise seeds:
+/// within 6% from 64 to 2048 samples). The 3.40 is then a Student t draw of
+/// some 5 (0.13% at 7 degrees of freedom) on a sigma some 10% small.
 fn quadrature_coverage(id_t: &[(&'static str, f64)]) {
     let t: Vec<f64> = id_t
         .iter()
