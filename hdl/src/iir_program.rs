@@ -130,14 +130,23 @@ impl Location {
     }
 }
 
-/// The physical RAM address of an address field at sample counter `base`.
+/// The physical RAM address of an address field at sample counter `base`
+/// (0..`ROTATING_SLOTS`): a rotating slot r becomes (r + base) mod 3, as
+/// one conditional subtraction, since r + base < 6 (the model runs this
+/// twice a clock, where a division by 3 was 4% of the datapath's time).
 #[inline(always)]
 pub fn physical_address(field: u8, base: u8) -> usize {
+    debug_assert!(base < ROTATING_SLOTS);
     let slot = (field >> 2) & 3;
     let slot = if slot == ROTATING_SLOTS {
         slot
     } else {
-        (slot + base) % ROTATING_SLOTS
+        let sum = slot + base;
+        if sum >= ROTATING_SLOTS {
+            sum - ROTATING_SLOTS
+        } else {
+            sum
+        }
     };
     ((field & !0b1100) | (slot << 2)) as usize
 }
@@ -633,6 +642,24 @@ impl Program {
 mod tests {
     use super::*;
     use crate::iir_lowpass::{LATENCY, SCHEDULE_CLOCKS};
+
+    /// Every field at every base: the rotating slot moves by the base
+    /// modulo 3, the fixed slot and the other bits stay.
+    #[test]
+    fn a_rotating_slot_moves_by_the_base_modulo_3() {
+        for base in 0..ROTATING_SLOTS {
+            for field in 0..=u8::MAX {
+                let slot = (field >> 2) & 3;
+                let moved = if slot == ROTATING_SLOTS {
+                    slot
+                } else {
+                    (slot + base) % ROTATING_SLOTS
+                };
+                let expected = (field & !0b1100) | (moved << 2);
+                assert_eq!(physical_address(field, base), usize::from(expected));
+            }
+        }
+    }
 
     #[test]
     fn constants_match_the_program() {
