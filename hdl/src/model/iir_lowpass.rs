@@ -57,6 +57,8 @@ pub struct IirLowpass {
     /// Outputs.
     z: [i64; 2],
     z_valid: bool,
+    /// `PROGRAM`'s words, dereferenced once instead of at every clock.
+    words: &'static [MicroWord],
 }
 
 impl Default for IirLowpass {
@@ -76,6 +78,7 @@ impl Default for IirLowpass {
             stage: [0; 6],
             z: [0; 2],
             z_valid: false,
+            words: &PROGRAM.words,
         }
     }
 }
@@ -121,7 +124,7 @@ impl IirLowpass {
             self.z_valid = false;
             return self.output();
         }
-        let w: MicroWord = PROGRAM.words[self.word];
+        let w: MicroWord = self.words[self.word];
         let accept = self.pc == 0 && x_valid;
         // Values at the rising edge, all from the current registers.
         let ram_q = self.ram[physical_address(w.read, self.base)];
@@ -171,7 +174,7 @@ impl IirLowpass {
         self.z_valid = w.publish;
         self.word = self.rom_q;
         self.rom_q = self.pc;
-        self.pc = if accept || (self.pc != 0 && self.pc + 1 < PROGRAM.words.len()) {
+        self.pc = if accept || (self.pc != 0 && self.pc + 1 < self.words.len()) {
             self.pc + 1
         } else {
             0
