@@ -55,8 +55,16 @@ impl DemodMux {
         if n > 1 {
             out[1] = held;
         }
-        for ((o, &x), &a) in out.iter_mut().skip(2).zip(adc).zip(aligned) {
-            *o = product(x, reference(a));
+        // The mux's choice outside the loop: two plain loops of products.
+        let pairs = out.iter_mut().skip(2).zip(adc).zip(aligned);
+        if select {
+            for ((o, &x), &a) in pairs {
+                *o = product(x, (a.1, a.0));
+            }
+        } else {
+            for ((o, &x), &a) in pairs {
+                *o = product(x, a);
+            }
         }
         self.w = if n == 1 {
             held

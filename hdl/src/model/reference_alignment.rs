@@ -65,8 +65,14 @@ impl ReferenceAlignment {
             }
         };
         out[0] = self.aligned;
-        for (t, o) in out[1..].iter_mut().enumerate() {
-            *o = reference(t);
+        // Cycles before the delay reach back into the ring; the rest copy
+        // the block's own references, a loop without a test.
+        let early = d.min(n - 1);
+        for (t, o) in out[1..=early].iter_mut().enumerate() {
+            *o = before(TAPS + t - d);
+        }
+        for (t, o) in out[1 + early..].iter_mut().enumerate() {
+            *o = refs(t);
         }
         self.aligned = reference(n - 1);
         let words: [(i16, i16); TAPS] = std::array::from_fn(|k| {
