@@ -309,17 +309,39 @@ impl AmMixer {
             let m = out.len();
             let turn = self.turn;
             let channel = |k: usize| turn ^ (k % 2 == 1);
+            // The channel alternates: picked by index, not by a branch.
             self.envelope.block(&mut envelope[..m], |k| {
-                if channel(k) {
-                    (amp.1, am[k].1)
-                } else {
-                    (amp.0, am[k].0)
-                }
+                let c = usize::from(channel(k));
+                ([amp.0, amp.1][c], [am[k].0, am[k].1][c])
             });
-            for (k, (f, &e)) in fa.iter_mut().zip(&envelope[..m]).enumerate() {
-                *f = self.fa;
-                latch(&mut self.fa, channel(k), e);
+            // F A latches alternate too: two cycles at a time, the first
+            // into the half `latch` chooses for cycle 0.
+            let mut first = (0i16, 0i16);
+            latch(&mut first, channel(0), 1);
+            let first_high = first.1 == 1;
+            let mut held = self.fa;
+            let mut pairs = fa[..m]
+                .chunks_exact_mut(2)
+                .zip(envelope[..m].chunks_exact(2));
+            for (f, e) in &mut pairs {
+                f[0] = held;
+                if first_high {
+                    held.1 = e[0]
+                } else {
+                    held.0 = e[0]
+                }
+                f[1] = held;
+                if first_high {
+                    held.0 = e[1]
+                } else {
+                    held.1 = e[1]
+                }
             }
+            if m % 2 == 1 {
+                fa[m - 1] = held;
+                latch(&mut held, channel(m - 1), envelope[m - 1]);
+            }
+            self.fa = held;
             self.turn = channel(m);
             self.products_block(&fa[..m], carriers, out);
         }
