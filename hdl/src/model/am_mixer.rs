@@ -320,10 +320,10 @@ impl AmMixer {
             latch(&mut first, channel(0), 1);
             let first_high = first.1 == 1;
             let mut held = self.fa;
-            let mut pairs = fa[..m]
+            let pairs = fa[..m]
                 .chunks_exact_mut(2)
                 .zip(envelope[..m].chunks_exact(2));
-            for (f, e) in &mut pairs {
+            for (f, e) in pairs {
                 f[0] = held;
                 if first_high {
                     held.1 = e[0]

@@ -52,6 +52,22 @@ pub fn turn() -> &'static Turn {
     })
 }
 
+/// The unfolded table as (sine, cosine) pairs: word `j` is `(turn()[j],
+/// turn()[j + TABLE_ENTRIES])`, the cosine a quarter turn on, so the four
+/// carriers of a clock are two reads instead of four (`table_carriers`).
+pub type Pairs = [(i16, i16); 4 * TABLE_ENTRIES];
+
+/// The pairs, built once per process from `turn()`.
+pub fn pairs() -> &'static Pairs {
+    static PAIRS: OnceLock<Box<Pairs>> = OnceLock::new();
+    PAIRS.get_or_init(|| {
+        let t = turn();
+        Box::new(std::array::from_fn(|j| {
+            (t[j], t[(j + TABLE_ENTRIES) & (4 * TABLE_ENTRIES - 1)])
+        }))
+    })
+}
+
 /// `table_sine(table(), phase, advance)` read from the unfolded table.
 #[inline(always)]
 pub fn turn_sine(turn: &Turn, phase: u32, advance: u8) -> i16 {
@@ -114,7 +130,7 @@ pub struct CarrierNco {
     count: u16,
     /// Outputs in flight.
     pipe: DelayRing<Carriers, LATENCY>,
-    turn: &'static Turn,
+    pairs: &'static Pairs,
     profile: CarrierProfile,
 }
 
@@ -131,7 +147,7 @@ impl CarrierNco {
             phase: 0,
             count: 0,
             pipe: DelayRing::default(),
-            turn: turn(),
+            pairs: pairs(),
             profile,
         }
     }
@@ -158,7 +174,7 @@ impl CarrierNco {
         let entering = if live {
             let reference = self.phase.wrapping_add(ref_offset);
             match self.profile {
-                CarrierProfile::Table => table_carriers(self.turn, self.phase, reference),
+                CarrierProfile::Table => table_carriers(self.pairs, self.phase, reference),
                 CarrierProfile::Fine => {
                     let ((drive_cos, drive_sin), (ref_cos, ref_sin)) =
                         (sine_pair(self.phase), sine_pair(reference));
@@ -203,10 +219,10 @@ impl CarrierNco {
     #[inline(always)]
     pub fn entering(&self, step: u32, ref_offset: u32) -> impl Fn(usize) -> Carriers + use<> {
         debug_assert!(self.blocks());
-        let (turn, phase) = (self.turn, self.phase);
+        let (pairs, phase) = (self.pairs, self.phase);
         move |k| {
             let drive = phase.wrapping_add(step.wrapping_mul(k as u32));
-            table_carriers(turn, drive, drive.wrapping_add(ref_offset))
+            table_carriers(pairs, drive, drive.wrapping_add(ref_offset))
         }
     }
 
@@ -227,14 +243,17 @@ impl CarrierNco {
     }
 }
 
-/// The table core's four carrier words at the drive and reference phases.
+/// The table core's four carrier words at the drive and reference phases:
+/// `turn_sine` at advance 1 (cosine) and 0 (sine) of each, read as pairs.
 #[inline(always)]
-fn table_carriers(t: &Turn, drive: u32, reference: u32) -> Carriers {
+fn table_carriers(p: &Pairs, drive: u32, reference: u32) -> Carriers {
+    let pair = |phase: u32| p[(phase >> PHASE_BELOW_INDEX) as usize & (4 * TABLE_ENTRIES - 1)];
+    let ((drive_sin, drive_cos), (ref_sin, ref_cos)) = (pair(drive), pair(reference));
     Carriers {
-        drive_cos: turn_sine(t, drive, 1).into(),
-        drive_sin: turn_sine(t, drive, 0).into(),
-        ref_cos: turn_sine(t, reference, 1).into(),
-        ref_sin: turn_sine(t, reference, 0).into(),
+        drive_cos: drive_cos.into(),
+        drive_sin: drive_sin.into(),
+        ref_cos: ref_cos.into(),
+        ref_sin: ref_sin.into(),
     }
 }
 
@@ -247,6 +266,29 @@ mod tests {
         CarrierProfile::{Fine, Table},
         calibration_word, carrier_table_word, q15_product, readout_word,
     };
+
+    /// The pairs the block reads are, at every phase interval of a turn,
+    /// the quarter table's sine and cosine (advance 0 and 1).
+    #[test]
+    fn the_pairs_are_the_quarter_tables_sine_and_cosine() {
+        let (quarter, p) = (table(), pairs());
+        for j in 0..4 * TABLE_ENTRIES as u32 {
+            for low in [0, (1 << PHASE_BELOW_INDEX) - 1] {
+                let phase = (j << PHASE_BELOW_INDEX) | low;
+                let c = table_carriers(p, phase, phase.wrapping_add(1 << 30));
+                assert_eq!(
+                    (c.drive_sin, c.drive_cos, c.ref_sin, c.ref_cos),
+                    (
+                        table_sine(quarter, phase, 0).into(),
+                        table_sine(quarter, phase, 1).into(),
+                        table_sine(quarter, phase, 1).into(),
+                        table_sine(quarter, phase, 2).into(),
+                    ),
+                    "phase {phase:#x}"
+                );
+            }
+        }
+    }
 
     /// The unfolded table reads, at every phase interval of a turn and
     /// every advance, the word the quarter table's lookup gives.
