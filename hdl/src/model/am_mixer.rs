@@ -2,7 +2,7 @@
 //! `crate::am_mixer::FineAmMixer`.
 
 use super::carrier_nco::Carriers;
-use super::delay_ring::latch_alternate;
+use super::delay_ring::{latch_alternate, latch_alternate_block};
 use super::notch_coefficient::NotchCoefficient;
 use super::q15_multiplier::{Q15Multiplier, product_in_flight, product_skip};
 use crate::carrier_multiplier::{FEEDBACK_SCALE, RESIDUE_DROP, SHIFT, WORD_LIMIT};
@@ -314,34 +314,8 @@ impl AmMixer {
                 let c = usize::from(channel(k));
                 ([amp.0, amp.1][c], [am[k].0, am[k].1][c])
             });
-            // F A latches alternate too: two cycles at a time, the first
-            // into the half `latch` chooses for cycle 0.
-            let mut first = (0i16, 0i16);
-            latch(&mut first, channel(0), 1);
-            let first_high = first.1 == 1;
-            let mut held = self.fa;
-            let pairs = fa[..m]
-                .chunks_exact_mut(2)
-                .zip(envelope[..m].chunks_exact(2));
-            for (f, e) in pairs {
-                f[0] = held;
-                if first_high {
-                    held.1 = e[0]
-                } else {
-                    held.0 = e[0]
-                }
-                f[1] = held;
-                if first_high {
-                    held.0 = e[1]
-                } else {
-                    held.1 = e[1]
-                }
-            }
-            if m % 2 == 1 {
-                fa[m - 1] = held;
-                latch(&mut held, channel(m - 1), envelope[m - 1]);
-            }
-            self.fa = held;
+            // F A latches alternate too.
+            latch_alternate_block(&mut self.fa, turn, LATENCY, &envelope[..m], &mut fa[..m]);
             self.turn = channel(m);
             self.products_block(&fa[..m], carriers, out);
         }

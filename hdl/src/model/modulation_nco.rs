@@ -1,6 +1,6 @@
 //! Bit-true model of `crate::modulation_nco::ModulationNco`.
 
-use super::delay_ring::latch_alternate;
+use super::delay_ring::{latch_alternate, latch_alternate_block};
 use super::sine::Sine;
 use crate::quarter_wave::PHASE_BELOW_INDEX;
 use crate::sine::LATENCY;
@@ -89,12 +89,8 @@ impl ModulationNco {
                     }),
                     None => self.sine.block(sines, |k| input(base + k)),
                 }
-                let mut turn = turn0 ^ (base % 2 == 1);
-                for (o, &s) in chunk.iter_mut().zip(sines.iter()) {
-                    *o = self.am;
-                    latch(&mut self.am, turn, s);
-                    turn = !turn;
-                }
+                let turn = turn0 ^ (base % 2 == 1);
+                latch_alternate_block(&mut self.am, turn, LATENCY, sines, chunk);
             }
         }
         self.turn = turn0 ^ (n % 2 == 1);
