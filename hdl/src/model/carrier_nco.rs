@@ -32,38 +32,47 @@ pub fn table() -> &'static Table {
     TABLE.get_or_init(|| Box::new(std::array::from_fn(entry)))
 }
 
-/// The quarter table as (sine, cosine) pairs over the first quadrant:
-/// word `r` is `(table()[r], table()[TABLE_ENTRIES - 1 - r])`, the sine
-/// and, mirrored, the cosine of interval r. The four carriers of a clock
-/// are two reads of it (`table_carriers`), and at 32 KB it stays in a
-/// core's first-level cache, where a table of the whole turn (64 KB, one
-/// word a read) did not.
-pub type Pairs = [(i16, i16); TABLE_ENTRIES];
+/// The carriers' table unfolded to a whole turn: word `j` is
+/// `table_sine(table(), j << PHASE_BELOW_INDEX, 0)`. The word of a phase
+/// depends only on its top `32 - PHASE_BELOW_INDEX` bits, so a lookup
+/// (`turn_sine`) is one read instead of the quadrant's mirror and sign
+/// around one: the model's shortcut, not the hardware's (which stores the
+/// quarter), equal word for word (a test reads every phase interval both
+/// ways).
+pub type Turn = [i16; 4 * TABLE_ENTRIES];
 
-/// The pairs, built once per process from `table()`.
-pub fn pairs() -> &'static Pairs {
-    static PAIRS: OnceLock<Box<Pairs>> = OnceLock::new();
-    PAIRS.get_or_init(|| {
+/// The unfolded table, built once per process from `table()`.
+pub fn turn() -> &'static Turn {
+    static TURN: OnceLock<Box<Turn>> = OnceLock::new();
+    TURN.get_or_init(|| {
         let t = table();
-        Box::new(std::array::from_fn(|r| (t[r], t[TABLE_ENTRIES - 1 - r])))
+        Box::new(std::array::from_fn(|j| {
+            table_sine(t, (j << PHASE_BELOW_INDEX) as u32, 0)
+        }))
     })
 }
 
-/// `(table_sine(table(), phase, 0), table_sine(table(), phase, 1))` from
-/// the pairs: in quadrant q the pair is rotated by q quarter turns, its
-/// halves swapped in odd quadrants and negated where `quarter_wave::lookup`
-/// negates, without a branch.
+/// The unfolded table as (sine, cosine) pairs: word `j` is `(turn()[j],
+/// turn()[j + TABLE_ENTRIES])`, the cosine a quarter turn on, so the four
+/// carriers of a clock are two reads instead of four (`table_carriers`).
+pub type Pairs = [(i16, i16); 4 * TABLE_ENTRIES];
+
+/// The pairs, built once per process from `turn()`.
+pub fn pairs() -> &'static Pairs {
+    static PAIRS: OnceLock<Box<Pairs>> = OnceLock::new();
+    PAIRS.get_or_init(|| {
+        let t = turn();
+        Box::new(std::array::from_fn(|j| {
+            (t[j], t[(j + TABLE_ENTRIES) & (4 * TABLE_ENTRIES - 1)])
+        }))
+    })
+}
+
+/// `table_sine(table(), phase, advance)` read from the unfolded table.
 #[inline(always)]
-fn sine_cosine(p: &Pairs, phase: u32) -> (i32, i32) {
-    let q = phase >> 30;
-    let (s, c) = p[(phase >> PHASE_BELOW_INDEX) as usize & (TABLE_ENTRIES - 1)];
-    let (s, c) = (i32::from(s), i32::from(c));
-    let odd = (q & 1) as i32;
-    let (a, b) = (s + odd * (c - s), c + odd * (s - c));
-    // Negative sine in quadrants 2 and 3, negative cosine in 1 and 2.
-    let sine_sign = 1 - (q & 2) as i32;
-    let cosine_sign = 1 - ((q + 1) & 2) as i32;
-    (sine_sign * a, cosine_sign * b)
+pub fn turn_sine(turn: &Turn, phase: u32, advance: u8) -> i16 {
+    let j = (phase >> PHASE_BELOW_INDEX) as usize + usize::from(advance) * TABLE_ENTRIES;
+    turn[j & (4 * TABLE_ENTRIES - 1)]
 }
 
 /// Carrier table entry `i`: a quarter of a ROM step from ROM centre i / 2,
@@ -235,16 +244,16 @@ impl CarrierNco {
 }
 
 /// The table core's four carrier words at the drive and reference phases:
-/// `table_sine` at advance 1 (cosine) and 0 (sine) of each, read as pairs.
+/// `turn_sine` at advance 1 (cosine) and 0 (sine) of each, read as pairs.
 #[inline(always)]
 fn table_carriers(p: &Pairs, drive: u32, reference: u32) -> Carriers {
-    let ((drive_sin, drive_cos), (ref_sin, ref_cos)) =
-        (sine_cosine(p, drive), sine_cosine(p, reference));
+    let pair = |phase: u32| p[(phase >> PHASE_BELOW_INDEX) as usize & (4 * TABLE_ENTRIES - 1)];
+    let ((drive_sin, drive_cos), (ref_sin, ref_cos)) = (pair(drive), pair(reference));
     Carriers {
-        drive_cos,
-        drive_sin,
-        ref_cos,
-        ref_sin,
+        drive_cos: drive_cos.into(),
+        drive_sin: drive_sin.into(),
+        ref_cos: ref_cos.into(),
+        ref_sin: ref_sin.into(),
     }
 }
 
@@ -281,6 +290,28 @@ mod tests {
         }
     }
 
+    /// The unfolded table reads, at every phase interval of a turn and
+    /// every advance, the word the quarter table's lookup gives.
+    #[test]
+    fn the_unfolded_table_is_the_quarter_tables_lookup() {
+        let (quarter, whole) = (table(), turn());
+        for j in 0..4 * TABLE_ENTRIES as u32 {
+            for low in [0, 1, (1 << PHASE_BELOW_INDEX) - 1] {
+                let phase = (j << PHASE_BELOW_INDEX) | low;
+                for advance in 0..4 {
+                    assert_eq!(
+                        turn_sine(whole, phase, advance),
+                        table_sine(quarter, phase, advance),
+                        "phase {phase:#x}, advance {advance}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// The host computes the table core's words without the gateware
+    /// (`gyrocal_regs::datapath::carrier_table_word`): every one is the
+    /// word this model's fill derives from the ROM's model.
     #[test]
     fn the_hosts_carrier_table_is_the_fill_s() {
         for (i, &v) in table().iter().enumerate() {
