@@ -32,47 +32,26 @@ pub fn table() -> &'static Table {
     TABLE.get_or_init(|| Box::new(std::array::from_fn(entry)))
 }
 
-/// The carriers' table unfolded to a whole turn: word `j` is
-/// `table_sine(table(), j << PHASE_BELOW_INDEX, 0)`. The word of a phase
-/// depends only on its top `32 - PHASE_BELOW_INDEX` bits, so a lookup
-/// (`turn_sine`) is one read instead of the quadrant's mirror and sign
-/// around one: the model's shortcut, not the hardware's (which stores the
-/// quarter), equal word for word (a test reads every phase interval both
-/// ways).
-pub type Turn = [i16; 4 * TABLE_ENTRIES];
-
-/// The unfolded table, built once per process from `table()`.
-pub fn turn() -> &'static Turn {
-    static TURN: OnceLock<Box<Turn>> = OnceLock::new();
-    TURN.get_or_init(|| {
-        let t = table();
-        Box::new(std::array::from_fn(|j| {
-            table_sine(t, (j << PHASE_BELOW_INDEX) as u32, 0)
-        }))
-    })
-}
-
-/// The unfolded table as (sine, cosine) pairs: word `j` is `(turn()[j],
-/// turn()[j + TABLE_ENTRIES])`, the cosine a quarter turn on, so the four
-/// carriers of a clock are two reads instead of four (`table_carriers`).
+/// The carriers' table unfolded to a whole turn as (sine, cosine) pairs:
+/// word `j` is `table_sine(table(), phase, 0)` and `(.., 1)` at the phase
+/// `j << PHASE_BELOW_INDEX`. The words of a phase depend only on its top
+/// `32 - PHASE_BELOW_INDEX` bits, so the four carriers of a clock are two
+/// reads (`table_carriers`) instead of four lookups with the quadrant's
+/// mirror and sign: the model's shortcut, not the hardware's (which stores
+/// the quarter), equal word for word (a test reads every phase interval
+/// both ways).
 pub type Pairs = [(i16, i16); 4 * TABLE_ENTRIES];
 
-/// The pairs, built once per process from `turn()`.
+/// The pairs, built once per process from `table()`.
 pub fn pairs() -> &'static Pairs {
     static PAIRS: OnceLock<Box<Pairs>> = OnceLock::new();
     PAIRS.get_or_init(|| {
-        let t = turn();
+        let t = table();
         Box::new(std::array::from_fn(|j| {
-            (t[j], t[(j + TABLE_ENTRIES) & (4 * TABLE_ENTRIES - 1)])
+            let phase = (j << PHASE_BELOW_INDEX) as u32;
+            (table_sine(t, phase, 0), table_sine(t, phase, 1))
         }))
     })
-}
-
-/// `table_sine(table(), phase, advance)` read from the unfolded table.
-#[inline(always)]
-pub fn turn_sine(turn: &Turn, phase: u32, advance: u8) -> i16 {
-    let j = (phase >> PHASE_BELOW_INDEX) as usize + usize::from(advance) * TABLE_ENTRIES;
-    turn[j & (4 * TABLE_ENTRIES - 1)]
 }
 
 /// Carrier table entry `i`: a quarter of a ROM step from ROM centre i / 2,
@@ -244,7 +223,7 @@ impl CarrierNco {
 }
 
 /// The table core's four carrier words at the drive and reference phases:
-/// `turn_sine` at advance 1 (cosine) and 0 (sine) of each, read as pairs.
+/// `table_sine` at advance 1 (cosine) and 0 (sine) of each, read as pairs.
 #[inline(always)]
 fn table_carriers(p: &Pairs, drive: u32, reference: u32) -> Carriers {
     let pair = |phase: u32| p[(phase >> PHASE_BELOW_INDEX) as usize & (4 * TABLE_ENTRIES - 1)];
@@ -290,28 +269,6 @@ mod tests {
         }
     }
 
-    /// The unfolded table reads, at every phase interval of a turn and
-    /// every advance, the word the quarter table's lookup gives.
-    #[test]
-    fn the_unfolded_table_is_the_quarter_tables_lookup() {
-        let (quarter, whole) = (table(), turn());
-        for j in 0..4 * TABLE_ENTRIES as u32 {
-            for low in [0, 1, (1 << PHASE_BELOW_INDEX) - 1] {
-                let phase = (j << PHASE_BELOW_INDEX) | low;
-                for advance in 0..4 {
-                    assert_eq!(
-                        turn_sine(whole, phase, advance),
-                        table_sine(quarter, phase, advance),
-                        "phase {phase:#x}, advance {advance}"
-                    );
-                }
-            }
-        }
-    }
-
-    /// The host computes the table core's words without the gateware
-    /// (`gyrocal_regs::datapath::carrier_table_word`): every one is the
-    /// word this model's fill derives from the ROM's model.
     #[test]
     fn the_hosts_carrier_table_is_the_fill_s() {
         for (i, &v) in table().iter().enumerate() {
