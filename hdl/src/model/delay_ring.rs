@@ -78,11 +78,18 @@ impl<T: Copy, const L: usize> DelayRing<T, L> {
 /// of `pair`, at an edge of `turn`.
 #[inline(always)]
 pub fn latch_alternate(pair: &mut (i16, i16), turn: bool, latency: usize, word: i16) {
-    if turn == (latency % 2 == 1) {
+    if latches_first(turn, latency) {
         pair.0 = word;
     } else {
         pair.1 = word;
     }
+}
+
+/// Whether a word leaving a pipeline of `latency` edges at an edge of
+/// `turn` goes into the pair's first half (channel 1's).
+#[inline(always)]
+fn latches_first(turn: bool, latency: usize) -> bool {
+    turn == (latency % 2 == 1)
 }
 
 /// `latch_alternate` over a run of edges whose turn alternates from
@@ -98,7 +105,7 @@ pub fn latch_alternate_block(
     out: &mut [(i16, i16)],
 ) {
     debug_assert_eq!(words.len(), out.len());
-    let first_low = turn == (latency % 2 == 1);
+    let first_low = latches_first(turn, latency);
     let mut held = *pair;
     for (o, w) in out.chunks_exact_mut(2).zip(words.chunks_exact(2)) {
         o[0] = held;
