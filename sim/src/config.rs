@@ -379,9 +379,12 @@ impl NoiseModel {
     }
 }
 
-/// The section a byte offset of `text` falls in.
+/// The section a byte offset of `text` falls in: the last header up to
+/// the end of its line (a header's own line is its section).
 fn section_at(text: &str, offset: usize) -> Option<String> {
-    text[..offset.min(text.len())]
+    let offset = offset.min(text.len());
+    let line_end = text[offset..].find('\n').map_or(text.len(), |n| offset + n);
+    text[..line_end]
         .lines()
         .rev()
         .map(str::trim)
@@ -941,7 +944,10 @@ mod tests {
                 REQUIRED.replace("q1 = 5000", "q1 = 5000\nbogus = 1"),
                 "c.toml line 5 in [gyro]: unknown field `bogus`",
             ),
-            (format!("[bogus]\nx = 1\n{REQUIRED}"), "c.toml line 1"),
+            (
+                format!("[bogus]\nx = 1\n{REQUIRED}"),
+                "c.toml line 1 in [bogus]: unknown field `bogus`",
+            ),
             (
                 REQUIRED.replace("carrier_hz = 1.0123e6", "carrier_hz = 30e6"),
                 "[drive] carrier_hz = 30000000",
