@@ -328,8 +328,9 @@ mod tests {
         }
     }
 
-    fn parse(text: &str) -> Result<Drift, String> {
-        let d: Drift = toml::from_str(text).map_err(|e| e.message().to_string())?;
+    fn parse(text: &str) -> Result<Drift, ConfigError> {
+        let d: Drift =
+            toml::from_str(text).map_err(|e| ConfigError::Syntax(e.message().to_string()))?;
         d.validate()?;
         Ok(d)
     }
@@ -467,7 +468,7 @@ mod tests {
             ),
         ];
         for (text, key) in cases {
-            let err = parse(text).expect_err(key);
+            let err = parse(text).expect_err(key).to_string();
             assert!(err.contains(key), "{key}: {err}");
             assert!(!err.trim_end().contains('\n'), "{err}");
         }

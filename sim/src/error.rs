@@ -2,10 +2,11 @@
 //! analog side (`ModelError`: the gyroscope, its thermal noise, the
 //! converters), the engines (`EngineError`), a configuration file's
 //! checks (`ConfigError`), planning and running an experiment's points
-//! (`RunError`), the Allan deviation (`AllanError`) and the field
-//! scenario's steps (`FieldError`). Each message is one line naming what
-//! is wrong and what is allowed. The few layers that still speak `String`
-//! (the server's requests) take any of them with `?`, as its message.
+//! (`RunError`), the Allan deviation (`AllanError`), the field
+//! scenario's file (`ScenarioError`) and steps (`FieldError`), and the
+//! device file of `gyrocal serve` and `gyrocal calibrate`
+//! (`DeviceError`). Each message is one line naming what
+//! is wrong and what is allowed.
 
 use gyrocal_host::datasheet::DatasheetError;
 use gyrocal_host::device::CouplingOutOfRange;
@@ -240,23 +241,69 @@ pub enum FieldError {
     NoProfile,
 }
 
-/// `From<E> for String` for each error: the layers above that still
-/// speak `String` take any of them with `?`, as its one-line message.
-macro_rules! into_message {
-    ($($error:ty),*) => {
-        $(impl From<$error> for String {
-            fn from(e: $error) -> Self {
-                e.to_string()
-            }
-        })*
-    };
+/// What reading a scenario file refuses (`crate::field::scenario::parse`,
+/// the sweep's and the device file's parsers): one line, led by the file.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ScenarioError {
+    /// The file is no TOML, or a key is unknown or of the wrong type:
+    /// the file, the line and the parser's message.
+    #[error("{0}")]
+    Syntax(String),
+    /// A key or a rule of its sections.
+    #[error("{file}: {error}")]
+    Invalid {
+        /// The file.
+        file: String,
+        /// The key or rule at fault.
+        error: ConfigError,
+    },
+    /// A `[spread]` in a file for `gyrocal field` (the file).
+    #[error(
+        "{0}: [spread] is read by `gyrocal sweep` (many devices); `gyrocal field` runs the file's one device: remove it"
+    )]
+    SpreadInField(String),
+    /// No `[drift]` in a file for `gyrocal field` (the file).
+    #[error(
+        "{0}: missing [drift]: `gyrocal field` needs its temperature steps (temperatures_c, tcf1_ppm_per_k, tcf2_ppm_per_k)"
+    )]
+    NoDrift(String),
 }
 
-into_message!(
-    ModelError,
-    EngineError,
-    ConfigError,
-    RunError,
-    AllanError,
-    FieldError
-);
+/// What the device of a `gyrocal serve` or `gyrocal calibrate` file
+/// refuses (`crate::serve::device`).
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum DeviceError {
+    /// The file, read as `gyrocal field` reads it (it has `[drift]`).
+    #[error(transparent)]
+    Scenario(#[from] ScenarioError),
+    /// The file, read as `gyrocal run` reads it.
+    #[error(transparent)]
+    Config(#[from] ConfigError),
+    /// A temperature asked of a file without `[drift]`.
+    #[error(
+        "temperature {0} deg C: the file has no [drift] section, its device is [gyro] at one temperature"
+    )]
+    NoDrift(f64),
+    /// A temperature out of the drift's range (`TEMPERATURE_RANGE_C`).
+    #[error("temperature {temperature_c} deg C: allowed {}..={}", range.0, range.1)]
+    Temperature {
+        /// The temperature asked (deg C).
+        temperature_c: f64,
+        /// The range allowed (deg C).
+        range: (f64, f64),
+    },
+    /// A temperature where the drift breaks a rule (a gain or Q at zero).
+    #[error("temperature {temperature_c} deg C: {error}")]
+    Drift {
+        /// The temperature asked (deg C).
+        temperature_c: f64,
+        /// The rule.
+        error: ConfigError,
+    },
+    /// Building the converters or the board.
+    #[error(transparent)]
+    Run(#[from] RunError),
+    /// Powering the board up.
+    #[error(transparent)]
+    Field(#[from] FieldError),
+}

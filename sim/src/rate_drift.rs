@@ -171,12 +171,13 @@ impl RateNoiseSource {
     /// The generator for `noise`, updated every `step_s` seconds, from the
     /// `[noise]` `seed` (its stream jumped past the Brownian noise's).
     /// Errors (one line) on a bad key or step.
-    pub fn new(noise: &RateNoise, step_s: f64, seed: u64) -> Result<Self, String> {
+    pub fn new(noise: &RateNoise, step_s: f64, seed: u64) -> Result<Self, ConfigError> {
         noise.validate()?;
         if !(step_s.is_finite() && step_s > 0.0 && 1.0 / step_s > FLICKER_LOW_HZ) {
-            return Err(format!(
-                "rate-noise update interval {step_s} s: must be > 0 and below {} s",
-                1.0 / FLICKER_LOW_HZ
+            return Err(ConfigError::rule(
+                "noise",
+                format!("rate-noise update interval {step_s} s"),
+                format!("must be > 0 and below {} s", 1.0 / FLICKER_LOW_HZ),
             ));
         }
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);

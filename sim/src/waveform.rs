@@ -114,7 +114,7 @@ impl Probe {
     }
 
     /// Parse a comma-separated list of names and groups.
-    pub fn parse_list(list: &str) -> Result<Vec<Probe>, String> {
+    pub fn parse_list(list: &str) -> Result<Vec<Probe>, ProbeError> {
         let mut out: Vec<Probe> = vec![];
         for item in list.split(',').map(str::trim).filter(|s| !s.is_empty()) {
             let add: Vec<Probe> = match item {
@@ -124,13 +124,7 @@ impl Probe {
                 "analog" => ANALOG.to_vec(),
                 name => match Probe::all().find(|p| p.name() == name) {
                     Some(p) => vec![p],
-                    None => {
-                        let names: Vec<&str> = Probe::all().map(Probe::name).collect();
-                        return Err(format!(
-                            "--vcd-signals: unknown signal {name:?}; allowed: all, ports, internals, analog, {}",
-                            names.join(", ")
-                        ));
-                    }
+                    None => return Err(ProbeError::UnknownSignal(name.into())),
                 },
             };
             for p in add {
@@ -140,19 +134,37 @@ impl Probe {
             }
         }
         if out.is_empty() {
-            return Err("--vcd-signals: empty selection".into());
+            return Err(ProbeError::Empty);
         }
         Ok(out)
     }
 }
 
+/// What the waveform's options (`--vcd-signals`, `--vcd-cycles`) refuse:
+/// one line naming the option.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum ProbeError {
+    /// A name that is no signal or group.
+    #[error("--vcd-signals: unknown signal {0:?}; allowed: all, ports, internals, analog, {names}", names = signal_names())]
+    UnknownSignal(String),
+    /// A list that names nothing.
+    #[error("--vcd-signals: empty selection")]
+    Empty,
+    /// A window that is not `START:END` within the limit (the text).
+    #[error(
+        "--vcd-cycles {0:?}: expected START:END in clocks with START < END and END - START <= {MAX_WINDOW}"
+    )]
+    Window(String),
+}
+
+/// Every signal's name, comma-separated.
+fn signal_names() -> String {
+    Probe::all().map(Probe::name).collect::<Vec<_>>().join(", ")
+}
+
 /// Parse `START:END` (clocks, END exclusive).
-pub fn parse_window(text: &str) -> Result<Range<u64>, String> {
-    let bad = || {
-        format!(
-            "--vcd-cycles {text:?}: expected START:END in clocks with START < END and END - START <= {MAX_WINDOW}"
-        )
-    };
+pub fn parse_window(text: &str) -> Result<Range<u64>, ProbeError> {
+    let bad = || ProbeError::Window(text.into());
     let (a, b) = text.split_once(':').ok_or_else(bad)?;
     let (a, b): (u64, u64) = (
         a.trim().parse().map_err(|_| bad())?,

@@ -97,8 +97,8 @@ impl RunOptions {
         let vcd = match &self.vcd {
             None => None,
             Some(path) => {
-                let window = parse_window(&self.vcd_cycles).map_err(Failure::Input)?;
-                let probes = Probe::parse_list(&self.vcd_signals).map_err(Failure::Input)?;
+                let window = parse_window(&self.vcd_cycles).map_err(Failure::input)?;
+                let probes = Probe::parse_list(&self.vcd_signals).map_err(Failure::input)?;
                 let points = exp.points.readout_rates_dps.len() + exp.points.cal_freqs_hz.len();
                 if self.vcd_point >= points {
                     return Err(Failure::Input(format!(

@@ -52,7 +52,7 @@ pub struct Args {
 /// Run the scenario.
 pub fn run(args: &Args) -> Result<(), Failure> {
     let (name, text) = super::experiment::read_config(&args.config)?;
-    let sc = scenario::parse(&name, &text).map_err(Failure::Input)?;
+    let sc = scenario::parse(&name, &text).map_err(Failure::input)?;
     let report = scenario::run(&sc, &|line| eprintln!("{line}")).map_err(Failure::run)?;
     eprintln!(
         "{} steps, {:.3e} clocks in {:.1} s wall",

@@ -54,7 +54,7 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         ));
     }
     let (name, text) = read_config(&args.config)?;
-    let file = device::parse(&name, &text).map_err(Failure::Input)?;
+    let file = device::parse(&name, &text).map_err(Failure::input)?;
     let at = file
         .at(args.temperature)
         .map_err(|e| Failure::Input(format!("--{e}")))?;
@@ -112,13 +112,16 @@ fn board(
     at: &DeviceAt,
     engine: EngineKind,
 ) -> Result<Box<dyn Board + Send>, Failure> {
-    let run = |e: String| Failure::Run(e);
     match engine {
         #[cfg(feature = "verilator")]
         EngineKind::Verilator => {
             use gyrocal_sim::verilator::VerilatorEngine;
-            Ok(Box::new(file.board::<VerilatorEngine>(at).map_err(run)?))
+            Ok(Box::new(
+                file.board::<VerilatorEngine>(at).map_err(Failure::run)?,
+            ))
         }
-        _ => Ok(Box::new(file.board::<ModelEngine>(at).map_err(run)?)),
+        _ => Ok(Box::new(
+            file.board::<ModelEngine>(at).map_err(Failure::run)?,
+        )),
     }
 }

@@ -54,7 +54,7 @@ pub fn run_series(
 ) -> Result<Series, Error> {
     let (block, rate_hz) = block(bench);
     let mut source = RateNoiseSource::new(rate_noise, 1.0 / rate_hz, bench.exp.noise.seed)
-        .map_err(Error::Input)?;
+        .map_err(|e| Error::Input(e.to_string()))?;
     let on = rate_noise.is_on();
     let first = if on { source.next_dps() } else { 0.0 };
     let mut board = bench.board(&bench.at0, first, false)?;

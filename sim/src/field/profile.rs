@@ -273,8 +273,9 @@ pub struct RateTrace {
 mod tests {
     use super::*;
 
-    fn profile(text: &str) -> Result<Profile, String> {
-        let p: Profile = toml::from_str(text).map_err(|e| e.message().to_string())?;
+    fn profile(text: &str) -> Result<Profile, ConfigError> {
+        let p: Profile =
+            toml::from_str(text).map_err(|e| ConfigError::Syntax(e.message().to_string()))?;
         p.validate(2e-5)?;
         Ok(p)
     }
@@ -322,7 +323,7 @@ mod tests {
             ),
         ];
         for (text, key) in cases {
-            let err = profile(text).expect_err(key);
+            let err = profile(text).expect_err(key).to_string();
             assert!(err.contains(key), "{key}: {err}");
             assert!(!err.trim_end().contains('\n'), "{err}");
         }

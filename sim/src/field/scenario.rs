@@ -29,11 +29,11 @@
 use super::board::{Board, SimBoard};
 use super::probe::DriveProbe;
 use super::profile::{self, Profile, ProfileRun, RateTrace};
-use crate::config::Experiment;
+use crate::config::{self, Experiment};
 use crate::config::{Drive, Filter, Frontend, Points};
 use crate::drift::{DeviceAt, Drift};
 use crate::engine::Engine;
-use crate::error::{ConfigError, FieldError, RunError};
+use crate::error::{ConfigError, FieldError, RunError, ScenarioError};
 use crate::experiment;
 use crate::fit::{coverage_factor, linear_fit};
 use crate::frontend::FrontEnd;
@@ -105,17 +105,13 @@ pub struct Scenario {
 /// `[profile]` (`Profile::validate`). Errors are one line; `name` labels
 /// them (the file path). A `[spread]` is refused: it is `gyrocal sweep`'s
 /// (`crate::sweep::parse`).
-pub fn parse(name: &str, text: &str) -> Result<Scenario, String> {
+pub fn parse(name: &str, text: &str) -> Result<Scenario, ScenarioError> {
     let (sc, spread, has_drift) = parse_file(name, text)?;
     if spread.is_some() {
-        return Err(format!(
-            "{name}: [spread] is read by `gyrocal sweep` (many devices); `gyrocal field` runs the file's one device: remove it"
-        ));
+        return Err(ScenarioError::SpreadInField(name.into()));
     }
     if !has_drift {
-        return Err(format!(
-            "{name}: missing [drift]: `gyrocal field` needs its temperature steps (temperatures_c, tcf1_ppm_per_k, tcf2_ppm_per_k)"
-        ));
+        return Err(ScenarioError::NoDrift(name.into()));
     }
     Ok(sc)
 }
@@ -126,17 +122,9 @@ pub fn parse(name: &str, text: &str) -> Result<Scenario, String> {
 pub(crate) fn parse_file(
     name: &str,
     text: &str,
-) -> Result<(Scenario, Option<Spread>, bool), String> {
-    let file: ScenarioFile = toml::from_str(text).map_err(|e| {
-        let message = e.message().replace('\n', " ");
-        match e.span() {
-            Some(span) => {
-                let line = text[..span.start.min(text.len())].matches('\n').count() + 1;
-                format!("{name} line {line}: {message}")
-            }
-            None => format!("{name}: {message}"),
-        }
-    })?;
+) -> Result<(Scenario, Option<Spread>, bool), ScenarioError> {
+    let file: ScenarioFile = toml::from_str(text)
+        .map_err(|e| ScenarioError::Syntax(config::parse_error(name, text, e)))?;
     let exp = Experiment {
         gyro: file.gyro,
         drive: file.drive,
@@ -154,7 +142,10 @@ pub(crate) fn parse_file(
         profile: file.profile,
         drive_probe: file.drive_probe,
     };
-    sc.validate().map_err(|e| format!("{name}: {e}"))?;
+    sc.validate().map_err(|error| ScenarioError::Invalid {
+        file: name.into(),
+        error,
+    })?;
     Ok((sc, file.spread, has_drift))
 }
 

@@ -13,7 +13,7 @@
 use crate::config::{self, Experiment};
 use crate::drift::{DeviceAt, Drift, TEMPERATURE_RANGE_C};
 use crate::engine::Engine;
-use crate::error::ConfigError;
+use crate::error::{ConfigError, DeviceError};
 use crate::field::board::SimBoard;
 use crate::field::scenario;
 use crate::frontend::FrontEnd;
@@ -31,7 +31,7 @@ pub struct DeviceFile {
 /// Parse a file: with a `[drift]` section as `gyrocal field` reads it
 /// (`scenario::parse`), else as `gyrocal run` does (`config::parse`).
 /// Errors are one line; `name` (the path) labels them.
-pub fn parse(name: &str, text: &str) -> Result<DeviceFile, String> {
+pub fn parse(name: &str, text: &str) -> Result<DeviceFile, DeviceError> {
     let has_drift = text
         .parse::<toml::Table>()
         .is_ok_and(|t| t.contains_key("drift"));
@@ -56,7 +56,7 @@ impl DeviceFile {
     }
 
     /// The converters as built for the nominal device (`experiment::plan`).
-    pub fn front_end(&self) -> Result<FrontEnd, String> {
+    pub fn front_end(&self) -> Result<FrontEnd, DeviceError> {
         Ok(scenario::build(&self.exp)?.0)
     }
 
@@ -64,7 +64,7 @@ impl DeviceFile {
     /// `[drift]` the file's `[gyro]`, whose `temperature_c` is then NaN (the
     /// file names no temperature). A temperature without `[drift]`, or one
     /// where the drift drives a gain or Q to zero, is refused.
-    pub fn at(&self, temperature_c: Option<f64>) -> Result<DeviceAt, String> {
+    pub fn at(&self, temperature_c: Option<f64>) -> Result<DeviceAt, DeviceError> {
         match (&self.drift, temperature_c) {
             (None, None) => Ok(DeviceAt {
                 temperature_c: f64::NAN,
@@ -74,19 +74,22 @@ impl DeviceFile {
                 drive_gain: [1.0; 2],
                 front_end_phase_deg: 0.0,
             }),
-            (None, Some(t)) => Err(format!(
-                "temperature {t} deg C: the file has no [drift] section, its device is [gyro] at one temperature"
-            )),
+            (None, Some(t)) => Err(DeviceError::NoDrift(t)),
             (Some(d), None) => Ok(d.at(&self.exp.gyro, d.reference_c())),
             (Some(d), Some(t)) => {
                 let (lo, hi) = TEMPERATURE_RANGE_C;
                 if !(t.is_finite() && (lo..=hi).contains(&t)) {
-                    return Err(format!("temperature {t} deg C: allowed {lo}..={hi}"));
+                    return Err(DeviceError::Temperature {
+                        temperature_c: t,
+                        range: TEMPERATURE_RANGE_C,
+                    });
                 }
                 let mut with = d.clone();
                 with.temperatures_c.push(t);
-                with.validate()
-                    .map_err(|e| format!("temperature {t} deg C: {e}"))?;
+                with.validate().map_err(|error| DeviceError::Drift {
+                    temperature_c: t,
+                    error,
+                })?;
                 Ok(d.at(&self.exp.gyro, t))
             }
         }
@@ -94,7 +97,7 @@ impl DeviceFile {
 
     /// A powered-up board on engine `E` holding the device at `at`
     /// (`scenario::board_on`: the drives have started).
-    pub fn board<E: Engine>(&self, at: &DeviceAt) -> Result<SimBoard<E>, String> {
+    pub fn board<E: Engine>(&self, at: &DeviceAt) -> Result<SimBoard<E>, DeviceError> {
         Ok(scenario::board_on(&self.exp, &self.front_end()?, at)?)
     }
 }
@@ -132,7 +135,8 @@ mod tests {
         assert_eq!(at.gyro, f.exp.gyro);
         assert!(at.temperature_c.is_nan());
         let e = f.at(Some(30.0)).unwrap_err();
-        assert!(e.contains("no [drift]"), "{e}");
+        assert_eq!(e, DeviceError::NoDrift(30.0));
+        assert!(e.to_string().contains("no [drift]"), "{e}");
     }
 
     #[test]
@@ -142,7 +146,7 @@ mod tests {
         let at = f.at(Some(35.0)).unwrap();
         let expected = 33.3e3 * (1.0 - 30e-6 * 10.0);
         assert!((at.gyro.f1_hz - expected).abs() < 1e-9, "{}", at.gyro.f1_hz);
-        let e = f.at(Some(1e4)).unwrap_err();
+        let e = f.at(Some(1e4)).unwrap_err().to_string();
         assert!(e.starts_with("temperature 10000 deg C: allowed"), "{e}");
         assert!(!e.contains('\n'));
     }
@@ -150,6 +154,6 @@ mod tests {
     #[test]
     fn errors_name_the_file_and_line() {
         let e = parse("bad.toml", "[gyro]\nf1_hz = 'x'\n").unwrap_err();
-        assert!(e.starts_with("bad.toml line 2"), "{e}");
+        assert!(e.to_string().starts_with("bad.toml line 2"), "{e}");
     }
 }

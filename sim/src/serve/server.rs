@@ -38,7 +38,7 @@
 //!   address is logged once. A malformed frame closes its connection.
 
 use gyrocal_host::board::Board;
-use gyrocal_host::transport::etherbone::{Record, read_frame};
+use gyrocal_host::transport::etherbone::{FrameError, Record, read_frame};
 use gyrocal_regs::map::{ADDRESS_BITS, BusError};
 use std::collections::HashSet;
 use std::io::Write;
@@ -217,12 +217,12 @@ impl Shared {
 impl Bus {
     /// Serve one record under the lock, answer its reads on `client`, and,
     /// paced, run the board its clocks.
-    fn serve(&self, record: &Record, client: &mut impl Write) -> Result<(), String> {
+    fn serve(&self, record: &Record, client: &mut impl Write) -> Result<(), ConnectionError> {
         self.waiting.fetch_add(1, Ordering::AcqRel);
         let mut shared = lock(&self.shared);
         self.waiting.fetch_sub(1, Ordering::AcqRel);
         if let Some(why) = &shared.stopped {
-            return Err(format!("the board has stopped: {why}"));
+            return Err(ConnectionError::Stopped(why.clone()));
         }
         let values = shared.record(record, &self.log);
         if !record.reads.is_empty() {
@@ -231,15 +231,40 @@ impl Bus {
                 writes: values,
                 ..Record::default()
             };
-            let frame = answer.encode().map_err(|e| e.to_string())?;
+            let frame = answer.encode()?;
             client
                 .write_all(&frame)
-                .map_err(|e| format!("cannot answer: {e}"))?;
+                .map_err(ConnectionError::socket("cannot answer: "))?;
         }
         if let Some(n) = self.clocking.per_request {
             shared.run(n, &self.log);
         }
         Ok(())
+    }
+}
+
+/// Why a connection was closed: one line for the log.
+#[derive(Debug, thiserror::Error)]
+enum ConnectionError {
+    /// The board stopped (why, as the log said it).
+    #[error("the board has stopped: {0}")]
+    Stopped(String),
+    /// A record that is no Etherbone record, or an answer too large for one.
+    #[error(transparent)]
+    Frame(#[from] FrameError),
+    /// The socket failed (what the server was doing).
+    #[error("{doing}{error}")]
+    Socket {
+        /// What failed, with its trailing ": " (or nothing).
+        doing: &'static str,
+        /// The system's error.
+        error: std::io::Error,
+    },
+}
+
+impl ConnectionError {
+    fn socket(doing: &'static str) -> impl FnOnce(std::io::Error) -> Self {
+        move |error| Self::Socket { doing, error }
     }
 }
 
@@ -254,14 +279,15 @@ fn connection(mut stream: TcpStream, bus: &Bus, greeting: &str) {
 }
 
 /// The connection's exchange; `Ok` at a clean end.
-fn talk(stream: &mut TcpStream, bus: &Bus, greeting: &str) -> Result<(), String> {
-    stream.set_nodelay(true).map_err(|e| e.to_string())?;
+fn talk(stream: &mut TcpStream, bus: &Bus, greeting: &str) -> Result<(), ConnectionError> {
+    stream
+        .set_nodelay(true)
+        .map_err(ConnectionError::socket(""))?;
     stream
         .write_all(greeting.as_bytes())
-        .map_err(|e| format!("cannot send the greeting: {e}"))?;
-    while let Some(frame) = read_frame(stream).map_err(|e| e.to_string())? {
-        let record = Record::decode(&frame).map_err(|e| e.to_string())?;
-        bus.serve(&record, stream)?;
+        .map_err(ConnectionError::socket("cannot send the greeting: "))?;
+    while let Some(frame) = read_frame(stream).map_err(ConnectionError::socket(""))? {
+        bus.serve(&Record::decode(&frame)?, stream)?;
     }
     Ok(())
 }

@@ -24,7 +24,7 @@
 pub mod spread;
 pub mod summary;
 
-use crate::error::FieldError;
+use crate::error::{FieldError, ScenarioError};
 use crate::field::scenario::{self, IdentifiedJson, Scenario};
 use crate::gyro::GyroParams;
 use rayon::prelude::*;
@@ -38,8 +38,8 @@ use summary::Summary;
 #[derive(Debug, thiserror::Error)]
 pub enum SweepError {
     /// The file (a section, a key) is wrong.
-    #[error("{0}")]
-    Config(String),
+    #[error(transparent)]
+    Config(#[from] ScenarioError),
     /// The file has no `[spread]`.
     #[error(
         "{0}: missing [spread]: `gyrocal sweep` needs `devices` and the parameters' spread (see `gyrocal sweep --help`)"
@@ -77,7 +77,7 @@ pub struct Sweep {
 /// Parse a sweep file: the sections of `gyrocal field` (`[drift]` and
 /// `[profile]` optional) plus `[spread]`. `name` labels the errors.
 pub fn parse(name: &str, text: &str) -> Result<Sweep, SweepError> {
-    let (scenario, spread, _) = scenario::parse_file(name, text).map_err(SweepError::Config)?;
+    let (scenario, spread, _) = scenario::parse_file(name, text)?;
     let spread = spread.ok_or_else(|| SweepError::NoSpread(name.into()))?;
     spread
         .validate(&scenario.exp.gyro)

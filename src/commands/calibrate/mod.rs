@@ -86,7 +86,7 @@ pub struct Outcome {
 /// Calibrate and print.
 pub fn run(args: &Args) -> Result<(), Failure> {
     let (name, text) = read_config(&args.config)?;
-    let file = device::parse(&name, &text).map_err(Failure::Input)?;
+    let file = device::parse(&name, &text).map_err(Failure::input)?;
     let knowns = file.knowns().map_err(Failure::input)?;
     let outcome = match &args.board {
         Some(url) => over_the_wire(url, &knowns, args.temperature)?,
@@ -144,11 +144,11 @@ fn in_process(
     let at = file
         .at(temperature)
         .map_err(|e| Failure::Input(format!("--{e}")))?;
-    let mut board: SimBoard = file.board(&at).map_err(Failure::Run)?;
+    let mut board: SimBoard = file.board(&at).map_err(Failure::run)?;
     eprintln!("calibrating the in-process simulated board");
     let (cal, samples, wall_s) = cycle(&mut board, knowns)?;
     eprintln!("rate table at the calibrated carrier and phase (the truth)");
-    let fe = file.front_end().map_err(Failure::Run)?;
+    let fe = file.front_end().map_err(Failure::run)?;
     let (table, clocks) =
         scenario::rate_table(&file.exp, &fe, &at, knowns, &cal.operating).map_err(Failure::run)?;
     Ok(Outcome {
