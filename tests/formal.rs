@@ -13,7 +13,7 @@
 //! `yices-smt2` (`scripts/fpga/install-venv.sh`); without it the tests fail
 //! with a message naming that script. The mutants run two at a time.
 
-use gyrocal_verify::formal::{self, MUTANTS, SbyReport, Status, Task};
+use gyrocal_verify::formal::{self, FormalError, MUTANTS, SbyReport, Status, Task};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
@@ -77,7 +77,7 @@ fn every_spec_property_has_a_mutant() {
 fn each_property_fails_on_its_mutant() {
     let bus = bus();
     let next = AtomicUsize::new(0);
-    let results: Mutex<Vec<(usize, Result<SbyReport, String>)>> = Mutex::new(Vec::new());
+    let results: Mutex<Vec<(usize, Result<SbyReport, FormalError>)>> = Mutex::new(Vec::new());
     let start = Instant::now();
     std::thread::scope(|s| {
         for _ in 0..2 {
@@ -87,8 +87,7 @@ fn each_property_fails_on_its_mutant() {
                     let Some(m) = MUTANTS.get(i) else { break };
                     let r = m
                         .apply(&bus)
-                        .and_then(|v| formal::run_sby(&v, Task::Mutant(m.property)))
-                        .map_err(|e| e.to_string());
+                        .and_then(|v| formal::run_sby(&v, Task::Mutant(m.property)));
                     results.lock().unwrap().push((i, r));
                 }
             });

@@ -34,28 +34,26 @@ fn golden() -> &'static GoldenVectors {
 
 /// The committed export of the core with this carrier profile, after
 /// checking that it is what the design exports now (the vectors come from
-/// the current design).
-fn committed(profile: CarrierProfile) -> Result<PathBuf, String> {
+/// the current design); panics saying which file and what to do if not.
+fn committed(profile: CarrierProfile) -> PathBuf {
     let path = verify::verilog_out_dir().join(gyrocal_hdl::export::verilog_file(profile));
     let committed =
-        std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
-    if committed != gyrocal_hdl::export::verilog_for(profile) {
-        return Err(format!(
-            "{} is not what the design exports now: regenerate it (`cargo run --release -- export`) \
-             before replaying",
-            path.display()
-        ));
-    }
-    Ok(path)
+        std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    assert!(
+        committed == gyrocal_hdl::export::verilog_for(profile),
+        "{} is not what the design exports now: regenerate it (`cargo run --release -- export`) \
+         before replaying",
+        path.display()
+    );
+    path
 }
 
 /// The committed table-core export, checked once per test process.
 fn committed_verilog() -> PathBuf {
-    static CHECKED: OnceLock<Result<PathBuf, String>> = OnceLock::new();
+    static CHECKED: OnceLock<PathBuf> = OnceLock::new();
     CHECKED
         .get_or_init(|| committed(CarrierProfile::Table))
         .clone()
-        .unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// The standard vectors on the fine-carrier (ECP5) core.
@@ -166,7 +164,7 @@ fn the_fine_core_replays_in_icarus_and_verilator() {
     require_icarus();
     require_verilator();
     let v = fine_golden();
-    let verilog = committed(CarrierProfile::Fine).unwrap_or_else(|e| panic!("{e}"));
+    let verilog = committed(CarrierProfile::Fine);
     expect_pass(&compile(Simulator::Icarus, &verilog), v);
     let tb = compile(Simulator::Verilator, &verilog);
     expect_pass(&tb, v);

@@ -207,8 +207,34 @@ pub struct Parsed {
     pub reached: Vec<Event>,
 }
 
+/// Why sby's standard output gives no verdict.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum SbyOutputError {
+    /// sby finished with neither PASS nor FAIL (an error, a timeout).
+    Finished(String),
+    /// No DONE line: sby did not finish.
+    NoDone,
+    /// A FAIL without a failed assertion or an unreached cover.
+    Unnamed,
+    /// A step number that is no number.
+    Step(String),
+}
+
+impl std::fmt::Display for SbyOutputError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Finished(status) => write!(f, "sby finished with {status}"),
+            Self::NoDone => write!(f, "sby printed no DONE line"),
+            Self::Unnamed => write!(f, "sby failed without naming a failed assertion"),
+            Self::Step(step) => write!(f, "step {step}: not a step number"),
+        }
+    }
+}
+
+impl std::error::Error for SbyOutputError {}
+
 /// Every (label, step) that `pattern` captures in `text`, once each.
-fn events(pattern: &str, text: &str) -> Result<Vec<Event>, String> {
+fn events(pattern: &str, text: &str) -> Result<Vec<Event>, SbyOutputError> {
     let re = Regex::new(pattern).expect("event pattern");
     let mut out: Vec<Event> = Vec::new();
     for c in re.captures_iter(text) {
@@ -216,7 +242,7 @@ fn events(pattern: &str, text: &str) -> Result<Vec<Event>, String> {
             property: c["label"].to_owned(),
             step: c["step"]
                 .parse()
-                .map_err(|e| format!("step {}: {e}", &c["step"]))?,
+                .map_err(|_| SbyOutputError::Step(c["step"].to_owned()))?,
         };
         if !out.contains(&e) {
             out.push(e);
@@ -228,13 +254,13 @@ fn events(pattern: &str, text: &str) -> Result<Vec<Event>, String> {
 /// sby's standard output, parsed; `Err` with the reason when sby gave
 /// neither PASS nor FAIL (an error, a timeout) or failed without naming
 /// an assertion.
-pub fn parse_sby(stdout: &str) -> Result<Parsed, String> {
+pub fn parse_sby(stdout: &str) -> Result<Parsed, SbyOutputError> {
     let done = Regex::new(r"DONE \((\w+), rc=\d+\)").expect("done pattern");
     let status = match done.captures_iter(stdout).last().map(|c| c[1].to_owned()) {
         Some(s) if s == "PASS" => Status::Pass,
         Some(s) if s == "FAIL" => Status::Fail,
-        Some(other) => return Err(format!("sby finished with {other}")),
-        None => return Err("sby printed no DONE line".into()),
+        Some(other) => return Err(SbyOutputError::Finished(other)),
+        None => return Err(SbyOutputError::NoDone),
     };
     let failed = events(
         &format!(
@@ -247,7 +273,7 @@ pub fn parse_sby(stdout: &str) -> Result<Parsed, String> {
         stdout,
     )?;
     if status == Status::Fail && failed.is_empty() && !stdout.contains("unreached cover") {
-        return Err("sby failed without naming a failed assertion".into());
+        return Err(SbyOutputError::Unnamed);
     }
     Ok(Parsed {
         status,
@@ -328,7 +354,7 @@ fn sby(tools: &Tools, dir: &Path, task: &str) -> Result<SbyReport, FormalError> 
     let parsed = parse_sby(&log).map_err(|reason| {
         FormalError::Verify(VerifyError::ToolFailed {
             command: describe(&cmd),
-            reason,
+            reason: reason.to_string(),
             output: tail(&combined_output(&out), 40),
         })
     })?;
@@ -483,13 +509,12 @@ mod tests {
         let p = parse_sby(cover).unwrap();
         assert_eq!(p.reached[0].property, "cover_write_okay");
         assert_eq!(p.reached[0].step, 2);
-        assert!(
-            parse_sby("SBY [p] DONE (ERROR, rc=16)")
-                .unwrap_err()
-                .contains("ERROR")
+        assert_eq!(
+            parse_sby("SBY [p] DONE (ERROR, rc=16)"),
+            Err(SbyOutputError::Finished("ERROR".into()))
         );
-        assert!(parse_sby("").is_err());
-        assert!(parse_sby("DONE (FAIL, rc=2)").is_err());
+        assert_eq!(parse_sby(""), Err(SbyOutputError::NoDone));
+        assert_eq!(parse_sby("DONE (FAIL, rc=2)"), Err(SbyOutputError::Unnamed));
     }
 
     #[test]

@@ -176,10 +176,60 @@ pub struct Waiver {
     pub reason: String,
 }
 
+/// A line of a waiver file that [`parse_waivers`] refuses, with the line.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct WaiverError {
+    /// The line number (from 1).
+    pub line: usize,
+    /// What is wrong with it.
+    pub fault: WaiverFault,
+    /// The line's text, trimmed.
+    pub text: String,
+}
+
+/// What is wrong with a waiver file's line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WaiverFault {
+    /// A comment Verilator would read as a metacomment.
+    Metacomment,
+    /// Not `lint_off -rule R -file "F" -match "P"`.
+    NotAWaiver,
+    /// A waiver without a `//` comment directly above it.
+    NoReason,
+    /// A waiver whose pattern matches everything.
+    Blanket,
+}
+
+impl std::fmt::Display for WaiverError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (n, line) = (self.line, &self.text);
+        match self.fault {
+            WaiverFault::Metacomment => write!(
+                f,
+                "line {n}: a comment starting with `verilator` is read as a Verilator metacomment: `{line}`"
+            ),
+            WaiverFault::NotAWaiver => write!(
+                f,
+                "line {n}: expected `lint_off -rule <RULE> -file \"<file>\" -match \"<pattern>\"`, found `{line}`"
+            ),
+            WaiverFault::NoReason => write!(
+                f,
+                "line {n}: waiver without a `//` comment giving its reason: `{line}`"
+            ),
+            WaiverFault::Blanket => write!(
+                f,
+                "line {n}: blanket waiver (empty -match pattern): `{line}`"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for WaiverError {}
+
 /// The waivers of a `.vlt` file. Errors name the line: a `lint_off` without
 /// `-rule`, `-file` or `-match`, one without a `//` comment directly above it,
 /// or any other directive.
-pub fn parse_waivers(text: &str) -> Result<Vec<Waiver>, String> {
+pub fn parse_waivers(text: &str) -> Result<Vec<Waiver>, WaiverError> {
     let directive = Regex::new(
         r#"^lint_off\s+-rule\s+([A-Z0-9_]+)\s+-file\s+"([^"]+)"\s+-match\s+"((?:[^"\\]|\\.)*)"\s*$"#,
     )
@@ -189,11 +239,14 @@ pub fn parse_waivers(text: &str) -> Result<Vec<Waiver>, String> {
     for (i, raw) in text.lines().enumerate() {
         let line = raw.trim();
         let n = i + 1;
+        let refuse = |fault| WaiverError {
+            line: n,
+            fault,
+            text: line.to_owned(),
+        };
         if let Some(c) = line.strip_prefix("//") {
             if c.trim_start().to_ascii_lowercase().starts_with("verilator") {
-                return Err(format!(
-                    "line {n}: a comment starting with `verilator` is read as a Verilator metacomment: `{line}`"
-                ));
+                return Err(refuse(WaiverFault::Metacomment));
             }
             comment.push(c.trim().to_owned());
             continue;
@@ -203,21 +256,15 @@ pub fn parse_waivers(text: &str) -> Result<Vec<Waiver>, String> {
             continue;
         }
         let Some(c) = directive.captures(line) else {
-            return Err(format!(
-                "line {n}: expected `lint_off -rule <RULE> -file \"<file>\" -match \"<pattern>\"`, found `{line}`"
-            ));
+            return Err(refuse(WaiverFault::NotAWaiver));
         };
         let reason = comment.join(" ");
         if reason.trim().is_empty() {
-            return Err(format!(
-                "line {n}: waiver without a `//` comment giving its reason: `{line}`"
-            ));
+            return Err(refuse(WaiverFault::NoReason));
         }
         let pattern = c[3].to_owned();
         if pattern.trim_matches('*').is_empty() {
-            return Err(format!(
-                "line {n}: blanket waiver (empty -match pattern): `{line}`"
-            ));
+            return Err(refuse(WaiverFault::Blanket));
         }
         waivers.push(Waiver {
             line: n,
@@ -262,7 +309,7 @@ pub fn waiver_usage_top(
         .map_err(io_error(format!("cannot read {}", waivers.display())))?;
     let parsed = parse_waivers(&text).map_err(|e| VerifyError::ToolFailed {
         command: format!("parse {}", waivers.display()),
-        reason: e,
+        reason: e.to_string(),
         output: String::new(),
     })?;
     let baseline = lint_files(&[verilog], top, &with(kept, waivers))?;
@@ -321,24 +368,25 @@ mod tests {
         assert_eq!((w[0].line, w[0].rule.as_str()), (4, "WIDTH"));
         assert_eq!(w[0].reason, "reason one continued");
         assert_eq!(w[0].pattern, "Operator EQ*");
+        let fault = |text: &str| parse_waivers(text).unwrap_err().fault;
         let no_reason = "`verilator_config\nlint_off -rule WIDTH -file \"*x.v\" -match \"a\"\n";
-        assert!(
-            parse_waivers(no_reason)
-                .unwrap_err()
-                .contains("without a `//` comment")
-        );
+        assert_eq!(fault(no_reason), WaiverFault::NoReason);
+        let e = parse_waivers(no_reason).unwrap_err();
+        assert_eq!(e.line, 2);
+        assert!(e.to_string().contains("without a `//` comment"), "{e}");
         let blanket = "// why\nlint_off -rule WIDTH -file \"*x.v\" -match \"*\"\n";
-        assert!(parse_waivers(blanket).unwrap_err().contains("blanket"));
+        assert_eq!(fault(blanket), WaiverFault::Blanket);
         let no_match = "// why\nlint_off -rule WIDTH -file \"*x.v\"\n";
-        assert!(parse_waivers(no_match).is_err());
+        assert_eq!(fault(no_match), WaiverFault::NotAWaiver);
         let gap = "// why\n\nlint_off -rule WIDTH -file \"*x.v\" -match \"a\"\n";
-        assert!(
-            parse_waivers(gap).is_err(),
+        assert_eq!(
+            fault(gap),
+            WaiverFault::NoReason,
             "a blank line separates the reason from its waiver"
         );
         let meta =
             "// Verilator waivers\n// why\nlint_off -rule WIDTH -file \"*x.v\" -match \"a\"\n";
-        assert!(parse_waivers(meta).unwrap_err().contains("metacomment"));
+        assert_eq!(fault(meta), WaiverFault::Metacomment);
     }
 
     #[test]

@@ -422,14 +422,19 @@ fn flip_flops_in_stat(stat: &str) -> u64 {
         .sum()
 }
 
+/// A bel a part's resources name that nextpnr's utilisation table lacks.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct MissingBel(&'static str);
+
+impl std::fmt::Display for MissingBel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "nextpnr's utilisation table has no {}", self.0)
+    }
+}
+
 /// The report's resource uses from nextpnr's table and Yosys's `stat`.
-fn uses(part: &Part, table: &[BelUse], stat: &str) -> Result<Vec<Use>, String> {
-    let find = |bel: &str| {
-        table
-            .iter()
-            .find(|b| b.bel == bel)
-            .ok_or_else(|| format!("nextpnr's utilisation table has no {bel}"))
-    };
+fn uses(part: &Part, table: &[BelUse], stat: &str) -> Result<Vec<Use>, MissingBel> {
+    let find = |bel: &'static str| table.iter().find(|b| b.bel == bel).ok_or(MissingBel(bel));
     part.resources
         .iter()
         .map(|r| match r.source {
@@ -492,7 +497,7 @@ pub fn place_and_route(core: &Core, part: &Part) -> Result<PnrReport, VerifyErro
         reason,
         output: tail(&format!("{log}\n{}", combined_output(&out)), 40),
     };
-    let uses = uses(part, &pnr_log::utilisation(&log), &stat).map_err(&failed)?;
+    let uses = uses(part, &pnr_log::utilisation(&log), &stat).map_err(|e| failed(e.to_string()))?;
     let outcome = if out.status.success() {
         Outcome::Routed {
             fmax: pnr_log::fmax(&log)
@@ -591,11 +596,7 @@ mod tests {
                 ("SPRAM", 0, 4)
             ]
         );
-        assert!(
-            uses(&ECP5_25F, &table, "")
-                .unwrap_err()
-                .contains("TRELLIS_COMB")
-        );
+        assert_eq!(uses(&ECP5_25F, &table, ""), Err(MissingBel("TRELLIS_COMB")));
     }
 
     #[test]

@@ -295,22 +295,44 @@ pub struct ReplayReport {
 
 impl ReplayReport {
     /// `Ok` when the replay passed over exactly the cycles of `vectors`;
-    /// otherwise a readable description of what failed.
-    pub fn check(&self, vectors: &GoldenVectors) -> Result<(), String> {
+    /// otherwise the failure, which displays what failed.
+    pub fn check<'a>(&'a self, vectors: &'a GoldenVectors) -> Result<(), ReplayFailure<'a>> {
         if self.passed && self.cycles == vectors.len() && self.errors.is_empty() {
             return Ok(());
         }
-        let mut s = format!(
-            "{} replay failed: {} mismatches, {} of {} cycles compared\n",
-            self.simulator,
-            self.mismatches,
-            self.cycles,
+        Err(ReplayFailure {
+            report: self,
+            vectors,
+        })
+    }
+}
+
+/// A replay that did not pass over exactly its vectors' cycles: its
+/// report, shown as a readable description (the mismatches with their
+/// cycle and segment, the simulator's errors and the end of its output).
+#[derive(Clone, Copy, Debug)]
+pub struct ReplayFailure<'a> {
+    /// The replay's report.
+    pub report: &'a ReplayReport,
+    /// The vectors it replayed.
+    pub vectors: &'a GoldenVectors,
+}
+
+impl std::fmt::Display for ReplayFailure<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (r, vectors) = (self.report, self.vectors);
+        writeln!(
+            f,
+            "{} replay failed: {} mismatches, {} of {} cycles compared",
+            r.simulator,
+            r.mismatches,
+            r.cycles,
             vectors.len()
-        );
-        for e in &self.errors {
-            let _ = writeln!(s, "  error: {e}");
+        )?;
+        for e in &r.errors {
+            writeln!(f, "  error: {e}")?;
         }
-        for m in &self.reported {
+        for m in &r.reported {
             let at = match m.cycle {
                 Some(c) => {
                     let seg = vectors
@@ -322,16 +344,17 @@ impl ReplayReport {
                 }
                 None => "power-up".to_owned(),
             };
-            let _ = writeln!(
-                s,
+            writeln!(
+                f,
                 "  {at}: port {} expected {} got {}",
                 m.port, m.expected, m.got
-            );
+            )?;
         }
-        let _ = write!(s, "--- simulator output ---\n{}", tail(&self.log, 40));
-        Err(s)
+        write!(f, "--- simulator output ---\n{}", tail(&r.log, 40))
     }
 }
+
+impl std::error::Error for ReplayFailure<'_> {}
 
 /// Testbench and design compiled for one simulator, ready to replay vector
 /// files. Lives in its own scratch folder.

@@ -207,7 +207,7 @@ pub fn synthesize(verilog: &Path, target: Target) -> Result<SynthesisReport, Ver
     let (log, stat, check) = (read("yosys.log")?, read("stat.txt")?, read("check.txt")?);
     let cells = parse_stat(&stat).map_err(|reason| VerifyError::ToolFailed {
         command: describe(&cmd),
-        reason,
+        reason: reason.to_string(),
         output: tail(&stat, 40),
     })?;
     let check_problems = check_problem_count(&check).ok_or_else(|| VerifyError::ToolFailed {
@@ -248,16 +248,38 @@ pub fn synthesize(verilog: &Path, target: Target) -> Result<SynthesisReport, Ver
     })
 }
 
+/// Why Yosys's `stat` output gives no cell counts.
+#[derive(Clone, Debug, PartialEq, Eq)]
+enum StatError {
+    /// Not one module (how many): the flattened top was expected.
+    Modules(usize),
+    /// A count that is no number (the text).
+    Count(String),
+    /// No cell listed.
+    NoCells,
+}
+
+impl std::fmt::Display for StatError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Modules(n) => write!(
+                f,
+                "`stat` lists {n} modules, expected the flattened top only"
+            ),
+            Self::Count(text) => write!(f, "`stat` cell count {text:?}: not a count"),
+            Self::NoCells => write!(f, "`stat` lists no cells"),
+        }
+    }
+}
+
 /// Cell counts of the single (flattened) module in `stat` output.
-fn parse_stat(stat: &str) -> Result<BTreeMap<String, u64>, String> {
+fn parse_stat(stat: &str) -> Result<BTreeMap<String, u64>, StatError> {
     let modules = stat
         .lines()
         .filter(|l| l.trim_start().starts_with("=== "))
         .count();
     if modules != 1 {
-        return Err(format!(
-            "`stat` lists {modules} modules, expected the flattened top only"
-        ));
+        return Err(StatError::Modules(modules));
     }
     let cell_line = Regex::new(r"^\s+(\S+)\s+(\d+)$").unwrap();
     let mut cells = BTreeMap::new();
@@ -272,7 +294,8 @@ fn parse_stat(stat: &str) -> Result<BTreeMap<String, u64>, String> {
                 Some(c) => {
                     cells.insert(
                         c[1].to_owned(),
-                        c[2].parse::<u64>().map_err(|e| e.to_string())?,
+                        c[2].parse::<u64>()
+                            .map_err(|_| StatError::Count(c[2].to_owned()))?,
                     );
                 }
                 None => in_cells = false,
@@ -280,7 +303,7 @@ fn parse_stat(stat: &str) -> Result<BTreeMap<String, u64>, String> {
         }
     }
     if cells.is_empty() {
-        return Err("`stat` lists no cells".into());
+        return Err(StatError::NoCells);
     }
     Ok(cells)
 }
@@ -380,7 +403,10 @@ mod tests {
         let cells = parse_stat(stat).unwrap();
         assert_eq!(cells.len(), 2);
         assert_eq!(cells["SB_LUT4"], 7);
-        assert!(parse_stat("=== a ===\n=== b ===\n").is_err());
+        assert_eq!(
+            parse_stat("=== a ===\n=== b ===\n"),
+            Err(StatError::Modules(2))
+        );
     }
 
     #[test]

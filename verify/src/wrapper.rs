@@ -86,6 +86,47 @@ fn is_identifier(s: &str) -> bool {
         && chars.all(|c| c.is_ascii_alphanumeric() || c == '_')
 }
 
+/// What [`Core::new`] refuses: one line naming the module, port or clock.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum CoreError {
+    /// The module name is no Verilog identifier, or the wrapper's own.
+    Module(String),
+    /// No Verilog file given (the module).
+    NoVerilog(String),
+    /// A port that is no Verilog identifier or has no bit (name, bits).
+    Port(String, usize),
+    /// A port listed twice.
+    Twice(String),
+    /// The clock is no 1-bit input port (the clock, the module).
+    Clock(String, String),
+    /// No input but the clock, or no output (the module).
+    NoData(String),
+}
+
+impl std::fmt::Display for CoreError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Module(m) => write!(
+                f,
+                "module name `{m}`: not a Verilog identifier, or `{WRAPPER_MODULE}`"
+            ),
+            Self::NoVerilog(m) => write!(f, "module `{m}`: no Verilog file given"),
+            Self::Port(name, bits) => write!(
+                f,
+                "port `{name}` of {bits} bits: allowed are Verilog identifiers of at least 1 bit"
+            ),
+            Self::Twice(name) => write!(f, "port `{name}` is listed twice"),
+            Self::Clock(clock, m) => write!(f, "clock `{clock}`: not a 1-bit input port of `{m}`"),
+            Self::NoData(m) => write!(
+                f,
+                "`{m}` needs at least one input besides the clock and one output"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for CoreError {}
+
 impl Core {
     /// A core, checked: Verilog identifiers, unique port names, widths of
     /// at least one bit, a 1-bit clock input, at least one other input and
@@ -95,31 +136,24 @@ impl Core {
         verilog: Vec<PathBuf>,
         clock: &str,
         ports: Vec<CorePort>,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, CoreError> {
         if !is_identifier(module) || module == WRAPPER_MODULE {
-            return Err(format!(
-                "module name `{module}`: not a Verilog identifier, or `{WRAPPER_MODULE}`"
-            ));
+            return Err(CoreError::Module(module.into()));
         }
         if verilog.is_empty() {
-            return Err(format!("module `{module}`: no Verilog file given"));
+            return Err(CoreError::NoVerilog(module.into()));
         }
         for (i, p) in ports.iter().enumerate() {
             if !is_identifier(&p.name) || p.bits == 0 {
-                return Err(format!(
-                    "port `{}` of {} bits: allowed are Verilog identifiers of at least 1 bit",
-                    p.name, p.bits
-                ));
+                return Err(CoreError::Port(p.name.clone(), p.bits));
             }
             if ports[..i].iter().any(|q| q.name == p.name) {
-                return Err(format!("port `{}` is listed twice", p.name));
+                return Err(CoreError::Twice(p.name.clone()));
             }
         }
         let clock_port = ports.iter().find(|p| p.name == clock);
         if !clock_port.is_some_and(|p| p.direction == PortDirection::Input && p.bits == 1) {
-            return Err(format!(
-                "clock `{clock}`: not a 1-bit input port of `{module}`"
-            ));
+            return Err(CoreError::Clock(clock.into(), module.into()));
         }
         let core = Self {
             module: module.to_owned(),
@@ -128,9 +162,7 @@ impl Core {
             ports,
         };
         if core.input_bits() == 0 || core.output_bits() == 0 {
-            return Err(format!(
-                "`{module}` needs at least one input besides the clock and one output"
-            ));
+            return Err(CoreError::NoData(module.into()));
         }
         Ok(core)
     }
@@ -141,7 +173,7 @@ impl Core {
         verilog: Vec<PathBuf>,
         clock: &str,
         ports: &[Port],
-    ) -> Result<Self, String> {
+    ) -> Result<Self, CoreError> {
         let ports = ports
             .iter()
             .map(|p| CorePort {
@@ -359,29 +391,29 @@ mod tests {
             Core::new("small", vec!["s.v".into()], "clk_i", ports)
         };
         assert!(with(&|_| {}).is_ok());
-        assert!(with(&|p| p[0].bits = 2).unwrap_err().contains("clock"));
-        assert!(
-            with(&|p| p[0].direction = Output)
-                .unwrap_err()
-                .contains("clock")
+        let clock = CoreError::Clock("clk_i".into(), "small".into());
+        assert_eq!(with(&|p| p[0].bits = 2).unwrap_err(), clock);
+        assert_eq!(with(&|p| p[0].direction = Output).unwrap_err(), clock);
+        assert_eq!(
+            with(&|p| p[1].name = "b".into()).unwrap_err(),
+            CoreError::Twice("b".into())
         );
-        assert!(
-            with(&|p| p[1].name = "b".into())
-                .unwrap_err()
-                .contains("twice")
+        let bad_name = with(&|p| p[1].name = "9a".into()).unwrap_err();
+        assert!(bad_name.to_string().contains("identifier"), "{bad_name}");
+        let no_bit = with(&|p| p[2].bits = 0).unwrap_err();
+        assert!(no_bit.to_string().contains("at least 1 bit"), "{no_bit}");
+        assert_eq!(
+            with(&|p| p.truncate(3)).unwrap_err(),
+            CoreError::NoData("small".into())
         );
-        assert!(
-            with(&|p| p[1].name = "9a".into())
-                .unwrap_err()
-                .contains("identifier")
+        assert_eq!(
+            Core::new("small", vec![], "clk_i", ok.ports.clone()).unwrap_err(),
+            CoreError::NoVerilog("small".into())
         );
-        assert!(
-            with(&|p| p[2].bits = 0)
-                .unwrap_err()
-                .contains("at least 1 bit")
+        let wrapper = Core::new(WRAPPER_MODULE, vec!["s.v".into()], "clk_i", ok.ports);
+        assert_eq!(
+            wrapper.unwrap_err(),
+            CoreError::Module(WRAPPER_MODULE.into())
         );
-        assert!(with(&|p| p.truncate(3)).unwrap_err().contains("one output"));
-        assert!(Core::new("small", vec![], "clk_i", ok.ports.clone()).is_err());
-        assert!(Core::new(WRAPPER_MODULE, vec!["s.v".into()], "clk_i", ok.ports).is_err());
     }
 }
