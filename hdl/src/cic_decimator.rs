@@ -45,48 +45,33 @@
 //! every integrator wrapping thousands of times) through the model and the
 //! rust-hdl design, and gets the exact rounded average.
 //!
-//! The rounding needs no adder as wide as the comb: with b the comb output
-//! and s the shift, floor(b / 2^s + 1/2) = floor((floor(2b / 2^s) + 1) / 2)
-//! (for real t, floor((floor(t) + 1) / 2) = floor((t + 1) / 2)). So the
-//! output stage shifts the doubled comb word right by s, keeping
-//! `HALF_BITS` = 41 bits (the output and one bit below it), adds 1 and
-//! drops that bit. The doubled word is b sign-extended to `DOUBLED_BITS` =
-//! 41 + 63 = 104 bits, so every shift the 6-bit setting can hold reads
-//! bits that exist and the shifts can be logical. It takes
-//! `OUTPUT_STAGES` = 3 clocks, so that no clock carries more than one
-//! carry chain or three mux levels:
-//! 1. coarse: (2b >> (shift & 0b111000)), low `COARSE_BITS` = 41 + 7 bits
-//!    (the fine step moves at most 7 bits);
-//! 2. fine: (coarse >> (shift & 0b000111)), low 41 bits;
-//! 3. round: (fine + 1) >> 1, low 40 bits (a 41-bit increment).
+//! The output stage (`crate::cic_output_stage`) rounds without an adder
+//! as wide as the comb, as floor(b / 2^s + 1/2) =
+//! floor((floor(2b / 2^s) + 1) / 2), in `OUTPUT_STAGES` = 3 clocks (coarse
+//! shift, fine shift, a 41-bit increment), running every clock on whatever
+//! the accumulator holds; the schedule reads the rounded result at the two clocks where it
+//! belongs to a comb output. (An earlier version added 2^(shift-1) to the
+//! 80-bit comb word first: the same outputs for every shift up to 40, at
+//! the cost of an 80-bit adder, a one-hot decoder and two XOR layers.)
 //!
-//! The coarse and fine registers run every clock on whatever the
-//! accumulator holds; the schedule reads the rounded result at the two
-//! clocks where it belongs to a comb output. (An earlier version added
-//! 2^(shift-1) to the 80-bit comb word first: the same outputs for every
-//! shift up to 40, at the cost of an 80-bit adder, a one-hot decoder and
-//! two XOR layers.)
+//! Each comb step (`crate::cic_comb`) subtracts in two 40-bit halves on
+//! consecutive clocks, so that no clock carries an 80-bit carry chain
+//! (with the RAM's clock-to-out in front, that chain held an iCE40 UP5K
+//! to 26 MHz).
 //!
-//! Each comb step subtracts in two halves on consecutive clocks, so that
-//! no clock carries an 80-bit carry chain (with the RAM's clock-to-out in
-//! front, that chain held an iCE40 UP5K to 26 MHz): the low clock
-//! subtracts the low 40 bits and keeps the borrow and the delay word's
-//! high half in registers, and writes the old accumulator as the new
-//! delay; the high clock subtracts the high halves and the borrow, as one
-//! 41-bit subtraction (2 hi + 0) - (2 delay_hi + borrow), halved.
+//! Schedule (`CicStep` and, in `Low` and `High`, the comb `stage` 0..3 and
+//! the `second` channel flag; t0 is the strobe cycle, when the down
+//! counter is 0 and the schedule is `Idle`):
 //!
-//! Schedule (`CicStep`, one state per clock; t0 is the strobe cycle, when
-//! the down counter is 0 and the schedule is `Idle`):
-//!
-//! | clock | state | subtractor / RAM | output stage |
+//! | clock | state | comb / RAM (`CicComb`) | output stage |
 //! |---|---|---|---|
 //! | t0 | `Idle` | acc <- integral 1, sample2 <- integral 2, shift held | |
-//! | t1..t8 | `FirstLow1`, `FirstHigh1` .. `FirstHigh4` | acc <- acc - delay\[k\], delay\[k\] <- acc (channel 1), low then high half | |
-//! | t9 | `SecondLoad` | acc <- sample2 | coarse (channel 1) |
-//! | t10..t17 | `SecondLow1` .. `SecondHigh4` | the same for channel 2 | fine (t10), round (t11) -> y_first |
-//! | t18 | `SecondCoarse` | | coarse (channel 2) |
-//! | t19 | `SecondFine` | | fine |
-//! | t20 | `SecondRound` | | round -> y2, y_first -> y1, valid |
+//! | t1..t8 | `Low`, `High` at stages 0..3 | acc <- acc - delay\[k\], delay\[k\] <- acc (channel 1), low then high half | |
+//! | t9 | `Load` | acc <- sample2, second <- 1 | coarse (channel 1) |
+//! | t10..t17 | `Low`, `High` at stages 0..3 | the same for channel 2 | fine (t10), round (t11, `High` at stage 0) -> y_first |
+//! | t18 | `Coarse` | | coarse (channel 2) |
+//! | t19 | `Fine` | | fine |
+//! | t20 | `Round` | | round -> y2, y_first -> y1, valid |
 //!
 //! `y1`, `y2` and a one-clock `valid` appear during t21, `SAMPLE_TO_OUTPUT`
 //! = 21 clocks after the strobe cycle, and the schedule is back in `Idle`
@@ -100,16 +85,18 @@
 //! delay); the read and write addresses of one clock always differ.
 //!
 //! Comb delays: 8 words of 80 bits (2 channels x 4 stages) in one
-//! `WordRam` (block RAM: five iCE40 `SB_RAM40_4K`; LUT RAM on ECP5), not
-//! in flip-flops: 640 flip-flops and an 80-bit 8-to-1 read multiplexer
-//! saved for five of the iCE40's 30 block RAMs.
+//! `WordRam` of `CicComb` (block RAM on iCE40, LUT RAM on ECP5), not in
+//! flip-flops.
 //!
-//! Resources (Yosys 0.23 `synth_ice40 -dsp`, this module alone, both
-//! channels): 1384 `SB_LUT4`, 773 `SB_CARRY`, 1036 flip-flops, 5
-//! `SB_RAM40_4K`; of these the two `CicIntegrators` are 640 LUT4 and 640
-//! flip-flops. The bias-first output stage took 1483 LUT4, 813 carries and
-//! 1075 flip-flops; the two single-channel decimators the shared back-end
-//! replaced took 2 x 1459 LUT4 and 2 x 1238 flip-flops.
+//! Resources (Yosys 0.23 `synth_ice40 -dsp -top gyro_interface__cic` on
+//! the exported Verilog, this module alone, both channels): 1392
+//! `SB_LUT4`, 773 `SB_CARRY`, 1169 flip-flops, 5 `SB_RAM40_4K`; of these
+//! each `CicIntegrators` is 320 LUT4, 316 carries and 365 flip-flops. The
+//! 21-state schedule before the stage counter took 1414 LUT4 and 1168
+//! flip-flops (the same command); the bias-first output stage 1483 LUT4,
+//! 813 carries and 1075 flip-flops, and the two single-channel decimators
+//! the shared back-end replaced 2 x 1459 LUT4 and 2 x 1238 flip-flops (an
+//! older Yosys flow).
 //!
 //! Run-time settings: `decimation` R in 21..=4096 (a 13-bit word; the down
 //! counter reloads R - 1 at each strobe, so a new R acts from the next
@@ -118,116 +105,36 @@
 //! all registers and delay words 0, the first strobe during the first
 //! clock.
 
+use crate::cic_comb::CicComb;
 use crate::cic_integrators::CicIntegrators;
-use crate::primitives::WordRam;
-use crate::primitives::convert::signed_bit_cast_exact;
+use crate::cic_output_stage::CicOutputStage;
+pub use crate::cic_widths::{
+    CHANNELS, COARSE_BITS, COARSE_SHIFT_MASK, COMB_CLOCKS, DECIMATION_BITS, DELAY_ADDRESS_BITS,
+    DOUBLED_BITS, FINE_SHIFT_BITS, FINE_SHIFT_MASK, HALF_BITS, INPUT_BITS, MAX_DECIMATION,
+    MAX_DECIMATION_LOG2, OUTPUT_BITS, OUTPUT_FRACTION_BITS, OUTPUT_STAGES, REGISTER_BITS,
+    REGISTER_HALF_BITS, SAMPLE_TO_OUTPUT, SCHEDULE_CLOCKS, SHIFT_BITS, STAGE_BITS, STAGES,
+};
 use rust_hdl::prelude::*;
 
-/// Number of integrator and comb stages.
-pub use gyrocal_regs::datapath::CIC_STAGES as STAGES;
-/// Width of the input word.
-pub const INPUT_BITS: usize = 32;
-pub use gyrocal_regs::datapath::{MAX_DECIMATION, MAX_DECIMATION_LOG2, OUTPUT_FRACTION_BITS};
-/// Hogenauer register width: B_in + N log2(R_max) = 32 + 4 * 12 = 80.
-pub const REGISTER_BITS: usize = INPUT_BITS + (STAGES * MAX_DECIMATION_LOG2) as usize;
-/// Width of the output word.
-pub const OUTPUT_BITS: usize = 40;
-/// Width of the decimation word: R up to 2^12 needs 13 bits.
-pub const DECIMATION_BITS: usize = gyrocal_regs::datapath::DECIMATION_BITS as usize;
-/// Width of the output shift word: shifts 0..=40 need 6 bits.
-pub const SHIFT_BITS: usize = gyrocal_regs::datapath::SHIFT_BITS as usize;
-/// Low bits of the shift applied by the last (fine) output step: 0..=7.
-pub const FINE_SHIFT_BITS: usize = 3;
-/// The shift bits of the fine step: `shift & 0b000111`.
-pub const FINE_SHIFT_MASK: u64 = (1 << FINE_SHIFT_BITS) - 1;
-/// The shift bits of the coarse step (multiples of 8): `shift & 0b111000`.
-pub const COARSE_SHIFT_MASK: u64 = ((1 << SHIFT_BITS) - 1) & !FINE_SHIFT_MASK;
-/// Width of floor(2b / 2^shift) as the output stage keeps it: the output
-/// and the one bit below it that decides the rounding.
-pub const HALF_BITS: usize = OUTPUT_BITS + 1;
-/// Width of the doubled, sign-extended comb word 2b: the largest shift the
-/// setting holds (63) plus `HALF_BITS` bits, so every read bit exists.
-pub const DOUBLED_BITS: usize = HALF_BITS + (1 << SHIFT_BITS) - 1;
-/// Width kept after the coarse step: the fine step shifts by at most
-/// 2^3 - 1 = 7 and keeps `HALF_BITS`, so bits 0..41 + 7 suffice.
-pub const COARSE_BITS: usize = HALF_BITS + (1 << FINE_SHIFT_BITS) - 1;
-/// Clocks from a comb output in the accumulator to its rounded value:
-/// coarse, fine, round.
-pub const OUTPUT_STAGES: usize = 3;
-/// Channels sharing the back-end.
-pub const CHANNELS: usize = 2;
-/// Address bits of the comb delay RAM: `CHANNELS * STAGES` = 8 words.
-pub const DELAY_ADDRESS_BITS: usize = 3;
-/// Width of a register half: the combs' 80-bit subtraction runs as two
-/// 40-bit ones on consecutive clocks (26 MHz on an iCE40 UP5K with one
-/// 80-bit carry chain behind the RAM), and each integrator adds in two
-/// halves, the high one a clock late (`crate::cic_integrator_stage`).
-pub const REGISTER_HALF_BITS: usize = REGISTER_BITS / 2;
-/// A comb half with its borrow (low half) or its borrow-in (high half).
-const COMB_CARRY_BITS: usize = REGISTER_HALF_BITS + 1;
-/// Clocks per comb step: the low half, then the high half.
-pub const COMB_CLOCKS: usize = 2;
-/// Clocks from leaving `Idle` to being back in it: per channel one load
-/// and `STAGES` comb steps, then the second channel's output steps. The
-/// least decimation at which no strobe is dropped.
-pub const SCHEDULE_CLOCKS: usize = CHANNELS * (1 + COMB_CLOCKS * STAGES as usize) + OUTPUT_STAGES;
-/// Clocks from the strobe cycle to `y1`, `y2` and `valid`.
-pub const SAMPLE_TO_OUTPUT: usize = SCHEDULE_CLOCKS;
-
-const _: () = assert!(CHANNELS * STAGES as usize == 1 << DELAY_ADDRESS_BITS);
-const _: () = assert!(2 * REGISTER_HALF_BITS == REGISTER_BITS);
-// `get_bits` offsets inside `update` are literals (rust-hdl prints a named
-// constant there verbatim into the Verilog): 40 is `REGISTER_HALF_BITS`,
-// here and in `cic_integrators` and `cic_integrator_stage`.
-const _: () = assert!(REGISTER_HALF_BITS == 40);
-const _: () = assert!(DOUBLED_BITS > REGISTER_BITS);
-const _: () = assert!(SCHEDULE_CLOCKS as u32 <= crate::filter_design::MIN_DECIMATION);
-
-/// The back-end schedule, one state per clock (see the module header).
+/// The back-end schedule's states (see the module header); `Low` and
+/// `High` repeat for the `STAGES` comb steps of each channel.
 #[derive(Copy, Clone, Debug, PartialEq, LogicState)]
 pub enum CicStep {
     /// Waiting for the strobe; on it load channel 1, sample channel 2.
     Idle,
-    /// Comb 1 of channel 1, low half.
-    FirstLow1,
-    /// Comb 1 of channel 1, high half.
-    FirstHigh1,
-    /// Comb 2 of channel 1, low half.
-    FirstLow2,
-    /// Comb 2 of channel 1, high half.
-    FirstHigh2,
-    /// Comb 3 of channel 1, low half.
-    FirstLow3,
-    /// Comb 3 of channel 1, high half.
-    FirstHigh3,
-    /// Comb 4 of channel 1, low half.
-    FirstLow4,
-    /// Comb 4 of channel 1, high half.
-    FirstHigh4,
+    /// A comb step's low half.
+    Low,
+    /// A comb step's high half; at channel 2's first, channel 1's rounded
+    /// result into `y_first`.
+    High,
     /// Load channel 2's sample; coarse step of channel 1's comb output.
-    SecondLoad,
-    /// Comb 1 of channel 2, low half; fine step of channel 1.
-    SecondLow1,
-    /// Comb 1 of channel 2, high half; channel 1's rounded result into `y_first`.
-    SecondHigh1,
-    /// Comb 2 of channel 2, low half.
-    SecondLow2,
-    /// Comb 2 of channel 2, high half.
-    SecondHigh2,
-    /// Comb 3 of channel 2, low half.
-    SecondLow3,
-    /// Comb 3 of channel 2, high half.
-    SecondHigh3,
-    /// Comb 4 of channel 2, low half.
-    SecondLow4,
-    /// Comb 4 of channel 2, high half.
-    SecondHigh4,
+    Load,
     /// Coarse step of channel 2's comb output.
-    SecondCoarse,
+    Coarse,
     /// Fine step of channel 2.
-    SecondFine,
+    Fine,
     /// Round channel 2 and publish both outputs at the next edge.
-    SecondRound,
+    Round,
 }
 
 /// Two-channel four-stage CIC decimator with run-time rate and output
@@ -252,43 +159,21 @@ pub struct CicDecimator {
     pub valid: Signal<Out, Bit>,
     integrators1: CicIntegrators,
     integrators2: CicIntegrators,
+    comb: CicComb,
+    rounding: CicOutputStage,
     count: DFF<Bits<DECIMATION_BITS>>,
     step: DFF<CicStep>,
-    acc: DFF<Signed<REGISTER_BITS>>,
+    stage: DFF<Bits<STAGE_BITS>>,
+    second: DFF<Bit>,
     sample2: DFF<Signed<REGISTER_BITS>>,
     held_shift: DFF<Bits<SHIFT_BITS>>,
-    delays: WordRam<REGISTER_BITS, DELAY_ADDRESS_BITS>,
-    delay_address: DFF<Bits<DELAY_ADDRESS_BITS>>,
-    comb_low: Signal<Local, Bit>,
-    comb_high: Signal<Local, Bit>,
-    borrow: DFF<Bits<1>>,
-    delay_high: DFF<Bits<REGISTER_HALF_BITS>>,
-    acc_bits: Signal<Local, Bits<REGISTER_BITS>>,
-    delay_bits: Signal<Local, Bits<REGISTER_BITS>>,
-    acc_low: Signal<Local, Bits<REGISTER_HALF_BITS>>,
-    acc_high: Signal<Local, Bits<REGISTER_HALF_BITS>>,
-    delay_low: Signal<Local, Bits<REGISTER_HALF_BITS>>,
-    low_difference: Signal<Local, Bits<COMB_CARRY_BITS>>,
-    high_difference: Signal<Local, Bits<COMB_CARRY_BITS>>,
-    extended: Signal<Local, Signed<DOUBLED_BITS>>,
-    doubled: Signal<Local, Bits<DOUBLED_BITS>>,
-    coarse_shift: Signal<Local, Bits<SHIFT_BITS>>,
-    coarse_shifted: Signal<Local, Bits<DOUBLED_BITS>>,
-    coarse: DFF<Bits<COARSE_BITS>>,
-    fine_shift: Signal<Local, Bits<SHIFT_BITS>>,
-    fine_shifted: Signal<Local, Bits<COARSE_BITS>>,
-    fine: DFF<Bits<HALF_BITS>>,
-    rounded_half: Signal<Local, Bits<HALF_BITS>>,
-    rounded: Signal<Local, Signed<OUTPUT_BITS>>,
     y_first: DFF<Signed<OUTPUT_BITS>>,
     y1_out: DFF<Signed<OUTPUT_BITS>>,
     y2_out: DFF<Signed<OUTPUT_BITS>>,
     valid_out: DFF<Bit>,
-    one: Constant<Bits<HALF_BITS>>,
-    coarse_shift_mask: Constant<Bits<SHIFT_BITS>>,
-    fine_shift_mask: Constant<Bits<SHIFT_BITS>>,
-    next_address: Constant<Bits<DELAY_ADDRESS_BITS>>,
-    half_shift: Constant<Bits<8>>,
+    next_stage: Constant<Bits<STAGE_BITS>>,
+    first_stage: Constant<Bits<STAGE_BITS>>,
+    last_stage: Constant<Bits<STAGE_BITS>>,
 }
 
 impl CicDecimator {
@@ -305,43 +190,21 @@ impl CicDecimator {
             valid: Default::default(),
             integrators1: CicIntegrators::new(),
             integrators2: CicIntegrators::new(),
+            comb: CicComb::new(),
+            rounding: CicOutputStage::new(),
             count: Default::default(),
             step: Default::default(),
-            acc: Default::default(),
+            stage: Default::default(),
+            second: Default::default(),
             sample2: Default::default(),
             held_shift: Default::default(),
-            delays: WordRam::new(),
-            delay_address: Default::default(),
-            comb_low: Default::default(),
-            comb_high: Default::default(),
-            borrow: Default::default(),
-            delay_high: Default::default(),
-            acc_bits: Default::default(),
-            delay_bits: Default::default(),
-            acc_low: Default::default(),
-            acc_high: Default::default(),
-            delay_low: Default::default(),
-            low_difference: Default::default(),
-            high_difference: Default::default(),
-            extended: Default::default(),
-            doubled: Default::default(),
-            coarse_shift: Default::default(),
-            coarse_shifted: Default::default(),
-            coarse: Default::default(),
-            fine_shift: Default::default(),
-            fine_shifted: Default::default(),
-            fine: Default::default(),
-            rounded_half: Default::default(),
-            rounded: Default::default(),
             y_first: Default::default(),
             y1_out: Default::default(),
             y2_out: Default::default(),
             valid_out: Default::default(),
-            one: Constant::new(1.into()),
-            coarse_shift_mask: Constant::new(COARSE_SHIFT_MASK.into()),
-            fine_shift_mask: Constant::new(FINE_SHIFT_MASK.into()),
-            next_address: Constant::new(1.into()),
-            half_shift: Constant::new((REGISTER_HALF_BITS as u64).into()),
+            next_stage: Constant::new(1.into()),
+            first_stage: Constant::new(0.into()),
+            last_stage: Constant::new((STAGES as u64 - 1).into()),
         }
     }
 }
@@ -356,26 +219,13 @@ impl Logic for CicDecimator {
     #[hdl_gen]
     fn update(&mut self) {
         dff_setup!(
-            self,
-            clock,
-            count,
-            step,
-            acc,
-            sample2,
-            held_shift,
-            delay_address,
-            borrow,
-            delay_high,
-            coarse,
-            fine,
-            y_first,
-            y1_out,
-            y2_out,
+            self, clock, count, step, stage, second, sample2, held_shift, y_first, y1_out, y2_out,
             valid_out
         );
         self.integrators1.clock.next = self.clock.val();
         self.integrators2.clock.next = self.clock.val();
-        self.delays.clock.next = self.clock.val();
+        self.comb.clock.next = self.clock.val();
+        self.rounding.clock.next = self.clock.val();
         self.integrators1.x.next = self.x1.val();
         self.integrators2.x.next = self.x2.val();
         // Rate counter: it runs whatever the schedule does.
@@ -384,155 +234,62 @@ impl Logic for CicDecimator {
         } else {
             self.count.d.next = self.count.q.val() - 1;
         }
-        // Output stage (module header), every clock on the accumulator.
-        self.extended.next = signed_bit_cast_exact::<DOUBLED_BITS, REGISTER_BITS>(self.acc.q.val());
-        self.doubled.next = unsigned_cast(self.extended.val()) << 1;
-        self.coarse_shift.next = self.held_shift.q.val() & self.coarse_shift_mask.val();
-        self.coarse_shifted.next = self.doubled.val() >> self.coarse_shift.val();
-        self.coarse.d.next = self.coarse_shifted.val().get_bits::<COARSE_BITS>(0);
-        self.fine_shift.next = self.held_shift.q.val() & self.fine_shift_mask.val();
-        self.fine_shifted.next = self.coarse.q.val() >> self.fine_shift.val();
-        self.fine.d.next = self.fine_shifted.val().get_bits::<HALF_BITS>(0);
-        self.rounded_half.next = (self.fine.q.val() + self.one.val()) >> 1;
-        self.rounded.next = signed_cast(self.rounded_half.val().get_bits::<OUTPUT_BITS>(0));
-        // Schedule.
-        self.comb_low.next = false;
-        self.comb_high.next = false;
+        // The output stage, every clock on the accumulator.
+        self.rounding.acc.next = self.comb.acc.val();
+        self.rounding.shift.next = self.held_shift.q.val();
+        // Schedule (module header).
+        self.comb.low.next = false;
+        self.comb.high.next = false;
+        self.comb.load.next = false;
+        self.comb.load_value.next = self.integrators1.integral.val();
         self.valid_out.d.next = false;
         match self.step.q.val() {
             CicStep::Idle => {
                 if self.count.q.val() == 0 {
-                    self.acc.d.next = self.integrators1.integral.val();
+                    self.comb.load.next = true;
                     self.sample2.d.next = self.integrators2.integral.val();
                     self.held_shift.d.next = self.shift.val();
-                    self.step.d.next = CicStep::FirstLow1;
+                    self.second.d.next = false;
+                    self.step.d.next = CicStep::Low;
                 }
             }
-            CicStep::FirstLow1 => {
-                self.comb_low.next = true;
-                self.step.d.next = CicStep::FirstHigh1;
+            CicStep::Low => {
+                self.comb.low.next = true;
+                self.step.d.next = CicStep::High;
             }
-            CicStep::FirstHigh1 => {
-                self.comb_high.next = true;
-                self.step.d.next = CicStep::FirstLow2;
+            CicStep::High => {
+                self.comb.high.next = true;
+                self.stage.d.next = self.stage.q.val() + self.next_stage.val();
+                self.step.d.next = CicStep::Low;
+                if self.stage.q.val() == self.first_stage.val() && self.second.q.val() {
+                    self.y_first.d.next = self.rounding.rounded.val();
+                }
+                if self.stage.q.val() == self.last_stage.val() {
+                    if self.second.q.val() {
+                        self.step.d.next = CicStep::Coarse;
+                    } else {
+                        self.step.d.next = CicStep::Load;
+                    }
+                }
             }
-            CicStep::FirstLow2 => {
-                self.comb_low.next = true;
-                self.step.d.next = CicStep::FirstHigh2;
+            CicStep::Load => {
+                self.comb.load.next = true;
+                self.comb.load_value.next = self.sample2.q.val();
+                self.second.d.next = true;
+                self.step.d.next = CicStep::Low;
             }
-            CicStep::FirstHigh2 => {
-                self.comb_high.next = true;
-                self.step.d.next = CicStep::FirstLow3;
+            CicStep::Coarse => {
+                self.step.d.next = CicStep::Fine;
             }
-            CicStep::FirstLow3 => {
-                self.comb_low.next = true;
-                self.step.d.next = CicStep::FirstHigh3;
+            CicStep::Fine => {
+                self.step.d.next = CicStep::Round;
             }
-            CicStep::FirstHigh3 => {
-                self.comb_high.next = true;
-                self.step.d.next = CicStep::FirstLow4;
-            }
-            CicStep::FirstLow4 => {
-                self.comb_low.next = true;
-                self.step.d.next = CicStep::FirstHigh4;
-            }
-            CicStep::FirstHigh4 => {
-                self.comb_high.next = true;
-                self.step.d.next = CicStep::SecondLoad;
-            }
-            CicStep::SecondLoad => {
-                self.acc.d.next = self.sample2.q.val();
-                self.step.d.next = CicStep::SecondLow1;
-            }
-            CicStep::SecondLow1 => {
-                self.comb_low.next = true;
-                self.step.d.next = CicStep::SecondHigh1;
-            }
-            CicStep::SecondHigh1 => {
-                self.comb_high.next = true;
-                self.y_first.d.next = self.rounded.val();
-                self.step.d.next = CicStep::SecondLow2;
-            }
-            CicStep::SecondLow2 => {
-                self.comb_low.next = true;
-                self.step.d.next = CicStep::SecondHigh2;
-            }
-            CicStep::SecondHigh2 => {
-                self.comb_high.next = true;
-                self.step.d.next = CicStep::SecondLow3;
-            }
-            CicStep::SecondLow3 => {
-                self.comb_low.next = true;
-                self.step.d.next = CicStep::SecondHigh3;
-            }
-            CicStep::SecondHigh3 => {
-                self.comb_high.next = true;
-                self.step.d.next = CicStep::SecondLow4;
-            }
-            CicStep::SecondLow4 => {
-                self.comb_low.next = true;
-                self.step.d.next = CicStep::SecondHigh4;
-            }
-            CicStep::SecondHigh4 => {
-                self.comb_high.next = true;
-                self.step.d.next = CicStep::SecondCoarse;
-            }
-            CicStep::SecondCoarse => {
-                self.step.d.next = CicStep::SecondFine;
-            }
-            CicStep::SecondFine => {
-                self.step.d.next = CicStep::SecondRound;
-            }
-            CicStep::SecondRound => {
+            CicStep::Round => {
                 self.y1_out.d.next = self.y_first.q.val();
-                self.y2_out.d.next = self.rounded.val();
+                self.y2_out.d.next = self.rounding.rounded.val();
                 self.valid_out.d.next = true;
                 self.step.d.next = CicStep::Idle;
             }
-        }
-        // Comb step acc - delay in two halves (module header): the low
-        // clock subtracts the low halves, keeps the borrow and the delay's
-        // high half, and writes the old acc as the new delay; the high
-        // clock subtracts the high halves and the borrow, as one 41-bit
-        // subtraction (2 hi) - (2 delay_hi + borrow), halved. The RAM
-        // reads the next step's word one clock ahead of its low clock.
-        self.acc_bits.next = unsigned_cast(self.acc.q.val());
-        self.delay_bits.next = unsigned_cast(self.delays.q.val());
-        self.acc_low.next = self.acc_bits.val().get_bits::<REGISTER_HALF_BITS>(0);
-        self.acc_high.next = self.acc_bits.val().get_bits::<REGISTER_HALF_BITS>(40);
-        self.delay_low.next = self.delay_bits.val().get_bits::<REGISTER_HALF_BITS>(0);
-        self.low_difference.next =
-            bit_cast::<COMB_CARRY_BITS, REGISTER_HALF_BITS>(self.acc_low.val())
-                - bit_cast::<COMB_CARRY_BITS, REGISTER_HALF_BITS>(self.delay_low.val());
-        self.high_difference.next =
-            (bit_cast::<COMB_CARRY_BITS, REGISTER_HALF_BITS>(self.acc_high.val()) << 1)
-                - ((bit_cast::<COMB_CARRY_BITS, REGISTER_HALF_BITS>(self.delay_high.q.val()) << 1)
-                    | bit_cast::<COMB_CARRY_BITS, 1>(self.borrow.q.val()));
-        self.delays.write_enable.next = self.comb_low.val();
-        self.delays.write_address.next = self.delay_address.q.val();
-        self.delays.write_data.next = self.acc.q.val();
-        self.delays.read_address.next = self.delay_address.q.val();
-        if self.comb_low.val() {
-            self.acc.d.next = signed_cast(
-                (bit_cast::<REGISTER_BITS, REGISTER_HALF_BITS>(self.acc_high.val())
-                    << self.half_shift.val())
-                    | bit_cast::<REGISTER_BITS, REGISTER_HALF_BITS>(
-                        self.low_difference.val().get_bits::<REGISTER_HALF_BITS>(0),
-                    ),
-            );
-            self.borrow.d.next = self.low_difference.val().get_bits::<1>(40);
-            self.delay_high.d.next = self.delay_bits.val().get_bits::<REGISTER_HALF_BITS>(40);
-            self.delays.read_address.next = self.delay_address.q.val() + self.next_address.val();
-        }
-        if self.comb_high.val() {
-            self.acc.d.next = signed_cast(
-                (bit_cast::<REGISTER_BITS, REGISTER_HALF_BITS>(
-                    self.high_difference.val().get_bits::<REGISTER_HALF_BITS>(1),
-                ) << self.half_shift.val())
-                    | bit_cast::<REGISTER_BITS, REGISTER_HALF_BITS>(self.acc_low.val()),
-            );
-            self.delay_address.d.next = self.delay_address.q.val() + self.next_address.val();
-            self.delays.read_address.next = self.delay_address.q.val() + self.next_address.val();
         }
         self.y1.next = self.y1_out.q.val();
         self.y2.next = self.y2_out.q.val();

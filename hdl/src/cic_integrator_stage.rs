@@ -18,7 +18,7 @@
 //! 80-bit add took 34 ns on an iCE40 UP5K (29 MHz); a 41-bit one half that.
 //! Power-up: 0. Resources: 81 flip-flops, two 41-bit adders.
 
-use crate::cic_decimator::REGISTER_HALF_BITS as HALF_BITS;
+use crate::cic_widths::REGISTER_HALF_BITS as HALF_BITS;
 use rust_hdl::prelude::*;
 
 /// A half with its carry.

@@ -27,8 +27,8 @@
 //!
 //! Resources: eight 41-bit adders and 4 x 81 + 41 flip-flops.
 
-use crate::cic_decimator::{INPUT_BITS, REGISTER_BITS, REGISTER_HALF_BITS as HALF_BITS};
 use crate::cic_integrator_stage::CicIntegratorStage;
+use crate::cic_widths::{INPUT_BITS, REGISTER_BITS, REGISTER_HALF_BITS as HALF_BITS};
 use crate::primitives::convert::signed_bit_cast_exact;
 use rust_hdl::prelude::*;
 

@@ -123,7 +123,7 @@ use crate::primitives::{DigitRam, MicrocodeRom, RegisteredMultiplier};
 use rust_hdl::prelude::*;
 
 /// Width of the input and output samples.
-pub const SAMPLE_BITS: usize = crate::cic_decimator::OUTPUT_BITS;
+pub const SAMPLE_BITS: usize = crate::cic_widths::OUTPUT_BITS;
 /// Fractional bits of the coefficients (Q2.30).
 pub use gyrocal_regs::datapath::COEFFICIENT_FRACTION_BITS;
 /// Width of the coefficients.

@@ -22485,34 +22485,18 @@ module gyro_interface_axi__core__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
     output reg  valid;
 
     // Constant declarations
-    localparam  one = 41'h1;
-    localparam  coarse_shift_mask = 6'b111000;
-    localparam  fine_shift_mask = 6'b111;
-    localparam  next_address = 3'b1;
-    localparam  half_shift = 8'h28;
+    localparam  next_stage = 2'b1;
+    localparam  first_stage = 2'b0;
+    localparam  last_stage = 2'b11;
 
     // Enums
     localparam CicStep$Idle = 0;
-    localparam CicStep$FirstLow1 = 1;
-    localparam CicStep$FirstHigh1 = 2;
-    localparam CicStep$FirstLow2 = 3;
-    localparam CicStep$FirstHigh2 = 4;
-    localparam CicStep$FirstLow3 = 5;
-    localparam CicStep$FirstHigh3 = 6;
-    localparam CicStep$FirstLow4 = 7;
-    localparam CicStep$FirstHigh4 = 8;
-    localparam CicStep$SecondLoad = 9;
-    localparam CicStep$SecondLow1 = 10;
-    localparam CicStep$SecondHigh1 = 11;
-    localparam CicStep$SecondLow2 = 12;
-    localparam CicStep$SecondHigh2 = 13;
-    localparam CicStep$SecondLow3 = 14;
-    localparam CicStep$SecondHigh3 = 15;
-    localparam CicStep$SecondLow4 = 16;
-    localparam CicStep$SecondHigh4 = 17;
-    localparam CicStep$SecondCoarse = 18;
-    localparam CicStep$SecondFine = 19;
-    localparam CicStep$SecondRound = 20;
+    localparam CicStep$Low = 1;
+    localparam CicStep$High = 2;
+    localparam CicStep$Load = 3;
+    localparam CicStep$Coarse = 4;
+    localparam CicStep$Fine = 5;
+    localparam CicStep$Round = 6;
 
     // Stub signals
     reg  integrators1$clock;
@@ -22521,42 +22505,34 @@ module gyro_interface_axi__core__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
     reg  integrators2$clock;
     reg signed [31:0] integrators2$x;
     wire signed [79:0] integrators2$integral;
+    reg  comb$clock;
+    reg  comb$low;
+    reg  comb$high;
+    reg  comb$load;
+    reg signed [79:0] comb$load_value;
+    wire signed [79:0] comb$acc;
+    reg  rounding$clock;
+    reg signed [79:0] rounding$acc;
+    reg  [5:0] rounding$shift;
+    wire signed [39:0] rounding$rounded;
     reg  [12:0] count$d;
     wire  [12:0] count$q;
     reg  count$clock;
-    reg  [4:0] step$d;
-    wire  [4:0] step$q;
+    reg  [2:0] step$d;
+    wire  [2:0] step$q;
     reg  step$clock;
-    reg signed [79:0] acc$d;
-    wire signed [79:0] acc$q;
-    reg  acc$clock;
+    reg  [1:0] stage$d;
+    wire  [1:0] stage$q;
+    reg  stage$clock;
+    reg  second$d;
+    wire  second$q;
+    reg  second$clock;
     reg signed [79:0] sample2$d;
     wire signed [79:0] sample2$q;
     reg  sample2$clock;
     reg  [5:0] held_shift$d;
     wire  [5:0] held_shift$q;
     reg  held_shift$clock;
-    reg  delays$clock;
-    reg  delays$write_enable;
-    reg  [2:0] delays$write_address;
-    reg signed [79:0] delays$write_data;
-    reg  [2:0] delays$read_address;
-    wire signed [79:0] delays$q;
-    reg  [2:0] delay_address$d;
-    wire  [2:0] delay_address$q;
-    reg  delay_address$clock;
-    reg  borrow$d;
-    wire  borrow$q;
-    reg  borrow$clock;
-    reg  [39:0] delay_high$d;
-    wire  [39:0] delay_high$q;
-    reg  delay_high$clock;
-    reg  [47:0] coarse$d;
-    wire  [47:0] coarse$q;
-    reg  coarse$clock;
-    reg  [40:0] fine$d;
-    wire  [40:0] fine$q;
-    reg  fine$clock;
     reg signed [39:0] y_first$d;
     wire signed [39:0] y_first$q;
     reg  y_first$clock;
@@ -22570,25 +22546,6 @@ module gyro_interface_axi__core__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
     wire  valid_out$q;
     reg  valid_out$clock;
 
-    // Local signals
-    reg  comb_low;
-    reg  comb_high;
-    reg  [79:0] acc_bits;
-    reg  [79:0] delay_bits;
-    reg  [39:0] acc_low;
-    reg  [39:0] acc_high;
-    reg  [39:0] delay_low;
-    reg  [40:0] low_difference;
-    reg  [40:0] high_difference;
-    reg signed [103:0] extended;
-    reg  [103:0] doubled;
-    reg  [5:0] coarse_shift;
-    reg  [103:0] coarse_shifted;
-    reg  [5:0] fine_shift;
-    reg  [47:0] fine_shifted;
-    reg  [40:0] rounded_half;
-    reg signed [39:0] rounded;
-
     // Sub module instances
     gyro_interface_axi__core__cic__integrators1 integrators1(
         .clock(integrators1$clock),
@@ -22600,6 +22557,20 @@ module gyro_interface_axi__core__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
         .x(integrators2$x),
         .integral(integrators2$integral)
     );
+    gyro_interface_axi__core__cic__comb comb(
+        .clock(comb$clock),
+        .low(comb$low),
+        .high(comb$high),
+        .load(comb$load),
+        .load_value(comb$load_value),
+        .acc(comb$acc)
+    );
+    gyro_interface_axi__core__cic__rounding rounding(
+        .clock(rounding$clock),
+        .acc(rounding$acc),
+        .shift(rounding$shift),
+        .rounded(rounding$rounded)
+    );
     gyro_interface_axi__core__cic__count count(
         .d(count$d),
         .q(count$q),
@@ -22610,10 +22581,15 @@ module gyro_interface_axi__core__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
         .q(step$q),
         .clock(step$clock)
     );
-    gyro_interface_axi__core__cic__acc acc(
-        .d(acc$d),
-        .q(acc$q),
-        .clock(acc$clock)
+    gyro_interface_axi__core__cic__stage stage(
+        .d(stage$d),
+        .q(stage$q),
+        .clock(stage$clock)
+    );
+    gyro_interface_axi__core__cic__second second(
+        .d(second$d),
+        .q(second$q),
+        .clock(second$clock)
     );
     gyro_interface_axi__core__cic__sample2 sample2(
         .d(sample2$d),
@@ -22624,39 +22600,6 @@ module gyro_interface_axi__core__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
         .d(held_shift$d),
         .q(held_shift$q),
         .clock(held_shift$clock)
-    );
-    gyro_interface_axi__core__cic__delays delays(
-        .clock(delays$clock),
-        .write_enable(delays$write_enable),
-        .write_address(delays$write_address),
-        .write_data(delays$write_data),
-        .read_address(delays$read_address),
-        .q(delays$q)
-    );
-    gyro_interface_axi__core__cic__delay_address delay_address(
-        .d(delay_address$d),
-        .q(delay_address$q),
-        .clock(delay_address$clock)
-    );
-    gyro_interface_axi__core__cic__borrow borrow(
-        .d(borrow$d),
-        .q(borrow$q),
-        .clock(borrow$clock)
-    );
-    gyro_interface_axi__core__cic__delay_high delay_high(
-        .d(delay_high$d),
-        .q(delay_high$q),
-        .clock(delay_high$clock)
-    );
-    gyro_interface_axi__core__cic__coarse coarse(
-        .d(coarse$d),
-        .q(coarse$q),
-        .clock(coarse$clock)
-    );
-    gyro_interface_axi__core__cic__fine fine(
-        .d(fine$d),
-        .q(fine$q),
-        .clock(fine$clock)
     );
     gyro_interface_axi__core__cic__y_first y_first(
         .d(y_first$d),
@@ -22683,35 +22626,28 @@ module gyro_interface_axi__core__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
     always @(*) begin
         count$clock = clock;
         step$clock = clock;
-        acc$clock = clock;
+        stage$clock = clock;
+        second$clock = clock;
         sample2$clock = clock;
         held_shift$clock = clock;
-        delay_address$clock = clock;
-        borrow$clock = clock;
-        delay_high$clock = clock;
-        coarse$clock = clock;
-        fine$clock = clock;
         y_first$clock = clock;
         y1_out$clock = clock;
         y2_out$clock = clock;
         valid_out$clock = clock;
         count$d = count$q;
         step$d = step$q;
-        acc$d = acc$q;
+        stage$d = stage$q;
+        second$d = second$q;
         sample2$d = sample2$q;
         held_shift$d = held_shift$q;
-        delay_address$d = delay_address$q;
-        borrow$d = borrow$q;
-        delay_high$d = delay_high$q;
-        coarse$d = coarse$q;
-        fine$d = fine$q;
         y_first$d = y_first$q;
         y1_out$d = y1_out$q;
         y2_out$d = y2_out$q;
         valid_out$d = valid_out$q;
         integrators1$clock = clock;
         integrators2$clock = clock;
-        delays$clock = clock;
+        comb$clock = clock;
+        rounding$clock = clock;
         integrators1$x = x1;
         integrators2$x = x2;
         if (count$q == 32'h0) begin
@@ -22720,153 +22656,69 @@ module gyro_interface_axi__core__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
         else begin
             count$d = count$q - 32'h1;
         end
-        extended = $signed(acc$q);
-        doubled = $unsigned(extended) << 32'h1;
-        coarse_shift = held_shift$q & coarse_shift_mask;
-        coarse_shifted = doubled >> coarse_shift;
-        coarse$d = coarse_shifted[(32'h0)+:(48)];
-        fine_shift = held_shift$q & fine_shift_mask;
-        fine_shifted = coarse$q >> fine_shift;
-        fine$d = fine_shifted[(32'h0)+:(41)];
-        rounded_half = (fine$q + one) >> 32'h1;
-        rounded = $signed(rounded_half[(32'h0)+:(40)]);
-        comb_low = 1'b0;
-        comb_high = 1'b0;
+        rounding$acc = comb$acc;
+        rounding$shift = held_shift$q;
+        comb$low = 1'b0;
+        comb$high = 1'b0;
+        comb$load = 1'b0;
+        comb$load_value = integrators1$integral;
         valid_out$d = 1'b0;
         case (step$q)
             CicStep$Idle:
                 begin
                     if (count$q == 32'h0) begin
-                        acc$d = integrators1$integral;
+                        comb$load = 1'b1;
                         sample2$d = integrators2$integral;
                         held_shift$d = shift;
-                        step$d = CicStep$FirstLow1;
+                        second$d = 1'b0;
+                        step$d = CicStep$Low;
                     end
                 end
-            CicStep$FirstLow1:
+            CicStep$Low:
                 begin
-                    comb_low = 1'b1;
-                    step$d = CicStep$FirstHigh1;
+                    comb$low = 1'b1;
+                    step$d = CicStep$High;
                 end
-            CicStep$FirstHigh1:
+            CicStep$High:
                 begin
-                    comb_high = 1'b1;
-                    step$d = CicStep$FirstLow2;
+                    comb$high = 1'b1;
+                    stage$d = stage$q + next_stage;
+                    step$d = CicStep$Low;
+                    if (stage$q == first_stage && second$q) begin
+                        y_first$d = rounding$rounded;
+                    end
+                    if (stage$q == last_stage) begin
+                        if (second$q) begin
+                            step$d = CicStep$Coarse;
+                        end
+                        else begin
+                            step$d = CicStep$Load;
+                        end
+                    end
                 end
-            CicStep$FirstLow2:
+            CicStep$Load:
                 begin
-                    comb_low = 1'b1;
-                    step$d = CicStep$FirstHigh2;
+                    comb$load = 1'b1;
+                    comb$load_value = sample2$q;
+                    second$d = 1'b1;
+                    step$d = CicStep$Low;
                 end
-            CicStep$FirstHigh2:
+            CicStep$Coarse:
                 begin
-                    comb_high = 1'b1;
-                    step$d = CicStep$FirstLow3;
+                    step$d = CicStep$Fine;
                 end
-            CicStep$FirstLow3:
+            CicStep$Fine:
                 begin
-                    comb_low = 1'b1;
-                    step$d = CicStep$FirstHigh3;
+                    step$d = CicStep$Round;
                 end
-            CicStep$FirstHigh3:
-                begin
-                    comb_high = 1'b1;
-                    step$d = CicStep$FirstLow4;
-                end
-            CicStep$FirstLow4:
-                begin
-                    comb_low = 1'b1;
-                    step$d = CicStep$FirstHigh4;
-                end
-            CicStep$FirstHigh4:
-                begin
-                    comb_high = 1'b1;
-                    step$d = CicStep$SecondLoad;
-                end
-            CicStep$SecondLoad:
-                begin
-                    acc$d = sample2$q;
-                    step$d = CicStep$SecondLow1;
-                end
-            CicStep$SecondLow1:
-                begin
-                    comb_low = 1'b1;
-                    step$d = CicStep$SecondHigh1;
-                end
-            CicStep$SecondHigh1:
-                begin
-                    comb_high = 1'b1;
-                    y_first$d = rounded;
-                    step$d = CicStep$SecondLow2;
-                end
-            CicStep$SecondLow2:
-                begin
-                    comb_low = 1'b1;
-                    step$d = CicStep$SecondHigh2;
-                end
-            CicStep$SecondHigh2:
-                begin
-                    comb_high = 1'b1;
-                    step$d = CicStep$SecondLow3;
-                end
-            CicStep$SecondLow3:
-                begin
-                    comb_low = 1'b1;
-                    step$d = CicStep$SecondHigh3;
-                end
-            CicStep$SecondHigh3:
-                begin
-                    comb_high = 1'b1;
-                    step$d = CicStep$SecondLow4;
-                end
-            CicStep$SecondLow4:
-                begin
-                    comb_low = 1'b1;
-                    step$d = CicStep$SecondHigh4;
-                end
-            CicStep$SecondHigh4:
-                begin
-                    comb_high = 1'b1;
-                    step$d = CicStep$SecondCoarse;
-                end
-            CicStep$SecondCoarse:
-                begin
-                    step$d = CicStep$SecondFine;
-                end
-            CicStep$SecondFine:
-                begin
-                    step$d = CicStep$SecondRound;
-                end
-            CicStep$SecondRound:
+            CicStep$Round:
                 begin
                     y1_out$d = y_first$q;
-                    y2_out$d = rounded;
+                    y2_out$d = rounding$rounded;
                     valid_out$d = 1'b1;
                     step$d = CicStep$Idle;
                 end
         endcase
-        acc_bits = $unsigned(acc$q);
-        delay_bits = $unsigned(delays$q);
-        acc_low = acc_bits[(32'h0)+:(40)];
-        acc_high = acc_bits[(32'h28)+:(40)];
-        delay_low = delay_bits[(32'h0)+:(40)];
-        low_difference = ((acc_low) & 41'h1ffffffffff) - ((delay_low) & 41'h1ffffffffff);
-        high_difference = (((acc_high) & 41'h1ffffffffff) << 32'h1) - ((((delay_high$q) & 41'h1ffffffffff) << 32'h1) | ((borrow$q) & 41'h1ffffffffff));
-        delays$write_enable = comb_low;
-        delays$write_address = delay_address$q;
-        delays$write_data = acc$q;
-        delays$read_address = delay_address$q;
-        if (comb_low) begin
-            acc$d = $signed((((acc_high) & 80'hffffffffffffffffffff) << half_shift) | ((low_difference[(32'h0)+:(40)]) & 80'hffffffffffffffffffff));
-            borrow$d = low_difference[(32'h28)+:(1)];
-            delay_high$d = delay_bits[(32'h28)+:(40)];
-            delays$read_address = delay_address$q + next_address;
-        end
-        if (comb_high) begin
-            acc$d = $signed((((high_difference[(32'h1)+:(40)]) & 80'hffffffffffffffffffff) << half_shift) | ((acc_low) & 80'hffffffffffffffffffff));
-            delay_address$d = delay_address$q + next_address;
-            delays$read_address = delay_address$q + next_address;
-        end
         y1 = y1_out$q;
         y2 = y2_out$q;
         valid = valid_out$q;
@@ -22875,7 +22727,122 @@ module gyro_interface_axi__core__cic(clock,x1,x2,decimation,shift,y1,y2,valid);
 endmodule // gyro_interface_axi__core__cic
 
 
-module gyro_interface_axi__core__cic__acc(d,q,clock);
+module gyro_interface_axi__core__cic__comb(clock,low,high,load,load_value,acc);
+
+    // Module arguments
+    input wire  clock;
+    input wire  low;
+    input wire  high;
+    input wire  load;
+    input wire signed [79:0] load_value;
+    output reg signed [79:0] acc;
+
+    // Constant declarations
+    localparam  next_address = 3'b1;
+    localparam  half_shift = 8'h28;
+
+    // Stub signals
+    reg signed [79:0] accumulator$d;
+    wire signed [79:0] accumulator$q;
+    reg  accumulator$clock;
+    reg  delays$clock;
+    reg  delays$write_enable;
+    reg  [2:0] delays$write_address;
+    reg signed [79:0] delays$write_data;
+    reg  [2:0] delays$read_address;
+    wire signed [79:0] delays$q;
+    reg  [2:0] delay_address$d;
+    wire  [2:0] delay_address$q;
+    reg  delay_address$clock;
+    reg  borrow$d;
+    wire  borrow$q;
+    reg  borrow$clock;
+    reg  [39:0] delay_high$d;
+    wire  [39:0] delay_high$q;
+    reg  delay_high$clock;
+
+    // Local signals
+    reg  [79:0] acc_bits;
+    reg  [79:0] delay_bits;
+    reg  [39:0] acc_low;
+    reg  [39:0] acc_high;
+    reg  [39:0] delay_low;
+    reg  [40:0] low_difference;
+    reg  [40:0] high_difference;
+
+    // Sub module instances
+    gyro_interface_axi__core__cic__comb__accumulator accumulator(
+        .d(accumulator$d),
+        .q(accumulator$q),
+        .clock(accumulator$clock)
+    );
+    gyro_interface_axi__core__cic__comb__delays delays(
+        .clock(delays$clock),
+        .write_enable(delays$write_enable),
+        .write_address(delays$write_address),
+        .write_data(delays$write_data),
+        .read_address(delays$read_address),
+        .q(delays$q)
+    );
+    gyro_interface_axi__core__cic__comb__delay_address delay_address(
+        .d(delay_address$d),
+        .q(delay_address$q),
+        .clock(delay_address$clock)
+    );
+    gyro_interface_axi__core__cic__comb__borrow borrow(
+        .d(borrow$d),
+        .q(borrow$q),
+        .clock(borrow$clock)
+    );
+    gyro_interface_axi__core__cic__comb__delay_high delay_high(
+        .d(delay_high$d),
+        .q(delay_high$q),
+        .clock(delay_high$clock)
+    );
+
+    // Update code
+    always @(*) begin
+        accumulator$clock = clock;
+        delay_address$clock = clock;
+        borrow$clock = clock;
+        delay_high$clock = clock;
+        accumulator$d = accumulator$q;
+        delay_address$d = delay_address$q;
+        borrow$d = borrow$q;
+        delay_high$d = delay_high$q;
+        delays$clock = clock;
+        acc = accumulator$q;
+        acc_bits = $unsigned(accumulator$q);
+        delay_bits = $unsigned(delays$q);
+        acc_low = acc_bits[(32'h0)+:(40)];
+        acc_high = acc_bits[(32'h28)+:(40)];
+        delay_low = delay_bits[(32'h0)+:(40)];
+        low_difference = ((acc_low) & 41'h1ffffffffff) - ((delay_low) & 41'h1ffffffffff);
+        high_difference = (((acc_high) & 41'h1ffffffffff) << 32'h1) - ((((delay_high$q) & 41'h1ffffffffff) << 32'h1) | ((borrow$q) & 41'h1ffffffffff));
+        delays$write_enable = low;
+        delays$write_address = delay_address$q;
+        delays$write_data = accumulator$q;
+        delays$read_address = delay_address$q;
+        if (load) begin
+            accumulator$d = load_value;
+        end
+        if (low) begin
+            accumulator$d = $signed((((acc_high) & 80'hffffffffffffffffffff) << half_shift) | ((low_difference[(32'h0)+:(40)]) & 80'hffffffffffffffffffff));
+            borrow$d = low_difference[(32'h28)+:(1)];
+            delay_high$d = delay_bits[(32'h28)+:(40)];
+            delays$read_address = delay_address$q + next_address;
+        end
+        if (high) begin
+            accumulator$d = $signed((((high_difference[(32'h1)+:(40)]) & 80'hffffffffffffffffffff) << half_shift) | ((acc_low) & 80'hffffffffffffffffffff));
+            delay_address$d = delay_address$q + next_address;
+            delays$read_address = delay_address$q + next_address;
+        end
+    end
+
+endmodule // gyro_interface_axi__core__cic__comb
+
+
+module gyro_interface_axi__core__cic__comb__accumulator(d,q,clock);
 
     // Module arguments
     input wire signed [79:0] d;
@@ -22891,10 +22858,10 @@ module gyro_interface_axi__core__cic__acc(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__cic__acc
+endmodule // gyro_interface_axi__core__cic__comb__accumulator
 
 
-module gyro_interface_axi__core__cic__borrow(d,q,clock);
+module gyro_interface_axi__core__cic__comb__borrow(d,q,clock);
 
     // Module arguments
     input wire  d;
@@ -22910,48 +22877,10 @@ module gyro_interface_axi__core__cic__borrow(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__cic__borrow
+endmodule // gyro_interface_axi__core__cic__comb__borrow
 
 
-module gyro_interface_axi__core__cic__coarse(d,q,clock);
-
-    // Module arguments
-    input wire  [47:0] d;
-    output reg  [47:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 48'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic__coarse
-
-
-module gyro_interface_axi__core__cic__count(d,q,clock);
-
-    // Module arguments
-    input wire  [12:0] d;
-    output reg  [12:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 13'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__cic__count
-
-
-module gyro_interface_axi__core__cic__delay_address(d,q,clock);
+module gyro_interface_axi__core__cic__comb__delay_address(d,q,clock);
 
     // Module arguments
     input wire  [2:0] d;
@@ -22967,10 +22896,10 @@ module gyro_interface_axi__core__cic__delay_address(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__cic__delay_address
+endmodule // gyro_interface_axi__core__cic__comb__delay_address
 
 
-module gyro_interface_axi__core__cic__delay_high(d,q,clock);
+module gyro_interface_axi__core__cic__comb__delay_high(d,q,clock);
 
     // Module arguments
     input wire  [39:0] d;
@@ -22986,10 +22915,10 @@ module gyro_interface_axi__core__cic__delay_high(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__cic__delay_high
+endmodule // gyro_interface_axi__core__cic__comb__delay_high
 
 
-module gyro_interface_axi__core__cic__delays(clock,write_enable,write_address,write_data,read_address,q);
+module gyro_interface_axi__core__cic__comb__delays(clock,write_enable,write_address,write_data,read_address,q);
 
     // Module arguments
     input wire  clock;
@@ -23014,26 +22943,26 @@ module gyro_interface_axi__core__cic__delays(clock,write_enable,write_address,wr
           words[write_address] <= write_data;
        q <= words[read_address];
     end
-endmodule // gyro_interface_axi__core__cic__delays
+endmodule // gyro_interface_axi__core__cic__comb__delays
 
 
-module gyro_interface_axi__core__cic__fine(d,q,clock);
+module gyro_interface_axi__core__cic__count(d,q,clock);
 
     // Module arguments
-    input wire  [40:0] d;
-    output reg  [40:0] q;
+    input wire  [12:0] d;
+    output reg  [12:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 41'h0;
+       q = 13'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__cic__fine
+endmodule // gyro_interface_axi__core__cic__count
 
 
 module gyro_interface_axi__core__cic__held_shift(d,q,clock);
@@ -24319,6 +24248,107 @@ module gyro_interface_axi__core__cic__integrators2__x_high(d,q,clock);
 endmodule // gyro_interface_axi__core__cic__integrators2__x_high
 
 
+module gyro_interface_axi__core__cic__rounding(clock,acc,shift,rounded);
+
+    // Module arguments
+    input wire  clock;
+    input wire signed [79:0] acc;
+    input wire  [5:0] shift;
+    output reg signed [39:0] rounded;
+
+    // Constant declarations
+    localparam  one = 41'h1;
+    localparam  coarse_shift_mask = 6'b111000;
+    localparam  fine_shift_mask = 6'b111;
+
+    // Stub signals
+    reg  [47:0] coarse$d;
+    wire  [47:0] coarse$q;
+    reg  coarse$clock;
+    reg  [40:0] fine$d;
+    wire  [40:0] fine$q;
+    reg  fine$clock;
+
+    // Local signals
+    reg signed [103:0] extended;
+    reg  [103:0] doubled;
+    reg  [5:0] coarse_shift;
+    reg  [103:0] coarse_shifted;
+    reg  [5:0] fine_shift;
+    reg  [47:0] fine_shifted;
+    reg  [40:0] rounded_half;
+
+    // Sub module instances
+    gyro_interface_axi__core__cic__rounding__coarse coarse(
+        .d(coarse$d),
+        .q(coarse$q),
+        .clock(coarse$clock)
+    );
+    gyro_interface_axi__core__cic__rounding__fine fine(
+        .d(fine$d),
+        .q(fine$q),
+        .clock(fine$clock)
+    );
+
+    // Update code
+    always @(*) begin
+        coarse$clock = clock;
+        fine$clock = clock;
+        coarse$d = coarse$q;
+        fine$d = fine$q;
+        extended = $signed(acc);
+        doubled = $unsigned(extended) << 32'h1;
+        coarse_shift = shift & coarse_shift_mask;
+        coarse_shifted = doubled >> coarse_shift;
+        coarse$d = coarse_shifted[(32'h0)+:(48)];
+        fine_shift = shift & fine_shift_mask;
+        fine_shifted = coarse$q >> fine_shift;
+        fine$d = fine_shifted[(32'h0)+:(41)];
+        rounded_half = (fine$q + one) >> 32'h1;
+        rounded = $signed(rounded_half[(32'h0)+:(40)]);
+    end
+
+endmodule // gyro_interface_axi__core__cic__rounding
+
+
+module gyro_interface_axi__core__cic__rounding__coarse(d,q,clock);
+
+    // Module arguments
+    input wire  [47:0] d;
+    output reg  [47:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 48'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__rounding__coarse
+
+
+module gyro_interface_axi__core__cic__rounding__fine(d,q,clock);
+
+    // Module arguments
+    input wire  [40:0] d;
+    output reg  [40:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 41'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__rounding__fine
+
+
 module gyro_interface_axi__core__cic__sample2(d,q,clock);
 
     // Module arguments
@@ -24338,35 +24368,59 @@ module gyro_interface_axi__core__cic__sample2(d,q,clock);
 endmodule // gyro_interface_axi__core__cic__sample2
 
 
+module gyro_interface_axi__core__cic__second(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__second
+
+
+module gyro_interface_axi__core__cic__stage(d,q,clock);
+
+    // Module arguments
+    input wire  [1:0] d;
+    output reg  [1:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 2'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__cic__stage
+
+
 module gyro_interface_axi__core__cic__step(d,q,clock);
 
     // Module arguments
-    input wire  [4:0] d;
-    output reg  [4:0] q;
+    input wire  [2:0] d;
+    output reg  [2:0] q;
     input wire  clock;
 
     // Enums
     localparam CicStep$Idle = 0;
-    localparam CicStep$FirstLow1 = 1;
-    localparam CicStep$FirstHigh1 = 2;
-    localparam CicStep$FirstLow2 = 3;
-    localparam CicStep$FirstHigh2 = 4;
-    localparam CicStep$FirstLow3 = 5;
-    localparam CicStep$FirstHigh3 = 6;
-    localparam CicStep$FirstLow4 = 7;
-    localparam CicStep$FirstHigh4 = 8;
-    localparam CicStep$SecondLoad = 9;
-    localparam CicStep$SecondLow1 = 10;
-    localparam CicStep$SecondHigh1 = 11;
-    localparam CicStep$SecondLow2 = 12;
-    localparam CicStep$SecondHigh2 = 13;
-    localparam CicStep$SecondLow3 = 14;
-    localparam CicStep$SecondHigh3 = 15;
-    localparam CicStep$SecondLow4 = 16;
-    localparam CicStep$SecondHigh4 = 17;
-    localparam CicStep$SecondCoarse = 18;
-    localparam CicStep$SecondFine = 19;
-    localparam CicStep$SecondRound = 20;
+    localparam CicStep$Low = 1;
+    localparam CicStep$High = 2;
+    localparam CicStep$Load = 3;
+    localparam CicStep$Coarse = 4;
+    localparam CicStep$Fine = 5;
+    localparam CicStep$Round = 6;
 
     // Update code (custom)
     initial begin

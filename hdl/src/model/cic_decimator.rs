@@ -14,7 +14,7 @@
 //! register; the output stage starts from the wrapped 80-bit comb word,
 //! where the upper bits would start to matter.
 
-use crate::cic_decimator::{
+use crate::cic_widths::{
     CHANNELS, DECIMATION_BITS, OUTPUT_BITS, REGISTER_BITS, SAMPLE_TO_OUTPUT, STAGES,
 };
 
