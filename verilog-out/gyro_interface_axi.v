@@ -7113,118 +7113,101 @@ module gyro_interface_axi__core__iir(clock,x1,x2,x_valid,k0,k1,k2,alpha,z1,z2,z_
     output reg  z_valid;
 
     // Constant declarations
-    localparam  last_pc = 8'ha5;
-    localparam  slot_mask = 7'b1110011;
     localparam signed pow29 = 36'h20000000;
-    localparam signed pow30 = 34'h40000000;
-    localparam signed pow31 = 34'h80000000;
-    localparam signed one = 16'h1;
-    localparam signed minus_one = 16'hffff;
-    localparam signed pow14 = 16'h4000;
 
     // Stub signals
-    reg  rom$clock;
-    reg  [7:0] rom$address;
-    wire  [29:0] rom$q;
-    reg  ram$clock;
-    reg  [6:0] ram$read_address;
-    wire signed [15:0] ram$q;
-    reg  [6:0] ram$write_address;
-    reg signed [15:0] ram$write_data;
-    reg  ram$write_enable;
+    reg  sequencer$clock;
+    reg  sequencer$x_valid;
+    wire  sequencer$idle;
+    wire  sequencer$wrap_top;
+    wire  sequencer$round_start;
+    wire  sequencer$publish;
+    wire  [4:0] sequencer$factor;
+    wire  [1:0] sequencer$op;
+    wire  [2:0] sequencer$emit;
+    wire  [2:0] sequencer$x_select;
+    wire  [6:0] sequencer$read_address;
+    wire  [6:0] sequencer$write_address;
+    reg  coefficient$clock;
+    reg  [4:0] coefficient$factor;
+    reg signed [31:0] coefficient$k0;
+    reg signed [31:0] coefficient$k1;
+    reg signed [31:0] coefficient$k2;
+    reg signed [31:0] coefficient$alpha;
+    wire signed [15:0] coefficient$digit;
+    reg  digits$clock;
+    reg signed [39:0] digits$x1;
+    reg signed [39:0] digits$x2;
+    reg  digits$capture;
+    reg  [6:0] digits$read_address;
+    reg  [6:0] digits$write_address;
+    reg  [2:0] digits$emit;
+    reg  [2:0] digits$x_select;
+    reg signed [14:0] digits$column;
+    reg  digits$publish;
+    wire signed [15:0] digits$q;
+    wire signed [39:0] digits$z1;
+    wire signed [39:0] digits$z2;
+    wire  digits$z_valid;
     reg  mul$clock;
     reg signed [15:0] mul$a;
     reg signed [15:0] mul$b;
     wire signed [31:0] mul$p;
-    reg  [7:0] pc$d;
-    wire  [7:0] pc$q;
-    reg  pc$clock;
-    reg  [29:0] word_reg$d;
-    wire  [29:0] word_reg$q;
-    reg  word_reg$clock;
-    reg  [1:0] base$d;
-    wire  [1:0] base$q;
-    reg  base$clock;
-    reg signed [39:0] x1_held$d;
-    wire signed [39:0] x1_held$q;
-    reg  x1_held$clock;
-    reg signed [39:0] x2_held$d;
-    wire signed [39:0] x2_held$q;
-    reg  x2_held$clock;
     reg signed [15:0] a$d;
     wire signed [15:0] a$q;
     reg  a$clock;
-    reg signed [15:0] b$d;
-    wire signed [15:0] b$q;
-    reg  b$clock;
     reg signed [35:0] acc$d;
     wire signed [35:0] acc$q;
     reg  acc$clock;
-    reg  [89:0] stage$d;
-    wire  [89:0] stage$q;
-    reg  stage$clock;
-    reg signed [39:0] z1_out$d;
-    wire signed [39:0] z1_out$q;
-    reg  z1_out$clock;
-    reg signed [39:0] z2_out$d;
-    wire signed [39:0] z2_out$q;
-    reg  z2_out$clock;
-    reg  z_valid_out$d;
-    wire  z_valid_out$q;
-    reg  z_valid_out$clock;
 
     // Local signals
-    reg  [29:0] word;
-    reg  [6:0] read_field;
-    reg  [6:0] write_field;
-    reg  [4:0] factor;
     reg  [1:0] op;
-    reg  [2:0] emit;
-    reg  [2:0] x_select;
-    reg  [2:0] read_sum;
-    reg  [2:0] read_wrapped;
-    reg  [1:0] read_slot;
-    reg  [2:0] write_sum;
-    reg  [2:0] write_wrapped;
-    reg  [1:0] write_slot;
     reg signed [12:0] ram_low;
     reg signed [15:0] ram_wrapped;
-    reg signed [33:0] k0_wide;
-    reg signed [33:0] k1_wide;
-    reg signed [33:0] k2_wide;
-    reg signed [33:0] alpha_wide;
-    reg signed [33:0] scaled;
-    reg signed [29:0] scaled_low;
-    reg  [29:0] scaled_bits;
-    reg signed [3:0] top_bits;
-    reg signed [15:0] top_digit;
     reg signed [35:0] product;
     reg signed [20:0] carry;
     reg signed [35:0] carry_wide;
     reg signed [35:0] addend;
-    reg  [14:0] digit_bits;
-    reg signed [15:0] column_digit;
-    reg signed [14:0] column_top;
-    reg signed [15:0] column_top_digit;
-    reg signed [29:0] x_low;
-    reg  [29:0] x_bits;
-    reg signed [9:0] x_top;
-    reg signed [15:0] input_digit;
-    reg signed [15:0] x_top_digit;
 
     // Sub module instances
-    gyro_interface_axi__core__iir__rom rom(
-        .clock(rom$clock),
-        .address(rom$address),
-        .q(rom$q)
+    gyro_interface_axi__core__iir__sequencer sequencer(
+        .clock(sequencer$clock),
+        .x_valid(sequencer$x_valid),
+        .idle(sequencer$idle),
+        .wrap_top(sequencer$wrap_top),
+        .round_start(sequencer$round_start),
+        .publish(sequencer$publish),
+        .factor(sequencer$factor),
+        .op(sequencer$op),
+        .emit(sequencer$emit),
+        .x_select(sequencer$x_select),
+        .read_address(sequencer$read_address),
+        .write_address(sequencer$write_address)
     );
-    gyro_interface_axi__core__iir__ram ram(
-        .clock(ram$clock),
-        .read_address(ram$read_address),
-        .q(ram$q),
-        .write_address(ram$write_address),
-        .write_data(ram$write_data),
-        .write_enable(ram$write_enable)
+    gyro_interface_axi__core__iir__coefficient coefficient(
+        .clock(coefficient$clock),
+        .factor(coefficient$factor),
+        .k0(coefficient$k0),
+        .k1(coefficient$k1),
+        .k2(coefficient$k2),
+        .alpha(coefficient$alpha),
+        .digit(coefficient$digit)
+    );
+    gyro_interface_axi__core__iir__digits digits(
+        .clock(digits$clock),
+        .x1(digits$x1),
+        .x2(digits$x2),
+        .capture(digits$capture),
+        .read_address(digits$read_address),
+        .write_address(digits$write_address),
+        .emit(digits$emit),
+        .x_select(digits$x_select),
+        .column(digits$column),
+        .publish(digits$publish),
+        .q(digits$q),
+        .z1(digits$z1),
+        .z2(digits$z2),
+        .z_valid(digits$z_valid)
     );
     gyro_interface_axi__core__iir__mul mul(
         .clock(mul$clock),
@@ -7232,202 +7215,57 @@ module gyro_interface_axi__core__iir(clock,x1,x2,x_valid,k0,k1,k2,alpha,z1,z2,z_
         .b(mul$b),
         .p(mul$p)
     );
-    gyro_interface_axi__core__iir__pc pc(
-        .d(pc$d),
-        .q(pc$q),
-        .clock(pc$clock)
-    );
-    gyro_interface_axi__core__iir__word_reg word_reg(
-        .d(word_reg$d),
-        .q(word_reg$q),
-        .clock(word_reg$clock)
-    );
-    gyro_interface_axi__core__iir__base base(
-        .d(base$d),
-        .q(base$q),
-        .clock(base$clock)
-    );
-    gyro_interface_axi__core__iir__x1_held x1_held(
-        .d(x1_held$d),
-        .q(x1_held$q),
-        .clock(x1_held$clock)
-    );
-    gyro_interface_axi__core__iir__x2_held x2_held(
-        .d(x2_held$d),
-        .q(x2_held$q),
-        .clock(x2_held$clock)
-    );
     gyro_interface_axi__core__iir__a a(
         .d(a$d),
         .q(a$q),
         .clock(a$clock)
-    );
-    gyro_interface_axi__core__iir__b b(
-        .d(b$d),
-        .q(b$q),
-        .clock(b$clock)
     );
     gyro_interface_axi__core__iir__acc acc(
         .d(acc$d),
         .q(acc$q),
         .clock(acc$clock)
     );
-    gyro_interface_axi__core__iir__stage stage(
-        .d(stage$d),
-        .q(stage$q),
-        .clock(stage$clock)
-    );
-    gyro_interface_axi__core__iir__z1_out z1_out(
-        .d(z1_out$d),
-        .q(z1_out$q),
-        .clock(z1_out$clock)
-    );
-    gyro_interface_axi__core__iir__z2_out z2_out(
-        .d(z2_out$d),
-        .q(z2_out$q),
-        .clock(z2_out$clock)
-    );
-    gyro_interface_axi__core__iir__z_valid_out z_valid_out(
-        .d(z_valid_out$d),
-        .q(z_valid_out$q),
-        .clock(z_valid_out$clock)
-    );
 
     // Update code
     always @(*) begin
-        pc$clock = clock;
-        word_reg$clock = clock;
-        base$clock = clock;
-        x1_held$clock = clock;
-        x2_held$clock = clock;
         a$clock = clock;
-        b$clock = clock;
         acc$clock = clock;
-        stage$clock = clock;
-        z1_out$clock = clock;
-        z2_out$clock = clock;
-        z_valid_out$clock = clock;
-        pc$d = pc$q;
-        word_reg$d = word_reg$q;
-        base$d = base$q;
-        x1_held$d = x1_held$q;
-        x2_held$d = x2_held$q;
         a$d = a$q;
-        b$d = b$q;
         acc$d = acc$q;
-        stage$d = stage$q;
-        z1_out$d = z1_out$q;
-        z2_out$d = z2_out$q;
-        z_valid_out$d = z_valid_out$q;
-        rom$clock = clock;
-        ram$clock = clock;
+        sequencer$clock = clock;
+        coefficient$clock = clock;
+        digits$clock = clock;
         mul$clock = clock;
-        rom$address = pc$q;
-        if (pc$q == 32'h0) begin
-            if (x_valid) begin
-                pc$d = 32'h1;
-                x1_held$d = x1;
-                x2_held$d = x2;
-                if (base$q == 32'h0) begin
-                    base$d = 32'h1;
-                end
-                if (base$q == 32'h1) begin
-                    base$d = 32'h2;
-                end
-                if (base$q == 32'h2) begin
-                    base$d = 32'h0;
-                end
-            end
-        end
-        else begin
-            pc$d = pc$q + 32'h1;
-            if (pc$q == last_pc) begin
-                pc$d = 32'h0;
-            end
-        end
-        word_reg$d = rom$q;
-        word = word_reg$q;
-        read_field = word[(32'h0)+:(7)];
-        factor = word[(32'h8)+:(5)];
-        op = word[(32'hd)+:(2)];
-        emit = word[(32'h10)+:(3)];
-        write_field = word[(32'h13)+:(7)];
-        x_select = word[(32'h1a)+:(3)];
-        read_sum = ((read_field[(32'h2)+:(2)]) & 3'h7) + ((base$q) & 3'h7);
-        read_wrapped = read_sum - 32'h3;
-        read_slot = read_sum[(32'h0)+:(2)];
-        if (read_sum >= 32'h3) begin
-            read_slot = read_wrapped[(32'h0)+:(2)];
-        end
-        if (read_field[(32'h2)+:(2)] == 32'h3) begin
-            read_slot = 32'h3;
-        end
-        write_sum = ((write_field[(32'h2)+:(2)]) & 3'h7) + ((base$q) & 3'h7);
-        write_wrapped = write_sum - 32'h3;
-        write_slot = write_sum[(32'h0)+:(2)];
-        if (write_sum >= 32'h3) begin
-            write_slot = write_wrapped[(32'h0)+:(2)];
-        end
-        if (write_field[(32'h2)+:(2)] == 32'h3) begin
-            write_slot = 32'h3;
-        end
-        ram$read_address = (read_field & slot_mask) | (((read_slot) & 7'h7f) << 32'h2);
-        ram$write_address = (write_field & slot_mask) | (((write_slot) & 7'h7f) << 32'h2);
-        ram_low = ram$q[(32'h0)+:(13)];
+        sequencer$x_valid = x_valid;
+        digits$x1 = x1;
+        digits$x2 = x2;
+        digits$capture = sequencer$idle & x_valid;
+        digits$read_address = sequencer$read_address;
+        digits$write_address = sequencer$write_address;
+        digits$emit = sequencer$emit;
+        digits$x_select = sequencer$x_select;
+        digits$publish = sequencer$publish;
+        op = sequencer$op;
+        ram_low = digits$q[(32'h0)+:(13)];
         ram_wrapped = $signed(ram_low);
-        a$d = ram$q;
-        if (word[32'h7]) begin
+        a$d = digits$q;
+        if (sequencer$wrap_top) begin
             a$d = ram_wrapped;
         end
-        k0_wide = $signed(k0);
-        k1_wide = $signed(k1);
-        k2_wide = $signed(k2);
-        alpha_wide = $signed(alpha);
-        scaled = alpha_wide;
-        if (factor[(32'h2)+:(3)] == 32'h1) begin
-            scaled = k1_wide + pow31;
-        end
-        if (factor[(32'h2)+:(3)] == 32'h2) begin
-            scaled = k2_wide - pow30;
-        end
-        if (factor[(32'h2)+:(3)] == 32'h3) begin
-            scaled = $signed($unsigned(k0_wide) << 32'h1);
-        end
-        if (factor[(32'h2)+:(3)] == 32'h4) begin
-            scaled = $signed($unsigned(k0_wide) << 32'h2);
-        end
-        scaled_low = scaled[(32'h0)+:(30)];
-        scaled_bits = $unsigned(scaled_low);
-        top_bits = scaled[(32'h1e)+:(4)];
-        top_digit = $signed(top_bits);
-        b$d = top_digit;
-        if (factor[(32'h0)+:(2)] == 32'h0) begin
-            b$d = $signed(((scaled_bits[(32'h0)+:(15)]) & 16'hffff));
-        end
-        if (factor[(32'h0)+:(2)] == 32'h1) begin
-            b$d = $signed(((scaled_bits[(32'hf)+:(15)]) & 16'hffff));
-        end
-        if (factor[(32'h2)+:(3)] == 32'h0) begin
-            b$d = 32'h0;
-            if (factor[(32'h0)+:(2)] == 32'h1) begin
-                b$d = one;
-            end
-            if (factor[(32'h0)+:(2)] == 32'h2) begin
-                b$d = minus_one;
-            end
-            if (factor[(32'h0)+:(2)] == 32'h3) begin
-                b$d = pow14;
-            end
-        end
+        coefficient$factor = sequencer$factor;
+        coefficient$k0 = k0;
+        coefficient$k1 = k1;
+        coefficient$k2 = k2;
+        coefficient$alpha = alpha;
         mul$a = a$q;
-        mul$b = b$q;
+        mul$b = coefficient$digit;
         product = $signed(mul$p);
         carry = acc$q[(32'hf)+:(21)];
         carry_wide = $signed(carry);
         addend = acc$q;
         if (op == 32'h1) begin
             addend = 32'h0;
-            if (word[32'hf]) begin
+            if (sequencer$round_start) begin
                 addend = pow29;
             end
         end
@@ -7437,49 +7275,10 @@ module gyro_interface_axi__core__iir(clock,x1,x2,x_valid,k0,k1,k2,alpha,z1,z2,z_
         if (op != 32'h0) begin
             acc$d = addend + product;
         end
-        column_top = acc$q[(32'h0)+:(15)];
-        digit_bits = $unsigned(column_top);
-        column_digit = $signed(((digit_bits) & 16'hffff));
-        column_top_digit = $signed(column_top);
-        x_low = x1_held$q[(32'h0)+:(30)];
-        x_top = x1_held$q[(32'h1e)+:(10)];
-        if (x_select >= 32'h3) begin
-            x_low = x2_held$q[(32'h0)+:(30)];
-            x_top = x2_held$q[(32'h1e)+:(10)];
-        end
-        x_bits = $unsigned(x_low);
-        x_top_digit = $signed(x_top);
-        input_digit = x_top_digit;
-        if ((x_select == 32'h0) | (x_select == 32'h3)) begin
-            input_digit = $signed(((x_bits[(32'h0)+:(15)]) & 16'hffff));
-        end
-        if ((x_select == 32'h1) | (x_select == 32'h4)) begin
-            input_digit = $signed(((x_bits[(32'hf)+:(15)]) & 16'hffff));
-        end
-        ram$write_enable = 1'b0;
-        ram$write_data = column_digit;
-        if (emit == 32'h1) begin
-            ram$write_enable = 1'b1;
-        end
-        if (emit == 32'h2) begin
-            ram$write_enable = 1'b1;
-            ram$write_data = column_top_digit;
-        end
-        if (emit == 32'h4) begin
-            ram$write_enable = 1'b1;
-            ram$write_data = input_digit;
-        end
-        if (emit == 32'h3) begin
-            stage$d = (stage$q >> 32'hf) | (((digit_bits) & 90'h3ffffffffffffffffffffff) << 32'h4b);
-        end
-        z_valid_out$d = word[32'h1d];
-        if (word[32'h1d]) begin
-            z1_out$d = $signed(stage$q[(32'h0)+:(40)]);
-            z2_out$d = $signed(stage$q[(32'h2d)+:(40)]);
-        end
-        z1 = z1_out$q;
-        z2 = z2_out$q;
-        z_valid = z_valid_out$q;
+        digits$column = acc$q[(32'h0)+:(15)];
+        z1 = digits$z1;
+        z2 = digits$z2;
+        z_valid = digits$z_valid;
     end
 
 endmodule // gyro_interface_axi__core__iir
@@ -7523,7 +7322,98 @@ module gyro_interface_axi__core__iir__acc(d,q,clock);
 endmodule // gyro_interface_axi__core__iir__acc
 
 
-module gyro_interface_axi__core__iir__b(d,q,clock);
+module gyro_interface_axi__core__iir__coefficient(clock,factor,k0,k1,k2,alpha,digit);
+
+    // Module arguments
+    input wire  clock;
+    input wire  [4:0] factor;
+    input wire signed [31:0] k0;
+    input wire signed [31:0] k1;
+    input wire signed [31:0] k2;
+    input wire signed [31:0] alpha;
+    output reg signed [15:0] digit;
+
+    // Constant declarations
+    localparam signed pow30 = 34'h40000000;
+    localparam signed pow31 = 34'h80000000;
+    localparam signed one = 16'h1;
+    localparam signed minus_one = 16'hffff;
+    localparam signed pow14 = 16'h4000;
+
+    // Stub signals
+    reg signed [15:0] b$d;
+    wire signed [15:0] b$q;
+    reg  b$clock;
+
+    // Local signals
+    reg signed [33:0] k0_wide;
+    reg signed [33:0] k1_wide;
+    reg signed [33:0] k2_wide;
+    reg signed [33:0] alpha_wide;
+    reg signed [33:0] scaled;
+    reg signed [29:0] scaled_low;
+    reg  [29:0] scaled_bits;
+    reg signed [3:0] top_bits;
+    reg signed [15:0] top_digit;
+
+    // Sub module instances
+    gyro_interface_axi__core__iir__coefficient__b b(
+        .d(b$d),
+        .q(b$q),
+        .clock(b$clock)
+    );
+
+    // Update code
+    always @(*) begin
+        b$clock = clock;
+        b$d = b$q;
+        k0_wide = $signed(k0);
+        k1_wide = $signed(k1);
+        k2_wide = $signed(k2);
+        alpha_wide = $signed(alpha);
+        scaled = alpha_wide;
+        if (factor[(32'h2)+:(3)] == 32'h1) begin
+            scaled = k1_wide + pow31;
+        end
+        if (factor[(32'h2)+:(3)] == 32'h2) begin
+            scaled = k2_wide - pow30;
+        end
+        if (factor[(32'h2)+:(3)] == 32'h3) begin
+            scaled = $signed($unsigned(k0_wide) << 32'h1);
+        end
+        if (factor[(32'h2)+:(3)] == 32'h4) begin
+            scaled = $signed($unsigned(k0_wide) << 32'h2);
+        end
+        scaled_low = scaled[(32'h0)+:(30)];
+        scaled_bits = $unsigned(scaled_low);
+        top_bits = scaled[(32'h1e)+:(4)];
+        top_digit = $signed(top_bits);
+        b$d = top_digit;
+        if (factor[(32'h0)+:(2)] == 32'h0) begin
+            b$d = $signed(((scaled_bits[(32'h0)+:(15)]) & 16'hffff));
+        end
+        if (factor[(32'h0)+:(2)] == 32'h1) begin
+            b$d = $signed(((scaled_bits[(32'hf)+:(15)]) & 16'hffff));
+        end
+        if (factor[(32'h2)+:(3)] == 32'h0) begin
+            b$d = 32'h0;
+            if (factor[(32'h0)+:(2)] == 32'h1) begin
+                b$d = one;
+            end
+            if (factor[(32'h0)+:(2)] == 32'h2) begin
+                b$d = minus_one;
+            end
+            if (factor[(32'h0)+:(2)] == 32'h3) begin
+                b$d = pow14;
+            end
+        end
+        digit = b$q;
+    end
+
+endmodule // gyro_interface_axi__core__iir__coefficient
+
+
+module gyro_interface_axi__core__iir__coefficient__b(d,q,clock);
 
     // Module arguments
     input wire signed [15:0] d;
@@ -7539,65 +7429,175 @@ module gyro_interface_axi__core__iir__b(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__iir__b
+endmodule // gyro_interface_axi__core__iir__coefficient__b
 
 
-module gyro_interface_axi__core__iir__base(d,q,clock);
-
-    // Module arguments
-    input wire  [1:0] d;
-    output reg  [1:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 2'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir__base
-
-
-module gyro_interface_axi__core__iir__mul(clock,a,b,p);
+module gyro_interface_axi__core__iir__digits(clock,x1,x2,capture,read_address,write_address,emit,x_select,column,publish,q,z1,z2,z_valid);
 
     // Module arguments
     input wire  clock;
-    input wire signed [15:0] a;
-    input wire signed [15:0] b;
-    output reg signed [31:0] p;
+    input wire signed [39:0] x1;
+    input wire signed [39:0] x2;
+    input wire  capture;
+    input wire  [6:0] read_address;
+    input wire  [6:0] write_address;
+    input wire  [2:0] emit;
+    input wire  [2:0] x_select;
+    input wire signed [14:0] column;
+    input wire  publish;
+    output reg signed [15:0] q;
+    output reg signed [39:0] z1;
+    output reg signed [39:0] z2;
+    output reg  z_valid;
 
-    // Update code (custom)
-    initial p = 0;
+    // Stub signals
+    reg  ram$clock;
+    reg  [6:0] ram$read_address;
+    wire signed [15:0] ram$q;
+    reg  [6:0] ram$write_address;
+    reg signed [15:0] ram$write_data;
+    reg  ram$write_enable;
+    reg signed [39:0] x1_held$d;
+    wire signed [39:0] x1_held$q;
+    reg  x1_held$clock;
+    reg signed [39:0] x2_held$d;
+    wire signed [39:0] x2_held$q;
+    reg  x2_held$clock;
+    reg  [89:0] stage$d;
+    wire  [89:0] stage$q;
+    reg  stage$clock;
+    reg signed [39:0] z1_out$d;
+    wire signed [39:0] z1_out$q;
+    reg  z1_out$clock;
+    reg signed [39:0] z2_out$d;
+    wire signed [39:0] z2_out$q;
+    reg  z2_out$clock;
+    reg  z_valid_out$d;
+    wire  z_valid_out$q;
+    reg  z_valid_out$clock;
 
-    always @(posedge clock) begin
-       p <= a * b;
+    // Local signals
+    reg  [14:0] digit_bits;
+    reg signed [15:0] column_digit;
+    reg signed [14:0] column_top;
+    reg signed [15:0] column_top_digit;
+    reg signed [29:0] x_low;
+    reg  [29:0] x_bits;
+    reg signed [9:0] x_top;
+    reg signed [15:0] input_digit;
+    reg signed [15:0] x_top_digit;
+
+    // Sub module instances
+    gyro_interface_axi__core__iir__digits__ram ram(
+        .clock(ram$clock),
+        .read_address(ram$read_address),
+        .q(ram$q),
+        .write_address(ram$write_address),
+        .write_data(ram$write_data),
+        .write_enable(ram$write_enable)
+    );
+    gyro_interface_axi__core__iir__digits__x1_held x1_held(
+        .d(x1_held$d),
+        .q(x1_held$q),
+        .clock(x1_held$clock)
+    );
+    gyro_interface_axi__core__iir__digits__x2_held x2_held(
+        .d(x2_held$d),
+        .q(x2_held$q),
+        .clock(x2_held$clock)
+    );
+    gyro_interface_axi__core__iir__digits__stage stage(
+        .d(stage$d),
+        .q(stage$q),
+        .clock(stage$clock)
+    );
+    gyro_interface_axi__core__iir__digits__z1_out z1_out(
+        .d(z1_out$d),
+        .q(z1_out$q),
+        .clock(z1_out$clock)
+    );
+    gyro_interface_axi__core__iir__digits__z2_out z2_out(
+        .d(z2_out$d),
+        .q(z2_out$q),
+        .clock(z2_out$clock)
+    );
+    gyro_interface_axi__core__iir__digits__z_valid_out z_valid_out(
+        .d(z_valid_out$d),
+        .q(z_valid_out$q),
+        .clock(z_valid_out$clock)
+    );
+
+    // Update code
+    always @(*) begin
+        x1_held$clock = clock;
+        x2_held$clock = clock;
+        stage$clock = clock;
+        z1_out$clock = clock;
+        z2_out$clock = clock;
+        z_valid_out$clock = clock;
+        x1_held$d = x1_held$q;
+        x2_held$d = x2_held$q;
+        stage$d = stage$q;
+        z1_out$d = z1_out$q;
+        z2_out$d = z2_out$q;
+        z_valid_out$d = z_valid_out$q;
+        ram$clock = clock;
+        ram$read_address = read_address;
+        ram$write_address = write_address;
+        q = ram$q;
+        if (capture) begin
+            x1_held$d = x1;
+            x2_held$d = x2;
+        end
+        column_top = column;
+        digit_bits = $unsigned(column_top);
+        column_digit = $signed(((digit_bits) & 16'hffff));
+        column_top_digit = $signed(column_top);
+        x_low = x1_held$q[(32'h0)+:(30)];
+        x_top = x1_held$q[(32'h1e)+:(10)];
+        if (x_select >= 32'h3) begin
+            x_low = x2_held$q[(32'h0)+:(30)];
+            x_top = x2_held$q[(32'h1e)+:(10)];
+        end
+        x_bits = $unsigned(x_low);
+        x_top_digit = $signed(x_top);
+        input_digit = x_top_digit;
+        if ((x_select == 32'h0) | (x_select == 32'h3)) begin
+            input_digit = $signed(((x_bits[(32'h0)+:(15)]) & 16'hffff));
+        end
+        if ((x_select == 32'h1) | (x_select == 32'h4)) begin
+            input_digit = $signed(((x_bits[(32'hf)+:(15)]) & 16'hffff));
+        end
+        ram$write_enable = 1'b0;
+        ram$write_data = column_digit;
+        if (emit == 32'h1) begin
+            ram$write_enable = 1'b1;
+        end
+        if (emit == 32'h2) begin
+            ram$write_enable = 1'b1;
+            ram$write_data = column_top_digit;
+        end
+        if (emit == 32'h4) begin
+            ram$write_enable = 1'b1;
+            ram$write_data = input_digit;
+        end
+        if (emit == 32'h3) begin
+            stage$d = (stage$q >> 32'hf) | (((digit_bits) & 90'h3ffffffffffffffffffffff) << 32'h4b);
+        end
+        z_valid_out$d = publish;
+        if (publish) begin
+            z1_out$d = $signed(stage$q[(32'h0)+:(40)]);
+            z2_out$d = $signed(stage$q[(32'h2d)+:(40)]);
+        end
+        z1 = z1_out$q;
+        z2 = z2_out$q;
+        z_valid = z_valid_out$q;
     end
-endmodule // gyro_interface_axi__core__iir__mul
+
+endmodule // gyro_interface_axi__core__iir__digits
 
 
-module gyro_interface_axi__core__iir__pc(d,q,clock);
-
-    // Module arguments
-    input wire  [7:0] d;
-    output reg  [7:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 8'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir__pc
-
-
-module gyro_interface_axi__core__iir__ram(clock,read_address,q,write_address,write_data,write_enable);
+module gyro_interface_axi__core__iir__digits__ram(clock,read_address,q,write_address,write_data,write_enable);
 
     // Module arguments
     input wire  clock;
@@ -7637,10 +7637,311 @@ module gyro_interface_axi__core__iir__ram(clock,read_address,q,write_address,wri
 
     always @(*)
        q = high_read ? q_high : q_low;
-endmodule // gyro_interface_axi__core__iir__ram
+endmodule // gyro_interface_axi__core__iir__digits__ram
 
 
-module gyro_interface_axi__core__iir__rom(clock,address,q);
+module gyro_interface_axi__core__iir__digits__stage(d,q,clock);
+
+    // Module arguments
+    input wire  [89:0] d;
+    output reg  [89:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 90'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__iir__digits__stage
+
+
+module gyro_interface_axi__core__iir__digits__x1_held(d,q,clock);
+
+    // Module arguments
+    input wire signed [39:0] d;
+    output reg signed [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__iir__digits__x1_held
+
+
+module gyro_interface_axi__core__iir__digits__x2_held(d,q,clock);
+
+    // Module arguments
+    input wire signed [39:0] d;
+    output reg signed [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__iir__digits__x2_held
+
+
+module gyro_interface_axi__core__iir__digits__z1_out(d,q,clock);
+
+    // Module arguments
+    input wire signed [39:0] d;
+    output reg signed [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__iir__digits__z1_out
+
+
+module gyro_interface_axi__core__iir__digits__z2_out(d,q,clock);
+
+    // Module arguments
+    input wire signed [39:0] d;
+    output reg signed [39:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 40'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__iir__digits__z2_out
+
+
+module gyro_interface_axi__core__iir__digits__z_valid_out(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__iir__digits__z_valid_out
+
+
+module gyro_interface_axi__core__iir__mul(clock,a,b,p);
+
+    // Module arguments
+    input wire  clock;
+    input wire signed [15:0] a;
+    input wire signed [15:0] b;
+    output reg signed [31:0] p;
+
+    // Update code (custom)
+    initial p = 0;
+
+    always @(posedge clock) begin
+       p <= a * b;
+    end
+endmodule // gyro_interface_axi__core__iir__mul
+
+
+module gyro_interface_axi__core__iir__sequencer(clock,x_valid,idle,wrap_top,round_start,publish,factor,op,emit,x_select,read_address,write_address);
+
+    // Module arguments
+    input wire  clock;
+    input wire  x_valid;
+    output reg  idle;
+    output reg  wrap_top;
+    output reg  round_start;
+    output reg  publish;
+    output reg  [4:0] factor;
+    output reg  [1:0] op;
+    output reg  [2:0] emit;
+    output reg  [2:0] x_select;
+    output reg  [6:0] read_address;
+    output reg  [6:0] write_address;
+
+    // Constant declarations
+    localparam  last_pc = 8'ha5;
+    localparam  slot_mask = 7'b1110011;
+
+    // Stub signals
+    reg  rom$clock;
+    reg  [7:0] rom$address;
+    wire  [29:0] rom$q;
+    reg  [7:0] pc$d;
+    wire  [7:0] pc$q;
+    reg  pc$clock;
+    reg  [29:0] word_reg$d;
+    wire  [29:0] word_reg$q;
+    reg  word_reg$clock;
+    reg  [1:0] base$d;
+    wire  [1:0] base$q;
+    reg  base$clock;
+
+    // Local signals
+    reg  [6:0] read_field;
+    reg  [6:0] write_field;
+    reg  [2:0] read_sum;
+    reg  [2:0] read_wrapped;
+    reg  [1:0] read_slot;
+    reg  [2:0] write_sum;
+    reg  [2:0] write_wrapped;
+    reg  [1:0] write_slot;
+
+    // Sub module instances
+    gyro_interface_axi__core__iir__sequencer__rom rom(
+        .clock(rom$clock),
+        .address(rom$address),
+        .q(rom$q)
+    );
+    gyro_interface_axi__core__iir__sequencer__pc pc(
+        .d(pc$d),
+        .q(pc$q),
+        .clock(pc$clock)
+    );
+    gyro_interface_axi__core__iir__sequencer__word_reg word_reg(
+        .d(word_reg$d),
+        .q(word_reg$q),
+        .clock(word_reg$clock)
+    );
+    gyro_interface_axi__core__iir__sequencer__base base(
+        .d(base$d),
+        .q(base$q),
+        .clock(base$clock)
+    );
+
+    // Update code
+    always @(*) begin
+        pc$clock = clock;
+        word_reg$clock = clock;
+        base$clock = clock;
+        pc$d = pc$q;
+        word_reg$d = word_reg$q;
+        base$d = base$q;
+        rom$clock = clock;
+        rom$address = pc$q;
+        idle = pc$q == 32'h0;
+        if (pc$q == 32'h0) begin
+            if (x_valid) begin
+                pc$d = 32'h1;
+                if (base$q == 32'h0) begin
+                    base$d = 32'h1;
+                end
+                if (base$q == 32'h1) begin
+                    base$d = 32'h2;
+                end
+                if (base$q == 32'h2) begin
+                    base$d = 32'h0;
+                end
+            end
+        end
+        else begin
+            pc$d = pc$q + 32'h1;
+            if (pc$q == last_pc) begin
+                pc$d = 32'h0;
+            end
+        end
+        word_reg$d = rom$q;
+        wrap_top = word_reg$q[32'h7];
+        round_start = word_reg$q[32'hf];
+        publish = word_reg$q[32'h1d];
+        read_field = word_reg$q[(32'h0)+:(7)];
+        factor = word_reg$q[(32'h8)+:(5)];
+        op = word_reg$q[(32'hd)+:(2)];
+        emit = word_reg$q[(32'h10)+:(3)];
+        write_field = word_reg$q[(32'h13)+:(7)];
+        x_select = word_reg$q[(32'h1a)+:(3)];
+        read_sum = ((read_field[(32'h2)+:(2)]) & 3'h7) + ((base$q) & 3'h7);
+        read_wrapped = read_sum - 32'h3;
+        read_slot = read_sum[(32'h0)+:(2)];
+        if (read_sum >= 32'h3) begin
+            read_slot = read_wrapped[(32'h0)+:(2)];
+        end
+        if (read_field[(32'h2)+:(2)] == 32'h3) begin
+            read_slot = 32'h3;
+        end
+        write_sum = ((write_field[(32'h2)+:(2)]) & 3'h7) + ((base$q) & 3'h7);
+        write_wrapped = write_sum - 32'h3;
+        write_slot = write_sum[(32'h0)+:(2)];
+        if (write_sum >= 32'h3) begin
+            write_slot = write_wrapped[(32'h0)+:(2)];
+        end
+        if (write_field[(32'h2)+:(2)] == 32'h3) begin
+            write_slot = 32'h3;
+        end
+        read_address = (read_field & slot_mask) | (((read_slot) & 7'h7f) << 32'h2);
+        write_address = (write_field & slot_mask) | (((write_slot) & 7'h7f) << 32'h2);
+    end
+
+endmodule // gyro_interface_axi__core__iir__sequencer
+
+
+module gyro_interface_axi__core__iir__sequencer__base(d,q,clock);
+
+    // Module arguments
+    input wire  [1:0] d;
+    output reg  [1:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 2'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__iir__sequencer__base
+
+
+module gyro_interface_axi__core__iir__sequencer__pc(d,q,clock);
+
+    // Module arguments
+    input wire  [7:0] d;
+    output reg  [7:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 8'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__core__iir__sequencer__pc
+
+
+module gyro_interface_axi__core__iir__sequencer__rom(clock,address,q);
 
     // Module arguments
     input wire  clock;
@@ -7913,29 +8214,10 @@ module gyro_interface_axi__core__iir__rom(clock,address,q);
     always @(posedge clock) begin
        q <= program_words[address];
     end
-endmodule // gyro_interface_axi__core__iir__rom
+endmodule // gyro_interface_axi__core__iir__sequencer__rom
 
 
-module gyro_interface_axi__core__iir__stage(d,q,clock);
-
-    // Module arguments
-    input wire  [89:0] d;
-    output reg  [89:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 90'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir__stage
-
-
-module gyro_interface_axi__core__iir__word_reg(d,q,clock);
+module gyro_interface_axi__core__iir__sequencer__word_reg(d,q,clock);
 
     // Module arguments
     input wire  [29:0] d;
@@ -7951,102 +8233,7 @@ module gyro_interface_axi__core__iir__word_reg(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__core__iir__word_reg
-
-
-module gyro_interface_axi__core__iir__x1_held(d,q,clock);
-
-    // Module arguments
-    input wire signed [39:0] d;
-    output reg signed [39:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 40'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir__x1_held
-
-
-module gyro_interface_axi__core__iir__x2_held(d,q,clock);
-
-    // Module arguments
-    input wire signed [39:0] d;
-    output reg signed [39:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 40'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir__x2_held
-
-
-module gyro_interface_axi__core__iir__z1_out(d,q,clock);
-
-    // Module arguments
-    input wire signed [39:0] d;
-    output reg signed [39:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 40'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir__z1_out
-
-
-module gyro_interface_axi__core__iir__z2_out(d,q,clock);
-
-    // Module arguments
-    input wire signed [39:0] d;
-    output reg signed [39:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 40'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir__z2_out
-
-
-module gyro_interface_axi__core__iir__z_valid_out(d,q,clock);
-
-    // Module arguments
-    input wire  d;
-    output reg  q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 1'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__core__iir__z_valid_out
+endmodule // gyro_interface_axi__core__iir__sequencer__word_reg
 
 
 module gyro_interface_axi__core__modulation_nco(clock,step,select,filling,fill_phase,fill_word,am1,am2);

@@ -88,14 +88,26 @@
 //! operand, product and accumulator registers, the 90-bit output staging
 //! register and the outputs.
 //!
-//! Schedule: a program counter and a micro-program ROM (one block RAM),
-//! not a state enum: the schedule is `SCHEDULE_CLOCKS` words, and each word
-//! drives four pipeline stages at once (a read, an operand, an
-//! accumulation, a write), so one enum state per clock would be a flat
-//! list of ~170 states with no structure to read. The structure lives in
-//! `crate::iir_program`, written with typed Rust (`Location`, `Factor`,
-//! `AccumulatorOp`, `Emit`) and encoded into the ROM; the model runs the
-//! same words, so the two cannot drift apart.
+//! Blocks, in the order a word runs through them:
+//! - `crate::iir_sequencer`: the program counter, the micro-program ROM
+//!   (one block RAM) and the word register after it, the sample counter
+//!   and the slot rotation of the RAM addresses;
+//! - this block: operand a (the RAM digit, a state's top digit
+//!   sign-extended), the multiplier and the column accumulator;
+//! - `crate::iir_coefficient_digit`: operand b, a digit of a scaled
+//!   coefficient or a constant;
+//! - `crate::iir_digits`: the digit RAM, what is written into it (a column
+//!   digit, a result's top digit, an input digit), the captured inputs and
+//!   the output staging and publication.
+//!
+//! Schedule: a program counter and a micro-program ROM, not a state enum:
+//! the schedule is `SCHEDULE_CLOCKS` words, and each word drives four
+//! pipeline stages at once (a read, an operand, an accumulation, a write),
+//! so one enum state per clock would be a flat list of ~170 states with no
+//! structure to read. The structure lives in `crate::iir_program`, written
+//! with typed Rust (`Location`, `Factor`, `AccumulatorOp`, `Emit`) and
+//! encoded into the ROM; the model runs the same words, so the two cannot
+//! drift apart.
 //!
 //! Timing: `x_valid` in idle (pc = 0) captures x1, x2 and starts the
 //! program; `publish`, its last word, copies the staged z1, z2 to the
@@ -108,18 +120,22 @@
 //! Gain: the filter's DC gain, 4 k0 / -(k1 + k2). Resources (Yosys 0.23,
 //! `synth_ice40 -dsp -top gyro_interface__iir` on the exported Verilog): 1
 //! `SB_MAC16`, 4 `SB_RAM40_4K` (the digit RAM's two halves, and the 256 x
-//! 30-bit program in two), 329 flip-flops, 375 `SB_LUT4`; with the digit RAM
+//! 30-bit program in two), 329 flip-flops, 381 `SB_LUT4` (380 in one block,
+//! before the sequencer, the coefficient digit and the digit store became
+//! blocks of their own); with the digit RAM
 //! in one piece and Yosys's collision logic it was 3 block RAMs, 369
 //! flip-flops and 385 LUT4. The 60 x 32 design before it took 8 `SB_MAC16`,
 //! 1870 flip-flops and 3379 `SB_LUT4` (`-noflatten`).
 
+use crate::iir_coefficient_digit::IirCoefficientDigit;
+use crate::iir_digits::IirDigits;
 use crate::iir_program::{
-    ACCUMULATOR_BITS as COLUMN_BITS, OPERAND_BITS as DIGIT_OPERAND_BITS, PC_BITS,
-    PRODUCT_BITS as DIGIT_PRODUCT_BITS, PROGRAM, RAM_ADDRESS_BITS, SCALED_COEFFICIENT_BITS,
-    STATE_TOP_BITS, WORD_BITS,
+    ACCUMULATOR_BITS as COLUMN_BITS, OPERAND_BITS as DIGIT_OPERAND_BITS,
+    PRODUCT_BITS as DIGIT_PRODUCT_BITS, STATE_TOP_BITS,
 };
+use crate::iir_sequencer::IirSequencer;
+use crate::primitives::RegisteredMultiplier;
 use crate::primitives::convert::signed_bit_cast_exact;
-use crate::primitives::{DigitRam, MicrocodeRom, RegisteredMultiplier};
 use rust_hdl::prelude::*;
 
 /// Width of the input and output samples.
@@ -143,8 +159,6 @@ pub const LATENCY: usize = 168;
 /// Clock cycles from a strobe to the next one accepted: the least decimation
 /// (`Program::schedule_clocks`, checked by a test).
 pub const SCHEDULE_CLOCKS: usize = gyrocal_regs::datapath::MIN_DECIMATION as usize;
-/// Width of the output staging register: two samples of three digits.
-const STAGE_BITS: usize = 6 * crate::iir_program::DIGIT_BITS;
 /// Width of the accumulator after dropping a finished 15-bit column digit.
 const CARRY_BITS: usize = COLUMN_BITS - crate::iir_program::DIGIT_BITS;
 
@@ -174,70 +188,23 @@ pub struct IirLowpass {
     pub z2: Signal<Out, Signed<SAMPLE_BITS>>,
     /// One-clock pulse marking new `z1`, `z2`.
     pub z_valid: Signal<Out, Bit>,
-    rom: MicrocodeRom<WORD_BITS, PC_BITS>,
-    ram: DigitRam<RAM_ADDRESS_BITS>,
+    sequencer: IirSequencer,
+    coefficient: IirCoefficientDigit,
+    digits: IirDigits,
     mul: RegisteredMultiplier<DIGIT_OPERAND_BITS, DIGIT_OPERAND_BITS, DIGIT_PRODUCT_BITS>,
-    pc: DFF<Bits<PC_BITS>>,
-    word_reg: DFF<Bits<WORD_BITS>>,
-    base: DFF<Bits<2>>,
-    x1_held: DFF<Signed<SAMPLE_BITS>>,
-    x2_held: DFF<Signed<SAMPLE_BITS>>,
     a: DFF<Signed<DIGIT_OPERAND_BITS>>,
-    b: DFF<Signed<DIGIT_OPERAND_BITS>>,
     acc: DFF<Signed<COLUMN_BITS>>,
-    stage: DFF<Bits<STAGE_BITS>>,
-    z1_out: DFF<Signed<SAMPLE_BITS>>,
-    z2_out: DFF<Signed<SAMPLE_BITS>>,
-    z_valid_out: DFF<Bit>,
-    // Fields of the ROM word (layout: `MicroWord::encode`).
-    word: Signal<Local, Bits<WORD_BITS>>,
-    read_field: Signal<Local, Bits<RAM_ADDRESS_BITS>>,
-    write_field: Signal<Local, Bits<RAM_ADDRESS_BITS>>,
-    factor: Signal<Local, Bits<5>>,
+    // The running word's fields (`crate::iir_sequencer`).
     op: Signal<Local, Bits<2>>,
-    emit: Signal<Local, Bits<3>>,
-    x_select: Signal<Local, Bits<3>>,
-    // Slot rotation.
-    read_sum: Signal<Local, Bits<3>>,
-    read_wrapped: Signal<Local, Bits<3>>,
-    read_slot: Signal<Local, Bits<2>>,
-    write_sum: Signal<Local, Bits<3>>,
-    write_wrapped: Signal<Local, Bits<3>>,
-    write_slot: Signal<Local, Bits<2>>,
-    // Operands.
+    // Operand a.
     ram_low: Signal<Local, Signed<STATE_TOP_BITS>>,
     ram_wrapped: Signal<Local, Signed<DIGIT_OPERAND_BITS>>,
-    k0_wide: Signal<Local, Signed<SCALED_COEFFICIENT_BITS>>,
-    k1_wide: Signal<Local, Signed<SCALED_COEFFICIENT_BITS>>,
-    k2_wide: Signal<Local, Signed<SCALED_COEFFICIENT_BITS>>,
-    alpha_wide: Signal<Local, Signed<SCALED_COEFFICIENT_BITS>>,
-    scaled: Signal<Local, Signed<SCALED_COEFFICIENT_BITS>>,
-    scaled_low: Signal<Local, Signed<30>>,
-    scaled_bits: Signal<Local, Bits<30>>,
-    top_bits: Signal<Local, Signed<4>>,
-    top_digit: Signal<Local, Signed<DIGIT_OPERAND_BITS>>,
-    // Accumulator and emissions.
+    // Accumulator.
     product: Signal<Local, Signed<COLUMN_BITS>>,
     carry: Signal<Local, Signed<CARRY_BITS>>,
     carry_wide: Signal<Local, Signed<COLUMN_BITS>>,
     addend: Signal<Local, Signed<COLUMN_BITS>>,
-    digit_bits: Signal<Local, Bits<15>>,
-    column_digit: Signal<Local, Signed<DIGIT_OPERAND_BITS>>,
-    column_top: Signal<Local, Signed<15>>,
-    column_top_digit: Signal<Local, Signed<DIGIT_OPERAND_BITS>>,
-    x_low: Signal<Local, Signed<30>>,
-    x_bits: Signal<Local, Bits<30>>,
-    x_top: Signal<Local, Signed<10>>,
-    input_digit: Signal<Local, Signed<DIGIT_OPERAND_BITS>>,
-    x_top_digit: Signal<Local, Signed<DIGIT_OPERAND_BITS>>,
-    last_pc: Constant<Bits<PC_BITS>>,
-    slot_mask: Constant<Bits<RAM_ADDRESS_BITS>>,
     pow29: Constant<Signed<COLUMN_BITS>>,
-    pow30: Constant<Signed<SCALED_COEFFICIENT_BITS>>,
-    pow31: Constant<Signed<SCALED_COEFFICIENT_BITS>>,
-    one: Constant<Signed<DIGIT_OPERAND_BITS>>,
-    minus_one: Constant<Signed<DIGIT_OPERAND_BITS>>,
-    pow14: Constant<Signed<DIGIT_OPERAND_BITS>>,
 }
 
 impl IirLowpass {
@@ -257,66 +224,20 @@ impl IirLowpass {
             z1: Default::default(),
             z2: Default::default(),
             z_valid: Default::default(),
-            rom: MicrocodeRom::new(PROGRAM.image()),
-            ram: DigitRam::new(),
+            sequencer: IirSequencer::new(),
+            coefficient: IirCoefficientDigit::new(),
+            digits: IirDigits::new(),
             mul: RegisteredMultiplier::new(),
-            pc: Default::default(),
-            word_reg: Default::default(),
-            base: Default::default(),
-            x1_held: Default::default(),
-            x2_held: Default::default(),
             a: Default::default(),
-            b: Default::default(),
             acc: Default::default(),
-            stage: Default::default(),
-            z1_out: Default::default(),
-            z2_out: Default::default(),
-            z_valid_out: Default::default(),
-            word: Default::default(),
-            read_field: Default::default(),
-            write_field: Default::default(),
-            factor: Default::default(),
             op: Default::default(),
-            emit: Default::default(),
-            x_select: Default::default(),
-            read_sum: Default::default(),
-            read_wrapped: Default::default(),
-            read_slot: Default::default(),
-            write_sum: Default::default(),
-            write_wrapped: Default::default(),
-            write_slot: Default::default(),
             ram_low: Default::default(),
             ram_wrapped: Default::default(),
-            k0_wide: Default::default(),
-            k1_wide: Default::default(),
-            k2_wide: Default::default(),
-            alpha_wide: Default::default(),
-            scaled: Default::default(),
-            scaled_low: Default::default(),
-            scaled_bits: Default::default(),
-            top_bits: Default::default(),
-            top_digit: Default::default(),
             product: Default::default(),
             carry: Default::default(),
             carry_wide: Default::default(),
             addend: Default::default(),
-            digit_bits: Default::default(),
-            column_digit: Default::default(),
-            column_top: Default::default(),
-            column_top_digit: Default::default(),
-            x_low: Default::default(),
-            x_bits: Default::default(),
-            x_top: Default::default(),
-            input_digit: Default::default(),
-            x_top_digit: Default::default(),
-            last_pc: Constant::new(((PROGRAM.words.len() - 1) as u64).into()),
-            slot_mask: Constant::new(0b111_0011u64.into()),
             pow29: Constant::new((1i64 << 29).into()),
-            pow30: Constant::new((1i64 << 30).into()),
-            pow31: Constant::new((1i64 << 31).into()),
-            one: Constant::new((1i64).into()),
-            minus_one: Constant::new((-1i64).into()),
-            pow14: Constant::new((1i64 << 14).into()),
         }
     }
 }
@@ -330,144 +251,39 @@ impl Default for IirLowpass {
 impl Logic for IirLowpass {
     #[hdl_gen]
     fn update(&mut self) {
-        dff_setup!(
-            self,
-            clock,
-            pc,
-            word_reg,
-            base,
-            x1_held,
-            x2_held,
-            a,
-            b,
-            acc,
-            stage,
-            z1_out,
-            z2_out,
-            z_valid_out
-        );
-        self.rom.clock.next = self.clock.val();
-        self.ram.clock.next = self.clock.val();
+        dff_setup!(self, clock, a, acc);
+        self.sequencer.clock.next = self.clock.val();
+        self.coefficient.clock.next = self.clock.val();
+        self.digits.clock.next = self.clock.val();
         self.mul.clock.next = self.clock.val();
-        // Program counter: idle at 0 until a strobe, then 1..=last, then 0.
-        self.rom.address.next = self.pc.q.val();
-        if self.pc.q.val() == 0 {
-            if self.x_valid.val() {
-                self.pc.d.next = 1.into();
-                self.x1_held.d.next = self.x1.val();
-                self.x2_held.d.next = self.x2.val();
-                // base counts samples modulo 3 (the slot rotation).
-                if self.base.q.val() == 0 {
-                    self.base.d.next = 1.into();
-                }
-                if self.base.q.val() == 1 {
-                    self.base.d.next = 2.into();
-                }
-                if self.base.q.val() == 2 {
-                    self.base.d.next = 0.into();
-                }
-            }
-        } else {
-            self.pc.d.next = self.pc.q.val() + 1;
-            if self.pc.q.val() == self.last_pc.val() {
-                self.pc.d.next = 0.into();
-            }
-        }
-        // Fields of the word (`MicroWord::encode`).
-        // The ROM word is registered once more in the fabric: a block RAM's
-        // clock-to-output is too slow to feed the coefficient multiplexer.
-        self.word_reg.d.next = self.rom.q.val();
-        self.word.next = self.word_reg.q.val();
-        self.read_field.next = self.word.val().get_bits::<RAM_ADDRESS_BITS>(0);
-        self.factor.next = self.word.val().get_bits::<5>(8);
-        self.op.next = self.word.val().get_bits::<2>(13);
-        self.emit.next = self.word.val().get_bits::<3>(16);
-        self.write_field.next = self.word.val().get_bits::<RAM_ADDRESS_BITS>(19);
-        self.x_select.next = self.word.val().get_bits::<3>(26);
-        // Slot rotation: slot r < 3 becomes (r + base) mod 3; slot 3 stays.
-        self.read_sum.next = bit_cast::<3, 2>(self.read_field.val().get_bits::<2>(2))
-            + bit_cast::<3, 2>(self.base.q.val());
-        self.read_wrapped.next = self.read_sum.val() - 3;
-        self.read_slot.next = self.read_sum.val().get_bits::<2>(0);
-        if self.read_sum.val() >= 3 {
-            self.read_slot.next = self.read_wrapped.val().get_bits::<2>(0);
-        }
-        if self.read_field.val().get_bits::<2>(2) == 3 {
-            self.read_slot.next = 3.into();
-        }
-        self.write_sum.next = bit_cast::<3, 2>(self.write_field.val().get_bits::<2>(2))
-            + bit_cast::<3, 2>(self.base.q.val());
-        self.write_wrapped.next = self.write_sum.val() - 3;
-        self.write_slot.next = self.write_sum.val().get_bits::<2>(0);
-        if self.write_sum.val() >= 3 {
-            self.write_slot.next = self.write_wrapped.val().get_bits::<2>(0);
-        }
-        if self.write_field.val().get_bits::<2>(2) == 3 {
-            self.write_slot.next = 3.into();
-        }
-        self.ram.read_address.next = (self.read_field.val() & self.slot_mask.val())
-            | (bit_cast::<RAM_ADDRESS_BITS, 2>(self.read_slot.val()) << 2);
-        self.ram.write_address.next = (self.write_field.val() & self.slot_mask.val())
-            | (bit_cast::<RAM_ADDRESS_BITS, 2>(self.write_slot.val()) << 2);
+        // A strobe in idle captures x1, x2 and starts the program.
+        self.sequencer.x_valid.next = self.x_valid.val();
+        self.digits.x1.next = self.x1.val();
+        self.digits.x2.next = self.x2.val();
+        self.digits.capture.next = self.sequencer.idle.val() & self.x_valid.val();
+        // The word's RAM addresses, emission and publication.
+        self.digits.read_address.next = self.sequencer.read_address.val();
+        self.digits.write_address.next = self.sequencer.write_address.val();
+        self.digits.emit.next = self.sequencer.emit.val();
+        self.digits.x_select.next = self.sequencer.x_select.val();
+        self.digits.publish.next = self.sequencer.publish.val();
+        self.op.next = self.sequencer.op.val();
         // Operand a: the RAM digit, a state's top digit sign-extended from bit 12.
-        self.ram_low.next = self.ram.q.val().get_bits::<STATE_TOP_BITS>(0);
+        self.ram_low.next = self.digits.q.val().get_bits::<STATE_TOP_BITS>(0);
         self.ram_wrapped.next =
             signed_bit_cast_exact::<DIGIT_OPERAND_BITS, STATE_TOP_BITS>(self.ram_low.val());
-        self.a.d.next = self.ram.q.val();
-        if self.word.val().get_bit(7) {
+        self.a.d.next = self.digits.q.val();
+        if self.sequencer.wrap_top.val() {
             self.a.d.next = self.ram_wrapped.val();
         }
         // Operand b: a digit of a scaled coefficient, or a constant.
-        self.k0_wide.next =
-            signed_bit_cast_exact::<SCALED_COEFFICIENT_BITS, COEFFICIENT_BITS>(self.k0.val());
-        self.k1_wide.next =
-            signed_bit_cast_exact::<SCALED_COEFFICIENT_BITS, COEFFICIENT_BITS>(self.k1.val());
-        self.k2_wide.next =
-            signed_bit_cast_exact::<SCALED_COEFFICIENT_BITS, COEFFICIENT_BITS>(self.k2.val());
-        self.alpha_wide.next =
-            signed_bit_cast_exact::<SCALED_COEFFICIENT_BITS, COEFFICIENT_BITS>(self.alpha.val());
-        self.scaled.next = self.alpha_wide.val();
-        if self.factor.val().get_bits::<3>(2) == 1 {
-            self.scaled.next = self.k1_wide.val() + self.pow31.val();
-        }
-        if self.factor.val().get_bits::<3>(2) == 2 {
-            self.scaled.next = self.k2_wide.val() - self.pow30.val();
-        }
-        if self.factor.val().get_bits::<3>(2) == 3 {
-            self.scaled.next = signed_cast(unsigned_cast(self.k0_wide.val()) << 1);
-        }
-        if self.factor.val().get_bits::<3>(2) == 4 {
-            self.scaled.next = signed_cast(unsigned_cast(self.k0_wide.val()) << 2);
-        }
-        self.scaled_low.next = self.scaled.val().get_bits::<30>(0);
-        self.scaled_bits.next = unsigned_cast(self.scaled_low.val());
-        self.top_bits.next = self.scaled.val().get_bits::<4>(30);
-        self.top_digit.next = signed_bit_cast_exact::<DIGIT_OPERAND_BITS, 4>(self.top_bits.val());
-        self.b.d.next = self.top_digit.val();
-        if self.factor.val().get_bits::<2>(0) == 0 {
-            self.b.d.next = signed_cast(bit_cast::<DIGIT_OPERAND_BITS, 15>(
-                self.scaled_bits.val().get_bits::<15>(0),
-            ));
-        }
-        if self.factor.val().get_bits::<2>(0) == 1 {
-            self.b.d.next = signed_cast(bit_cast::<DIGIT_OPERAND_BITS, 15>(
-                self.scaled_bits.val().get_bits::<15>(15),
-            ));
-        }
-        if self.factor.val().get_bits::<3>(2) == 0 {
-            self.b.d.next = 0.into();
-            if self.factor.val().get_bits::<2>(0) == 1 {
-                self.b.d.next = self.one.val();
-            }
-            if self.factor.val().get_bits::<2>(0) == 2 {
-                self.b.d.next = self.minus_one.val();
-            }
-            if self.factor.val().get_bits::<2>(0) == 3 {
-                self.b.d.next = self.pow14.val();
-            }
-        }
+        self.coefficient.factor.next = self.sequencer.factor.val();
+        self.coefficient.k0.next = self.k0.val();
+        self.coefficient.k1.next = self.k1.val();
+        self.coefficient.k2.next = self.k2.val();
+        self.coefficient.alpha.next = self.alpha.val();
         self.mul.a.next = self.a.q.val();
-        self.mul.b.next = self.b.q.val();
+        self.mul.b.next = self.coefficient.digit.val();
         // Accumulator: hold, start (+ 2^29), add, or shift a column and add.
         self.product.next =
             signed_bit_cast_exact::<COLUMN_BITS, DIGIT_PRODUCT_BITS>(self.mul.p.val());
@@ -476,7 +292,7 @@ impl Logic for IirLowpass {
         self.addend.next = self.acc.q.val();
         if self.op.val() == 1 {
             self.addend.next = 0.into();
-            if self.word.val().get_bit(15) {
+            if self.sequencer.round_start.val() {
                 self.addend.next = self.pow29.val();
             }
         }
@@ -486,59 +302,10 @@ impl Logic for IirLowpass {
         if self.op.val() != 0 {
             self.acc.d.next = self.addend.val() + self.product.val();
         }
-        // Emissions: the finished column digit, or an input digit.
-        self.column_top.next = self.acc.q.val().get_bits::<15>(0);
-        self.digit_bits.next = unsigned_cast(self.column_top.val());
-        self.column_digit.next =
-            signed_cast(bit_cast::<DIGIT_OPERAND_BITS, 15>(self.digit_bits.val()));
-        self.column_top_digit.next =
-            signed_bit_cast_exact::<DIGIT_OPERAND_BITS, 15>(self.column_top.val());
-        self.x_low.next = self.x1_held.q.val().get_bits::<30>(0);
-        self.x_top.next = self.x1_held.q.val().get_bits::<10>(30);
-        if self.x_select.val() >= 3 {
-            self.x_low.next = self.x2_held.q.val().get_bits::<30>(0);
-            self.x_top.next = self.x2_held.q.val().get_bits::<10>(30);
-        }
-        self.x_bits.next = unsigned_cast(self.x_low.val());
-        self.x_top_digit.next = signed_bit_cast_exact::<DIGIT_OPERAND_BITS, 10>(self.x_top.val());
-        self.input_digit.next = self.x_top_digit.val();
-        if (self.x_select.val() == 0) | (self.x_select.val() == 3) {
-            self.input_digit.next = signed_cast(bit_cast::<DIGIT_OPERAND_BITS, 15>(
-                self.x_bits.val().get_bits::<15>(0),
-            ));
-        }
-        if (self.x_select.val() == 1) | (self.x_select.val() == 4) {
-            self.input_digit.next = signed_cast(bit_cast::<DIGIT_OPERAND_BITS, 15>(
-                self.x_bits.val().get_bits::<15>(15),
-            ));
-        }
-        self.ram.write_enable.next = false;
-        self.ram.write_data.next = self.column_digit.val();
-        if self.emit.val() == 1 {
-            self.ram.write_enable.next = true;
-        }
-        if self.emit.val() == 2 {
-            self.ram.write_enable.next = true;
-            self.ram.write_data.next = self.column_top_digit.val();
-        }
-        if self.emit.val() == 4 {
-            self.ram.write_enable.next = true;
-            self.ram.write_data.next = self.input_digit.val();
-        }
-        if self.emit.val() == 3 {
-            // 75 = STAGE_BITS - 15: the new digit enters at the top.
-            self.stage.d.next = (self.stage.q.val() >> 15)
-                | (bit_cast::<STAGE_BITS, 15>(self.digit_bits.val()) << 75);
-        }
-        // Publish: z1 = staged digits 0..2, z2 = 3..5 (45 = 3 x 15).
-        self.z_valid_out.d.next = self.word.val().get_bit(29);
-        if self.word.val().get_bit(29) {
-            self.z1_out.d.next = signed_cast(self.stage.q.val().get_bits::<SAMPLE_BITS>(0));
-            self.z2_out.d.next = signed_cast(self.stage.q.val().get_bits::<SAMPLE_BITS>(45));
-        }
-        self.z1.next = self.z1_out.q.val();
-        self.z2.next = self.z2_out.q.val();
-        self.z_valid.next = self.z_valid_out.q.val();
+        self.digits.column.next = self.acc.q.val().get_bits::<15>(0);
+        self.z1.next = self.digits.z1.val();
+        self.z2.next = self.digits.z2.val();
+        self.z_valid.next = self.digits.z_valid.val();
     }
 }
 
