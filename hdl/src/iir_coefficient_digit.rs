@@ -17,8 +17,8 @@
 //! unsigned 15-bit digits and a signed 4-bit top digit. The digit is
 //! registered (`b`), one pipeline stage of the program's word. Power-up: 0.
 
-use crate::iir_lowpass::COEFFICIENT_BITS;
 use crate::iir_program::{OPERAND_BITS, SCALED_COEFFICIENT_BITS};
+use crate::iir_widths::COEFFICIENT_BITS;
 use crate::primitives::convert::signed_bit_cast_exact;
 use rust_hdl::prelude::*;
 

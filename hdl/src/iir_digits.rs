@@ -18,8 +18,8 @@
 //! at `capture` (a strobe in idle). Every output is a register (the RAM
 //! reads into one). Power-up: all 0.
 
-use crate::iir_lowpass::SAMPLE_BITS;
 use crate::iir_program::{DIGIT_BITS, OPERAND_BITS, RAM_ADDRESS_BITS};
+use crate::iir_widths::SAMPLE_BITS;
 use crate::primitives::DigitRam;
 use crate::primitives::convert::signed_bit_cast_exact;
 use rust_hdl::prelude::*;

@@ -39,8 +39,8 @@
 //! the same schedule by construction. `build` inserts idle words where a
 //! read would come before the write it depends on.
 
-use crate::iir_lowpass::SAMPLE_BITS;
-use crate::model::iir_lowpass::Coefficients;
+use crate::iir_widths::{SAMPLE_BITS, STATE_BITS};
+use gyrocal_regs::Coefficients;
 use std::sync::LazyLock;
 
 /// Bits of a digit below its sign: 15.
@@ -56,7 +56,7 @@ pub const SAMPLE_DIGITS: usize = 3;
 /// Digits of a coefficient (up to 34 bits once scaled): 3, the top one 4 bits.
 pub const COEFFICIENT_DIGITS: usize = 3;
 /// Width of the top digit of a state (58 = 3 x 15 + 13).
-pub const STATE_TOP_BITS: usize = crate::iir_lowpass::STATE_BITS - 3 * DIGIT_BITS;
+pub const STATE_TOP_BITS: usize = STATE_BITS - 3 * DIGIT_BITS;
 /// Width of the top digit of a sample (40 = 2 x 15 + 10).
 pub const SAMPLE_TOP_BITS: usize = SAMPLE_BITS - 2 * DIGIT_BITS;
 /// Width of the top digit of a scaled coefficient (34 = 2 x 15 + 4).

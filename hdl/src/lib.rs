@@ -24,6 +24,7 @@ pub mod iir_digits;
 pub mod iir_lowpass;
 pub mod iir_program;
 pub mod iir_sequencer;
+pub mod iir_widths;
 pub mod model;
 pub mod modulation_nco;
 pub mod notch_coefficient;

@@ -168,7 +168,7 @@ impl IirLowpass {
             for (c, z) in self.z.iter_mut().enumerate() {
                 let d = &self.stage[3 * c..3 * c + 3];
                 let value = d[0] | d[1] << DIGIT_BITS | d[2] << (2 * DIGIT_BITS);
-                *z = wrap(value, crate::iir_lowpass::SAMPLE_BITS);
+                *z = wrap(value, crate::iir_widths::SAMPLE_BITS);
             }
         }
         self.z_valid = w.publish;
@@ -579,7 +579,7 @@ mod tests {
                         "R {} {register:?}: a register wrapped",
                         d.decimation
                     );
-                    let scale = (1u64 << crate::iir_lowpass::GUARD_BITS) as f64;
+                    let scale = (1u64 << crate::iir_widths::GUARD_BITS) as f64;
                     let peak = peaks.max[register as usize] as f64;
                     let (low, high) = (
                         full_scale as f64 * l1_n * scale,
