@@ -4,7 +4,7 @@
 //! ```text
 //!            low clock                                high clock
 //!  acc[80] ─► lo: acc_lo - delay_lo ──► borrow       hi: (2 acc_hi) - (2 delay_hi + borrow), halved
-//!            result = {acc_hi, difference_lo}         result = {difference_hi, acc_lo}
+//!            acc <- {acc_hi, difference_lo}           acc <- {difference_hi, acc_lo}
 //!            delay[k] <- acc, delay_hi <- delay[k]    k <- k + 1
 //! ```
 //!
@@ -16,12 +16,12 @@
 //! accumulator as the new delay; the high clock subtracts the high halves
 //! and the borrow as one 41-bit subtraction, halved, and moves to the next
 //! delay word. The accumulator is this block's register, so the schedule
-//! (`crate::cic_decimator`) reads nothing here that its own signals
-//! drive combinationally: it loads a channel's integral (`load`) and
-//! steps the halves (`low`, `high`), and reads `acc`. The RAM is read one clock ahead of each
-//! step's low clock and again during it (the old value of the word it
-//! reads is the delay); the read and write addresses of one clock always
-//! differ.
+//! (`crate::cic_decimator`) reads nothing here that its own signals drive
+//! combinationally: it loads a channel's integral (`load`), steps the
+//! halves (`low`, `high`) and reads `acc`. The RAM is read one clock ahead
+//! of each step's low clock and again during it (the old value of the word
+//! it reads is the delay); the read and write addresses of one clock
+//! always differ.
 //!
 //! Widths: the halves are `REGISTER_HALF_BITS` = 40 bits, each difference
 //! `COMB_CARRY_BITS` = 41 (the borrow, or the borrow-in). The delays: 8
