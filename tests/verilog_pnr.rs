@@ -27,13 +27,12 @@ const ASSERTED_TARGETS: &[&str] = &["ice40-up5k", "ecp5-25f"];
 
 /// Every part, placed and routed once per test process.
 fn reports() -> &'static [PnrReport] {
-    static REPORTS: OnceLock<Result<Vec<PnrReport>, String>> = OnceLock::new();
+    static REPORTS: OnceLock<Result<Vec<PnrReport>, verify::VerifyError>> = OnceLock::new();
     REPORTS
         .get_or_init(|| {
             let t = Instant::now();
             let out = verify::verilog_out_dir();
-            let r = pnr::place_and_route_all(&|p| resources::pnr_core(&out, p), &pnr::PARTS)
-                .map_err(|e| e.to_string());
+            let r = pnr::place_and_route_all(&|p| resources::pnr_core(&out, p), &pnr::PARTS);
             for x in r.iter().flatten() {
                 eprintln!(
                     "{}: fits {}, Fmax {:?} MHz; synthesis {:.1?}, place and route {:.1?}",

@@ -22,12 +22,11 @@ fn require_yosys() {
 
 /// Both targets, synthesized once per test process.
 fn reports() -> &'static [SynthesisReport] {
-    static REPORTS: OnceLock<Result<Vec<SynthesisReport>, String>> = OnceLock::new();
+    static REPORTS: OnceLock<Result<Vec<SynthesisReport>, verify::VerifyError>> = OnceLock::new();
     REPORTS
         .get_or_init(|| {
             let t = Instant::now();
-            let r =
-                synthesis::synthesize_all(&verify::committed_verilog()).map_err(|e| e.to_string());
+            let r = synthesis::synthesize_all(&verify::committed_verilog());
             if let Ok(r) = &r {
                 for x in r {
                     eprintln!(
