@@ -283,7 +283,7 @@ pub enum DeviceError {
     #[error(
         "temperature {0} deg C: the file has no [drift] section, its device is [gyro] at one temperature"
     )]
-    NoDrift(f64),
+    TemperatureWithoutDrift(f64),
     /// A temperature out of the drift's range (`TEMPERATURE_RANGE_C`).
     #[error("temperature {temperature_c} deg C: allowed {}..={}", range.0, range.1)]
     Temperature {

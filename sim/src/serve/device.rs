@@ -74,7 +74,7 @@ impl DeviceFile {
                 drive_gain: [1.0; 2],
                 front_end_phase_deg: 0.0,
             }),
-            (None, Some(t)) => Err(DeviceError::NoDrift(t)),
+            (None, Some(t)) => Err(DeviceError::TemperatureWithoutDrift(t)),
             (Some(d), None) => Ok(d.at(&self.exp.gyro, d.reference_c())),
             (Some(d), Some(t)) => {
                 let (lo, hi) = TEMPERATURE_RANGE_C;
@@ -135,7 +135,7 @@ mod tests {
         assert_eq!(at.gyro, f.exp.gyro);
         assert!(at.temperature_c.is_nan());
         let e = f.at(Some(30.0)).unwrap_err();
-        assert_eq!(e, DeviceError::NoDrift(30.0));
+        assert_eq!(e, DeviceError::TemperatureWithoutDrift(30.0));
         assert!(e.to_string().contains("no [drift]"), "{e}");
     }
 
