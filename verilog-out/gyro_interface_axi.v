@@ -38,12 +38,6 @@ module gyro_interface_axi(aclk,aresetn,adc1,adc2,dac1,dac2,s_axil_awvalid,s_axil
     output reg  [95:0] m_axis_tdata;
     output reg  m_axis_tlast;
 
-    // Constant declarations
-    localparam  id_word = 32'h4759524f;
-    localparam  version_word = 32'h10001;
-    localparam  slverr = 2'b10;
-    localparam  byte_lane = 32'hff;
-
     // Stub signals
     reg  core$clock;
     reg signed [15:0] core$adc1;
@@ -66,217 +60,68 @@ module gyro_interface_axi(aclk,aresetn,adc1,adc2,dac1,dac2,s_axil_awvalid,s_axil
     reg signed [31:0] core$iir_k1;
     reg signed [31:0] core$iir_k2;
     reg signed [31:0] core$iir_alpha;
-    reg  settings$0$clock;
-    reg  settings$0$reset;
-    reg  settings$0$write;
-    reg  [5:0] settings$0$write_index;
-    reg  [31:0] settings$0$write_data;
-    reg  [31:0] settings$0$write_mask;
-    reg  [5:0] settings$0$read_index;
-    wire  [31:0] settings$0$value;
-    wire  settings$0$write_hit;
-    wire  settings$0$read_hit;
-    wire  [31:0] settings$0$read_word;
-    reg  settings$1$clock;
-    reg  settings$1$reset;
-    reg  settings$1$write;
-    reg  [5:0] settings$1$write_index;
-    reg  [31:0] settings$1$write_data;
-    reg  [31:0] settings$1$write_mask;
-    reg  [5:0] settings$1$read_index;
-    wire  [31:0] settings$1$value;
-    wire  settings$1$write_hit;
-    wire  settings$1$read_hit;
-    wire  [31:0] settings$1$read_word;
-    reg  settings$2$clock;
-    reg  settings$2$reset;
-    reg  settings$2$write;
-    reg  [5:0] settings$2$write_index;
-    reg  [31:0] settings$2$write_data;
-    reg  [31:0] settings$2$write_mask;
-    reg  [5:0] settings$2$read_index;
-    wire  [31:0] settings$2$value;
-    wire  settings$2$write_hit;
-    wire  settings$2$read_hit;
-    wire  [31:0] settings$2$read_word;
-    reg  settings$3$clock;
-    reg  settings$3$reset;
-    reg  settings$3$write;
-    reg  [5:0] settings$3$write_index;
-    reg  [31:0] settings$3$write_data;
-    reg  [31:0] settings$3$write_mask;
-    reg  [5:0] settings$3$read_index;
-    wire  [31:0] settings$3$value;
-    wire  settings$3$write_hit;
-    wire  settings$3$read_hit;
-    wire  [31:0] settings$3$read_word;
-    reg  settings$4$clock;
-    reg  settings$4$reset;
-    reg  settings$4$write;
-    reg  [5:0] settings$4$write_index;
-    reg  [31:0] settings$4$write_data;
-    reg  [31:0] settings$4$write_mask;
-    reg  [5:0] settings$4$read_index;
-    wire  [31:0] settings$4$value;
-    wire  settings$4$write_hit;
-    wire  settings$4$read_hit;
-    wire  [31:0] settings$4$read_word;
-    reg  settings$5$clock;
-    reg  settings$5$reset;
-    reg  settings$5$write;
-    reg  [5:0] settings$5$write_index;
-    reg  [31:0] settings$5$write_data;
-    reg  [31:0] settings$5$write_mask;
-    reg  [5:0] settings$5$read_index;
-    wire  [31:0] settings$5$value;
-    wire  settings$5$write_hit;
-    wire  settings$5$read_hit;
-    wire  [31:0] settings$5$read_word;
-    reg  settings$6$clock;
-    reg  settings$6$reset;
-    reg  settings$6$write;
-    reg  [5:0] settings$6$write_index;
-    reg  [31:0] settings$6$write_data;
-    reg  [31:0] settings$6$write_mask;
-    reg  [5:0] settings$6$read_index;
-    wire  [31:0] settings$6$value;
-    wire  settings$6$write_hit;
-    wire  settings$6$read_hit;
-    wire  [31:0] settings$6$read_word;
-    reg  settings$7$clock;
-    reg  settings$7$reset;
-    reg  settings$7$write;
-    reg  [5:0] settings$7$write_index;
-    reg  [31:0] settings$7$write_data;
-    reg  [31:0] settings$7$write_mask;
-    reg  [5:0] settings$7$read_index;
-    wire  [31:0] settings$7$value;
-    wire  settings$7$write_hit;
-    wire  settings$7$read_hit;
-    wire  [31:0] settings$7$read_word;
-    reg  settings$8$clock;
-    reg  settings$8$reset;
-    reg  settings$8$write;
-    reg  [5:0] settings$8$write_index;
-    reg  [31:0] settings$8$write_data;
-    reg  [31:0] settings$8$write_mask;
-    reg  [5:0] settings$8$read_index;
-    wire  [31:0] settings$8$value;
-    wire  settings$8$write_hit;
-    wire  settings$8$read_hit;
-    wire  [31:0] settings$8$read_word;
-    reg  settings$9$clock;
-    reg  settings$9$reset;
-    reg  settings$9$write;
-    reg  [5:0] settings$9$write_index;
-    reg  [31:0] settings$9$write_data;
-    reg  [31:0] settings$9$write_mask;
-    reg  [5:0] settings$9$read_index;
-    wire  [31:0] settings$9$value;
-    wire  settings$9$write_hit;
-    wire  settings$9$read_hit;
-    wire  [31:0] settings$9$read_word;
-    reg  settings$10$clock;
-    reg  settings$10$reset;
-    reg  settings$10$write;
-    reg  [5:0] settings$10$write_index;
-    reg  [31:0] settings$10$write_data;
-    reg  [31:0] settings$10$write_mask;
-    reg  [5:0] settings$10$read_index;
-    wire  [31:0] settings$10$value;
-    wire  settings$10$write_hit;
-    wire  settings$10$read_hit;
-    wire  [31:0] settings$10$read_word;
-    reg  settings$11$clock;
-    reg  settings$11$reset;
-    reg  settings$11$write;
-    reg  [5:0] settings$11$write_index;
-    reg  [31:0] settings$11$write_data;
-    reg  [31:0] settings$11$write_mask;
-    reg  [5:0] settings$11$read_index;
-    wire  [31:0] settings$11$value;
-    wire  settings$11$write_hit;
-    wire  settings$11$read_hit;
-    wire  [31:0] settings$11$read_word;
-    reg  settings$12$clock;
-    reg  settings$12$reset;
-    reg  settings$12$write;
-    reg  [5:0] settings$12$write_index;
-    reg  [31:0] settings$12$write_data;
-    reg  [31:0] settings$12$write_mask;
-    reg  [5:0] settings$12$read_index;
-    wire  [31:0] settings$12$value;
-    wire  settings$12$write_hit;
-    wire  settings$12$read_hit;
-    wire  [31:0] settings$12$read_word;
-    reg  settings$13$clock;
-    reg  settings$13$reset;
-    reg  settings$13$write;
-    reg  [5:0] settings$13$write_index;
-    reg  [31:0] settings$13$write_data;
-    reg  [31:0] settings$13$write_mask;
-    reg  [5:0] settings$13$read_index;
-    wire  [31:0] settings$13$value;
-    wire  settings$13$write_hit;
-    wire  settings$13$read_hit;
-    wire  [31:0] settings$13$read_word;
-    reg  settings$14$clock;
-    reg  settings$14$reset;
-    reg  settings$14$write;
-    reg  [5:0] settings$14$write_index;
-    reg  [31:0] settings$14$write_data;
-    reg  [31:0] settings$14$write_mask;
-    reg  [5:0] settings$14$read_index;
-    wire  [31:0] settings$14$value;
-    wire  settings$14$write_hit;
-    wire  settings$14$read_hit;
-    wire  [31:0] settings$14$read_word;
-    reg  [31:0] status$0$live;
-    reg  [5:0] status$0$read_index;
-    wire  status$0$read_hit;
-    wire  [31:0] status$0$read_word;
-    reg  [31:0] status$1$live;
-    reg  [5:0] status$1$read_index;
-    wire  status$1$read_hit;
-    wire  [31:0] status$1$read_word;
-    reg  [31:0] status$2$live;
-    reg  [5:0] status$2$read_index;
-    wire  status$2$read_hit;
-    wire  [31:0] status$2$read_word;
-    reg  [31:0] status$3$live;
-    reg  [5:0] status$3$read_index;
-    wire  status$3$read_hit;
-    wire  [31:0] status$3$read_word;
-    reg  [31:0] status$4$live;
-    reg  [5:0] status$4$read_index;
-    wire  status$4$read_hit;
-    wire  [31:0] status$4$read_word;
-    reg  [31:0] status$5$live;
-    reg  [5:0] status$5$read_index;
-    wire  status$5$read_hit;
-    wire  [31:0] status$5$read_word;
-    reg  [31:0] status$6$live;
-    reg  [5:0] status$6$read_index;
-    wire  status$6$read_hit;
-    wire  [31:0] status$6$read_word;
-    reg  [31:0] status$7$live;
-    reg  [5:0] status$7$read_index;
-    wire  status$7$read_hit;
-    wire  [31:0] status$7$read_word;
-    reg  [31:0] status$8$live;
-    reg  [5:0] status$8$read_index;
-    wire  status$8$read_hit;
-    wire  [31:0] status$8$read_word;
-    reg  clip$0$clock;
-    reg  clip$0$reset;
-    reg signed [15:0] clip$0$adc;
-    reg  clip$0$clear;
-    wire  [15:0] clip$0$count;
-    reg  clip$1$clock;
-    reg  clip$1$reset;
-    reg signed [15:0] clip$1$adc;
-    reg  clip$1$clear;
-    wire  [15:0] clip$1$count;
+    reg  axil_write$clock;
+    reg  axil_write$reset;
+    reg  axil_write$s_axil_awvalid;
+    wire  axil_write$s_axil_awready;
+    reg  [7:0] axil_write$s_axil_awaddr;
+    reg  axil_write$s_axil_wvalid;
+    wire  axil_write$s_axil_wready;
+    reg  [31:0] axil_write$s_axil_wdata;
+    reg  [3:0] axil_write$s_axil_wstrb;
+    wire  axil_write$s_axil_bvalid;
+    reg  axil_write$s_axil_bready;
+    wire  [1:0] axil_write$s_axil_bresp;
+    wire  axil_write$write;
+    wire  [5:0] axil_write$index;
+    wire  [31:0] axil_write$data;
+    wire  [31:0] axil_write$mask;
+    reg  axil_write$accepted;
+    reg  axil_read$clock;
+    reg  axil_read$reset;
+    reg  axil_read$s_axil_arvalid;
+    wire  axil_read$s_axil_arready;
+    reg  [7:0] axil_read$s_axil_araddr;
+    wire  axil_read$s_axil_rvalid;
+    reg  axil_read$s_axil_rready;
+    wire  [31:0] axil_read$s_axil_rdata;
+    wire  [1:0] axil_read$s_axil_rresp;
+    wire  axil_read$read;
+    wire  [5:0] axil_read$index;
+    reg  [31:0] axil_read$word;
+    reg  axil_read$accepted;
+    reg  registers$clock;
+    reg  registers$reset;
+    reg  registers$write;
+    reg  [5:0] registers$write_index;
+    reg  [31:0] registers$write_data;
+    reg  [31:0] registers$write_mask;
+    wire  registers$write_hit;
+    reg  registers$read;
+    reg  [5:0] registers$read_index;
+    wire  registers$read_hit;
+    wire  [31:0] registers$read_word;
+    reg signed [39:0] registers$z1;
+    reg signed [39:0] registers$z2;
+    reg  registers$z_valid;
+    reg  registers$dropped;
+    reg signed [15:0] registers$adc1;
+    reg signed [15:0] registers$adc2;
+    wire  [95:0] registers$beat;
+    wire  registers$stream_enable;
+    wire  registers$select;
+    wire  [31:0] registers$carrier_step;
+    wire  [31:0] registers$ref_phase;
+    wire  [5:0] registers$ref_delay;
+    wire  [47:0] registers$mod_step;
+    wire signed [15:0] registers$amp1;
+    wire signed [15:0] registers$amp2;
+    wire  [12:0] registers$cic_decimation;
+    wire  [5:0] registers$cic_shift;
+    wire signed [31:0] registers$iir_k0;
+    wire signed [31:0] registers$iir_k1;
+    wire signed [31:0] registers$iir_k2;
+    wire signed [31:0] registers$iir_alpha;
     reg  fifo$clock;
     reg  fifo$reset;
     reg  fifo$push;
@@ -285,72 +130,9 @@ module gyro_interface_axi(aclk,aresetn,adc1,adc2,dac1,dac2,s_axil_awvalid,s_axil
     wire  fifo$tvalid;
     wire  [95:0] fifo$tdata;
     wire  fifo$dropped;
-    reg  aw_held$d;
-    wire  aw_held$q;
-    reg  aw_held$clock;
-    reg  [5:0] aw_index$d;
-    wire  [5:0] aw_index$q;
-    reg  aw_index$clock;
-    reg  w_held$d;
-    wire  w_held$q;
-    reg  w_held$clock;
-    reg  [31:0] w_data$d;
-    wire  [31:0] w_data$q;
-    reg  w_data$clock;
-    reg  [3:0] w_strb$d;
-    wire  [3:0] w_strb$q;
-    reg  w_strb$clock;
-    reg  b_valid$d;
-    wire  b_valid$q;
-    reg  b_valid$clock;
-    reg  [1:0] b_resp$d;
-    wire  [1:0] b_resp$q;
-    reg  b_resp$clock;
-    reg  ar_held$d;
-    wire  ar_held$q;
-    reg  ar_held$clock;
-    reg  [5:0] ar_index$d;
-    wire  [5:0] ar_index$q;
-    reg  ar_index$clock;
-    reg  r_valid$d;
-    wire  r_valid$q;
-    reg  r_valid$clock;
-    reg  [31:0] r_data$d;
-    wire  [31:0] r_data$q;
-    reg  r_data$clock;
-    reg  [1:0] r_resp$d;
-    wire  [1:0] r_resp$q;
-    reg  r_resp$clock;
-    reg  [31:0] mod_step_low$d;
-    wire  [31:0] mod_step_low$q;
-    reg  mod_step_low$clock;
-    reg  [31:0] sample_count$d;
-    wire  [31:0] sample_count$q;
-    reg  sample_count$clock;
-    reg  [31:0] overflow_count$d;
-    wire  [31:0] overflow_count$q;
-    reg  overflow_count$clock;
-    reg  [39:0] snapshot_z1$d;
-    wire  [39:0] snapshot_z1$q;
-    reg  snapshot_z1$clock;
-    reg  [39:0] snapshot_z2$d;
-    wire  [39:0] snapshot_z2$q;
-    reg  snapshot_z2$clock;
 
     // Local signals
     reg  reset;
-    reg  write;
-    reg  write_ok;
-    reg  read;
-    reg  read_ok;
-    reg  [31:0] read_word;
-    reg  [31:0] lane0;
-    reg  [31:0] lane1;
-    reg  [31:0] lane2;
-    reg  [31:0] lane3;
-    reg  [31:0] count_now;
-    reg  [39:0] z1_bits;
-    reg  [39:0] z2_bits;
 
     // Sub module instances
     gyro_interface_axi__core core(
@@ -376,268 +158,73 @@ module gyro_interface_axi(aclk,aresetn,adc1,adc2,dac1,dac2,s_axil_awvalid,s_axil
         .iir_k2(core$iir_k2),
         .iir_alpha(core$iir_alpha)
     );
-    gyro_interface_axi__settings__0 settings$0(
-        .clock(settings$0$clock),
-        .reset(settings$0$reset),
-        .write(settings$0$write),
-        .write_index(settings$0$write_index),
-        .write_data(settings$0$write_data),
-        .write_mask(settings$0$write_mask),
-        .read_index(settings$0$read_index),
-        .value(settings$0$value),
-        .write_hit(settings$0$write_hit),
-        .read_hit(settings$0$read_hit),
-        .read_word(settings$0$read_word)
+    gyro_interface_axi__axil_write axil_write(
+        .clock(axil_write$clock),
+        .reset(axil_write$reset),
+        .s_axil_awvalid(axil_write$s_axil_awvalid),
+        .s_axil_awready(axil_write$s_axil_awready),
+        .s_axil_awaddr(axil_write$s_axil_awaddr),
+        .s_axil_wvalid(axil_write$s_axil_wvalid),
+        .s_axil_wready(axil_write$s_axil_wready),
+        .s_axil_wdata(axil_write$s_axil_wdata),
+        .s_axil_wstrb(axil_write$s_axil_wstrb),
+        .s_axil_bvalid(axil_write$s_axil_bvalid),
+        .s_axil_bready(axil_write$s_axil_bready),
+        .s_axil_bresp(axil_write$s_axil_bresp),
+        .write(axil_write$write),
+        .index(axil_write$index),
+        .data(axil_write$data),
+        .mask(axil_write$mask),
+        .accepted(axil_write$accepted)
     );
-    gyro_interface_axi__settings__1 settings$1(
-        .clock(settings$1$clock),
-        .reset(settings$1$reset),
-        .write(settings$1$write),
-        .write_index(settings$1$write_index),
-        .write_data(settings$1$write_data),
-        .write_mask(settings$1$write_mask),
-        .read_index(settings$1$read_index),
-        .value(settings$1$value),
-        .write_hit(settings$1$write_hit),
-        .read_hit(settings$1$read_hit),
-        .read_word(settings$1$read_word)
+    gyro_interface_axi__axil_read axil_read(
+        .clock(axil_read$clock),
+        .reset(axil_read$reset),
+        .s_axil_arvalid(axil_read$s_axil_arvalid),
+        .s_axil_arready(axil_read$s_axil_arready),
+        .s_axil_araddr(axil_read$s_axil_araddr),
+        .s_axil_rvalid(axil_read$s_axil_rvalid),
+        .s_axil_rready(axil_read$s_axil_rready),
+        .s_axil_rdata(axil_read$s_axil_rdata),
+        .s_axil_rresp(axil_read$s_axil_rresp),
+        .read(axil_read$read),
+        .index(axil_read$index),
+        .word(axil_read$word),
+        .accepted(axil_read$accepted)
     );
-    gyro_interface_axi__settings__2 settings$2(
-        .clock(settings$2$clock),
-        .reset(settings$2$reset),
-        .write(settings$2$write),
-        .write_index(settings$2$write_index),
-        .write_data(settings$2$write_data),
-        .write_mask(settings$2$write_mask),
-        .read_index(settings$2$read_index),
-        .value(settings$2$value),
-        .write_hit(settings$2$write_hit),
-        .read_hit(settings$2$read_hit),
-        .read_word(settings$2$read_word)
-    );
-    gyro_interface_axi__settings__3 settings$3(
-        .clock(settings$3$clock),
-        .reset(settings$3$reset),
-        .write(settings$3$write),
-        .write_index(settings$3$write_index),
-        .write_data(settings$3$write_data),
-        .write_mask(settings$3$write_mask),
-        .read_index(settings$3$read_index),
-        .value(settings$3$value),
-        .write_hit(settings$3$write_hit),
-        .read_hit(settings$3$read_hit),
-        .read_word(settings$3$read_word)
-    );
-    gyro_interface_axi__settings__4 settings$4(
-        .clock(settings$4$clock),
-        .reset(settings$4$reset),
-        .write(settings$4$write),
-        .write_index(settings$4$write_index),
-        .write_data(settings$4$write_data),
-        .write_mask(settings$4$write_mask),
-        .read_index(settings$4$read_index),
-        .value(settings$4$value),
-        .write_hit(settings$4$write_hit),
-        .read_hit(settings$4$read_hit),
-        .read_word(settings$4$read_word)
-    );
-    gyro_interface_axi__settings__5 settings$5(
-        .clock(settings$5$clock),
-        .reset(settings$5$reset),
-        .write(settings$5$write),
-        .write_index(settings$5$write_index),
-        .write_data(settings$5$write_data),
-        .write_mask(settings$5$write_mask),
-        .read_index(settings$5$read_index),
-        .value(settings$5$value),
-        .write_hit(settings$5$write_hit),
-        .read_hit(settings$5$read_hit),
-        .read_word(settings$5$read_word)
-    );
-    gyro_interface_axi__settings__6 settings$6(
-        .clock(settings$6$clock),
-        .reset(settings$6$reset),
-        .write(settings$6$write),
-        .write_index(settings$6$write_index),
-        .write_data(settings$6$write_data),
-        .write_mask(settings$6$write_mask),
-        .read_index(settings$6$read_index),
-        .value(settings$6$value),
-        .write_hit(settings$6$write_hit),
-        .read_hit(settings$6$read_hit),
-        .read_word(settings$6$read_word)
-    );
-    gyro_interface_axi__settings__7 settings$7(
-        .clock(settings$7$clock),
-        .reset(settings$7$reset),
-        .write(settings$7$write),
-        .write_index(settings$7$write_index),
-        .write_data(settings$7$write_data),
-        .write_mask(settings$7$write_mask),
-        .read_index(settings$7$read_index),
-        .value(settings$7$value),
-        .write_hit(settings$7$write_hit),
-        .read_hit(settings$7$read_hit),
-        .read_word(settings$7$read_word)
-    );
-    gyro_interface_axi__settings__8 settings$8(
-        .clock(settings$8$clock),
-        .reset(settings$8$reset),
-        .write(settings$8$write),
-        .write_index(settings$8$write_index),
-        .write_data(settings$8$write_data),
-        .write_mask(settings$8$write_mask),
-        .read_index(settings$8$read_index),
-        .value(settings$8$value),
-        .write_hit(settings$8$write_hit),
-        .read_hit(settings$8$read_hit),
-        .read_word(settings$8$read_word)
-    );
-    gyro_interface_axi__settings__9 settings$9(
-        .clock(settings$9$clock),
-        .reset(settings$9$reset),
-        .write(settings$9$write),
-        .write_index(settings$9$write_index),
-        .write_data(settings$9$write_data),
-        .write_mask(settings$9$write_mask),
-        .read_index(settings$9$read_index),
-        .value(settings$9$value),
-        .write_hit(settings$9$write_hit),
-        .read_hit(settings$9$read_hit),
-        .read_word(settings$9$read_word)
-    );
-    gyro_interface_axi__settings__10 settings$10(
-        .clock(settings$10$clock),
-        .reset(settings$10$reset),
-        .write(settings$10$write),
-        .write_index(settings$10$write_index),
-        .write_data(settings$10$write_data),
-        .write_mask(settings$10$write_mask),
-        .read_index(settings$10$read_index),
-        .value(settings$10$value),
-        .write_hit(settings$10$write_hit),
-        .read_hit(settings$10$read_hit),
-        .read_word(settings$10$read_word)
-    );
-    gyro_interface_axi__settings__11 settings$11(
-        .clock(settings$11$clock),
-        .reset(settings$11$reset),
-        .write(settings$11$write),
-        .write_index(settings$11$write_index),
-        .write_data(settings$11$write_data),
-        .write_mask(settings$11$write_mask),
-        .read_index(settings$11$read_index),
-        .value(settings$11$value),
-        .write_hit(settings$11$write_hit),
-        .read_hit(settings$11$read_hit),
-        .read_word(settings$11$read_word)
-    );
-    gyro_interface_axi__settings__12 settings$12(
-        .clock(settings$12$clock),
-        .reset(settings$12$reset),
-        .write(settings$12$write),
-        .write_index(settings$12$write_index),
-        .write_data(settings$12$write_data),
-        .write_mask(settings$12$write_mask),
-        .read_index(settings$12$read_index),
-        .value(settings$12$value),
-        .write_hit(settings$12$write_hit),
-        .read_hit(settings$12$read_hit),
-        .read_word(settings$12$read_word)
-    );
-    gyro_interface_axi__settings__13 settings$13(
-        .clock(settings$13$clock),
-        .reset(settings$13$reset),
-        .write(settings$13$write),
-        .write_index(settings$13$write_index),
-        .write_data(settings$13$write_data),
-        .write_mask(settings$13$write_mask),
-        .read_index(settings$13$read_index),
-        .value(settings$13$value),
-        .write_hit(settings$13$write_hit),
-        .read_hit(settings$13$read_hit),
-        .read_word(settings$13$read_word)
-    );
-    gyro_interface_axi__settings__14 settings$14(
-        .clock(settings$14$clock),
-        .reset(settings$14$reset),
-        .write(settings$14$write),
-        .write_index(settings$14$write_index),
-        .write_data(settings$14$write_data),
-        .write_mask(settings$14$write_mask),
-        .read_index(settings$14$read_index),
-        .value(settings$14$value),
-        .write_hit(settings$14$write_hit),
-        .read_hit(settings$14$read_hit),
-        .read_word(settings$14$read_word)
-    );
-    gyro_interface_axi__status__0 status$0(
-        .live(status$0$live),
-        .read_index(status$0$read_index),
-        .read_hit(status$0$read_hit),
-        .read_word(status$0$read_word)
-    );
-    gyro_interface_axi__status__1 status$1(
-        .live(status$1$live),
-        .read_index(status$1$read_index),
-        .read_hit(status$1$read_hit),
-        .read_word(status$1$read_word)
-    );
-    gyro_interface_axi__status__2 status$2(
-        .live(status$2$live),
-        .read_index(status$2$read_index),
-        .read_hit(status$2$read_hit),
-        .read_word(status$2$read_word)
-    );
-    gyro_interface_axi__status__3 status$3(
-        .live(status$3$live),
-        .read_index(status$3$read_index),
-        .read_hit(status$3$read_hit),
-        .read_word(status$3$read_word)
-    );
-    gyro_interface_axi__status__4 status$4(
-        .live(status$4$live),
-        .read_index(status$4$read_index),
-        .read_hit(status$4$read_hit),
-        .read_word(status$4$read_word)
-    );
-    gyro_interface_axi__status__5 status$5(
-        .live(status$5$live),
-        .read_index(status$5$read_index),
-        .read_hit(status$5$read_hit),
-        .read_word(status$5$read_word)
-    );
-    gyro_interface_axi__status__6 status$6(
-        .live(status$6$live),
-        .read_index(status$6$read_index),
-        .read_hit(status$6$read_hit),
-        .read_word(status$6$read_word)
-    );
-    gyro_interface_axi__status__7 status$7(
-        .live(status$7$live),
-        .read_index(status$7$read_index),
-        .read_hit(status$7$read_hit),
-        .read_word(status$7$read_word)
-    );
-    gyro_interface_axi__status__8 status$8(
-        .live(status$8$live),
-        .read_index(status$8$read_index),
-        .read_hit(status$8$read_hit),
-        .read_word(status$8$read_word)
-    );
-    gyro_interface_axi__clip__0 clip$0(
-        .clock(clip$0$clock),
-        .reset(clip$0$reset),
-        .adc(clip$0$adc),
-        .clear(clip$0$clear),
-        .count(clip$0$count)
-    );
-    gyro_interface_axi__clip__1 clip$1(
-        .clock(clip$1$clock),
-        .reset(clip$1$reset),
-        .adc(clip$1$adc),
-        .clear(clip$1$clear),
-        .count(clip$1$count)
+    gyro_interface_axi__registers registers(
+        .clock(registers$clock),
+        .reset(registers$reset),
+        .write(registers$write),
+        .write_index(registers$write_index),
+        .write_data(registers$write_data),
+        .write_mask(registers$write_mask),
+        .write_hit(registers$write_hit),
+        .read(registers$read),
+        .read_index(registers$read_index),
+        .read_hit(registers$read_hit),
+        .read_word(registers$read_word),
+        .z1(registers$z1),
+        .z2(registers$z2),
+        .z_valid(registers$z_valid),
+        .dropped(registers$dropped),
+        .adc1(registers$adc1),
+        .adc2(registers$adc2),
+        .beat(registers$beat),
+        .stream_enable(registers$stream_enable),
+        .select(registers$select),
+        .carrier_step(registers$carrier_step),
+        .ref_phase(registers$ref_phase),
+        .ref_delay(registers$ref_delay),
+        .mod_step(registers$mod_step),
+        .amp1(registers$amp1),
+        .amp2(registers$amp2),
+        .cic_decimation(registers$cic_decimation),
+        .cic_shift(registers$cic_shift),
+        .iir_k0(registers$iir_k0),
+        .iir_k1(registers$iir_k1),
+        .iir_k2(registers$iir_k2),
+        .iir_alpha(registers$iir_alpha)
     );
     gyro_interface_axi__fifo fifo(
         .clock(fifo$clock),
@@ -649,111 +236,384 @@ module gyro_interface_axi(aclk,aresetn,adc1,adc2,dac1,dac2,s_axil_awvalid,s_axil
         .tdata(fifo$tdata),
         .dropped(fifo$dropped)
     );
-    gyro_interface_axi__aw_held aw_held(
-        .d(aw_held$d),
-        .q(aw_held$q),
-        .clock(aw_held$clock)
-    );
-    gyro_interface_axi__aw_index aw_index(
-        .d(aw_index$d),
-        .q(aw_index$q),
-        .clock(aw_index$clock)
-    );
-    gyro_interface_axi__w_held w_held(
-        .d(w_held$d),
-        .q(w_held$q),
-        .clock(w_held$clock)
-    );
-    gyro_interface_axi__w_data w_data(
-        .d(w_data$d),
-        .q(w_data$q),
-        .clock(w_data$clock)
-    );
-    gyro_interface_axi__w_strb w_strb(
-        .d(w_strb$d),
-        .q(w_strb$q),
-        .clock(w_strb$clock)
-    );
-    gyro_interface_axi__b_valid b_valid(
-        .d(b_valid$d),
-        .q(b_valid$q),
-        .clock(b_valid$clock)
-    );
-    gyro_interface_axi__b_resp b_resp(
-        .d(b_resp$d),
-        .q(b_resp$q),
-        .clock(b_resp$clock)
-    );
-    gyro_interface_axi__ar_held ar_held(
+
+    // Update code
+    always @(*) begin
+        reset = ~aresetn;
+        core$clock = aclk;
+        axil_write$clock = aclk;
+        axil_read$clock = aclk;
+        registers$clock = aclk;
+        fifo$clock = aclk;
+        axil_write$reset = reset;
+        axil_read$reset = reset;
+        registers$reset = reset;
+        fifo$reset = reset;
+        axil_write$s_axil_awvalid = s_axil_awvalid;
+        axil_write$s_axil_awaddr = s_axil_awaddr;
+        axil_write$s_axil_wvalid = s_axil_wvalid;
+        axil_write$s_axil_wdata = s_axil_wdata;
+        axil_write$s_axil_wstrb = s_axil_wstrb;
+        axil_write$s_axil_bready = s_axil_bready;
+        s_axil_awready = axil_write$s_axil_awready;
+        s_axil_wready = axil_write$s_axil_wready;
+        s_axil_bvalid = axil_write$s_axil_bvalid;
+        s_axil_bresp = axil_write$s_axil_bresp;
+        registers$write = axil_write$write;
+        registers$write_index = axil_write$index;
+        registers$write_data = axil_write$data;
+        registers$write_mask = axil_write$mask;
+        axil_write$accepted = registers$write_hit;
+        axil_read$s_axil_arvalid = s_axil_arvalid;
+        axil_read$s_axil_araddr = s_axil_araddr;
+        axil_read$s_axil_rready = s_axil_rready;
+        s_axil_arready = axil_read$s_axil_arready;
+        s_axil_rvalid = axil_read$s_axil_rvalid;
+        s_axil_rdata = axil_read$s_axil_rdata;
+        s_axil_rresp = axil_read$s_axil_rresp;
+        registers$read = axil_read$read;
+        registers$read_index = axil_read$index;
+        axil_read$word = registers$read_word;
+        axil_read$accepted = registers$read_hit;
+        registers$z1 = core$z1;
+        registers$z2 = core$z2;
+        registers$z_valid = core$z_valid;
+        registers$dropped = fifo$dropped;
+        registers$adc1 = adc1;
+        registers$adc2 = adc2;
+        fifo$push = core$z_valid & registers$stream_enable;
+        fifo$push_data = registers$beat;
+        fifo$tready = m_axis_tready;
+        m_axis_tvalid = fifo$tvalid;
+        m_axis_tdata = fifo$tdata;
+        m_axis_tlast = 1'b1;
+        core$select = registers$select;
+        core$carrier_step = registers$carrier_step;
+        core$ref_phase = registers$ref_phase;
+        core$ref_delay = registers$ref_delay;
+        core$mod_step = registers$mod_step;
+        core$amp1 = registers$amp1;
+        core$amp2 = registers$amp2;
+        core$cic_decimation = registers$cic_decimation;
+        core$cic_shift = registers$cic_shift;
+        core$iir_k0 = registers$iir_k0;
+        core$iir_k1 = registers$iir_k1;
+        core$iir_k2 = registers$iir_k2;
+        core$iir_alpha = registers$iir_alpha;
+        core$adc1 = adc1;
+        core$adc2 = adc2;
+        dac1 = core$dac1;
+        dac2 = core$dac2;
+    end
+
+endmodule // gyro_interface_axi
+
+
+module gyro_interface_axi__axil_read(clock,reset,s_axil_arvalid,s_axil_arready,s_axil_araddr,s_axil_rvalid,s_axil_rready,s_axil_rdata,s_axil_rresp,read,index,word,accepted);
+
+    // Module arguments
+    input wire  clock;
+    input wire  reset;
+    input wire  s_axil_arvalid;
+    output reg  s_axil_arready;
+    input wire  [7:0] s_axil_araddr;
+    output reg  s_axil_rvalid;
+    input wire  s_axil_rready;
+    output reg  [31:0] s_axil_rdata;
+    output reg  [1:0] s_axil_rresp;
+    output reg  read;
+    output reg  [5:0] index;
+    input wire  [31:0] word;
+    input wire  accepted;
+
+    // Constant declarations
+    localparam  slverr = 2'b10;
+
+    // Stub signals
+    reg  ar_held$d;
+    wire  ar_held$q;
+    reg  ar_held$clock;
+    reg  [5:0] ar_index$d;
+    wire  [5:0] ar_index$q;
+    reg  ar_index$clock;
+    reg  r_valid$d;
+    wire  r_valid$q;
+    reg  r_valid$clock;
+    reg  [31:0] r_data$d;
+    wire  [31:0] r_data$q;
+    reg  r_data$clock;
+    reg  [1:0] r_resp$d;
+    wire  [1:0] r_resp$q;
+    reg  r_resp$clock;
+
+    // Sub module instances
+    gyro_interface_axi__axil_read__ar_held ar_held(
         .d(ar_held$d),
         .q(ar_held$q),
         .clock(ar_held$clock)
     );
-    gyro_interface_axi__ar_index ar_index(
+    gyro_interface_axi__axil_read__ar_index ar_index(
         .d(ar_index$d),
         .q(ar_index$q),
         .clock(ar_index$clock)
     );
-    gyro_interface_axi__r_valid r_valid(
+    gyro_interface_axi__axil_read__r_valid r_valid(
         .d(r_valid$d),
         .q(r_valid$q),
         .clock(r_valid$clock)
     );
-    gyro_interface_axi__r_data r_data(
+    gyro_interface_axi__axil_read__r_data r_data(
         .d(r_data$d),
         .q(r_data$q),
         .clock(r_data$clock)
     );
-    gyro_interface_axi__r_resp r_resp(
+    gyro_interface_axi__axil_read__r_resp r_resp(
         .d(r_resp$d),
         .q(r_resp$q),
         .clock(r_resp$clock)
     );
-    gyro_interface_axi__mod_step_low mod_step_low(
-        .d(mod_step_low$d),
-        .q(mod_step_low$q),
-        .clock(mod_step_low$clock)
+
+    // Update code
+    always @(*) begin
+        ar_held$clock = clock;
+        ar_index$clock = clock;
+        r_valid$clock = clock;
+        r_data$clock = clock;
+        r_resp$clock = clock;
+        ar_held$d = ar_held$q;
+        ar_index$d = ar_index$q;
+        r_valid$d = r_valid$q;
+        r_data$d = r_data$q;
+        r_resp$d = r_resp$q;
+        s_axil_arready = ~ar_held$q;
+        s_axil_rvalid = r_valid$q;
+        s_axil_rdata = r_data$q;
+        s_axil_rresp = r_resp$q;
+        if (s_axil_arvalid & (~ar_held$q)) begin
+            ar_held$d = 1'b1;
+            ar_index$d = s_axil_araddr[(32'h2)+:(6)];
+        end
+        read = ar_held$q & (~r_valid$q);
+        index = ar_index$q;
+        if (read) begin
+            ar_held$d = 1'b0;
+            r_valid$d = 1'b1;
+            r_data$d = word;
+            r_resp$d = 32'h0;
+            if (~accepted) begin
+                r_resp$d = slverr;
+            end
+        end
+        if (r_valid$q & s_axil_rready) begin
+            r_valid$d = 1'b0;
+        end
+        if (reset) begin
+            ar_held$d = 1'b0;
+            ar_index$d = 32'h0;
+            r_valid$d = 1'b0;
+            r_data$d = 32'h0;
+            r_resp$d = 32'h0;
+        end
+    end
+
+endmodule // gyro_interface_axi__axil_read
+
+
+module gyro_interface_axi__axil_read__ar_held(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__axil_read__ar_held
+
+
+module gyro_interface_axi__axil_read__ar_index(d,q,clock);
+
+    // Module arguments
+    input wire  [5:0] d;
+    output reg  [5:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 6'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__axil_read__ar_index
+
+
+module gyro_interface_axi__axil_read__r_data(d,q,clock);
+
+    // Module arguments
+    input wire  [31:0] d;
+    output reg  [31:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 32'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__axil_read__r_data
+
+
+module gyro_interface_axi__axil_read__r_resp(d,q,clock);
+
+    // Module arguments
+    input wire  [1:0] d;
+    output reg  [1:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 2'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__axil_read__r_resp
+
+
+module gyro_interface_axi__axil_read__r_valid(d,q,clock);
+
+    // Module arguments
+    input wire  d;
+    output reg  q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 1'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__axil_read__r_valid
+
+
+module gyro_interface_axi__axil_write(clock,reset,s_axil_awvalid,s_axil_awready,s_axil_awaddr,s_axil_wvalid,s_axil_wready,s_axil_wdata,s_axil_wstrb,s_axil_bvalid,s_axil_bready,s_axil_bresp,write,index,data,mask,accepted);
+
+    // Module arguments
+    input wire  clock;
+    input wire  reset;
+    input wire  s_axil_awvalid;
+    output reg  s_axil_awready;
+    input wire  [7:0] s_axil_awaddr;
+    input wire  s_axil_wvalid;
+    output reg  s_axil_wready;
+    input wire  [31:0] s_axil_wdata;
+    input wire  [3:0] s_axil_wstrb;
+    output reg  s_axil_bvalid;
+    input wire  s_axil_bready;
+    output reg  [1:0] s_axil_bresp;
+    output reg  write;
+    output reg  [5:0] index;
+    output reg  [31:0] data;
+    output reg  [31:0] mask;
+    input wire  accepted;
+
+    // Constant declarations
+    localparam  slverr = 2'b10;
+    localparam  byte_lane = 32'hff;
+
+    // Stub signals
+    reg  aw_held$d;
+    wire  aw_held$q;
+    reg  aw_held$clock;
+    reg  [5:0] aw_index$d;
+    wire  [5:0] aw_index$q;
+    reg  aw_index$clock;
+    reg  w_held$d;
+    wire  w_held$q;
+    reg  w_held$clock;
+    reg  [31:0] w_data$d;
+    wire  [31:0] w_data$q;
+    reg  w_data$clock;
+    reg  [3:0] w_strb$d;
+    wire  [3:0] w_strb$q;
+    reg  w_strb$clock;
+    reg  b_valid$d;
+    wire  b_valid$q;
+    reg  b_valid$clock;
+    reg  [1:0] b_resp$d;
+    wire  [1:0] b_resp$q;
+    reg  b_resp$clock;
+
+    // Local signals
+    reg  [31:0] lane0;
+    reg  [31:0] lane1;
+    reg  [31:0] lane2;
+    reg  [31:0] lane3;
+
+    // Sub module instances
+    gyro_interface_axi__axil_write__aw_held aw_held(
+        .d(aw_held$d),
+        .q(aw_held$q),
+        .clock(aw_held$clock)
     );
-    gyro_interface_axi__sample_count sample_count(
-        .d(sample_count$d),
-        .q(sample_count$q),
-        .clock(sample_count$clock)
+    gyro_interface_axi__axil_write__aw_index aw_index(
+        .d(aw_index$d),
+        .q(aw_index$q),
+        .clock(aw_index$clock)
     );
-    gyro_interface_axi__overflow_count overflow_count(
-        .d(overflow_count$d),
-        .q(overflow_count$q),
-        .clock(overflow_count$clock)
+    gyro_interface_axi__axil_write__w_held w_held(
+        .d(w_held$d),
+        .q(w_held$q),
+        .clock(w_held$clock)
     );
-    gyro_interface_axi__snapshot_z1 snapshot_z1(
-        .d(snapshot_z1$d),
-        .q(snapshot_z1$q),
-        .clock(snapshot_z1$clock)
+    gyro_interface_axi__axil_write__w_data w_data(
+        .d(w_data$d),
+        .q(w_data$q),
+        .clock(w_data$clock)
     );
-    gyro_interface_axi__snapshot_z2 snapshot_z2(
-        .d(snapshot_z2$d),
-        .q(snapshot_z2$q),
-        .clock(snapshot_z2$clock)
+    gyro_interface_axi__axil_write__w_strb w_strb(
+        .d(w_strb$d),
+        .q(w_strb$q),
+        .clock(w_strb$clock)
+    );
+    gyro_interface_axi__axil_write__b_valid b_valid(
+        .d(b_valid$d),
+        .q(b_valid$q),
+        .clock(b_valid$clock)
+    );
+    gyro_interface_axi__axil_write__b_resp b_resp(
+        .d(b_resp$d),
+        .q(b_resp$q),
+        .clock(b_resp$clock)
     );
 
     // Update code
     always @(*) begin
-        aw_held$clock = aclk;
-        aw_index$clock = aclk;
-        w_held$clock = aclk;
-        w_data$clock = aclk;
-        w_strb$clock = aclk;
-        b_valid$clock = aclk;
-        b_resp$clock = aclk;
-        ar_held$clock = aclk;
-        ar_index$clock = aclk;
-        r_valid$clock = aclk;
-        r_data$clock = aclk;
-        r_resp$clock = aclk;
-        mod_step_low$clock = aclk;
-        sample_count$clock = aclk;
-        overflow_count$clock = aclk;
-        snapshot_z1$clock = aclk;
-        snapshot_z2$clock = aclk;
+        aw_held$clock = clock;
+        aw_index$clock = clock;
+        w_held$clock = clock;
+        w_data$clock = clock;
+        w_strb$clock = clock;
+        b_valid$clock = clock;
+        b_resp$clock = clock;
         aw_held$d = aw_held$q;
         aw_index$d = aw_index$q;
         w_held$d = w_held$q;
@@ -761,19 +621,6 @@ module gyro_interface_axi(aclk,aresetn,adc1,adc2,dac1,dac2,s_axil_awvalid,s_axil
         w_strb$d = w_strb$q;
         b_valid$d = b_valid$q;
         b_resp$d = b_resp$q;
-        ar_held$d = ar_held$q;
-        ar_index$d = ar_index$q;
-        r_valid$d = r_valid$q;
-        r_data$d = r_data$q;
-        r_resp$d = r_resp$q;
-        mod_step_low$d = mod_step_low$q;
-        sample_count$d = sample_count$q;
-        overflow_count$d = overflow_count$q;
-        snapshot_z1$d = snapshot_z1$q;
-        snapshot_z2$d = snapshot_z2$q;
-        core$clock = aclk;
-        fifo$clock = aclk;
-        reset = ~aresetn;
         s_axil_awready = ~aw_held$q;
         s_axil_wready = ~w_held$q;
         s_axil_bvalid = b_valid$q;
@@ -788,6 +635,8 @@ module gyro_interface_axi(aclk,aresetn,adc1,adc2,dac1,dac2,s_axil_awvalid,s_axil
             w_strb$d = s_axil_wstrb;
         end
         write = aw_held$q & w_held$q & (~b_valid$q);
+        index = aw_index$q;
+        data = w_data$q;
         lane0 = 32'h0;
         lane1 = 32'h0;
         lane2 = 32'h0;
@@ -804,355 +653,19 @@ module gyro_interface_axi(aclk,aresetn,adc1,adc2,dac1,dac2,s_axil_awvalid,s_axil
         if (w_strb$q[32'h3]) begin
             lane3 = byte_lane << 32'h18;
         end
-        write_ok = 1'b0;
-        settings$0$clock = aclk;
-        settings$0$reset = reset;
-        settings$0$write = write;
-        settings$0$write_index = aw_index$q;
-        settings$0$write_data = w_data$q;
-        settings$0$write_mask = lane0 | lane1 | lane2 | lane3;
-        settings$0$read_index = ar_index$q;
-        if (settings$0$write_hit) begin
-            write_ok = 1'b1;
-        end
-        settings$1$clock = aclk;
-        settings$1$reset = reset;
-        settings$1$write = write;
-        settings$1$write_index = aw_index$q;
-        settings$1$write_data = w_data$q;
-        settings$1$write_mask = lane0 | lane1 | lane2 | lane3;
-        settings$1$read_index = ar_index$q;
-        if (settings$1$write_hit) begin
-            write_ok = 1'b1;
-        end
-        settings$2$clock = aclk;
-        settings$2$reset = reset;
-        settings$2$write = write;
-        settings$2$write_index = aw_index$q;
-        settings$2$write_data = w_data$q;
-        settings$2$write_mask = lane0 | lane1 | lane2 | lane3;
-        settings$2$read_index = ar_index$q;
-        if (settings$2$write_hit) begin
-            write_ok = 1'b1;
-        end
-        settings$3$clock = aclk;
-        settings$3$reset = reset;
-        settings$3$write = write;
-        settings$3$write_index = aw_index$q;
-        settings$3$write_data = w_data$q;
-        settings$3$write_mask = lane0 | lane1 | lane2 | lane3;
-        settings$3$read_index = ar_index$q;
-        if (settings$3$write_hit) begin
-            write_ok = 1'b1;
-        end
-        settings$4$clock = aclk;
-        settings$4$reset = reset;
-        settings$4$write = write;
-        settings$4$write_index = aw_index$q;
-        settings$4$write_data = w_data$q;
-        settings$4$write_mask = lane0 | lane1 | lane2 | lane3;
-        settings$4$read_index = ar_index$q;
-        if (settings$4$write_hit) begin
-            write_ok = 1'b1;
-        end
-        settings$5$clock = aclk;
-        settings$5$reset = reset;
-        settings$5$write = write;
-        settings$5$write_index = aw_index$q;
-        settings$5$write_data = w_data$q;
-        settings$5$write_mask = lane0 | lane1 | lane2 | lane3;
-        settings$5$read_index = ar_index$q;
-        if (settings$5$write_hit) begin
-            write_ok = 1'b1;
-        end
-        settings$6$clock = aclk;
-        settings$6$reset = reset;
-        settings$6$write = write;
-        settings$6$write_index = aw_index$q;
-        settings$6$write_data = w_data$q;
-        settings$6$write_mask = lane0 | lane1 | lane2 | lane3;
-        settings$6$read_index = ar_index$q;
-        if (settings$6$write_hit) begin
-            write_ok = 1'b1;
-        end
-        settings$7$clock = aclk;
-        settings$7$reset = reset;
-        settings$7$write = write;
-        settings$7$write_index = aw_index$q;
-        settings$7$write_data = w_data$q;
-        settings$7$write_mask = lane0 | lane1 | lane2 | lane3;
-        settings$7$read_index = ar_index$q;
-        if (settings$7$write_hit) begin
-            write_ok = 1'b1;
-        end
-        settings$8$clock = aclk;
-        settings$8$reset = reset;
-        settings$8$write = write;
-        settings$8$write_index = aw_index$q;
-        settings$8$write_data = w_data$q;
-        settings$8$write_mask = lane0 | lane1 | lane2 | lane3;
-        settings$8$read_index = ar_index$q;
-        if (settings$8$write_hit) begin
-            write_ok = 1'b1;
-        end
-        settings$9$clock = aclk;
-        settings$9$reset = reset;
-        settings$9$write = write;
-        settings$9$write_index = aw_index$q;
-        settings$9$write_data = w_data$q;
-        settings$9$write_mask = lane0 | lane1 | lane2 | lane3;
-        settings$9$read_index = ar_index$q;
-        if (settings$9$write_hit) begin
-            write_ok = 1'b1;
-        end
-        settings$10$clock = aclk;
-        settings$10$reset = reset;
-        settings$10$write = write;
-        settings$10$write_index = aw_index$q;
-        settings$10$write_data = w_data$q;
-        settings$10$write_mask = lane0 | lane1 | lane2 | lane3;
-        settings$10$read_index = ar_index$q;
-        if (settings$10$write_hit) begin
-            write_ok = 1'b1;
-        end
-        settings$11$clock = aclk;
-        settings$11$reset = reset;
-        settings$11$write = write;
-        settings$11$write_index = aw_index$q;
-        settings$11$write_data = w_data$q;
-        settings$11$write_mask = lane0 | lane1 | lane2 | lane3;
-        settings$11$read_index = ar_index$q;
-        if (settings$11$write_hit) begin
-            write_ok = 1'b1;
-        end
-        settings$12$clock = aclk;
-        settings$12$reset = reset;
-        settings$12$write = write;
-        settings$12$write_index = aw_index$q;
-        settings$12$write_data = w_data$q;
-        settings$12$write_mask = lane0 | lane1 | lane2 | lane3;
-        settings$12$read_index = ar_index$q;
-        if (settings$12$write_hit) begin
-            write_ok = 1'b1;
-        end
-        settings$13$clock = aclk;
-        settings$13$reset = reset;
-        settings$13$write = write;
-        settings$13$write_index = aw_index$q;
-        settings$13$write_data = w_data$q;
-        settings$13$write_mask = lane0 | lane1 | lane2 | lane3;
-        settings$13$read_index = ar_index$q;
-        if (settings$13$write_hit) begin
-            write_ok = 1'b1;
-        end
-        settings$14$clock = aclk;
-        settings$14$reset = reset;
-        settings$14$write = write;
-        settings$14$write_index = aw_index$q;
-        settings$14$write_data = w_data$q;
-        settings$14$write_mask = lane0 | lane1 | lane2 | lane3;
-        settings$14$read_index = ar_index$q;
-        if (settings$14$write_hit) begin
-            write_ok = 1'b1;
-        end
+        mask = lane0 | lane1 | lane2 | lane3;
         if (write) begin
             aw_held$d = 1'b0;
             w_held$d = 1'b0;
             b_valid$d = 1'b1;
             b_resp$d = 32'h0;
-            if (~write_ok) begin
+            if (~accepted) begin
                 b_resp$d = slverr;
             end
         end
         if (b_valid$q & s_axil_bready) begin
             b_valid$d = 1'b0;
         end
-        if (settings$5$write_hit) begin
-            mod_step_low$d = settings$4$value;
-        end
-        z1_bits = $unsigned(core$z1);
-        z2_bits = $unsigned(core$z2);
-        count_now = sample_count$q;
-        if (core$z_valid) begin
-            count_now = sample_count$q + 32'h1;
-        end
-        sample_count$d = count_now;
-        if (fifo$dropped) begin
-            overflow_count$d = overflow_count$q + 32'h1;
-        end
-        status$0$live = id_word;
-        status$1$live = version_word;
-        status$2$live = overflow_count$q;
-        status$3$live = count_now;
-        status$4$live = snapshot_z1$q[(32'h0)+:(32)];
-        status$5$live = ((snapshot_z1$q[(32'h20)+:(8)]) & 32'hffffffff);
-        status$6$live = snapshot_z2$q[(32'h0)+:(32)];
-        status$7$live = ((snapshot_z2$q[(32'h20)+:(8)]) & 32'hffffffff);
-        status$8$live = ((clip$0$count) & 32'hffffffff) | (((clip$1$count) & 32'hffffffff) << 32'h10);
-        s_axil_arready = ~ar_held$q;
-        s_axil_rvalid = r_valid$q;
-        s_axil_rdata = r_data$q;
-        s_axil_rresp = r_resp$q;
-        if (s_axil_arvalid & (~ar_held$q)) begin
-            ar_held$d = 1'b1;
-            ar_index$d = s_axil_araddr[(32'h2)+:(6)];
-        end
-        read = ar_held$q & (~r_valid$q);
-        read_ok = 1'b0;
-        read_word = 32'h0;
-        if (settings$0$read_hit) begin
-            read_ok = 1'b1;
-            read_word = settings$0$read_word;
-        end
-        if (settings$1$read_hit) begin
-            read_ok = 1'b1;
-            read_word = settings$1$read_word;
-        end
-        if (settings$2$read_hit) begin
-            read_ok = 1'b1;
-            read_word = settings$2$read_word;
-        end
-        if (settings$3$read_hit) begin
-            read_ok = 1'b1;
-            read_word = settings$3$read_word;
-        end
-        if (settings$4$read_hit) begin
-            read_ok = 1'b1;
-            read_word = settings$4$read_word;
-        end
-        if (settings$5$read_hit) begin
-            read_ok = 1'b1;
-            read_word = settings$5$read_word;
-        end
-        if (settings$6$read_hit) begin
-            read_ok = 1'b1;
-            read_word = settings$6$read_word;
-        end
-        if (settings$7$read_hit) begin
-            read_ok = 1'b1;
-            read_word = settings$7$read_word;
-        end
-        if (settings$8$read_hit) begin
-            read_ok = 1'b1;
-            read_word = settings$8$read_word;
-        end
-        if (settings$9$read_hit) begin
-            read_ok = 1'b1;
-            read_word = settings$9$read_word;
-        end
-        if (settings$10$read_hit) begin
-            read_ok = 1'b1;
-            read_word = settings$10$read_word;
-        end
-        if (settings$11$read_hit) begin
-            read_ok = 1'b1;
-            read_word = settings$11$read_word;
-        end
-        if (settings$12$read_hit) begin
-            read_ok = 1'b1;
-            read_word = settings$12$read_word;
-        end
-        if (settings$13$read_hit) begin
-            read_ok = 1'b1;
-            read_word = settings$13$read_word;
-        end
-        if (settings$14$read_hit) begin
-            read_ok = 1'b1;
-            read_word = settings$14$read_word;
-        end
-        status$0$read_index = ar_index$q;
-        if (status$0$read_hit) begin
-            read_ok = 1'b1;
-            read_word = status$0$read_word;
-        end
-        status$1$read_index = ar_index$q;
-        if (status$1$read_hit) begin
-            read_ok = 1'b1;
-            read_word = status$1$read_word;
-        end
-        status$2$read_index = ar_index$q;
-        if (status$2$read_hit) begin
-            read_ok = 1'b1;
-            read_word = status$2$read_word;
-        end
-        status$3$read_index = ar_index$q;
-        if (status$3$read_hit) begin
-            read_ok = 1'b1;
-            read_word = status$3$read_word;
-        end
-        status$4$read_index = ar_index$q;
-        if (status$4$read_hit) begin
-            read_ok = 1'b1;
-            read_word = status$4$read_word;
-        end
-        status$5$read_index = ar_index$q;
-        if (status$5$read_hit) begin
-            read_ok = 1'b1;
-            read_word = status$5$read_word;
-        end
-        status$6$read_index = ar_index$q;
-        if (status$6$read_hit) begin
-            read_ok = 1'b1;
-            read_word = status$6$read_word;
-        end
-        status$7$read_index = ar_index$q;
-        if (status$7$read_hit) begin
-            read_ok = 1'b1;
-            read_word = status$7$read_word;
-        end
-        status$8$read_index = ar_index$q;
-        if (status$8$read_hit) begin
-            read_ok = 1'b1;
-            read_word = status$8$read_word;
-        end
-        if (read) begin
-            ar_held$d = 1'b0;
-            r_valid$d = 1'b1;
-            r_data$d = read_word;
-            r_resp$d = 32'h0;
-            if (~read_ok) begin
-                r_resp$d = slverr;
-            end
-            if (status$3$read_hit) begin
-                snapshot_z1$d = z1_bits;
-                snapshot_z2$d = z2_bits;
-            end
-        end
-        if (r_valid$q & s_axil_rready) begin
-            r_valid$d = 1'b0;
-        end
-        clip$0$adc = adc1;
-        clip$1$adc = adc2;
-        clip$0$clock = aclk;
-        clip$0$reset = reset;
-        clip$0$clear = read & status$8$read_hit;
-        clip$1$clock = aclk;
-        clip$1$reset = reset;
-        clip$1$clear = read & status$8$read_hit;
-        fifo$reset = reset;
-        fifo$push = core$z_valid & settings$14$value[32'h0];
-        fifo$push_data = ((z1_bits) & 96'hffffffffffffffffffffffff) | (((z2_bits) & 96'hffffffffffffffffffffffff) << 32'h28) | (((count_now[(32'h0)+:(16)]) & 96'hffffffffffffffffffffffff) << 32'h50);
-        fifo$tready = m_axis_tready;
-        m_axis_tvalid = fifo$tvalid;
-        m_axis_tdata = fifo$tdata;
-        m_axis_tlast = 1'b1;
-        core$select = settings$0$value[32'h0];
-        core$carrier_step = settings$1$value;
-        core$ref_phase = settings$2$value;
-        core$ref_delay = settings$3$value[(32'h0)+:(6)];
-        core$mod_step = ((mod_step_low$q) & 48'hffffffffffff) | (((settings$5$value[(32'h0)+:(16)]) & 48'hffffffffffff) << 32'h20);
-        core$amp1 = $signed(settings$6$value[(32'h0)+:(16)]);
-        core$amp2 = $signed(settings$7$value[(32'h0)+:(16)]);
-        core$cic_decimation = settings$8$value[(32'h0)+:(13)];
-        core$cic_shift = settings$9$value[(32'h0)+:(6)];
-        core$iir_k0 = $signed(settings$10$value);
-        core$iir_k1 = $signed(settings$11$value);
-        core$iir_k2 = $signed(settings$12$value);
-        core$iir_alpha = $signed(settings$13$value);
-        core$adc1 = adc1;
-        core$adc2 = adc2;
-        dac1 = core$dac1;
-        dac2 = core$dac2;
         if (reset) begin
             aw_held$d = 1'b0;
             aw_index$d = 32'h0;
@@ -1161,61 +674,13 @@ module gyro_interface_axi(aclk,aresetn,adc1,adc2,dac1,dac2,s_axil_awvalid,s_axil
             w_strb$d = 32'h0;
             b_valid$d = 1'b0;
             b_resp$d = 32'h0;
-            ar_held$d = 1'b0;
-            ar_index$d = 32'h0;
-            r_valid$d = 1'b0;
-            r_data$d = 32'h0;
-            r_resp$d = 32'h0;
-            mod_step_low$d = 32'h0;
-            sample_count$d = 32'h0;
-            overflow_count$d = 32'h0;
-            snapshot_z1$d = 32'h0;
-            snapshot_z2$d = 32'h0;
         end
     end
 
-endmodule // gyro_interface_axi
+endmodule // gyro_interface_axi__axil_write
 
 
-module gyro_interface_axi__ar_held(d,q,clock);
-
-    // Module arguments
-    input wire  d;
-    output reg  q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 1'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__ar_held
-
-
-module gyro_interface_axi__ar_index(d,q,clock);
-
-    // Module arguments
-    input wire  [5:0] d;
-    output reg  [5:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 6'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__ar_index
-
-
-module gyro_interface_axi__aw_held(d,q,clock);
+module gyro_interface_axi__axil_write__aw_held(d,q,clock);
 
     // Module arguments
     input wire  d;
@@ -1231,10 +696,10 @@ module gyro_interface_axi__aw_held(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__aw_held
+endmodule // gyro_interface_axi__axil_write__aw_held
 
 
-module gyro_interface_axi__aw_index(d,q,clock);
+module gyro_interface_axi__axil_write__aw_index(d,q,clock);
 
     // Module arguments
     input wire  [5:0] d;
@@ -1250,10 +715,10 @@ module gyro_interface_axi__aw_index(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__aw_index
+endmodule // gyro_interface_axi__axil_write__aw_index
 
 
-module gyro_interface_axi__b_resp(d,q,clock);
+module gyro_interface_axi__axil_write__b_resp(d,q,clock);
 
     // Module arguments
     input wire  [1:0] d;
@@ -1269,10 +734,10 @@ module gyro_interface_axi__b_resp(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__b_resp
+endmodule // gyro_interface_axi__axil_write__b_resp
 
 
-module gyro_interface_axi__b_valid(d,q,clock);
+module gyro_interface_axi__axil_write__b_valid(d,q,clock);
 
     // Module arguments
     input wire  d;
@@ -1288,149 +753,64 @@ module gyro_interface_axi__b_valid(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__b_valid
+endmodule // gyro_interface_axi__axil_write__b_valid
 
 
-module gyro_interface_axi__clip__0(clock,reset,adc,clear,count);
-
-    // Module arguments
-    input wire  clock;
-    input wire  reset;
-    input wire signed [15:0] adc;
-    input wire  clear;
-    output reg  [15:0] count;
-
-    // Constant declarations
-    localparam signed top = 16'h7fff;
-    localparam signed bottom = 16'h8000;
-    localparam  full = 16'hffff;
-
-    // Stub signals
-    reg  [15:0] counter$d;
-    wire  [15:0] counter$q;
-    reg  counter$clock;
-
-    // Local signals
-    reg  at_rail;
-
-    // Sub module instances
-    gyro_interface_axi__clip__0__counter counter(
-        .d(counter$d),
-        .q(counter$q),
-        .clock(counter$clock)
-    );
-
-    // Update code
-    always @(*) begin
-        counter$clock = clock;
-        counter$d = counter$q;
-        at_rail = (adc == top) | (adc == bottom);
-        count = counter$q;
-        if (clear) begin
-            counter$d = 32'h0;
-            if (at_rail) begin
-                counter$d = 32'h1;
-            end
-        end
-        else if (at_rail & (counter$q != full)) begin
-            counter$d = counter$q + 32'h1;
-        end
-        if (reset) begin
-            counter$d = 32'h0;
-        end
-    end
-
-endmodule // gyro_interface_axi__clip__0
-
-
-module gyro_interface_axi__clip__0__counter(d,q,clock);
+module gyro_interface_axi__axil_write__w_data(d,q,clock);
 
     // Module arguments
-    input wire  [15:0] d;
-    output reg  [15:0] q;
+    input wire  [31:0] d;
+    output reg  [31:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 16'h0;
+       q = 32'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface_axi__clip__0__counter
+endmodule // gyro_interface_axi__axil_write__w_data
 
 
-module gyro_interface_axi__clip__1(clock,reset,adc,clear,count);
-
-    // Module arguments
-    input wire  clock;
-    input wire  reset;
-    input wire signed [15:0] adc;
-    input wire  clear;
-    output reg  [15:0] count;
-
-    // Constant declarations
-    localparam signed top = 16'h7fff;
-    localparam signed bottom = 16'h8000;
-    localparam  full = 16'hffff;
-
-    // Stub signals
-    reg  [15:0] counter$d;
-    wire  [15:0] counter$q;
-    reg  counter$clock;
-
-    // Local signals
-    reg  at_rail;
-
-    // Sub module instances
-    gyro_interface_axi__clip__1__counter counter(
-        .d(counter$d),
-        .q(counter$q),
-        .clock(counter$clock)
-    );
-
-    // Update code
-    always @(*) begin
-        counter$clock = clock;
-        counter$d = counter$q;
-        at_rail = (adc == top) | (adc == bottom);
-        count = counter$q;
-        if (clear) begin
-            counter$d = 32'h0;
-            if (at_rail) begin
-                counter$d = 32'h1;
-            end
-        end
-        else if (at_rail & (counter$q != full)) begin
-            counter$d = counter$q + 32'h1;
-        end
-        if (reset) begin
-            counter$d = 32'h0;
-        end
-    end
-
-endmodule // gyro_interface_axi__clip__1
-
-
-module gyro_interface_axi__clip__1__counter(d,q,clock);
+module gyro_interface_axi__axil_write__w_held(d,q,clock);
 
     // Module arguments
-    input wire  [15:0] d;
-    output reg  [15:0] q;
+    input wire  d;
+    output reg  q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 16'h0;
+       q = 1'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface_axi__clip__1__counter
+endmodule // gyro_interface_axi__axil_write__w_held
+
+
+module gyro_interface_axi__axil_write__w_strb(d,q,clock);
+
+    // Module arguments
+    input wire  [3:0] d;
+    output reg  [3:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 4'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__axil_write__w_strb
 
 
 module gyro_interface_axi__core(clock,adc1,adc2,dac1,dac2,z1,z2,z_valid,select,carrier_step,ref_phase,ref_delay,mod_step,amp1,amp2,cic_decimation,cic_shift,iir_k0,iir_k1,iir_k2,iir_alpha);
@@ -13641,7 +13021,1134 @@ module gyro_interface_axi__fifo__write_ptr(d,q,clock);
 endmodule // gyro_interface_axi__fifo__write_ptr
 
 
-module gyro_interface_axi__mod_step_low(d,q,clock);
+module gyro_interface_axi__registers(clock,reset,write,write_index,write_data,write_mask,write_hit,read,read_index,read_hit,read_word,z1,z2,z_valid,dropped,adc1,adc2,beat,stream_enable,select,carrier_step,ref_phase,ref_delay,mod_step,amp1,amp2,cic_decimation,cic_shift,iir_k0,iir_k1,iir_k2,iir_alpha);
+
+    // Module arguments
+    input wire  clock;
+    input wire  reset;
+    input wire  write;
+    input wire  [5:0] write_index;
+    input wire  [31:0] write_data;
+    input wire  [31:0] write_mask;
+    output reg  write_hit;
+    input wire  read;
+    input wire  [5:0] read_index;
+    output reg  read_hit;
+    output reg  [31:0] read_word;
+    input wire signed [39:0] z1;
+    input wire signed [39:0] z2;
+    input wire  z_valid;
+    input wire  dropped;
+    input wire signed [15:0] adc1;
+    input wire signed [15:0] adc2;
+    output reg  [95:0] beat;
+    output reg  stream_enable;
+    output reg  select;
+    output reg  [31:0] carrier_step;
+    output reg  [31:0] ref_phase;
+    output reg  [5:0] ref_delay;
+    output reg  [47:0] mod_step;
+    output reg signed [15:0] amp1;
+    output reg signed [15:0] amp2;
+    output reg  [12:0] cic_decimation;
+    output reg  [5:0] cic_shift;
+    output reg signed [31:0] iir_k0;
+    output reg signed [31:0] iir_k1;
+    output reg signed [31:0] iir_k2;
+    output reg signed [31:0] iir_alpha;
+
+    // Constant declarations
+    localparam  id_word = 32'h4759524f;
+    localparam  version_word = 32'h10001;
+
+    // Stub signals
+    reg  settings$0$clock;
+    reg  settings$0$reset;
+    reg  settings$0$write;
+    reg  [5:0] settings$0$write_index;
+    reg  [31:0] settings$0$write_data;
+    reg  [31:0] settings$0$write_mask;
+    reg  [5:0] settings$0$read_index;
+    wire  [31:0] settings$0$value;
+    wire  settings$0$write_hit;
+    wire  settings$0$read_hit;
+    wire  [31:0] settings$0$read_word;
+    reg  settings$1$clock;
+    reg  settings$1$reset;
+    reg  settings$1$write;
+    reg  [5:0] settings$1$write_index;
+    reg  [31:0] settings$1$write_data;
+    reg  [31:0] settings$1$write_mask;
+    reg  [5:0] settings$1$read_index;
+    wire  [31:0] settings$1$value;
+    wire  settings$1$write_hit;
+    wire  settings$1$read_hit;
+    wire  [31:0] settings$1$read_word;
+    reg  settings$2$clock;
+    reg  settings$2$reset;
+    reg  settings$2$write;
+    reg  [5:0] settings$2$write_index;
+    reg  [31:0] settings$2$write_data;
+    reg  [31:0] settings$2$write_mask;
+    reg  [5:0] settings$2$read_index;
+    wire  [31:0] settings$2$value;
+    wire  settings$2$write_hit;
+    wire  settings$2$read_hit;
+    wire  [31:0] settings$2$read_word;
+    reg  settings$3$clock;
+    reg  settings$3$reset;
+    reg  settings$3$write;
+    reg  [5:0] settings$3$write_index;
+    reg  [31:0] settings$3$write_data;
+    reg  [31:0] settings$3$write_mask;
+    reg  [5:0] settings$3$read_index;
+    wire  [31:0] settings$3$value;
+    wire  settings$3$write_hit;
+    wire  settings$3$read_hit;
+    wire  [31:0] settings$3$read_word;
+    reg  settings$4$clock;
+    reg  settings$4$reset;
+    reg  settings$4$write;
+    reg  [5:0] settings$4$write_index;
+    reg  [31:0] settings$4$write_data;
+    reg  [31:0] settings$4$write_mask;
+    reg  [5:0] settings$4$read_index;
+    wire  [31:0] settings$4$value;
+    wire  settings$4$write_hit;
+    wire  settings$4$read_hit;
+    wire  [31:0] settings$4$read_word;
+    reg  settings$5$clock;
+    reg  settings$5$reset;
+    reg  settings$5$write;
+    reg  [5:0] settings$5$write_index;
+    reg  [31:0] settings$5$write_data;
+    reg  [31:0] settings$5$write_mask;
+    reg  [5:0] settings$5$read_index;
+    wire  [31:0] settings$5$value;
+    wire  settings$5$write_hit;
+    wire  settings$5$read_hit;
+    wire  [31:0] settings$5$read_word;
+    reg  settings$6$clock;
+    reg  settings$6$reset;
+    reg  settings$6$write;
+    reg  [5:0] settings$6$write_index;
+    reg  [31:0] settings$6$write_data;
+    reg  [31:0] settings$6$write_mask;
+    reg  [5:0] settings$6$read_index;
+    wire  [31:0] settings$6$value;
+    wire  settings$6$write_hit;
+    wire  settings$6$read_hit;
+    wire  [31:0] settings$6$read_word;
+    reg  settings$7$clock;
+    reg  settings$7$reset;
+    reg  settings$7$write;
+    reg  [5:0] settings$7$write_index;
+    reg  [31:0] settings$7$write_data;
+    reg  [31:0] settings$7$write_mask;
+    reg  [5:0] settings$7$read_index;
+    wire  [31:0] settings$7$value;
+    wire  settings$7$write_hit;
+    wire  settings$7$read_hit;
+    wire  [31:0] settings$7$read_word;
+    reg  settings$8$clock;
+    reg  settings$8$reset;
+    reg  settings$8$write;
+    reg  [5:0] settings$8$write_index;
+    reg  [31:0] settings$8$write_data;
+    reg  [31:0] settings$8$write_mask;
+    reg  [5:0] settings$8$read_index;
+    wire  [31:0] settings$8$value;
+    wire  settings$8$write_hit;
+    wire  settings$8$read_hit;
+    wire  [31:0] settings$8$read_word;
+    reg  settings$9$clock;
+    reg  settings$9$reset;
+    reg  settings$9$write;
+    reg  [5:0] settings$9$write_index;
+    reg  [31:0] settings$9$write_data;
+    reg  [31:0] settings$9$write_mask;
+    reg  [5:0] settings$9$read_index;
+    wire  [31:0] settings$9$value;
+    wire  settings$9$write_hit;
+    wire  settings$9$read_hit;
+    wire  [31:0] settings$9$read_word;
+    reg  settings$10$clock;
+    reg  settings$10$reset;
+    reg  settings$10$write;
+    reg  [5:0] settings$10$write_index;
+    reg  [31:0] settings$10$write_data;
+    reg  [31:0] settings$10$write_mask;
+    reg  [5:0] settings$10$read_index;
+    wire  [31:0] settings$10$value;
+    wire  settings$10$write_hit;
+    wire  settings$10$read_hit;
+    wire  [31:0] settings$10$read_word;
+    reg  settings$11$clock;
+    reg  settings$11$reset;
+    reg  settings$11$write;
+    reg  [5:0] settings$11$write_index;
+    reg  [31:0] settings$11$write_data;
+    reg  [31:0] settings$11$write_mask;
+    reg  [5:0] settings$11$read_index;
+    wire  [31:0] settings$11$value;
+    wire  settings$11$write_hit;
+    wire  settings$11$read_hit;
+    wire  [31:0] settings$11$read_word;
+    reg  settings$12$clock;
+    reg  settings$12$reset;
+    reg  settings$12$write;
+    reg  [5:0] settings$12$write_index;
+    reg  [31:0] settings$12$write_data;
+    reg  [31:0] settings$12$write_mask;
+    reg  [5:0] settings$12$read_index;
+    wire  [31:0] settings$12$value;
+    wire  settings$12$write_hit;
+    wire  settings$12$read_hit;
+    wire  [31:0] settings$12$read_word;
+    reg  settings$13$clock;
+    reg  settings$13$reset;
+    reg  settings$13$write;
+    reg  [5:0] settings$13$write_index;
+    reg  [31:0] settings$13$write_data;
+    reg  [31:0] settings$13$write_mask;
+    reg  [5:0] settings$13$read_index;
+    wire  [31:0] settings$13$value;
+    wire  settings$13$write_hit;
+    wire  settings$13$read_hit;
+    wire  [31:0] settings$13$read_word;
+    reg  settings$14$clock;
+    reg  settings$14$reset;
+    reg  settings$14$write;
+    reg  [5:0] settings$14$write_index;
+    reg  [31:0] settings$14$write_data;
+    reg  [31:0] settings$14$write_mask;
+    reg  [5:0] settings$14$read_index;
+    wire  [31:0] settings$14$value;
+    wire  settings$14$write_hit;
+    wire  settings$14$read_hit;
+    wire  [31:0] settings$14$read_word;
+    reg  [31:0] status$0$live;
+    reg  [5:0] status$0$read_index;
+    wire  status$0$read_hit;
+    wire  [31:0] status$0$read_word;
+    reg  [31:0] status$1$live;
+    reg  [5:0] status$1$read_index;
+    wire  status$1$read_hit;
+    wire  [31:0] status$1$read_word;
+    reg  [31:0] status$2$live;
+    reg  [5:0] status$2$read_index;
+    wire  status$2$read_hit;
+    wire  [31:0] status$2$read_word;
+    reg  [31:0] status$3$live;
+    reg  [5:0] status$3$read_index;
+    wire  status$3$read_hit;
+    wire  [31:0] status$3$read_word;
+    reg  [31:0] status$4$live;
+    reg  [5:0] status$4$read_index;
+    wire  status$4$read_hit;
+    wire  [31:0] status$4$read_word;
+    reg  [31:0] status$5$live;
+    reg  [5:0] status$5$read_index;
+    wire  status$5$read_hit;
+    wire  [31:0] status$5$read_word;
+    reg  [31:0] status$6$live;
+    reg  [5:0] status$6$read_index;
+    wire  status$6$read_hit;
+    wire  [31:0] status$6$read_word;
+    reg  [31:0] status$7$live;
+    reg  [5:0] status$7$read_index;
+    wire  status$7$read_hit;
+    wire  [31:0] status$7$read_word;
+    reg  [31:0] status$8$live;
+    reg  [5:0] status$8$read_index;
+    wire  status$8$read_hit;
+    wire  [31:0] status$8$read_word;
+    reg  counters$clock;
+    reg  counters$reset;
+    reg signed [39:0] counters$z1;
+    reg signed [39:0] counters$z2;
+    reg  counters$z_valid;
+    reg  counters$dropped;
+    reg  counters$snapshot;
+    reg signed [15:0] counters$adc1;
+    reg signed [15:0] counters$adc2;
+    reg  counters$clip_clear;
+    wire  [31:0] counters$count;
+    wire  [31:0] counters$overflow;
+    wire  [31:0] counters$z1_low;
+    wire  [31:0] counters$z1_high;
+    wire  [31:0] counters$z2_low;
+    wire  [31:0] counters$z2_high;
+    wire  [31:0] counters$clip;
+    wire  [95:0] counters$beat;
+    reg  [31:0] mod_step_low$d;
+    wire  [31:0] mod_step_low$q;
+    reg  mod_step_low$clock;
+
+    // Sub module instances
+    gyro_interface_axi__registers__settings__0 settings$0(
+        .clock(settings$0$clock),
+        .reset(settings$0$reset),
+        .write(settings$0$write),
+        .write_index(settings$0$write_index),
+        .write_data(settings$0$write_data),
+        .write_mask(settings$0$write_mask),
+        .read_index(settings$0$read_index),
+        .value(settings$0$value),
+        .write_hit(settings$0$write_hit),
+        .read_hit(settings$0$read_hit),
+        .read_word(settings$0$read_word)
+    );
+    gyro_interface_axi__registers__settings__1 settings$1(
+        .clock(settings$1$clock),
+        .reset(settings$1$reset),
+        .write(settings$1$write),
+        .write_index(settings$1$write_index),
+        .write_data(settings$1$write_data),
+        .write_mask(settings$1$write_mask),
+        .read_index(settings$1$read_index),
+        .value(settings$1$value),
+        .write_hit(settings$1$write_hit),
+        .read_hit(settings$1$read_hit),
+        .read_word(settings$1$read_word)
+    );
+    gyro_interface_axi__registers__settings__2 settings$2(
+        .clock(settings$2$clock),
+        .reset(settings$2$reset),
+        .write(settings$2$write),
+        .write_index(settings$2$write_index),
+        .write_data(settings$2$write_data),
+        .write_mask(settings$2$write_mask),
+        .read_index(settings$2$read_index),
+        .value(settings$2$value),
+        .write_hit(settings$2$write_hit),
+        .read_hit(settings$2$read_hit),
+        .read_word(settings$2$read_word)
+    );
+    gyro_interface_axi__registers__settings__3 settings$3(
+        .clock(settings$3$clock),
+        .reset(settings$3$reset),
+        .write(settings$3$write),
+        .write_index(settings$3$write_index),
+        .write_data(settings$3$write_data),
+        .write_mask(settings$3$write_mask),
+        .read_index(settings$3$read_index),
+        .value(settings$3$value),
+        .write_hit(settings$3$write_hit),
+        .read_hit(settings$3$read_hit),
+        .read_word(settings$3$read_word)
+    );
+    gyro_interface_axi__registers__settings__4 settings$4(
+        .clock(settings$4$clock),
+        .reset(settings$4$reset),
+        .write(settings$4$write),
+        .write_index(settings$4$write_index),
+        .write_data(settings$4$write_data),
+        .write_mask(settings$4$write_mask),
+        .read_index(settings$4$read_index),
+        .value(settings$4$value),
+        .write_hit(settings$4$write_hit),
+        .read_hit(settings$4$read_hit),
+        .read_word(settings$4$read_word)
+    );
+    gyro_interface_axi__registers__settings__5 settings$5(
+        .clock(settings$5$clock),
+        .reset(settings$5$reset),
+        .write(settings$5$write),
+        .write_index(settings$5$write_index),
+        .write_data(settings$5$write_data),
+        .write_mask(settings$5$write_mask),
+        .read_index(settings$5$read_index),
+        .value(settings$5$value),
+        .write_hit(settings$5$write_hit),
+        .read_hit(settings$5$read_hit),
+        .read_word(settings$5$read_word)
+    );
+    gyro_interface_axi__registers__settings__6 settings$6(
+        .clock(settings$6$clock),
+        .reset(settings$6$reset),
+        .write(settings$6$write),
+        .write_index(settings$6$write_index),
+        .write_data(settings$6$write_data),
+        .write_mask(settings$6$write_mask),
+        .read_index(settings$6$read_index),
+        .value(settings$6$value),
+        .write_hit(settings$6$write_hit),
+        .read_hit(settings$6$read_hit),
+        .read_word(settings$6$read_word)
+    );
+    gyro_interface_axi__registers__settings__7 settings$7(
+        .clock(settings$7$clock),
+        .reset(settings$7$reset),
+        .write(settings$7$write),
+        .write_index(settings$7$write_index),
+        .write_data(settings$7$write_data),
+        .write_mask(settings$7$write_mask),
+        .read_index(settings$7$read_index),
+        .value(settings$7$value),
+        .write_hit(settings$7$write_hit),
+        .read_hit(settings$7$read_hit),
+        .read_word(settings$7$read_word)
+    );
+    gyro_interface_axi__registers__settings__8 settings$8(
+        .clock(settings$8$clock),
+        .reset(settings$8$reset),
+        .write(settings$8$write),
+        .write_index(settings$8$write_index),
+        .write_data(settings$8$write_data),
+        .write_mask(settings$8$write_mask),
+        .read_index(settings$8$read_index),
+        .value(settings$8$value),
+        .write_hit(settings$8$write_hit),
+        .read_hit(settings$8$read_hit),
+        .read_word(settings$8$read_word)
+    );
+    gyro_interface_axi__registers__settings__9 settings$9(
+        .clock(settings$9$clock),
+        .reset(settings$9$reset),
+        .write(settings$9$write),
+        .write_index(settings$9$write_index),
+        .write_data(settings$9$write_data),
+        .write_mask(settings$9$write_mask),
+        .read_index(settings$9$read_index),
+        .value(settings$9$value),
+        .write_hit(settings$9$write_hit),
+        .read_hit(settings$9$read_hit),
+        .read_word(settings$9$read_word)
+    );
+    gyro_interface_axi__registers__settings__10 settings$10(
+        .clock(settings$10$clock),
+        .reset(settings$10$reset),
+        .write(settings$10$write),
+        .write_index(settings$10$write_index),
+        .write_data(settings$10$write_data),
+        .write_mask(settings$10$write_mask),
+        .read_index(settings$10$read_index),
+        .value(settings$10$value),
+        .write_hit(settings$10$write_hit),
+        .read_hit(settings$10$read_hit),
+        .read_word(settings$10$read_word)
+    );
+    gyro_interface_axi__registers__settings__11 settings$11(
+        .clock(settings$11$clock),
+        .reset(settings$11$reset),
+        .write(settings$11$write),
+        .write_index(settings$11$write_index),
+        .write_data(settings$11$write_data),
+        .write_mask(settings$11$write_mask),
+        .read_index(settings$11$read_index),
+        .value(settings$11$value),
+        .write_hit(settings$11$write_hit),
+        .read_hit(settings$11$read_hit),
+        .read_word(settings$11$read_word)
+    );
+    gyro_interface_axi__registers__settings__12 settings$12(
+        .clock(settings$12$clock),
+        .reset(settings$12$reset),
+        .write(settings$12$write),
+        .write_index(settings$12$write_index),
+        .write_data(settings$12$write_data),
+        .write_mask(settings$12$write_mask),
+        .read_index(settings$12$read_index),
+        .value(settings$12$value),
+        .write_hit(settings$12$write_hit),
+        .read_hit(settings$12$read_hit),
+        .read_word(settings$12$read_word)
+    );
+    gyro_interface_axi__registers__settings__13 settings$13(
+        .clock(settings$13$clock),
+        .reset(settings$13$reset),
+        .write(settings$13$write),
+        .write_index(settings$13$write_index),
+        .write_data(settings$13$write_data),
+        .write_mask(settings$13$write_mask),
+        .read_index(settings$13$read_index),
+        .value(settings$13$value),
+        .write_hit(settings$13$write_hit),
+        .read_hit(settings$13$read_hit),
+        .read_word(settings$13$read_word)
+    );
+    gyro_interface_axi__registers__settings__14 settings$14(
+        .clock(settings$14$clock),
+        .reset(settings$14$reset),
+        .write(settings$14$write),
+        .write_index(settings$14$write_index),
+        .write_data(settings$14$write_data),
+        .write_mask(settings$14$write_mask),
+        .read_index(settings$14$read_index),
+        .value(settings$14$value),
+        .write_hit(settings$14$write_hit),
+        .read_hit(settings$14$read_hit),
+        .read_word(settings$14$read_word)
+    );
+    gyro_interface_axi__registers__status__0 status$0(
+        .live(status$0$live),
+        .read_index(status$0$read_index),
+        .read_hit(status$0$read_hit),
+        .read_word(status$0$read_word)
+    );
+    gyro_interface_axi__registers__status__1 status$1(
+        .live(status$1$live),
+        .read_index(status$1$read_index),
+        .read_hit(status$1$read_hit),
+        .read_word(status$1$read_word)
+    );
+    gyro_interface_axi__registers__status__2 status$2(
+        .live(status$2$live),
+        .read_index(status$2$read_index),
+        .read_hit(status$2$read_hit),
+        .read_word(status$2$read_word)
+    );
+    gyro_interface_axi__registers__status__3 status$3(
+        .live(status$3$live),
+        .read_index(status$3$read_index),
+        .read_hit(status$3$read_hit),
+        .read_word(status$3$read_word)
+    );
+    gyro_interface_axi__registers__status__4 status$4(
+        .live(status$4$live),
+        .read_index(status$4$read_index),
+        .read_hit(status$4$read_hit),
+        .read_word(status$4$read_word)
+    );
+    gyro_interface_axi__registers__status__5 status$5(
+        .live(status$5$live),
+        .read_index(status$5$read_index),
+        .read_hit(status$5$read_hit),
+        .read_word(status$5$read_word)
+    );
+    gyro_interface_axi__registers__status__6 status$6(
+        .live(status$6$live),
+        .read_index(status$6$read_index),
+        .read_hit(status$6$read_hit),
+        .read_word(status$6$read_word)
+    );
+    gyro_interface_axi__registers__status__7 status$7(
+        .live(status$7$live),
+        .read_index(status$7$read_index),
+        .read_hit(status$7$read_hit),
+        .read_word(status$7$read_word)
+    );
+    gyro_interface_axi__registers__status__8 status$8(
+        .live(status$8$live),
+        .read_index(status$8$read_index),
+        .read_hit(status$8$read_hit),
+        .read_word(status$8$read_word)
+    );
+    gyro_interface_axi__registers__counters counters(
+        .clock(counters$clock),
+        .reset(counters$reset),
+        .z1(counters$z1),
+        .z2(counters$z2),
+        .z_valid(counters$z_valid),
+        .dropped(counters$dropped),
+        .snapshot(counters$snapshot),
+        .adc1(counters$adc1),
+        .adc2(counters$adc2),
+        .clip_clear(counters$clip_clear),
+        .count(counters$count),
+        .overflow(counters$overflow),
+        .z1_low(counters$z1_low),
+        .z1_high(counters$z1_high),
+        .z2_low(counters$z2_low),
+        .z2_high(counters$z2_high),
+        .clip(counters$clip),
+        .beat(counters$beat)
+    );
+    gyro_interface_axi__registers__mod_step_low mod_step_low(
+        .d(mod_step_low$d),
+        .q(mod_step_low$q),
+        .clock(mod_step_low$clock)
+    );
+
+    // Update code
+    always @(*) begin
+        mod_step_low$clock = clock;
+        mod_step_low$d = mod_step_low$q;
+        write_hit = 1'b0;
+        read_hit = 1'b0;
+        read_word = 32'h0;
+        settings$0$clock = clock;
+        settings$0$reset = reset;
+        settings$0$write = write;
+        settings$0$write_index = write_index;
+        settings$0$write_data = write_data;
+        settings$0$write_mask = write_mask;
+        settings$0$read_index = read_index;
+        if (settings$0$write_hit) begin
+            write_hit = 1'b1;
+        end
+        if (settings$0$read_hit) begin
+            read_hit = 1'b1;
+            read_word = settings$0$read_word;
+        end
+        settings$1$clock = clock;
+        settings$1$reset = reset;
+        settings$1$write = write;
+        settings$1$write_index = write_index;
+        settings$1$write_data = write_data;
+        settings$1$write_mask = write_mask;
+        settings$1$read_index = read_index;
+        if (settings$1$write_hit) begin
+            write_hit = 1'b1;
+        end
+        if (settings$1$read_hit) begin
+            read_hit = 1'b1;
+            read_word = settings$1$read_word;
+        end
+        settings$2$clock = clock;
+        settings$2$reset = reset;
+        settings$2$write = write;
+        settings$2$write_index = write_index;
+        settings$2$write_data = write_data;
+        settings$2$write_mask = write_mask;
+        settings$2$read_index = read_index;
+        if (settings$2$write_hit) begin
+            write_hit = 1'b1;
+        end
+        if (settings$2$read_hit) begin
+            read_hit = 1'b1;
+            read_word = settings$2$read_word;
+        end
+        settings$3$clock = clock;
+        settings$3$reset = reset;
+        settings$3$write = write;
+        settings$3$write_index = write_index;
+        settings$3$write_data = write_data;
+        settings$3$write_mask = write_mask;
+        settings$3$read_index = read_index;
+        if (settings$3$write_hit) begin
+            write_hit = 1'b1;
+        end
+        if (settings$3$read_hit) begin
+            read_hit = 1'b1;
+            read_word = settings$3$read_word;
+        end
+        settings$4$clock = clock;
+        settings$4$reset = reset;
+        settings$4$write = write;
+        settings$4$write_index = write_index;
+        settings$4$write_data = write_data;
+        settings$4$write_mask = write_mask;
+        settings$4$read_index = read_index;
+        if (settings$4$write_hit) begin
+            write_hit = 1'b1;
+        end
+        if (settings$4$read_hit) begin
+            read_hit = 1'b1;
+            read_word = settings$4$read_word;
+        end
+        settings$5$clock = clock;
+        settings$5$reset = reset;
+        settings$5$write = write;
+        settings$5$write_index = write_index;
+        settings$5$write_data = write_data;
+        settings$5$write_mask = write_mask;
+        settings$5$read_index = read_index;
+        if (settings$5$write_hit) begin
+            write_hit = 1'b1;
+        end
+        if (settings$5$read_hit) begin
+            read_hit = 1'b1;
+            read_word = settings$5$read_word;
+        end
+        settings$6$clock = clock;
+        settings$6$reset = reset;
+        settings$6$write = write;
+        settings$6$write_index = write_index;
+        settings$6$write_data = write_data;
+        settings$6$write_mask = write_mask;
+        settings$6$read_index = read_index;
+        if (settings$6$write_hit) begin
+            write_hit = 1'b1;
+        end
+        if (settings$6$read_hit) begin
+            read_hit = 1'b1;
+            read_word = settings$6$read_word;
+        end
+        settings$7$clock = clock;
+        settings$7$reset = reset;
+        settings$7$write = write;
+        settings$7$write_index = write_index;
+        settings$7$write_data = write_data;
+        settings$7$write_mask = write_mask;
+        settings$7$read_index = read_index;
+        if (settings$7$write_hit) begin
+            write_hit = 1'b1;
+        end
+        if (settings$7$read_hit) begin
+            read_hit = 1'b1;
+            read_word = settings$7$read_word;
+        end
+        settings$8$clock = clock;
+        settings$8$reset = reset;
+        settings$8$write = write;
+        settings$8$write_index = write_index;
+        settings$8$write_data = write_data;
+        settings$8$write_mask = write_mask;
+        settings$8$read_index = read_index;
+        if (settings$8$write_hit) begin
+            write_hit = 1'b1;
+        end
+        if (settings$8$read_hit) begin
+            read_hit = 1'b1;
+            read_word = settings$8$read_word;
+        end
+        settings$9$clock = clock;
+        settings$9$reset = reset;
+        settings$9$write = write;
+        settings$9$write_index = write_index;
+        settings$9$write_data = write_data;
+        settings$9$write_mask = write_mask;
+        settings$9$read_index = read_index;
+        if (settings$9$write_hit) begin
+            write_hit = 1'b1;
+        end
+        if (settings$9$read_hit) begin
+            read_hit = 1'b1;
+            read_word = settings$9$read_word;
+        end
+        settings$10$clock = clock;
+        settings$10$reset = reset;
+        settings$10$write = write;
+        settings$10$write_index = write_index;
+        settings$10$write_data = write_data;
+        settings$10$write_mask = write_mask;
+        settings$10$read_index = read_index;
+        if (settings$10$write_hit) begin
+            write_hit = 1'b1;
+        end
+        if (settings$10$read_hit) begin
+            read_hit = 1'b1;
+            read_word = settings$10$read_word;
+        end
+        settings$11$clock = clock;
+        settings$11$reset = reset;
+        settings$11$write = write;
+        settings$11$write_index = write_index;
+        settings$11$write_data = write_data;
+        settings$11$write_mask = write_mask;
+        settings$11$read_index = read_index;
+        if (settings$11$write_hit) begin
+            write_hit = 1'b1;
+        end
+        if (settings$11$read_hit) begin
+            read_hit = 1'b1;
+            read_word = settings$11$read_word;
+        end
+        settings$12$clock = clock;
+        settings$12$reset = reset;
+        settings$12$write = write;
+        settings$12$write_index = write_index;
+        settings$12$write_data = write_data;
+        settings$12$write_mask = write_mask;
+        settings$12$read_index = read_index;
+        if (settings$12$write_hit) begin
+            write_hit = 1'b1;
+        end
+        if (settings$12$read_hit) begin
+            read_hit = 1'b1;
+            read_word = settings$12$read_word;
+        end
+        settings$13$clock = clock;
+        settings$13$reset = reset;
+        settings$13$write = write;
+        settings$13$write_index = write_index;
+        settings$13$write_data = write_data;
+        settings$13$write_mask = write_mask;
+        settings$13$read_index = read_index;
+        if (settings$13$write_hit) begin
+            write_hit = 1'b1;
+        end
+        if (settings$13$read_hit) begin
+            read_hit = 1'b1;
+            read_word = settings$13$read_word;
+        end
+        settings$14$clock = clock;
+        settings$14$reset = reset;
+        settings$14$write = write;
+        settings$14$write_index = write_index;
+        settings$14$write_data = write_data;
+        settings$14$write_mask = write_mask;
+        settings$14$read_index = read_index;
+        if (settings$14$write_hit) begin
+            write_hit = 1'b1;
+        end
+        if (settings$14$read_hit) begin
+            read_hit = 1'b1;
+            read_word = settings$14$read_word;
+        end
+        if (settings$5$write_hit) begin
+            mod_step_low$d = settings$4$value;
+        end
+        if (reset) begin
+            mod_step_low$d = 32'h0;
+        end
+        counters$clock = clock;
+        counters$reset = reset;
+        counters$z1 = z1;
+        counters$z2 = z2;
+        counters$z_valid = z_valid;
+        counters$dropped = dropped;
+        beat = counters$beat;
+        counters$adc1 = adc1;
+        counters$adc2 = adc2;
+        counters$clip_clear = read & status$8$read_hit;
+        status$0$live = id_word;
+        status$1$live = version_word;
+        status$2$live = counters$overflow;
+        status$3$live = counters$count;
+        status$4$live = counters$z1_low;
+        status$5$live = counters$z1_high;
+        status$6$live = counters$z2_low;
+        status$7$live = counters$z2_high;
+        status$8$live = counters$clip;
+        status$0$read_index = read_index;
+        if (status$0$read_hit) begin
+            read_hit = 1'b1;
+            read_word = status$0$read_word;
+        end
+        status$1$read_index = read_index;
+        if (status$1$read_hit) begin
+            read_hit = 1'b1;
+            read_word = status$1$read_word;
+        end
+        status$2$read_index = read_index;
+        if (status$2$read_hit) begin
+            read_hit = 1'b1;
+            read_word = status$2$read_word;
+        end
+        status$3$read_index = read_index;
+        if (status$3$read_hit) begin
+            read_hit = 1'b1;
+            read_word = status$3$read_word;
+        end
+        status$4$read_index = read_index;
+        if (status$4$read_hit) begin
+            read_hit = 1'b1;
+            read_word = status$4$read_word;
+        end
+        status$5$read_index = read_index;
+        if (status$5$read_hit) begin
+            read_hit = 1'b1;
+            read_word = status$5$read_word;
+        end
+        status$6$read_index = read_index;
+        if (status$6$read_hit) begin
+            read_hit = 1'b1;
+            read_word = status$6$read_word;
+        end
+        status$7$read_index = read_index;
+        if (status$7$read_hit) begin
+            read_hit = 1'b1;
+            read_word = status$7$read_word;
+        end
+        status$8$read_index = read_index;
+        if (status$8$read_hit) begin
+            read_hit = 1'b1;
+            read_word = status$8$read_word;
+        end
+        counters$snapshot = read & status$3$read_hit;
+        stream_enable = settings$14$value[32'h0];
+        select = settings$0$value[32'h0];
+        carrier_step = settings$1$value;
+        ref_phase = settings$2$value;
+        ref_delay = settings$3$value[(32'h0)+:(6)];
+        mod_step = ((mod_step_low$q) & 48'hffffffffffff) | (((settings$5$value[(32'h0)+:(16)]) & 48'hffffffffffff) << 32'h20);
+        amp1 = $signed(settings$6$value[(32'h0)+:(16)]);
+        amp2 = $signed(settings$7$value[(32'h0)+:(16)]);
+        cic_decimation = settings$8$value[(32'h0)+:(13)];
+        cic_shift = settings$9$value[(32'h0)+:(6)];
+        iir_k0 = $signed(settings$10$value);
+        iir_k1 = $signed(settings$11$value);
+        iir_k2 = $signed(settings$12$value);
+        iir_alpha = $signed(settings$13$value);
+    end
+
+endmodule // gyro_interface_axi__registers
+
+
+module gyro_interface_axi__registers__counters(clock,reset,z1,z2,z_valid,dropped,snapshot,adc1,adc2,clip_clear,count,overflow,z1_low,z1_high,z2_low,z2_high,clip,beat);
+
+    // Module arguments
+    input wire  clock;
+    input wire  reset;
+    input wire signed [39:0] z1;
+    input wire signed [39:0] z2;
+    input wire  z_valid;
+    input wire  dropped;
+    input wire  snapshot;
+    input wire signed [15:0] adc1;
+    input wire signed [15:0] adc2;
+    input wire  clip_clear;
+    output reg  [31:0] count;
+    output reg  [31:0] overflow;
+    output reg  [31:0] z1_low;
+    output reg  [31:0] z1_high;
+    output reg  [31:0] z2_low;
+    output reg  [31:0] z2_high;
+    output reg  [31:0] clip;
+    output reg  [95:0] beat;
+
+    // Stub signals
+    reg  clip_counters$0$clock;
+    reg  clip_counters$0$reset;
+    reg signed [15:0] clip_counters$0$adc;
+    reg  clip_counters$0$clear;
+    wire  [15:0] clip_counters$0$count;
+    reg  clip_counters$1$clock;
+    reg  clip_counters$1$reset;
+    reg signed [15:0] clip_counters$1$adc;
+    reg  clip_counters$1$clear;
+    wire  [15:0] clip_counters$1$count;
+    reg  [31:0] sample_count$d;
+    wire  [31:0] sample_count$q;
+    reg  sample_count$clock;
+    reg  [31:0] overflow_count$d;
+    wire  [31:0] overflow_count$q;
+    reg  overflow_count$clock;
+    reg  [39:0] snapshot_z1$d;
+    wire  [39:0] snapshot_z1$q;
+    reg  snapshot_z1$clock;
+    reg  [39:0] snapshot_z2$d;
+    wire  [39:0] snapshot_z2$q;
+    reg  snapshot_z2$clock;
+
+    // Local signals
+    reg  [39:0] z1_bits;
+    reg  [39:0] z2_bits;
+    reg  [31:0] count_now;
+
+    // Sub module instances
+    gyro_interface_axi__registers__counters__clip_counters__0 clip_counters$0(
+        .clock(clip_counters$0$clock),
+        .reset(clip_counters$0$reset),
+        .adc(clip_counters$0$adc),
+        .clear(clip_counters$0$clear),
+        .count(clip_counters$0$count)
+    );
+    gyro_interface_axi__registers__counters__clip_counters__1 clip_counters$1(
+        .clock(clip_counters$1$clock),
+        .reset(clip_counters$1$reset),
+        .adc(clip_counters$1$adc),
+        .clear(clip_counters$1$clear),
+        .count(clip_counters$1$count)
+    );
+    gyro_interface_axi__registers__counters__sample_count sample_count(
+        .d(sample_count$d),
+        .q(sample_count$q),
+        .clock(sample_count$clock)
+    );
+    gyro_interface_axi__registers__counters__overflow_count overflow_count(
+        .d(overflow_count$d),
+        .q(overflow_count$q),
+        .clock(overflow_count$clock)
+    );
+    gyro_interface_axi__registers__counters__snapshot_z1 snapshot_z1(
+        .d(snapshot_z1$d),
+        .q(snapshot_z1$q),
+        .clock(snapshot_z1$clock)
+    );
+    gyro_interface_axi__registers__counters__snapshot_z2 snapshot_z2(
+        .d(snapshot_z2$d),
+        .q(snapshot_z2$q),
+        .clock(snapshot_z2$clock)
+    );
+
+    // Update code
+    always @(*) begin
+        sample_count$clock = clock;
+        overflow_count$clock = clock;
+        snapshot_z1$clock = clock;
+        snapshot_z2$clock = clock;
+        sample_count$d = sample_count$q;
+        overflow_count$d = overflow_count$q;
+        snapshot_z1$d = snapshot_z1$q;
+        snapshot_z2$d = snapshot_z2$q;
+        z1_bits = $unsigned(z1);
+        z2_bits = $unsigned(z2);
+        count_now = sample_count$q;
+        if (z_valid) begin
+            count_now = sample_count$q + 32'h1;
+        end
+        sample_count$d = count_now;
+        if (dropped) begin
+            overflow_count$d = overflow_count$q + 32'h1;
+        end
+        if (snapshot) begin
+            snapshot_z1$d = z1_bits;
+            snapshot_z2$d = z2_bits;
+        end
+        count = count_now;
+        overflow = overflow_count$q;
+        z1_low = snapshot_z1$q[(32'h0)+:(32)];
+        z1_high = ((snapshot_z1$q[(32'h20)+:(8)]) & 32'hffffffff);
+        z2_low = snapshot_z2$q[(32'h0)+:(32)];
+        z2_high = ((snapshot_z2$q[(32'h20)+:(8)]) & 32'hffffffff);
+        clip_counters$0$adc = adc1;
+        clip_counters$1$adc = adc2;
+        clip_counters$0$clock = clock;
+        clip_counters$0$reset = reset;
+        clip_counters$0$clear = clip_clear;
+        clip_counters$1$clock = clock;
+        clip_counters$1$reset = reset;
+        clip_counters$1$clear = clip_clear;
+        clip = ((clip_counters$0$count) & 32'hffffffff) | (((clip_counters$1$count) & 32'hffffffff) << 32'h10);
+        beat = ((z1_bits) & 96'hffffffffffffffffffffffff) | (((z2_bits) & 96'hffffffffffffffffffffffff) << 32'h28) | (((count_now[(32'h0)+:(16)]) & 96'hffffffffffffffffffffffff) << 32'h50);
+        if (reset) begin
+            sample_count$d = 32'h0;
+            overflow_count$d = 32'h0;
+            snapshot_z1$d = 32'h0;
+            snapshot_z2$d = 32'h0;
+        end
+    end
+
+endmodule // gyro_interface_axi__registers__counters
+
+
+module gyro_interface_axi__registers__counters__clip_counters__0(clock,reset,adc,clear,count);
+
+    // Module arguments
+    input wire  clock;
+    input wire  reset;
+    input wire signed [15:0] adc;
+    input wire  clear;
+    output reg  [15:0] count;
+
+    // Constant declarations
+    localparam signed top = 16'h7fff;
+    localparam signed bottom = 16'h8000;
+    localparam  full = 16'hffff;
+
+    // Stub signals
+    reg  [15:0] counter$d;
+    wire  [15:0] counter$q;
+    reg  counter$clock;
+
+    // Local signals
+    reg  at_rail;
+
+    // Sub module instances
+    gyro_interface_axi__registers__counters__clip_counters__0__counter counter(
+        .d(counter$d),
+        .q(counter$q),
+        .clock(counter$clock)
+    );
+
+    // Update code
+    always @(*) begin
+        counter$clock = clock;
+        counter$d = counter$q;
+        at_rail = (adc == top) | (adc == bottom);
+        count = counter$q;
+        if (clear) begin
+            counter$d = 32'h0;
+            if (at_rail) begin
+                counter$d = 32'h1;
+            end
+        end
+        else if (at_rail & (counter$q != full)) begin
+            counter$d = counter$q + 32'h1;
+        end
+        if (reset) begin
+            counter$d = 32'h0;
+        end
+    end
+
+endmodule // gyro_interface_axi__registers__counters__clip_counters__0
+
+
+module gyro_interface_axi__registers__counters__clip_counters__0__counter(d,q,clock);
+
+    // Module arguments
+    input wire  [15:0] d;
+    output reg  [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__registers__counters__clip_counters__0__counter
+
+
+module gyro_interface_axi__registers__counters__clip_counters__1(clock,reset,adc,clear,count);
+
+    // Module arguments
+    input wire  clock;
+    input wire  reset;
+    input wire signed [15:0] adc;
+    input wire  clear;
+    output reg  [15:0] count;
+
+    // Constant declarations
+    localparam signed top = 16'h7fff;
+    localparam signed bottom = 16'h8000;
+    localparam  full = 16'hffff;
+
+    // Stub signals
+    reg  [15:0] counter$d;
+    wire  [15:0] counter$q;
+    reg  counter$clock;
+
+    // Local signals
+    reg  at_rail;
+
+    // Sub module instances
+    gyro_interface_axi__registers__counters__clip_counters__1__counter counter(
+        .d(counter$d),
+        .q(counter$q),
+        .clock(counter$clock)
+    );
+
+    // Update code
+    always @(*) begin
+        counter$clock = clock;
+        counter$d = counter$q;
+        at_rail = (adc == top) | (adc == bottom);
+        count = counter$q;
+        if (clear) begin
+            counter$d = 32'h0;
+            if (at_rail) begin
+                counter$d = 32'h1;
+            end
+        end
+        else if (at_rail & (counter$q != full)) begin
+            counter$d = counter$q + 32'h1;
+        end
+        if (reset) begin
+            counter$d = 32'h0;
+        end
+    end
+
+endmodule // gyro_interface_axi__registers__counters__clip_counters__1
+
+
+module gyro_interface_axi__registers__counters__clip_counters__1__counter(d,q,clock);
+
+    // Module arguments
+    input wire  [15:0] d;
+    output reg  [15:0] q;
+    input wire  clock;
+
+    // Update code (custom)
+    initial begin
+       q = 16'h0;
+    end
+
+    always @(posedge clock) begin
+       q <= d;
+    end
+
+endmodule // gyro_interface_axi__registers__counters__clip_counters__1__counter
+
+
+module gyro_interface_axi__registers__counters__overflow_count(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -13657,29 +14164,10 @@ module gyro_interface_axi__mod_step_low(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__mod_step_low
+endmodule // gyro_interface_axi__registers__counters__overflow_count
 
 
-module gyro_interface_axi__overflow_count(d,q,clock);
-
-    // Module arguments
-    input wire  [31:0] d;
-    output reg  [31:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 32'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__overflow_count
-
-
-module gyro_interface_axi__r_data(d,q,clock);
+module gyro_interface_axi__registers__counters__sample_count(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -13695,48 +14183,48 @@ module gyro_interface_axi__r_data(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__r_data
+endmodule // gyro_interface_axi__registers__counters__sample_count
 
 
-module gyro_interface_axi__r_resp(d,q,clock);
+module gyro_interface_axi__registers__counters__snapshot_z1(d,q,clock);
 
     // Module arguments
-    input wire  [1:0] d;
-    output reg  [1:0] q;
+    input wire  [39:0] d;
+    output reg  [39:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 2'h0;
+       q = 40'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface_axi__r_resp
+endmodule // gyro_interface_axi__registers__counters__snapshot_z1
 
 
-module gyro_interface_axi__r_valid(d,q,clock);
+module gyro_interface_axi__registers__counters__snapshot_z2(d,q,clock);
 
     // Module arguments
-    input wire  d;
-    output reg  q;
+    input wire  [39:0] d;
+    output reg  [39:0] q;
     input wire  clock;
 
     // Update code (custom)
     initial begin
-       q = 1'h0;
+       q = 40'h0;
     end
 
     always @(posedge clock) begin
        q <= d;
     end
 
-endmodule // gyro_interface_axi__r_valid
+endmodule // gyro_interface_axi__registers__counters__snapshot_z2
 
 
-module gyro_interface_axi__sample_count(d,q,clock);
+module gyro_interface_axi__registers__mod_step_low(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -13752,10 +14240,10 @@ module gyro_interface_axi__sample_count(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__sample_count
+endmodule // gyro_interface_axi__registers__mod_step_low
 
 
-module gyro_interface_axi__settings__0(clock,reset,write,write_index,write_data,write_mask,read_index,value,write_hit,read_hit,read_word);
+module gyro_interface_axi__registers__settings__0(clock,reset,write,write_index,write_data,write_mask,read_index,value,write_hit,read_hit,read_word);
 
     // Module arguments
     input wire  clock;
@@ -13783,7 +14271,7 @@ module gyro_interface_axi__settings__0(clock,reset,write,write_index,write_data,
     reg  field$clock;
 
     // Sub module instances
-    gyro_interface_axi__settings__0__field field(
+    gyro_interface_axi__registers__settings__0__field field(
         .d(field$d),
         .q(field$q),
         .clock(field$clock)
@@ -13808,10 +14296,10 @@ module gyro_interface_axi__settings__0(clock,reset,write,write_index,write_data,
         end
     end
 
-endmodule // gyro_interface_axi__settings__0
+endmodule // gyro_interface_axi__registers__settings__0
 
 
-module gyro_interface_axi__settings__0__field(d,q,clock);
+module gyro_interface_axi__registers__settings__0__field(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -13827,7 +14315,7 @@ module gyro_interface_axi__settings__0__field(d,q,clock);
     reg  dff$clock;
 
     // Sub module instances
-    gyro_interface_axi__settings__0__field__dff dff(
+    gyro_interface_axi__registers__settings__0__field__dff dff(
         .d(dff$d),
         .q(dff$q),
         .clock(dff$clock)
@@ -13840,10 +14328,10 @@ module gyro_interface_axi__settings__0__field(d,q,clock);
         dff$d = d ^ init;
     end
 
-endmodule // gyro_interface_axi__settings__0__field
+endmodule // gyro_interface_axi__registers__settings__0__field
 
 
-module gyro_interface_axi__settings__0__field__dff(d,q,clock);
+module gyro_interface_axi__registers__settings__0__field__dff(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -13859,10 +14347,10 @@ module gyro_interface_axi__settings__0__field__dff(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__settings__0__field__dff
+endmodule // gyro_interface_axi__registers__settings__0__field__dff
 
 
-module gyro_interface_axi__settings__1(clock,reset,write,write_index,write_data,write_mask,read_index,value,write_hit,read_hit,read_word);
+module gyro_interface_axi__registers__settings__1(clock,reset,write,write_index,write_data,write_mask,read_index,value,write_hit,read_hit,read_word);
 
     // Module arguments
     input wire  clock;
@@ -13890,7 +14378,7 @@ module gyro_interface_axi__settings__1(clock,reset,write,write_index,write_data,
     reg  field$clock;
 
     // Sub module instances
-    gyro_interface_axi__settings__1__field field(
+    gyro_interface_axi__registers__settings__1__field field(
         .d(field$d),
         .q(field$q),
         .clock(field$clock)
@@ -13915,10 +14403,10 @@ module gyro_interface_axi__settings__1(clock,reset,write,write_index,write_data,
         end
     end
 
-endmodule // gyro_interface_axi__settings__1
+endmodule // gyro_interface_axi__registers__settings__1
 
 
-module gyro_interface_axi__settings__1__field(d,q,clock);
+module gyro_interface_axi__registers__settings__1__field(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -13934,7 +14422,7 @@ module gyro_interface_axi__settings__1__field(d,q,clock);
     reg  dff$clock;
 
     // Sub module instances
-    gyro_interface_axi__settings__1__field__dff dff(
+    gyro_interface_axi__registers__settings__1__field__dff dff(
         .d(dff$d),
         .q(dff$q),
         .clock(dff$clock)
@@ -13947,10 +14435,10 @@ module gyro_interface_axi__settings__1__field(d,q,clock);
         dff$d = d ^ init;
     end
 
-endmodule // gyro_interface_axi__settings__1__field
+endmodule // gyro_interface_axi__registers__settings__1__field
 
 
-module gyro_interface_axi__settings__1__field__dff(d,q,clock);
+module gyro_interface_axi__registers__settings__1__field__dff(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -13966,10 +14454,10 @@ module gyro_interface_axi__settings__1__field__dff(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__settings__1__field__dff
+endmodule // gyro_interface_axi__registers__settings__1__field__dff
 
 
-module gyro_interface_axi__settings__10(clock,reset,write,write_index,write_data,write_mask,read_index,value,write_hit,read_hit,read_word);
+module gyro_interface_axi__registers__settings__10(clock,reset,write,write_index,write_data,write_mask,read_index,value,write_hit,read_hit,read_word);
 
     // Module arguments
     input wire  clock;
@@ -13997,7 +14485,7 @@ module gyro_interface_axi__settings__10(clock,reset,write,write_index,write_data
     reg  field$clock;
 
     // Sub module instances
-    gyro_interface_axi__settings__10__field field(
+    gyro_interface_axi__registers__settings__10__field field(
         .d(field$d),
         .q(field$q),
         .clock(field$clock)
@@ -14022,10 +14510,10 @@ module gyro_interface_axi__settings__10(clock,reset,write,write_index,write_data
         end
     end
 
-endmodule // gyro_interface_axi__settings__10
+endmodule // gyro_interface_axi__registers__settings__10
 
 
-module gyro_interface_axi__settings__10__field(d,q,clock);
+module gyro_interface_axi__registers__settings__10__field(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -14041,7 +14529,7 @@ module gyro_interface_axi__settings__10__field(d,q,clock);
     reg  dff$clock;
 
     // Sub module instances
-    gyro_interface_axi__settings__10__field__dff dff(
+    gyro_interface_axi__registers__settings__10__field__dff dff(
         .d(dff$d),
         .q(dff$q),
         .clock(dff$clock)
@@ -14054,10 +14542,10 @@ module gyro_interface_axi__settings__10__field(d,q,clock);
         dff$d = d ^ init;
     end
 
-endmodule // gyro_interface_axi__settings__10__field
+endmodule // gyro_interface_axi__registers__settings__10__field
 
 
-module gyro_interface_axi__settings__10__field__dff(d,q,clock);
+module gyro_interface_axi__registers__settings__10__field__dff(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -14073,10 +14561,10 @@ module gyro_interface_axi__settings__10__field__dff(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__settings__10__field__dff
+endmodule // gyro_interface_axi__registers__settings__10__field__dff
 
 
-module gyro_interface_axi__settings__11(clock,reset,write,write_index,write_data,write_mask,read_index,value,write_hit,read_hit,read_word);
+module gyro_interface_axi__registers__settings__11(clock,reset,write,write_index,write_data,write_mask,read_index,value,write_hit,read_hit,read_word);
 
     // Module arguments
     input wire  clock;
@@ -14104,7 +14592,7 @@ module gyro_interface_axi__settings__11(clock,reset,write,write_index,write_data
     reg  field$clock;
 
     // Sub module instances
-    gyro_interface_axi__settings__11__field field(
+    gyro_interface_axi__registers__settings__11__field field(
         .d(field$d),
         .q(field$q),
         .clock(field$clock)
@@ -14129,10 +14617,10 @@ module gyro_interface_axi__settings__11(clock,reset,write,write_index,write_data
         end
     end
 
-endmodule // gyro_interface_axi__settings__11
+endmodule // gyro_interface_axi__registers__settings__11
 
 
-module gyro_interface_axi__settings__11__field(d,q,clock);
+module gyro_interface_axi__registers__settings__11__field(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -14148,7 +14636,7 @@ module gyro_interface_axi__settings__11__field(d,q,clock);
     reg  dff$clock;
 
     // Sub module instances
-    gyro_interface_axi__settings__11__field__dff dff(
+    gyro_interface_axi__registers__settings__11__field__dff dff(
         .d(dff$d),
         .q(dff$q),
         .clock(dff$clock)
@@ -14161,10 +14649,10 @@ module gyro_interface_axi__settings__11__field(d,q,clock);
         dff$d = d ^ init;
     end
 
-endmodule // gyro_interface_axi__settings__11__field
+endmodule // gyro_interface_axi__registers__settings__11__field
 
 
-module gyro_interface_axi__settings__11__field__dff(d,q,clock);
+module gyro_interface_axi__registers__settings__11__field__dff(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -14180,10 +14668,10 @@ module gyro_interface_axi__settings__11__field__dff(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__settings__11__field__dff
+endmodule // gyro_interface_axi__registers__settings__11__field__dff
 
 
-module gyro_interface_axi__settings__12(clock,reset,write,write_index,write_data,write_mask,read_index,value,write_hit,read_hit,read_word);
+module gyro_interface_axi__registers__settings__12(clock,reset,write,write_index,write_data,write_mask,read_index,value,write_hit,read_hit,read_word);
 
     // Module arguments
     input wire  clock;
@@ -14211,7 +14699,7 @@ module gyro_interface_axi__settings__12(clock,reset,write,write_index,write_data
     reg  field$clock;
 
     // Sub module instances
-    gyro_interface_axi__settings__12__field field(
+    gyro_interface_axi__registers__settings__12__field field(
         .d(field$d),
         .q(field$q),
         .clock(field$clock)
@@ -14236,10 +14724,10 @@ module gyro_interface_axi__settings__12(clock,reset,write,write_index,write_data
         end
     end
 
-endmodule // gyro_interface_axi__settings__12
+endmodule // gyro_interface_axi__registers__settings__12
 
 
-module gyro_interface_axi__settings__12__field(d,q,clock);
+module gyro_interface_axi__registers__settings__12__field(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -14255,7 +14743,7 @@ module gyro_interface_axi__settings__12__field(d,q,clock);
     reg  dff$clock;
 
     // Sub module instances
-    gyro_interface_axi__settings__12__field__dff dff(
+    gyro_interface_axi__registers__settings__12__field__dff dff(
         .d(dff$d),
         .q(dff$q),
         .clock(dff$clock)
@@ -14268,10 +14756,10 @@ module gyro_interface_axi__settings__12__field(d,q,clock);
         dff$d = d ^ init;
     end
 
-endmodule // gyro_interface_axi__settings__12__field
+endmodule // gyro_interface_axi__registers__settings__12__field
 
 
-module gyro_interface_axi__settings__12__field__dff(d,q,clock);
+module gyro_interface_axi__registers__settings__12__field__dff(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -14287,10 +14775,10 @@ module gyro_interface_axi__settings__12__field__dff(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__settings__12__field__dff
+endmodule // gyro_interface_axi__registers__settings__12__field__dff
 
 
-module gyro_interface_axi__settings__13(clock,reset,write,write_index,write_data,write_mask,read_index,value,write_hit,read_hit,read_word);
+module gyro_interface_axi__registers__settings__13(clock,reset,write,write_index,write_data,write_mask,read_index,value,write_hit,read_hit,read_word);
 
     // Module arguments
     input wire  clock;
@@ -14318,7 +14806,7 @@ module gyro_interface_axi__settings__13(clock,reset,write,write_index,write_data
     reg  field$clock;
 
     // Sub module instances
-    gyro_interface_axi__settings__13__field field(
+    gyro_interface_axi__registers__settings__13__field field(
         .d(field$d),
         .q(field$q),
         .clock(field$clock)
@@ -14343,10 +14831,10 @@ module gyro_interface_axi__settings__13(clock,reset,write,write_index,write_data
         end
     end
 
-endmodule // gyro_interface_axi__settings__13
+endmodule // gyro_interface_axi__registers__settings__13
 
 
-module gyro_interface_axi__settings__13__field(d,q,clock);
+module gyro_interface_axi__registers__settings__13__field(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -14362,7 +14850,7 @@ module gyro_interface_axi__settings__13__field(d,q,clock);
     reg  dff$clock;
 
     // Sub module instances
-    gyro_interface_axi__settings__13__field__dff dff(
+    gyro_interface_axi__registers__settings__13__field__dff dff(
         .d(dff$d),
         .q(dff$q),
         .clock(dff$clock)
@@ -14375,10 +14863,10 @@ module gyro_interface_axi__settings__13__field(d,q,clock);
         dff$d = d ^ init;
     end
 
-endmodule // gyro_interface_axi__settings__13__field
+endmodule // gyro_interface_axi__registers__settings__13__field
 
 
-module gyro_interface_axi__settings__13__field__dff(d,q,clock);
+module gyro_interface_axi__registers__settings__13__field__dff(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -14394,10 +14882,10 @@ module gyro_interface_axi__settings__13__field__dff(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__settings__13__field__dff
+endmodule // gyro_interface_axi__registers__settings__13__field__dff
 
 
-module gyro_interface_axi__settings__14(clock,reset,write,write_index,write_data,write_mask,read_index,value,write_hit,read_hit,read_word);
+module gyro_interface_axi__registers__settings__14(clock,reset,write,write_index,write_data,write_mask,read_index,value,write_hit,read_hit,read_word);
 
     // Module arguments
     input wire  clock;
@@ -14425,7 +14913,7 @@ module gyro_interface_axi__settings__14(clock,reset,write,write_index,write_data
     reg  field$clock;
 
     // Sub module instances
-    gyro_interface_axi__settings__14__field field(
+    gyro_interface_axi__registers__settings__14__field field(
         .d(field$d),
         .q(field$q),
         .clock(field$clock)
@@ -14450,10 +14938,10 @@ module gyro_interface_axi__settings__14(clock,reset,write,write_index,write_data
         end
     end
 
-endmodule // gyro_interface_axi__settings__14
+endmodule // gyro_interface_axi__registers__settings__14
 
 
-module gyro_interface_axi__settings__14__field(d,q,clock);
+module gyro_interface_axi__registers__settings__14__field(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -14469,7 +14957,7 @@ module gyro_interface_axi__settings__14__field(d,q,clock);
     reg  dff$clock;
 
     // Sub module instances
-    gyro_interface_axi__settings__14__field__dff dff(
+    gyro_interface_axi__registers__settings__14__field__dff dff(
         .d(dff$d),
         .q(dff$q),
         .clock(dff$clock)
@@ -14482,10 +14970,10 @@ module gyro_interface_axi__settings__14__field(d,q,clock);
         dff$d = d ^ init;
     end
 
-endmodule // gyro_interface_axi__settings__14__field
+endmodule // gyro_interface_axi__registers__settings__14__field
 
 
-module gyro_interface_axi__settings__14__field__dff(d,q,clock);
+module gyro_interface_axi__registers__settings__14__field__dff(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -14501,10 +14989,10 @@ module gyro_interface_axi__settings__14__field__dff(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__settings__14__field__dff
+endmodule // gyro_interface_axi__registers__settings__14__field__dff
 
 
-module gyro_interface_axi__settings__2(clock,reset,write,write_index,write_data,write_mask,read_index,value,write_hit,read_hit,read_word);
+module gyro_interface_axi__registers__settings__2(clock,reset,write,write_index,write_data,write_mask,read_index,value,write_hit,read_hit,read_word);
 
     // Module arguments
     input wire  clock;
@@ -14532,7 +15020,7 @@ module gyro_interface_axi__settings__2(clock,reset,write,write_index,write_data,
     reg  field$clock;
 
     // Sub module instances
-    gyro_interface_axi__settings__2__field field(
+    gyro_interface_axi__registers__settings__2__field field(
         .d(field$d),
         .q(field$q),
         .clock(field$clock)
@@ -14557,10 +15045,10 @@ module gyro_interface_axi__settings__2(clock,reset,write,write_index,write_data,
         end
     end
 
-endmodule // gyro_interface_axi__settings__2
+endmodule // gyro_interface_axi__registers__settings__2
 
 
-module gyro_interface_axi__settings__2__field(d,q,clock);
+module gyro_interface_axi__registers__settings__2__field(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -14576,7 +15064,7 @@ module gyro_interface_axi__settings__2__field(d,q,clock);
     reg  dff$clock;
 
     // Sub module instances
-    gyro_interface_axi__settings__2__field__dff dff(
+    gyro_interface_axi__registers__settings__2__field__dff dff(
         .d(dff$d),
         .q(dff$q),
         .clock(dff$clock)
@@ -14589,10 +15077,10 @@ module gyro_interface_axi__settings__2__field(d,q,clock);
         dff$d = d ^ init;
     end
 
-endmodule // gyro_interface_axi__settings__2__field
+endmodule // gyro_interface_axi__registers__settings__2__field
 
 
-module gyro_interface_axi__settings__2__field__dff(d,q,clock);
+module gyro_interface_axi__registers__settings__2__field__dff(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -14608,10 +15096,10 @@ module gyro_interface_axi__settings__2__field__dff(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__settings__2__field__dff
+endmodule // gyro_interface_axi__registers__settings__2__field__dff
 
 
-module gyro_interface_axi__settings__3(clock,reset,write,write_index,write_data,write_mask,read_index,value,write_hit,read_hit,read_word);
+module gyro_interface_axi__registers__settings__3(clock,reset,write,write_index,write_data,write_mask,read_index,value,write_hit,read_hit,read_word);
 
     // Module arguments
     input wire  clock;
@@ -14639,7 +15127,7 @@ module gyro_interface_axi__settings__3(clock,reset,write,write_index,write_data,
     reg  field$clock;
 
     // Sub module instances
-    gyro_interface_axi__settings__3__field field(
+    gyro_interface_axi__registers__settings__3__field field(
         .d(field$d),
         .q(field$q),
         .clock(field$clock)
@@ -14664,10 +15152,10 @@ module gyro_interface_axi__settings__3(clock,reset,write,write_index,write_data,
         end
     end
 
-endmodule // gyro_interface_axi__settings__3
+endmodule // gyro_interface_axi__registers__settings__3
 
 
-module gyro_interface_axi__settings__3__field(d,q,clock);
+module gyro_interface_axi__registers__settings__3__field(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -14683,7 +15171,7 @@ module gyro_interface_axi__settings__3__field(d,q,clock);
     reg  dff$clock;
 
     // Sub module instances
-    gyro_interface_axi__settings__3__field__dff dff(
+    gyro_interface_axi__registers__settings__3__field__dff dff(
         .d(dff$d),
         .q(dff$q),
         .clock(dff$clock)
@@ -14696,10 +15184,10 @@ module gyro_interface_axi__settings__3__field(d,q,clock);
         dff$d = d ^ init;
     end
 
-endmodule // gyro_interface_axi__settings__3__field
+endmodule // gyro_interface_axi__registers__settings__3__field
 
 
-module gyro_interface_axi__settings__3__field__dff(d,q,clock);
+module gyro_interface_axi__registers__settings__3__field__dff(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -14715,10 +15203,10 @@ module gyro_interface_axi__settings__3__field__dff(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__settings__3__field__dff
+endmodule // gyro_interface_axi__registers__settings__3__field__dff
 
 
-module gyro_interface_axi__settings__4(clock,reset,write,write_index,write_data,write_mask,read_index,value,write_hit,read_hit,read_word);
+module gyro_interface_axi__registers__settings__4(clock,reset,write,write_index,write_data,write_mask,read_index,value,write_hit,read_hit,read_word);
 
     // Module arguments
     input wire  clock;
@@ -14746,7 +15234,7 @@ module gyro_interface_axi__settings__4(clock,reset,write,write_index,write_data,
     reg  field$clock;
 
     // Sub module instances
-    gyro_interface_axi__settings__4__field field(
+    gyro_interface_axi__registers__settings__4__field field(
         .d(field$d),
         .q(field$q),
         .clock(field$clock)
@@ -14771,10 +15259,10 @@ module gyro_interface_axi__settings__4(clock,reset,write,write_index,write_data,
         end
     end
 
-endmodule // gyro_interface_axi__settings__4
+endmodule // gyro_interface_axi__registers__settings__4
 
 
-module gyro_interface_axi__settings__4__field(d,q,clock);
+module gyro_interface_axi__registers__settings__4__field(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -14790,7 +15278,7 @@ module gyro_interface_axi__settings__4__field(d,q,clock);
     reg  dff$clock;
 
     // Sub module instances
-    gyro_interface_axi__settings__4__field__dff dff(
+    gyro_interface_axi__registers__settings__4__field__dff dff(
         .d(dff$d),
         .q(dff$q),
         .clock(dff$clock)
@@ -14803,10 +15291,10 @@ module gyro_interface_axi__settings__4__field(d,q,clock);
         dff$d = d ^ init;
     end
 
-endmodule // gyro_interface_axi__settings__4__field
+endmodule // gyro_interface_axi__registers__settings__4__field
 
 
-module gyro_interface_axi__settings__4__field__dff(d,q,clock);
+module gyro_interface_axi__registers__settings__4__field__dff(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -14822,10 +15310,10 @@ module gyro_interface_axi__settings__4__field__dff(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__settings__4__field__dff
+endmodule // gyro_interface_axi__registers__settings__4__field__dff
 
 
-module gyro_interface_axi__settings__5(clock,reset,write,write_index,write_data,write_mask,read_index,value,write_hit,read_hit,read_word);
+module gyro_interface_axi__registers__settings__5(clock,reset,write,write_index,write_data,write_mask,read_index,value,write_hit,read_hit,read_word);
 
     // Module arguments
     input wire  clock;
@@ -14853,7 +15341,7 @@ module gyro_interface_axi__settings__5(clock,reset,write,write_index,write_data,
     reg  field$clock;
 
     // Sub module instances
-    gyro_interface_axi__settings__5__field field(
+    gyro_interface_axi__registers__settings__5__field field(
         .d(field$d),
         .q(field$q),
         .clock(field$clock)
@@ -14878,10 +15366,10 @@ module gyro_interface_axi__settings__5(clock,reset,write,write_index,write_data,
         end
     end
 
-endmodule // gyro_interface_axi__settings__5
+endmodule // gyro_interface_axi__registers__settings__5
 
 
-module gyro_interface_axi__settings__5__field(d,q,clock);
+module gyro_interface_axi__registers__settings__5__field(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -14897,7 +15385,7 @@ module gyro_interface_axi__settings__5__field(d,q,clock);
     reg  dff$clock;
 
     // Sub module instances
-    gyro_interface_axi__settings__5__field__dff dff(
+    gyro_interface_axi__registers__settings__5__field__dff dff(
         .d(dff$d),
         .q(dff$q),
         .clock(dff$clock)
@@ -14910,10 +15398,10 @@ module gyro_interface_axi__settings__5__field(d,q,clock);
         dff$d = d ^ init;
     end
 
-endmodule // gyro_interface_axi__settings__5__field
+endmodule // gyro_interface_axi__registers__settings__5__field
 
 
-module gyro_interface_axi__settings__5__field__dff(d,q,clock);
+module gyro_interface_axi__registers__settings__5__field__dff(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -14929,10 +15417,10 @@ module gyro_interface_axi__settings__5__field__dff(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__settings__5__field__dff
+endmodule // gyro_interface_axi__registers__settings__5__field__dff
 
 
-module gyro_interface_axi__settings__6(clock,reset,write,write_index,write_data,write_mask,read_index,value,write_hit,read_hit,read_word);
+module gyro_interface_axi__registers__settings__6(clock,reset,write,write_index,write_data,write_mask,read_index,value,write_hit,read_hit,read_word);
 
     // Module arguments
     input wire  clock;
@@ -14960,7 +15448,7 @@ module gyro_interface_axi__settings__6(clock,reset,write,write_index,write_data,
     reg  field$clock;
 
     // Sub module instances
-    gyro_interface_axi__settings__6__field field(
+    gyro_interface_axi__registers__settings__6__field field(
         .d(field$d),
         .q(field$q),
         .clock(field$clock)
@@ -14985,10 +15473,10 @@ module gyro_interface_axi__settings__6(clock,reset,write,write_index,write_data,
         end
     end
 
-endmodule // gyro_interface_axi__settings__6
+endmodule // gyro_interface_axi__registers__settings__6
 
 
-module gyro_interface_axi__settings__6__field(d,q,clock);
+module gyro_interface_axi__registers__settings__6__field(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -15004,7 +15492,7 @@ module gyro_interface_axi__settings__6__field(d,q,clock);
     reg  dff$clock;
 
     // Sub module instances
-    gyro_interface_axi__settings__6__field__dff dff(
+    gyro_interface_axi__registers__settings__6__field__dff dff(
         .d(dff$d),
         .q(dff$q),
         .clock(dff$clock)
@@ -15017,10 +15505,10 @@ module gyro_interface_axi__settings__6__field(d,q,clock);
         dff$d = d ^ init;
     end
 
-endmodule // gyro_interface_axi__settings__6__field
+endmodule // gyro_interface_axi__registers__settings__6__field
 
 
-module gyro_interface_axi__settings__6__field__dff(d,q,clock);
+module gyro_interface_axi__registers__settings__6__field__dff(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -15036,10 +15524,10 @@ module gyro_interface_axi__settings__6__field__dff(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__settings__6__field__dff
+endmodule // gyro_interface_axi__registers__settings__6__field__dff
 
 
-module gyro_interface_axi__settings__7(clock,reset,write,write_index,write_data,write_mask,read_index,value,write_hit,read_hit,read_word);
+module gyro_interface_axi__registers__settings__7(clock,reset,write,write_index,write_data,write_mask,read_index,value,write_hit,read_hit,read_word);
 
     // Module arguments
     input wire  clock;
@@ -15067,7 +15555,7 @@ module gyro_interface_axi__settings__7(clock,reset,write,write_index,write_data,
     reg  field$clock;
 
     // Sub module instances
-    gyro_interface_axi__settings__7__field field(
+    gyro_interface_axi__registers__settings__7__field field(
         .d(field$d),
         .q(field$q),
         .clock(field$clock)
@@ -15092,10 +15580,10 @@ module gyro_interface_axi__settings__7(clock,reset,write,write_index,write_data,
         end
     end
 
-endmodule // gyro_interface_axi__settings__7
+endmodule // gyro_interface_axi__registers__settings__7
 
 
-module gyro_interface_axi__settings__7__field(d,q,clock);
+module gyro_interface_axi__registers__settings__7__field(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -15111,7 +15599,7 @@ module gyro_interface_axi__settings__7__field(d,q,clock);
     reg  dff$clock;
 
     // Sub module instances
-    gyro_interface_axi__settings__7__field__dff dff(
+    gyro_interface_axi__registers__settings__7__field__dff dff(
         .d(dff$d),
         .q(dff$q),
         .clock(dff$clock)
@@ -15124,10 +15612,10 @@ module gyro_interface_axi__settings__7__field(d,q,clock);
         dff$d = d ^ init;
     end
 
-endmodule // gyro_interface_axi__settings__7__field
+endmodule // gyro_interface_axi__registers__settings__7__field
 
 
-module gyro_interface_axi__settings__7__field__dff(d,q,clock);
+module gyro_interface_axi__registers__settings__7__field__dff(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -15143,10 +15631,10 @@ module gyro_interface_axi__settings__7__field__dff(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__settings__7__field__dff
+endmodule // gyro_interface_axi__registers__settings__7__field__dff
 
 
-module gyro_interface_axi__settings__8(clock,reset,write,write_index,write_data,write_mask,read_index,value,write_hit,read_hit,read_word);
+module gyro_interface_axi__registers__settings__8(clock,reset,write,write_index,write_data,write_mask,read_index,value,write_hit,read_hit,read_word);
 
     // Module arguments
     input wire  clock;
@@ -15174,7 +15662,7 @@ module gyro_interface_axi__settings__8(clock,reset,write,write_index,write_data,
     reg  field$clock;
 
     // Sub module instances
-    gyro_interface_axi__settings__8__field field(
+    gyro_interface_axi__registers__settings__8__field field(
         .d(field$d),
         .q(field$q),
         .clock(field$clock)
@@ -15199,10 +15687,10 @@ module gyro_interface_axi__settings__8(clock,reset,write,write_index,write_data,
         end
     end
 
-endmodule // gyro_interface_axi__settings__8
+endmodule // gyro_interface_axi__registers__settings__8
 
 
-module gyro_interface_axi__settings__8__field(d,q,clock);
+module gyro_interface_axi__registers__settings__8__field(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -15218,7 +15706,7 @@ module gyro_interface_axi__settings__8__field(d,q,clock);
     reg  dff$clock;
 
     // Sub module instances
-    gyro_interface_axi__settings__8__field__dff dff(
+    gyro_interface_axi__registers__settings__8__field__dff dff(
         .d(dff$d),
         .q(dff$q),
         .clock(dff$clock)
@@ -15231,10 +15719,10 @@ module gyro_interface_axi__settings__8__field(d,q,clock);
         dff$d = d ^ init;
     end
 
-endmodule // gyro_interface_axi__settings__8__field
+endmodule // gyro_interface_axi__registers__settings__8__field
 
 
-module gyro_interface_axi__settings__8__field__dff(d,q,clock);
+module gyro_interface_axi__registers__settings__8__field__dff(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -15250,10 +15738,10 @@ module gyro_interface_axi__settings__8__field__dff(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__settings__8__field__dff
+endmodule // gyro_interface_axi__registers__settings__8__field__dff
 
 
-module gyro_interface_axi__settings__9(clock,reset,write,write_index,write_data,write_mask,read_index,value,write_hit,read_hit,read_word);
+module gyro_interface_axi__registers__settings__9(clock,reset,write,write_index,write_data,write_mask,read_index,value,write_hit,read_hit,read_word);
 
     // Module arguments
     input wire  clock;
@@ -15281,7 +15769,7 @@ module gyro_interface_axi__settings__9(clock,reset,write,write_index,write_data,
     reg  field$clock;
 
     // Sub module instances
-    gyro_interface_axi__settings__9__field field(
+    gyro_interface_axi__registers__settings__9__field field(
         .d(field$d),
         .q(field$q),
         .clock(field$clock)
@@ -15306,10 +15794,10 @@ module gyro_interface_axi__settings__9(clock,reset,write,write_index,write_data,
         end
     end
 
-endmodule // gyro_interface_axi__settings__9
+endmodule // gyro_interface_axi__registers__settings__9
 
 
-module gyro_interface_axi__settings__9__field(d,q,clock);
+module gyro_interface_axi__registers__settings__9__field(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -15325,7 +15813,7 @@ module gyro_interface_axi__settings__9__field(d,q,clock);
     reg  dff$clock;
 
     // Sub module instances
-    gyro_interface_axi__settings__9__field__dff dff(
+    gyro_interface_axi__registers__settings__9__field__dff dff(
         .d(dff$d),
         .q(dff$q),
         .clock(dff$clock)
@@ -15338,10 +15826,10 @@ module gyro_interface_axi__settings__9__field(d,q,clock);
         dff$d = d ^ init;
     end
 
-endmodule // gyro_interface_axi__settings__9__field
+endmodule // gyro_interface_axi__registers__settings__9__field
 
 
-module gyro_interface_axi__settings__9__field__dff(d,q,clock);
+module gyro_interface_axi__registers__settings__9__field__dff(d,q,clock);
 
     // Module arguments
     input wire  [31:0] d;
@@ -15357,48 +15845,10 @@ module gyro_interface_axi__settings__9__field__dff(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface_axi__settings__9__field__dff
+endmodule // gyro_interface_axi__registers__settings__9__field__dff
 
 
-module gyro_interface_axi__snapshot_z1(d,q,clock);
-
-    // Module arguments
-    input wire  [39:0] d;
-    output reg  [39:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 40'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__snapshot_z1
-
-
-module gyro_interface_axi__snapshot_z2(d,q,clock);
-
-    // Module arguments
-    input wire  [39:0] d;
-    output reg  [39:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 40'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__snapshot_z2
-
-
-module gyro_interface_axi__status__0(live,read_index,read_hit,read_word);
+module gyro_interface_axi__registers__status__0(live,read_index,read_hit,read_word);
 
     // Module arguments
     input wire  [31:0] live;
@@ -15425,10 +15875,10 @@ module gyro_interface_axi__status__0(live,read_index,read_hit,read_word);
         end
     end
 
-endmodule // gyro_interface_axi__status__0
+endmodule // gyro_interface_axi__registers__status__0
 
 
-module gyro_interface_axi__status__1(live,read_index,read_hit,read_word);
+module gyro_interface_axi__registers__status__1(live,read_index,read_hit,read_word);
 
     // Module arguments
     input wire  [31:0] live;
@@ -15455,10 +15905,10 @@ module gyro_interface_axi__status__1(live,read_index,read_hit,read_word);
         end
     end
 
-endmodule // gyro_interface_axi__status__1
+endmodule // gyro_interface_axi__registers__status__1
 
 
-module gyro_interface_axi__status__2(live,read_index,read_hit,read_word);
+module gyro_interface_axi__registers__status__2(live,read_index,read_hit,read_word);
 
     // Module arguments
     input wire  [31:0] live;
@@ -15485,10 +15935,10 @@ module gyro_interface_axi__status__2(live,read_index,read_hit,read_word);
         end
     end
 
-endmodule // gyro_interface_axi__status__2
+endmodule // gyro_interface_axi__registers__status__2
 
 
-module gyro_interface_axi__status__3(live,read_index,read_hit,read_word);
+module gyro_interface_axi__registers__status__3(live,read_index,read_hit,read_word);
 
     // Module arguments
     input wire  [31:0] live;
@@ -15515,10 +15965,10 @@ module gyro_interface_axi__status__3(live,read_index,read_hit,read_word);
         end
     end
 
-endmodule // gyro_interface_axi__status__3
+endmodule // gyro_interface_axi__registers__status__3
 
 
-module gyro_interface_axi__status__4(live,read_index,read_hit,read_word);
+module gyro_interface_axi__registers__status__4(live,read_index,read_hit,read_word);
 
     // Module arguments
     input wire  [31:0] live;
@@ -15545,10 +15995,10 @@ module gyro_interface_axi__status__4(live,read_index,read_hit,read_word);
         end
     end
 
-endmodule // gyro_interface_axi__status__4
+endmodule // gyro_interface_axi__registers__status__4
 
 
-module gyro_interface_axi__status__5(live,read_index,read_hit,read_word);
+module gyro_interface_axi__registers__status__5(live,read_index,read_hit,read_word);
 
     // Module arguments
     input wire  [31:0] live;
@@ -15575,10 +16025,10 @@ module gyro_interface_axi__status__5(live,read_index,read_hit,read_word);
         end
     end
 
-endmodule // gyro_interface_axi__status__5
+endmodule // gyro_interface_axi__registers__status__5
 
 
-module gyro_interface_axi__status__6(live,read_index,read_hit,read_word);
+module gyro_interface_axi__registers__status__6(live,read_index,read_hit,read_word);
 
     // Module arguments
     input wire  [31:0] live;
@@ -15605,10 +16055,10 @@ module gyro_interface_axi__status__6(live,read_index,read_hit,read_word);
         end
     end
 
-endmodule // gyro_interface_axi__status__6
+endmodule // gyro_interface_axi__registers__status__6
 
 
-module gyro_interface_axi__status__7(live,read_index,read_hit,read_word);
+module gyro_interface_axi__registers__status__7(live,read_index,read_hit,read_word);
 
     // Module arguments
     input wire  [31:0] live;
@@ -15635,10 +16085,10 @@ module gyro_interface_axi__status__7(live,read_index,read_hit,read_word);
         end
     end
 
-endmodule // gyro_interface_axi__status__7
+endmodule // gyro_interface_axi__registers__status__7
 
 
-module gyro_interface_axi__status__8(live,read_index,read_hit,read_word);
+module gyro_interface_axi__registers__status__8(live,read_index,read_hit,read_word);
 
     // Module arguments
     input wire  [31:0] live;
@@ -15665,61 +16115,4 @@ module gyro_interface_axi__status__8(live,read_index,read_hit,read_word);
         end
     end
 
-endmodule // gyro_interface_axi__status__8
-
-
-module gyro_interface_axi__w_data(d,q,clock);
-
-    // Module arguments
-    input wire  [31:0] d;
-    output reg  [31:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 32'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__w_data
-
-
-module gyro_interface_axi__w_held(d,q,clock);
-
-    // Module arguments
-    input wire  d;
-    output reg  q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 1'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__w_held
-
-
-module gyro_interface_axi__w_strb(d,q,clock);
-
-    // Module arguments
-    input wire  [3:0] d;
-    output reg  [3:0] q;
-    input wire  clock;
-
-    // Update code (custom)
-    initial begin
-       q = 4'h0;
-    end
-
-    always @(posedge clock) begin
-       q <= d;
-    end
-
-endmodule // gyro_interface_axi__w_strb
+endmodule // gyro_interface_axi__registers__status__8

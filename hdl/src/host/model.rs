@@ -4,13 +4,15 @@
 //! with the inputs of the current cycle and returns the outputs after it,
 //! like every model in `crate::model`.
 
-use super::clip_counter::{ClipCount, clip_word};
+use super::Z_BITS;
+use super::axil_read::ReadChannels;
+use super::axil_write::WriteChannels;
 use super::register_map::{
     self, ADC_CLIP, Access, BusError, DATA_BITS, ID_WORD, RegisterBank, SAMPLE_COUNT,
     STREAM_OVERFLOW, VERSION_WORD, Z1_HI, Z1_LO, Z2_HI, Z2_LO,
 };
 use super::sample_fifo::FIFO_DEPTH;
-use super::{OKAY, SLVERR, Z_BITS};
+use super::status_counters::Counters;
 use crate::model::gyro_interface::{CarrierProfile, GyroInterface, Outputs};
 use std::collections::VecDeque;
 
@@ -92,26 +94,16 @@ pub struct BusOutputs {
     pub tlast: bool,
 }
 
-/// The registers of the bus wrapper (everything `aresetn` resets).
+/// The registers of the bus wrapper (everything `aresetn` resets), block
+/// by block: the write and read channels (`super::axil_write`,
+/// `super::axil_read`), and the register file's settings and counters
+/// (`super::register_file`, `super::status_counters`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct Wrapper {
     bank: RegisterBank,
-    aw_held: bool,
-    aw_index: u32,
-    w_held: bool,
-    w_data: u32,
-    w_strb: u8,
-    b_valid: bool,
-    b_resp: u8,
-    ar_held: bool,
-    ar_index: u32,
-    r_valid: bool,
-    r_data: u32,
-    r_resp: u8,
-    sample_count: u32,
-    overflow_count: u32,
-    snapshot: (u64, u64),
-    clip: [ClipCount; 2],
+    write: WriteChannels,
+    read: ReadChannels,
+    counters: Counters,
 }
 
 /// The stream FIFO's registers (`super::sample_fifo`): the words stored
@@ -166,22 +158,9 @@ impl Wrapper {
     fn power_up() -> Self {
         Self {
             bank: RegisterBank::power_up(),
-            aw_held: false,
-            aw_index: 0,
-            w_held: false,
-            w_data: 0,
-            w_strb: 0,
-            b_valid: false,
-            b_resp: 0,
-            ar_held: false,
-            ar_index: 0,
-            r_valid: false,
-            r_data: 0,
-            r_resp: 0,
-            sample_count: 0,
-            overflow_count: 0,
-            snapshot: (0, 0),
-            clip: [ClipCount::default(); 2],
+            write: WriteChannels::default(),
+            read: ReadChannels::default(),
+            counters: Counters::default(),
         }
     }
 
@@ -191,9 +170,9 @@ impl Wrapper {
         if reg.access == Access::ReadWrite {
             return self.bank.read(reg.offset);
         }
-        let (z1, z2) = self.snapshot;
+        let (z1, z2) = self.counters.snapshot();
         let live = match reg.offset {
-            o if o == STREAM_OVERFLOW.offset => self.overflow_count,
+            o if o == STREAM_OVERFLOW.offset => self.counters.overflow(),
             o if o == SAMPLE_COUNT.offset => count_now,
             o if o == Z1_LO.offset => z1 as u32,
             o if o == Z1_HI.offset => (z1 >> DATA_BITS) as u32,
@@ -201,7 +180,7 @@ impl Wrapper {
             o if o == Z2_HI.offset => (z2 >> DATA_BITS) as u32,
             o if o == register_map::ID.offset => ID_WORD,
             o if o == register_map::VERSION.offset => VERSION_WORD,
-            o if o == ADC_CLIP.offset => clip_word(self.clip),
+            o if o == ADC_CLIP.offset => self.counters.clip_word(),
             _ => unreachable!("status word {} has no source", reg.name),
         };
         Ok(reg.extend(live))
@@ -224,10 +203,6 @@ impl Default for GyroInterfaceAxi {
     }
 }
 
-fn response(result: bool) -> u8 {
-    if result { OKAY } else { SLVERR }
-}
-
 impl GyroInterfaceAxi {
     /// The bus top at power-up.
     pub fn new() -> Self {
@@ -245,17 +220,19 @@ impl GyroInterfaceAxi {
 
     /// The output ports during the current cycle.
     pub fn outputs(&self) -> BusOutputs {
-        let b = &self.bus;
+        let (awready, wready) = self.bus.write.ready();
+        let (bvalid, bresp) = self.bus.write.response();
+        let (rvalid, rdata, rresp) = self.bus.read.response();
         BusOutputs {
             dac: self.core.outputs().dac,
-            awready: !b.aw_held,
-            wready: !b.w_held,
-            bvalid: b.b_valid,
-            bresp: b.b_resp,
-            arready: !b.ar_held,
-            rvalid: b.r_valid,
-            rdata: b.r_data,
-            rresp: b.r_resp,
+            awready,
+            wready,
+            bvalid,
+            bresp,
+            arready: self.bus.read.ready(),
+            rvalid,
+            rdata,
+            rresp,
             tvalid: self.fifo.output().0,
             tdata: self.fifo.output().1,
             tlast: true,
@@ -276,58 +253,30 @@ impl GyroInterfaceAxi {
     pub fn step(&mut self, i: &BusInputs) -> BusOutputs {
         let core = self.core.outputs();
         let regs = self.bus.bank.registers();
-        let count_now = self.bus.sample_count.wrapping_add(core.z_valid as u32);
         let now = self.bus;
         let next = &mut self.bus;
-        // Write channel.
-        if i.awvalid && !now.aw_held {
-            next.aw_held = true;
-            next.aw_index = u32::from(i.awaddr) >> 2;
-        }
-        if i.wvalid && !now.w_held {
-            next.w_held = true;
-            next.w_data = i.wdata;
-            next.w_strb = i.wstrb & 0xf;
-        }
-        if now.aw_held && now.w_held && !now.b_valid {
-            let done = next.bank.write(now.aw_index * 4, now.w_data, now.w_strb);
-            next.aw_held = false;
-            next.w_held = false;
-            next.b_valid = true;
-            next.b_resp = response(done.is_ok());
-        }
-        if now.b_valid && i.bready {
-            next.b_valid = false;
-        }
-        // Read channel.
-        if i.arvalid && !now.ar_held {
-            next.ar_held = true;
-            next.ar_index = u32::from(i.araddr) >> 2;
-        }
-        let read = now.ar_held && !now.r_valid;
-        let clear_clip = read && now.ar_index == ADC_CLIP.word_index();
-        next.clip[0].step(i.adc.0, clear_clip);
-        next.clip[1].step(i.adc.1, clear_clip);
-        if read {
-            let word = now.read_word(now.ar_index, count_now);
-            next.ar_held = false;
-            next.r_valid = true;
-            next.r_data = *word.as_ref().unwrap_or(&0);
-            next.r_resp = response(word.is_ok());
-            if now.ar_index == SAMPLE_COUNT.word_index() {
-                next.snapshot = (core.z.0 as u64 & Z_MASK, core.z.1 as u64 & Z_MASK);
-            }
-        }
-        if now.r_valid && i.rready {
-            next.r_valid = false;
-        }
-        // Counters and stream.
-        next.sample_count = count_now;
-        let push =
-            (core.z_valid && now.bank.stream_enabled()).then(|| sample_word(core, count_now));
-        if self.fifo.step(push, i.tready) {
-            next.overflow_count = now.overflow_count.wrapping_add(1);
-        }
+        // The write channels, and the register file's write.
+        let accepted = now
+            .write
+            .write()
+            .is_some_and(|w| next.bank.write(w.index * 4, w.data, w.strb).is_ok());
+        let aw = i.awvalid.then_some(i.awaddr);
+        let w = i.wvalid.then_some((i.wdata, i.wstrb));
+        next.write.step(aw, w, i.bready, accepted);
+        // The read channels, and the register file's read.
+        let read = now.read.read();
+        let count_now = now.counters.count(core.z_valid);
+        let answer = read.and_then(|index| now.read_word(index, count_now).ok());
+        next.read
+            .step(i.arvalid.then_some(i.araddr), i.rready, answer);
+        // The counters, the snapshot and the stream.
+        let push = (core.z_valid && now.bank.stream_enabled())
+            .then(|| now.counters.beat(core.z, core.z_valid));
+        let dropped = self.fifo.step(push, i.tready);
+        let snapshot = read == Some(SAMPLE_COUNT.word_index());
+        next.counters.step(core.z, core.z_valid, dropped, snapshot);
+        next.counters
+            .step_clip(i.adc, read == Some(ADC_CLIP.word_index()));
         if !i.aresetn {
             *next = Wrapper::power_up();
             self.fifo = Fifo::default();
@@ -335,12 +284,6 @@ impl GyroInterfaceAxi {
         self.core.step(i.adc, &regs);
         self.outputs()
     }
-}
-
-/// The stream word of a sample: {count\[15:0\], z2, z1}.
-pub fn sample_word(core: Outputs, count: u32) -> u128 {
-    let z = |v: i64| u128::from(v as u64 & Z_MASK);
-    z(core.z.0) | (z(core.z.1) << Z_BITS) | (u128::from(count & 0xffff) << (2 * Z_BITS))
 }
 
 /// z1, z2 and the 16-bit sequence number of a stream word.
@@ -375,7 +318,9 @@ mod tests {
             -(1 << (Z_BITS - 1)),
         ];
         for z in rails {
-            w.snapshot = (z as u64 & Z_MASK, !z as u64 & Z_MASK);
+            let mut counters = Counters::default();
+            counters.step((z, !z), false, false, true);
+            w.counters = counters;
             let word = |reg: &register_map::Register| w.read_word(reg.word_index(), 0).unwrap();
             let join = |hi: u32, lo: u32| (i64::from(hi as i32) << 32) | i64::from(lo);
             assert_eq!(join(word(&Z1_HI), word(&Z1_LO)), z, "z1 = {z:#x}");
