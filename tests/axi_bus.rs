@@ -4,7 +4,9 @@
 //! order or together, B and R backpressure, SLVERR, write and read back
 //! every setting, coherent snapshot while z updates, stream backpressure
 //! and overflow counting) plus a replay of golden vectors from the
-//! bit-true model (every output, every cycle, random bus traffic).
+//! bit-true model (every output, every cycle, random bus traffic); and the
+//! write and read channel modules alone, each its own toplevel
+//! (`tests/axi/test_axil_write.py`, `test_axil_read.py`).
 //!
 //! The Python environment is a virtual environment made by
 //! `scripts/test.sh` (pinned cocotb and cocotbext-axi); its interpreter is
@@ -70,23 +72,36 @@ fn require(tool: &str, package: &str) {
 }
 
 fn run_cocotb(simulator: &str, profile: CarrierProfile) {
-    let python = python();
     let dir = tempfile::tempdir().unwrap();
     let (program_file, vectors_file) = axi_vectors::write_inputs(dir.path(), profile);
     let verilog = root()
         .join("verilog-out")
         .join(export::axi_verilog_file(profile));
+    let header = root().join("verilog-out").join(export::C_HEADER_FILE);
+    run_py(
+        simulator,
+        &verilog,
+        &dir.path().join("build"),
+        &[],
+        &[
+            ("GYRO_HEADER", header.as_path()),
+            ("GYRO_PROGRAM", &program_file),
+            ("GYRO_VECTORS", &vectors_file),
+        ],
+    );
+}
+
+/// `tests/axi/run.py` in `simulator` on `verilog` with `args` after the
+/// build directory; fails with the failing tests' tracebacks.
+fn run_py(simulator: &str, verilog: &Path, build: &Path, args: &[&str], env: &[(&str, &Path)]) {
+    let python = python();
     let out = Command::new(&python)
         .arg(root().join("tests/axi/run.py"))
         .arg(simulator)
-        .arg(&verilog)
-        .arg(dir.path().join("build"))
-        .env(
-            "GYRO_HEADER",
-            root().join("verilog-out").join(export::C_HEADER_FILE),
-        )
-        .env("GYRO_PROGRAM", &program_file)
-        .env("GYRO_VECTORS", &vectors_file)
+        .arg(verilog)
+        .arg(build)
+        .args(args)
+        .envs(env.iter().copied())
         .output()
         .unwrap_or_else(|e| panic!("{}: {e}", python.display()));
     let log =
@@ -103,9 +118,39 @@ fn run_cocotb(simulator: &str, profile: CarrierProfile) {
     let tail = report.join("\n");
     assert!(
         out.status.success(),
-        "cocotb in {simulator} failed:\n{tail}"
+        "cocotb in {simulator} {args:?} failed:\n{tail}"
     );
     assert!(log.contains("FAIL=0"), "no cocotb summary:\n{tail}");
+}
+
+/// The bus top's channel modules, each its own toplevel under its own
+/// cocotb test (`tests/axi/test_axil_write.py`, `test_axil_read.py`).
+fn run_channels(simulator: &str) {
+    let verilog = root()
+        .join("verilog-out")
+        .join(export::axi_verilog_file(CarrierProfile::Table));
+    for (module, tests) in [
+        ("gyro_interface_axi__axil_write", "test_axil_write"),
+        ("gyro_interface_axi__axil_read", "test_axil_read"),
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        let args = ["--toplevel", module, "--tests", tests];
+        run_py(simulator, &verilog, &dir.path().join("build"), &args, &[]);
+    }
+}
+
+#[test]
+fn channel_modules_alone_in_icarus() {
+    require("iverilog", "iverilog");
+    run_channels("icarus");
+}
+
+#[test]
+fn channel_modules_alone_in_verilator() {
+    require("verilator", "verilator");
+    require("make", "make");
+    require("g++", "g++");
+    run_channels("verilator");
 }
 
 #[test]
