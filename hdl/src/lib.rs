@@ -15,6 +15,7 @@ pub mod drive;
 pub mod export;
 pub mod fine_carrier_nco;
 pub mod fine_sine_table;
+pub mod fine_slope;
 /// The output filter's design, from the leaf crate `gyrocal-regs`.
 pub use gyrocal_regs::filter_design;
 pub mod gyro_interface;

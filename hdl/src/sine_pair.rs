@@ -7,7 +7,7 @@
 //!  clock:   1 address          2 ROM read      3 words, slope     4 products, bases       5 output
 //!  phase[29:17] ─► [i, ~i] ─► FineSineRom ─► [a, b] ─┬─► b x k ─► [p_s] ─┐
 //!                                                   ├─► a x k ─► [p_c] ─┼─► base ± (p >> 22) ─► [>> 8] ─► sin, cos
-//!  phase[16:14] ─► [s] ──────► [s] ─► slope[s] ─► [k]     bases ─► [base] ┘
+//!  phase[16:14] ─► [s] ──────► [s] ─► FineSlope [k]       bases ─► [base] ┘
 //!  phase[31:30] ─► [q] ──────► [q] ──────────► [q] ─► (which word, sign) ─► [pick, add]
 //!  live ─────────► [live] ───► [live] ───────► [live] ─────────────────► [live] ─► (else 0)
 //! ```
@@ -29,7 +29,8 @@
 //! `DP16KD`), two 18 x 18 multipliers (`MULT18X18D`), about 290 flip-flops
 //! of which the products' 72 sit in the multipliers' output registers.
 
-use crate::fine_sine_table::{OUTPUT_BITS, SUBINTERVALS, TABLE_BITS, slope};
+use crate::fine_sine_table::{OUTPUT_BITS, TABLE_BITS};
+use crate::fine_slope::FineSlope;
 use crate::primitives::convert::signed_bit_cast_exact;
 use crate::primitives::{FineSineRom, RegisteredMultiplier};
 use rust_hdl::prelude::*;
@@ -61,9 +62,9 @@ pub struct SinePair {
     mirror_1: DFF<Bits<TABLE_BITS>>,
     sine_word_3: DFF<Signed<18>>,
     cosine_word_3: DFF<Signed<18>>,
-    slope_3: DFF<Signed<18>>,
     quadrant_3: DFF<Bits<2>>,
     live_3: DFF<Bit>,
+    slope_stage: FineSlope,
     sine_cross: RegisteredMultiplier<18, 18, 36>,
     cosine_cross: RegisteredMultiplier<18, 18, 36>,
     sin_part: OutputPart,
@@ -71,20 +72,6 @@ pub struct SinePair {
     cos_quadrant: Signal<Local, Bits<2>>,
     quarter_turn: Constant<Bits<2>>,
     live_4: DFF<Bit>,
-    slope_at_01: Signal<Local, Signed<18>>,
-    slope_at_23: Signal<Local, Signed<18>>,
-    slope_at_45: Signal<Local, Signed<18>>,
-    slope_at_67: Signal<Local, Signed<18>>,
-    slope_at_0123: Signal<Local, Signed<18>>,
-    slope_at_4567: Signal<Local, Signed<18>>,
-    slope_at_0: Constant<Signed<18>>,
-    slope_at_1: Constant<Signed<18>>,
-    slope_at_2: Constant<Signed<18>>,
-    slope_at_3: Constant<Signed<18>>,
-    slope_at_4: Constant<Signed<18>>,
-    slope_at_5: Constant<Signed<18>>,
-    slope_at_6: Constant<Signed<18>>,
-    slope_at_7: Constant<Signed<18>>,
 }
 
 /// Stages 4 and 5 of one output: which of `s`, `c`, `-s`, `-c` it is, the
@@ -211,9 +198,9 @@ impl SinePair {
             mirror_1: Default::default(),
             sine_word_3: Default::default(),
             cosine_word_3: Default::default(),
-            slope_3: Default::default(),
             quadrant_3: Default::default(),
             live_3: Default::default(),
+            slope_stage: FineSlope::new(),
             sine_cross: RegisteredMultiplier::new(),
             cosine_cross: RegisteredMultiplier::new(),
             sin_part: OutputPart::new(),
@@ -221,20 +208,6 @@ impl SinePair {
             cos_quadrant: Default::default(),
             quarter_turn: Constant::new(1.into()),
             live_4: Default::default(),
-            slope_at_01: Default::default(),
-            slope_at_23: Default::default(),
-            slope_at_45: Default::default(),
-            slope_at_67: Default::default(),
-            slope_at_0123: Default::default(),
-            slope_at_4567: Default::default(),
-            slope_at_0: slope_constant(0),
-            slope_at_1: slope_constant(1),
-            slope_at_2: slope_constant(2),
-            slope_at_3: slope_constant(3),
-            slope_at_4: slope_constant(4),
-            slope_at_5: slope_constant(5),
-            slope_at_6: slope_constant(6),
-            slope_at_7: slope_constant(7),
         }
     }
 }
@@ -261,12 +234,12 @@ impl Logic for SinePair {
             mirror_1,
             sine_word_3,
             cosine_word_3,
-            slope_3,
             quadrant_3,
             live_3,
             live_4
         );
         self.rom.clock.next = self.clock.val();
+        self.slope_stage.clock.next = self.clock.val();
         self.sine_cross.clock.next = self.clock.val();
         self.cosine_cross.clock.next = self.clock.val();
         self.sin_part.clock.next = self.clock.val();
@@ -283,36 +256,18 @@ impl Logic for SinePair {
         self.sub_2.d.next = self.sub_1.q.val();
         self.quadrant_2.d.next = self.quadrant_1.q.val();
         self.live_2.d.next = self.live_1.q.val();
-        // Stage 3: the words registered (a block RAM's clock-to-out), the slope.
+        // Stage 3: the words registered (a block RAM's clock-to-out), the
+        // slope (`FineSlope`, its register inside).
         self.sine_word_3.d.next = self.rom.word_a.val();
         self.cosine_word_3.d.next = self.rom.word_b.val();
-        self.slope_at_01.next = self.slope_at_0.val();
-        self.slope_at_23.next = self.slope_at_2.val();
-        self.slope_at_45.next = self.slope_at_4.val();
-        self.slope_at_67.next = self.slope_at_6.val();
-        if self.sub_2.q.val().get_bit(0) {
-            self.slope_at_01.next = self.slope_at_1.val();
-            self.slope_at_23.next = self.slope_at_3.val();
-            self.slope_at_45.next = self.slope_at_5.val();
-            self.slope_at_67.next = self.slope_at_7.val();
-        }
-        self.slope_at_0123.next = self.slope_at_01.val();
-        self.slope_at_4567.next = self.slope_at_45.val();
-        if self.sub_2.q.val().get_bit(1) {
-            self.slope_at_0123.next = self.slope_at_23.val();
-            self.slope_at_4567.next = self.slope_at_67.val();
-        }
-        self.slope_3.d.next = self.slope_at_0123.val();
-        if self.sub_2.q.val().get_bit(2) {
-            self.slope_3.d.next = self.slope_at_4567.val();
-        }
+        self.slope_stage.sub.next = self.sub_2.q.val();
         self.quadrant_3.d.next = self.quadrant_2.q.val();
         self.live_3.d.next = self.live_2.q.val();
         // Stage 4: the cross products; each output's base (OutputPart).
         self.sine_cross.a.next = self.cosine_word_3.q.val();
-        self.sine_cross.b.next = self.slope_3.q.val();
+        self.sine_cross.b.next = self.slope_stage.slope.val();
         self.cosine_cross.a.next = self.sine_word_3.q.val();
-        self.cosine_cross.b.next = self.slope_3.q.val();
+        self.cosine_cross.b.next = self.slope_stage.slope.val();
         self.live_4.d.next = self.live_3.q.val();
         self.cos_quadrant.next = self.quadrant_3.q.val() + self.quarter_turn.val();
         self.sin_part.quadrant.next = self.quadrant_3.q.val();
@@ -331,12 +286,6 @@ impl Logic for SinePair {
         self.sin.next = self.sin_part.value.val();
         self.cos.next = self.cos_part.value.val();
     }
-}
-
-/// `slope[s]` as a constant of the block.
-fn slope_constant(s: usize) -> Constant<Signed<18>> {
-    assert!(s < SUBINTERVALS);
-    Constant::new(i64::from(slope(s)).into())
 }
 
 crate::impl_clocked!(SinePair);

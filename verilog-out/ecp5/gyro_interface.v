@@ -2669,14 +2669,6 @@ module gyro_interface__carrier_nco__drive(clock,phase,live,cos,sin);
 
     // Constant declarations
     localparam  quarter_turn = 2'b1;
-    localparam signed slope_at_0 = 18'b101010000000100100;
-    localparam signed slope_at_1 = 18'b110000010010101100;
-    localparam signed slope_at_2 = 18'b110110100100110100;
-    localparam signed slope_at_3 = 18'b111100110110111100;
-    localparam signed slope_at_4 = 18'b11001001000100;
-    localparam signed slope_at_5 = 18'b1001011011001100;
-    localparam signed slope_at_6 = 18'b1111101101010100;
-    localparam signed slope_at_7 = 18'b10101111111011100;
 
     // Stub signals
     reg  rom$clock;
@@ -2714,15 +2706,15 @@ module gyro_interface__carrier_nco__drive(clock,phase,live,cos,sin);
     reg signed [17:0] cosine_word_3$d;
     wire signed [17:0] cosine_word_3$q;
     reg  cosine_word_3$clock;
-    reg signed [17:0] slope_3$d;
-    wire signed [17:0] slope_3$q;
-    reg  slope_3$clock;
     reg  [1:0] quadrant_3$d;
     wire  [1:0] quadrant_3$q;
     reg  quadrant_3$clock;
     reg  live_3$d;
     wire  live_3$q;
     reg  live_3$clock;
+    reg  slope_stage$clock;
+    reg  [2:0] slope_stage$sub;
+    wire signed [17:0] slope_stage$slope;
     reg  sine_cross$clock;
     reg signed [17:0] sine_cross$a;
     reg signed [17:0] sine_cross$b;
@@ -2753,12 +2745,6 @@ module gyro_interface__carrier_nco__drive(clock,phase,live,cos,sin);
 
     // Local signals
     reg  [1:0] cos_quadrant;
-    reg signed [17:0] slope_at_01;
-    reg signed [17:0] slope_at_23;
-    reg signed [17:0] slope_at_45;
-    reg signed [17:0] slope_at_67;
-    reg signed [17:0] slope_at_0123;
-    reg signed [17:0] slope_at_4567;
 
     // Sub module instances
     gyro_interface__carrier_nco__drive__rom rom(
@@ -2818,11 +2804,6 @@ module gyro_interface__carrier_nco__drive(clock,phase,live,cos,sin);
         .q(cosine_word_3$q),
         .clock(cosine_word_3$clock)
     );
-    gyro_interface__carrier_nco__drive__slope_3 slope_3(
-        .d(slope_3$d),
-        .q(slope_3$q),
-        .clock(slope_3$clock)
-    );
     gyro_interface__carrier_nco__drive__quadrant_3 quadrant_3(
         .d(quadrant_3$d),
         .q(quadrant_3$q),
@@ -2832,6 +2813,11 @@ module gyro_interface__carrier_nco__drive(clock,phase,live,cos,sin);
         .d(live_3$d),
         .q(live_3$q),
         .clock(live_3$clock)
+    );
+    gyro_interface__carrier_nco__drive__slope_stage slope_stage(
+        .clock(slope_stage$clock),
+        .sub(slope_stage$sub),
+        .slope(slope_stage$slope)
     );
     gyro_interface__carrier_nco__drive__sine_cross sine_cross(
         .clock(sine_cross$clock),
@@ -2883,7 +2869,6 @@ module gyro_interface__carrier_nco__drive(clock,phase,live,cos,sin);
         mirror_1$clock = clock;
         sine_word_3$clock = clock;
         cosine_word_3$clock = clock;
-        slope_3$clock = clock;
         quadrant_3$clock = clock;
         live_3$clock = clock;
         live_4$clock = clock;
@@ -2897,11 +2882,11 @@ module gyro_interface__carrier_nco__drive(clock,phase,live,cos,sin);
         mirror_1$d = mirror_1$q;
         sine_word_3$d = sine_word_3$q;
         cosine_word_3$d = cosine_word_3$q;
-        slope_3$d = slope_3$q;
         quadrant_3$d = quadrant_3$q;
         live_3$d = live_3$q;
         live_4$d = live_4$q;
         rom$clock = clock;
+        slope_stage$clock = clock;
         sine_cross$clock = clock;
         cosine_cross$clock = clock;
         sin_part$clock = clock;
@@ -2918,32 +2903,13 @@ module gyro_interface__carrier_nco__drive(clock,phase,live,cos,sin);
         live_2$d = live_1$q;
         sine_word_3$d = rom$word_a;
         cosine_word_3$d = rom$word_b;
-        slope_at_01 = slope_at_0;
-        slope_at_23 = slope_at_2;
-        slope_at_45 = slope_at_4;
-        slope_at_67 = slope_at_6;
-        if (sub_2$q[32'h0]) begin
-            slope_at_01 = slope_at_1;
-            slope_at_23 = slope_at_3;
-            slope_at_45 = slope_at_5;
-            slope_at_67 = slope_at_7;
-        end
-        slope_at_0123 = slope_at_01;
-        slope_at_4567 = slope_at_45;
-        if (sub_2$q[32'h1]) begin
-            slope_at_0123 = slope_at_23;
-            slope_at_4567 = slope_at_67;
-        end
-        slope_3$d = slope_at_0123;
-        if (sub_2$q[32'h2]) begin
-            slope_3$d = slope_at_4567;
-        end
+        slope_stage$sub = sub_2$q;
         quadrant_3$d = quadrant_2$q;
         live_3$d = live_2$q;
         sine_cross$a = cosine_word_3$q;
-        sine_cross$b = slope_3$q;
+        sine_cross$b = slope_stage$slope;
         cosine_cross$a = sine_word_3$q;
-        cosine_cross$b = slope_3$q;
+        cosine_cross$b = slope_stage$slope;
         live_4$d = live_3$q;
         cos_quadrant = quadrant_3$q + quarter_turn;
         sin_part$quadrant = quadrant_3$q;
@@ -11785,7 +11751,74 @@ module gyro_interface__carrier_nco__drive__sine_word_3(d,q,clock);
 endmodule // gyro_interface__carrier_nco__drive__sine_word_3
 
 
-module gyro_interface__carrier_nco__drive__slope_3(d,q,clock);
+module gyro_interface__carrier_nco__drive__slope_stage(clock,sub,slope);
+
+    // Module arguments
+    input wire  clock;
+    input wire  [2:0] sub;
+    output reg signed [17:0] slope;
+
+    // Constant declarations
+    localparam signed slope_at_0 = 18'b101010000000100100;
+    localparam signed slope_at_1 = 18'b110000010010101100;
+    localparam signed slope_at_2 = 18'b110110100100110100;
+    localparam signed slope_at_3 = 18'b111100110110111100;
+    localparam signed slope_at_4 = 18'b11001001000100;
+    localparam signed slope_at_5 = 18'b1001011011001100;
+    localparam signed slope_at_6 = 18'b1111101101010100;
+    localparam signed slope_at_7 = 18'b10101111111011100;
+
+    // Stub signals
+    reg signed [17:0] slope_3$d;
+    wire signed [17:0] slope_3$q;
+    reg  slope_3$clock;
+
+    // Local signals
+    reg signed [17:0] slope_at_01;
+    reg signed [17:0] slope_at_23;
+    reg signed [17:0] slope_at_45;
+    reg signed [17:0] slope_at_67;
+    reg signed [17:0] slope_at_0123;
+    reg signed [17:0] slope_at_4567;
+
+    // Sub module instances
+    gyro_interface__carrier_nco__drive__slope_stage__slope_3 slope_3(
+        .d(slope_3$d),
+        .q(slope_3$q),
+        .clock(slope_3$clock)
+    );
+
+    // Update code
+    always @(*) begin
+        slope_3$clock = clock;
+        slope_3$d = slope_3$q;
+        slope_at_01 = slope_at_0;
+        slope_at_23 = slope_at_2;
+        slope_at_45 = slope_at_4;
+        slope_at_67 = slope_at_6;
+        if (sub[32'h0]) begin
+            slope_at_01 = slope_at_1;
+            slope_at_23 = slope_at_3;
+            slope_at_45 = slope_at_5;
+            slope_at_67 = slope_at_7;
+        end
+        slope_at_0123 = slope_at_01;
+        slope_at_4567 = slope_at_45;
+        if (sub[32'h1]) begin
+            slope_at_0123 = slope_at_23;
+            slope_at_4567 = slope_at_67;
+        end
+        slope_3$d = slope_at_0123;
+        if (sub[32'h2]) begin
+            slope_3$d = slope_at_4567;
+        end
+        slope = slope_3$q;
+    end
+
+endmodule // gyro_interface__carrier_nco__drive__slope_stage
+
+
+module gyro_interface__carrier_nco__drive__slope_stage__slope_3(d,q,clock);
 
     // Module arguments
     input wire signed [17:0] d;
@@ -11801,7 +11834,7 @@ module gyro_interface__carrier_nco__drive__slope_3(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__drive__slope_3
+endmodule // gyro_interface__carrier_nco__drive__slope_stage__slope_3
 
 
 module gyro_interface__carrier_nco__drive__sub_1(d,q,clock);
@@ -11872,14 +11905,6 @@ module gyro_interface__carrier_nco__reference(clock,phase,live,cos,sin);
 
     // Constant declarations
     localparam  quarter_turn = 2'b1;
-    localparam signed slope_at_0 = 18'b101010000000100100;
-    localparam signed slope_at_1 = 18'b110000010010101100;
-    localparam signed slope_at_2 = 18'b110110100100110100;
-    localparam signed slope_at_3 = 18'b111100110110111100;
-    localparam signed slope_at_4 = 18'b11001001000100;
-    localparam signed slope_at_5 = 18'b1001011011001100;
-    localparam signed slope_at_6 = 18'b1111101101010100;
-    localparam signed slope_at_7 = 18'b10101111111011100;
 
     // Stub signals
     reg  rom$clock;
@@ -11917,15 +11942,15 @@ module gyro_interface__carrier_nco__reference(clock,phase,live,cos,sin);
     reg signed [17:0] cosine_word_3$d;
     wire signed [17:0] cosine_word_3$q;
     reg  cosine_word_3$clock;
-    reg signed [17:0] slope_3$d;
-    wire signed [17:0] slope_3$q;
-    reg  slope_3$clock;
     reg  [1:0] quadrant_3$d;
     wire  [1:0] quadrant_3$q;
     reg  quadrant_3$clock;
     reg  live_3$d;
     wire  live_3$q;
     reg  live_3$clock;
+    reg  slope_stage$clock;
+    reg  [2:0] slope_stage$sub;
+    wire signed [17:0] slope_stage$slope;
     reg  sine_cross$clock;
     reg signed [17:0] sine_cross$a;
     reg signed [17:0] sine_cross$b;
@@ -11956,12 +11981,6 @@ module gyro_interface__carrier_nco__reference(clock,phase,live,cos,sin);
 
     // Local signals
     reg  [1:0] cos_quadrant;
-    reg signed [17:0] slope_at_01;
-    reg signed [17:0] slope_at_23;
-    reg signed [17:0] slope_at_45;
-    reg signed [17:0] slope_at_67;
-    reg signed [17:0] slope_at_0123;
-    reg signed [17:0] slope_at_4567;
 
     // Sub module instances
     gyro_interface__carrier_nco__reference__rom rom(
@@ -12021,11 +12040,6 @@ module gyro_interface__carrier_nco__reference(clock,phase,live,cos,sin);
         .q(cosine_word_3$q),
         .clock(cosine_word_3$clock)
     );
-    gyro_interface__carrier_nco__reference__slope_3 slope_3(
-        .d(slope_3$d),
-        .q(slope_3$q),
-        .clock(slope_3$clock)
-    );
     gyro_interface__carrier_nco__reference__quadrant_3 quadrant_3(
         .d(quadrant_3$d),
         .q(quadrant_3$q),
@@ -12035,6 +12049,11 @@ module gyro_interface__carrier_nco__reference(clock,phase,live,cos,sin);
         .d(live_3$d),
         .q(live_3$q),
         .clock(live_3$clock)
+    );
+    gyro_interface__carrier_nco__reference__slope_stage slope_stage(
+        .clock(slope_stage$clock),
+        .sub(slope_stage$sub),
+        .slope(slope_stage$slope)
     );
     gyro_interface__carrier_nco__reference__sine_cross sine_cross(
         .clock(sine_cross$clock),
@@ -12086,7 +12105,6 @@ module gyro_interface__carrier_nco__reference(clock,phase,live,cos,sin);
         mirror_1$clock = clock;
         sine_word_3$clock = clock;
         cosine_word_3$clock = clock;
-        slope_3$clock = clock;
         quadrant_3$clock = clock;
         live_3$clock = clock;
         live_4$clock = clock;
@@ -12100,11 +12118,11 @@ module gyro_interface__carrier_nco__reference(clock,phase,live,cos,sin);
         mirror_1$d = mirror_1$q;
         sine_word_3$d = sine_word_3$q;
         cosine_word_3$d = cosine_word_3$q;
-        slope_3$d = slope_3$q;
         quadrant_3$d = quadrant_3$q;
         live_3$d = live_3$q;
         live_4$d = live_4$q;
         rom$clock = clock;
+        slope_stage$clock = clock;
         sine_cross$clock = clock;
         cosine_cross$clock = clock;
         sin_part$clock = clock;
@@ -12121,32 +12139,13 @@ module gyro_interface__carrier_nco__reference(clock,phase,live,cos,sin);
         live_2$d = live_1$q;
         sine_word_3$d = rom$word_a;
         cosine_word_3$d = rom$word_b;
-        slope_at_01 = slope_at_0;
-        slope_at_23 = slope_at_2;
-        slope_at_45 = slope_at_4;
-        slope_at_67 = slope_at_6;
-        if (sub_2$q[32'h0]) begin
-            slope_at_01 = slope_at_1;
-            slope_at_23 = slope_at_3;
-            slope_at_45 = slope_at_5;
-            slope_at_67 = slope_at_7;
-        end
-        slope_at_0123 = slope_at_01;
-        slope_at_4567 = slope_at_45;
-        if (sub_2$q[32'h1]) begin
-            slope_at_0123 = slope_at_23;
-            slope_at_4567 = slope_at_67;
-        end
-        slope_3$d = slope_at_0123;
-        if (sub_2$q[32'h2]) begin
-            slope_3$d = slope_at_4567;
-        end
+        slope_stage$sub = sub_2$q;
         quadrant_3$d = quadrant_2$q;
         live_3$d = live_2$q;
         sine_cross$a = cosine_word_3$q;
-        sine_cross$b = slope_3$q;
+        sine_cross$b = slope_stage$slope;
         cosine_cross$a = sine_word_3$q;
-        cosine_cross$b = slope_3$q;
+        cosine_cross$b = slope_stage$slope;
         live_4$d = live_3$q;
         cos_quadrant = quadrant_3$q + quarter_turn;
         sin_part$quadrant = quadrant_3$q;
@@ -20988,7 +20987,74 @@ module gyro_interface__carrier_nco__reference__sine_word_3(d,q,clock);
 endmodule // gyro_interface__carrier_nco__reference__sine_word_3
 
 
-module gyro_interface__carrier_nco__reference__slope_3(d,q,clock);
+module gyro_interface__carrier_nco__reference__slope_stage(clock,sub,slope);
+
+    // Module arguments
+    input wire  clock;
+    input wire  [2:0] sub;
+    output reg signed [17:0] slope;
+
+    // Constant declarations
+    localparam signed slope_at_0 = 18'b101010000000100100;
+    localparam signed slope_at_1 = 18'b110000010010101100;
+    localparam signed slope_at_2 = 18'b110110100100110100;
+    localparam signed slope_at_3 = 18'b111100110110111100;
+    localparam signed slope_at_4 = 18'b11001001000100;
+    localparam signed slope_at_5 = 18'b1001011011001100;
+    localparam signed slope_at_6 = 18'b1111101101010100;
+    localparam signed slope_at_7 = 18'b10101111111011100;
+
+    // Stub signals
+    reg signed [17:0] slope_3$d;
+    wire signed [17:0] slope_3$q;
+    reg  slope_3$clock;
+
+    // Local signals
+    reg signed [17:0] slope_at_01;
+    reg signed [17:0] slope_at_23;
+    reg signed [17:0] slope_at_45;
+    reg signed [17:0] slope_at_67;
+    reg signed [17:0] slope_at_0123;
+    reg signed [17:0] slope_at_4567;
+
+    // Sub module instances
+    gyro_interface__carrier_nco__reference__slope_stage__slope_3 slope_3(
+        .d(slope_3$d),
+        .q(slope_3$q),
+        .clock(slope_3$clock)
+    );
+
+    // Update code
+    always @(*) begin
+        slope_3$clock = clock;
+        slope_3$d = slope_3$q;
+        slope_at_01 = slope_at_0;
+        slope_at_23 = slope_at_2;
+        slope_at_45 = slope_at_4;
+        slope_at_67 = slope_at_6;
+        if (sub[32'h0]) begin
+            slope_at_01 = slope_at_1;
+            slope_at_23 = slope_at_3;
+            slope_at_45 = slope_at_5;
+            slope_at_67 = slope_at_7;
+        end
+        slope_at_0123 = slope_at_01;
+        slope_at_4567 = slope_at_45;
+        if (sub[32'h1]) begin
+            slope_at_0123 = slope_at_23;
+            slope_at_4567 = slope_at_67;
+        end
+        slope_3$d = slope_at_0123;
+        if (sub[32'h2]) begin
+            slope_3$d = slope_at_4567;
+        end
+        slope = slope_3$q;
+    end
+
+endmodule // gyro_interface__carrier_nco__reference__slope_stage
+
+
+module gyro_interface__carrier_nco__reference__slope_stage__slope_3(d,q,clock);
 
     // Module arguments
     input wire signed [17:0] d;
@@ -21004,7 +21070,7 @@ module gyro_interface__carrier_nco__reference__slope_3(d,q,clock);
        q <= d;
     end
 
-endmodule // gyro_interface__carrier_nco__reference__slope_3
+endmodule // gyro_interface__carrier_nco__reference__slope_stage__slope_3
 
 
 module gyro_interface__carrier_nco__reference__sub_1(d,q,clock);
