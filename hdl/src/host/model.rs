@@ -1,8 +1,11 @@
 //! Bit-true, cycle-true model of `super::axi_top::GyroInterfaceAxi`: the
-//! datapath model plus the AXI4-Lite slave, the snapshot, the counters and
-//! the stream FIFO, register for register. `step` plays one rising edge
-//! with the inputs of the current cycle and returns the outputs after it,
-//! like every model in `crate::model`.
+//! datapath model and the models that sit beside the bus top's blocks,
+//! wired as the top wires the blocks: `WriteChannels` (`super::axil_write`),
+//! `ReadChannels` (`super::axil_read`), the settings' `RegisterBank`
+//! (`super::register_file`), `Counters` (`super::status_counters`) and
+//! `Fifo` (`super::sample_fifo`). `step` plays one rising edge with the
+//! inputs of the current cycle and returns the outputs after it, like every
+//! model in `crate::model`.
 
 use super::Z_BITS;
 use super::axil_read::ReadChannels;
@@ -11,10 +14,9 @@ use super::register_map::{
     self, ADC_CLIP, Access, BusError, DATA_BITS, ID_WORD, RegisterBank, SAMPLE_COUNT,
     STREAM_OVERFLOW, VERSION_WORD, Z1_HI, Z1_LO, Z2_HI, Z2_LO,
 };
-use super::sample_fifo::FIFO_DEPTH;
+use super::sample_fifo::Fifo;
 use super::status_counters::Counters;
 use crate::model::gyro_interface::{CarrierProfile, GyroInterface, Outputs};
-use std::collections::VecDeque;
 
 /// The input ports of `gyro_interface_axi` during one cycle.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -104,52 +106,6 @@ struct Wrapper {
     write: WriteChannels,
     read: ReadChannels,
     counters: Counters,
-}
-
-/// The stream FIFO's registers (`super::sample_fifo`): the words stored
-/// in its RAM, the RAM's read register, and the output register. The
-/// hardware's fill count is every sample held: `held()`.
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub(crate) struct Fifo {
-    stored: VecDeque<u128>,
-    fetching: bool,
-    read_word: u128,
-    out_valid: bool,
-    out_data: u128,
-}
-
-impl Fifo {
-    /// `(tvalid, tdata)` during the current cycle.
-    pub(crate) fn output(&self) -> (bool, u128) {
-        (self.out_valid, self.out_data)
-    }
-
-    /// Samples held: in the RAM, in flight from it, in the output register.
-    fn held(&self) -> usize {
-        self.stored.len() + usize::from(self.fetching) + usize::from(self.out_valid)
-    }
-
-    /// One edge; returns true when the push was dropped.
-    pub(crate) fn step(&mut self, push: Option<u128>, tready: bool) -> bool {
-        let full = self.held() == FIFO_DEPTH;
-        let pop = self.out_valid && tready;
-        let issue = !self.stored.is_empty() && !self.fetching && (!self.out_valid || pop);
-        if self.fetching {
-            self.out_valid = true;
-            self.out_data = self.read_word;
-        } else if pop {
-            self.out_valid = false;
-        }
-        self.fetching = issue;
-        if issue {
-            self.read_word = self.stored.pop_front().expect("issue needs a stored word");
-        }
-        match push {
-            Some(sample) if !full => self.stored.push_back(sample),
-            _ => {}
-        }
-        push.is_some() && full
-    }
 }
 
 const Z_MASK: u64 = (1 << Z_BITS) - 1;

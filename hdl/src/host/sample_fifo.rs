@@ -35,6 +35,7 @@
 
 use crate::primitives::WordRam;
 use rust_hdl::prelude::*;
+use std::collections::VecDeque;
 
 /// Samples the FIFO holds (block RAM words; the output register holds the
 /// oldest of them).
@@ -184,11 +185,56 @@ impl Logic for SampleFifo {
 
 crate::impl_clocked!(SampleFifo);
 
+/// Bit-true model of `SampleFifo`: the words stored in its RAM, the RAM's
+/// read register, and the output register. The
+/// hardware's fill count is every sample held: `held()`.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Fifo {
+    stored: VecDeque<u128>,
+    fetching: bool,
+    read_word: u128,
+    out_valid: bool,
+    out_data: u128,
+}
+
+impl Fifo {
+    /// `(tvalid, tdata)` during the current cycle.
+    pub fn output(&self) -> (bool, u128) {
+        (self.out_valid, self.out_data)
+    }
+
+    /// Samples held: in the RAM, in flight from it, in the output register.
+    fn held(&self) -> usize {
+        self.stored.len() + usize::from(self.fetching) + usize::from(self.out_valid)
+    }
+
+    /// One edge; returns true when the push was dropped.
+    pub fn step(&mut self, push: Option<u128>, tready: bool) -> bool {
+        let full = self.held() == FIFO_DEPTH;
+        let pop = self.out_valid && tready;
+        let issue = !self.stored.is_empty() && !self.fetching && (!self.out_valid || pop);
+        if self.fetching {
+            self.out_valid = true;
+            self.out_data = self.read_word;
+        } else if pop {
+            self.out_valid = false;
+        }
+        self.fetching = issue;
+        if issue {
+            self.read_word = self.stored.pop_front().expect("issue needs a stored word");
+        }
+        match push {
+            Some(sample) if !full => self.stored.push_back(sample),
+            _ => {}
+        }
+        push.is_some() && full
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::drive::{prepare, settle, tick};
-    use crate::host::model::Fifo;
     use crate::primitives::convert::{bits_to_i128, u128_to_bits};
     use proptest::prelude::*;
 
