@@ -25,7 +25,7 @@
 //! can depend on them without a loop. `reset` (active high, synchronous)
 //! empties both holding registers and drops B.
 
-use super::register_map::{ADDRESS_BITS, DATA_BITS, WORD_INDEX_BITS};
+use super::register_map::{self, ADDRESS_BITS, DATA_BITS, WORD_INDEX_BITS};
 use super::{OKAY, RESP_BITS, SLVERR};
 use rust_hdl::prelude::*;
 
@@ -205,10 +205,7 @@ pub struct Write {
 impl Write {
     /// The strobes as a bit mask, as the block's `mask` port.
     pub fn mask(&self) -> u32 {
-        (0..4)
-            .filter(|b| self.strb >> b & 1 == 1)
-            .map(|b| 0xff << (8 * b))
-            .sum()
+        register_map::byte_mask(self.strb)
     }
 }
 

@@ -29,6 +29,8 @@ pub mod traffic;
 
 /// Width of z1 and z2 (40-bit two's complement, 8 fractional bits).
 pub const Z_BITS: usize = gyrocal_regs::datapath::Z_BITS as usize;
+/// The low `Z_BITS` bits: a z as its two's complement bits.
+pub const Z_MASK: u64 = (1 << Z_BITS) - 1;
 /// Width of an AXI response code.
 pub const RESP_BITS: usize = 2;
 /// AXI response OKAY.

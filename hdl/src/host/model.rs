@@ -7,7 +7,6 @@
 //! inputs of the current cycle and returns the outputs after it, like every
 //! model in `crate::model`.
 
-use super::Z_BITS;
 use super::axil_read::ReadChannels;
 use super::axil_write::WriteChannels;
 use super::register_map::{
@@ -15,7 +14,8 @@ use super::register_map::{
     STREAM_OVERFLOW, VERSION_WORD, Z1_HI, Z1_LO, Z2_HI, Z2_LO,
 };
 use super::sample_fifo::Fifo;
-use super::status_counters::Counters;
+use super::status_counters::{Counters, StatusInputs};
+use super::{Z_BITS, Z_MASK};
 use crate::model::gyro_interface::{CarrierProfile, GyroInterface, Outputs};
 
 /// The input ports of `gyro_interface_axi` during one cycle.
@@ -107,8 +107,6 @@ struct Wrapper {
     read: ReadChannels,
     counters: Counters,
 }
-
-const Z_MASK: u64 = (1 << Z_BITS) - 1;
 
 impl Wrapper {
     fn power_up() -> Self {
@@ -230,9 +228,16 @@ impl GyroInterfaceAxi {
             .then(|| now.counters.beat(core.z, core.z_valid));
         let dropped = self.fifo.step(push, i.tready);
         let snapshot = read == Some(SAMPLE_COUNT.word_index());
-        next.counters.step(core.z, core.z_valid, dropped, snapshot);
-        next.counters
-            .step_clip(i.adc, read == Some(ADC_CLIP.word_index()));
+        let clip_clear = read == Some(ADC_CLIP.word_index());
+        let status = StatusInputs {
+            z: core.z,
+            z_valid: core.z_valid,
+            dropped,
+            snapshot,
+            adc: i.adc,
+            clip_clear,
+        };
+        next.counters.step(&status);
         if !i.aresetn {
             *next = Wrapper::power_up();
             self.fifo = Fifo::default();
@@ -275,7 +280,11 @@ mod tests {
         ];
         for z in rails {
             let mut counters = Counters::default();
-            counters.step((z, !z), false, false, true);
+            counters.step(&StatusInputs {
+                z: (z, !z),
+                snapshot: true,
+                ..StatusInputs::default()
+            });
             w.counters = counters;
             let word = |reg: &register_map::Register| w.read_word(reg.word_index(), 0).unwrap();
             let join = |hi: u32, lo: u32| (i64::from(hi as i32) << 32) | i64::from(lo);

@@ -19,10 +19,10 @@
 //! high, synchronous) zeroes the counts and the snapshot. Cost: 176
 //! flip-flops, two 32-bit and two 16-bit incrementers.
 
-use super::Z_BITS;
 use super::clip_counter::{COUNT_BITS, ClipCount, ClipCounter, clip_word};
 use super::register_map::DATA_BITS;
 use super::sample_fifo::SAMPLE_BITS;
+use super::{Z_BITS, Z_MASK};
 use rust_hdl::prelude::*;
 
 const _: () = assert!(Z_BITS == 40 && SAMPLE_BITS == 2 * Z_BITS + 16 && COUNT_BITS == 16);
@@ -173,8 +173,23 @@ impl Logic for StatusCounters {
 
 crate::impl_clocked!(StatusCounters);
 
-/// z as its 40 bits, two's complement.
-const Z_MASK: u64 = (1 << Z_BITS) - 1;
+/// The inputs of `StatusCounters` during one cycle (its ports but the
+/// clock and reset).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct StatusInputs {
+    /// The core's z1, z2.
+    pub z: (i64, i64),
+    /// The core publishes `z` during this clock.
+    pub z_valid: bool,
+    /// The stream FIFO drops a sample at this edge.
+    pub dropped: bool,
+    /// Latch `z` at this edge (the read of SAMPLE_COUNT).
+    pub snapshot: bool,
+    /// The ADC words.
+    pub adc: (i16, i16),
+    /// Restart the clip counts at this edge (the read of ADC_CLIP).
+    pub clip_clear: bool,
+}
 
 /// Bit-true model of `StatusCounters`: its registers, an edge at a time.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -216,23 +231,17 @@ impl Counters {
         bits(z.0) | (bits(z.1) << Z_BITS) | (count << (2 * Z_BITS))
     }
 
-    /// One edge: the core's `z` and `z_valid`, the FIFO's `dropped`, the
-    /// `snapshot` strobe (a read of SAMPLE_COUNT), the ADC words and the
-    /// clip counters' `clip_clear` (a read of ADC_CLIP).
-    pub fn step(&mut self, z: (i64, i64), z_valid: bool, dropped: bool, snapshot: bool) {
-        self.sample_count = self.count(z_valid);
-        if dropped {
+    /// One edge with this cycle's inputs.
+    pub fn step(&mut self, i: &StatusInputs) {
+        self.sample_count = self.count(i.z_valid);
+        if i.dropped {
             self.overflow_count = self.overflow_count.wrapping_add(1);
         }
-        if snapshot {
-            self.snapshot = (z.0 as u64 & Z_MASK, z.1 as u64 & Z_MASK);
+        if i.snapshot {
+            self.snapshot = (i.z.0 as u64 & Z_MASK, i.z.1 as u64 & Z_MASK);
         }
-    }
-
-    /// The clip counters' edge: this cycle's ADC words and `clip_clear`.
-    pub fn step_clip(&mut self, adc: (i16, i16), clip_clear: bool) {
-        self.clip[0].step(adc.0, clip_clear);
-        self.clip[1].step(adc.1, clip_clear);
+        self.clip[0].step(i.adc.0, i.clip_clear);
+        self.clip[1].step(i.adc.1, i.clip_clear);
     }
 }
 
@@ -299,8 +308,14 @@ mod tests {
                 .sum::<u128>();
             assert_eq!(beat, model.beat(z, z_valid), "cycle {cycle}");
             tick(&mut uut);
-            model.step(z, z_valid, dropped, snapshot);
-            model.step_clip(adc, clip_clear);
+            model.step(&StatusInputs {
+                z,
+                z_valid,
+                dropped,
+                snapshot,
+                adc,
+                clip_clear,
+            });
             most = most.max(model.count(false));
             if reset {
                 model = Counters::default();
