@@ -15,7 +15,9 @@
 //! -31 ppm/K, Q -2000 ppm/K, a 1 deg front-end phase growing 0.1 deg/K),
 //! so each gives four figures, t = selfcal_error / its sigma. Half of them
 //! carry a quadrature coupling of +-1 to 300 deg/s (`coupling_of`) that
-//! their datasheet does not give, which the cycle measures.
+//! their datasheet does not give, which the cycle measures. The same
+//! devices run again with a damping coupling on half of them
+//! (`damping_of`, `damping_couplings_lie_within_their_sigmas_as_promised`).
 //!
 //! What was found with it, and fixed: on seed 2047 (clock 2.6 carriers,
 //! Q 960) the identified loop phase lay 4 sigma low and the self-cal
@@ -89,16 +91,46 @@ fn drift(lag: f64, per_k: f64) -> String {
 }
 
 /// The scenario of device `d` with a quadrature coupling of `coupling`
-/// deg/s its datasheet does not give, through `drift`, with `extra`
-/// sections.
-fn scenario_text(d: &RandomDevice, coupling: f64, drift: &str, extra: &str) -> String {
+/// deg/s and a damping coupling of `damping` deg/s, which its datasheet
+/// does not give, through `drift`, with `extra` sections.
+fn scenario_text(
+    d: &RandomDevice,
+    coupling: f64,
+    damping: f64,
+    drift: &str,
+    extra: &str,
+) -> String {
     format!(
-        "{}{drift}{extra}[datasheet]\nquadrature_dps = 0\n",
+        "{}{drift}{extra}[datasheet]\nquadrature_dps = 0\ndamping_coupling_dps = 0\n",
         d.toml("").replace(
             "angular_gain =",
-            &format!("quadrature_dps = {coupling}\nangular_gain =")
+            &format!(
+                "quadrature_dps = {coupling}\ndamping_coupling_dps = {damping}\nangular_gain ="
+            )
         )
     )
+}
+
+/// The damping coupling of device `d` (deg/s): none for half the seeds,
+/// else a log-uniform fraction 1e-3..0.3 of its stability limit (the
+/// geometric mean of the modes' bandwidths, `d^2 < B1 B2`, over 2
+/// lambda) and at most 300 deg/s (the quadrature's span), either sign,
+/// from splitmix64 of the seed apart from the device's and the
+/// quadrature coupling's draws.
+fn damping_of(d: &RandomDevice) -> f64 {
+    let mut g = Rng(d.seed ^ 0x6a09_e667_f3bc_c909);
+    let mut unit = || (g.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+    if unit() < 0.5 {
+        return 0.0;
+    }
+    let sign = if unit() < 0.5 { -1.0 } else { 1.0 };
+    let fraction = (1e-3f64.ln() + (0.3f64 / 1e-3).ln() * unit()).exp();
+    let two_pi = 2.0 * std::f64::consts::PI;
+    let bandwidths = (two_pi * d.f_hz[0] / d.q[0]) * (two_pi * d.f_hz[1] / d.q[1]);
+    let limit_dps = (bandwidths.sqrt() / (2.0 * d.lambda)).to_degrees();
+    format!("{:.4e}", sign * (fraction * limit_dps).min(300.0))
+        .parse()
+        .unwrap()
 }
 
 /// The quadrature coupling of device `seed` (deg/s): none for half the
@@ -119,14 +151,16 @@ fn coupling_of(seed: u64) -> f64 {
     format!("{:.4e}", sign * magnitude).parse().unwrap()
 }
 
-/// The field run of the device of `seed`, or None when its clock is too
-/// fast for the test.
-fn field(seed: u64) -> Option<(RandomDevice, FieldReport)> {
+/// The field run of the device of `seed`, with its damping coupling
+/// (`damping_of`) when `damping`, or None when its clock is too fast for
+/// the test.
+fn field(seed: u64, damping: bool) -> Option<(RandomDevice, FieldReport)> {
     let d = RandomDevice::draw(seed, FAST);
     if d.clock_hz > MAX_CLOCK_HZ {
         return None;
     }
-    let text = scenario_text(&d, coupling_of(seed), &drift(LAG.0, LAG.1), "");
+    let damping = if damping { damping_of(&d) } else { 0.0 };
+    let text = scenario_text(&d, coupling_of(seed), damping, &drift(LAG.0, LAG.1), "");
     let sc = scenario::parse("random.toml", &text).unwrap();
     let report = scenario::run(&sc, &|_| {}).unwrap();
     Some((d, report))
@@ -141,7 +175,7 @@ fn t_values(r: &FieldReport) -> Vec<f64> {
 }
 
 /// The identified parameters with a truth, as `identified_t` names them.
-const IDENTIFIED: [&str; 5] = ["f1", "f2", "Q1", "Q2", "quadrature"];
+const IDENTIFIED: [&str; 6] = ["f1", "f2", "Q1", "Q2", "quadrature", "damping"];
 
 /// Those whose coverage the test asserts (`identified_coverage`).
 const ASSERTED: [&str; 4] = ["f1", "f2", "Q1", "Q2"];
@@ -163,7 +197,17 @@ fn identified_t(r: &FieldReport) -> Vec<(&'static str, f64)> {
                     "quadrature",
                     (id.quadrature_dps - g.quadrature_dps) / id.quadrature_dps_uncertainty,
                 ),
+                (
+                    "damping",
+                    (id.damping_coupling_dps - g.damping_coupling_dps)
+                        / id.damping_coupling_dps_uncertainty,
+                ),
             ]
+            .into_iter()
+            // A damping coupling seen as none is reported as exactly 0
+            // (`selfcal::DAMPING_SEEN`): on a device without one its t is
+            // 0 by construction and says nothing of the sigma.
+            .filter(|p| p.0 != "damping" || g.damping_coupling_dps != 0.0)
         })
         .collect()
 }
@@ -180,10 +224,13 @@ fn coverage(t: &[f64]) -> (f64, f64, f64) {
 /// One line per device.
 fn describe(d: &RandomDevice, r: &FieldReport) -> String {
     let mut line = format!(
-        "seed {} {}, coupling {} deg/s, {:.2e} clocks:",
+        "seed {} {}, coupling {} deg/s, damping {} deg/s, {:.2e} clocks:",
         d.seed,
         d.summary(),
         coupling_of(d.seed),
+        r.steps
+            .first()
+            .map_or(0.0, |s| s.truth.gyro.damping_coupling_dps),
         r.clocks as f64
     );
     for s in &r.steps {
@@ -203,6 +250,12 @@ fn describe(d: &RandomDevice, r: &FieldReport) -> String {
             s.identified.quadrature_dps_uncertainty,
             s.truth.gyro.quadrature_dps
         );
+        line += &format!(
+            " damping {:.4} +- {:.4} (true {:.4})",
+            s.identified.damping_coupling_dps,
+            s.identified.damping_coupling_dps_uncertainty,
+            s.truth.gyro.damping_coupling_dps
+        );
     }
     for f in &r.failed {
         line += &format!(
@@ -213,10 +266,18 @@ fn describe(d: &RandomDevice, r: &FieldReport) -> String {
     line
 }
 
-#[test]
-fn self_calibrated_scale_factors_lie_within_their_sigmas_as_promised() {
-    let runs: Vec<(RandomDevice, FieldReport)> =
-        (FIRST_SEED..).filter_map(field).take(DEVICES).collect();
+/// An identified parameter's name and t.
+type Named = (&'static str, f64);
+
+/// The `DEVICES` coverage devices' field runs, with their damping
+/// couplings when `damping`, each described on stderr: every step's
+/// self-calibration t, every identified parameter's t, and the
+/// self-calibration t's (share within 2, largest |t|, RMS).
+fn coverage_runs(damping: bool) -> (Vec<f64>, Vec<Named>, (f64, f64, f64)) {
+    let runs: Vec<(RandomDevice, FieldReport)> = (FIRST_SEED..)
+        .filter_map(|s| field(s, damping))
+        .take(DEVICES)
+        .collect();
     let mut t = vec![];
     let mut id_t = vec![];
     for (d, r) in &runs {
@@ -238,6 +299,12 @@ fn self_calibrated_scale_factors_lie_within_their_sigmas_as_promised() {
         t.len(),
         100.0 * in2
     );
+    (t, id_t, (in2, worst, rms))
+}
+
+#[test]
+fn self_calibrated_scale_factors_lie_within_their_sigmas_as_promised() {
+    let (t, id_t, (in2, worst, rms)) = coverage_runs(false);
     assert_eq!(t.len(), 4 * DEVICES);
     assert!(
         (0.90..=0.995).contains(&in2),
@@ -341,6 +408,91 @@ fn quadrature_coverage(id_t: &[(&'static str, f64)]) {
     assert!(rms >= 0.3, "quadrature: RMS t {rms:.2}, its sigma inflated");
 }
 
+/// The damping coupling (`gyrocal_host::coupling`, the imaginary part of
+/// the quadrature's estimate) of the half of the devices that carry one
+/// (`damping_of`; on the others it is seen as none and reported as 0):
+/// 90% to 99.5% within 2, every t within 3, an RMS t of at least 0.3.
+///
+/// What this found: with the phasor G_k in the estimate the DAC's images
+/// on a detuned output read both couplings 1.6% large at 2.6 clocks per
+/// carrier (seeds 2212 and 2360 at 14 to 16 sigma, 2380 at 14 to 21 and
+/// its self-calibrated scale factors at -9.3 and +5.0 sigma through the
+/// drive-gain ratio measured at rest); seeds 2001..2400 (336 figures)
+/// gave 94.6% within 2 and 7 beyond 3. With the images in
+/// (`drive_ratio::Folded`): 98.5% within 2, none beyond 3.
+fn damping_coverage(id_t: &[(&'static str, f64)]) {
+    let t: Vec<f64> = id_t
+        .iter()
+        .filter(|p| p.0 == "damping")
+        .map(|p| p.1)
+        .collect();
+    let (in2, worst, rms) = coverage(&t);
+    assert!(t.len() >= DEVICES / 2, "{} damping figures", t.len());
+    assert!(
+        (0.90..=0.995).contains(&in2),
+        "damping: {:.1}% within 2 sigma",
+        100.0 * in2
+    );
+    assert!(worst <= 3.0, "damping: a figure at {worst:.2} sigma");
+    assert!(rms >= 0.3, "damping: RMS t {rms:.2}, its sigma inflated");
+}
+
+/// The same devices with their damping couplings (`damping_of`: half of
+/// them, 1e-3 to 0.3 of the stability limit, up to 300 deg/s): the
+/// identified coupling covers its truth (`damping_coverage`), and every
+/// self-calibrated scale factor lies within 3 of its sigma and at least
+/// 90% within 2. Not asserted here, and why:
+/// - the 99.5% ceiling on the scale factors: these 160 read 100% within
+///   2 (largest |t| 1.95, RMS t 0.72), where seeds 2001..2400 with their
+///   damping couplings (1328 figures) give 97.8%, of which 160 figures
+///   (40 to 160 trials) show none beyond 2 in 3% to 40% of draws. The
+///   devices that carry one read RMS t 0.79 there against 0.96 for the
+///   same devices without (98.4% and 97.5% within 2): the coupling's
+///   sigma in the budget costs some 20% of width, not a twofold;
+/// - f and Q, asserted without couplings above: here f2 of seed 2033 (at
+///   2.94 clocks per carrier, -11 deg/s) at 35 deg C reads 3.9 sigma high
+///   at noise seed 1, and -0.19 and -0.05 at seeds 2 and 3: a sigma of
+///   3e-5 Hz some draws exceed, left as found.
+#[test]
+fn damping_couplings_lie_within_their_sigmas_as_promised() {
+    let (_, id_t, (in2, worst, rms)) = coverage_runs(true);
+    assert!(in2 >= 0.90, "{:.1}% within 2 sigma", 100.0 * in2);
+    assert!(worst <= 3.0, "a figure at {worst:.2} sigma");
+    assert!(rms >= 0.3, "RMS t {rms:.2}: sigmas inflated");
+    damping_coverage(&id_t);
+}
+
+/// Devices at 2.6 to 2.8 clocks per carrier with a damping coupling of
+/// 211 and 300 deg/s, where the DAC's images had read the coupling 14 to
+/// 21 sigma off and, through the drive-gain ratio measured at rest, the
+/// self-calibrated scale factors of seed 2380 9.3 sigma off
+/// (`damping_coverage`): now the couplings and every scale factor within
+/// 3 of their sigmas.
+#[test]
+fn the_dac_images_are_in_the_couplings_at_few_clocks_per_carrier() {
+    for seed in [2360, 2380] {
+        let d = RandomDevice::draw(seed, FAST);
+        let text = scenario_text(
+            &d,
+            coupling_of(seed),
+            damping_of(&d),
+            &drift(LAG.0, LAG.1),
+            "",
+        );
+        let sc = scenario::parse("random.toml", &text).unwrap();
+        let r = scenario::run(&sc, &|_| {}).unwrap();
+        assert!(r.failed.is_empty(), "seed {seed}: {:?}", r.failed);
+        eprintln!("{}", describe(&d, &r));
+        for (name, t) in identified_t(&r) {
+            if ["quadrature", "damping"].contains(&name) {
+                assert!(t.abs() <= 3.0, "seed {seed}: {name} at {t:.2} sigma");
+            }
+        }
+        let t = t_values(&r);
+        assert!(t.iter().all(|x| x.abs() <= 3.0), "seed {seed}: t {t:.2?}");
+    }
+}
+
 /// The front end's gain slope across the calibration's sidebands
 /// (`selfcal::budget::front_slope`): seed 2096 (Q 154, output 1 detuned)
 /// behind a pick-off lag of 8 deg at both steps, noise seeds 1 to 6.
@@ -360,7 +512,7 @@ fn a_large_front_end_lag_is_in_the_sigma() {
     let mut t = vec![];
     for noise_seed in 1..=6 {
         let extra = format!("[frontend]\nseed = {noise_seed}\n");
-        let text = scenario_text(&d, coupling_of(d.seed), &lagged, &extra);
+        let text = scenario_text(&d, coupling_of(d.seed), 0.0, &lagged, &extra);
         let sc = scenario::parse("lagged.toml", &text).unwrap();
         let r = scenario::run(&sc, &|_| {}).unwrap();
         assert!(
@@ -386,7 +538,8 @@ fn explore() {
     let range = a.parse::<u64>().unwrap()..b.parse::<u64>().unwrap();
     let mut t = vec![];
     let mut id_t = vec![];
-    for (d, r) in range.filter_map(field) {
+    let damping = std::env::var("GYROCAL_FIELD_DAMPING").map_or(true, |v| v != "0");
+    for (d, r) in range.filter_map(|s| field(s, damping)) {
         println!("{}", describe(&d, &r));
         t.extend(t_values(&r));
         id_t.extend(identified_t(&r));
@@ -405,4 +558,23 @@ fn explore() {
         let t: Vec<f64> = id_t.iter().filter(|p| p.0 == name).map(|p| p.1).collect();
         line(name, &t);
     }
+}
+
+/// The scenario file of device `GYROCAL_FIELD_SEED` as the coverage test
+/// runs it, to run alone with `gyrocal field --config FILE`.
+#[test]
+#[ignore = "prints a scenario, run by hand"]
+fn scenario_file() {
+    let seed = std::env::var("GYROCAL_FIELD_SEED").map_or(2001, |s| s.parse().unwrap());
+    let d = RandomDevice::draw(seed, FAST);
+    print!(
+        "{}",
+        scenario_text(
+            &d,
+            coupling_of(seed),
+            damping_of(&d),
+            &drift(LAG.0, LAG.1),
+            ""
+        )
+    );
 }

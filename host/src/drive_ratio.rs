@@ -87,7 +87,7 @@
 
 use crate::board::Board;
 use crate::error::Error;
-use crate::identify::{self, Estimate, Identified};
+use crate::identify::{self, Estimate, Identified, ModeFit};
 use crate::knowns::Knowns;
 use crate::sampling::average_z;
 use crate::selfcal::Operating;
@@ -125,6 +125,74 @@ pub struct DriveRatio {
 /// G_k(f) up to a common factor: 1 / ((f_k - f)(f_k + f) + j f b_k).
 pub(crate) fn resonator(f_k: f64, q_k: f64, f: f64) -> C64 {
     1.0 / C64::new((f_k - f) * (f_k + f), f * f_k / q_k)
+}
+
+/// What output `k`'s windows see of the coupled modes at `carrier_hz`,
+/// each DAC image folded onto the carrier (`crate::images`; the module
+/// header of `crate::coupling`, "Images"), weighted by the front end that
+/// output's mode was fitted through (`ModeFit::front_at`): the direct
+/// response S_kk and the cross response per unit of each coupling term,
+/// to first order in kappa(v) = K + j v D (K in Hz^2, D in Hz):
+/// M_cross / M_direct = -(K `stiffness` + D `damping`) / `direct`.
+/// Without images (j = 0 alone) these are G_k, G_1 G_2 and j f G_1 G_2.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Folded {
+    /// S_kk.
+    pub direct: C64,
+    /// Per unit K.
+    pub stiffness: C64,
+    /// Per unit D (and, turning, per unit of the Coriolis term 2 lambda
+    /// Omega, which also grows as j v).
+    pub damping: C64,
+}
+
+impl Folded {
+    /// Output `k`'s sums for the modes of `id`.
+    pub fn of(id: &Identified, k: usize, carrier_hz: f64, clock_hz: f64) -> Self {
+        let [m1, m2] = &id.modes;
+        let mode: &ModeFit = &id.modes[k];
+        let modes = [(m1.f_hz.value, m1.q.value), (m2.f_hz.value, m2.q.value)];
+        Self::sum(modes, k, carrier_hz, clock_hz, |v| mode.front_at(v))
+    }
+
+    /// Output `k`'s sums for modes `(f_k, Q_k)` behind a front end whose
+    /// response at v is `front(v)`.
+    pub fn sum(
+        modes: [(f64, f64); 2],
+        k: usize,
+        carrier_hz: f64,
+        clock_hz: f64,
+        front: impl Fn(f64) -> C64,
+    ) -> Self {
+        let g = |i: usize, v: f64| resonator(modes[i].0, modes[i].1, v);
+        let zero = C64::new(0.0, 0.0);
+        let mut sum = Self {
+            direct: zero,
+            stiffness: zero,
+            damping: zero,
+        };
+        for j in -identify::IMAGES..=identify::IMAGES {
+            let v = carrier_hz + f64::from(j) * clock_hz;
+            let weight = front(v) * (carrier_hz / v);
+            let cross = g(0, v) * g(1, v);
+            sum.direct += weight * g(k, v);
+            sum.stiffness += weight * cross;
+            sum.damping += weight * C64::new(0.0, v) * cross;
+        }
+        sum
+    }
+
+    /// The phasor theory's sums (the carrier alone) for resonators `g`
+    /// at `f`.
+    #[cfg(test)]
+    pub fn phasor(g: [C64; 2], k: usize, f: f64) -> Self {
+        let cross = g[0] * g[1];
+        Self {
+            direct: g[k],
+            stiffness: cross,
+            damping: C64::new(0.0, f) * cross,
+        }
+    }
 }
 
 /// The line y = P + Q W_2 through `y` measured at drive 2's two signed
@@ -167,6 +235,19 @@ fn resonator_ratio(id: &Identified, carrier_hz: f64) -> (C64, f64) {
     let [m1, m2] = &id.modes;
     let centre = ratio([m1.f_hz.value, m1.q.value, m2.f_hz.value, m2.q.value]);
     (centre, propagated(id, |v| ratio(v).norm()))
+}
+
+/// What takes G_1 / G_2's place in [`ratio_squared`] in the sampled
+/// loop: (S_11 / S_22) (X_2 / X_1), the direct responses and the cross
+/// responses (each output's `Folded::damping`, the form of the Coriolis
+/// and damping terms, which grow as j v) with the DAC's images folded in.
+/// Without images it is G_1 / G_2 (the outputs' front ends cancel).
+/// Images matter on a detuned output at a few clocks per carrier: on a
+/// Q 270 / 410 device 12.6 bandwidths split at 2.64 clocks per carrier,
+/// mode 2's direct response at the carrier carries 3% of images.
+fn folded_ratio(id: &Identified, carrier_hz: f64, clock_hz: f64) -> C64 {
+    let s = [0, 1].map(|k| Folded::of(id, k, carrier_hz, clock_hz));
+    s[0].direct / s[1].direct * (s[1].damping / s[0].damping)
 }
 
 /// Mean and standard error of `v`, times the coverage factor of its
@@ -297,7 +378,8 @@ pub(crate) fn from_windows(
     op: &Operating,
     id: &Identified,
 ) -> DriveRatio {
-    let (g_ratio, g_error) = resonator_ratio(id, op.carrier_hz);
+    let (_, g_error) = resonator_ratio(id, op.carrier_hz);
+    let g_ratio = folded_ratio(id, op.carrier_hz, knowns.clock_hz);
     let squared: Vec<C64> = (0..BATCHES)
         .map(|b| {
             let ((p1, q1), (p2, q2)) = windows.lines(Some(b));

@@ -83,7 +83,7 @@ pub(crate) struct FrontSlope {
 impl FrontSlope {
     /// The response h at `f` relative to the mode `fk`, and its
     /// derivative in fk.
-    fn at(self, f: f64, fk: f64) -> (C64, C64) {
+    pub(crate) fn at(self, f: f64, fk: f64) -> (C64, C64) {
         let d = f - fk;
         if self.linear {
             let s = C64::new(self.gain_per_hz, -TAU * self.delay_s);

@@ -243,6 +243,19 @@ pub struct ModeFit {
     pub probed_delay_s: Option<Estimate>,
 }
 
+impl ModeFit {
+    /// The front end's response at `f_hz` relative to this mode's
+    /// frequency, as the fit took it (`front`): what weights each DAC image
+    /// of the output this mode was identified through.
+    pub(crate) fn front_at(&self, f_hz: f64) -> C64 {
+        self.front.at(f_hz, self.f_hz.value).0
+    }
+}
+
+/// DAC images each side of the carrier that the models of the sampled
+/// responses sum (`fit::FIT_IMAGES`).
+pub(crate) const IMAGES: i32 = fit::FIT_IMAGES;
+
 /// The identified device.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Identified {
