@@ -9,10 +9,8 @@
 
 use super::axil_read::ReadChannels;
 use super::axil_write::WriteChannels;
-use super::register_map::{
-    self, ADC_CLIP, Access, BusError, DATA_BITS, ID_WORD, RegisterBank, SAMPLE_COUNT,
-    STREAM_OVERFLOW, VERSION_WORD, Z1_HI, Z1_LO, Z2_HI, Z2_LO,
-};
+use super::register_file::{STATUS, status_live};
+use super::register_map::{self, ADC_CLIP, Access, BusError, RegisterBank, SAMPLE_COUNT};
 use super::sample_fifo::Fifo;
 use super::status_counters::{Counters, StatusInputs};
 use super::{Z_BITS, Z_MASK};
@@ -118,26 +116,20 @@ impl Wrapper {
         }
     }
 
-    /// What a read of word `index` returns during this cycle.
-    fn read_word(&self, index: u32, count_now: u32) -> Result<u32, BusError> {
+    /// What a read of word `index` returns during this cycle, the core
+    /// publishing z when `z_valid`: a setting from the bank, a status word
+    /// from its source (`register_file::status_live`) cut to its field.
+    fn read_word(&self, index: u32, z_valid: bool) -> Result<u32, BusError> {
         let reg = register_map::lookup(index * 4).ok_or(BusError::Unmapped)?;
         if reg.access == Access::ReadWrite {
             return self.bank.read(reg.offset);
         }
-        let (z1, z2) = self.counters.snapshot();
-        let live = match reg.offset {
-            o if o == STREAM_OVERFLOW.offset => self.counters.overflow(),
-            o if o == SAMPLE_COUNT.offset => count_now,
-            o if o == Z1_LO.offset => z1 as u32,
-            o if o == Z1_HI.offset => (z1 >> DATA_BITS) as u32,
-            o if o == Z2_LO.offset => z2 as u32,
-            o if o == Z2_HI.offset => (z2 >> DATA_BITS) as u32,
-            o if o == register_map::ID.offset => ID_WORD,
-            o if o == register_map::VERSION.offset => VERSION_WORD,
-            o if o == ADC_CLIP.offset => self.counters.clip_word(),
-            _ => unreachable!("status word {} has no source", reg.name),
-        };
-        Ok(reg.extend(live))
+        let live = status_live(&self.counters.words(z_valid));
+        let i = STATUS
+            .iter()
+            .position(|s| s.offset == reg.offset)
+            .expect("every read-only word of the map is in STATUS");
+        Ok(reg.extend(live[i]))
     }
 }
 
@@ -219,8 +211,7 @@ impl GyroInterfaceAxi {
         next.write.step(aw, w, i.bready, accepted);
         // The read channels, and the register file's read.
         let read = now.read.read();
-        let count_now = now.counters.count(core.z_valid);
-        let answer = read.and_then(|index| now.read_word(index, count_now).ok());
+        let answer = read.and_then(|index| now.read_word(index, core.z_valid).ok());
         next.read
             .step(i.arvalid.then_some(i.araddr), i.rready, answer);
         // The counters, the snapshot and the stream.
@@ -256,6 +247,7 @@ pub fn unpack_sample(word: u128) -> (i64, i64, u16) {
 
 #[cfg(test)]
 mod tests {
+    use super::super::register_map::{Z1_HI, Z1_LO, Z2_HI, Z2_LO};
     use super::*;
 
     /// Z1_HI:Z1_LO and Z2_HI:Z2_LO give back any 40-bit snapshot, sign
@@ -286,7 +278,7 @@ mod tests {
                 ..StatusInputs::default()
             });
             w.counters = counters;
-            let word = |reg: &register_map::Register| w.read_word(reg.word_index(), 0).unwrap();
+            let word = |reg: &register_map::Register| w.read_word(reg.word_index(), false).unwrap();
             let join = |hi: u32, lo: u32| (i64::from(hi as i32) << 32) | i64::from(lo);
             assert_eq!(join(word(&Z1_HI), word(&Z1_LO)), z, "z1 = {z:#x}");
             assert_eq!(join(word(&Z2_HI), word(&Z2_LO)), !z, "z2 = {:#x}", !z);

@@ -30,7 +30,7 @@ use super::register_map::{
 };
 use super::sample_fifo::SAMPLE_BITS;
 use super::setting_register::SettingRegister;
-use super::status_counters::StatusCounters;
+use super::status_counters::{CounterWords, StatusCounters};
 use super::status_word::StatusWord;
 use super::{Z_BITS, register_map};
 use crate::cic_decimator::{DECIMATION_BITS, SHIFT_BITS};
@@ -69,6 +69,25 @@ pub const STATUS: [Register; 9] = [
     Z2_HI,
     ADC_CLIP,
 ];
+
+/// The model of the status words' sources, as `update` wires them: the
+/// live value of each word of `STATUS`, in its order, from the counters'
+/// words of the cycle (`StatusCounters`' model). Each `StatusWord` then
+/// returns its field (`Register::extend`).
+pub fn status_live(counters: &CounterWords) -> [u32; 9] {
+    let c = counters;
+    [
+        ID.power_up,
+        VERSION.power_up,
+        c.overflow,
+        c.count,
+        c.z1_low,
+        c.z1_high,
+        c.z2_low,
+        c.z2_high,
+        c.clip,
+    ]
+}
 
 const _: () = assert!(SETTINGS.len() + STATUS.len() == register_map::REGISTERS.len());
 // The core ports' widths, which `update` cuts from the fields as literals.

@@ -191,6 +191,28 @@ pub struct StatusInputs {
     pub clip_clear: bool,
 }
 
+/// What `StatusCounters` shows the status words during one cycle: its
+/// `overflow`, `count`, `z1_low`, `z1_high`, `z2_low`, `z2_high` and
+/// `clip` ports (the z snapshot's 40 bits as a low word and the high
+/// byte).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct CounterWords {
+    /// STREAM_OVERFLOW.
+    pub overflow: u32,
+    /// SAMPLE_COUNT.
+    pub count: u32,
+    /// Z1_LO.
+    pub z1_low: u32,
+    /// Z1_HI (8 bits).
+    pub z1_high: u32,
+    /// Z2_LO.
+    pub z2_low: u32,
+    /// Z2_HI (8 bits).
+    pub z2_high: u32,
+    /// ADC_CLIP.
+    pub clip: u32,
+}
+
 /// Bit-true model of `StatusCounters`: its registers, an edge at a time.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Counters {
@@ -208,19 +230,19 @@ impl Counters {
         self.sample_count.wrapping_add(u32::from(z_valid))
     }
 
-    /// STREAM_OVERFLOW during the current cycle.
-    pub fn overflow(&self) -> u32 {
-        self.overflow_count
-    }
-
-    /// z1 and z2 at the last snapshot, as their 40 bits.
-    pub fn snapshot(&self) -> (u64, u64) {
-        self.snapshot
-    }
-
-    /// ADC_CLIP during the current cycle.
-    pub fn clip_word(&self) -> u32 {
-        clip_word(self.clip)
+    /// The words the block shows the status words during the current
+    /// cycle, this cycle's sample counted when `z_valid`.
+    pub fn words(&self, z_valid: bool) -> CounterWords {
+        let (z1, z2) = self.snapshot;
+        CounterWords {
+            overflow: self.overflow_count,
+            count: self.count(z_valid),
+            z1_low: z1 as u32,
+            z1_high: (z1 >> DATA_BITS) as u32,
+            z2_low: z2 as u32,
+            z2_high: (z2 >> DATA_BITS) as u32,
+            clip: clip_word(self.clip),
+        }
     }
 
     /// The stream beat {count\[15:0\], z2, z1} of a cycle with the core's
@@ -289,15 +311,15 @@ mod tests {
             uut.clip_clear.next = clip_clear;
             uut.reset.next = reset;
             crate::drive::settle(&mut uut);
-            let (z1, z2) = model.snapshot();
+            let want = model.words(z_valid);
             let words = [
-                (uut.count.val().index() as u32, model.count(z_valid)),
-                (uut.overflow.val().index() as u32, model.overflow()),
-                (uut.z1_low.val().index() as u32, z1 as u32),
-                (uut.z1_high.val().index() as u32, (z1 >> 32) as u32),
-                (uut.z2_low.val().index() as u32, z2 as u32),
-                (uut.z2_high.val().index() as u32, (z2 >> 32) as u32),
-                (uut.clip.val().index() as u32, model.clip_word()),
+                (uut.count.val().index() as u32, want.count),
+                (uut.overflow.val().index() as u32, want.overflow),
+                (uut.z1_low.val().index() as u32, want.z1_low),
+                (uut.z1_high.val().index() as u32, want.z1_high),
+                (uut.z2_low.val().index() as u32, want.z2_low),
+                (uut.z2_high.val().index() as u32, want.z2_high),
+                (uut.clip.val().index() as u32, want.clip),
             ];
             for (n, (got, want)) in words.into_iter().enumerate() {
                 assert_eq!(got, want, "cycle {cycle}, word {n}");
