@@ -29,7 +29,7 @@
 //! has a baseline (its baseline fields are null).
 
 use crate::Failure;
-use gyrocal_host::selfcal::{ScaledDrives, Spurs};
+use gyrocal_host::selfcal::{AT_REST_RATIO_SIGMA, ScaledDrives, Spurs};
 use gyrocal_sim::field::profile::RateTrace;
 use gyrocal_sim::field::scenario::{self, FAILED_CYCLE, FieldReport};
 use std::fmt::Write as _;
@@ -244,7 +244,7 @@ fn step_notes(s: &mut String, report: &FieldReport) {
     if !design.is_empty() && report.knowns.drive_gain_ratio_uncertainty == 0.0 {
         let _ = writeln!(
             s,
-            "note: at {} deg C the drive-gain ratio g2/g1 is the design's (no quadrature coupling seen at rest, no [drive_probe]) and [datasheet] gives no drive_gain_ratio_uncertainty: a drive gain that drifted is not in the sigma",
+            "note: at {} deg C the drive-gain ratio g2/g1 is the design's (no coupling at rest that measures it within {AT_REST_RATIO_SIGMA:e}, no [drive_probe]) and [datasheet] gives no drive_gain_ratio_uncertainty: a drive gain that drifted is not in the sigma",
             design.join(", ")
         );
     }
