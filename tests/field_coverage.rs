@@ -269,6 +269,11 @@ fn describe(d: &RandomDevice, r: &FieldReport) -> String {
 /// An identified parameter's name and t.
 type Named = (&'static str, f64);
 
+/// The t of the parameter `name` in `id_t`, in order.
+fn named(id_t: &[Named], name: &str) -> Vec<f64> {
+    id_t.iter().filter(|p| p.0 == name).map(|p| p.1).collect()
+}
+
 /// The `DEVICES` coverage devices' field runs, with their damping
 /// couplings when `damping`, each described on stderr: every step's
 /// self-calibration t, every identified parameter's t, and the
@@ -337,7 +342,7 @@ fn self_calibrated_scale_factors_lie_within_their_sigmas_as_promised() {
 /// a first-order front end's +-100% had put those Q sigmas 40 times their
 /// errors). Pinned now: 98.4% within 2, largest |t| 2.49, RMS t f1 0.64,
 /// f2 0.70, Q1 0.74, Q2 0.59.
-fn identified_coverage(id_t: &[(&'static str, f64)]) {
+fn identified_coverage(id_t: &[Named]) {
     let all: Vec<f64> = id_t
         .iter()
         .filter(|p| ASSERTED.contains(&p.0))
@@ -350,7 +355,7 @@ fn identified_coverage(id_t: &[(&'static str, f64)]) {
         100.0 * in2
     );
     for name in IDENTIFIED {
-        let t: Vec<f64> = id_t.iter().filter(|p| p.0 == name).map(|p| p.1).collect();
+        let t = named(id_t, name);
         let (in2, worst, rms) = coverage(&t);
         eprintln!(
             "  {name}: {:.1}% within 2, largest |t| {worst:.2}, RMS t {rms:.2}",
@@ -364,7 +369,7 @@ fn identified_coverage(id_t: &[(&'static str, f64)]) {
     );
     assert!(worst <= 3.0, "an identified parameter at {worst:.2} sigma");
     for name in ASSERTED {
-        let t: Vec<f64> = id_t.iter().filter(|p| p.0 == name).map(|p| p.1).collect();
+        let t = named(id_t, name);
         let rms = coverage(&t).2;
         assert!(rms >= 0.3, "{name}: RMS t {rms:.2}, its sigma inflated");
     }
@@ -393,12 +398,8 @@ fn identified_coverage(id_t: &[(&'static str, f64)]) {
 /// z is white beyond (2^20 samples of the difference of two noise seeds:
 /// within 6% from 64 to 2048 samples). The 3.40 is then a Student t draw of
 /// some 5 (0.13% at 7 degrees of freedom) on a sigma some 10% small.
-fn quadrature_coverage(id_t: &[(&'static str, f64)]) {
-    let t: Vec<f64> = id_t
-        .iter()
-        .filter(|p| p.0 == "quadrature")
-        .map(|p| p.1)
-        .collect();
+fn quadrature_coverage(id_t: &[Named]) {
+    let t = named(id_t, "quadrature");
     let (in2, _, rms) = coverage(&t);
     assert!(
         (0.90..=0.995).contains(&in2),
@@ -420,12 +421,8 @@ fn quadrature_coverage(id_t: &[(&'static str, f64)]) {
 /// drive-gain ratio measured at rest); seeds 2001..2400 (336 figures)
 /// gave 94.6% within 2 and 7 beyond 3. With the images in
 /// (`drive_ratio::Folded`): 98.5% within 2, none beyond 3.
-fn damping_coverage(id_t: &[(&'static str, f64)]) {
-    let t: Vec<f64> = id_t
-        .iter()
-        .filter(|p| p.0 == "damping")
-        .map(|p| p.1)
-        .collect();
+fn damping_coverage(id_t: &[Named]) {
+    let t = named(id_t, "damping");
     let (in2, worst, rms) = coverage(&t);
     assert!(t.len() >= DEVICES / 2, "{} damping figures", t.len());
     assert!(
@@ -555,7 +552,7 @@ fn explore() {
     };
     line("self-calibrated scale factors", &t);
     for name in IDENTIFIED {
-        let t: Vec<f64> = id_t.iter().filter(|p| p.0 == name).map(|p| p.1).collect();
+        let t = named(&id_t, name);
         line(name, &t);
     }
 }

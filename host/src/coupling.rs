@@ -104,7 +104,7 @@ fn solve(s: &Folded, ratio: C64) -> (f64, f64) {
 
 /// kappa at the carrier, K + j fc D (Hz^2), from one batch's lines
 /// (module header): each output's (K, D) from its cross over direct
-/// response (`Folded::solve`), then their mean, for the design drive-gain
+/// response (`solve`), then their mean, for the design drive-gain
 /// ratio `rho`.
 fn coupling_hz2(
     lines: ((C64, C64), (C64, C64)),

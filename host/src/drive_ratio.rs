@@ -87,7 +87,7 @@
 
 use crate::board::Board;
 use crate::error::Error;
-use crate::identify::{self, Estimate, Identified, ModeFit};
+use crate::identify::{self, Estimate, Identified};
 use crate::knowns::Knowns;
 use crate::sampling::average_z;
 use crate::selfcal::Operating;
@@ -150,7 +150,7 @@ impl Folded {
     /// Output `k`'s sums for the modes of `id`.
     pub fn of(id: &Identified, k: usize, carrier_hz: f64, clock_hz: f64) -> Self {
         let [m1, m2] = &id.modes;
-        let mode: &ModeFit = &id.modes[k];
+        let mode = &id.modes[k];
         let modes = [(m1.f_hz.value, m1.q.value), (m2.f_hz.value, m2.q.value)];
         Self::sum(modes, k, carrier_hz, clock_hz, |v| mode.front_at(v))
     }
@@ -228,13 +228,11 @@ pub(crate) fn propagated(id: &Identified, size: impl Fn([f64; 4]) -> f64) -> f64
         .sqrt()
 }
 
-/// G_1 / G_2 at the carrier from the identified modes, and the relative
-/// 1-sigma uncertainty of its magnitude ([`propagated`]).
-fn resonator_ratio(id: &Identified, carrier_hz: f64) -> (C64, f64) {
+/// The relative 1-sigma uncertainty of |G_1 / G_2| at the carrier from
+/// the identified modes ([`propagated`]).
+fn resonator_ratio_error(id: &Identified, carrier_hz: f64) -> f64 {
     let ratio = |v: [f64; 4]| resonator(v[0], v[1], carrier_hz) / resonator(v[2], v[3], carrier_hz);
-    let [m1, m2] = &id.modes;
-    let centre = ratio([m1.f_hz.value, m1.q.value, m2.f_hz.value, m2.q.value]);
-    (centre, propagated(id, |v| ratio(v).norm()))
+    propagated(id, |v| ratio(v).norm())
 }
 
 /// What takes G_1 / G_2's place in [`ratio_squared`] in the sampled
@@ -378,7 +376,7 @@ pub(crate) fn from_windows(
     op: &Operating,
     id: &Identified,
 ) -> DriveRatio {
-    let (_, g_error) = resonator_ratio(id, op.carrier_hz);
+    let g_error = resonator_ratio_error(id, op.carrier_hz);
     let g_ratio = folded_ratio(id, op.carrier_hz, knowns.clock_hz);
     let squared: Vec<C64> = (0..BATCHES)
         .map(|b| {

@@ -74,7 +74,7 @@ pub const STATUS: [Register; 9] = [
 /// live value of each word of `STATUS`, in its order, from the counters'
 /// words of the cycle (`StatusCounters`' model). Each `StatusWord` then
 /// returns its field (`Register::extend`).
-pub fn status_live(counters: &CounterWords) -> [u32; 9] {
+pub fn status_live(counters: &CounterWords) -> [u32; STATUS.len()] {
     let c = counters;
     [
         ID.power_up,
