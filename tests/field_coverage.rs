@@ -412,7 +412,11 @@ fn quadrature_coverage(id_t: &[Named]) {
 /// The damping coupling (`gyrocal_host::coupling`, the imaginary part of
 /// the quadrature's estimate) of the half of the devices that carry one
 /// (`damping_of`; on the others it is seen as none and reported as 0):
-/// 90% to 99.5% within 2, every t within 3, an RMS t of at least 0.3.
+/// at least 90% within 2, every t within 3, an RMS t of at least 0.3.
+/// Not the 99.5% ceiling: these are some 40 figures, and 40 figures of a
+/// sigma exactly right all fall within 2 in 0.954^40 = 15% of draws
+/// (with the spur term of `coupling::spur_power` they read 100%); the
+/// ceiling is the survey's, seeds 2001..2400 (336 figures), 99.4%.
 ///
 /// What this found: with the phasor G_k in the estimate the DAC's images
 /// on a detuned output read both couplings 1.6% large at 2.6 clocks per
@@ -420,16 +424,20 @@ fn quadrature_coverage(id_t: &[Named]) {
 /// its self-calibrated scale factors at -9.3 and +5.0 sigma through the
 /// drive-gain ratio measured at rest); seeds 2001..2400 (336 figures)
 /// gave 94.6% within 2 and 7 beyond 3. With the images in
-/// (`drive_ratio::Folded`): 98.5% within 2, none beyond 3.
+/// (`drive_ratio::Folded`): 98.5% within 2, none beyond 3; with the
+/// table core's spur lines in the sigma too (`coupling::spur_power`),
+/// 99.4% within 2, none beyond 3, and the quadrature coupling's 664
+/// figures 98.8% within 2, none beyond 3 (97.7% and 2 beyond before).
 fn damping_coverage(id_t: &[Named]) {
     let t = named(id_t, "damping");
     let (in2, worst, rms) = coverage(&t);
-    assert!(t.len() >= DEVICES / 2, "{} damping figures", t.len());
-    assert!(
-        (0.90..=0.995).contains(&in2),
-        "damping: {:.1}% within 2 sigma",
+    eprintln!(
+        "damping, {} figures: {:.1}% within 2 sigma, largest |t| {worst:.2}, RMS t {rms:.2}",
+        t.len(),
         100.0 * in2
     );
+    assert!(t.len() >= DEVICES / 2, "{} damping figures", t.len());
+    assert!(in2 >= 0.90, "damping: {:.1}% within 2 sigma", 100.0 * in2);
     assert!(worst <= 3.0, "damping: a figure at {worst:.2} sigma");
     assert!(rms >= 0.3, "damping: RMS t {rms:.2}, its sigma inflated");
 }
@@ -488,6 +496,47 @@ fn the_dac_images_are_in_the_couplings_at_few_clocks_per_carrier() {
         let t = t_values(&r);
         assert!(t.iter().all(|x| x.abs() <= 3.0), "seed {seed}: t {t:.2?}");
     }
+}
+
+/// A carrier-table spur line that beats slower than the coupling's
+/// windows: seed 2258 (2 MHz, Q 9600 / 8100, 3.06 clocks per carrier)
+/// without couplings, where at 35 deg C the report names a line 2.8 Hz
+/// from the carrier. Each window's mean carries it whole and every batch
+/// the same, so the batch spread never saw it: over noise seeds 1 to 8
+/// the quadrature coupling read -2.25 to +1.71 deg/s (RMS 1.56) against
+/// sigmas of 0.19 to 0.72, up to 10 sigma. The lines' power in the
+/// windows (`coupling::spur_power`) now enters the sigma, 2.2 deg/s
+/// there: every figure within 3 sigma, and RMS t at least 0.3 (a sigma
+/// more than three times its error fails it; measured 0.7).
+#[test]
+fn a_slow_spur_line_is_in_the_couplings_sigma() {
+    let d = RandomDevice::draw(2258, FAST);
+    let mut t = vec![];
+    for noise_seed in 1..=8 {
+        let extra = format!("[frontend]\nseed = {noise_seed}\n");
+        let text = scenario_text(&d, 0.0, 0.0, &drift(LAG.0, LAG.1), &extra);
+        let sc = scenario::parse("spur.toml", &text).unwrap();
+        let r = scenario::run(&sc, &|_| {}).unwrap();
+        assert!(
+            r.failed.is_empty(),
+            "noise seed {noise_seed}: {:?}",
+            r.failed
+        );
+        for (name, x) in identified_t(&r) {
+            if ["quadrature", "damping"].contains(&name) {
+                assert!(
+                    x.abs() <= 3.0,
+                    "noise seed {noise_seed}: {name} at {x:.2} sigma"
+                );
+                if name == "quadrature" {
+                    t.push(x);
+                }
+            }
+        }
+    }
+    let rms = (t.iter().map(|x| x * x).sum::<f64>() / t.len() as f64).sqrt();
+    eprintln!("quadrature t {t:.2?}, RMS {rms:.2}");
+    assert!(rms >= 0.3, "RMS t {rms:.2}: the sigma inflated");
 }
 
 /// The front end's gain slope across the calibration's sidebands

@@ -65,12 +65,34 @@
 //! unseen device (2.2 MHz, Q 8000 / 6000, six noise seeds) the quadrature
 //! coupling at one step lay at an RMS of 1.5 of its sigmas, one seed at
 //! -3.18.
+//!
+//! On the table core, a third term: the carrier spurs (`selfcal::spurs`).
+//! A line that beats slower than a window is the same in each of its
+//! batches, so the spread never sees it, yet it moves each window's mean
+//! by up to its amplitude. `spur_power` sums the lines' power in a
+//! window's mean (each line's amplitude at the cross responses' drive
+//! amplitudes, as a fraction of the output's magnitude, times |sinc(pi f
+//! T)| over the window T), and `spur_sigma` carries it through the
+//! estimate: its derivative by each of the eight window means times that
+//! output's magnitude, the windows' lines taken with phases of their own
+//! (measured minutes apart, a slow line's phases are not; independent
+//! phases overstate a line that barely moves between the windows and
+//! understate, by at most a factor 2 in variance, one that turns half a
+//! period). Seed 2258 of `tests/field_coverage.rs` (2 MHz, 3.06 clocks
+//! per carrier) at 35 deg C, whose report names a line 2.8 Hz from the
+//! carrier, read its quadrature coupling (truly 0) at -2.25 to +1.71 deg/s
+//! over eight noise seeds (RMS 1.56) against sigmas of 0.19 to 0.72; the
+//! term makes them 2.2 (`a_slow_spur_line_is_in_the_couplings_sigma`).
+//! On the fine core (no such lines) the same device read -0.55 to +0.03.
 
-use crate::drive_ratio::{BATCHES, CrossWindows, Folded, mean_and_error, propagated, resonator};
+use crate::drive_ratio::{
+    BATCHES, CrossWindows, DRIVE1_FRACTION, Folded, mean_and_error, propagated, resonator,
+};
 use crate::error::Error;
 use crate::identify::{self, Estimate, FrontEnd, Identified, ModeFit};
 use crate::knowns::Knowns;
 use crate::selfcal::Operating;
+use crate::selfcal::spurs;
 use nalgebra::Complex;
 use serde::Serialize;
 
@@ -138,22 +160,24 @@ fn resonator_error(id: &Identified, carrier_hz: f64) -> f64 {
 /// The coupling from the cross-response windows measured at rest at the
 /// operating point `op` of identification `id`: one round, which the
 /// cycle iterates with [`uncouple`] (`selfcal`).
+///
+/// `spur_power`: the table core's lines in the windows' means
+/// ([`spur_power`]), whose spread the batches do not see.
 pub(crate) fn from_windows(
     windows: &CrossWindows,
     knowns: &Knowns,
     op: &Operating,
     id: &Identified,
+    spur_power: Option<[f64; 2]>,
 ) -> Result<Coupling, Error> {
     let g_error = resonator_error(id, op.carrier_hz);
     let folded = [0, 1].map(|k| Folded::of(id, k, op.carrier_hz, knowns.clock_hz));
     let rho = knowns.force_full_scale[1] / knowns.force_full_scale[0];
     let per_hz2 = 180.0 / (knowns.nominal.angular_gain * id.modes[0].f_hz.value);
-    let batches: Vec<C64> = (0..BATCHES)
-        .map(|b| {
-            let lines = windows.lines(Some(b));
-            per_hz2 * coupling_hz2(lines, windows.w1, &folded, rho, op.carrier_hz)
-        })
-        .collect();
+    let in_dps = |w: &CrossWindows, b: Option<usize>| {
+        per_hz2 * coupling_hz2(w.lines(b), w.w1, &folded, rho, op.carrier_hz)
+    };
+    let batches: Vec<C64> = (0..BATCHES).map(|b| in_dps(windows, Some(b))).collect();
     if batches.iter().any(|k| !k.re.is_finite()) {
         return Err(Error::Measurement {
             what: "quadrature coupling",
@@ -162,19 +186,70 @@ pub(crate) fn from_windows(
     }
     // The real part is Omega_q (k = 2 lambda w1 Omega_q); the imaginary
     // part w_c d with d = 2 lambda Omega_d, so Omega_d is it times f1 / fc.
-    let estimate = |v: Vec<f64>| {
+    let spurs = spur_power.map_or(C64::new(0.0, 0.0), |power| {
+        spur_sigma(windows, power, |w| in_dps(w, None))
+    });
+    let estimate = |v: Vec<f64>, spur: f64| {
         let noise = mean_and_error(&v);
         Estimate {
             value: noise.value,
-            uncertainty: noise.uncertainty.hypot(g_error * noise.value),
+            uncertainty: noise.uncertainty.hypot(g_error * noise.value).hypot(spur),
         }
     };
     let to_damping = id.modes[0].f_hz.value / op.carrier_hz;
     Ok(Coupling {
-        quadrature_dps: estimate(batches.iter().map(|k| k.re).collect()),
-        damping_dps: estimate(batches.iter().map(|k| k.im * to_damping).collect()),
+        quadrature_dps: estimate(batches.iter().map(|k| k.re).collect(), spurs.re),
+        damping_dps: estimate(
+            batches.iter().map(|k| k.im * to_damping).collect(),
+            spurs.im * to_damping,
+        ),
         clocks: windows.clocks,
     })
+}
+
+/// The power of the table core's carrier spurs in the windows' means at
+/// the cross responses' drive amplitudes, per output, as a fraction of
+/// each output's magnitude squared (`spurs::relative_power_over_records`
+/// over one window); `None` on the fine core.
+pub(crate) fn spur_power(
+    windows: &CrossWindows,
+    knowns: &Knowns,
+    op: &Operating,
+    id: &Identified,
+) -> Result<Option<[f64; 2]>, Error> {
+    let cross = Operating {
+        amplitude: (DRIVE1_FRACTION * op.amplitude.0, op.amplitude.1),
+        ..op.clone()
+    };
+    spurs::relative_power_over_records(knowns, id, &cross, windows.window_s)
+}
+
+/// The 1-sigma of the estimate `estimate` (deg/s; the real and the
+/// imaginary part) from spur lines of relative power `power` per output
+/// in each window's mean (module header, "Uncertainty"): the estimate's
+/// derivative by each of the eight window means (two signs, in-phase and
+/// quadrature, two outputs) times that output's magnitude, each window's
+/// lines taken with phases of their own.
+fn spur_sigma(
+    windows: &CrossWindows,
+    power: [f64; 2],
+    estimate: impl Fn(&CrossWindows) -> C64,
+) -> C64 {
+    let mut variance = C64::new(0.0, 0.0);
+    for s in 0..2 {
+        for (k, p) in power.iter().enumerate() {
+            let m = windows.magnitude(s, k);
+            let h = 1e-6 * m;
+            for q in 0..2 {
+                let slope = (estimate(&windows.shifted(s, q, k, h))
+                    - estimate(&windows.shifted(s, q, k, -h)))
+                    / (2.0 * h);
+                let d = slope * m;
+                variance += C64::new(d.re * d.re, d.im * d.im) * p;
+            }
+        }
+    }
+    C64::new(variance.re.sqrt(), variance.im.sqrt())
 }
 
 /// Fixed-point rounds of [`uncouple`] at most (each mode's pull is
@@ -338,6 +413,68 @@ mod tests {
             );
             assert!(got.im.abs() <= 1e-9 * k.abs().max(1.0), "{got}");
         }
+    }
+
+    /// `spur_sigma` against its premise: each of the eight window means
+    /// moved by a line of power p_k (a fraction of its output's magnitude
+    /// squared) at a phase of its own. Over 4000 draws of the phases the
+    /// estimate's error has an RMS equal to the sigma, real and imaginary
+    /// part, within 5% (the RMS of 4000 draws scatters by about 1 / sqrt(2
+    /// x 4000) = 1.1%, the first-order slopes by far less).
+    #[test]
+    fn the_spur_sigma_is_the_spread_lines_leave() {
+        let f = 25.1e3;
+        let g = [resonator(25.1e3, 3000.0, f), resonator(25.8e3, 3000.0, f)];
+        let kappa = C64::new(3.0e3, 800.0);
+        let det = 1.0 / (g[0] * g[1]) - kappa * kappa;
+        let m = [
+            [1.0 / (g[1] * det), -kappa / det],
+            [-kappa / det, 1.0 / (g[0] * det)],
+        ];
+        let (w1, w2) = (2500.0, [15000.0, -14999.0]);
+        let j = C64::new(0.0, 1.0);
+        let z = |w: f64| {
+            let x1 = m[0][0] * w1 - j * m[0][1] * w;
+            let x2 = m[1][0] * w1 - j * m[1][1] * w;
+            [w1 * x1, w * x2]
+        };
+        let windows = CrossWindows::constant([z(w2[0]), z(w2[1])], w1, w2);
+        let folded = [0, 1].map(|k| Folded::phasor(g, k, f));
+        let estimate = |w: &CrossWindows| coupling_hz2(w.lines(None), w.w1, &folded, 1.0, f);
+        let power = [3e-7, 1e-6];
+        let sigma = spur_sigma(&windows, power, estimate);
+        let clean = estimate(&windows);
+        let mut state = 2258u64;
+        let mut phase = || {
+            // splitmix64, to a phase uniform over a turn.
+            state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+            let mut x = state;
+            x = (x ^ (x >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+            x = (x ^ (x >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+            (x ^ (x >> 31)) as f64 / 2f64.powi(64) * std::f64::consts::TAU
+        };
+        let draws = 4000;
+        let mut sum = [0.0; 2];
+        for _ in 0..draws {
+            let mut moved = windows.clone();
+            for s in 0..2 {
+                for (k, p) in power.iter().enumerate() {
+                    let amplitude = (2.0 * p).sqrt() * windows.magnitude(s, k);
+                    for q in 0..2 {
+                        moved = moved.shifted(s, q, k, amplitude * phase().cos());
+                    }
+                }
+            }
+            let e = estimate(&moved) - clean;
+            sum[0] += e.re * e.re;
+            sum[1] += e.im * e.im;
+        }
+        let ratio = [sum[0].sqrt() / sigma.re, sum[1].sqrt() / sigma.im]
+            .map(|r| r / f64::from(draws).sqrt());
+        assert!(
+            ratio.iter().all(|r| (r - 1.0).abs() <= 0.05),
+            "RMS over sigma {ratio:?}, sigma {sigma}"
+        );
     }
 
     /// The windows of a device at 2.64 clocks per carrier with its output 2

@@ -274,6 +274,7 @@ fn batch_means(board: &mut dyn Board, settle: u64, per_batch: u64) -> Result<Vec
 /// the four responses"): both drives at the readout amplitudes (drive 1 at
 /// `DRIVE1_FRACTION`), drive 2 at its two signs, I and Q of each; every
 /// window `min_window_s` long, cut into `BATCHES` batches.
+#[derive(Clone)]
 pub(crate) struct CrossWindows {
     /// Batch means, `means[sign][quadrature][batch][output]`.
     means: Vec<Vec<Vec<[f64; 2]>>>,
@@ -283,6 +284,8 @@ pub(crate) struct CrossWindows {
     pub words: [f64; 2],
     /// Clocks the windows took.
     pub clocks: u64,
+    /// Each window's length (s).
+    pub window_s: f64,
 }
 
 impl CrossWindows {
@@ -324,6 +327,7 @@ impl CrossWindows {
             w1,
             words,
             clocks,
+            window_s: (BATCHES as u64 * per_batch * u64::from(r)) as f64 / knowns.clock_hz,
         })
     }
 
@@ -334,6 +338,43 @@ impl CrossWindows {
             None => self.means[s][q].iter().map(|m| m[k]).sum::<f64>(),
         };
         C64::new(part(0), part(1))
+    }
+
+    /// Windows whose every batch reads `z[s][k]` (output k at drive 2's
+    /// sign s, in-phase and quadrature as the real and imaginary part).
+    #[cfg(test)]
+    pub fn constant(z: [[C64; 2]; 2], w1: f64, words: [f64; 2]) -> Self {
+        let means = z
+            .iter()
+            .map(|zs| {
+                [0, 1]
+                    .map(|q| vec![zs.map(|v| if q == 0 { v.re } else { v.im }); BATCHES])
+                    .to_vec()
+            })
+            .collect();
+        Self {
+            means,
+            w1,
+            words,
+            clocks: 0,
+            window_s: 0.0,
+        }
+    }
+
+    /// |output k's mean| over drive 2's sign s's two windows (in-phase
+    /// and quadrature), all batches.
+    pub fn magnitude(&self, s: usize, k: usize) -> f64 {
+        self.z(s, k, None).norm() / BATCHES as f64
+    }
+
+    /// The same windows with `delta` added to output k's every batch mean
+    /// at drive 2's sign s, in-phase (q = 0) or quadrature (q = 1).
+    pub fn shifted(&self, s: usize, q: usize, k: usize, delta: f64) -> Self {
+        let mut moved = self.clone();
+        for batch in &mut moved.means[s][q] {
+            batch[k] += delta;
+        }
+        moved
     }
 
     /// Both outputs' lines in W_2 of batch `b` (`None`: the sums):

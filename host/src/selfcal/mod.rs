@@ -106,7 +106,7 @@
 //! the same reach and `STATIC_FOLD_SF_CHANGE`.
 mod budget;
 mod predict;
-mod spurs;
+pub(crate) mod spurs;
 mod staircase;
 
 pub use budget::SfUncertainty;
@@ -636,7 +636,8 @@ fn uncoupled(
     angular_gain: f64,
 ) -> Result<Identified, Error> {
     let mut id = apparent.clone();
-    let mut c = coupling::from_windows(windows, knowns, op, &id)?;
+    let spur_power = coupling::spur_power(windows, knowns, op, &id)?;
+    let mut c = coupling::from_windows(windows, knowns, op, &id, spur_power)?;
     let uncouple = |c: &coupling::Coupling| {
         let values = [c.quadrature_dps.value, c.damping_dps.value];
         coupling::uncouple(
@@ -649,7 +650,7 @@ fn uncoupled(
     };
     for _ in 0..COUPLING_ROUNDS {
         id = uncouple(&c)?;
-        c = coupling::from_windows(windows, knowns, op, &id)?;
+        c = coupling::from_windows(windows, knowns, op, &id, spur_power)?;
     }
     let damping = c.damping_dps;
     if damping.value.abs() < DAMPING_SEEN * damping.uncertainty {

@@ -94,11 +94,7 @@ impl Spurs {
     /// The RMS of the lines after averaging over records of `record_s`
     /// seconds, each line's amplitude times |sinc(pi offset record_s)|.
     pub fn rms_over_records_dps(&self, record_s: f64) -> [f64; 2] {
-        rms(self.lines.iter().map(|l| {
-            let x = PI * l.offset_hz * record_s;
-            let g = if x == 0.0 { 1.0 } else { (x.sin() / x).abs() };
-            l.amplitude_dps.map(|a| a * g)
-        }))
+        rms_over_records(&self.lines, record_s)
     }
 }
 
@@ -114,6 +110,16 @@ impl std::fmt::Display for Spurs {
         }
         Ok(())
     }
+}
+
+/// The RMS of `lines` after averaging over records of `record_s` seconds,
+/// each line's amplitude times |sinc(pi offset record_s)|.
+fn rms_over_records(lines: &[SpurLine], record_s: f64) -> [f64; 2] {
+    rms(lines.iter().map(|l| {
+        let x = PI * l.offset_hz * record_s;
+        let g = if x == 0.0 { 1.0 } else { (x.sin() / x).abs() };
+        l.amplitude_dps.map(|a| a * g)
+    }))
 }
 
 /// Root mean square of lines of these amplitudes at distinct offsets.
@@ -145,12 +151,49 @@ pub fn spurs(knowns: &Knowns, id: &Identified, op: &Operating) -> Result<Option<
     }))
 }
 
+/// What a line's amplitude is given in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Unit {
+    /// The rate ripple at the filter's output (deg/s, peak).
+    Dps,
+    /// The ripple at the filter's output as a fraction of the output's
+    /// full magnitude M (module header).
+    Relative,
+}
+
 /// The lines of [`spurs`] to `depth`, by offset.
 fn spur_lines(
     knowns: &Knowns,
     id: &Identified,
     op: &Operating,
     depth: Depth,
+) -> Result<Option<Vec<SpurLine>>, Error> {
+    lines_in(knowns, id, op, depth, Unit::Dps)
+}
+
+/// The power the lines leave in means over records of `record_s` seconds
+/// at `op`, per output, as a fraction of the output's full magnitude
+/// squared: the sum over the lines of (amplitude / M times |sinc(pi
+/// offset record_s)|)^2 / 2, a line's phase being uniform over a turn.
+/// `None` on the fine core.
+pub(crate) fn relative_power_over_records(
+    knowns: &Knowns,
+    id: &Identified,
+    op: &Operating,
+    record_s: f64,
+) -> Result<Option<[f64; 2]>, Error> {
+    let lines = lines_in(knowns, id, op, FULL, Unit::Relative)?;
+    Ok(lines.map(|l| rms_over_records(&l, record_s).map(|r| r * r)))
+}
+
+/// The lines of [`spurs`] to `depth`, by offset, their amplitudes in
+/// `unit` (in the field `amplitude_dps` whatever the unit).
+fn lines_in(
+    knowns: &Knowns,
+    id: &Identified,
+    op: &Operating,
+    depth: Depth,
+    unit: Unit,
 ) -> Result<Option<Vec<SpurLine>>, Error> {
     if knowns.carrier_profile != CarrierProfile::Table {
         return Ok(None);
@@ -193,7 +236,10 @@ fn spur_lines(
             let g = filter(omega.abs());
             let amp = std::array::from_fn(|k| {
                 let rho = spectra[k][(m % TURN) as usize] * sinc(m) / fundamental[k];
-                m_full[k] * rho * (1.0 + m_moved[k] / m_full[k]) * g / sf_dps[k]
+                match unit {
+                    Unit::Dps => m_full[k] * rho * (1.0 + m_moved[k] / m_full[k]) * g / sf_dps[k],
+                    Unit::Relative => rho * (1.0 + m_moved[k] / m_full[k]) * g,
+                }
             });
             (side.unsigned_abs(), amp)
         })
