@@ -16,7 +16,9 @@
 # The base is built once in a git worktree under target/bench-base/REV
 # with its own target directory, and only its binary is kept there; the
 # first call takes some minutes. Only the timings go to stdout; builds and
-# progress go to stderr.
+# progress go to stderr. Besides the pooled medians it prints the paired
+# ratios: each round's median over the base's in that round, their median
+# over the rounds (robust where the machine's speed drifts over minutes).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -77,6 +79,17 @@ def speeds(name):
         for m in json.load(open(f"{out}/{name}.{r}.json"))["measurements"]:
             s[m["with_gyro"]].extend(m["samples"])
     return s
+def paired(name, gyro):
+    # Each round's median over the base's median in the same round: on a
+    # machine whose speed drifts over minutes, the ratio of runs seconds
+    # apart holds where the pooled medians wander.
+    ratios = []
+    for r in range(1, rounds + 1):
+        med = lambda n: next(m["median_clocks_per_s"]
+                             for m in json.load(open(f"{out}/{n}.{r}.json"))["measurements"]
+                             if m["with_gyro"] == gyro)
+        ratios.append(med(name) / med("base"))
+    return statistics.median(ratios), sum(x > 1 for x in ratios)
 base, head, portable = speeds("base"), speeds("head"), speeds("portable")
 isa = json.load(open(f"{out}/head.1.json"))["model_isa"]
 print(f"model engine, one core, {rounds} alternated rounds of 3 repetitions (M clocks/s)")
@@ -88,4 +101,8 @@ for gyro, label in [(False, "datapath alone"), (True, "with the gyroscope")]:
     p, h = statistics.median(portable[gyro]), statistics.median(head[gyro])
     cells = "".join(f"{cell(v):>24}" for v in (base[gyro], portable[gyro], head[gyro]))
     print(f"{label:<20} {cells} {p / b:>6.3f} {h / b:>6.3f}")
+print(f"paired: the median over rounds of each round's ratio (rounds above 1 of {rounds})")
+for gyro, label in [(False, "datapath alone"), (True, "with the gyroscope")]:
+    (pp, pn), (hp, hn) = paired("portable", gyro), paired("head", gyro)
+    print(f"{label:<20} {'portable':>10} {pp:.3f} ({pn}) {isa:>12} {hp:.3f} ({hn})")
 EOF
