@@ -68,22 +68,26 @@
 //!
 //! On the table core, a third term: the carrier spurs (`selfcal::spurs`).
 //! A line that beats slower than a window is the same in each of its
-//! batches, so the spread never sees it, yet it moves each window's mean
-//! by up to its amplitude. `spur_power` sums the lines' power in a
-//! window's mean (each line's amplitude at the cross responses' drive
-//! amplitudes, as a fraction of the output's magnitude, times |sinc(pi f
-//! T)| over the window T), and `spur_sigma` carries it through the
-//! estimate: its derivative by each of the eight window means times that
-//! output's magnitude, the windows' lines taken with phases of their own
-//! (measured minutes apart, a slow line's phases are not; independent
-//! phases overstate a line that barely moves between the windows and
-//! understate, by at most a factor 2 in variance, one that turns half a
-//! period). Seed 2258 of `tests/field_coverage.rs` (2 MHz, 3.06 clocks
-//! per carrier) at 35 deg C, whose report names a line 2.8 Hz from the
-//! carrier, read its quadrature coupling (truly 0) at -2.25 to +1.71 deg/s
-//! over eight noise seeds (RMS 1.56) against sigmas of 0.19 to 0.72; the
-//! term makes them 2.2 (`a_slow_spur_line_is_in_the_couplings_sigma`).
-//! On the fine core (no such lines) the same device read -0.55 to +0.03.
+//! batches, so the spread never sees it, yet it moves the window's mean.
+//! A line multiplies an output's signal by 1 + rho e^(j(Omega t + phi));
+//! the four windows (two signs, in-phase and quadrature) read it at
+//! their own times, 30 to 200 ms apart. `spur_lines` takes each line's
+//! rho at the cross responses' drive amplitudes, times |sinc(pi f T)|
+//! over a window T, and `spur_sigma` carries it through the estimate's
+//! slopes by the windows' means, at those times (its doc comment has the
+//! algebra). A line that barely moves over the measurement is a common
+//! complex gain on an output's windows, which the estimate's ratios
+//! cancel; one that turns between the windows does not cancel. Seed 2258
+//! of `tests/field_coverage.rs` (2 MHz, 3.06 clocks per carrier) at 35
+//! deg C, whose report names a line 2.8 Hz from the carrier, read its
+//! quadrature coupling (truly 0) at -2.25 to +1.71 deg/s over eight noise
+//! seeds (RMS 1.56) against sigmas of 0.19 to 0.72; the term makes them
+//! 2.3 to 2.5 (`a_slow_spur_line_is_in_the_couplings_sigma`). On the fine
+//! core (no such lines) the same device read -0.55 to +0.03. Taking the
+//! windows' phases as independent instead had tripled the consumer
+//! device's coupling sigma at 35 deg C (0.016 -> 0.048 deg/s, its
+//! scattered estimates within 0.02 of the truth), and through it its
+//! output 2's scale-factor sigma (0.075% -> 0.216%).
 
 use crate::drive_ratio::{
     BATCHES, CrossWindows, DRIVE1_FRACTION, Folded, mean_and_error, propagated, resonator,
@@ -92,7 +96,7 @@ use crate::error::Error;
 use crate::identify::{self, Estimate, FrontEnd, Identified, ModeFit};
 use crate::knowns::Knowns;
 use crate::selfcal::Operating;
-use crate::selfcal::spurs;
+use crate::selfcal::spurs::{self, SpurLine};
 use nalgebra::Complex;
 use serde::Serialize;
 
@@ -161,14 +165,14 @@ fn resonator_error(id: &Identified, carrier_hz: f64) -> f64 {
 /// operating point `op` of identification `id`: one round, which the
 /// cycle iterates with [`uncouple`] (`selfcal`).
 ///
-/// `spur_power`: the table core's lines in the windows' means
-/// ([`spur_power`]), whose spread the batches do not see.
+/// `spur_lines`: the table core's lines in the windows' means
+/// ([`spur_lines`]), which the batches' spread does not see.
 pub(crate) fn from_windows(
     windows: &CrossWindows,
     knowns: &Knowns,
     op: &Operating,
     id: &Identified,
-    spur_power: Option<[f64; 2]>,
+    spur_lines: Option<&[SpurLine]>,
 ) -> Result<Coupling, Error> {
     let g_error = resonator_error(id, op.carrier_hz);
     let folded = [0, 1].map(|k| Folded::of(id, k, op.carrier_hz, knowns.clock_hz));
@@ -186,8 +190,8 @@ pub(crate) fn from_windows(
     }
     // The real part is Omega_q (k = 2 lambda w1 Omega_q); the imaginary
     // part w_c d with d = 2 lambda Omega_d, so Omega_d is it times f1 / fc.
-    let spurs = spur_power.map_or(C64::new(0.0, 0.0), |power| {
-        spur_sigma(windows, power, |w| in_dps(w, None))
+    let spurs = spur_lines.map_or(C64::new(0.0, 0.0), |lines| {
+        spur_sigma(windows, lines, |w| in_dps(w, None))
     });
     let estimate = |v: Vec<f64>, spur: f64| {
         let noise = mean_and_error(&v);
@@ -207,49 +211,80 @@ pub(crate) fn from_windows(
     })
 }
 
-/// The power of the table core's carrier spurs in the windows' means at
-/// the cross responses' drive amplitudes, per output, as a fraction of
-/// each output's magnitude squared (`spurs::relative_power_over_records`
-/// over one window); `None` on the fine core.
-pub(crate) fn spur_power(
+/// The table core's carrier spur lines in the windows' means at the cross
+/// responses' drive amplitudes, each per output as a fraction of that
+/// output's magnitude (`spurs::relative_lines_over_records` over one
+/// window); `None` on the fine core.
+pub(crate) fn spur_lines(
     windows: &CrossWindows,
     knowns: &Knowns,
     op: &Operating,
     id: &Identified,
-) -> Result<Option<[f64; 2]>, Error> {
+) -> Result<Option<Vec<SpurLine>>, Error> {
     let cross = Operating {
         amplitude: (DRIVE1_FRACTION * op.amplitude.0, op.amplitude.1),
         ..op.clone()
     };
-    spurs::relative_power_over_records(knowns, id, &cross, windows.window_s)
+    spurs::relative_lines_over_records(knowns, id, &cross, windows.window_s)
 }
 
 /// The 1-sigma of the estimate `estimate` (deg/s; the real and the
-/// imaginary part) from spur lines of relative power `power` per output
-/// in each window's mean (module header, "Uncertainty"): the estimate's
-/// derivative by each of the eight window means (two signs, in-phase and
-/// quadrature, two outputs) times that output's magnitude, each window's
-/// lines taken with phases of their own.
+/// imaginary part) from the spur `lines` (module header, "Uncertainty").
+/// A line of relative amplitude rho on output k multiplies its signal by
+/// 1 + rho e^(j(Omega t + phi)): window (s, q) at time t_sq reads the part
+/// q of Z_sk (1 + rho e^(j(Omega t_sq + phi))). With a and b the
+/// estimate's slopes by output k's in-phase and quadrature means at sign
+/// s, the error is rho Re(e^(j phi) S_k), S_k = sum_s (a e^(j Omega t_s0) -
+/// j b e^(j Omega t_s1)) Z_sk, whose variance over phi is rho^2 |S_k|^2
+/// / 2; the outputs' lines (other carriers) are taken independent, each
+/// line at whichever side of the carrier gives the larger, the lines
+/// added in power. A line that barely moves over the measurement is a
+/// common complex gain on an output's windows, which the estimate's
+/// ratios cancel.
 fn spur_sigma(
     windows: &CrossWindows,
-    power: [f64; 2],
+    lines: &[SpurLine],
     estimate: impl Fn(&CrossWindows) -> C64,
 ) -> C64 {
-    let mut variance = C64::new(0.0, 0.0);
-    for s in 0..2 {
-        for (k, p) in power.iter().enumerate() {
-            let m = windows.magnitude(s, k);
-            let h = 1e-6 * m;
-            for q in 0..2 {
-                let slope = (estimate(&windows.shifted(s, q, k, h))
+    // slope[s][q][k]: the estimate's derivative by window (s, q)'s
+    // output-k mean.
+    let mut slope = [[[C64::new(0.0, 0.0); 2]; 2]; 2];
+    for (s, by_q) in slope.iter_mut().enumerate() {
+        for (q, by_k) in by_q.iter_mut().enumerate() {
+            for (k, d) in by_k.iter_mut().enumerate() {
+                let h = 1e-6 * windows.mean(s, k).norm();
+                *d = (estimate(&windows.shifted(s, q, k, h))
                     - estimate(&windows.shifted(s, q, k, -h)))
                     / (2.0 * h);
-                let d = slope * m;
-                variance += C64::new(d.re * d.re, d.im * d.im) * p;
             }
         }
     }
-    C64::new(variance.re.sqrt(), variance.im.sqrt())
+    let j = C64::new(0.0, 1.0);
+    let t = windows.times_s;
+    let mut variance = [0.0; 2];
+    for line in lines {
+        let mut worst = [0.0f64; 2];
+        for side in [1.0, -1.0] {
+            let omega = side * std::f64::consts::TAU * line.offset_hz;
+            let turn = |time: f64| C64::from_polar(1.0, omega * time);
+            let mut v = [0.0; 2];
+            for (part, v) in v.iter_mut().enumerate() {
+                let of = |d: C64| if part == 0 { d.re } else { d.im };
+                for (k, rho) in line.amplitude_dps.iter().enumerate() {
+                    let s_k: C64 = (0..2)
+                        .map(|s| {
+                            let (a, b) = (of(slope[s][0][k]), of(slope[s][1][k]));
+                            (a * turn(t[s][0]) - j * b * turn(t[s][1])) * windows.mean(s, k)
+                        })
+                        .sum();
+                    *v += rho * rho * s_k.norm_sqr() / 2.0;
+                }
+            }
+            worst = [worst[0].max(v[0]), worst[1].max(v[1])];
+        }
+        variance = [variance[0] + worst[0], variance[1] + worst[1]];
+    }
+    C64::new(variance[0].sqrt(), variance[1].sqrt())
 }
 
 /// Fixed-point rounds of [`uncouple`] at most (each mode's pull is
@@ -415,14 +450,17 @@ mod tests {
         }
     }
 
-    /// `spur_sigma` against its premise: each of the eight window means
-    /// moved by a line of power p_k (a fraction of its output's magnitude
-    /// squared) at a phase of its own. Over 4000 draws of the phases the
-    /// estimate's error has an RMS equal to the sigma, real and imaginary
-    /// part, within 5% (the RMS of 4000 draws scatters by about 1 / sqrt(2
-    /// x 4000) = 1.1%, the first-order slopes by far less).
+    /// `spur_sigma` against its premise (its doc comment): one line of
+    /// relative amplitudes rho_k multiplying each output's signal by 1 +
+    /// rho_k e^(j(Omega t + phi_k)), each window reading it at its own
+    /// time. Over 4000 draws of the phases, at the side of the carrier
+    /// that gives the larger, the estimate's error has an RMS equal to the
+    /// sigma, real and imaginary part, within 5% (the RMS of 4000 draws
+    /// scatters by about 1 / sqrt(2 x 4000) = 1.1%). A line that barely
+    /// moves over the measurement is a common gain on each output's
+    /// windows and leaves (almost) nothing.
     #[test]
-    fn the_spur_sigma_is_the_spread_lines_leave() {
+    fn the_spur_sigma_is_the_spread_a_line_leaves() {
         let f = 25.1e3;
         let g = [resonator(25.1e3, 3000.0, f), resonator(25.8e3, 3000.0, f)];
         let kappa = C64::new(3.0e3, 800.0);
@@ -438,11 +476,15 @@ mod tests {
             let x2 = m[1][0] * w1 - j * m[1][1] * w;
             [w1 * x1, w * x2]
         };
-        let windows = CrossWindows::constant([z(w2[0]), z(w2[1])], w1, w2);
+        let times = [[0.05, 0.09], [0.17, 0.21]];
+        let windows = CrossWindows::constant([z(w2[0]), z(w2[1])], w1, w2, times);
         let folded = [0, 1].map(|k| Folded::phasor(g, k, f));
         let estimate = |w: &CrossWindows| coupling_hz2(w.lines(None), w.w1, &folded, 1.0, f);
-        let power = [3e-7, 1e-6];
-        let sigma = spur_sigma(&windows, power, estimate);
+        let line = |offset_hz: f64| SpurLine {
+            offset_hz,
+            amplitude_dps: [3e-4, 1e-3],
+        };
+        let sigma = spur_sigma(&windows, &[line(2.8)], estimate);
         let clean = estimate(&windows);
         let mut state = 2258u64;
         let mut phase = || {
@@ -454,26 +496,36 @@ mod tests {
             (x ^ (x >> 31)) as f64 / 2f64.powi(64) * std::f64::consts::TAU
         };
         let draws = 4000;
-        let mut sum = [0.0; 2];
-        for _ in 0..draws {
-            let mut moved = windows.clone();
-            for s in 0..2 {
-                for (k, p) in power.iter().enumerate() {
-                    let amplitude = (2.0 * p).sqrt() * windows.magnitude(s, k);
-                    for q in 0..2 {
-                        moved = moved.shifted(s, q, k, amplitude * phase().cos());
+        let mut rms = [0.0f64; 2];
+        for side in [1.0, -1.0] {
+            let omega = side * std::f64::consts::TAU * 2.8;
+            let mut sum = [0.0; 2];
+            for _ in 0..draws {
+                let mut moved = windows.clone();
+                for (k, rho) in line(2.8).amplitude_dps.iter().enumerate() {
+                    let phi = phase();
+                    for (s, at) in times.iter().enumerate() {
+                        let zk = windows.mean(s, k);
+                        let ripple = |q: usize| zk * C64::from_polar(*rho, omega * at[q] + phi);
+                        moved = moved.shifted(s, 0, k, ripple(0).re);
+                        moved = moved.shifted(s, 1, k, ripple(1).im);
                     }
                 }
+                let e = estimate(&moved) - clean;
+                sum[0] += e.re * e.re;
+                sum[1] += e.im * e.im;
             }
-            let e = estimate(&moved) - clean;
-            sum[0] += e.re * e.re;
-            sum[1] += e.im * e.im;
+            rms = [0, 1].map(|p| rms[p].max((sum[p] / f64::from(draws)).sqrt()));
         }
-        let ratio = [sum[0].sqrt() / sigma.re, sum[1].sqrt() / sigma.im]
-            .map(|r| r / f64::from(draws).sqrt());
+        let ratio = [rms[0] / sigma.re, rms[1] / sigma.im];
         assert!(
             ratio.iter().all(|r| (r - 1.0).abs() <= 0.05),
             "RMS over sigma {ratio:?}, sigma {sigma}"
+        );
+        let slow = spur_sigma(&windows, &[line(1e-4)], estimate);
+        assert!(
+            slow.re < 1e-3 * sigma.re && slow.im < 1e-3 * sigma.im,
+            "{slow} against {sigma}"
         );
     }
 

@@ -286,6 +286,9 @@ pub(crate) struct CrossWindows {
     pub clocks: u64,
     /// Each window's length (s).
     pub window_s: f64,
+    /// Each window's centre from the first write (s),
+    /// `times_s[sign][quadrature]`.
+    pub times_s: [[f64; 2]; 2],
 }
 
 impl CrossWindows {
@@ -300,19 +303,23 @@ impl CrossWindows {
         let mut words = [0.0; 2];
         let mut w1 = 0.0;
         let mut clocks = 0;
+        let window_clocks = BATCHES as u64 * per_batch * u64::from(r);
+        let mut times_s = [[0.0; 2]; 2];
         for (s, sign) in [1.0, -1.0].into_iter().enumerate() {
             let amps = (DRIVE1_FRACTION * op.amplitude.0, sign * op.amplitude.1);
             let (regs, _) = knowns.registers(op.carrier_hz, None, amps, op.ref_lag_deg)?;
             w1 = signed_readout_word(knowns.carrier_profile, regs.amp.0);
             words[s] = signed_readout_word(knowns.carrier_profile, regs.amp.1);
             let mut pair = vec![];
-            for quarter in [0u32, 1 << 30] {
+            for (q, quarter) in [0u32, 1 << 30].into_iter().enumerate() {
                 let mut rotated = regs;
                 rotated.ref_phase = regs.ref_phase.wrapping_add(quarter);
                 board.program(&rotated)?;
                 let wait = if quarter == 0 { settle } else { filter };
                 pair.push(batch_means(board, wait, per_batch)?);
-                clocks += wait + BATCHES as u64 * per_batch * u64::from(r);
+                times_s[s][q] = (clocks + wait) as f64 + window_clocks as f64 / 2.0;
+                times_s[s][q] /= knowns.clock_hz;
+                clocks += wait + window_clocks;
             }
             means.push(pair);
         }
@@ -327,7 +334,8 @@ impl CrossWindows {
             w1,
             words,
             clocks,
-            window_s: (BATCHES as u64 * per_batch * u64::from(r)) as f64 / knowns.clock_hz,
+            window_s: window_clocks as f64 / knowns.clock_hz,
+            times_s,
         })
     }
 
@@ -343,7 +351,7 @@ impl CrossWindows {
     /// Windows whose every batch reads `z[s][k]` (output k at drive 2's
     /// sign s, in-phase and quadrature as the real and imaginary part).
     #[cfg(test)]
-    pub fn constant(z: [[C64; 2]; 2], w1: f64, words: [f64; 2]) -> Self {
+    pub fn constant(z: [[C64; 2]; 2], w1: f64, words: [f64; 2], times_s: [[f64; 2]; 2]) -> Self {
         let means = z
             .iter()
             .map(|zs| {
@@ -358,13 +366,14 @@ impl CrossWindows {
             words,
             clocks: 0,
             window_s: 0.0,
+            times_s,
         }
     }
 
-    /// |output k's mean| over drive 2's sign s's two windows (in-phase
-    /// and quadrature), all batches.
-    pub fn magnitude(&self, s: usize, k: usize) -> f64 {
-        self.z(s, k, None).norm() / BATCHES as f64
+    /// Output k's complex mean at drive 2's sign s (its in-phase and
+    /// quadrature windows), all batches.
+    pub fn mean(&self, s: usize, k: usize) -> C64 {
+        self.z(s, k, None) / BATCHES as f64
     }
 
     /// The same windows with `delta` added to output k's every batch mean

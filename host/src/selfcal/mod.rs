@@ -636,8 +636,9 @@ fn uncoupled(
     angular_gain: f64,
 ) -> Result<Identified, Error> {
     let mut id = apparent.clone();
-    let spur_power = coupling::spur_power(windows, knowns, op, &id)?;
-    let mut c = coupling::from_windows(windows, knowns, op, &id, spur_power)?;
+    let spur_lines = coupling::spur_lines(windows, knowns, op, &id)?;
+    let spur_lines = spur_lines.as_deref();
+    let mut c = coupling::from_windows(windows, knowns, op, &id, spur_lines)?;
     let uncouple = |c: &coupling::Coupling| {
         let values = [c.quadrature_dps.value, c.damping_dps.value];
         coupling::uncouple(
@@ -650,7 +651,7 @@ fn uncoupled(
     };
     for _ in 0..COUPLING_ROUNDS {
         id = uncouple(&c)?;
-        c = coupling::from_windows(windows, knowns, op, &id, spur_power)?;
+        c = coupling::from_windows(windows, knowns, op, &id, spur_lines)?;
     }
     let damping = c.damping_dps;
     if damping.value.abs() < DAMPING_SEEN * damping.uncertainty {

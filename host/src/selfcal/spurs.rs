@@ -116,10 +116,15 @@ impl std::fmt::Display for Spurs {
 /// each line's amplitude times |sinc(pi offset record_s)|.
 fn rms_over_records(lines: &[SpurLine], record_s: f64) -> [f64; 2] {
     rms(lines.iter().map(|l| {
-        let x = PI * l.offset_hz * record_s;
-        let g = if x == 0.0 { 1.0 } else { (x.sin() / x).abs() };
+        let g = record_gain(l.offset_hz, record_s);
         l.amplitude_dps.map(|a| a * g)
     }))
+}
+
+/// |sinc(pi offset record_s)|: a line's amplitude in a record's mean.
+fn record_gain(offset_hz: f64, record_s: f64) -> f64 {
+    let x = PI * offset_hz * record_s;
+    if x == 0.0 { 1.0 } else { (x.sin() / x).abs() }
 }
 
 /// Root mean square of lines of these amplitudes at distinct offsets.
@@ -171,19 +176,28 @@ fn spur_lines(
     lines_in(knowns, id, op, depth, Unit::Dps)
 }
 
-/// The power the lines leave in means over records of `record_s` seconds
-/// at `op`, per output, as a fraction of the output's full magnitude
-/// squared: the sum over the lines of (amplitude / M times |sinc(pi
-/// offset record_s)|)^2 / 2, a line's phase being uniform over a turn.
-/// `None` on the fine core.
-pub(crate) fn relative_power_over_records(
+/// The lines at `op`, each amplitude a fraction of its output's full
+/// magnitude M (module header) times |sinc(pi offset record_s)|: what
+/// the line leaves in a mean over a record of `record_s` seconds (in the
+/// field `amplitude_dps`). `None` on the fine core.
+pub(crate) fn relative_lines_over_records(
     knowns: &Knowns,
     id: &Identified,
     op: &Operating,
     record_s: f64,
-) -> Result<Option<[f64; 2]>, Error> {
+) -> Result<Option<Vec<SpurLine>>, Error> {
     let lines = lines_in(knowns, id, op, FULL, Unit::Relative)?;
-    Ok(lines.map(|l| rms_over_records(&l, record_s).map(|r| r * r)))
+    Ok(lines.map(|lines| {
+        lines
+            .into_iter()
+            .map(|l| SpurLine {
+                amplitude_dps: l
+                    .amplitude_dps
+                    .map(|a| a * record_gain(l.offset_hz, record_s)),
+                ..l
+            })
+            .collect()
+    }))
 }
 
 /// The lines of [`spurs`] to `depth`, by offset, their amplitudes in
