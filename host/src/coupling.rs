@@ -96,7 +96,7 @@ use crate::error::Error;
 use crate::identify::{self, Estimate, FrontEnd, Identified, ModeFit};
 use crate::knowns::Knowns;
 use crate::selfcal::Operating;
-use crate::selfcal::spurs::{self, SpurLine};
+use crate::selfcal::spurs::{self, RelativeLine};
 use nalgebra::Complex;
 use serde::Serialize;
 
@@ -172,7 +172,7 @@ pub(crate) fn from_windows(
     knowns: &Knowns,
     op: &Operating,
     id: &Identified,
-    spur_lines: Option<&[SpurLine]>,
+    spur_lines: Option<&[RelativeLine]>,
 ) -> Result<Coupling, Error> {
     let g_error = resonator_error(id, op.carrier_hz);
     let folded = [0, 1].map(|k| Folded::of(id, k, op.carrier_hz, knowns.clock_hz));
@@ -220,7 +220,7 @@ pub(crate) fn spur_lines(
     knowns: &Knowns,
     op: &Operating,
     id: &Identified,
-) -> Result<Option<Vec<SpurLine>>, Error> {
+) -> Result<Option<Vec<RelativeLine>>, Error> {
     let cross = Operating {
         amplitude: (DRIVE1_FRACTION * op.amplitude.0, op.amplitude.1),
         ..op.clone()
@@ -243,7 +243,7 @@ pub(crate) fn spur_lines(
 /// ratios cancel.
 fn spur_sigma(
     windows: &CrossWindows,
-    lines: &[SpurLine],
+    lines: &[RelativeLine],
     estimate: impl Fn(&CrossWindows) -> C64,
 ) -> C64 {
     // slope[s][q][k]: the estimate's derivative by window (s, q)'s
@@ -270,7 +270,7 @@ fn spur_sigma(
             let mut v = [0.0; 2];
             for (part, v) in v.iter_mut().enumerate() {
                 let of = |d: C64| if part == 0 { d.re } else { d.im };
-                for (k, rho) in line.amplitude_dps.iter().enumerate() {
+                for (k, rho) in line.rho.iter().enumerate() {
                     let s_k: C64 = (0..2)
                         .map(|s| {
                             let (a, b) = (of(slope[s][0][k]), of(slope[s][1][k]));
@@ -408,6 +408,27 @@ pub fn uncouple(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use rand_xoshiro::Xoshiro256PlusPlus;
+    use rand_xoshiro::rand_core::{Rng, SeedableRng};
+
+    /// The module header's coupled response at one frequency: the inverse
+    /// of [[1 / G1, kappa], [kappa, 1 / G2]].
+    fn coupled(g: [C64; 2], kappa: C64) -> [[C64; 2]; 2] {
+        let det = 1.0 / (g[0] * g[1]) - kappa * kappa;
+        [
+            [1.0 / (g[1] * det), -kappa / det],
+            [-kappa / det, 1.0 / (g[0] * det)],
+        ]
+    }
+
+    /// The demodulated outputs of the cross responses `m` with drive 1 at
+    /// `w1` and drive 2 at `w` (unit gains and phases).
+    fn outputs(m: &[[C64; 2]; 2], w1: f64, w: f64) -> [C64; 2] {
+        let j = C64::new(0.0, 1.0);
+        let x1 = m[0][0] * w1 - j * m[0][1] * w;
+        let x2 = m[1][0] * w1 - j * m[1][1] * w;
+        [w1 * x1, w * x2]
+    }
 
     /// The module header's model with a stiffness coupling at rest, chosen
     /// gains, pick-off phases and a drive-gain ratio 1% off the design's:
@@ -417,11 +438,7 @@ mod tests {
         let f = 25.1e3;
         let g = [resonator(25.1e3, 3000.0, f), resonator(25.8e3, 3000.0, f)];
         for k in [3.0e3, -1.2e4, 0.0] {
-            let det = 1.0 / (g[0] * g[1]) - C64::new(k * k, 0.0);
-            let m = [
-                [1.0 / (g[1] * det), -k / det],
-                [-k / det, 1.0 / (g[0] * det)],
-            ];
+            let m = coupled(g, C64::new(k, 0.0));
             let r = 1.01;
             let (gain1, gain2) = (2.0, 2.0 * r);
             let (a1, a2) = (C64::from_polar(3.0, 0.2), C64::from_polar(5.0, -0.4));
@@ -463,38 +480,22 @@ mod tests {
     fn the_spur_sigma_is_the_spread_a_line_leaves() {
         let f = 25.1e3;
         let g = [resonator(25.1e3, 3000.0, f), resonator(25.8e3, 3000.0, f)];
-        let kappa = C64::new(3.0e3, 800.0);
-        let det = 1.0 / (g[0] * g[1]) - kappa * kappa;
-        let m = [
-            [1.0 / (g[1] * det), -kappa / det],
-            [-kappa / det, 1.0 / (g[0] * det)],
-        ];
+        let m = coupled(g, C64::new(3.0e3, 800.0));
         let (w1, w2) = (2500.0, [15000.0, -14999.0]);
-        let j = C64::new(0.0, 1.0);
-        let z = |w: f64| {
-            let x1 = m[0][0] * w1 - j * m[0][1] * w;
-            let x2 = m[1][0] * w1 - j * m[1][1] * w;
-            [w1 * x1, w * x2]
-        };
+        let z = |w: f64| outputs(&m, w1, w);
         let times = [[0.05, 0.09], [0.17, 0.21]];
         let windows = CrossWindows::constant([z(w2[0]), z(w2[1])], w1, w2, times);
         let folded = [0, 1].map(|k| Folded::phasor(g, k, f));
         let estimate = |w: &CrossWindows| coupling_hz2(w.lines(None), w.w1, &folded, 1.0, f);
-        let line = |offset_hz: f64| SpurLine {
+        let line = |offset_hz: f64| RelativeLine {
             offset_hz,
-            amplitude_dps: [3e-4, 1e-3],
+            rho: [3e-4, 1e-3],
         };
         let sigma = spur_sigma(&windows, &[line(2.8)], estimate);
         let clean = estimate(&windows);
-        let mut state = 2258u64;
-        let mut phase = || {
-            // splitmix64, to a phase uniform over a turn.
-            state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
-            let mut x = state;
-            x = (x ^ (x >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-            x = (x ^ (x >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-            (x ^ (x >> 31)) as f64 / 2f64.powi(64) * std::f64::consts::TAU
-        };
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(2258);
+        // A phase uniform over a turn, from the top 53 bits.
+        let mut phase = || (rng.next_u64() >> 11) as f64 / 2f64.powi(53) * std::f64::consts::TAU;
         let draws = 4000;
         let mut rms = [0.0f64; 2];
         for side in [1.0, -1.0] {
@@ -502,7 +503,7 @@ mod tests {
             let mut sum = [0.0; 2];
             for _ in 0..draws {
                 let mut moved = windows.clone();
-                for (k, rho) in line(2.8).amplitude_dps.iter().enumerate() {
+                for (k, rho) in line(2.8).rho.iter().enumerate() {
                     let phi = phase();
                     for (s, at) in times.iter().enumerate() {
                         let zk = windows.mean(s, k);
@@ -542,17 +543,11 @@ mod tests {
         let modes = [(1.022937e5, 267.7369), (9.749131e4, 406.1596)];
         let (f, clock) = (modes[0].0, 2.697518e5);
         let (kk, dd) = (3.0e6, 50.0);
-        let j = C64::new(0.0, 1.0);
         let mut m = [[C64::new(0.0, 0.0); 2]; 2];
         for i in -identify::IMAGES..=identify::IMAGES {
             let v = f + f64::from(i) * clock;
             let g = modes.map(|(fk, qk)| resonator(fk, qk, v));
-            let kappa = C64::new(kk, v * dd);
-            let det = 1.0 / (g[0] * g[1]) - kappa * kappa;
-            let at_v = [
-                [1.0 / (g[1] * det), -kappa / det],
-                [-kappa / det, 1.0 / (g[0] * det)],
-            ];
+            let at_v = coupled(g, C64::new(kk, v * dd));
             for (row, sums) in at_v.iter().zip(&mut m) {
                 for (x, sum) in row.iter().zip(sums) {
                     *sum += x * (f / v);
@@ -560,12 +555,7 @@ mod tests {
             }
         }
         let (w1, w2) = (2500.0, [15000.0, -14999.0]);
-        let z = |w: f64| {
-            let x1 = m[0][0] * w1 - j * m[0][1] * w;
-            let x2 = m[1][0] * w1 - j * m[1][1] * w;
-            [w1 * x1, w * x2]
-        };
-        let (y0, y1) = (z(w2[0]), z(w2[1]));
+        let (y0, y1) = (outputs(&m, w1, w2[0]), outputs(&m, w1, w2[1]));
         let lines = (
             crate::drive_ratio::line([y0[0], y1[0]], w2),
             crate::drive_ratio::line([y0[1] / w2[0], y1[1] / w2[1]], w2),

@@ -67,6 +67,19 @@ pub struct SpurLine {
     pub amplitude_dps: [f64; 2],
 }
 
+/// One line next to the carrier, its amplitude per output a fraction rho
+/// of the output's full magnitude M (module header) as a mean over a
+/// record leaves it ([`relative_lines_over_records`]): what the coupling's
+/// uncertainty takes (`crate::coupling`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct RelativeLine {
+    /// Distance from the carrier (Hz, both sides folded together).
+    pub offset_hz: f64,
+    /// rho per output (peak), times the record's |sinc(pi offset
+    /// record_s)|.
+    pub rho: [f64; 2],
+}
+
 /// Points a mode bandwidth f / Q at which the drive lines' response is
 /// taken from the exact theory and interpolated between (a field step on
 /// a slow clock has some 1e5 lines). A Lorentzian's magnitude at its peak
@@ -173,42 +186,46 @@ fn spur_lines(
     op: &Operating,
     depth: Depth,
 ) -> Result<Option<Vec<SpurLine>>, Error> {
-    lines_in(knowns, id, op, depth, Unit::Dps)
+    lines_in(
+        knowns,
+        id,
+        op,
+        depth,
+        Unit::Dps,
+        |offset_hz, amplitude_dps| SpurLine {
+            offset_hz,
+            amplitude_dps,
+        },
+    )
 }
 
-/// The lines at `op`, each amplitude a fraction of its output's full
-/// magnitude M (module header) times |sinc(pi offset record_s)|: what
-/// the line leaves in a mean over a record of `record_s` seconds (in the
-/// field `amplitude_dps`). `None` on the fine core.
+/// The lines at `op`, as a mean over a record of `record_s` seconds
+/// leaves them (each amplitude times |sinc(pi offset record_s)|), in
+/// fractions of their outputs' full magnitudes. `None` on the fine core.
 pub(crate) fn relative_lines_over_records(
     knowns: &Knowns,
     id: &Identified,
     op: &Operating,
     record_s: f64,
-) -> Result<Option<Vec<SpurLine>>, Error> {
-    let lines = lines_in(knowns, id, op, FULL, Unit::Relative)?;
-    Ok(lines.map(|lines| {
-        lines
-            .into_iter()
-            .map(|l| SpurLine {
-                amplitude_dps: l
-                    .amplitude_dps
-                    .map(|a| a * record_gain(l.offset_hz, record_s)),
-                ..l
-            })
-            .collect()
-    }))
+) -> Result<Option<Vec<RelativeLine>>, Error> {
+    lines_in(knowns, id, op, FULL, Unit::Relative, |offset_hz, rho| {
+        RelativeLine {
+            offset_hz,
+            rho: rho.map(|a| a * record_gain(offset_hz, record_s)),
+        }
+    })
 }
 
-/// The lines of [`spurs`] to `depth`, by offset, their amplitudes in
-/// `unit` (in the field `amplitude_dps` whatever the unit).
-fn lines_in(
+/// The lines of [`spurs`] to `depth`, by offset, each made by `line` from
+/// its offset (Hz) and its amplitudes per output in `unit`.
+fn lines_in<L>(
     knowns: &Knowns,
     id: &Identified,
     op: &Operating,
     depth: Depth,
     unit: Unit,
-) -> Result<Option<Vec<SpurLine>>, Error> {
+    line: impl Fn(f64, [f64; 2]) -> L,
+) -> Result<Option<Vec<L>>, Error> {
     if knowns.carrier_profile != CarrierProfile::Table {
         return Ok(None);
     }
@@ -261,21 +278,18 @@ fn lines_in(
     // Lines by |offset| in NCO steps: the two sides of a fold and the
     // drive's and reference's lines at one offset add.
     found.sort_unstable_by_key(|f| f.0);
-    let mut lines: Vec<SpurLine> = Vec::new();
+    let mut lines: Vec<(f64, [f64; 2])> = Vec::new();
     for (s, amp) in found {
         let offset_hz = f64::from(s) * per_step;
         match lines.last_mut() {
-            Some(l) if l.offset_hz == offset_hz => {
-                l.amplitude_dps[0] += amp[0];
-                l.amplitude_dps[1] += amp[1];
+            Some((at, sum)) if *at == offset_hz => {
+                sum[0] += amp[0];
+                sum[1] += amp[1];
             }
-            _ => lines.push(SpurLine {
-                offset_hz,
-                amplitude_dps: amp,
-            }),
+            _ => lines.push((offset_hz, amp)),
         }
     }
-    Ok(Some(lines))
+    Ok(Some(lines.into_iter().map(|(o, a)| line(o, a)).collect()))
 }
 
 /// The bound of [`spurs`] alone, its RMS per output (deg/s), over the
