@@ -163,14 +163,13 @@ impl Converters {
     }
 
     /// One ADC conversion of the displacement `x` (m) on `channel` (0, 1)
-    /// with the standard normal draw `g` (when there is noise).
+    /// with the standard normal draw `g`. Without noise `g` is 0 and so is
+    /// `noise_lsb` (the generator exists exactly when it is positive), and
+    /// the term adds 0: the same code as the bare displacement (a -0
+    /// becoming +0 rounds to the same 0).
     #[inline(always)]
     fn convert(&self, channel: usize, x: f64, g: f64) -> i16 {
-        let mut v = x * self.config.adc_per_meter[channel];
-        if self.noise.is_some() {
-            v += self.config.noise_lsb * g;
-        }
-        self.code(v)
+        self.code(x * self.config.adc_per_meter[channel] + self.config.noise_lsb * g)
     }
 
     /// The ADC word of `v` (16-bit LSB, noise included).
@@ -223,19 +222,9 @@ impl Converters {
         // The conversions in a loop of their own, which the compiler
         // vectorizes (packed conversions in the x86-64-v3 build; the
         // ring's indexing in the loop kept it scalar), then the latency
-        // over the block. Without noise `g` is zeros and the
-        // noise term adds 0: the same codes as `convert`.
-        let lsb = if self.noise.is_some() {
-            self.config.noise_lsb
-        } else {
-            0.0
-        };
-        let gain = self.config.adc_per_meter;
+        // over the block. Without noise `g` is zeros (`convert`).
         for ((o, &x), g) in out.iter_mut().zip(x).zip(g.chunks_exact(2)) {
-            *o = (
-                self.code(x.0 * gain[0] + lsb * g[0]),
-                self.code(x.1 * gain[1] + lsb * g[1]),
-            );
+            *o = (self.convert(0, x.0, g[0]), self.convert(1, x.1, g[1]));
         }
         self.adc_ring.delay_block(out, self.config.adc_latency);
     }
