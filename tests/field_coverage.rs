@@ -166,6 +166,31 @@ fn field(seed: u64, damping: bool) -> Option<(RandomDevice, FieldReport)> {
     Some((d, report))
 }
 
+/// Device `d`'s scenario with its (quadrature, damping) couplings and
+/// `drift` under each ADC noise seed of `noise_seeds` (`[frontend]
+/// seed`): the reports by noise seed, every step finished.
+fn under_noise_seeds(
+    d: &RandomDevice,
+    (coupling, damping): (f64, f64),
+    drift: &str,
+    noise_seeds: std::ops::RangeInclusive<u64>,
+) -> Vec<(u64, FieldReport)> {
+    noise_seeds
+        .map(|noise_seed| {
+            let extra = format!("[frontend]\nseed = {noise_seed}\n");
+            let text = scenario_text(d, coupling, damping, drift, &extra);
+            let sc = scenario::parse("noise-seeds.toml", &text).unwrap();
+            let r = scenario::run(&sc, &|_| {}).unwrap();
+            assert!(
+                r.failed.is_empty(),
+                "noise seed {noise_seed}: {:?}",
+                r.failed
+            );
+            (noise_seed, r)
+        })
+        .collect()
+}
+
 /// t = error / sigma of each step and output.
 fn t_values(r: &FieldReport) -> Vec<f64> {
     r.steps
@@ -513,16 +538,7 @@ fn the_dac_images_are_in_the_couplings_at_few_clocks_per_carrier() {
 fn a_slow_spur_line_is_in_the_couplings_sigma() {
     let d = RandomDevice::draw(2258, FAST);
     let mut t = vec![];
-    for noise_seed in 1..=8 {
-        let extra = format!("[frontend]\nseed = {noise_seed}\n");
-        let text = scenario_text(&d, 0.0, 0.0, &drift(LAG.0, LAG.1), &extra);
-        let sc = scenario::parse("spur.toml", &text).unwrap();
-        let r = scenario::run(&sc, &|_| {}).unwrap();
-        assert!(
-            r.failed.is_empty(),
-            "noise seed {noise_seed}: {:?}",
-            r.failed
-        );
+    for (noise_seed, r) in under_noise_seeds(&d, (0.0, 0.0), &drift(LAG.0, LAG.1), 1..=8) {
         for (name, x) in identified_t(&r) {
             if ["quadrature", "damping"].contains(&name) {
                 assert!(
@@ -555,18 +571,9 @@ fn a_slow_spur_line_is_in_the_couplings_sigma() {
 #[test]
 fn a_large_front_end_lag_is_in_the_sigma() {
     let d = RandomDevice::draw(2096, FAST);
-    let lagged = drift(8.0, 0.0);
     let mut t = vec![];
-    for noise_seed in 1..=6 {
-        let extra = format!("[frontend]\nseed = {noise_seed}\n");
-        let text = scenario_text(&d, coupling_of(d.seed), 0.0, &lagged, &extra);
-        let sc = scenario::parse("lagged.toml", &text).unwrap();
-        let r = scenario::run(&sc, &|_| {}).unwrap();
-        assert!(
-            r.failed.is_empty(),
-            "noise seed {noise_seed}: {:?}",
-            r.failed
-        );
+    let couplings = (coupling_of(d.seed), 0.0);
+    for (_, r) in under_noise_seeds(&d, couplings, &drift(8.0, 0.0), 1..=6) {
         // Output 1 of each step.
         t.extend(t_values(&r).into_iter().step_by(2));
     }
