@@ -252,14 +252,20 @@ impl GyroInterface {
         let mut next = samples.iter().peekable();
         let mut t = 0;
         while t < n {
+            let at = next.peek().map_or(n, |&&(at, _)| at);
             if self.iir.idle() {
                 // Idle until the next sample, if any in this block.
-                let at = next.peek().map_or(n, |&&(at, _)| at);
                 if at > t {
                     self.iir.step((0, 0), false, &regs.iir);
                     t = at;
                     continue;
                 }
+            } else if at > t {
+                // Busy, no sample before `at`: the schedule runs on.
+                let from = t;
+                let on = |i: usize, z| on_z((from + i) as u64, z);
+                t += self.iir.run_without_input(at - t, &regs.iir, on);
+                continue;
             }
             let sample = next.next_if(|&&(at, _)| at == t);
             let (x, valid) = sample.map_or(((0, 0), false), |&(_, y)| (y, true));
