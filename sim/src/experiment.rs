@@ -368,11 +368,14 @@ fn span(v: &[f64]) -> f64 {
 }
 
 /// Plan an experiment: registers, ADC gains, settling, batches, targets.
+/// In order: the readout registers and the plan's fixed parts
+/// (`plan_without_points`), each calibration frequency's registers, the
+/// ADC gains from the largest displacement any point samples
+/// (`adc_gains`), then the settling and batches of each sweep
+/// (`readout_points`, `calibration_points`).
 pub fn plan(exp: &Experiment) -> Result<Plan, RunError> {
     exp.validate()?;
     let derived = exp.derived()?;
-    let rates = &exp.points.readout_rates_dps;
-    let cals = &exp.points.cal_freqs_hz;
     let fe = &exp.frontend;
     let base = FrequencyPlan {
         clock_hz: exp.drive.clock_hz,
@@ -387,30 +390,62 @@ pub fn plan(exp: &Experiment) -> Result<Plan, RunError> {
         adc_latency: fe.adc_latency,
     };
     let (readout_regs, realized) = settings::registers(&base)?;
-    let filter = realized.filter.clone();
+    let mut plan = plan_without_points(exp, derived, &realized, readout_regs.amp)?;
+    let mut dev = plan.theory_device(exp);
+    dev.f1_force *= plan.hold_gain;
+    dev.f2_force *= plan.hold_gain;
+    let cal_plans: Vec<(Registers, f64)> = exp
+        .points
+        .cal_freqs_hz
+        .iter()
+        .map(|&f| {
+            let p = FrequencyPlan {
+                cal_hz: f,
+                calibration: true,
+                ..base.clone()
+            };
+            settings::registers(&p).map(|(r, real)| (r, real.cal_hz))
+        })
+        .collect::<Result<_, _>>()?;
+    let cal_hz: Vec<f64> = cal_plans.iter().map(|c| c.1).collect();
+    plan.front_end.adc_per_meter = adc_gains(exp, &dev, &cal_hz);
+    Converters::new(&plan.front_end)?;
+    let read = readout_points(exp, &mut plan, &dev, readout_regs);
+    let cal = calibration_points(exp, &mut plan, &dev, cal_plans);
+    plan.points = read.into_iter().chain(cal).collect();
+    Ok(plan)
+}
+
+/// The plan's parts that do not depend on the points: the drive words
+/// (an error if one is below an LSB), the front end with unit ADC gains,
+/// the filter, the hold's gain, the settling's timing and the warnings.
+fn plan_without_points(
+    exp: &Experiment,
+    derived: Derived,
+    realized: &settings::Realized,
+    amp: (i16, i16),
+) -> Result<Plan, RunError> {
+    let fe = &exp.frontend;
     let profile = exp.drive.carrier_profile;
-    let drive_words = realized_words(readout_regs.amp, Mode::Readout, profile);
-    let cal_drive_words = realized_words(readout_regs.amp, Mode::Calibration, profile);
+    let drive_words = realized_words(amp, Mode::Readout, profile);
+    let cal_drive_words = realized_words(amp, Mode::Calibration, profile);
     if drive_words.iter().any(|&w| w < 1.0) {
         return Err(RunError::DrivesBelowOneLsb);
     }
     let force_full_scale = exp.drive.force_full_scale();
     let force_per_lsb = [force_full_scale[0] / 32768.0, force_full_scale[1] / 32768.0];
     let clock = exp.drive.clock_hz;
-    let hold_gain = hold_gain(realized.carrier_hz, clock);
     let mut warnings = vec![];
     if let Some(q) = settings::commensurate_period(exp.drive.carrier_hz, clock) {
         warnings.push(format!(
             "carrier_hz / clock_hz is a ratio of small integers (period {q} clocks): the converters see only {q} phases and their quantization errors do not average out (errors of percent); use a non-round carrier or dither (noise_lsb)"
         ));
     }
-
     // Theory for gains and timing (the hold scales every force alike).
     let tau_s = exp.gyro.slowest_time_constant_s();
     let step = f64::from(1u32 << (16 - fe.adc_bits));
-    let mut plan = Plan {
+    Ok(Plan {
         points: vec![],
-        derived: derived.clone(),
         front_end: FrontEnd {
             dac_latency: fe.dac_latency,
             adc_latency: fe.adc_latency,
@@ -422,10 +457,10 @@ pub fn plan(exp: &Experiment) -> Result<Plan, RunError> {
             seed: fe.seed,
         },
         carrier_hz: realized.carrier_hz,
-        filter,
+        filter: realized.filter.clone(),
         drive_words,
         cal_drive_words,
-        hold_gain,
+        hold_gain: hold_gain(realized.carrier_hz, clock),
         tau_s,
         settling: settling::Timing {
             tau_s,
@@ -436,132 +471,145 @@ pub fn plan(exp: &Experiment) -> Result<Plan, RunError> {
             adc_variance: fe.noise_lsb * fe.noise_lsb + step * step / 12.0,
             drive_start: DRIVE_START_CLOCKS as u64,
         },
+        derived,
         signal_lsb: [[0.0; 2]; 2],
         warnings,
-    };
-    let mut dev = plan.theory_device(exp);
-    dev.f1_force *= hold_gain;
-    dev.f2_force *= hold_gain;
+    })
+}
+
+/// The ADC gains (LSB per metre): `exp`'s own, or the largest sampled
+/// displacement of any point (the DAC's images included, `crate::images`)
+/// at `adc_headroom`; `dev` the theory's device with the hold's gain,
+/// `cal_hz` the realized calibration frequencies.
+fn adc_gains(exp: &Experiment, dev: &Device, cal_hz: &[f64]) -> [f64; 2] {
+    if let Some(g) = exp.adc_per_meter() {
+        return g;
+    }
+    let clock = exp.drive.clock_hz;
     let rad = PI / 180.0;
-    let cal_plans: Vec<(Registers, f64)> = cals
-        .iter()
-        .map(|&f| {
-            let p = FrequencyPlan {
-                cal_hz: f,
-                calibration: true,
-                ..base.clone()
-            };
-            settings::registers(&p).map(|(r, real)| (r, real.cal_hz))
-        })
-        .collect::<Result<_, _>>()?;
-    // ADC gains: the largest sampled displacement of any point (the DAC's
-    // images included, `crate::images`) at `adc_headroom`.
     let mut peak_x = [0.0f64; 2];
-    for &r in rates {
-        let x = sampled_peak(&dev, clock, |d| {
+    for &r in &exp.points.readout_rates_dps {
+        let x = sampled_peak(dev, clock, |d| {
             theory::readout_peak_displacement(d, r * rad)
         });
         peak_x = [peak_x[0].max(x[0]), peak_x[1].max(x[1])];
     }
-    for (_, f) in &cal_plans {
-        let x = sampled_peak(&dev, clock, |d| {
-            theory::calibration_peak_displacement(d, *f)
-        });
+    for &f in cal_hz {
+        let x = sampled_peak(dev, clock, |d| theory::calibration_peak_displacement(d, f));
         peak_x = [peak_x[0].max(x[0]), peak_x[1].max(x[1])];
     }
-    plan.front_end.adc_per_meter = match exp.adc_per_meter() {
-        Some(g) => g,
-        None => [
-            fe.adc_headroom * 32767.0 / peak_x[0],
-            fe.adc_headroom * 32767.0 / peak_x[1],
-        ],
-    };
-    Converters::new(&plan.front_end)?;
+    let headroom = exp.frontend.adc_headroom;
+    peak_x.map(|x| headroom * 32767.0 / x)
+}
 
-    // Settling: see the module header and `crate::settling`.
-    let sf_read = theory::sf_read_per_rad_s(&dev).map(|v| v * rad);
-    let sf_cal = theory::sf_cal_per_rad_s(&dev).map(|v| v * rad);
-    let virtual_rates: Vec<f64> = cal_plans.iter().map(|c| 360.0 * c.1).collect();
-    let read_signal = sf_read.map(|s| s.abs() * span(rates));
-    let cal_signal = sf_cal.map(|s| s.abs() * span(&virtual_rates));
-
-    // Rate signal in ADC LSB of in-phase amplitude: mean(adc x ref) = A W / 2.
+/// The readout sweep's points: one settling time for all (so the points'
+/// batches line up) and one window, its rate signal in ADC LSB set in
+/// `plan.signal_lsb[0]` (see the module header and `crate::settling`).
+/// The transient's scale is the peak product: x_k's amplitude times its
+/// reference's (output k mixes with drive k in readout).
+fn readout_points(
+    exp: &Experiment,
+    plan: &mut Plan,
+    dev: &Device,
+    regs: Registers,
+) -> Vec<PointPlan> {
+    let rad = PI / 180.0;
+    let rates = &exp.points.readout_rates_dps;
+    let sf_read = theory::sf_read_per_rad_s(dev).map(|v| v * rad);
+    let signal = sf_read.map(|s| s.abs() * span(rates));
     let forces = [dev.f1_force, dev.f2_force];
     let adc = plan.front_end.adc_per_meter;
-    plan.signal_lsb = [
-        std::array::from_fn(|k| 2.0 * read_signal[k] * adc[k] / forces[k]),
-        std::array::from_fn(|k| 2.0 * cal_signal[k] * adc[k] / forces[1 - k]),
-    ];
-    let window_cycles = derived.min_window_s * clock;
-    // Whole ripple periods, the same number at every point of the
-    // staircase (their batches pair up in the slope fit): enough for the
-    // first window at the slowest point, and at least `MIN_RIPPLE_PERIODS`.
-    let slowest = cal_plans.iter().map(|c| c.1).fold(f64::INFINITY, f64::min);
-    let fastest = cal_plans.iter().map(|c| c.1).fold(0.0, f64::max);
-    let periods = ((window_cycles * 2.0 * slowest / clock).ceil() as u32).max(MIN_RIPPLE_PERIODS);
-    // One settling time per sweep, so the points' batches line up. The
-    // transient's scale is the peak product: x_k's amplitude times its
-    // reference's (output k mixes with drive k in readout, the other in
-    // calibration).
-    let (read_settle, read_residues) = settling::settle(
+    // Rate signal in ADC LSB of in-phase amplitude: mean(adc x ref) = A W / 2.
+    plan.signal_lsb[0] = std::array::from_fn(|k| 2.0 * signal[k] * adc[k] / forces[k]);
+    let window_cycles = plan.derived.min_window_s * exp.drive.clock_hz;
+    let (settle_cycles, residues) = settling::settle(
         &Sweep {
             transient: rates
                 .iter()
                 .map(|&r| {
-                    let x = theory::readout_peak_displacement(&dev, r * rad);
+                    let x = theory::readout_peak_displacement(dev, r * rad);
                     [x[0] * forces[0], x[1] * forces[1]]
                 })
                 .collect(),
-            signal: read_signal,
+            signal,
             signal_lsb: plan.signal_lsb[0],
             window_cycles,
         },
         &plan.settling,
         exp.points.tolerance,
     );
-    let (cal_settle, cal_residues) = settling::settle(
+    rates
+        .iter()
+        .zip(residues)
+        .map(|(&r, residue)| PointPlan {
+            mode: Mode::Readout,
+            rate_dps: r,
+            cal_hz: 0.0,
+            omz_rad_s: r * rad,
+            regs,
+            settle_cycles,
+            unit_cycles: window_cycles / f64::from(BATCHES),
+            units: 1,
+            residue,
+        })
+        .collect()
+}
+
+/// The calibration sweep's points (`cal_plans`: registers and realized
+/// frequency of each), as `readout_points` does the readout's, in whole
+/// ripple periods: the same number at every point (their batches pair up
+/// in the slope fit), enough for the first window at the slowest point
+/// and at least `MIN_RIPPLE_PERIODS`. Output k mixes with the other
+/// drive in calibration.
+fn calibration_points(
+    exp: &Experiment,
+    plan: &mut Plan,
+    dev: &Device,
+    cal_plans: Vec<(Registers, f64)>,
+) -> Vec<PointPlan> {
+    let rad = PI / 180.0;
+    let clock = exp.drive.clock_hz;
+    let sf_cal = theory::sf_cal_per_rad_s(dev).map(|v| v * rad);
+    let virtual_rates: Vec<f64> = cal_plans.iter().map(|c| 360.0 * c.1).collect();
+    let signal = sf_cal.map(|s| s.abs() * span(&virtual_rates));
+    let forces = [dev.f1_force, dev.f2_force];
+    let adc = plan.front_end.adc_per_meter;
+    plan.signal_lsb[1] = std::array::from_fn(|k| 2.0 * signal[k] * adc[k] / forces[1 - k]);
+    let window_cycles = plan.derived.min_window_s * clock;
+    let slowest = cal_plans.iter().map(|c| c.1).fold(f64::INFINITY, f64::min);
+    let fastest = cal_plans.iter().map(|c| c.1).fold(0.0, f64::max);
+    let periods = ((window_cycles * 2.0 * slowest / clock).ceil() as u32).max(MIN_RIPPLE_PERIODS);
+    let (settle_cycles, residues) = settling::settle(
         &Sweep {
             transient: cal_plans
                 .iter()
                 .map(|&(_, f)| {
-                    let x = theory::calibration_peak_displacement(&dev, f);
+                    let x = theory::calibration_peak_displacement(dev, f);
                     [x[0] * forces[1], x[1] * forces[0]]
                 })
                 .collect(),
-            signal: cal_signal,
+            signal,
             signal_lsb: plan.signal_lsb[1],
             window_cycles: f64::from(periods) * clock / (2.0 * fastest),
         },
         &plan.settling,
         exp.points.tolerance,
     );
-    for (&r, residue) in rates.iter().zip(read_residues) {
-        plan.points.push(PointPlan {
-            mode: Mode::Readout,
-            rate_dps: r,
-            cal_hz: 0.0,
-            omz_rad_s: r * rad,
-            regs: readout_regs,
-            settle_cycles: read_settle,
-            unit_cycles: window_cycles / f64::from(BATCHES),
-            units: 1,
-            residue,
-        });
-    }
-    for ((regs, f), residue) in cal_plans.into_iter().zip(cal_residues) {
-        plan.points.push(PointPlan {
+    cal_plans
+        .into_iter()
+        .zip(residues)
+        .map(|((regs, f), residue)| PointPlan {
             mode: Mode::Calibration,
             rate_dps: 360.0 * f,
             cal_hz: f,
             omz_rad_s: 0.0,
             regs,
-            settle_cycles: cal_settle,
+            settle_cycles,
             unit_cycles: clock / (2.0 * f),
             units: periods,
             residue,
-        });
-    }
-    Ok(plan)
+        })
+        .collect()
 }
 
 /// A decimated sample of the outputs, for plots.
