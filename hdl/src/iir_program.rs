@@ -135,7 +135,7 @@ impl Location {
 /// one conditional subtraction, since r + base < 6 (the model runs this
 /// twice a clock, where a division by 3 was 4% of the datapath's time).
 #[inline(always)]
-pub fn physical_address(field: u8, base: u8) -> usize {
+pub const fn physical_address(field: u8, base: u8) -> usize {
     debug_assert!(base < ROTATING_SLOTS);
     let slot = (field >> 2) & 3;
     let slot = if slot == ROTATING_SLOTS {

@@ -612,6 +612,54 @@ mod tests {
         }
     }
 
+    /// Runs and single steps mixed on one model play the clocks of steps
+    /// alone: runs of 1 to 400 clocks (ending anywhere in the IIR's
+    /// schedules) with 1 to 5 steps after each, on both cores, against a
+    /// model stepped throughout. A run's shortcuts may keep their own
+    /// bookkeeping only if they leave the state a step reads.
+    #[test]
+    fn runs_and_steps_mixed_are_the_steps() {
+        for profile in CarrierProfile::ALL {
+            let mut rng = Rng::new(23);
+            let (mut mixed, mut stepped) = (
+                GyroInterface::with_profile(profile),
+                GyroInterface::with_profile(profile),
+            );
+            let (mut count_m, mut count_s) = (0, 0);
+            let (mut z_mixed, mut z_stepped) = (vec![], vec![]);
+            let mut clock = 0u64;
+            for run in 0..8 {
+                let regs = run_registers(&mut rng);
+                for _ in 0..40 {
+                    let clocks = rng.range(1, 400) as u64;
+                    let mut o = mixed.run(&regs, clocks, &mut analog(&mut count_m), |i, z| {
+                        z_mixed.push((clock + i, z))
+                    });
+                    let steps = rng.range(1, 5) as u64;
+                    let mut feed = analog_word(&mut count_m);
+                    for i in 0..steps {
+                        o = mixed.step(feed(o.dac), &regs);
+                        if o.z_valid {
+                            z_mixed.push((clock + clocks + i, o.z));
+                        }
+                    }
+                    let mut feed = analog_word(&mut count_s);
+                    let mut p = stepped.outputs();
+                    for i in 0..clocks + steps {
+                        p = stepped.step(feed(p.dac), &regs);
+                        if p.z_valid {
+                            z_stepped.push((clock + i, p.z));
+                        }
+                    }
+                    assert_eq!(o, p, "{profile}, run {run}, clock {clock}");
+                    clock += clocks + steps;
+                }
+                assert_eq!(z_mixed, z_stepped, "{profile}, run {run}");
+            }
+            assert!(z_stepped.len() > 50, "{profile}: {} z", z_stepped.len());
+        }
+    }
+
     /// `quiet_clocks` is exact where it is not 0: from any cycle of runs
     /// with changing registers, the next z comes at the edge after the
     /// quiet ones; and it is known on most cycles.

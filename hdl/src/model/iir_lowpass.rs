@@ -13,8 +13,8 @@
 //! in i128; a property test shows the program computes exactly it.
 
 use crate::iir_program::{
-    ACCUMULATOR_BITS, AccumulatorOp, DIGIT_BITS, Emit, MicroWord, PROGRAM, STATE_TOP_BITS,
-    factor_value, physical_address,
+    ACCUMULATOR_BITS, AccumulatorOp, DIGIT_BITS, Emit, MicroWord, PROGRAM, ROTATING_SLOTS,
+    STATE_TOP_BITS, factor_value, physical_address,
 };
 
 pub use gyrocal_regs::Coefficients;
@@ -27,6 +27,35 @@ fn wrap(x: i64, bits: usize) -> i64 {
 
 /// Low digit mask.
 const DIGIT_MASK: i64 = (1 << DIGIT_BITS) - 1;
+
+/// Words of the digit RAM.
+const RAM_WORDS: usize = 1 << crate::iir_program::RAM_ADDRESS_BITS;
+
+/// `physical_address` of every address field at each sample counter: a
+/// busy clock looks its two addresses up (`run_without_input`).
+static PHYSICAL: [[u8; RAM_WORDS]; ROTATING_SLOTS as usize] = {
+    let mut table = [[0; RAM_WORDS]; ROTATING_SLOTS as usize];
+    let mut base = 0;
+    while base < ROTATING_SLOTS as usize {
+        let mut field = 0;
+        while field < RAM_WORDS {
+            table[base][field] = physical_address(field as u8, base as u8) as u8;
+            field += 1;
+        }
+        base += 1;
+    }
+    table
+};
+
+/// `factor_value` of every 5-bit factor select for one set of
+/// coefficients, looked up by a busy clock (`run_without_input`).
+struct Factors([i64; 32]);
+
+impl Factors {
+    fn new(k: &Coefficients) -> Self {
+        Self(std::array::from_fn(|select| factor_value(select as u8, k)))
+    }
+}
 
 /// Cycle-true model of the two-channel filter.
 #[derive(Clone, Debug)]
@@ -43,7 +72,7 @@ pub struct IirLowpass {
     x: [i64; 2],
     /// Digit RAM (an array, not a `Vec`: a copy of the whole filter in
     /// locals, `run_without_input`, allocates nothing).
-    ram: [i16; 1 << crate::iir_program::RAM_ADDRESS_BITS],
+    ram: [i16; RAM_WORDS],
     /// RAM read register.
     ram_q: i16,
     /// Operand registers.
@@ -70,7 +99,7 @@ impl Default for IirLowpass {
             word: 0,
             base: 0,
             x: [0; 2],
-            ram: [0; 1 << crate::iir_program::RAM_ADDRESS_BITS],
+            ram: [0; RAM_WORDS],
             ram_q: 0,
             a: 0,
             b: 0,
@@ -131,9 +160,11 @@ impl IirLowpass {
         mut on_z: impl FnMut(usize, (i64, i64)),
     ) -> usize {
         let mut local = self.clone();
+        let factors = Factors::new(k);
+        let at = |field: u8, base: u8| usize::from(PHYSICAL[usize::from(base)][usize::from(field)]);
         let mut i = 0;
         while i < clocks && !local.idle() {
-            let (z1, z2, z_valid) = local.step((0, 0), false, k);
+            let (z1, z2, z_valid) = local.clock((0, 0), false, at, |f| factors.0[usize::from(f)]);
             if z_valid {
                 on_z(i, (z1, z2));
             }
@@ -147,6 +178,19 @@ impl IirLowpass {
     /// `(z1, z2, z_valid)` after the edge.
     #[inline(always)]
     pub fn step(&mut self, x: (i64, i64), x_valid: bool, k: &Coefficients) -> (i64, i64, bool) {
+        self.clock(x, x_valid, physical_address, |f| factor_value(f, k))
+    }
+
+    /// `step`, with the RAM address of a field at a sample counter from
+    /// `address` and a factor select's operand from `factor`.
+    #[inline(always)]
+    fn clock(
+        &mut self,
+        x: (i64, i64),
+        x_valid: bool,
+        address: impl Fn(u8, u8) -> usize,
+        factor: impl Fn(u8) -> i64,
+    ) -> (i64, i64, bool) {
         if self.idle() && !x_valid {
             // Idle: word 0 does nothing that a schedule reads back.
             self.z_valid = false;
@@ -155,7 +199,7 @@ impl IirLowpass {
         let w: MicroWord = self.words[self.word];
         let accept = self.pc == 0 && x_valid;
         // Values at the rising edge, all from the current registers.
-        let ram_q = self.ram[physical_address(w.read, self.base)];
+        let ram_q = self.ram[address(w.read, self.base)];
         let digit = self.acc & DIGIT_MASK;
         let top_digit = wrap(self.acc, DIGIT_BITS);
         match w.emit {
@@ -170,7 +214,7 @@ impl IirLowpass {
                     Emit::TopDigit => top_digit,
                     _ => self.input_digit(w.x_select),
                 };
-                self.ram[physical_address(w.write, self.base)] = value as i16;
+                self.ram[address(w.write, self.base)] = value as i16;
             }
         }
         let p = self.p;
@@ -189,7 +233,7 @@ impl IirLowpass {
         } else {
             self.ram_q as i64
         };
-        self.b = factor_value(w.factor, k);
+        self.b = factor(w.factor);
         self.ram_q = ram_q;
         if w.publish {
             // Digits 0..2 are z1 (45 bits), 3..5 z2; each keeps 40 bits.
