@@ -162,84 +162,129 @@ pub(super) fn fit_mode(
     clock_hz: Option<f64>,
     pull: &dyn Fn(f64) -> C64,
     front: FrontSlope,
-) -> Result<ModeFit, &'static str> {
+) -> Result<ModeFit, FitError> {
     let shape = |fk: f64, bk: f64, f: f64| shape(fk, bk, f, clock_hz, pull, front);
     // Best C for given (fk, bk) is linear: C = sum(Y conj(g)) / sum |g|^2,
     // g the model's shape.
-    let best_c = |fk: f64, bk: f64| {
+    let c = {
         let (mut num, mut norm) = (C64::new(0.0, 0.0), 0.0);
         for &(f, y) in points {
-            let g = shape(fk, bk, f).0;
+            let g = shape(fk0, bk0, f).0;
             num += y * g.conj();
             norm += g.norm_sqr();
         }
         num / norm
     };
-    let mut p = {
-        let c = best_c(fk0, bk0);
-        [c.re, c.im, fk0, bk0]
-    };
-    let n = points.len();
-    let jacobian = |p: &[f64; 4]| {
-        let c = C64::new(p[0], p[1]);
-        let mut j = DMatrix::<f64>::zeros(2 * n, 4);
-        let mut r = DVector::<f64>::zeros(2 * n);
-        for (i, &(f, y)) in points.iter().enumerate() {
-            let (g, dfk, dbk) = shape(p[2], p[3], f);
-            let res = y - c * g;
-            r[2 * i] = res.re;
-            r[2 * i + 1] = res.im;
-            let cols = [g, C64::new(0.0, 1.0) * g, c * dfk, c * dbk];
-            for (col, v) in cols.iter().enumerate() {
-                j[(2 * i, col)] = v.re;
-                j[(2 * i + 1, col)] = v.im;
-            }
-        }
-        (j, r)
-    };
-    let scaled_solve =
-        |j: &DMatrix<f64>, r: &DVector<f64>| -> Option<(DVector<f64>, DMatrix<f64>)> {
-            let scale: Vec<f64> = (0..4).map(|c| j.column(c).norm()).collect();
-            let mut js = j.clone();
-            for (c, s) in scale.iter().enumerate() {
-                js.column_mut(c).scale_mut(1.0 / s);
-            }
-            let normal = js.transpose() * &js;
-            let inv = normal.try_inverse()?;
-            let step = &inv * js.transpose() * r;
-            let mut cov = inv;
-            for a in 0..4 {
-                for b in 0..4 {
-                    cov[(a, b)] /= scale[a] * scale[b];
-                }
-            }
-            Some((step.component_div(&DVector::from_vec(scale)), cov))
-        };
-    let mut cov = DMatrix::<f64>::zeros(4, 4);
-    let mut rss = 0.0;
+    let (p, cov, rss) = gauss_newton(points, [c.re, c.im, fk0, bk0], &shape)?;
+    mode_fit(points, p, &cov, rss, clock_hz, front)
+}
+
+/// Why a fit of a mode gave no estimates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+pub(crate) enum FitError {
+    /// The normal equations had no inverse.
+    #[error("singular fit")]
+    Singular,
+    /// The estimates left the model's domain.
+    #[error("the fit diverged (no finite, positive bandwidth)")]
+    Diverged,
+}
+
+/// Gauss-Newton from `p` = [Re C, Im C, fk, bk] on the model C
+/// shape(fk, bk, f), at most 30 steps, until a step moves fk and bk by less
+/// than 1e-9 bk: the parameters, their unscaled covariance (times the
+/// residuals' variance it is theirs) and the residuals' sum of squares,
+/// both taken at the end (or, should the normal equations be singular
+/// there, at the last step's start).
+fn gauss_newton(
+    points: &[(f64, C64)],
+    mut p: [f64; 4],
+    shape: &impl Fn(f64, f64, f64) -> (C64, C64, C64),
+) -> Result<([f64; 4], DMatrix<f64>, f64), FitError> {
+    let mut last = None;
     for _ in 0..30 {
-        let (j, r) = jacobian(&p);
-        let (step, c) = scaled_solve(&j, &r).ok_or("singular fit")?;
+        let (j, r) = jacobian(points, &p, shape);
+        let (step, cov) = scaled_solve(&j, &r).ok_or(FitError::Singular)?;
         for (v, s) in p.iter_mut().zip(step.iter()) {
             *v += s;
         }
-        cov = c;
-        rss = r.norm_squared();
+        last = Some((cov, r.norm_squared()));
         if step[2].abs() < 1e-9 * p[3] && step[3].abs() < 1e-9 * p[3] {
             break;
         }
     }
-    let (j, r) = jacobian(&p);
-    if let Some((_, c)) = scaled_solve(&j, &r) {
-        cov = c;
-        rss = r.norm_squared();
+    let (j, r) = jacobian(points, &p, shape);
+    let (cov, rss) = match scaled_solve(&j, &r) {
+        Some((_, cov)) => (cov, r.norm_squared()),
+        None => last.ok_or(FitError::Singular)?,
+    };
+    Ok((p, cov, rss))
+}
+
+/// The residuals Y - C g (real and imaginary rows) at `p` and their
+/// Jacobian by (Re C, Im C, fk, bk), with the sign that makes a step
+/// J^+ r.
+fn jacobian(
+    points: &[(f64, C64)],
+    p: &[f64; 4],
+    shape: &impl Fn(f64, f64, f64) -> (C64, C64, C64),
+) -> (DMatrix<f64>, DVector<f64>) {
+    let n = points.len();
+    let c = C64::new(p[0], p[1]);
+    let mut j = DMatrix::<f64>::zeros(2 * n, 4);
+    let mut r = DVector::<f64>::zeros(2 * n);
+    for (i, &(f, y)) in points.iter().enumerate() {
+        let (g, dfk, dbk) = shape(p[2], p[3], f);
+        let res = y - c * g;
+        r[2 * i] = res.re;
+        r[2 * i + 1] = res.im;
+        let cols = [g, C64::new(0.0, 1.0) * g, c * dfk, c * dbk];
+        for (col, v) in cols.iter().enumerate() {
+            j[(2 * i, col)] = v.re;
+            j[(2 * i + 1, col)] = v.im;
+        }
     }
+    (j, r)
+}
+
+/// The least-squares step J^+ r and (J^T J)^-1, with J's columns scaled
+/// to unit norm for the inverse (fk and C differ by orders of magnitude);
+/// `None` when singular.
+fn scaled_solve(j: &DMatrix<f64>, r: &DVector<f64>) -> Option<(DVector<f64>, DMatrix<f64>)> {
+    let scale: Vec<f64> = (0..4).map(|c| j.column(c).norm()).collect();
+    let mut js = j.clone();
+    for (c, s) in scale.iter().enumerate() {
+        js.column_mut(c).scale_mut(1.0 / s);
+    }
+    let normal = js.transpose() * &js;
+    let inv = normal.try_inverse()?;
+    let step = &inv * js.transpose() * r;
+    let mut cov = inv;
+    for a in 0..4 {
+        for b in 0..4 {
+            cov[(a, b)] /= scale[a] * scale[b];
+        }
+    }
+    Some((step.component_div(&DVector::from_vec(scale)), cov))
+}
+
+/// The mode's estimates from the fit's parameters `p`, unscaled
+/// covariance `cov` and residual sum of squares `rss` over `points`.
+fn mode_fit(
+    points: &[(f64, C64)],
+    p: [f64; 4],
+    cov: &DMatrix<f64>,
+    rss: f64,
+    clock_hz: Option<f64>,
+    front: FrontSlope,
+) -> Result<ModeFit, FitError> {
+    let n = points.len();
     let dof = (2 * n).saturating_sub(4).max(1) as f64;
     let s2 = rss / dof;
     let sd = |a: usize| (s2 * cov[(a, a)]).sqrt();
     let (fk, bk) = (p[2], p[3]);
     if !(fk.is_finite() && bk.is_finite() && bk > 0.0) {
-        return Err("the fit diverged (no finite, positive bandwidth)");
+        return Err(FitError::Diverged);
     }
     let q = fk / bk;
     let q_sd = q * ((sd(3) / bk).powi(2) + (sd(2) / fk).powi(2)).sqrt();

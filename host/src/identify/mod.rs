@@ -356,7 +356,7 @@ pub fn identify_mode(
     )
     .map_err(|reason| Error::Identification {
         mode: k + 1,
-        reason: reason.into(),
+        reason: reason.to_string(),
     })?;
     fit.waited_s = probe.waited_s();
     fit.scanned = scanned;
@@ -385,7 +385,7 @@ pub(crate) fn refit(
     )
     .map_err(|reason| Error::Identification {
         mode: k + 1,
-        reason: reason.into(),
+        reason: reason.to_string(),
     })?;
     fit.waited_s = mode.waited_s;
     fit.scanned = mode.scanned;
