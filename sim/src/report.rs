@@ -166,27 +166,11 @@ impl Report {
         let cal_per_lsb = plan.z_per_lsb(Mode::Calibration);
         let in_lsb = |v: [f64; 2], per_lsb: [f64; 2]| [v[0] / per_lsb[0], v[1] / per_lsb[1]];
         let exact: ScaleFactors = exact_scale_factors(&points);
-        let mut dev = plan.theory_device(exp);
-        dev.f1_force *= plan.hold_gain.sqrt();
-        dev.f2_force *= plan.hold_gain.sqrt();
-        let sf_read = theory::sf_read_per_rad_s(&dev).map(|v| v * PER_DPS);
-        let sf_cal = theory::sf_cal_per_rad_s(&dev).map(|v| v * PER_DPS);
-        let eq5 = theory::eq5_sf_read_per_rad_s(&dev) * PER_DPS;
-        let eq6 = theory::eq6_sf_cal_per_rad_s(&dev).map(|v| v * PER_DPS);
-        let eq56_ratio = [eq5 / eq6[0], eq5 / eq6[1]];
+        let small_signal = SmallSignal::of(exp, plan);
         let predicted: [f64; 2] = std::array::from_fn(|k| sim.sf_cal_per_dps[k] * exact.ratio[k]);
         let predicted_eq56: [f64; 2] =
-            std::array::from_fn(|k| sim.sf_cal_per_dps[k] * eq56_ratio[k]);
+            std::array::from_fn(|k| sim.sf_cal_per_dps[k] * small_signal.eq56_ratio[k]);
         let rel = |a: f64, b: f64| a / b - 1.0;
-        let d1 = (exp.gyro.f1_hz - plan.carrier_hz).abs();
-        let d2 = (exp.gyro.f2_hz - plan.carrier_hz).abs();
-        let detuned_output = if d1 == d2 {
-            None
-        } else if d2 > d1 {
-            Some(1)
-        } else {
-            Some(0)
-        };
         let target = sim
             .ratio
             .map(|r| experiment::ratio_target(exp.points.tolerance, r));
@@ -203,7 +187,6 @@ impl Report {
             target,
             plan.carrier_hz / exp.drive.clock_hz,
         ));
-        let theory_device = plan.theory_device(exp);
         Report {
             ratio_error: std::array::from_fn(|k| rel(sim.ratio[k], exact.ratio[k])),
             predicted_sf_read_per_dps: predicted,
@@ -223,34 +206,10 @@ impl Report {
                 sf_cal_per_dps: exact.sf_cal_per_dps,
                 ratio: exact.ratio,
                 images,
-                small_signal: SmallSignal {
-                    sf_read_per_dps: sf_read,
-                    sf_cal_per_dps: sf_cal,
-                    ratio: [sf_read[0] / sf_cal[0], sf_read[1] / sf_cal[1]],
-                    eq5_sf_read_per_dps: eq5,
-                    eq6_sf_cal_per_dps: eq6,
-                    eq56_ratio,
-                },
+                small_signal,
             },
-            detuned_output,
-            device: DeviceSummary {
-                f1_hz: exp.gyro.f1_hz,
-                f2_hz: exp.gyro.f2_hz,
-                q1: exp.gyro.q1,
-                q2: exp.gyro.q2,
-                angular_gain: exp.gyro.angular_gain,
-                quadrature_dps: exp.gyro.quadrature_dps,
-                damping_coupling_dps: exp.gyro.damping_coupling_dps,
-                carrier_hz: plan.carrier_hz,
-                clock_hz: exp.drive.clock_hz,
-                force_n_per_kg: [theory_device.f1_force, theory_device.f2_force],
-                hold_gain: plan.hold_gain,
-                adc_per_meter: plan.front_end.adc_per_meter,
-                decimation: plan.filter.decimation,
-                z_rate_hz: plan.filter.output_rate_hz,
-                filter_dc_gain: plan.filter.dc_gain,
-                tau_s: plan.tau_s,
-            },
+            detuned_output: detuned_output(exp, plan),
+            device: DeviceSummary::of(exp, plan),
             settings: plan.derived.clone(),
             noise_lsb: plan.front_end.noise_lsb,
             rate_signal_adc_lsb: plan.signal_lsb,
@@ -259,6 +218,67 @@ impl Report {
             warnings,
             scale_factors: sim,
         }
+    }
+}
+
+impl SmallSignal {
+    /// The small-signal theory of `exp`'s device as `plan` drives it, the
+    /// hold's gain split evenly between drive and pick-off.
+    fn of(exp: &Experiment, plan: &Plan) -> Self {
+        let mut dev = plan.theory_device(exp);
+        dev.f1_force *= plan.hold_gain.sqrt();
+        dev.f2_force *= plan.hold_gain.sqrt();
+        let sf_read = theory::sf_read_per_rad_s(&dev).map(|v| v * PER_DPS);
+        let sf_cal = theory::sf_cal_per_rad_s(&dev).map(|v| v * PER_DPS);
+        let eq5 = theory::eq5_sf_read_per_rad_s(&dev) * PER_DPS;
+        let eq6 = theory::eq6_sf_cal_per_rad_s(&dev).map(|v| v * PER_DPS);
+        SmallSignal {
+            sf_read_per_dps: sf_read,
+            sf_cal_per_dps: sf_cal,
+            ratio: [sf_read[0] / sf_cal[0], sf_read[1] / sf_cal[1]],
+            eq5_sf_read_per_dps: eq5,
+            eq6_sf_cal_per_dps: eq6,
+            eq56_ratio: [eq5 / eq6[0], eq5 / eq6[1]],
+        }
+    }
+}
+
+impl DeviceSummary {
+    /// `exp`'s device and the settings `plan` gives it.
+    fn of(exp: &Experiment, plan: &Plan) -> Self {
+        let theory_device = plan.theory_device(exp);
+        DeviceSummary {
+            f1_hz: exp.gyro.f1_hz,
+            f2_hz: exp.gyro.f2_hz,
+            q1: exp.gyro.q1,
+            q2: exp.gyro.q2,
+            angular_gain: exp.gyro.angular_gain,
+            quadrature_dps: exp.gyro.quadrature_dps,
+            damping_coupling_dps: exp.gyro.damping_coupling_dps,
+            carrier_hz: plan.carrier_hz,
+            clock_hz: exp.drive.clock_hz,
+            force_n_per_kg: [theory_device.f1_force, theory_device.f2_force],
+            hold_gain: plan.hold_gain,
+            adc_per_meter: plan.front_end.adc_per_meter,
+            decimation: plan.filter.decimation,
+            z_rate_hz: plan.filter.output_rate_hz,
+            filter_dc_gain: plan.filter.dc_gain,
+            tau_s: plan.tau_s,
+        }
+    }
+}
+
+/// The output (0, 1) whose mode lies farther from the carrier, `None`
+/// when both are as far.
+fn detuned_output(exp: &Experiment, plan: &Plan) -> Option<usize> {
+    let d1 = (exp.gyro.f1_hz - plan.carrier_hz).abs();
+    let d2 = (exp.gyro.f2_hz - plan.carrier_hz).abs();
+    if d1 == d2 {
+        None
+    } else if d2 > d1 {
+        Some(1)
+    } else {
+        Some(0)
     }
 }
 
