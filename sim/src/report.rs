@@ -11,6 +11,7 @@ use crate::experiment::{
     measured_scale_factors,
 };
 use crate::fit::ScaleFactors;
+use crate::gyro::GyroParams;
 use crate::theory;
 use serde::Serialize;
 
@@ -20,20 +21,9 @@ const PER_DPS: f64 = std::f64::consts::PI / 180.0;
 /// The device as simulated.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct DeviceSummary {
-    /// Mode 1 frequency (Hz).
-    pub f1_hz: f64,
-    /// Mode 2 frequency (Hz).
-    pub f2_hz: f64,
-    /// Mode 1 quality factor.
-    pub q1: f64,
-    /// Mode 2 quality factor.
-    pub q2: f64,
-    /// Angular gain lambda.
-    pub angular_gain: f64,
-    /// Quadrature (stiffness) coupling (deg/s).
-    pub quadrature_dps: f64,
-    /// Damping coupling (deg/s).
-    pub damping_coupling_dps: f64,
+    /// The gyroscope's parameters (its fields at this level in JSON).
+    #[serde(flatten)]
+    pub gyro: GyroParams,
     /// Realized carrier (Hz).
     pub carrier_hz: f64,
     /// FPGA clock (Hz).
@@ -248,13 +238,7 @@ impl DeviceSummary {
     fn of(exp: &Experiment, plan: &Plan) -> Self {
         let theory_device = plan.theory_device(exp);
         DeviceSummary {
-            f1_hz: exp.gyro.f1_hz,
-            f2_hz: exp.gyro.f2_hz,
-            q1: exp.gyro.q1,
-            q2: exp.gyro.q2,
-            angular_gain: exp.gyro.angular_gain,
-            quadrature_dps: exp.gyro.quadrature_dps,
-            damping_coupling_dps: exp.gyro.damping_coupling_dps,
+            gyro: exp.gyro.clone(),
             carrier_hz: plan.carrier_hz,
             clock_hz: exp.drive.clock_hz,
             force_n_per_kg: [theory_device.f1_force, theory_device.f2_force],

@@ -71,7 +71,7 @@ impl<'a> Data<'a> {
     /// "output 2 (f₂ − f_c = +250.0 Hz, detuned: the paper's output)".
     pub(super) fn output_name(&self, k: usize) -> String {
         let d = &self.report.device;
-        let offset = [d.f1_hz, d.f2_hz][k] - d.carrier_hz;
+        let offset = d.gyro.f_hz(k) - d.carrier_hz;
         let tag = if self.report.detuned_output == Some(k) {
             ", detuned: the paper's output"
         } else {
