@@ -392,6 +392,7 @@ impl Gaussian {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use rand_xoshiro::rand_core::Rng;
 
     fn front_end() -> FrontEnd {
         FrontEnd {
@@ -408,13 +409,8 @@ mod tests {
 
     #[test]
     fn a_block_through_the_ring_is_its_words_one_by_one() {
-        let mut state = 47u64;
-        let mut next = |m: u64| {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 33) % m
-        };
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(47);
+        let mut next = |m: u64| rng.next_u64() % m;
         for latency in 0..=MAX_LATENCY {
             let (mut block, mut single) = (LatencyRing::default(), LatencyRing::default());
             for _ in 0..12 {
