@@ -73,25 +73,26 @@ done
 python3 - "$out" "$rounds" "$base_rev" "$(git rev-parse --short HEAD)" <<'EOF'
 import json, statistics, sys
 out, rounds, base_rev, head_rev = sys.argv[1], int(sys.argv[2]), sys.argv[3], sys.argv[4]
+# runs[name][r]: the measurements of round r (from 0), each file read once.
+runs = {name: [json.load(open(f"{out}/{name}.{r}.json")) for r in range(1, rounds + 1)]
+        for name in ("base", "head", "portable")}
 def speeds(name):
     s = {False: [], True: []}
-    for r in range(1, rounds + 1):
-        for m in json.load(open(f"{out}/{name}.{r}.json"))["measurements"]:
+    for run in runs[name]:
+        for m in run["measurements"]:
             s[m["with_gyro"]].extend(m["samples"])
     return s
+def median_of(run, gyro):
+    return next(m["median_clocks_per_s"] for m in run["measurements"] if m["with_gyro"] == gyro)
 def paired(name, gyro):
     # Each round's median over the base's median in the same round: on a
     # machine whose speed drifts over minutes, the ratio of runs seconds
     # apart holds where the pooled medians wander.
-    ratios = []
-    for r in range(1, rounds + 1):
-        med = lambda n: next(m["median_clocks_per_s"]
-                             for m in json.load(open(f"{out}/{n}.{r}.json"))["measurements"]
-                             if m["with_gyro"] == gyro)
-        ratios.append(med(name) / med("base"))
+    ratios = [median_of(run, gyro) / median_of(base_run, gyro)
+              for run, base_run in zip(runs[name], runs["base"])]
     return statistics.median(ratios), sum(x > 1 for x in ratios)
 base, head, portable = speeds("base"), speeds("head"), speeds("portable")
-isa = json.load(open(f"{out}/head.1.json"))["model_isa"]
+isa = runs["head"][0]["model_isa"]
 print(f"model engine, one core, {rounds} alternated rounds of 3 repetitions (M clocks/s)")
 print(f"this tree {head_rev} as it chooses ({isa}) and with GYROCAL_ISA=portable")
 print(f"{'setting':<20} {'base ' + base_rev:>24} {'portable':>24} {isa:>24} {'ratios':>13}")
