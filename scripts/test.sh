@@ -71,7 +71,10 @@ warm_pid=$!
 
 cargo fmt --all -- --check
 cargo clippy --release --workspace --all-targets --all-features -- -D warnings
-RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --quiet
+# --release: the documentation then reads the dependencies' metadata that
+# clippy just made in the release profile, where the default profile
+# checks them all again (56 s against 10 s, fresh, two cores).
+RUSTDOCFLAGS="-D warnings" cargo doc --release --workspace --no-deps --quiet
 cargo test --release --workspace --all-features --no-run --quiet
 wait "$warm_pid" || { cat "$warm_log"; echo "warming the YoWASP cache failed (above); the tests that use YoWASP will say more"; }
 
