@@ -69,6 +69,8 @@ mod random_device;
 use gyrocal_hdl::host::traffic::Rng;
 use gyrocal_sim::field::scenario::{self, FieldReport};
 use random_device::{FAST, RandomDevice};
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, OnceLock};
 
 /// Devices in the coverage test.
 const DEVICES: usize = 40;
@@ -154,16 +156,33 @@ fn coupling_of(seed: u64) -> f64 {
 /// The field run of the device of `seed`, with its damping coupling
 /// (`damping_of`) when `damping`, or None when its clock is too fast for
 /// the test.
-fn field(seed: u64, damping: bool) -> Option<(RandomDevice, FieldReport)> {
+fn field(seed: u64, damping: bool) -> Option<(RandomDevice, Arc<FieldReport>)> {
     let d = RandomDevice::draw(seed, FAST);
     if d.clock_hz > MAX_CLOCK_HZ {
         return None;
     }
     let damping = if damping { damping_of(&d) } else { 0.0 };
     let text = scenario_text(&d, coupling_of(seed), damping, &drift(LAG.0, LAG.1), "");
-    let sc = scenario::parse("random.toml", &text).unwrap();
-    let report = scenario::run(&sc, &|_| {}).unwrap();
-    Some((d, report))
+    Some((d, run_once(text)))
+}
+
+/// The report of the scenario `text`, run once per test binary: the
+/// damping test's devices without a damping coupling (half of them) are
+/// the coverage test's runs, text for text, and a run is a function of
+/// its text (every noise seeded). Both tests ask side by side; a text
+/// asked while it runs waits for that run.
+fn run_once(text: String) -> Arc<FieldReport> {
+    type Cell = Arc<OnceLock<Arc<FieldReport>>>;
+    static RUNS: OnceLock<Mutex<HashMap<String, Cell>>> = OnceLock::new();
+    let cell: Cell = {
+        let mut runs = RUNS.get_or_init(Default::default).lock().unwrap();
+        runs.entry(text.clone()).or_default().clone()
+    };
+    cell.get_or_init(|| {
+        let sc = scenario::parse("random.toml", &text).unwrap();
+        Arc::new(scenario::run(&sc, &|_| {}).unwrap())
+    })
+    .clone()
 }
 
 /// Device `d`'s scenario with its (quadrature, damping) couplings and
@@ -304,7 +323,7 @@ fn named(id_t: &[Named], name: &str) -> Vec<f64> {
 /// self-calibration t, every identified parameter's t, and the
 /// self-calibration t's (share within 2, largest |t|, RMS).
 fn coverage_runs(damping: bool) -> (Vec<f64>, Vec<Named>, (f64, f64, f64)) {
-    let runs: Vec<(RandomDevice, FieldReport)> = (FIRST_SEED..)
+    let runs: Vec<(RandomDevice, Arc<FieldReport>)> = (FIRST_SEED..)
         .filter_map(|s| field(s, damping))
         .take(DEVICES)
         .collect();
