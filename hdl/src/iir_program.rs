@@ -327,6 +327,100 @@ enum Target {
     Stage { first: usize },
 }
 
+/// The first digit of `word` of `age` on `channel`.
+fn at(channel: usize, word: Word, age: Age) -> Location {
+    Location {
+        channel,
+        word,
+        age,
+        digit: 0,
+    }
+}
+
+impl Term {
+    /// A state word (`STATE_DIGITS`, its top digit read as the 58-bit
+    /// state's when `wrap_top`) times the three digits of coefficient `s`.
+    fn state_by(word: Location, wrap_top: bool, s: Scaled) -> Self {
+        Term {
+            word,
+            digits: STATE_DIGITS,
+            wrap_top,
+            factors: [
+                Factor::Digit(s, 0),
+                Factor::Digit(s, 1),
+                Factor::Digit(s, 2),
+            ],
+            factor_digits: 3,
+            offset: 0,
+        }
+    }
+
+    /// A sample word (`SAMPLE_DIGITS`) times the three digits of
+    /// coefficient `s`, one column up.
+    fn sample_by(word: Location, s: Scaled) -> Self {
+        Term {
+            digits: SAMPLE_DIGITS,
+            offset: 1,
+            ..Term::state_by(word, false, s)
+        }
+    }
+
+    /// A state word times the one-digit constant `f`, `offset` columns up.
+    fn state_times(word: Location, wrap_top: bool, f: Factor, offset: usize) -> Self {
+        Term {
+            word,
+            digits: STATE_DIGITS,
+            wrap_top,
+            factors: [f, Factor::Zero, Factor::Zero],
+            factor_digits: 1,
+            offset,
+        }
+    }
+}
+
+/// The biquad's terms (module header): `(k1 + 2^31) y1 + (k2 - 2^30) y2`
+/// and `2 k0 x + 4 k0 x0 + 2 k0 x1`, the samples one column (2^15) up.
+fn biquad(channel: usize) -> [Term; 5] {
+    [
+        Term::state_by(at(channel, Word::Y, Age::Previous), true, Scaled::K1Plus),
+        Term::state_by(at(channel, Word::Y, Age::TwoBack), true, Scaled::K2Minus),
+        Term::sample_by(at(channel, Word::X, Age::New), Scaled::K0Twice),
+        Term::sample_by(at(channel, Word::X, Age::Previous), Scaled::K0Quad),
+        Term::sample_by(at(channel, Word::X, Age::TwoBack), Scaled::K0Twice),
+    ]
+}
+
+/// The difference `d = y - u`, u the previous RC output.
+fn difference(channel: usize) -> [Term; 2] {
+    [
+        Term::state_times(at(channel, Word::Y, Age::New), false, Factor::One, 0),
+        Term::state_times(
+            at(channel, Word::U, Age::Previous),
+            true,
+            Factor::MinusOne,
+            0,
+        ),
+    ]
+}
+
+/// The RC step's terms `alpha d + u 2^30` (u two columns up).
+fn rc(channel: usize) -> [Term; 2] {
+    [
+        Term::state_by(at(channel, Word::D, Age::New), false, Scaled::Alpha),
+        Term::state_times(at(channel, Word::U, Age::Previous), true, Factor::One, 2),
+    ]
+}
+
+/// The output's term `u 2^14`, into the staging register.
+fn output(channel: usize) -> [Term; 1] {
+    [Term::state_times(
+        at(channel, Word::U, Age::New),
+        true,
+        Factor::Pow14,
+        0,
+    )]
+}
+
 /// The schedule: ROM words and the figures derived from them.
 #[derive(Clone, Debug)]
 pub struct Program {
@@ -475,15 +569,33 @@ impl Program {
         }
     }
 
+    /// The schedule: the input digits, then per channel the biquad, the
+    /// difference `y - u`, the RC step and the output, each a pass of
+    /// dot products (`biquad` .. `output` below), then the publish word.
     fn build() -> Self {
         let mut p = Program::new();
-        let at = |channel, word, age| Location {
-            channel,
-            word,
-            age,
-            digit: 0,
-        };
-        // Input samples into the new x slots, one digit per word.
+        p.input_words();
+        for channel in 0..2 {
+            let to = at(channel, Word::Y, Age::New);
+            p.pass(&biquad(channel), true, 6, Target::Ram { to, first: 2 });
+        }
+        for channel in 0..2 {
+            let to = at(channel, Word::D, Age::New);
+            p.pass(&difference(channel), false, 4, Target::Ram { to, first: 0 });
+        }
+        for channel in 0..2 {
+            let to = at(channel, Word::U, Age::New);
+            p.pass(&rc(channel), true, 6, Target::Ram { to, first: 2 });
+        }
+        for channel in 0..2 {
+            p.pass(&output(channel), true, 5, Target::Stage { first: 2 });
+        }
+        p.publish_after_the_last_stage();
+        p
+    }
+
+    /// Input samples into the new x slots, one digit per word.
+    fn input_words(&mut self) {
         for channel in 0..2 {
             for digit in 0..SAMPLE_DIGITS {
                 let w = 1 + channel * SAMPLE_DIGITS + digit;
@@ -491,133 +603,19 @@ impl Program {
                     digit,
                     ..at(channel, Word::X, Age::New)
                 };
-                p.emit(w, Emit::Input, to.encode());
-                p.word(w).x_select = (channel * SAMPLE_DIGITS + digit) as u8;
+                self.emit(w, Emit::Input, to.encode());
+                self.word(w).x_select = (channel * SAMPLE_DIGITS + digit) as u8;
             }
         }
-        let coefficient = |s| {
-            [
-                Factor::Digit(s, 0),
-                Factor::Digit(s, 1),
-                Factor::Digit(s, 2),
-            ]
-        };
-        let constant = |f| [f, Factor::Zero, Factor::Zero];
-        let term = |word, digits, wrap_top, factors, factor_digits, offset| Term {
-            word,
-            digits,
-            wrap_top,
-            factors,
-            factor_digits,
-            offset,
-        };
-        for channel in 0..2 {
-            let biquad = [
-                term(
-                    at(channel, Word::Y, Age::Previous),
-                    STATE_DIGITS,
-                    true,
-                    coefficient(Scaled::K1Plus),
-                    3,
-                    0,
-                ),
-                term(
-                    at(channel, Word::Y, Age::TwoBack),
-                    STATE_DIGITS,
-                    true,
-                    coefficient(Scaled::K2Minus),
-                    3,
-                    0,
-                ),
-                term(
-                    at(channel, Word::X, Age::New),
-                    SAMPLE_DIGITS,
-                    false,
-                    coefficient(Scaled::K0Twice),
-                    3,
-                    1,
-                ),
-                term(
-                    at(channel, Word::X, Age::Previous),
-                    SAMPLE_DIGITS,
-                    false,
-                    coefficient(Scaled::K0Quad),
-                    3,
-                    1,
-                ),
-                term(
-                    at(channel, Word::X, Age::TwoBack),
-                    SAMPLE_DIGITS,
-                    false,
-                    coefficient(Scaled::K0Twice),
-                    3,
-                    1,
-                ),
-            ];
-            let to = at(channel, Word::Y, Age::New);
-            p.pass(&biquad, true, 6, Target::Ram { to, first: 2 });
-        }
-        for channel in 0..2 {
-            let difference = [
-                term(
-                    at(channel, Word::Y, Age::New),
-                    STATE_DIGITS,
-                    false,
-                    constant(Factor::One),
-                    1,
-                    0,
-                ),
-                term(
-                    at(channel, Word::U, Age::Previous),
-                    STATE_DIGITS,
-                    true,
-                    constant(Factor::MinusOne),
-                    1,
-                    0,
-                ),
-            ];
-            let to = at(channel, Word::D, Age::New);
-            p.pass(&difference, false, 4, Target::Ram { to, first: 0 });
-        }
-        for channel in 0..2 {
-            let rc = [
-                term(
-                    at(channel, Word::D, Age::New),
-                    STATE_DIGITS,
-                    false,
-                    coefficient(Scaled::Alpha),
-                    3,
-                    0,
-                ),
-                term(
-                    at(channel, Word::U, Age::Previous),
-                    STATE_DIGITS,
-                    true,
-                    constant(Factor::One),
-                    1,
-                    2,
-                ),
-            ];
-            let to = at(channel, Word::U, Age::New);
-            p.pass(&rc, true, 6, Target::Ram { to, first: 2 });
-        }
-        for channel in 0..2 {
-            let output = [term(
-                at(channel, Word::U, Age::New),
-                STATE_DIGITS,
-                true,
-                constant(Factor::Pow14),
-                1,
-                0,
-            )];
-            p.pass(&output, true, 5, Target::Stage { first: 2 });
-        }
-        // Publish once the last staged digit is in.
-        let last_stage = p.words.iter().rposition(|w| w.emit == Emit::Stage).unwrap();
-        let publish = (last_stage + 1).max(p.words.len() - 1);
-        p.word(publish).publish = true;
-        p.words.truncate(publish + 1);
-        p
+    }
+
+    /// Publish once the last staged digit is in; the schedule ends there.
+    fn publish_after_the_last_stage(&mut self) {
+        let last_stage = self.words.iter().rposition(|w| w.emit == Emit::Stage);
+        let last_stage = last_stage.expect("the output pass stages digits");
+        let publish = (last_stage + 1).max(self.words.len() - 1);
+        self.word(publish).publish = true;
+        self.words.truncate(publish + 1);
     }
 
     /// Clocks from accepting a strobe to accepting the next one.
