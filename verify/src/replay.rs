@@ -44,7 +44,7 @@ use crate::vectors::{GoldenVectors, input_ports, output_ports};
 use crate::{
     ScratchDir, VerifyError, combined_output, describe, io_error, run, run_ok, tail, tools,
 };
-use gyrocal_hdl::export::TOP_MODULE;
+use gyrocal_hdl::export::{Port, TOP_MODULE};
 use regex::Regex;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -89,11 +89,22 @@ fn declaration(kind: &str, signed: bool, bits: usize, name: &str) -> String {
 }
 
 /// The SystemVerilog testbench (module [`TESTBENCH_TOP`]), generated from
-/// `export::PORTS` so it follows the port list.
+/// `export::PORTS` so it follows the port list: the declarations, the
+/// design under test, the comparison task, then the replay loop.
 pub fn testbench_source() -> String {
-    let inputs: Vec<_> = input_ports().collect();
-    let outputs: Vec<_> = output_ports().collect();
-    let n_fields = inputs.len() + outputs.len();
+    let inputs: Vec<&Port> = input_ports().collect();
+    let outputs: Vec<&Port> = output_ports().collect();
+    let mut s = declarations(&inputs, &outputs);
+    s.push_str(&instance(&inputs, &outputs));
+    s.push_str(&compare_task(&outputs));
+    s.push_str(&replay_loop(&inputs, &outputs));
+    s
+}
+
+/// The header comment, the module line and every signal: the clock, the
+/// inputs and their next values, the outputs and their expected values,
+/// the loop's variables.
+fn declarations(inputs: &[&Port], outputs: &[&Port]) -> String {
     let mut s = String::new();
     let _ = write!(
         s,
@@ -102,48 +113,53 @@ pub fn testbench_source() -> String {
          // run with +vectors=<file>. Compares every output on every cycle with !==.\n\
          module {TESTBENCH_TOP};\n\
          \x20   localparam integer MAX_REPORTED = {MAX_REPORTED};\n\
-         \x20   localparam integer FIELDS = {n_fields};\n\
-         \x20   reg clock;\n"
+         \x20   localparam integer FIELDS = {};\n\
+         \x20   reg clock;\n",
+        inputs.len() + outputs.len()
     );
-    for p in &inputs {
-        s.push_str(&declaration("reg", p.signed, p.bits, p.name));
-    }
-    for p in &inputs {
-        s.push_str(&declaration(
-            "reg",
-            p.signed,
-            p.bits,
-            &format!("next_{}", p.name),
-        ));
-    }
-    for p in &outputs {
-        s.push_str(&declaration("wire", p.signed, p.bits, p.name));
-    }
-    for p in &outputs {
-        s.push_str(&declaration(
-            "reg",
-            false,
-            p.bits,
-            &format!("expected_{}", p.name),
-        ));
+    let groups = [
+        ("reg", inputs, ""),
+        ("reg", inputs, "next_"),
+        ("wire", outputs, ""),
+        ("reg", outputs, "expected_"),
+    ];
+    for (kind, ports, prefix) in groups {
+        for p in ports {
+            // The expected values are compared bit by bit: unsigned.
+            let signed = p.signed && prefix != "expected_";
+            s.push_str(&declaration(
+                kind,
+                signed,
+                p.bits,
+                &format!("{prefix}{}", p.name),
+            ));
+        }
     }
     s.push_str(
         "    integer fd, status, n, cycle, cycles_done, mismatches, reported, file_ok;\n\
          \x20   string vectors;\n\n",
     );
+    s
+}
+
+/// The design under test, every port connected to its namesake.
+fn instance(inputs: &[&Port], outputs: &[&Port]) -> String {
     let connections: Vec<String> = std::iter::once("clock")
         .chain(inputs.iter().map(|p| p.name))
         .chain(outputs.iter().map(|p| p.name))
         .map(|n| format!("        .{n}({n})"))
         .collect();
-    let _ = write!(
-        s,
+    format!(
         "    {TOP_MODULE} dut(\n{}\n    );\n\n",
         connections.join(",\n")
-    );
-    // Comparison task: one block per output port.
-    s.push_str("    task automatic compare(input integer at_cycle);\n        begin\n");
-    for p in &outputs {
+    )
+}
+
+/// The comparison task: one block per output port.
+fn compare_task(outputs: &[&Port]) -> String {
+    let mut s =
+        String::from("    task automatic compare(input integer at_cycle);\n        begin\n");
+    for p in outputs {
         let (n, e) = (p.name, format!("expected_{}", p.name));
         let _ = write!(
             s,
@@ -160,19 +176,37 @@ pub fn testbench_source() -> String {
         );
     }
     s.push_str("        end\n    endtask\n\n");
-    let out_fmt = vec!["%h"; outputs.len()].join(" ");
+    s
+}
+
+/// The file-error task and the initial block that reads the vectors and
+/// replays them (`REPLAY_LOOP` with its port lists filled in).
+fn replay_loop(inputs: &[&Port], outputs: &[&Port]) -> String {
     let out_args: Vec<String> = outputs
         .iter()
         .map(|p| format!("expected_{}", p.name))
         .collect();
-    let cycle_fmt = vec!["%h"; n_fields].join(" ");
     let cycle_args: Vec<String> = inputs
         .iter()
         .map(|p| format!("next_{}", p.name))
         .chain(out_args.iter().cloned())
         .collect();
-    s.push_str(
-        &r#"    // A vector file problem: reported, counted as a mismatch, stops the replay.
+    let apply: String = inputs
+        .iter()
+        .map(|p| format!("                {0} = next_{0};\n", p.name))
+        .collect();
+    REPLAY_LOOP
+        .replace("OUT_FMT", &vec!["%h"; outputs.len()].join(" "))
+        .replace("OUT_ARGS", &out_args.join(", "))
+        .replace("N_OUT", &outputs.len().to_string())
+        .replace("CYCLE_FMT", &vec!["%h"; cycle_args.len()].join(" "))
+        .replace("CYCLE_ARGS", &cycle_args.join(", "))
+        .replace("APPLY", &apply)
+}
+
+/// The replay's tasks and initial block; `replay_loop` fills in OUT_FMT,
+/// OUT_ARGS, N_OUT, CYCLE_FMT, CYCLE_ARGS and APPLY.
+const REPLAY_LOOP: &str = r#"    // A vector file problem: reported, counted as a mismatch, stops the replay.
     task automatic file_error(input string message);
         begin
             $display("REPLAY ERROR %s", message);
@@ -238,22 +272,7 @@ APPLY            end
         $finish;
     end
 endmodule
-"#
-        .replace("OUT_FMT", &out_fmt)
-        .replace("OUT_ARGS", &out_args.join(", "))
-        .replace("N_OUT", &outputs.len().to_string())
-        .replace("CYCLE_FMT", &cycle_fmt)
-        .replace("CYCLE_ARGS", &cycle_args.join(", "))
-        .replace(
-            "APPLY",
-            &inputs
-                .iter()
-                .map(|p| format!("                {0} = next_{0};\n", p.name))
-                .collect::<String>(),
-        ),
-    );
-    s
-}
+"#;
 
 /// One output that differed.
 #[derive(Clone, Debug, PartialEq, Eq)]
