@@ -137,7 +137,8 @@ fn a_failed_step_is_reported_and_the_finished_steps_stand() {
 /// A drive-gain ratio the cycle cannot measure (no coupling, no
 /// `[drive_probe]`) is the design's: the summary says, in one line, that
 /// its error is not in the sigma unless `[datasheet]
-/// drive_gain_ratio_uncertainty` bounds it, and with that key it is silent.
+/// drive_gain_ratio_uncertainty` bounds it, and with that key it is silent;
+/// the written report carries the same line in its `warnings`.
 #[test]
 fn an_unbudgeted_design_drive_ratio_is_said() {
     let drift = "[drift]\ntemperatures_c = [25]\ntcf1_ppm_per_k = -30\ntcf2_ppm_per_k = -30\n";
@@ -150,13 +151,25 @@ fn an_unbudgeted_design_drive_ratio_is_said() {
     ] {
         let config = dir.path().join("design_ratio.toml");
         std::fs::write(&config, format!("{GOOD}{drift}{datasheet}")).unwrap();
+        let out = dir.path().join(if said { "said" } else { "silent" });
         let run = gyrocal(&[
             OsStr::new("field"),
             OsStr::new("--config"),
             config.as_os_str(),
+            OsStr::new("--out"),
+            out.as_os_str(),
         ]);
         assert!(run.status.success(), "{}", common::stderr(&run));
         let text = String::from_utf8(run.stdout).unwrap();
         assert_eq!(text.contains(note), said, "{datasheet}: {text}");
+        let written: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("field.json")).unwrap())
+                .unwrap();
+        let warned = written["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|w| w.as_str().unwrap().contains(note));
+        assert_eq!(warned, said, "{datasheet}: {written}");
     }
 }

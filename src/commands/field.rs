@@ -13,8 +13,10 @@
 //! `selfcal_error_uncertainty` (the two in quadrature), and
 //! `identified` (`f1_hz`, `f2_hz`, `q1`, `q2`, `loop_phase_deg`, each with
 //! an `_uncertainty` twin), and `warnings`: inputs that no sigma covers,
-//! one line each, also printed first (ADC noise below half an ADC step,
-//! `gyrocal_sim::frontend::dithers`), and per step `carrier_fold`: the
+//! one line each, also printed as progress and in the summary (ADC noise
+//! below half an ADC step, `gyrocal_sim::frontend::dithers`; a design
+//! drive-gain ratio that no `[datasheet] drive_gain_ratio_uncertainty`
+//! bounds, `design_ratio_warning`), and per step `carrier_fold`: the
 //! nearest fold of the carrier tables' errors, whether it is in the
 //! passband, and `static_fold`, a short fold slower than a window, whose
 //! error no sigma sees. `--out` writes field.json, field.csv and
@@ -29,7 +31,7 @@
 //! has a baseline (its baseline fields are null).
 
 use crate::Failure;
-use gyrocal_host::selfcal::{AT_REST_RATIO_SIGMA, ScaledDrives, Spurs};
+use gyrocal_host::selfcal::{ScaledDrives, Spurs};
 use gyrocal_sim::field::profile::RateTrace;
 use gyrocal_sim::field::scenario::{self, FAILED_CYCLE, FieldReport};
 use std::fmt::Write as _;
@@ -235,18 +237,10 @@ fn step_notes(s: &mut String, report: &FieldReport) {
             let _ = writeln!(s, "{:>8.2}  {d}", st.temperature_c);
         }
     }
-    let design: Vec<String> = report
-        .steps
-        .iter()
-        .filter(|st| st.selfcal.drive_ratio.is_none())
-        .map(|st| format!("{}", st.temperature_c))
-        .collect();
-    if !design.is_empty() && report.knowns.drive_gain_ratio_uncertainty == 0.0 {
-        let _ = writeln!(
-            s,
-            "note: at {} deg C the drive-gain ratio g2/g1 is the design's (no coupling at rest that measures it within {AT_REST_RATIO_SIGMA:e}, no [drive_probe]) and [datasheet] gives no drive_gain_ratio_uncertainty: a drive gain that drifted is not in the sigma",
-            design.join(", ")
-        );
+    // Inputs no sigma covers (`FieldReport::warnings`): printed as
+    // progress too, but the summary is what is kept.
+    for w in &report.warnings {
+        let _ = writeln!(s, "{w}");
     }
     for st in report
         .steps

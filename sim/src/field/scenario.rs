@@ -367,8 +367,10 @@ pub struct FieldReport {
     /// The steps (or their baselines) that failed, in the scenario's order;
     /// empty when every step finished.
     pub failed: Vec<StepFailure>,
-    /// Inputs that make a figure less than it says, one line each (also
-    /// printed when the run starts): ADCs the scenario leaves undithered.
+    /// Inputs that make a figure less than it says, one line each, also
+    /// printed as progress: ADCs the scenario leaves undithered (when the
+    /// run starts), steps whose sigma leaves a drifted drive gain out
+    /// ([`design_ratio_warning`], when the steps are done).
     pub warnings: Vec<String>,
     /// Clocks simulated, all steps.
     pub clocks: u64,
@@ -390,6 +392,26 @@ pub fn warnings(exp: &Experiment) -> Vec<String> {
         ));
     }
     lines
+}
+
+/// The steps whose drive-gain ratio g2/g1 is the design's (no coupling
+/// at rest measured it within [`selfcal::AT_REST_RATIO_SIGMA`], no
+/// `[drive_probe]`) while `[datasheet]` gives no
+/// `drive_gain_ratio_uncertainty`: a drive gain that drifted moves their
+/// scale factors and no sigma includes it. One line naming them, or None.
+pub fn design_ratio_warning(steps: &[FieldStep], knowns: &Knowns) -> Option<String> {
+    let design: Vec<String> = steps
+        .iter()
+        .filter(|st| st.selfcal.drive_ratio.is_none())
+        .map(|st| format!("{}", st.temperature_c))
+        .collect();
+    (!design.is_empty() && knowns.drive_gain_ratio_uncertainty == 0.0).then(|| {
+        format!(
+            "warning: at {} deg C the drive-gain ratio g2/g1 is the design's (no coupling at rest that measures it within {:e}, no [drive_probe]) and [datasheet] gives no drive_gain_ratio_uncertainty: a drive gain that drifted is not in the sigma",
+            design.join(", "),
+            selfcal::AT_REST_RATIO_SIGMA
+        )
+    })
 }
 
 /// What a host programmed for `exp` would know: its `[datasheet]` over its
@@ -782,7 +804,7 @@ pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldRepor
     drift.validate()?;
     let start = Instant::now();
     let (fe, knowns) = build(exp)?;
-    let warnings = warnings(exp);
+    let mut warnings = warnings(exp);
     warnings.iter().for_each(|w| progress(w));
     let cycles = run_cycles(sc, &fe, &knowns, progress);
     let factory = cycles[0].as_ref().ok().map(|c| Factory {
@@ -838,6 +860,10 @@ pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldRepor
     }
     if factory.is_none() && !steps.is_empty() {
         progress("no factory calibration (the first step failed): no step has a baseline");
+    }
+    if let Some(w) = design_ratio_warning(&steps, &knowns) {
+        progress(&w);
+        warnings.push(w);
     }
     let clocks = job_clocks + steps.iter().map(|s| s.clocks).sum::<u64>();
     Ok(FieldReport {
