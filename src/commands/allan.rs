@@ -225,67 +225,10 @@ fn summary(report: &AllanReport) -> String {
         p.thermal.temperature_k, p.thermal.mass_kg, p.adc_noise_lsb, p.adc_step_lsb
     ));
     s.push_str("                                              output 1          output 2\n");
-    let row = |name: &str, v: [f64; 2]| format!("{name:<40}{:>16.5}  {:>16.5}\n", v[0], v[1]);
-    let both = |f: &dyn Fn(usize) -> f64| [f(0), f(1)];
-    s.push_str(&row(
-        "predicted ARW, white density (deg/sqrt h)",
-        both(&|k| p.outputs[k].arw_deg_per_sqrt_h),
-    ));
-    s.push_str(&row(
-        "  Brownian share of the density (%)",
-        both(&|k| 100.0 * p.outputs[k].thermal_rate_psd / p.outputs[k].rate_psd),
-    ));
-    s.push_str(&row(
-        "predicted 60 sigma(1 s) sqrt(1 s)",
-        both(&|k| {
-            let tau = run.outputs[k].arw_at_1s.tau_s;
-            60.0 * p.adev(k, tau) * tau.sqrt()
-        }),
-    ));
-    s.push_str(&row(
-        "measured ARW = 60 sigma(1 s) (deg/sqrt h)",
-        both(&|k| run.outputs[k].arw_at_1s.deg_per_sqrt_h),
-    ));
-    s.push_str(&row(
-        "  its 1-sigma (%, white-noise edf)",
-        both(&|k| 100.0 * run.outputs[k].arw_at_1s.relative_sigma),
-    ));
-    s.push_str(&row(
-        "  measured / predicted - 1 (%)",
-        both(&|k| {
-            let tau = run.outputs[k].arw_at_1s.tau_s;
-            let predicted = 60.0 * p.adev(k, tau) * tau.sqrt();
-            100.0 * (run.outputs[k].arw_at_1s.deg_per_sqrt_h / predicted - 1.0)
-        }),
-    ));
-    s.push_str(&row(
-        "ARW fitted over 0.25..4 s (deg/sqrt h)",
-        both(&|k| {
-            run.outputs[k]
-                .analysis
-                .angle_random_walk
-                .as_ref()
-                .map_or(f64::NAN, |a| a.deg_per_sqrt_h)
-        }),
-    ));
-    s.push_str(&row(
-        "  its free slope",
-        both(&|k| {
-            run.outputs[k]
-                .analysis
-                .angle_random_walk
-                .as_ref()
-                .map_or(f64::NAN, |a| a.fitted_slope)
-        }),
-    ));
-    s.push_str(&row(
-        "bias instability (deg/h)",
-        both(&|k| run.outputs[k].analysis.bias_instability.deg_per_h),
-    ));
-    s.push_str(&row(
-        "  at tau (s)",
-        both(&|k| run.outputs[k].analysis.bias_instability.tau_s),
-    ));
+    let row = |(name, v): (&str, [f64; 2])| format!("{name:<40}{:>16.5}  {:>16.5}\n", v[0], v[1]);
+    noise_rows(run, p)
+        .into_iter()
+        .for_each(|r| s.push_str(&row(r)));
     let at_longest = (0..2).any(|k| {
         let a = &run.outputs[k].analysis;
         a.points.last().map(|p| p.tau_s) == Some(a.bias_instability.tau_s)
@@ -295,13 +238,67 @@ fn summary(report: &AllanReport) -> String {
             "  (minimum at the longest tau: no floor reached in this run, an upper bound)\n",
         );
     }
-    s.push_str(&row(
+    s.push_str(&row((
         "mean rate less the applied (deg/s)",
-        both(&|k| run.outputs[k].mean_rate_dps - run.rate_dps),
-    ));
-    s.push_str(&row(
+        both(|k| run.outputs[k].mean_rate_dps - run.rate_dps),
+    )));
+    s.push_str(&row((
         "scale factor (z LSB per deg/s)",
-        both(&|k| p.outputs[k].sf_lsb_per_dps),
-    ));
+        both(|k| p.outputs[k].sf_lsb_per_dps),
+    )));
     s
+}
+
+/// `f` of output 0 and output 1.
+fn both(f: impl Fn(usize) -> f64) -> [f64; 2] {
+    [f(0), f(1)]
+}
+
+/// The summary's noise rows, predicted against measured: the angle
+/// random walk three ways, its fit, and the bias instability.
+fn noise_rows(run: &NoisyRun, p: &RateNoisePrediction) -> [(&'static str, [f64; 2]); 10] {
+    let predicted_at_1s = |k: usize| {
+        let tau = run.outputs[k].arw_at_1s.tau_s;
+        60.0 * p.adev(k, tau) * tau.sqrt()
+    };
+    let fitted = |k: usize| run.outputs[k].analysis.angle_random_walk.as_ref();
+    [
+        (
+            "predicted ARW, white density (deg/sqrt h)",
+            both(|k| p.outputs[k].arw_deg_per_sqrt_h),
+        ),
+        (
+            "  Brownian share of the density (%)",
+            both(|k| 100.0 * p.outputs[k].thermal_rate_psd / p.outputs[k].rate_psd),
+        ),
+        ("predicted 60 sigma(1 s) sqrt(1 s)", both(predicted_at_1s)),
+        (
+            "measured ARW = 60 sigma(1 s) (deg/sqrt h)",
+            both(|k| run.outputs[k].arw_at_1s.deg_per_sqrt_h),
+        ),
+        (
+            "  its 1-sigma (%, white-noise edf)",
+            both(|k| 100.0 * run.outputs[k].arw_at_1s.relative_sigma),
+        ),
+        (
+            "  measured / predicted - 1 (%)",
+            both(|k| 100.0 * (run.outputs[k].arw_at_1s.deg_per_sqrt_h / predicted_at_1s(k) - 1.0)),
+        ),
+        (
+            "ARW fitted over 0.25..4 s (deg/sqrt h)",
+            both(|k| fitted(k).map_or(f64::NAN, |a| a.deg_per_sqrt_h)),
+        ),
+        (
+            "  its free slope",
+            both(|k| fitted(k).map_or(f64::NAN, |a| a.fitted_slope)),
+        ),
+        (
+            "bias instability (deg/h)",
+            both(|k| run.outputs[k].analysis.bias_instability.deg_per_h),
+        ),
+        (
+            "  at tau (s)",
+            both(|k| run.outputs[k].analysis.bias_instability.tau_s),
+        ),
+    ]
 }

@@ -309,6 +309,32 @@ pub fn summary(report: &FieldReport) -> String {
         }
         _ => s.push_str("factory: its calibration failed (below); no step has a baseline\n"),
     }
+    step_table(&mut s, report);
+    step_notes(&mut s, report);
+    measured_lines(&mut s, report);
+    for st in &report.steps {
+        if let Some(sp) = &st.selfcal.carrier_spurs {
+            spur_line(&mut s, st.temperature_c, sp, st.profile.as_ref());
+        }
+    }
+    for f in &report.failed {
+        let _ = writeln!(
+            s,
+            "{:>8.2}  FAILED ({}): {}",
+            f.temperature_c, f.stage, f.error
+        );
+    }
+    let _ = writeln!(
+        s,
+        "wall time {:.1} s, {:.3e} clocks",
+        report.wall_s, report.clocks as f64
+    );
+    s
+}
+
+/// The summary's table: one row per finished step, the self-calibration's
+/// error and sigma beside the baseline's error and the identified modes.
+fn step_table(s: &mut String, report: &FieldReport) {
     let _ = writeln!(
         s,
         "{:>8}  {:>27}  {:>21}  {:>19}  {:>21}  {:>14}  {:>14}  {:>11}",
@@ -341,7 +367,11 @@ pub fn summary(report: &FieldReport) -> String {
             i.loop_phase_deg
         );
     }
-    step_notes(&mut s, report);
+}
+
+/// Per step, the drive-gain ratio measured at rest (when measured) and
+/// the rate profile's RMS errors (with a `[profile]`).
+fn measured_lines(s: &mut String, report: &FieldReport) {
     for st in &report.steps {
         if let Some(d) = &st.selfcal.drive_ratio {
             let _ = writeln!(
@@ -368,22 +398,4 @@ pub fn summary(report: &FieldReport) -> String {
             );
         }
     }
-    for st in &report.steps {
-        if let Some(sp) = &st.selfcal.carrier_spurs {
-            spur_line(&mut s, st.temperature_c, sp, st.profile.as_ref());
-        }
-    }
-    for f in &report.failed {
-        let _ = writeln!(
-            s,
-            "{:>8.2}  FAILED ({}): {}",
-            f.temperature_c, f.stage, f.error
-        );
-    }
-    let _ = writeln!(
-        s,
-        "wall time {:.1} s, {:.3e} clocks",
-        report.wall_s, report.clocks as f64
-    );
-    s
 }

@@ -26,8 +26,6 @@ pub struct Args {
 /// scale factor is taken at the mode that is not excited at resonance).
 pub fn paper_table(report: &Report) -> String {
     let d = report.detuned_output.unwrap_or(1);
-    let t = &report.theory;
-    let ss = &t.small_signal;
     let mut s = format!(
         "The paper's figures against this co-simulation, output {} (the detuned mode).\n\
          The paper's scale factors are volts after its analog chain; ours are the\n\
@@ -39,72 +37,9 @@ pub fn paper_table(report: &Report) -> String {
         "{:<40} {:>14} {:>24} {:>16}\n",
         "", "paper", "simulated (1 sigma)", "exact theory"
     ));
-    let line = |name: &str, paper: &str, sim: String, exact: String| {
-        format!("{name:<40} {paper:>14} {sim:>24} {exact:>16}\n")
-    };
-    s.push_str(&line(
-        "readout scale factor SF_read",
-        "115 uV/deg/s",
-        format!(
-            "{:+.5e} +- {:.1e}",
-            report.scale_factors.sf_read_per_dps[d], report.scale_factors.sf_read_uncertainty[d]
-        ),
-        format!("{:+.5e}", t.sf_read_per_dps[d]),
-    ));
-    s.push_str(&line(
-        "calibration scale factor SF_cal",
-        "73 uV/deg/s",
-        format!(
-            "{:+.5e} +- {:.1e}",
-            report.scale_factors.sf_cal_per_dps[d], report.scale_factors.sf_cal_uncertainty[d]
-        ),
-        format!("{:+.5e}", t.sf_cal_per_dps[d]),
-    ));
-    s.push_str(&line(
-        "ratio SF_read / SF_cal (fitted)",
-        "1.53",
-        format!(
-            "{:.5} +- {:.1e}",
-            report.scale_factors.ratio[d], report.scale_factors.ratio_uncertainty[d]
-        ),
-        format!("{:.5}", t.ratio[d]),
-    ));
-    s.push_str(&line(
-        "  small signal, exact",
-        "",
-        String::new(),
-        format!("{:.5}", ss.ratio[d]),
-    ));
-    s.push_str(&line(
-        "  small signal, eqs. (5)/(6)",
-        "1.53",
-        String::new(),
-        format!("{:.5}", ss.eq56_ratio[d]),
-    ));
-    s.push_str(&line(
-        "SF_read predicted: SF_cal x eqs.(5)/(6)",
-        "111.7 uV/deg/s",
-        format!("{:+.5e}", report.predicted_sf_read_eq56_per_dps[d]),
-        String::new(),
-    ));
-    s.push_str(&line(
-        "  error against SF_read",
-        "3%",
-        format!("{:+.3}%", 100.0 * report.prediction_error_eq56[d]),
-        String::new(),
-    ));
-    s.push_str(&line(
-        "SF_read predicted: SF_cal x exact ratio",
-        "",
-        format!("{:+.5e}", report.predicted_sf_read_per_dps[d]),
-        String::new(),
-    ));
-    s.push_str(&line(
-        "  error against SF_read",
-        "",
-        format!("{:+.4}%", 100.0 * report.prediction_error[d]),
-        String::new(),
-    ));
+    for (name, paper, sim, exact) in paper_rows(report, d) {
+        s.push_str(&format!("{name:<40} {paper:>14} {sim:>24} {exact:>16}\n"));
+    }
     s.push_str(&format!(
         "\nsimulated ratio against the exact theory at the same points: {:+.4}% (output {}), 1 sigma {:.4}%; {} clocks in {:.2} s wall\n",
         100.0 * report.ratio_error[d],
@@ -114,6 +49,72 @@ pub fn paper_table(report: &Report) -> String {
         report.timing.wall_s
     ));
     s
+}
+
+/// The rows of `paper_table` for output `d`: what, the paper's figure,
+/// the simulated one (with its 1 sigma where it has one), the exact
+/// theory's.
+fn paper_rows(report: &Report, d: usize) -> [(&'static str, &'static str, String, String); 9] {
+    let (t, sf) = (&report.theory, &report.scale_factors);
+    let ss = &t.small_signal;
+    let with_sigma = |v: f64, u: f64| format!("{v:+.5e} +- {u:.1e}");
+    let none = String::new;
+    [
+        (
+            "readout scale factor SF_read",
+            "115 uV/deg/s",
+            with_sigma(sf.sf_read_per_dps[d], sf.sf_read_uncertainty[d]),
+            format!("{:+.5e}", t.sf_read_per_dps[d]),
+        ),
+        (
+            "calibration scale factor SF_cal",
+            "73 uV/deg/s",
+            with_sigma(sf.sf_cal_per_dps[d], sf.sf_cal_uncertainty[d]),
+            format!("{:+.5e}", t.sf_cal_per_dps[d]),
+        ),
+        (
+            "ratio SF_read / SF_cal (fitted)",
+            "1.53",
+            format!("{:.5} +- {:.1e}", sf.ratio[d], sf.ratio_uncertainty[d]),
+            format!("{:.5}", t.ratio[d]),
+        ),
+        (
+            "  small signal, exact",
+            "",
+            none(),
+            format!("{:.5}", ss.ratio[d]),
+        ),
+        (
+            "  small signal, eqs. (5)/(6)",
+            "1.53",
+            none(),
+            format!("{:.5}", ss.eq56_ratio[d]),
+        ),
+        (
+            "SF_read predicted: SF_cal x eqs.(5)/(6)",
+            "111.7 uV/deg/s",
+            format!("{:+.5e}", report.predicted_sf_read_eq56_per_dps[d]),
+            none(),
+        ),
+        (
+            "  error against SF_read",
+            "3%",
+            format!("{:+.3}%", 100.0 * report.prediction_error_eq56[d]),
+            none(),
+        ),
+        (
+            "SF_read predicted: SF_cal x exact ratio",
+            "",
+            format!("{:+.5e}", report.predicted_sf_read_per_dps[d]),
+            none(),
+        ),
+        (
+            "  error against SF_read",
+            "",
+            format!("{:+.4}%", 100.0 * report.prediction_error[d]),
+            none(),
+        ),
+    ]
 }
 
 /// Reproduce the paper's measurement.
