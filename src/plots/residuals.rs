@@ -6,6 +6,7 @@
 use super::error::PlotError;
 use gyrocal_sim::experiment::PointResult;
 use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 use super::data::Data;
@@ -74,80 +75,106 @@ pub(super) fn draw_residuals<DB: DrawingBackend>(
             r.theory.sf_cal_per_dps,
         ),
     ];
-    for (area, (what, x_label, points, sf, sf_theory)) in panels.iter().zip(sets) {
-        let ResidualPanel {
-            series,
-            x: (x0, x1),
-            y: (y0, y1),
-        } = residual_panel(points, sf_theory);
-        let rel = |k: usize| fmt_sci(sf[k] / sf_theory[k] - 1.0, 2);
-        let mut chart = ChartBuilder::on(area)
-            .caption(
-                format!(
-                    "{what}: SF_sim / SF_theory − 1 = {} (output 1), {} (output 2)",
-                    rel(0),
-                    rel(1)
-                ),
-                text_style(17),
-            )
-            .margin(12)
-            .margin_right(24)
-            .x_label_area_size(56)
-            .y_label_area_size(80)
-            .build_cartesian_2d(x0..x1, y0..y1)
-            .map_err(err)?;
-        chart
-            .configure_mesh()
-            .max_light_lines(0)
-            .bold_line_style(LIGHT)
-            .x_desc(x_label)
-            .y_desc("(z − z_theory) / (|SF|·span), less its mean  (ppm)")
-            .axis_desc_style(text_style(16))
-            .label_style(text_style(14))
-            .x_labels(8)
-            .y_labels(8)
-            .x_label_formatter(&tick_formatter(x1 - x0))
-            .y_label_formatter(&tick_formatter(y1 - y0))
-            .draw()
-            .map_err(err)?;
-        chart
-            .draw_series(LineSeries::new(
-                [(x0, 0.0), (x1, 0.0)],
-                GREY.stroke_width(1),
-            ))
-            .map_err(err)?;
-        for (k, (s, mean)) in series.iter().enumerate() {
-            let color = OUT_COLOR[k];
-            chart
-                .draw_series(LineSeries::new(
-                    s.iter().copied(),
-                    color.mix(0.5).stroke_width(1),
-                ))
-                .map_err(err)?;
-            chart
-                .draw_series(s.iter().map(|&q| Circle::new(q, 4, color.filled())))
-                .map_err(err)?
-                .label(format!(
-                    "output {}{}: mean {} ppm",
-                    k + 1,
-                    if r.detuned_output == Some(k) {
-                        " (detuned)"
-                    } else {
-                        ""
-                    },
-                    fmt_num(*mean, 3)
-                ))
-                .legend(move |(x, y)| Circle::new((x + 12, y), 4, color.filled()));
-        }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .margin(10)
-            .label_font(text_style(14))
-            .background_style(WHITE.mix(0.9))
-            .border_style(LIGHT)
-            .draw()
-            .map_err(err)?;
+    for (area, set) in panels.iter().zip(sets) {
+        draw_panel(area, set, r.detuned_output)?;
     }
     Ok(())
+}
+
+/// One panel's set: what, the x axis's label, the points, the simulated
+/// and the theory's scale factors.
+type PanelSet<'a> = (
+    &'a str,
+    &'a str,
+    &'a Vec<&'a PointResult>,
+    [f64; 2],
+    [f64; 2],
+);
+
+/// One panel: its chart (`residual_chart`), the zero line, each output's
+/// residuals as a line and circles, and the legend.
+fn draw_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    (what, x_label, points, sf, sf_theory): PanelSet,
+    detuned: Option<usize>,
+) -> Result<(), PlotError> {
+    let ResidualPanel {
+        series,
+        x: (x0, x1),
+        y: (y0, y1),
+    } = residual_panel(points, sf_theory);
+    let rel = |k: usize| fmt_sci(sf[k] / sf_theory[k] - 1.0, 2);
+    let caption = format!(
+        "{what}: SF_sim / SF_theory − 1 = {} (output 1), {} (output 2)",
+        rel(0),
+        rel(1)
+    );
+    let mut chart = residual_chart(area, caption, x_label, (x0, x1), (y0, y1))?;
+    chart
+        .draw_series(LineSeries::new(
+            [(x0, 0.0), (x1, 0.0)],
+            GREY.stroke_width(1),
+        ))
+        .map_err(err)?;
+    for (k, (s, mean)) in series.iter().enumerate() {
+        let color = OUT_COLOR[k];
+        chart
+            .draw_series(LineSeries::new(
+                s.iter().copied(),
+                color.mix(0.5).stroke_width(1),
+            ))
+            .map_err(err)?;
+        let detuned = if detuned == Some(k) { " (detuned)" } else { "" };
+        chart
+            .draw_series(s.iter().map(|&q| Circle::new(q, 4, color.filled())))
+            .map_err(err)?
+            .label(format!(
+                "output {}{detuned}: mean {} ppm",
+                k + 1,
+                fmt_num(*mean, 3)
+            ))
+            .legend(move |(x, y)| Circle::new((x + 12, y), 4, color.filled()));
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .margin(10)
+        .label_font(text_style(14))
+        .background_style(WHITE.mix(0.9))
+        .border_style(LIGHT)
+        .draw()
+        .map_err(err)
+}
+
+/// A panel's chart over `x` and `y` with its caption and mesh.
+fn residual_chart<'a, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    caption: String,
+    x_label: &str,
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+) -> Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>, PlotError> {
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, text_style(17))
+        .margin(12)
+        .margin_right(24)
+        .x_label_area_size(56)
+        .y_label_area_size(80)
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .max_light_lines(0)
+        .bold_line_style(LIGHT)
+        .x_desc(x_label)
+        .y_desc("(z − z_theory) / (|SF|·span), less its mean  (ppm)")
+        .axis_desc_style(text_style(16))
+        .label_style(text_style(14))
+        .x_labels(8)
+        .y_labels(8)
+        .x_label_formatter(&tick_formatter(x1 - x0))
+        .y_label_formatter(&tick_formatter(y1 - y0))
+        .draw()
+        .map_err(err)?;
+    Ok(chart)
 }
