@@ -12,7 +12,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::format::{fmt_num, padded_range};
-use super::style::{GREY, LIGHT, OUT_COLOR, header, text_style};
+use super::style::{GREY, LIGHT, OUT_COLOR, draw_legend, header, text_style};
 use super::{Plot, err};
 
 /// Pixel size of the figure.
@@ -148,8 +148,26 @@ impl Plot for AllanFigure {
     fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), PlotError> {
         root.fill(&WHITE).map_err(err)?;
         let body = header(root, &self.title, &self.subtitle)?;
+        let mut chart = self.chart(&body)?;
+        self.draw_measured(&mut chart)?;
+        self.draw_prediction_and_arw(&mut chart)?;
+        self.draw_floor(&mut chart)?;
+        draw_legend(&mut chart, SeriesLabelPosition::LowerLeft, (10, 14))?;
+        Ok(())
+    }
+}
+
+/// The figure's log-log chart.
+type LogChart<'a, DB> = ChartContext<'a, DB, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>;
+
+impl AllanFigure {
+    /// The log-log axes over the figure's ranges, with their mesh.
+    fn chart<'a, DB: DrawingBackend>(
+        &self,
+        body: &'a DrawingArea<DB, Shift>,
+    ) -> Result<LogChart<'a, DB>, PlotError> {
         let (x, y) = (self.x, self.y);
-        let mut chart = ChartBuilder::on(&body)
+        let mut chart = ChartBuilder::on(body)
             .margin(16)
             .margin_right(32)
             .x_label_area_size(56)
@@ -168,6 +186,14 @@ impl Plot for AllanFigure {
             .y_label_formatter(&|v: &f64| fmt_num(*v, 3))
             .draw()
             .map_err(err)?;
+        Ok(chart)
+    }
+
+    /// The measured deviations, as a line and circles.
+    fn draw_measured<DB: DrawingBackend>(
+        &self,
+        chart: &mut LogChart<'_, DB>,
+    ) -> Result<(), PlotError> {
         let color = OUT_COLOR[0];
         chart
             .draw_series(LineSeries::new(
@@ -184,6 +210,15 @@ impl Plot for AllanFigure {
             .map_err(err)?
             .label("σ(τ) of the rate output")
             .legend(move |(x, y)| Circle::new((x + 12, y), 4, color.filled()));
+        Ok(())
+    }
+
+    /// The predicted curve and the angle random walk's line, each when
+    /// the figure has it.
+    fn draw_prediction_and_arw<DB: DrawingBackend>(
+        &self,
+        chart: &mut LogChart<'_, DB>,
+    ) -> Result<(), PlotError> {
         if let Some((curve, label)) = &self.prediction {
             let color = PREDICTION_COLOR;
             chart
@@ -207,8 +242,16 @@ impl Plot for AllanFigure {
                 .draw_series([Cross::new(arw.at_1s, 8, BLACK.stroke_width(2))])
                 .map_err(err)?;
         }
+        Ok(())
+    }
+
+    /// The floor: a dashed line at the least deviation and a ring on it.
+    fn draw_floor<DB: DrawingBackend>(
+        &self,
+        chart: &mut LogChart<'_, DB>,
+    ) -> Result<(), PlotError> {
         let ((tau_min, sigma_min), label) = &self.floor;
-        let highlight = OUT_COLOR[1];
+        let (x, highlight) = (self.x, OUT_COLOR[1]);
         chart
             .draw_series(DashedLineSeries::new(
                 [(x.0, *sigma_min), (x.1, *sigma_min)],
@@ -226,15 +269,6 @@ impl Plot for AllanFigure {
             .map_err(err)?
             .label(label.clone())
             .legend(move |(x, y)| Circle::new((x + 12, y), 8, highlight.stroke_width(3)));
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerLeft)
-            .margin(10)
-            .label_font(text_style(14))
-            .background_style(WHITE.mix(0.9))
-            .border_style(LIGHT)
-            .draw()
-            .map_err(err)?;
         Ok(())
     }
 }

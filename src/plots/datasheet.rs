@@ -14,7 +14,7 @@
 
 use super::error::PlotError;
 use super::format::{fmt_num, padded_range};
-use super::style::{GREY, LIGHT, OUT_COLOR, header, text_style};
+use super::style::{GREY, LIGHT, OUT_COLOR, draw_legend, header, text_style};
 use super::{Plot, err};
 use gyrocal_sim::datasheet::Datasheet;
 use gyrocal_sim::datasheet::temperature::Temperature;
@@ -154,15 +154,7 @@ impl Plot for AdevFigure {
                     .map_err(err)?;
             }
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .margin(10)
-            .label_font(text_style(14))
-            .background_style(WHITE.mix(0.9))
-            .border_style(LIGHT)
-            .draw()
-            .map_err(err)
+        draw_legend(&mut chart, SeriesLabelPosition::UpperLeft, (10, 14))
     }
 }
 

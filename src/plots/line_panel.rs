@@ -11,7 +11,7 @@ use super::err;
 use super::format::{
     eng_exponent, fmt_num, fmt_sci, padded_range, scaled_unit, sub, tick_formatter,
 };
-use super::style::{LIGHT, OUT_COLOR, SF_UNIT, free_corner, text_style};
+use super::style::{LIGHT, OUT_COLOR, SF_UNIT, draw_legend, free_corner, text_style};
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 /// A linear fit panel: simulated points, the least-squares line, exact
@@ -202,15 +202,7 @@ pub(super) fn draw_line_panel<DB: DrawingBackend>(
         .map_err(err)?
         .label(format!("exact theory: {}", sf_note(p.theory_slope)))
         .legend(|(x, y)| Circle::new((x + 12, y), 8, BLACK.stroke_width(1)));
-    chart
-        .configure_series_labels()
-        .position(v.corner.clone())
-        .margin(10)
-        .label_font(text_style(14))
-        .background_style(WHITE.mix(0.9))
-        .border_style(LIGHT)
-        .draw()
-        .map_err(err)?;
+    draw_legend(&mut chart, v.corner.clone(), (10, 14))?;
     if v.offset != 0.0 {
         let (xs, ys) = chart.plotting_area().get_pixel_range();
         intercept_notes(area, k, &v, (xs, ys))?;

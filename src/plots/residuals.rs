@@ -12,7 +12,7 @@ use plotters::prelude::*;
 use super::data::Data;
 use super::err;
 use super::format::{fmt_num, fmt_sci, padded_range, tick_formatter};
-use super::style::{GREY, LIGHT, OUT_COLOR, header, text_style};
+use super::style::{GREY, LIGHT, OUT_COLOR, draw_legend, header, text_style};
 
 /// One panel's data: per output, the residuals in ppm less their mean,
 /// and the mean; the axis ranges.
@@ -135,15 +135,7 @@ fn draw_panel<DB: DrawingBackend>(
             ))
             .legend(move |(x, y)| Circle::new((x + 12, y), 4, color.filled()));
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .margin(10)
-        .label_font(text_style(14))
-        .background_style(WHITE.mix(0.9))
-        .border_style(LIGHT)
-        .draw()
-        .map_err(err)
+    draw_legend(&mut chart, SeriesLabelPosition::UpperRight, (10, 14))
 }
 
 /// A panel's chart over `x` and `y` with its caption and mesh.

@@ -15,7 +15,7 @@ use super::err;
 use super::format::{
     clip_polyline, eng_exponent, fmt_num, padded_range, scaled_unit, sub, tick_formatter,
 };
-use super::style::{GREY, LIGHT, OUT_COLOR, header, text_style};
+use super::style::{GREY, LIGHT, OUT_COLOR, draw_legend, header, text_style};
 
 /// One calibration run placed on the common time axis.
 struct Step<'a> {
@@ -223,15 +223,7 @@ fn staircase_raw<DB: DrawingBackend>(
                 });
         }
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .margin(8)
-        .label_font(text_style(13))
-        .background_style(WHITE.mix(0.9))
-        .border_style(LIGHT)
-        .draw()
-        .map_err(err)?;
+    draw_legend(&mut chart, SeriesLabelPosition::UpperRight, (8, 13))?;
     Ok(())
 }
 
@@ -273,7 +265,6 @@ fn staircase_smooth<DB: DrawingBackend>(
     k: usize,
     end: f64,
 ) -> Result<(), PlotError> {
-    let color = OUT_COLOR[k];
     let SmoothRange {
         exp,
         room,
@@ -293,6 +284,32 @@ fn staircase_smooth<DB: DrawingBackend>(
         steps,
         false,
     )?;
+    let on = Scaled { k, scale };
+    draw_ripple_means(&mut chart, steps, on, (y0, y1))?;
+    draw_windows(&mut chart, steps, on)?;
+    draw_cal_labels(&mut chart, steps, on, room)?;
+    draw_legend(&mut chart, SeriesLabelPosition::UpperLeft, (8, 13))?;
+    Ok(())
+}
+
+/// The staircase chart's coordinates.
+type StaircaseChart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// Output `k`'s values drawn in the chart's units: times `scale`.
+#[derive(Clone, Copy)]
+struct Scaled {
+    k: usize,
+    scale: f64,
+}
+
+/// Each step's mean over one ripple period, clipped to `(y0, y1)`.
+fn draw_ripple_means<DB: DrawingBackend>(
+    chart: &mut StaircaseChart<'_, DB>,
+    steps: &[Step],
+    Scaled { k, scale }: Scaled,
+    (y0, y1): (f64, f64),
+) -> Result<(), PlotError> {
+    let color = OUT_COLOR[k];
     let mut first = true;
     for s in steps {
         let scaled: Vec<(f64, f64)> = s.smooth[k].iter().map(|&(t, v)| (t, v * scale)).collect();
@@ -310,10 +327,23 @@ fn staircase_smooth<DB: DrawingBackend>(
             }
         }
     }
-    let window = |s: &Step| {
-        let a = s.start + s.point.settle_s;
-        (a, a + s.point.window_s)
-    };
+    Ok(())
+}
+
+/// The window a step's point averages, from its settling to its end (s).
+fn window(s: &Step) -> (f64, f64) {
+    let a = s.start + s.point.settle_s;
+    (a, a + s.point.window_s)
+}
+
+/// Each step's window mean (the fit's data point) and the exact theory
+/// over the same window, dashed.
+fn draw_windows<DB: DrawingBackend>(
+    chart: &mut StaircaseChart<'_, DB>,
+    steps: &[Step],
+    Scaled { k, scale }: Scaled,
+) -> Result<(), PlotError> {
+    let color = OUT_COLOR[k];
     chart
         .draw_series(steps.iter().map(|s| {
             let (a, b) = window(s);
@@ -340,6 +370,17 @@ fn staircase_smooth<DB: DrawingBackend>(
                 .legend(|(x, y)| PathElement::new([(x, y), (x + 24, y)], BLACK.stroke_width(1)));
         }
     }
+    Ok(())
+}
+
+/// Each step's calibration frequency above its window, `room` (in the
+/// data's units) times 0.15 over the higher of its mean and its theory.
+fn draw_cal_labels<DB: DrawingBackend>(
+    chart: &mut StaircaseChart<'_, DB>,
+    steps: &[Step],
+    Scaled { k, scale }: Scaled,
+    room: f64,
+) -> Result<(), PlotError> {
     let label_style = text_style(13).pos(plotters::style::text_anchor::Pos::new(
         plotters::style::text_anchor::HPos::Center,
         plotters::style::text_anchor::VPos::Bottom,
@@ -354,15 +395,6 @@ fn staircase_smooth<DB: DrawingBackend>(
                 label_style.clone(),
             )
         }))
-        .map_err(err)?;
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .margin(8)
-        .label_font(text_style(13))
-        .background_style(WHITE.mix(0.9))
-        .border_style(LIGHT)
-        .draw()
         .map_err(err)?;
     Ok(())
 }
