@@ -714,12 +714,34 @@ impl Experiment {
     /// An explicit value that conflicts with the others is refused with
     /// both values and what is allowed.
     pub fn derived(&self) -> Result<Derived, ConfigError> {
+        let decimation = self.decimation()?;
+        let (rc_hz, butterworth_hz) = self.cutoffs(decimation)?;
+        let fz = self.drive.clock_hz / f64::from(decimation);
+        let min_window_s = match self.points.min_window_s {
+            Some(w) => w,
+            None => {
+                let batch = FILTER_TIMES_PER_BATCH / (std::f64::consts::TAU * butterworth_hz);
+                8.0 * batch.max(64.0 / fz)
+            }
+        };
+        Ok(Derived {
+            decimation,
+            butterworth_hz,
+            rc_hz,
+            min_window_s,
+        })
+    }
+
+    /// The CIC decimation: `[filter] decimation` checked against its range
+    /// and the calibration ripple's `SAMPLES_PER_RIPPLE` z samples a
+    /// period, or derived from the signal band within both.
+    fn decimation(&self) -> Result<u32, ConfigError> {
         let clock = self.drive.clock_hz;
         let band = self.signal_band_hz();
         let max_cal = self.points.cal_freqs_hz.iter().cloned().fold(0.0, f64::max);
         // Largest R that still samples the ripple SAMPLES_PER_RIPPLE times.
         let ripple_limit = (clock / (SAMPLES_PER_RIPPLE * 2.0 * max_cal)).floor();
-        let decimation = match self.filter.decimation {
+        Ok(match self.filter.decimation {
             Some(r) => {
                 if !(MIN_DECIMATION..=MAX_DECIMATION).contains(&r) {
                     return Err(ConfigError::key(
@@ -758,7 +780,14 @@ impl Experiment {
                     f64::from(MAX_DECIMATION).min(ripple_limit),
                 ) as u32
             }
-        };
+        })
+    }
+
+    /// The RC and Butterworth cutoffs (Hz) at `decimation`: given ones
+    /// checked against `MIN_CUTOFF_RATIO..=MAX_CUTOFF_RATIO` of the z
+    /// rate, missing ones derived from the signal band within it.
+    fn cutoffs(&self, decimation: u32) -> Result<(f64, f64), ConfigError> {
+        let (clock, band) = (self.drive.clock_hz, self.signal_band_hz());
         let fz = clock / f64::from(decimation);
         let (lo, hi) = (fz * MIN_CUTOFF_RATIO, fz * MAX_CUTOFF_RATIO);
         let why = match self.filter.decimation {
@@ -786,19 +815,7 @@ impl Experiment {
             self.filter.butterworth_hz,
             (CUTOFF_STEP * band).min(rc_hz),
         )?;
-        let min_window_s = match self.points.min_window_s {
-            Some(w) => w,
-            None => {
-                let batch = FILTER_TIMES_PER_BATCH / (std::f64::consts::TAU * butterworth_hz);
-                8.0 * batch.max(64.0 / fz)
-            }
-        };
-        Ok(Derived {
-            decimation,
-            butterworth_hz,
-            rc_hz,
-            min_window_s,
-        })
+        Ok((rc_hz, butterworth_hz))
     }
 }
 
