@@ -260,17 +260,33 @@ pub fn analyze(rate: &[f64], fs: f64, tau_fit_min_s: f64) -> Result<NoiseAnalysi
             sample_rate_hz: fs,
         });
     }
+    let (c, sd) = weighted_fit(&fitted, n);
+    let taus = (fitted[0].tau_s, fitted[fitted.len() - 1].tau_s);
+    let fit = noise_fit(c, sd, taus);
+    let points = confident_points(&raw, &c, n);
+    Ok(NoiseAnalysis {
+        sample_rate_hz: fs,
+        samples: n,
+        arw_deg_per_sqrt_h: arw_reading(&points, n, fs),
+        bias_instability_deg_per_h: bias_reading(&points, tau_fit_min_s),
+        rrw_deg_per_h_per_sqrt_h: fit.rrw_deg_per_h_per_sqrt_h.clone(),
+        points,
+        fit,
+    })
+}
+
+/// The three terms' coefficients fitted to the variances of `fitted` (a
+/// series of `n` samples), `FIT_ROUNDS` rounds each weighted by the edf
+/// the previous round's model gives, and their 1-sigma from the last.
+fn weighted_fit(fitted: &[&AllanPoint], n: usize) -> ([f64; 3], [f64; 3]) {
     let taus: Vec<f64> = fitted.iter().map(|p| p.tau_s).collect();
     let y: Vec<f64> = fitted.iter().map(|p| p.adev * p.adev).collect();
-    let edf_at = |c: &[f64; 3], p: &AllanPoint| {
-        edf::edf_mixture(n, p.cluster, shares(c, p.tau_s)).unwrap_or(1.0)
-    };
+    let edfs_at = |c: &[f64; 3]| -> Vec<f64> { fitted.iter().map(|p| edf_at(c, p, n)).collect() };
     let mut c = [1.0, 0.0, 0.0];
     let mut model = y.clone();
     let mut rows = vec![];
     for _ in 0..FIT_ROUNDS {
-        let edfs: Vec<f64> = fitted.iter().map(|p| edf_at(&c, p)).collect();
-        (c, rows) = fit_once(&taus, &y, &edfs, &model);
+        (c, rows) = fit_once(&taus, &y, &edfs_at(&c), &model);
         model = taus
             .iter()
             .zip(&y)
@@ -280,15 +296,27 @@ pub fn analyze(rate: &[f64], fs: f64, tau_fit_min_s: f64) -> Result<NoiseAnalysi
             })
             .collect();
     }
-    let edfs: Vec<f64> = fitted.iter().map(|p| edf_at(&c, p)).collect();
+    let edfs = edfs_at(&c);
     let sd: [f64; 3] = std::array::from_fn(|k| {
         rows.iter()
             .zip(model.iter().zip(&edfs))
             .map(|(r, (m, e))| r[k].abs() * m * (2.0 / e).sqrt())
             .sum()
     });
+    (c, sd)
+}
+
+/// The edf of point `p` of a series of `n` samples, under the mixture of
+/// noises the coefficients `c` give at its tau (1 where it has none).
+fn edf_at(c: &[f64; 3], p: &AllanPoint, n: usize) -> f64 {
+    edf::edf_mixture(n, p.cluster, shares(c, p.tau_s)).unwrap_or(1.0)
+}
+
+/// The fit's readings in the datasheet's units, from the coefficients `c`
+/// and their 1-sigma `sd`, fitted over `tau_range_s`.
+fn noise_fit(c: [f64; 3], sd: [f64; 3], tau_range_s: (f64, f64)) -> NoiseFit {
     let b_scale = DPH_PER_DPS / FLICKER_ADEV_PER_B;
-    let fit = NoiseFit {
+    NoiseFit {
         arw_deg_per_sqrt_h: coefficient_reading(c[0], sd[0], 60.0, "the white (-1/2) term"),
         bias_instability_deg_per_h: coefficient_reading(
             c[1],
@@ -303,12 +331,16 @@ pub fn analyze(rate: &[f64], fs: f64, tau_fit_min_s: f64) -> Result<NoiseAnalysi
             "the random-walk (+1/2) term",
         ),
         coefficients: c,
-        tau_range_s: (taus[0], taus[taus.len() - 1]),
-    };
-    let points: Vec<ConfidentPoint> = raw
-        .iter()
+        tau_range_s,
+    }
+}
+
+/// Every point of `raw` with its edf under the fitted mixture `c`, its
+/// 1-sigma interval and the mixture's shares at its tau.
+fn confident_points(raw: &[AllanPoint], c: &[f64; 3], n: usize) -> Vec<ConfidentPoint> {
+    raw.iter()
         .map(|p| {
-            let e = edf_at(&c, p);
+            let e = edf_at(c, p, n);
             let (lo, hi) = edf::interval(p.adev, e, ONE_SIGMA).unwrap_or((f64::NAN, f64::NAN));
             ConfidentPoint {
                 tau_s: p.tau_s,
@@ -317,19 +349,10 @@ pub fn analyze(rate: &[f64], fs: f64, tau_fit_min_s: f64) -> Result<NoiseAnalysi
                 edf: e,
                 ci_low_dps: lo,
                 ci_high_dps: hi,
-                shares: shares(&c, p.tau_s),
+                shares: shares(c, p.tau_s),
             }
         })
-        .collect();
-    Ok(NoiseAnalysis {
-        sample_rate_hz: fs,
-        samples: n,
-        arw_deg_per_sqrt_h: arw_reading(&points, n, fs),
-        bias_instability_deg_per_h: bias_reading(&points, tau_fit_min_s),
-        rrw_deg_per_h_per_sqrt_h: fit.rrw_deg_per_h_per_sqrt_h.clone(),
-        points,
-        fit,
-    })
+        .collect()
 }
 
 /// IEEE 952's ARW: the point nearest 1 s, moved along -1/2 (null when
