@@ -172,7 +172,7 @@ pub(crate) fn from_windows(
     knowns: &Knowns,
     op: &Operating,
     id: &Identified,
-    spur_lines: Option<&[RelativeLine]>,
+    spur_lines: Option<&[TurningLine]>,
 ) -> Result<Coupling, Error> {
     let g_error = resonator_error(id, op.carrier_hz);
     let folded = [0, 1].map(|k| Folded::of(id, k, op.carrier_hz, knowns.clock_hz));
@@ -214,18 +214,51 @@ pub(crate) fn from_windows(
 /// The table core's carrier spur lines in the windows' means at the cross
 /// responses' drive amplitudes, each per output as a fraction of that
 /// output's magnitude (`spurs::relative_lines_over_records` over one
-/// window); `None` on the fine core.
+/// window), as the windows read them ([`TurningLine`]); `None` on the
+/// fine core.
 pub(crate) fn spur_lines(
     windows: &CrossWindows,
     knowns: &Knowns,
     op: &Operating,
     id: &Identified,
-) -> Result<Option<Vec<RelativeLine>>, Error> {
+) -> Result<Option<Vec<TurningLine>>, Error> {
     let cross = Operating {
         amplitude: (DRIVE1_FRACTION * op.amplitude.0, op.amplitude.1),
         ..op.clone()
     };
-    spurs::relative_lines_over_records(knowns, id, &cross, windows.window_s)
+    let lines = spurs::relative_lines_over_records(knowns, id, &cross, windows.window_s)?;
+    Ok(lines.map(|lines| turning(windows, &lines)))
+}
+
+/// A spur line as the four windows read it: its relative amplitude per
+/// output and, at each side of the carrier, its phasor e^(j Omega t_sq)
+/// at window (s, q)'s time. Made once per measurement ([`turning`]): the
+/// coupling's rounds (`selfcal`'s `uncoupled`, nine of them) read the
+/// same lines with other slopes, and a step on a slow clock has some 1e5
+/// lines, whose phasors were most of a field step's time.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct TurningLine {
+    /// rho per output ([`RelativeLine::rho`]).
+    rho: [f64; 2],
+    /// `turn[side][s][q]`: side 0 at +Omega (above the carrier), 1 at
+    /// -Omega.
+    turn: [[[C64; 2]; 2]; 2],
+}
+
+/// `lines` as `windows` read them, at their `times_s`.
+fn turning(windows: &CrossWindows, lines: &[RelativeLine]) -> Vec<TurningLine> {
+    let phasors = |omega: f64| {
+        windows
+            .times_s
+            .map(|by_q| by_q.map(|time| C64::from_polar(1.0, omega * time)))
+    };
+    lines
+        .iter()
+        .map(|line| TurningLine {
+            rho: line.rho,
+            turn: [1.0, -1.0].map(|side| phasors(side * std::f64::consts::TAU * line.offset_hz)),
+        })
+        .collect()
 }
 
 /// The 1-sigma of the estimate `estimate` (deg/s; the real and the
@@ -243,7 +276,7 @@ pub(crate) fn spur_lines(
 /// ratios cancel.
 fn spur_sigma(
     windows: &CrossWindows,
-    lines: &[RelativeLine],
+    lines: &[TurningLine],
     estimate: impl Fn(&CrossWindows) -> C64,
 ) -> C64 {
     // slope[s][q][k]: the estimate's derivative by window (s, q)'s
@@ -260,13 +293,13 @@ fn spur_sigma(
         }
     }
     let j = C64::new(0.0, 1.0);
-    let t = windows.times_s;
+    // The windows' means once a call: the sums below read each 4 times a
+    // line.
+    let mean = [0, 1].map(|s| [0, 1].map(|k| windows.mean(s, k)));
     let mut variance = [0.0; 2];
     for line in lines {
         let mut worst = [0.0f64; 2];
-        for side in [1.0, -1.0] {
-            let omega = side * std::f64::consts::TAU * line.offset_hz;
-            let turn = |time: f64| C64::from_polar(1.0, omega * time);
+        for turn in &line.turn {
             let mut v = [0.0; 2];
             for (part, v) in v.iter_mut().enumerate() {
                 let of = |d: C64| if part == 0 { d.re } else { d.im };
@@ -274,7 +307,7 @@ fn spur_sigma(
                     let s_k: C64 = (0..2)
                         .map(|s| {
                             let (a, b) = (of(slope[s][0][k]), of(slope[s][1][k]));
-                            (a * turn(t[s][0]) - j * b * turn(t[s][1])) * windows.mean(s, k)
+                            (a * turn[s][0] - j * b * turn[s][1]) * mean[s][k]
                         })
                         .sum();
                     *v += rho * rho * s_k.norm_sqr() / 2.0;
@@ -491,7 +524,7 @@ mod tests {
             offset_hz,
             rho: [3e-4, 1e-3],
         };
-        let sigma = spur_sigma(&windows, &[line(2.8)], estimate);
+        let sigma = spur_sigma(&windows, &turning(&windows, &[line(2.8)]), estimate);
         let clean = estimate(&windows);
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(2258);
         // A phase uniform over a turn, from the top 53 bits.
@@ -523,7 +556,7 @@ mod tests {
             ratio.iter().all(|r| (r - 1.0).abs() <= 0.05),
             "RMS over sigma {ratio:?}, sigma {sigma}"
         );
-        let slow = spur_sigma(&windows, &[line(1e-4)], estimate);
+        let slow = spur_sigma(&windows, &turning(&windows, &[line(1e-4)]), estimate);
         assert!(
             slow.re < 1e-3 * sigma.re && slow.im < 1e-3 * sigma.im,
             "{slow} against {sigma}"
