@@ -137,6 +137,25 @@ impl IirLowpass {
         self.pc == 0 && self.rom_q == 0 && self.word == 0
     }
 
+    /// Edges from now to the one that publishes z, while a schedule's
+    /// publishing word (the program's last) is still to run: the edges
+    /// run the words `word`, `rom_q`, then `pc` on to the end, and a
+    /// running schedule takes no strobe. `None` when idle.
+    #[inline(always)]
+    pub fn edges_to_publish(&self) -> Option<u64> {
+        let last = self.words.len() - 1;
+        if self.word == last {
+            Some(1)
+        } else if self.rom_q == last {
+            Some(2)
+        } else if self.pc != 0 {
+            Some(3 + (last - self.pc) as u64)
+        } else {
+            debug_assert!(self.idle(), "a schedule's tail holds its last word");
+            None
+        }
+    }
+
     /// The input digit `select` (channel * 3 + digit) as stored in RAM.
     #[inline(always)]
     fn input_digit(&self, select: u8) -> i64 {
