@@ -8,10 +8,10 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use super::err;
-use super::format::{
-    eng_exponent, fmt_num, fmt_sci, padded_range, scaled_unit, sub, tick_formatter,
+use super::format::{eng_exponent, fmt_num, fmt_sci, padded_range, scaled_unit, sub};
+use super::style::{
+    OUT_COLOR, SF_UNIT, draw_legend, draw_panel_mesh, free_corner, panel_builder, text_style,
 };
-use super::style::{LIGHT, OUT_COLOR, SF_UNIT, draw_legend, free_corner, text_style};
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 /// A linear fit panel: simulated points, the least-squares line, exact
@@ -145,13 +145,7 @@ pub(super) fn draw_line_panel<DB: DrawingBackend>(
     let v = p.view();
     let ((x0, x1), (y0, y1)) = (v.x, v.y);
     let top_factor = p.top_axis.map_or(1.0, |a| a.1);
-    let mut builder = ChartBuilder::on(area);
-    builder
-        .caption(&p.caption, text_style(17))
-        .margin(12)
-        .margin_right(24)
-        .x_label_area_size(56)
-        .y_label_area_size(80);
+    let mut builder = panel_builder(area, &p.caption, 56);
     if p.top_axis.is_some() {
         builder.top_x_label_area_size(34);
     }
@@ -159,20 +153,8 @@ pub(super) fn draw_line_panel<DB: DrawingBackend>(
         .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(err)?
         .set_secondary_coord(x0 * top_factor..x1 * top_factor, y0..y1);
-    chart
-        .configure_mesh()
-        .max_light_lines(0)
-        .bold_line_style(LIGHT)
-        .x_desc(p.x_label.as_str())
-        .y_desc(v.y_label.as_str())
-        .axis_desc_style(text_style(16))
-        .label_style(text_style(14))
-        .x_labels(8)
-        .y_labels(8)
-        .x_label_formatter(&tick_formatter(x1 - x0))
-        .y_label_formatter(&tick_formatter(y1 - y0))
-        .draw()
-        .map_err(err)?;
+    let desc = (p.x_label.as_str(), v.y_label.as_str());
+    draw_panel_mesh(&mut chart, desc, (8, 8), (16, 14))?;
     if let Some((unit, _)) = p.top_axis {
         chart
             .configure_secondary_axes()

@@ -11,8 +11,8 @@ use plotters::prelude::*;
 
 use super::data::Data;
 use super::err;
-use super::format::{fmt_num, fmt_sci, padded_range, tick_formatter};
-use super::style::{GREY, LIGHT, OUT_COLOR, draw_legend, header, text_style};
+use super::format::{fmt_num, fmt_sci, padded_range};
+use super::style::{GREY, OUT_COLOR, draw_legend, draw_panel_mesh, header, panel_builder};
 
 /// One panel's data: per output, the residuals in ppm less their mean,
 /// and the mean; the axis ranges.
@@ -146,27 +146,10 @@ fn residual_chart<'a, DB: DrawingBackend>(
     (x0, x1): (f64, f64),
     (y0, y1): (f64, f64),
 ) -> Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>, PlotError> {
-    let mut chart = ChartBuilder::on(area)
-        .caption(caption, text_style(17))
-        .margin(12)
-        .margin_right(24)
-        .x_label_area_size(56)
-        .y_label_area_size(80)
+    let mut chart = panel_builder(area, &caption, 56)
         .build_cartesian_2d(x0..x1, y0..y1)
         .map_err(err)?;
-    chart
-        .configure_mesh()
-        .max_light_lines(0)
-        .bold_line_style(LIGHT)
-        .x_desc(x_label)
-        .y_desc("(z − z_theory) / (|SF|·span), less its mean  (ppm)")
-        .axis_desc_style(text_style(16))
-        .label_style(text_style(14))
-        .x_labels(8)
-        .y_labels(8)
-        .x_label_formatter(&tick_formatter(x1 - x0))
-        .y_label_formatter(&tick_formatter(y1 - y0))
-        .draw()
-        .map_err(err)?;
+    let y_desc = "(z − z_theory) / (|SF|·span), less its mean  (ppm)";
+    draw_panel_mesh(&mut chart, (x_label, y_desc), (8, 8), (16, 14))?;
     Ok(chart)
 }

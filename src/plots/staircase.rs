@@ -12,10 +12,10 @@ use plotters::prelude::*;
 
 use super::data::Data;
 use super::err;
-use super::format::{
-    clip_polyline, eng_exponent, fmt_num, padded_range, scaled_unit, sub, tick_formatter,
+use super::format::{clip_polyline, eng_exponent, fmt_num, padded_range, scaled_unit, sub};
+use super::style::{
+    GREY, LIGHT, OUT_COLOR, draw_legend, draw_panel_mesh, header, panel_builder, text_style,
 };
-use super::style::{GREY, LIGHT, OUT_COLOR, draw_legend, header, text_style};
 
 /// One calibration run placed on the common time axis.
 struct Step<'a> {
@@ -123,28 +123,12 @@ fn staircase_axes<'a, DB: DrawingBackend>(
     steps: &[Step],
     label_windows: bool,
 ) -> Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>, PlotError> {
-    let mut chart = ChartBuilder::on(area)
-        .caption(caption, text_style(17))
-        .margin(12)
-        .margin_right(24)
-        .x_label_area_size(46)
-        .y_label_area_size(80)
+    let mut chart = panel_builder(area, &caption, 46)
         .build_cartesian_2d(0.0..end, y0..y1)
         .map_err(err)?;
-    chart
-        .configure_mesh()
-        .max_light_lines(0)
-        .bold_line_style(LIGHT)
-        .x_desc("time, runs end to end (s)")
-        .y_desc(format!("z{}  ({})", sub(k + 1), scaled_unit(exp, "m²/s²")))
-        .axis_desc_style(text_style(15))
-        .label_style(text_style(13))
-        .x_labels(10)
-        .y_labels(y_labels)
-        .x_label_formatter(&tick_formatter(end))
-        .y_label_formatter(&tick_formatter(y1 - y0))
-        .draw()
-        .map_err(err)?;
+    let y_desc = format!("z{}  ({})", sub(k + 1), scaled_unit(exp, "m²/s²"));
+    let desc = ("time, runs end to end (s)", y_desc.as_str());
+    draw_panel_mesh(&mut chart, desc, (10, y_labels), (15, 13))?;
     let windows = chart
         .draw_series(steps.iter().map(|s| {
             let a = s.start + s.point.settle_s;

@@ -8,6 +8,8 @@ use plotters::style::FontStyle;
 use std::sync::OnceLock;
 
 use super::err;
+use super::format::tick_formatter;
+use plotters::coord::types::RangedCoordf64;
 
 /// DejaVu Sans, Latin-1, Greek and a few symbols (see assets/fonts/README.md).
 static FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans-subset.ttf");
@@ -95,6 +97,50 @@ pub(super) fn draw_legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
         .label_font(text_style(font))
         .background_style(WHITE.mix(0.9))
         .border_style(LIGHT)
+        .draw()
+        .map_err(err)
+}
+
+/// A panel's chart builder (the readout and calibration lines, the
+/// residuals, the staircase): the caption at 17 px, 12 px margins but 24
+/// on the right, an 80 px y label area and `x_label_area` px for x.
+pub(super) fn panel_builder<'a, 'b, DB: DrawingBackend>(
+    area: &'a DrawingArea<DB, Shift>,
+    caption: &str,
+    x_label_area: u32,
+) -> ChartBuilder<'a, 'b, DB> {
+    let mut builder = ChartBuilder::on(area);
+    builder
+        .caption(caption, text_style(17))
+        .margin(12)
+        .margin_right(24)
+        .x_label_area_size(x_label_area)
+        .y_label_area_size(80);
+    builder
+}
+
+/// A panel's mesh: light bold lines only, the axes described by `desc`
+/// (x, y), `labels` ticks (x, y) formatted for the axes' spans, the
+/// descriptions and tick labels at `fonts` px.
+pub(super) fn draw_panel_mesh<DB: DrawingBackend>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    desc: (&str, &str),
+    labels: (usize, usize),
+    fonts: (u32, u32),
+) -> Result<(), PlotError> {
+    let (x, y) = (chart.x_range(), chart.y_range());
+    chart
+        .configure_mesh()
+        .max_light_lines(0)
+        .bold_line_style(LIGHT)
+        .x_desc(desc.0)
+        .y_desc(desc.1)
+        .axis_desc_style(text_style(fonts.0))
+        .label_style(text_style(fonts.1))
+        .x_labels(labels.0)
+        .y_labels(labels.1)
+        .x_label_formatter(&tick_formatter(x.end - x.start))
+        .y_label_formatter(&tick_formatter(y.end - y.start))
         .draw()
         .map_err(err)
 }
