@@ -292,10 +292,14 @@ fn spur_sigma(
             }
         }
     }
-    let j = C64::new(0.0, 1.0);
     // The windows' means once a call: the sums below read each 4 times a
     // line.
     let mean = [0, 1].map(|s| [0, 1].map(|k| windows.mean(s, k)));
+    // a e^(j x) - j b e^(j y), written out: the complex product by j b
+    // that it stands for gives the same numbers but for the signs of
+    // zeros, which |S_k|^2 squares away.
+    let turned =
+        |a: f64, b: f64, [x, y]: [C64; 2]| C64::new(a * x.re + b * y.im, a * x.im - b * y.re);
     let mut variance = [0.0; 2];
     for line in lines {
         let mut worst = [0.0f64; 2];
@@ -304,12 +308,11 @@ fn spur_sigma(
             for (part, v) in v.iter_mut().enumerate() {
                 let of = |d: C64| if part == 0 { d.re } else { d.im };
                 for (k, rho) in line.rho.iter().enumerate() {
-                    let s_k: C64 = (0..2)
-                        .map(|s| {
-                            let (a, b) = (of(slope[s][0][k]), of(slope[s][1][k]));
-                            (a * turn[s][0] - j * b * turn[s][1]) * mean[s][k]
-                        })
-                        .sum();
+                    let term = |s: usize| {
+                        let (a, b) = (of(slope[s][0][k]), of(slope[s][1][k]));
+                        turned(a, b, turn[s]) * mean[s][k]
+                    };
+                    let s_k = term(0) + term(1);
                     *v += rho * rho * s_k.norm_sqr() / 2.0;
                 }
             }
