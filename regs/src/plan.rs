@@ -297,7 +297,22 @@ pub fn fold_clear_carrier_within(
         .flat_map(|k| [k * stride, -k * stride])
         .map(|k| (nearest + k as f64) * grid)
         .filter(|f| (f - carrier_hz).abs() <= max_shift_hz && *f > 0.0 && *f < clock_hz / 2.0)
-        .find(|&f| nearest_fold_within(f, clock_hz, max_period).1 >= clear_hz)
+        .find(|&f| clear_of_folds(f, clock_hz, clear_hz, max_period))
+}
+
+/// `nearest_fold_within(carrier_hz, clock_hz, max_period).1 >= clear_hz`,
+/// stopping at the first period whose fold is nearer: the same distances,
+/// compared one at a time instead of through their minimum (a NaN distance
+/// is passed over by both, and a NaN `clear_hz` clears nothing in either).
+/// A carrier search on a slow clock rejects most points it tries, each
+/// after 4096 periods before.
+fn clear_of_folds(carrier_hz: f64, clock_hz: f64, clear_hz: f64, max_period: u64) -> bool {
+    let r = carrier_hz / clock_hz;
+    !clear_hz.is_nan()
+        && !(1..=max_period).any(|q| {
+            let x = r * q as f64;
+            clock_hz * (x - x.round()).abs() < clear_hz
+        })
 }
 
 #[cfg(test)]
@@ -317,6 +332,48 @@ mod tests {
             dac_latency: 1,
             adc_latency: 2,
         }
+    }
+
+    /// `clear_of_folds` is the minimum's comparison it replaces: random
+    /// carriers and clocks (a carrier near a fold of a short period half
+    /// the time), clearances around the nearest fold's distance.
+    #[test]
+    fn clear_of_folds_is_the_nearest_folds_comparison() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut uniform = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / 2f64.powi(53)
+        };
+        let (mut clear, mut near) = (0, 0);
+        for i in 0..20_000 {
+            let clock = 1e5 * 500f64.powf(uniform());
+            let carrier = if i % 2 == 0 {
+                let q = 1 + (uniform() * 64.0) as u64;
+                let p = (uniform() * q as f64 / 2.0).floor();
+                clock * p / q as f64 + 50.0 * (uniform() - 0.5)
+            } else {
+                clock * 0.5 * uniform()
+            };
+            let max_period = 1 + (uniform() * 4096.0) as u64;
+            let (_, eps) = nearest_fold_within(carrier, clock, max_period);
+            let clear_hz = eps * (0.5 + uniform());
+            let expected = eps >= clear_hz;
+            assert_eq!(
+                clear_of_folds(carrier, clock, clear_hz, max_period),
+                expected,
+                "carrier {carrier}, clock {clock}, clear {clear_hz}, periods {max_period}"
+            );
+            assert!(clear_of_folds(carrier, clock, eps, max_period));
+            if expected {
+                clear += 1;
+            } else {
+                near += 1;
+            }
+        }
+        assert!(clear > 5_000 && near > 5_000, "{clear} clear, {near} near");
+        assert!(!clear_of_folds(1e6, 5e7, f64::NAN, 16));
     }
 
     #[test]
