@@ -221,16 +221,9 @@ pub const SETTLED_FOLD_BEATS: f64 = 4.0;
 
 /// [`nearest_fold`] among periods up to `max_period`.
 pub fn nearest_fold_within(carrier_hz: f64, clock_hz: f64, max_period: u64) -> (u64, f64) {
-    let r = carrier_hz / clock_hz;
-    (1..=max_period)
-        .map(|q| {
-            let x = r * q as f64;
-            (q, clock_hz * (x - x.round()).abs())
-        })
-        .fold(
-            (0, f64::INFINITY),
-            |best, c| if c.1 < best.1 { c } else { best },
-        )
+    fold_distances(carrier_hz, clock_hz, max_period).fold((0, f64::INFINITY), |best, c| {
+        if c.1 < best.1 { c } else { best }
+    })
 }
 
 /// Folds closer to the carrier than this many Butterworth corners of the
@@ -307,12 +300,22 @@ pub fn fold_clear_carrier_within(
 /// A carrier search on a slow clock rejects most points it tries, each
 /// after 4096 periods before.
 fn clear_of_folds(carrier_hz: f64, clock_hz: f64, clear_hz: f64, max_period: u64) -> bool {
-    let r = carrier_hz / clock_hz;
     !clear_hz.is_nan()
-        && !(1..=max_period).any(|q| {
-            let x = r * q as f64;
-            clock_hz * (x - x.round()).abs() < clear_hz
-        })
+        && !fold_distances(carrier_hz, clock_hz, max_period).any(|(_, eps)| eps < clear_hz)
+}
+
+/// Each period q up to `max_period` with the distance (Hz) from the
+/// carrier of its fold: q f_c lies that far from a multiple of the clock.
+fn fold_distances(
+    carrier_hz: f64,
+    clock_hz: f64,
+    max_period: u64,
+) -> impl Iterator<Item = (u64, f64)> {
+    let r = carrier_hz / clock_hz;
+    (1..=max_period).map(move |q| {
+        let x = r * q as f64;
+        (q, clock_hz * (x - x.round()).abs())
+    })
 }
 
 #[cfg(test)]
