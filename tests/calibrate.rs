@@ -81,6 +81,60 @@ fn calibrate(config: &Path, extra: &[&str]) -> Value {
     json_object(gyrocal(&args))
 }
 
+/// How many of a run's `warnings` say its drive-gain ratio is the
+/// design's with no bound.
+fn design_ratio_lines(run: &Value) -> usize {
+    run["warnings"]
+        .as_array()
+        .unwrap_or_else(|| panic!("no warnings list in {run}"))
+        .iter()
+        .filter(|w| {
+            w.as_str()
+                .unwrap()
+                .starts_with("warning: the drive-gain ratio g2/g1 is the design's")
+        })
+        .count()
+}
+
+/// A cycle whose scale factors rest on the design's drive-gain ratio, which
+/// nothing measured (no coupling at rest) and the datasheet does not bound,
+/// says so in one line (JSON, stderr, the table); with
+/// `[datasheet] drive_gain_ratio_uncertainty` the sigma holds the ratio
+/// (`sf_selfcal_uncertainty_sources.drive_ratio`) and the line is gone.
+#[test]
+fn a_drive_gain_ratio_nothing_bounds_is_said_in_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let bare = dir.path().join("bare.toml");
+    std::fs::write(&bare, DEVICE).unwrap();
+    let o = gyrocal(&["calibrate", "--config", bare.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let line = "warning: the drive-gain ratio g2/g1 is the design's";
+    let out = String::from_utf8(o.stdout.clone()).unwrap();
+    assert_eq!(
+        out.lines().filter(|l| l.starts_with(line)).count(),
+        1,
+        "{out}"
+    );
+    assert!(
+        stderr(&o).lines().any(|l| l.starts_with(line)),
+        "{}",
+        stderr(&o)
+    );
+    let run = calibrate(&bare, &[]);
+    assert_eq!(design_ratio_lines(&run), 1, "{}", run["warnings"]);
+    let sources = &run["sf_selfcal_uncertainty_sources"];
+    assert_eq!(pair(sources, "drive_ratio"), [0.0, 0.0]);
+
+    let bounded = dir.path().join("bounded.toml");
+    let text = format!("{DEVICE}\n[datasheet]\ndrive_gain_ratio_uncertainty = 0.004\n");
+    std::fs::write(&bounded, text).unwrap();
+    let run = calibrate(&bounded, &[]);
+    assert_eq!(design_ratio_lines(&run), 0, "{}", run["warnings"]);
+    let sources = &run["sf_selfcal_uncertainty_sources"];
+    let ratio = pair(sources, "drive_ratio");
+    assert!(ratio.iter().all(|&u| u > 0.0), "{sources}");
+}
+
 /// The identified parameters compared, and the truth's key for each.
 const PARAMETERS: [(&str, Option<&str>); 6] = [
     ("f1_hz", Some("f1_hz")),
@@ -127,6 +181,11 @@ fn compare_over_the_wire(pace_r: u64) -> (f64, f64) {
     let wire = calibrate(&config, &["--board", &served.url]);
     let truth = &local["truth"];
     assert!(wire["truth"].is_null());
+    // No coupling at rest measures this device's drive-gain ratio and the
+    // file gives it no uncertainty: both runs say so, over the wire too.
+    for run in [&local, &wire] {
+        assert_eq!(design_ratio_lines(run), 1, "{}", run["warnings"]);
+    }
 
     println!(
         "{:<16} {:>24} {:>24} {:>16}",

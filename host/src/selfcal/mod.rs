@@ -314,6 +314,34 @@ pub struct SelfCal {
     pub clocks: u64,
 }
 
+impl SelfCal {
+    /// Whether this cycle's scale factors rest on the design's drive-gain
+    /// ratio g2/g1 with nothing to bound it: no coupling at rest measured
+    /// the ratio within [`AT_REST_RATIO_SIGMA`] (`drive_ratio` is None) and
+    /// `knowns` give it no uncertainty. A drive gain that drifted since the
+    /// design then moves a detuned output's scale factor one for one, and
+    /// no sigma holds it.
+    pub fn rests_on_design_ratio(&self, knowns: &Knowns) -> bool {
+        self.drive_ratio.is_none() && knowns.drive_gain_ratio_uncertainty == 0.0
+    }
+
+    /// One line each: what this cycle's sigma leaves out, and an output it
+    /// cannot calibrate ([`rests_on_design_ratio`](Self::rests_on_design_ratio),
+    /// [`Operating::static_fold`]). Empty when the sigma covers it all.
+    pub fn warnings(&self, knowns: &Knowns) -> Vec<String> {
+        let mut lines = vec![];
+        if self.rests_on_design_ratio(knowns) {
+            lines.push(format!(
+                "warning: the drive-gain ratio g2/g1 is the design's (no coupling at rest measured it within {AT_REST_RATIO_SIGMA:e}) and the datasheet gives no drive_gain_ratio_uncertainty: a drive gain that drifted is not in the sigma"
+            ));
+        }
+        if let Some(fold) = &self.operating.static_fold {
+            lines.push(format!("warning: {fold}"));
+        }
+        lines
+    }
+}
+
 /// The operating point for an identification: carrier kept at its
 /// configured place against the nearer mode (`Knowns::operating_carrier`),
 /// reference lagged by the identified loop phase, drives scaled below

@@ -402,10 +402,10 @@ pub fn warnings(exp: &Experiment) -> Vec<String> {
 pub fn design_ratio_warning(steps: &[FieldStep], knowns: &Knowns) -> Option<String> {
     let design: Vec<String> = steps
         .iter()
-        .filter(|st| st.selfcal.drive_ratio.is_none())
+        .filter(|st| st.selfcal.rests_on_design_ratio(knowns))
         .map(|st| format!("{}", st.temperature_c))
         .collect();
-    (!design.is_empty() && knowns.drive_gain_ratio_uncertainty == 0.0).then(|| {
+    (!design.is_empty()).then(|| {
         format!(
             "warning: at {} deg C the drive-gain ratio g2/g1 is the design's (no coupling at rest that measures it within {:e}, no [drive_probe]) and [datasheet] gives no drive_gain_ratio_uncertainty: a drive gain that drifted is not in the sigma",
             design.join(", "),

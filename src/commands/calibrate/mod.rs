@@ -19,8 +19,10 @@
 //!   `_uncertainty` twin, 1 sigma), `sf_cal_per_dps`, `ratio`,
 //!   `sf_selfcal_per_dps` and `sf_selfcal_uncertainty` (relative 1 sigma,
 //!   as in `gyrocal field`), one per output, `clocks`, `wall_s`, `samples`
-//!   (read and missed over the run) and `truth` (null over the wire).
-//!   Progress goes to stderr.
+//!   (read and missed over the run), `warnings` (what the sigma leaves
+//!   out, one line each, also on stderr: a drive-gain ratio nothing
+//!   measured nor bounds, a carrier on a slow fold) and `truth` (null over
+//!   the wire). Progress goes to stderr.
 
 pub mod output;
 pub mod watch;
@@ -75,6 +77,9 @@ pub struct Outcome {
     pub board: String,
     /// The cycle's result.
     pub cal: SelfCal,
+    /// What the cycle's sigma leaves out, one line each
+    /// (`SelfCal::warnings`).
+    pub warnings: Vec<String>,
     /// z samples read and missed.
     pub samples: SampleCounts,
     /// Wall time of the cycle (s).
@@ -96,6 +101,10 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         "cycle done in {:.1} s wall, {:.3e} clocks; {} z samples read, {} went by unread",
         outcome.wall_s, outcome.cal.clocks as f64, outcome.samples.read, outcome.samples.missed
     );
+    // Printed as progress too, as `gyrocal field` prints its own.
+    for w in &outcome.warnings {
+        eprintln!("{w}");
+    }
     if args.json {
         println!("{}", output::json(&outcome));
     } else {
@@ -129,6 +138,7 @@ fn over_the_wire(url: &str, knowns: &Knowns, temperature: Option<f64>) -> Result
     let (cal, samples, wall_s) = cycle(board.as_mut(), knowns)?;
     Ok(Outcome {
         board: url.into(),
+        warnings: cal.warnings(knowns),
         cal,
         samples,
         wall_s,
@@ -153,6 +163,7 @@ fn in_process(
         scenario::rate_table(&file.exp, &fe, &at, knowns, &cal.operating).map_err(Failure::run)?;
     Ok(Outcome {
         board: "in-process".into(),
+        warnings: cal.warnings(knowns),
         cal,
         samples,
         wall_s,

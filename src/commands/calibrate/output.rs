@@ -2,9 +2,9 @@
 //! factors are z LSB per deg/s, one per output; uncertainties 1 sigma
 //! (relative for the scale factors, as in `gyrocal field`).
 
-use super::Outcome;
+use super::{Outcome, Truth};
 use gyrocal_host::identify::Estimate;
-use gyrocal_host::selfcal::ScaledDrives;
+use gyrocal_host::selfcal::{ScaledDrives, SelfCal};
 use serde_json::{Map, Value, json};
 use std::fmt::Write as _;
 
@@ -33,6 +33,13 @@ fn error(sf: [f64; 2], truth: [f64; 2]) -> [f64; 2] {
     std::array::from_fn(|k| sf[k] / truth[k] - 1.0)
 }
 
+/// The self-calibration error's own 1-sigma: the self-calibrated scale
+/// factor's and the rate table's in quadrature, two independent
+/// measurements (as `field`'s `selfcal_error_uncertainty`).
+fn error_sigma(cal: &SelfCal, t: &Truth) -> [f64; 2] {
+    std::array::from_fn(|k| cal.sf_selfcal_uncertainty.total[k].hypot(t.sf_true_uncertainty[k]))
+}
+
 /// The one JSON object of `--json`.
 pub fn json(o: &Outcome) -> Value {
     let mut identified = Map::new();
@@ -42,10 +49,7 @@ pub fn json(o: &Outcome) -> Value {
     let cal = &o.cal;
     let truth = o.truth.as_ref().map(|t| {
         let d = &t.device;
-        // The two are independent measurements (as `field`'s).
-        let combined: [f64; 2] = std::array::from_fn(|k| {
-            cal.sf_selfcal_uncertainty.total[k].hypot(t.sf_true_uncertainty[k])
-        });
+        let combined = error_sigma(cal, t);
         json!({
             "temperature_c": d.temperature_c,
             "f1_hz": d.gyro.f1_hz,
@@ -78,6 +82,7 @@ pub fn json(o: &Outcome) -> Value {
         "wall_s": o.wall_s,
         "samples": {"read": o.samples.read, "missed": o.samples.missed},
         "carrier_spurs": cal.carrier_spurs,
+        "warnings": o.warnings,
         "truth": truth,
     })
 }
@@ -114,8 +119,8 @@ pub fn table(o: &Outcome) -> String {
     if let Some(d) = scaled.filter(ScaledDrives::is_said) {
         let _ = writeln!(s, "{d}");
     }
-    if let Some(fold) = cal.operating.static_fold {
-        let _ = writeln!(s, "warning: {fold}");
+    for w in &o.warnings {
+        let _ = writeln!(s, "{w}");
     }
     if let Some(sp) = &cal.carrier_spurs {
         let _ = writeln!(s, "{sp}");
@@ -143,11 +148,13 @@ pub fn table(o: &Outcome) -> String {
     row("SF_selfcal 1-sigma", cal.sf_selfcal_uncertainty.total, true);
     if let Some(t) = &o.truth {
         row("SF_true (rate table)", t.sf_true_per_dps, false);
+        row("SF_true 1-sigma", t.sf_true_uncertainty, true);
         row(
             "self-cal error",
             error(cal.sf_selfcal_per_dps, t.sf_true_per_dps),
             true,
         );
+        row("self-cal error 1-sigma", error_sigma(cal, t), true);
     }
     let _ = writeln!(
         s,
