@@ -165,6 +165,12 @@ fn shards_run_by_slurm_and_gnu_parallel_merge_into_the_unsharded_sweep() {
     }
 }
 
+/// A JSON list of strings.
+fn strings(v: &serde_json::Value) -> Vec<&str> {
+    let list = v.as_array().unwrap_or_else(|| panic!("not a list: {v}"));
+    list.iter().map(|w| w.as_str().unwrap()).collect()
+}
+
 #[test]
 fn with_a_drift_every_part_runs_every_step() {
     let dir = tempfile::tempdir().unwrap();
@@ -194,7 +200,66 @@ fn with_a_drift_every_part_runs_every_step() {
             .unwrap();
         assert_eq!(d["worst_temperature_c"], worst["temperature_c"]);
         assert_eq!(d["sf_selfcal_error"], worst["sf_selfcal_error"]);
+        // The field run's warning on the drive-gain ratio is kept, naming
+        // exactly the steps where no coupling at rest measured it (the
+        // file's datasheet gives no drive_gain_ratio_uncertainty).
+        let design: Vec<String> = steps
+            .iter()
+            .filter(|s| s["identified"]["drive_gain_ratio"].is_null())
+            .map(|s| s["temperature_c"].as_f64().unwrap().to_string())
+            .collect();
+        let lines = strings(&d["warnings"]);
+        let ratio: Vec<&&str> = lines
+            .iter()
+            .filter(|w| w.contains("drive-gain ratio"))
+            .collect();
+        if design.is_empty() {
+            assert!(ratio.is_empty(), "{lines:?}");
+        } else {
+            let head = format!(
+                "warning: at {} deg C the drive-gain ratio",
+                design.join(", ")
+            );
+            assert!(
+                ratio.len() == 1 && ratio[0].starts_with(&head),
+                "{lines:?}, {head}"
+            );
+        }
     }
+    // The summary names each distinct warning once, with its parts.
+    let summary = &report["summary"];
+    let lines = strings(&summary["warnings"]);
+    let devices = report["devices"].as_array().unwrap();
+    let mut distinct: Vec<&str> = devices
+        .iter()
+        .flat_map(|d| strings(&d["warnings"]))
+        .collect();
+    distinct.sort_unstable();
+    distinct.dedup();
+    for w in &distinct {
+        let carriers = devices
+            .iter()
+            .filter(|d| d["warnings"].as_array().unwrap().iter().any(|x| x == w))
+            .count();
+        let text = w.strip_prefix("warning: ").unwrap();
+        let line = format!("warning: {carriers} of 2 parts (device ");
+        assert!(
+            lines
+                .iter()
+                .any(|l| l.starts_with(&line) && l.ends_with(text)),
+            "{lines:?} lacks {line}...{text}"
+        );
+    }
+    let beyond = summary["beyond_3_sigma"].as_u64().unwrap();
+    let named = lines
+        .iter()
+        .filter(|l| l.contains("beyond 3 of their reported sigmas"));
+    assert_eq!(named.count(), usize::from(beyond > 0), "{lines:?}");
+    assert_eq!(
+        lines.len(),
+        distinct.len() + usize::from(beyond > 0),
+        "{lines:?}"
+    );
 }
 
 #[test]

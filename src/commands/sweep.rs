@@ -8,8 +8,10 @@
 //! plus `[spread]` (`gyrocal_sim::sweep::spread`). Progress goes to stderr:
 //! a bar on a terminal, else one line per device. With `--json` stdout is
 //! the report (`devices`, each with `index`, `device`, `sf_selfcal_error`,
-//! `sf_selfcal_uncertainty`, `identified`, its `steps` and `failed`; and
-//! `summary`: yield at the tolerance, error percentiles, coverage). `--out`
+//! `sf_selfcal_uncertainty`, `identified`, its `steps`, `failed` and
+//! `warnings`; and `summary`: yield at the tolerance, error percentiles,
+//! coverage, and the warnings: inputs no sigma covers, errors beyond 3
+//! sigma; printed on stderr and in the text summary too). `--out`
 //! writes sweep.json, sweep.csv (a row per device and step) and the
 //! figures fig_sweep (the error's CDF against the tolerance, the error
 //! against the split and against Q1).
@@ -107,6 +109,11 @@ pub fn run(args: &Args) -> Result<(), Failure> {
         start.elapsed().as_secs_f64(),
         clocks = clocks as f64
     );
+    // Inputs no sigma covers, and errors it does not: on stderr whatever
+    // the output, as `gyrocal field` prints its own.
+    for w in &report.summary.warnings {
+        eprintln!("{w}");
+    }
     emit(&report, &name, &args.output)
 }
 
@@ -273,6 +280,9 @@ pub fn summary(report: &SweepReport) -> String {
     }
     for d in report.devices.iter().filter(|d| !d.failed.is_empty()) {
         let _ = writeln!(s, "{}", device_line(d));
+    }
+    for w in &sm.warnings {
+        let _ = writeln!(s, "{w}");
     }
     s
 }

@@ -199,6 +199,9 @@ pub struct DeviceResult {
     pub steps: Vec<DeviceStep>,
     /// What failed.
     pub failed: Vec<DeviceFailure>,
+    /// Its field run's warnings, one line each: inputs no sigma covers
+    /// (`FieldReport::warnings`).
+    pub warnings: Vec<String>,
     /// Clocks simulated.
     pub clocks: u64,
 }
@@ -264,6 +267,7 @@ impl Sweep {
         let mut failed = vec![];
         let mut steps = vec![];
         let mut clocks = 0;
+        let mut warnings = vec![];
         let started = sc
             .validate()
             .map_err(FieldError::from)
@@ -276,6 +280,7 @@ impl Sweep {
             }),
             Ok(report) => {
                 clocks = report.clocks;
+                warnings = report.warnings;
                 failed.extend(report.failed.into_iter().map(|f| DeviceFailure {
                     temperature_c: Some(f.temperature_c),
                     stage: f.stage.into(),
@@ -291,7 +296,8 @@ impl Sweep {
                 }));
             }
         }
-        DeviceResult::new(index, drawn, steps, failed, clocks, self.spread.tolerance)
+        let tolerance = self.spread.tolerance;
+        DeviceResult::new(index, drawn, steps, failed, warnings, clocks, tolerance)
     }
 
     /// Run the sweep's devices (`shard`'s alone, if given) in parallel;
@@ -346,6 +352,7 @@ impl DeviceResult {
         drawn: Drawn,
         steps: Vec<DeviceStep>,
         failed: Vec<DeviceFailure>,
+        warnings: Vec<String>,
         clocks: u64,
         tolerance: f64,
     ) -> Self {
@@ -365,6 +372,7 @@ impl DeviceResult {
                 && steps.iter().all(|s| size(s) <= tolerance),
             steps,
             failed,
+            warnings,
             clocks,
         }
     }

@@ -11,6 +11,11 @@
 //! - **Coverage**: over every finished step and output, the fraction of
 //!   |error| within 2 of its reported sigmas (`selfcal_error_uncertainty`),
 //!   and how many lie beyond 3.
+//! - **Warnings**, one line each: every distinct warning of the parts'
+//!   field runs (an input no sigma covers, as `gyrocal field` prints it)
+//!   with how many parts and which carry it, and the errors that lie
+//!   beyond 3 of their sigmas, each named. A sigma that does not cover its
+//!   error is never left to a fraction alone.
 
 use super::DeviceResult;
 use serde::{Deserialize, Serialize};
@@ -40,6 +45,96 @@ pub struct Summary {
     pub within_2_sigma: Option<f64>,
     /// How many |error| lie beyond 3 reported sigmas.
     pub beyond_3_sigma: u32,
+    /// One line each: the parts' distinct warnings ([`carried_warnings`]),
+    /// then the errors beyond 3 sigma ([`uncovered_errors`]).
+    pub warnings: Vec<String>,
+}
+
+/// At most this many parts, or errors, are named in a warning's line; the
+/// JSON's `devices` name them all.
+pub const NAMED: usize = 8;
+
+/// The first `NAMED` items, comma-separated, and ", ..." when there are
+/// more.
+fn named<T: std::fmt::Display>(items: &[T]) -> String {
+    let mut s = items
+        .iter()
+        .take(NAMED)
+        .map(T::to_string)
+        .collect::<Vec<_>>()
+        .join(", ");
+    if items.len() > NAMED {
+        s.push_str(", ...");
+    }
+    s
+}
+
+/// Each distinct warning of `parts` (index, the warnings of its field run)
+/// once, in the order first met, as one line: how many of the `total`
+/// parts carry it, and which.
+pub fn carried_warnings<'a>(
+    parts: impl IntoIterator<Item = (u32, &'a [String])>,
+    total: usize,
+) -> Vec<String> {
+    let mut distinct: Vec<(&str, Vec<u32>)> = vec![];
+    for (index, lines) in parts {
+        for line in lines {
+            let text = line.strip_prefix("warning: ").unwrap_or(line);
+            match distinct.iter_mut().find(|(t, _)| *t == text) {
+                Some((_, parts)) => parts.push(index),
+                None => distinct.push((text, vec![index])),
+            }
+        }
+    }
+    distinct
+        .into_iter()
+        .map(|(text, parts)| {
+            format!(
+                "warning: {} of {total} parts (device {}): {text}",
+                parts.len(),
+                named(&parts)
+            )
+        })
+        .collect()
+}
+
+/// An error and its sigma: which part, step and output.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Scored {
+    /// The part's index.
+    pub device: u32,
+    /// The step's temperature (deg C).
+    pub temperature_c: f64,
+    /// The output, 0 or 1.
+    pub output: usize,
+    /// Error over its reported sigma.
+    pub t: f64,
+}
+
+impl std::fmt::Display for Scored {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "device {} at {} deg C output {} ({:+.3} sigma)",
+            self.device,
+            self.temperature_c,
+            self.output + 1,
+            self.t
+        )
+    }
+}
+
+/// One line naming the errors beyond 3 of their reported sigmas, or None.
+pub fn uncovered_errors(scored: &[Scored]) -> Option<String> {
+    let beyond: Vec<Scored> = scored.iter().filter(|s| s.t.abs() > 3.0).copied().collect();
+    (!beyond.is_empty()).then(|| {
+        format!(
+            "warning: {} of {} errors lie beyond 3 of their reported sigmas, which do not cover them: {}",
+            beyond.len(),
+            scored.len(),
+            named(&beyond)
+        )
+    })
 }
 
 /// Nearest-rank percentile `p` (0 < p <= 100) of sorted values.
@@ -60,13 +155,24 @@ impl Summary {
         };
         let sorted = [worst(0), worst(1)];
         let within = |k: usize| sorted[k].iter().filter(|&&e| e <= tolerance).count() as f64 / n;
-        let t: Vec<f64> = devices
+        let scored: Vec<Scored> = devices
             .iter()
-            .flat_map(|d| &d.steps)
-            .flat_map(|s| {
-                (0..2).map(|k| (s.sf_selfcal_error[k] / s.selfcal_error_uncertainty[k]).abs())
+            .flat_map(|d| d.steps.iter().map(move |s| (d.index, s)))
+            .flat_map(|(device, s)| {
+                (0..2).map(move |output| Scored {
+                    device,
+                    temperature_c: s.temperature_c,
+                    output,
+                    t: s.sf_selfcal_error[output] / s.selfcal_error_uncertainty[output],
+                })
             })
             .collect();
+        let t: Vec<f64> = scored.iter().map(|s| s.t.abs()).collect();
+        let mut warnings = carried_warnings(
+            devices.iter().map(|d| (d.index, d.warnings.as_slice())),
+            devices.len(),
+        );
+        warnings.extend(uncovered_errors(&scored));
         let has = !sorted[0].is_empty();
         Self {
             devices: devices.len() as u32,
@@ -91,6 +197,7 @@ impl Summary {
             within_2_sigma: (!t.is_empty())
                 .then(|| t.iter().filter(|&&t| t <= 2.0).count() as f64 / t.len() as f64),
             beyond_3_sigma: t.iter().filter(|&&t| t > 3.0).count() as u32,
+            warnings,
         }
     }
 }
@@ -107,5 +214,126 @@ mod tests {
         assert_eq!(nearest_rank(&v, 95.0), 10.0);
         assert_eq!(nearest_rank(&v, 100.0), 10.0);
         assert_eq!(nearest_rank(&[3.0], 50.0), 3.0);
+    }
+
+    #[test]
+    fn each_distinct_warning_is_one_line_with_its_parts() {
+        let line = |t: &str| format!("warning: at {t} deg C the ratio is the design's");
+        let parts: Vec<(u32, Vec<String>)> = vec![
+            (0, vec![line("25, 5")]),
+            (1, vec![]),
+            (2, vec![line("25, 5"), "warning: undithered".into()]),
+            (3, vec![line("5")]),
+        ];
+        let lines = carried_warnings(parts.iter().map(|(i, w)| (*i, w.as_slice())), 4);
+        assert_eq!(
+            lines,
+            [
+                "warning: 2 of 4 parts (device 0, 2): at 25, 5 deg C the ratio is the design's",
+                "warning: 1 of 4 parts (device 2): undithered",
+                "warning: 1 of 4 parts (device 3): at 5 deg C the ratio is the design's",
+            ]
+        );
+        // Past `NAMED` parts the line says there are more.
+        let many: Vec<(u32, Vec<String>)> = (0..10).map(|i| (i, vec![line("5")])).collect();
+        let lines = carried_warnings(many.iter().map(|(i, w)| (*i, w.as_slice())), 10);
+        assert_eq!(
+            lines,
+            [
+                "warning: 10 of 10 parts (device 0, 1, 2, 3, 4, 5, 6, 7, ...): at 5 deg C the ratio is the design's"
+            ]
+        );
+        assert!(carried_warnings(std::iter::empty(), 3).is_empty());
+    }
+
+    /// A finished part with one step at 5 deg C: errors `t` times a sigma
+    /// of 1e-4, and its field run's `warnings`.
+    fn part(index: u32, t: [f64; 2], warnings: &[&str]) -> DeviceResult {
+        let identified: serde_json::Map<String, serde_json::Value> = [
+            "f1_hz",
+            "f2_hz",
+            "q1",
+            "q2",
+            "loop_phase_deg",
+            "quadrature_dps",
+            "damping_coupling_dps",
+        ]
+        .iter()
+        .flat_map(|k| [(k.to_string(), 1.0), (format!("{k}_uncertainty"), 0.1)])
+        .map(|(k, v)| (k, serde_json::json!(v)))
+        .chain(
+            ["drive_gain_ratio", "drive_gain_ratio_uncertainty"]
+                .map(|k| (k.into(), serde_json::Value::Null)),
+        )
+        .collect();
+        let step = serde_json::json!({
+            "temperature_c": 5.0,
+            "sf_selfcal_error": [1e-4 * t[0], 1e-4 * t[1]],
+            "sf_selfcal_uncertainty": [1e-4, 1e-4],
+            "selfcal_error_uncertainty": [1e-4, 1e-4],
+            "sf_true_per_dps": [1.0, 1.0],
+            "identified": identified,
+        });
+        serde_json::from_value(serde_json::json!({
+            "index": index,
+            "device": { "f1_hz": 1e4, "f2_hz": 1.01e4, "q1": 1e3, "q2": 1e3, "angular_gain": 0.8 },
+            "frontend_seed": 1, "noise_seed": 2,
+            "worst_temperature_c": 5.0,
+            "sf_selfcal_error": step["sf_selfcal_error"],
+            "sf_selfcal_uncertainty": step["sf_selfcal_uncertainty"],
+            "identified": identified,
+            "within_tolerance": true,
+            "steps": [step],
+            "failed": [],
+            "warnings": warnings,
+            "clocks": 0,
+        }))
+        .unwrap()
+    }
+
+    #[test]
+    fn the_summary_keeps_the_parts_warnings_and_names_the_uncovered_errors() {
+        let parts = [
+            part(0, [0.5, -1.0], &["warning: ratio"]),
+            part(1, [3.5, -0.2], &[]),
+            part(2, [1.0, -3.2], &["warning: ratio"]),
+        ];
+        let sm = Summary::of(&parts, 1e-3);
+        assert_eq!(sm.beyond_3_sigma, 2);
+        assert_eq!(
+            sm.warnings,
+            [
+                "warning: 2 of 3 parts (device 0, 2): ratio",
+                "warning: 2 of 6 errors lie beyond 3 of their reported sigmas, which do not cover \
+                 them: device 1 at 5 deg C output 1 (+3.500 sigma), device 2 at 5 deg C output 2 \
+                 (-3.200 sigma)",
+            ]
+        );
+        assert!(
+            Summary::of(&[part(0, [0.5, 2.9], &[])], 1e-3)
+                .warnings
+                .is_empty()
+        );
+    }
+
+    #[test]
+    fn errors_beyond_three_sigma_are_named_and_those_within_are_not() {
+        let at = |device, t| Scored {
+            device,
+            temperature_c: 5.0,
+            output: 0,
+            t,
+        };
+        assert_eq!(
+            uncovered_errors(&[at(0, 3.0), at(1, -2.9), at(2, 0.1)]),
+            None
+        );
+        assert_eq!(
+            uncovered_errors(&[at(0, -3.07), at(1, 2.0), at(4, 3.5)]).as_deref(),
+            Some(
+                "warning: 2 of 3 errors lie beyond 3 of their reported sigmas, which do not cover them: \
+                 device 0 at 5 deg C output 1 (-3.070 sigma), device 4 at 5 deg C output 1 (+3.500 sigma)"
+            )
+        );
     }
 }
