@@ -135,6 +135,35 @@ fn a_drive_gain_ratio_nothing_bounds_is_said_in_one_line() {
     assert!(ratio.iter().all(|&u| u > 0.0), "{sources}");
 }
 
+/// A carrier written at the device's f1 while the datasheet puts f1 2.5%
+/// higher: the cycle keeps the carrier's offset from the datasheet's f1
+/// (`Knowns::operating_carrier`), so it runs 1190 Hz below the f1 it finds,
+/// off both modes (760 Hz apart), and says so in one line.
+#[test]
+fn a_carrier_written_off_both_modes_is_said_in_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("off.toml");
+    let text = format!("{DEVICE}\n[datasheet]\nf1_hz = 48.5e3\nf2_hz = 49.26e3\n");
+    std::fs::write(&config, text).unwrap();
+    let run = calibrate(&config, &[]);
+    let line = run["warnings"][0]
+        .as_str()
+        .unwrap_or_else(|| panic!("{run}"));
+    assert!(
+        line.starts_with(
+            "warning: [drive] carrier_hz = 47310.0 Hz is -1190.0 Hz from the datasheet's f1 \
+             (48500.0 Hz), farther than the modes' split (760.0 Hz)"
+        ),
+        "{line}"
+    );
+    let found = number(&run, &["identified", "f1_hz"]);
+    let carrier = number(&run, &["operating", "carrier_hz"]);
+    assert!(
+        (carrier - (found - 1190.0)).abs() < 1.0,
+        "{carrier} {found}"
+    );
+}
+
 /// The identified parameters compared, and the truth's key for each.
 const PARAMETERS: [(&str, Option<&str>); 6] = [
     ("f1_hz", Some("f1_hz")),

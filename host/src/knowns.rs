@@ -143,6 +143,30 @@ impl Knowns {
         }
     }
 
+    /// One line when the configured carrier lies farther from the nearer
+    /// datasheet mode than the modes lie from each other: the cycle keeps
+    /// that offset from the mode it finds (`operating_carrier`), so the
+    /// carrier runs off both modes, a readout unlike the one at a mode. The
+    /// usual cause is a carrier written at the device's measured f1 while
+    /// `[datasheet]` gives another; a carrier at a mode or between the two
+    /// says nothing.
+    pub fn carrier_off_the_modes(&self) -> Option<String> {
+        let (d1, d2) = (self.nominal.f1_hz, self.nominal.f2_hz);
+        let c = self.carrier_hz;
+        let (k, d) = if (c - d1).abs() <= (c - d2).abs() {
+            (1, d1)
+        } else {
+            (2, d2)
+        };
+        let split = (d2 - d1).abs();
+        ((c - d).abs() > split).then(|| {
+            format!(
+                "warning: [drive] carrier_hz = {c:.1} Hz is {:+.1} Hz from the datasheet's f{k} ({d:.1} Hz), farther than the modes' split ({split:.1} Hz): the cycle keeps that offset from the f{k} it finds and runs the carrier off both modes; if it was meant on the mode, write carrier_hz at the datasheet's f{k} or correct [datasheet] f{k}_hz",
+                c - d
+            )
+        })
+    }
+
     /// These knowns with `gyro` as the device: every wait after
     /// identification uses the identified modes, not the datasheet's.
     pub fn with_device(&self, gyro: &GyroParams) -> Self {
@@ -161,5 +185,65 @@ impl Knowns {
     /// z samples in the first averaging window.
     pub fn window_samples(&self) -> u64 {
         (self.filter.min_window_s * self.clock_hz / f64::from(self.filter.decimation)).ceil() as u64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn knowns(carrier_hz: f64) -> Knowns {
+        Knowns {
+            clock_hz: 1.6e6,
+            nominal: GyroParams {
+                f1_hz: 34_155.0,
+                f2_hz: 34_570.0,
+                q1: 1e4,
+                q2: 1e4,
+                angular_gain: 0.7,
+                quadrature_dps: 0.0,
+                damping_coupling_dps: 0.0,
+            },
+            angular_gain_uncertainty: 0.0,
+            drive_gain_ratio_uncertainty: 0.0,
+            amplitude: (0.9, 0.9),
+            force_full_scale: [1.0, 1.0],
+            dac_latency: 2,
+            adc_latency: 3,
+            filter: Derived {
+                decimation: 100,
+                butterworth_hz: 50.0,
+                rc_hz: 200.0,
+                min_window_s: 0.1,
+            },
+            carrier_hz,
+            rates_dps: vec![10.0],
+            cal_freqs_hz: vec![3.0],
+            carrier_profile: CarrierProfile::Table,
+        }
+    }
+
+    /// At a mode, between the two, or beyond one by less than the split
+    /// (415 Hz): nothing. Beyond by more, on either side: one line with
+    /// the offset, the mode and the split.
+    #[test]
+    fn a_carrier_off_both_modes_is_said_and_one_near_them_is_not() {
+        for c in [34_155.0, 34_362.5, 34_570.0, 33_741.0, 34_984.0] {
+            assert_eq!(knowns(c).carrier_off_the_modes(), None, "{c}");
+        }
+        let line = knowns(33_000.0).carrier_off_the_modes().unwrap();
+        assert!(
+            line.starts_with(
+                "warning: [drive] carrier_hz = 33000.0 Hz is -1155.0 Hz from the datasheet's f1 (34155.0 Hz), farther than the modes' split (415.0 Hz)"
+            ),
+            "{line}"
+        );
+        // Just past the split (416 Hz below f1).
+        assert!(knowns(33_739.0).carrier_off_the_modes().is_some());
+        let line = knowns(35_000.0).carrier_off_the_modes().unwrap();
+        assert!(
+            line.contains("is +430.0 Hz from the datasheet's f2 (34570.0 Hz)"),
+            "{line}"
+        );
     }
 }

@@ -325,11 +325,13 @@ impl SelfCal {
         self.drive_ratio.is_none() && knowns.drive_gain_ratio_uncertainty == 0.0
     }
 
-    /// One line each: what this cycle's sigma leaves out, and an output it
-    /// cannot calibrate ([`rests_on_design_ratio`](Self::rests_on_design_ratio),
-    /// [`Operating::static_fold`]). Empty when the sigma covers it all.
+    /// One line each: a carrier configured off both modes
+    /// ([`Knowns::carrier_off_the_modes`]), what this cycle's sigma leaves
+    /// out ([`rests_on_design_ratio`](Self::rests_on_design_ratio)) and an
+    /// output it cannot calibrate ([`Operating::static_fold`]). Empty when
+    /// there is nothing to say.
     pub fn warnings(&self, knowns: &Knowns) -> Vec<String> {
-        let mut lines = vec![];
+        let mut lines: Vec<String> = knowns.carrier_off_the_modes().into_iter().collect();
         if self.rests_on_design_ratio(knowns) {
             lines.push(format!(
                 "warning: the drive-gain ratio g2/g1 is the design's (no coupling at rest measured it within {AT_REST_RATIO_SIGMA:e}) and the datasheet gives no drive_gain_ratio_uncertainty: a drive gain that drifted is not in the sigma"

@@ -368,8 +368,9 @@ pub struct FieldReport {
     /// empty when every step finished.
     pub failed: Vec<StepFailure>,
     /// Inputs that make a figure less than it says, one line each, also
-    /// printed as progress: ADCs the scenario leaves undithered (when the
-    /// run starts), steps whose sigma leaves a drifted drive gain out
+    /// printed as progress: ADCs the scenario leaves undithered and a
+    /// carrier configured off both modes (`Knowns::carrier_off_the_modes`;
+    /// when the run starts), steps whose sigma leaves a drifted drive gain out
     /// ([`design_ratio_warning`], when the steps are done).
     pub warnings: Vec<String>,
     /// Clocks simulated, all steps.
@@ -378,11 +379,17 @@ pub struct FieldReport {
     pub wall_s: f64,
 }
 
-/// The scenario's inputs that no sigma covers, one line each: ADC noise
-/// below half an ADC step ([`crate::frontend::dithers`]).
+/// The scenario's inputs that make a figure less than it says, one line
+/// each: ADC noise below half an ADC step ([`crate::frontend::dithers`]),
+/// a carrier configured off both modes
+/// ([`Knowns::carrier_off_the_modes`](gyrocal_host::Knowns::carrier_off_the_modes)).
 pub fn warnings(exp: &Experiment) -> Vec<String> {
     let fe = &exp.frontend;
-    let mut lines = vec![];
+    let mut lines: Vec<String> = knowns(exp)
+        .ok()
+        .and_then(|k| k.carrier_off_the_modes())
+        .into_iter()
+        .collect();
     if !crate::frontend::dithers(fe.noise_lsb, fe.adc_bits) {
         lines.push(format!(
             "warning: [frontend] noise_lsb = {} is below half an ADC step ({} word LSB at adc_bits = {}): unless the device's own noise dithers the ADCs, an output far below their range carries a static quantization error that no sigma includes",
@@ -1055,6 +1062,24 @@ mod tests {
         let f = CarrierFold::of(&operating_at(9638553.9975, &paper), &paper);
         assert!(f.in_passband && f.static_fold.is_none(), "{f:?}");
         assert!(f.clause().expect("a clause").contains("may ripple"));
+    }
+
+    #[test]
+    fn a_carrier_configured_off_both_modes_is_named_in_one_line() {
+        let mut sc = paper();
+        assert!(warnings(&sc.exp).is_empty(), "{:?}", warnings(&sc.exp));
+        // The datasheet's f1 0.3% high, the carrier at the device's f1:
+        // 28.9 kHz from the datasheet's f1, the split 250 Hz.
+        sc.exp.datasheet.f1_hz = Some(9.66892e6);
+        sc.exp.datasheet.f2_hz = Some(9.66917e6);
+        let lines = warnings(&sc.exp);
+        assert_eq!(lines.len(), 1, "{lines:?}");
+        assert!(
+            lines[0].starts_with(
+                "warning: [drive] carrier_hz = 9640000.0 Hz is -28920.0 Hz from the datasheet's f1"
+            ),
+            "{lines:?}"
+        );
     }
 
     #[test]
