@@ -173,3 +173,44 @@ fn an_unbudgeted_design_drive_ratio_is_said() {
         assert_eq!(warned, said, "{datasheet}: {written}");
     }
 }
+
+/// A profile that leaves the rates the scale factors were fitted over (the
+/// rate table's 50 and 100 deg/s, and the null at 0) is said in one line,
+/// in the summary and the JSON's `warnings`: beyond them the profile's
+/// error holds the readout's departure from its fitted line, which no
+/// sigma bounds.
+#[test]
+fn a_profile_beyond_the_rate_table_is_said() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("beyond.toml");
+    let text = format!(
+        "{GOOD}[drift]\ntemperatures_c = [25]\ntcf1_ppm_per_k = -30\ntcf2_ppm_per_k = -30\n\
+         [profile]\nduration_s = 0.6\nrate_points = [[0, 0], [0.2, 0], [0.2, 300], [0.6, 300]]\n"
+    );
+    std::fs::write(&config, text).unwrap();
+    let line = "warning: [profile] reaches 300 deg/s, outside the 0 to 100 deg/s";
+    let run = gyrocal(&[
+        OsStr::new("field"),
+        OsStr::new("--config"),
+        config.as_os_str(),
+    ]);
+    assert!(run.status.success(), "{}", common::stderr(&run));
+    let text = String::from_utf8(run.stdout).unwrap();
+    assert_eq!(
+        text.lines().filter(|l| l.starts_with(line)).count(),
+        1,
+        "{text}"
+    );
+    let run = gyrocal(&[
+        OsStr::new("field"),
+        OsStr::new("--config"),
+        config.as_os_str(),
+        OsStr::new("--json"),
+    ]);
+    let report: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+    let warned = report["warnings"].as_array().unwrap();
+    assert!(
+        warned.iter().any(|w| w.as_str().unwrap().starts_with(line)),
+        "{warned:?}"
+    );
+}

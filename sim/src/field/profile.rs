@@ -171,6 +171,32 @@ impl Profile {
         let (a, b) = (&p[after - 1], &p[after]);
         a[1] + (b[1] - a[1]) * (t_s - a[0]) / (b[0] - a[0])
     }
+
+    /// One line when the profile's rate leaves the interval its scale
+    /// factors were fitted over: the rate table's rates `table_dps`
+    /// (`[experiment] readout_rates_dps`) and 0, where the null is
+    /// measured. Beyond it the profile's error holds the readout's
+    /// departure from the fitted line (on a detuned output mostly its
+    /// quadratic term), which no sigma bounds. The rate is linear between
+    /// points, so its extremes are at the points within the profile or at
+    /// its end.
+    pub fn beyond_the_table(&self, table_dps: &[f64]) -> Option<String> {
+        let (lo, hi) = table_dps
+            .iter()
+            .fold((0.0f64, 0.0f64), |(lo, hi), &r| (lo.min(r), hi.max(r)));
+        let reached = self
+            .rate_points
+            .iter()
+            .filter(|p| p[0] <= self.duration_s)
+            .map(|p| p[1])
+            .chain([self.rate_dps_at(self.duration_s)]);
+        let farthest = reached
+            .filter(|&r| r < lo || r > hi)
+            .max_by(|a, b| a.abs().total_cmp(&b.abs()))?;
+        Some(format!(
+            "warning: [profile] reaches {farthest} deg/s, outside the {lo} to {hi} deg/s over which the scale factors were fitted ([experiment] readout_rates_dps, and 0 where the null is measured): the profile's error there holds the readout's departure from its fitted line, which no sigma bounds"
+        ))
+    }
 }
 
 /// The readout of one board under the profile, record by record.
@@ -278,6 +304,37 @@ mod tests {
             toml::from_str(text).map_err(|e| ConfigError::Syntax(e.message().to_string()))?;
         p.validate(2e-5)?;
         Ok(p)
+    }
+
+    #[test]
+    fn a_profile_beyond_the_rate_table_is_said_and_one_within_it_is_not() {
+        let p =
+            |points: &str| profile(&format!("duration_s = 3.0\nrate_points = {points}\n")).unwrap();
+        let table = [50.0, 100.0, 150.0, 200.0];
+        let within = p("[[0, 0], [0.3, 0], [0.3, 100], [2.0, 200], [2.5, 50], [3.0, 50]]");
+        assert_eq!(within.beyond_the_table(&table), None);
+        // A point after the profile's end is never applied.
+        let late = p("[[0, 0], [3.0, 200], [4.0, 900]]");
+        assert_eq!(late.beyond_the_table(&table), None);
+        let line = p("[[0, 0], [0.3, 3000], [1.0, 6000], [2.5, 50]]")
+            .beyond_the_table(&table)
+            .unwrap();
+        assert!(
+            line.starts_with(
+                "warning: [profile] reaches 6000 deg/s, outside the 0 to 200 deg/s over which"
+            ),
+            "{line}"
+        );
+        // Below the table, and held past the last point.
+        let line = p("[[0, 0], [1.0, -80]]").beyond_the_table(&table).unwrap();
+        assert!(
+            line.contains("reaches -80 deg/s, outside the 0 to 200 deg/s"),
+            "{line}"
+        );
+        assert_eq!(
+            p("[[0, 0], [1.0, -80]]").beyond_the_table(&[-100.0, 100.0]),
+            None
+        );
     }
 
     #[test]

@@ -368,8 +368,9 @@ pub struct FieldReport {
     /// empty when every step finished.
     pub failed: Vec<StepFailure>,
     /// Inputs that make a figure less than it says, one line each, also
-    /// printed as progress: ADCs the scenario leaves undithered and a
-    /// carrier configured off both modes (`Knowns::carrier_off_the_modes`;
+    /// printed as progress: ADCs the scenario leaves undithered, a
+    /// carrier configured off both modes (`Knowns::carrier_off_the_modes`)
+    /// and a profile beyond the rate table (`Profile::beyond_the_table`;
     /// when the run starts), steps whose sigma leaves a drifted drive gain out
     /// ([`design_ratio_warning`], when the steps are done).
     pub warnings: Vec<String>,
@@ -812,6 +813,8 @@ pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldRepor
     let start = Instant::now();
     let (fe, knowns) = build(exp)?;
     let mut warnings = warnings(exp);
+    let profile = sc.profile.as_ref();
+    warnings.extend(profile.and_then(|p| p.beyond_the_table(&knowns.rates_dps)));
     warnings.iter().for_each(|w| progress(w));
     let cycles = run_cycles(sc, &fe, &knowns, progress);
     let factory = cycles[0].as_ref().ok().map(|c| Factory {
