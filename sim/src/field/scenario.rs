@@ -381,16 +381,14 @@ pub struct FieldReport {
 }
 
 /// The scenario's inputs that make a figure less than it says, one line
-/// each: ADC noise below half an ADC step ([`crate::frontend::dithers`]),
-/// a carrier configured off both modes
-/// ([`Knowns::carrier_off_the_modes`](gyrocal_host::Knowns::carrier_off_the_modes)).
-pub fn warnings(exp: &Experiment) -> Vec<String> {
-    let fe = &exp.frontend;
-    let mut lines: Vec<String> = knowns(exp)
-        .ok()
-        .and_then(|k| k.carrier_off_the_modes())
-        .into_iter()
-        .collect();
+/// each, in this order: a carrier configured off both modes
+/// ([`Knowns::carrier_off_the_modes`]), ADC noise below half an ADC step
+/// ([`crate::frontend::dithers`]), a profile beyond the rate table
+/// ([`Profile::beyond_the_table`]). `knowns` are the host's, as
+/// [`build`] makes them.
+pub fn warnings(sc: &Scenario, knowns: &Knowns) -> Vec<String> {
+    let fe = &sc.exp.frontend;
+    let mut lines: Vec<String> = knowns.carrier_off_the_modes().into_iter().collect();
     if !crate::frontend::dithers(fe.noise_lsb, fe.adc_bits) {
         lines.push(format!(
             "warning: [frontend] noise_lsb = {} is below half an ADC step ({} word LSB at adc_bits = {}): unless the device's own noise dithers the ADCs, an output far below their range carries a static quantization error that no sigma includes",
@@ -399,6 +397,8 @@ pub fn warnings(exp: &Experiment) -> Vec<String> {
             fe.adc_bits
         ));
     }
+    let profile = sc.profile.as_ref();
+    lines.extend(profile.and_then(|p| p.beyond_the_table(&knowns.rates_dps)));
     lines
 }
 
@@ -812,9 +812,7 @@ pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldRepor
     drift.validate()?;
     let start = Instant::now();
     let (fe, knowns) = build(exp)?;
-    let mut warnings = warnings(exp);
-    let profile = sc.profile.as_ref();
-    warnings.extend(profile.and_then(|p| p.beyond_the_table(&knowns.rates_dps)));
+    let mut warnings = warnings(sc, &knowns);
     warnings.iter().for_each(|w| progress(w));
     let cycles = run_cycles(sc, &fe, &knowns, progress);
     let factory = cycles[0].as_ref().ok().map(|c| Factory {
@@ -1067,15 +1065,20 @@ mod tests {
         assert!(f.clause().expect("a clause").contains("may ripple"));
     }
 
+    /// The scenario's warnings with the host's knowns.
+    fn said(sc: &Scenario) -> Vec<String> {
+        warnings(sc, &knowns(&sc.exp).expect("knowns"))
+    }
+
     #[test]
     fn a_carrier_configured_off_both_modes_is_named_in_one_line() {
         let mut sc = paper();
-        assert!(warnings(&sc.exp).is_empty(), "{:?}", warnings(&sc.exp));
+        assert!(said(&sc).is_empty(), "{:?}", said(&sc));
         // The datasheet's f1 0.3% high, the carrier at the device's f1:
         // 28.9 kHz from the datasheet's f1, the split 250 Hz.
         sc.exp.datasheet.f1_hz = Some(9.66892e6);
         sc.exp.datasheet.f2_hz = Some(9.66917e6);
-        let lines = warnings(&sc.exp);
+        let lines = said(&sc);
         assert_eq!(lines.len(), 1, "{lines:?}");
         assert!(
             lines[0].starts_with(
@@ -1088,15 +1091,15 @@ mod tests {
     #[test]
     fn an_undithered_adc_is_named_in_one_line_and_a_dithered_one_is_not() {
         let mut sc = paper();
-        assert!(warnings(&sc.exp).is_empty(), "{:?}", warnings(&sc.exp));
+        assert!(said(&sc).is_empty(), "{:?}", said(&sc));
         sc.exp.frontend.noise_lsb = 0.0;
-        let lines = warnings(&sc.exp);
+        let lines = said(&sc);
         assert_eq!(lines.len(), 1, "{lines:?}");
         assert!(lines[0].contains("noise_lsb = 0 is below half an ADC step (0.5 word LSB"));
         // The criterion is in ADC steps: 1 word LSB does not dither a 12-bit ADC.
         sc.exp.frontend.noise_lsb = 1.0;
         sc.exp.frontend.adc_bits = 12;
-        let lines = warnings(&sc.exp);
+        let lines = said(&sc);
         assert_eq!(lines.len(), 1, "{lines:?}");
         assert!(
             lines[0].contains("(8 word LSB at adc_bits = 12)"),

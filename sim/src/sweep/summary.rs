@@ -124,15 +124,19 @@ impl std::fmt::Display for Scored {
     }
 }
 
-/// One line naming the errors beyond 3 of their reported sigmas, or None.
-pub fn uncovered_errors(scored: &[Scored]) -> Option<String> {
-    let beyond: Vec<Scored> = scored.iter().filter(|s| s.t.abs() > 3.0).copied().collect();
+/// The errors beyond 3 of their reported sigmas.
+pub fn beyond_three_sigma(scored: &[Scored]) -> Vec<Scored> {
+    scored.iter().filter(|s| s.t.abs() > 3.0).copied().collect()
+}
+
+/// One line naming `beyond` ([`beyond_three_sigma`] of `total` errors),
+/// or None when there are none.
+pub fn uncovered_errors(beyond: &[Scored], total: usize) -> Option<String> {
     (!beyond.is_empty()).then(|| {
         format!(
-            "warning: {} of {} errors lie beyond 3 of their reported sigmas, which do not cover them: {}",
+            "warning: {} of {total} errors lie beyond 3 of their reported sigmas, which do not cover them: {}",
             beyond.len(),
-            scored.len(),
-            named(&beyond)
+            named(beyond)
         )
     })
 }
@@ -167,12 +171,12 @@ impl Summary {
                 })
             })
             .collect();
-        let t: Vec<f64> = scored.iter().map(|s| s.t.abs()).collect();
+        let beyond = beyond_three_sigma(&scored);
         let mut warnings = carried_warnings(
             devices.iter().map(|d| (d.index, d.warnings.as_slice())),
             devices.len(),
         );
-        warnings.extend(uncovered_errors(&scored));
+        warnings.extend(uncovered_errors(&beyond, scored.len()));
         let has = !sorted[0].is_empty();
         Self {
             devices: devices.len() as u32,
@@ -194,9 +198,11 @@ impl Summary {
                     sorted[1][sorted[1].len() - 1],
                 ]
             }),
-            within_2_sigma: (!t.is_empty())
-                .then(|| t.iter().filter(|&&t| t <= 2.0).count() as f64 / t.len() as f64),
-            beyond_3_sigma: t.iter().filter(|&&t| t > 3.0).count() as u32,
+            within_2_sigma: (!scored.is_empty()).then(|| {
+                let within = scored.iter().filter(|s| s.t.abs() <= 2.0).count();
+                within as f64 / scored.len() as f64
+            }),
+            beyond_3_sigma: beyond.len() as u32,
             warnings,
         }
     }
@@ -324,12 +330,11 @@ mod tests {
             output: 0,
             t,
         };
+        let uncovered =
+            |scored: &[Scored]| uncovered_errors(&beyond_three_sigma(scored), scored.len());
+        assert_eq!(uncovered(&[at(0, 3.0), at(1, -2.9), at(2, 0.1)]), None);
         assert_eq!(
-            uncovered_errors(&[at(0, 3.0), at(1, -2.9), at(2, 0.1)]),
-            None
-        );
-        assert_eq!(
-            uncovered_errors(&[at(0, -3.07), at(1, 2.0), at(4, 3.5)]).as_deref(),
+            uncovered(&[at(0, -3.07), at(1, 2.0), at(4, 3.5)]).as_deref(),
             Some(
                 "warning: 2 of 3 errors lie beyond 3 of their reported sigmas, which do not cover them: \
                  device 0 at 5 deg C output 1 (-3.070 sigma), device 4 at 5 deg C output 1 (+3.500 sigma)"
