@@ -281,8 +281,11 @@ module axi_formal (
     // that edge (its data appearing now: clip_read) restarted them instead,
     // with that edge's rail code counted (rail*_q). clip*_cur: as they stand
     // this clock, which a read performed at this edge returns.
-    wire rail1 = adc1 == 16'sh7fff || adc1 == 16'sh8000;
-    wire rail2 = adc2 == 16'sh7fff || adc2 == 16'sh8000;
+    // A word at a rail: within 1/128 of full scale (top byte 0x7f or 0x80),
+    // where every rail code of an 8- to 16-bit converter lies (the words
+    // are left-justified: a 12-bit converter's positive rail is +32752).
+    wire rail1 = adc1[15:8] == 8'h7f || adc1[15:8] == 8'h80;
+    wire rail2 = adc2[15:8] == 8'h7f || adc2[15:8] == 8'h80;
     reg rail1_q = 1'b0, rail2_q = 1'b0;
     reg [15:0] clip1 = 16'd0, clip2 = 16'd0;
     wire clip_read = new_r && ar_n && q_ar == I_ADC_CLIP;

@@ -14016,8 +14016,8 @@ module gyro_interface_axi__registers__counters__clip_counters__0(clock,reset,adc
     output reg  [15:0] count;
 
     // Constant declarations
-    localparam signed top = 16'h7fff;
-    localparam signed bottom = 16'h8000;
+    localparam signed top = 8'h7f;
+    localparam signed bottom = 8'h80;
     localparam  full = 16'hffff;
 
     // Stub signals
@@ -14026,6 +14026,7 @@ module gyro_interface_axi__registers__counters__clip_counters__0(clock,reset,adc
     reg  counter$clock;
 
     // Local signals
+    reg signed [7:0] high;
     reg  at_rail;
 
     // Sub module instances
@@ -14039,7 +14040,8 @@ module gyro_interface_axi__registers__counters__clip_counters__0(clock,reset,adc
     always @(*) begin
         counter$clock = clock;
         counter$d = counter$q;
-        at_rail = (adc == top) | (adc == bottom);
+        high = adc[(32'h8)+:(8)];
+        at_rail = (high == top) | (high == bottom);
         count = counter$q;
         if (clear) begin
             counter$d = 32'h0;
@@ -14087,8 +14089,8 @@ module gyro_interface_axi__registers__counters__clip_counters__1(clock,reset,adc
     output reg  [15:0] count;
 
     // Constant declarations
-    localparam signed top = 16'h7fff;
-    localparam signed bottom = 16'h8000;
+    localparam signed top = 8'h7f;
+    localparam signed bottom = 8'h80;
     localparam  full = 16'hffff;
 
     // Stub signals
@@ -14097,6 +14099,7 @@ module gyro_interface_axi__registers__counters__clip_counters__1(clock,reset,adc
     reg  counter$clock;
 
     // Local signals
+    reg signed [7:0] high;
     reg  at_rail;
 
     // Sub module instances
@@ -14110,7 +14113,8 @@ module gyro_interface_axi__registers__counters__clip_counters__1(clock,reset,adc
     always @(*) begin
         counter$clock = clock;
         counter$d = counter$q;
-        at_rail = (adc == top) | (adc == bottom);
+        high = adc[(32'h8)+:(8)];
+        at_rail = (high == top) | (high == bottom);
         count = counter$q;
         if (clear) begin
             counter$d = 32'h0;

@@ -143,7 +143,7 @@
 #define GYRO_Z2_HI_BITS 8u
 #define GYRO_Z2_HI_MASK 0x000000ffu
 
-/* ADC_CLIP: read-only, 32 bits. Clocks on which ADC1 (bits 15..0) and ADC2 (bits 31..16) read a rail code, -32768 or +32767, since the last read of this word; each count saturates at 65535. A read returns the counts and restarts them (a rail code on the clock of the read counts toward the next read). Any count means a measurement over that time was not linear. */
+/* ADC_CLIP: read-only, 32 bits. Clocks on which ADC1 (bits 15..0) and ADC2 (bits 31..16) read a word within 1/128 of full scale (top byte 0x7f or 0x80: +32512..+32767 or -32768..-32513, which holds both rail codes of any left-justified converter of 8 to 16 bits) since the last read of this word; each count saturates at 65535. A read returns the counts and restarts them (a rail code on the clock of the read counts toward the next read). Any count means a measurement over that time was not linear. */
 #define GYRO_ADC_CLIP_OFFSET 0x5cu
 #define GYRO_ADC_CLIP_BITS 32u
 #define GYRO_ADC_CLIP_MASK 0xffffffffu

@@ -365,7 +365,7 @@ pub const ADC_CLIP: Register = Register {
         0x5c,
         32,
         false,
-        "Clocks on which ADC1 (bits 15..0) and ADC2 (bits 31..16) read a rail code, -32768 or +32767, since the last read of this word; each count saturates at 65535. A read returns the counts and restarts them (a rail code on the clock of the read counts toward the next read). Any count means a measurement over that time was not linear.",
+        "Clocks on which ADC1 (bits 15..0) and ADC2 (bits 31..16) read a word within 1/128 of full scale (top byte 0x7f or 0x80: +32512..+32767 or -32768..-32513, which holds both rail codes of any left-justified converter of 8 to 16 bits) since the last read of this word; each count saturates at 65535. A read returns the counts and restarts them (a rail code on the clock of the read counts toward the next read). Any count means a measurement over that time was not linear.",
     )
 };
 
@@ -618,7 +618,8 @@ const COHERENCE_NOTES: &str = r#"
   FIFO is full is dropped and counted in `STREAM_OVERFLOW`.
 - **Reset.** `aresetn` low (synchronous) returns every register above to its power-up
   value and empties the FIFO; the datapath core itself has no reset.
-- **Over range.** `ADC_CLIP` counts the clocks on which each ADC read a rail code; reading
+- **Over range.** `ADC_CLIP` counts the clocks on which each ADC read a word within 1/128
+  of full scale (the rail codes of any converter of 8 to 16 bits, left-justified); reading
   it restarts both counts. Read it before and after a measurement: a non-zero second read
   means the converter clipped during it.
 - **Power-up.** The core fills its carrier tables during its first clocks: the drives are

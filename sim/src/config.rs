@@ -54,6 +54,7 @@ use crate::noise::ThermalNoise;
 use crate::rate_drift::RateNoise;
 use gyrocal_hdl::cic_decimator::MAX_DECIMATION;
 use gyrocal_hdl::filter_design::{MAX_CUTOFF_RATIO, MIN_CUTOFF_RATIO, MIN_DECIMATION};
+use gyrocal_hdl::host::clip_counter::MIN_CONVERTER_BITS;
 use gyrocal_hdl::model::gyro_interface::CarrierProfile;
 use gyrocal_hdl::settings::{MAX_CAL_RATIO, MAX_REF_DELAY};
 use serde::{Deserialize, Serialize};
@@ -183,7 +184,8 @@ pub struct Frontend {
     pub adc_latency: u32,
     /// DAC resolution (bits), 1..=`MAX_CONVERTER_BITS`.
     pub dac_bits: u32,
-    /// ADC resolution (bits), 1..=`MAX_CONVERTER_BITS`.
+    /// ADC resolution (bits), `MIN_CONVERTER_BITS`..=`MAX_CONVERTER_BITS`
+    /// (`ADC_CLIP` sees the rails of no narrower converter).
     pub adc_bits: u32,
     /// Peak ADC input as a fraction of full scale, used to set the ADC gains
     /// from the theory when `adc_per_meter1/2` are not given.
@@ -592,14 +594,22 @@ impl Experiment {
                 format!("at most {MAX_REF_DELAY} clocks (the reference delay line)"),
             ));
         }
-        let bits = format!("allowed 1..={MAX_CONVERTER_BITS}");
-        for (key, v) in [("dac_bits", f.dac_bits), ("adc_bits", f.adc_bits)] {
+        // ADC_CLIP sees the rail codes of converters of MIN_CONVERTER_BITS
+        // and more only (`gyrocal_hdl::host::clip_counter`): a narrower
+        // ADC would clip high unseen.
+        let adc_why = format!(
+            " (ADC_CLIP sees the rails of converters of {MIN_CONVERTER_BITS} bits and more)"
+        );
+        for (key, v, least, why) in [
+            ("dac_bits", f.dac_bits, 1, ""),
+            ("adc_bits", f.adc_bits, MIN_CONVERTER_BITS, adc_why.as_str()),
+        ] {
             check(
                 "frontend",
                 key,
                 f64::from(v),
-                (1..=MAX_CONVERTER_BITS).contains(&v),
-                &bits,
+                (least..=MAX_CONVERTER_BITS).contains(&v),
+                &format!("allowed {least}..={MAX_CONVERTER_BITS}{why}"),
             )?;
         }
         let h = f.adc_headroom;
@@ -993,6 +1003,14 @@ mod tests {
             (
                 format!("{REQUIRED}[frontend]\nadc_per_meter1 = 1e9\n"),
                 "[frontend] adc_per_meter1 and adc_per_meter2",
+            ),
+            (
+                format!("{REQUIRED}[frontend]\nadc_bits = 7\n"),
+                "[frontend] adc_bits = 7: allowed 8..=16 (ADC_CLIP sees the rails of converters of 8 bits and more)",
+            ),
+            (
+                format!("{REQUIRED}[frontend]\ndac_bits = 0\n"),
+                "[frontend] dac_bits = 0: allowed 1..=16",
             ),
             (
                 REQUIRED.replace("q1 = 5000", "q1 = 5000\nquadrature_dps = 2e5"),

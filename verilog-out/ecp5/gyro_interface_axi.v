@@ -31706,8 +31706,8 @@ module gyro_interface_axi__registers__counters__clip_counters__0(clock,reset,adc
     output reg  [15:0] count;
 
     // Constant declarations
-    localparam signed top = 16'h7fff;
-    localparam signed bottom = 16'h8000;
+    localparam signed top = 8'h7f;
+    localparam signed bottom = 8'h80;
     localparam  full = 16'hffff;
 
     // Stub signals
@@ -31716,6 +31716,7 @@ module gyro_interface_axi__registers__counters__clip_counters__0(clock,reset,adc
     reg  counter$clock;
 
     // Local signals
+    reg signed [7:0] high;
     reg  at_rail;
 
     // Sub module instances
@@ -31729,7 +31730,8 @@ module gyro_interface_axi__registers__counters__clip_counters__0(clock,reset,adc
     always @(*) begin
         counter$clock = clock;
         counter$d = counter$q;
-        at_rail = (adc == top) | (adc == bottom);
+        high = adc[(32'h8)+:(8)];
+        at_rail = (high == top) | (high == bottom);
         count = counter$q;
         if (clear) begin
             counter$d = 32'h0;
@@ -31777,8 +31779,8 @@ module gyro_interface_axi__registers__counters__clip_counters__1(clock,reset,adc
     output reg  [15:0] count;
 
     // Constant declarations
-    localparam signed top = 16'h7fff;
-    localparam signed bottom = 16'h8000;
+    localparam signed top = 8'h7f;
+    localparam signed bottom = 8'h80;
     localparam  full = 16'hffff;
 
     // Stub signals
@@ -31787,6 +31789,7 @@ module gyro_interface_axi__registers__counters__clip_counters__1(clock,reset,adc
     reg  counter$clock;
 
     // Local signals
+    reg signed [7:0] high;
     reg  at_rail;
 
     // Sub module instances
@@ -31800,7 +31803,8 @@ module gyro_interface_axi__registers__counters__clip_counters__1(clock,reset,adc
     always @(*) begin
         counter$clock = clock;
         counter$d = counter$q;
-        at_rail = (adc == top) | (adc == bottom);
+        high = adc[(32'h8)+:(8)];
+        at_rail = (high == top) | (high == bottom);
         count = counter$q;
         if (clear) begin
             counter$d = 32'h0;

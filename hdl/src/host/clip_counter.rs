@@ -2,7 +2,8 @@
 //! `ADC_CLIP` status word.
 //!
 //! ```text
-//!  adc ──► at_rail = (adc == +32767) | (adc == -32768)
+//!  adc ──► high = adc[15:8]
+//!          at_rail = (high == 8'h7f) | (high == 8'h80)
 //!  count <= clear ? at_rail : (count == 65535 ? 65535 : count + at_rail)
 //! ```
 //!
@@ -10,9 +11,19 @@
 //! is the bus read of `ADC_CLIP`: the read returns `count` as it is during
 //! that clock, and a rail code sampled at the same edge starts the next
 //! count, so every clipped clock is reported by exactly one read (until the
-//! count saturates). A converter at a rail code is over range or exactly
-//! at full scale: either way the measurement it feeds is no longer linear.
-//! Cost: 16 flip-flops, a 16-bit incrementer and two 16-bit compares.
+//! count saturates).
+//!
+//! The ADC words are left-justified: a converter of b bits fills the top b
+//! bits and leaves the rest 0, so its positive rail is 32768 - 2^(16-b),
+//! +32767 only at 16 bits (+32752 at 12). A word counts as at a rail when
+//! it lies within 1/128 of full scale (`RAIL_HIGH_BYTES`: its top byte
+//! 0x7f or 0x80), which holds every rail code of every converter of
+//! `MIN_CONVERTER_BITS` (8) to 16 bits; a compare with +32767 never saw a
+//! 12-bit converter clip high. On a 16-bit converter the band is its last
+//! 256 codes: above the 0.95 of full scale the host plans its peaks at,
+//! and nearer the rail than any measurement stays linear to with
+//! certainty. Cost: 16 flip-flops, a 16-bit incrementer and two 8-bit
+//! compares.
 
 use rust_hdl::prelude::*;
 
@@ -20,6 +31,12 @@ use rust_hdl::prelude::*;
 pub const COUNT_BITS: usize = 16;
 /// The count saturates here.
 pub const COUNT_MAX: u64 = (1 << COUNT_BITS) - 1;
+/// The top bytes of a word at a rail (positive, negative): the words
+/// +32512..=+32767 and -32768..=-32513.
+pub const RAIL_HIGH_BYTES: [u8; 2] = [0x7f, 0x80];
+/// The narrowest converter whose rail codes all lie in that band: its
+/// positive rail, 32768 - 2^(16-8) = +32512, has the top byte 0x7f.
+pub const MIN_CONVERTER_BITS: u32 = 8;
 
 /// One ADC's clip counter.
 #[derive(LogicBlock)]
@@ -35,9 +52,11 @@ pub struct ClipCounter {
     /// Clipped clocks since the last clear (saturating).
     pub count: Signal<Out, Bits<COUNT_BITS>>,
     counter: DFF<Bits<COUNT_BITS>>,
-    top: Constant<Signed<16>>,
-    bottom: Constant<Signed<16>>,
+    top: Constant<Signed<8>>,
+    bottom: Constant<Signed<8>>,
     full: Constant<Bits<COUNT_BITS>>,
+    /// The word's top byte (a signed local: only compared for equality).
+    high: Signal<Local, Signed<8>>,
     at_rail: Signal<Local, Bit>,
 }
 
@@ -51,9 +70,10 @@ impl ClipCounter {
             clear: Default::default(),
             count: Default::default(),
             counter: Default::default(),
-            top: Constant::new(i64::from(i16::MAX).into()),
-            bottom: Constant::new(i64::from(i16::MIN).into()),
+            top: Constant::new(i64::from(RAIL_HIGH_BYTES[0] as i8).into()),
+            bottom: Constant::new(i64::from(RAIL_HIGH_BYTES[1] as i8).into()),
             full: Constant::new(COUNT_MAX.into()),
+            high: Default::default(),
             at_rail: Default::default(),
         }
     }
@@ -69,8 +89,9 @@ impl Logic for ClipCounter {
     #[hdl_gen]
     fn update(&mut self) {
         dff_setup!(self, clock, counter);
+        self.high.next = self.adc.val().get_bits::<8>(8);
         self.at_rail.next =
-            (self.adc.val() == self.top.val()) | (self.adc.val() == self.bottom.val());
+            (self.high.val() == self.top.val()) | (self.high.val() == self.bottom.val());
         self.count.next = self.counter.q.val();
         if self.clear.val() {
             self.counter.d.next = 0.into();
@@ -103,13 +124,20 @@ impl ClipCount {
     /// One edge with this clock's ADC word and read strobe.
     #[inline(always)]
     pub fn step(&mut self, adc: i16, clear: bool) {
-        let at_rail = u16::from(adc == i16::MAX || adc == i16::MIN);
+        let at_rail = u16::from(at_rail(adc));
         self.count = if clear {
             at_rail
         } else {
             self.count.saturating_add(at_rail)
         };
     }
+}
+
+/// Whether `adc` counts as at a rail (module header): its top byte is one
+/// of `RAIL_HIGH_BYTES`.
+#[inline(always)]
+pub fn at_rail(adc: i16) -> bool {
+    RAIL_HIGH_BYTES.contains(&((adc as u16 >> 8) as u8))
 }
 
 /// The `ADC_CLIP` word of two counts: ADC1 in bits 15..0, ADC2 in 31..16.
@@ -132,9 +160,10 @@ mod tests {
         let mut rng = crate::test_util::Rng::new(11);
         for cycle in 0..70_000u32 {
             let r = rng.next_u64();
+            // Rails, the band's edges and their neighbours, and any word.
+            let edges = [i16::MAX, i16::MIN, 32_512, 32_511, -32_513, -32_512, 32_752];
             let adc = match r % 4 {
-                0 => i16::MAX,
-                1 => i16::MIN,
+                0 | 1 => edges[(r >> 8) as usize % edges.len()],
                 _ => (r >> 8) as i16,
             };
             // Rare clears early on, none in the middle stretch: the count saturates.
@@ -153,6 +182,27 @@ mod tests {
         assert!(model.count() < u16::MAX, "cleared at the end");
     }
 
+    /// Both rail codes of every converter from `MIN_CONVERTER_BITS` to 16
+    /// bits are counted, and exactly the words within 1/128 of full
+    /// scale are.
+    #[test]
+    fn every_converters_rails_are_counted() {
+        for bits in MIN_CONVERTER_BITS..=16 {
+            let step = 1i32 << (16 - bits);
+            let rails = [32_768 - step, -32_768];
+            for rail in rails {
+                assert!(at_rail(rail as i16), "{bits}-bit rail {rail}");
+            }
+        }
+        let counted = (i16::MIN..=i16::MAX).filter(|&w| at_rail(w)).count();
+        assert_eq!(counted, 512);
+        assert!(at_rail(32_512) && !at_rail(32_511));
+        assert!(at_rail(-32_513) && !at_rail(-32_512));
+        // Narrower than that, the positive rail lies below the band.
+        let seven_bit_rail = 32_768 - (1i32 << (16 - (MIN_CONVERTER_BITS - 1)));
+        assert!(!at_rail(seven_bit_rail as i16));
+    }
+
     #[test]
     fn saturates_and_restarts_on_a_read() {
         let mut c = ClipCount::default();
@@ -162,7 +212,7 @@ mod tests {
         assert_eq!(c.count(), u16::MAX);
         c.step(i16::MAX, true);
         assert_eq!(c.count(), 1);
-        c.step(i16::MAX - 1, false);
+        c.step(32_511, false);
         assert_eq!(c.count(), 1);
     }
 }

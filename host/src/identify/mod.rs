@@ -100,7 +100,8 @@ pub const SETTLE_TAUS: f64 = 12.0;
 /// Fraction of ADC full scale the identification drives the peak to.
 pub const ADC_TARGET: f64 = 0.5;
 /// Above this fraction of full scale a response is taken as clipped even
-/// before the ADC_CLIP counts say so (the counts see rail codes only).
+/// before the ADC_CLIP counts say so (the counts see words within 1/128
+/// of full scale only).
 pub const ADC_NEAR_CLIP: f64 = 0.8;
 /// Carriers of the fine sweep (each measured going up and coming down).
 pub const FINE_POINTS: usize = 5;

@@ -90,14 +90,16 @@ impl<E: Engine> SimBoard<E> {
         self.cycle
     }
 
+    /// One clock; returns the ADC words the core read during it.
     #[inline(always)]
-    fn step(&mut self) {
+    fn step(&mut self) -> Words {
         let adc = self.analog.step(self.outputs.dac);
         self.clip[0].step(adc.0, false);
         self.clip[1].step(adc.1, false);
         self.outputs = self.engine.step(adc, self.host.registers());
         self.samples = self.samples.wrapping_add(self.outputs.z_valid as u32);
         self.cycle += 1;
+        adc
     }
 
     /// `step` `clocks` times, in the engine's blocks (`Engine::run`).
@@ -142,7 +144,9 @@ impl<E: Engine> Board for SimBoard<E> {
     fn next_sample(&mut self, after: u32) -> Result<ZSample, BusError> {
         while self.samples == after {
             match self.engine.quiet_clocks() {
-                0 => self.step(),
+                0 => {
+                    self.step();
+                }
                 quiet => self.run(quiet),
             }
         }
@@ -174,12 +178,16 @@ mod tests {
     use super::*;
     use crate::config::Experiment;
     use crate::field::scenario;
+    use gyrocal_hdl::host::clip_counter::at_rail;
 
     /// The paper's board in readout at 50 deg/s, ADC noise on, with a
     /// front-end phase lag (the path `run` takes through `PickoffPhase`)
     /// and ADC 1's gain 4 times too high, so that it clips.
     fn readout_board() -> SimBoard {
-        let exp = Experiment::paper();
+        readout_board_of(Experiment::paper())
+    }
+
+    fn readout_board_of(exp: Experiment) -> SimBoard {
         let (fe, knowns) = scenario::build(&exp).unwrap();
         let (regs, _) = knowns
             .registers(exp.drive.carrier_hz, None, knowns.amplitude, 0.0)
@@ -230,5 +238,36 @@ mod tests {
         let clip = blocked.read_register(ADC_CLIP.offset).unwrap();
         assert_ne!(clip, 0, "ADC 1 never clipped");
         assert_eq!(Ok(clip), stepped.read_register(ADC_CLIP.offset));
+    }
+
+    /// A 12-bit ADC driven past its range: ADC_CLIP counts the clocks at
+    /// both its rails, the positive one +32752 (left-justified; a compare
+    /// with +32767 counted none of them), and at its codes within 1/128
+    /// of full scale beside them, and no others.
+    #[test]
+    fn a_12_bit_adc_is_counted_at_both_rails() {
+        let mut exp = Experiment::paper();
+        exp.frontend.adc_bits = 12;
+        let mut board = readout_board_of(exp);
+        board.wait_clocks(100_000).unwrap();
+        board.read_register(ADC_CLIP.offset).unwrap();
+        let rails = [32_752i16, i16::MIN];
+        let (mut at, mut band) = ([0u32; 2], 0);
+        for _ in 0..20_000 {
+            let adc = board.step().0;
+            for (n, rail) in at.iter_mut().zip(rails) {
+                *n += u32::from(adc == rail);
+            }
+            band += u32::from(at_rail(adc));
+        }
+        assert!(at[0] > 100 && at[1] > 100, "rails reached {at:?} times");
+        let clip = board.read_register(ADC_CLIP.offset).unwrap();
+        assert_eq!(clip & 0xffff, band);
+        // The band beside the rails: 12-bit codes from +32512 up, and
+        // the negative rail's word alone.
+        assert!(
+            band > at[0] + at[1] && band < 2 * (at[0] + at[1]),
+            "{band} in the band"
+        );
     }
 }

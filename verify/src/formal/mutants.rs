@@ -6,9 +6,10 @@
 use super::Mutant;
 
 /// One mutant per `spec_*` property (`spec_r_data` has two: a wrong
-/// register and a register that reset does not restore; `spec_clip` two:
-/// a count a read does not restart, a rail code at the read lost).
-pub const MUTANTS: [Mutant; 26] = [
+/// register and a register that reset does not restore; `spec_clip`
+/// three: a count a read does not restart, a rail code at the read lost,
+/// a narrower converter's rail not seen).
+pub const MUTANTS: [Mutant; 27] = [
     Mutant {
         name: "reset_keeps_bvalid",
         what: "aresetn leaves BVALID as it was",
@@ -143,6 +144,14 @@ pub const MUTANTS: [Mutant; 26] = [
         module: Some("gyro_interface_axi__registers__counters__clip_counters__1"),
         find: "counter$d = 32'h1;",
         replace: "counter$d = 32'h0;",
+        property: "spec_clip",
+    },
+    Mutant {
+        name: "clip_full_scale_only",
+        what: "ADC1's count sees only the words -32768 and +32767: a 12-bit converter's positive rail (+32752) is not counted",
+        module: Some("gyro_interface_axi__registers__counters__clip_counters__0"),
+        find: "at_rail = (high == top) | (high == bottom);",
+        replace: "at_rail = (adc == 16'h7fff) | (adc == 16'h8000);",
         property: "spec_clip",
     },
     Mutant {
