@@ -214,3 +214,71 @@ fn a_profile_beyond_the_rate_table_is_said() {
         "{warned:?}"
     );
 }
+
+/// A profile that drives the sense ADC past its range (100,000 deg/s on a
+/// table of 50 and 100) is said in one line naming the step, the ADC and
+/// its records, in the summary and the JSON; those records and the
+/// settle_s after them are not settled, so the RMS errors leave them out,
+/// and the records before the step stay in.
+#[test]
+fn a_profile_that_clips_an_adc_is_said_and_left_out_of_the_rms() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("clips.toml");
+    let text = format!(
+        "{GOOD}[drift]\ntemperatures_c = [25]\ntcf1_ppm_per_k = -30\ntcf2_ppm_per_k = -30\n\
+         [profile]\nduration_s = 0.6\nrate_points = [[0, 0], [0.2, 0], [0.2, 100000], [0.6, 100000]]\n\
+         settle_s = 0.05\n"
+    );
+    std::fs::write(&config, text).unwrap();
+    let line = "warning: an ADC clipped under [profile] at 25 deg C (ADC 2 in ";
+    let run = gyrocal(&[
+        OsStr::new("field"),
+        OsStr::new("--config"),
+        config.as_os_str(),
+        OsStr::new("--json"),
+    ]);
+    assert!(run.status.success(), "{}", common::stderr(&run));
+    let report: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+    let warned = report["warnings"].as_array().unwrap();
+    assert_eq!(
+        warned
+            .iter()
+            .filter(|w| w.as_str().unwrap().starts_with(line))
+            .count(),
+        1,
+        "{warned:?}"
+    );
+    let trace = &report["steps"][0]["profile"];
+    let clipped = &trace["clipped"];
+    let records = clipped["records"].as_u64().unwrap() as usize;
+    let adc2 = clipped["selfcal"][1].as_u64().unwrap() as usize;
+    // After the step at 0.2 s every record of the 0.4 s clips: two thirds.
+    assert!(3 * adc2 >= 2 * records - 6 && adc2 <= records, "{clipped}");
+    let per_record = trace["clip_clocks"].as_array().unwrap();
+    assert_eq!(per_record.len(), records);
+    let counted = per_record
+        .iter()
+        .filter(|c| c[1].as_u64().unwrap() > 0)
+        .count();
+    assert_eq!(counted, adc2);
+    let settled: Vec<bool> = trace["settled"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|b| b.as_bool().unwrap())
+        .collect();
+    let time: Vec<f64> = trace["time_s"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t.as_f64().unwrap())
+        .collect();
+    // settle_s after the points at 0 and 0.2 s, then clipped to the end.
+    for (t, s) in time.iter().zip(&settled) {
+        if *t > 0.2 || (0.06..0.19).contains(t) {
+            assert_eq!(*s, *t < 0.2, "record at {t} s: settled {s}");
+        }
+    }
+    let rms = trace["selfcal_rms_error_dps"][1].as_f64().unwrap();
+    assert!(rms < 1.0, "the records at rest alone: {rms} deg/s RMS");
+}

@@ -20,7 +20,21 @@ pub fn readout_null(
     window_z(board, decimation, f64::from(decimation), length)
 }
 
-/// `records` record means of `per_record` successive z samples each.
+/// One record of the rate output: the mean z and what the converters did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Record {
+    /// Mean of the record's z samples (z LSB, both outputs).
+    pub z: [f64; 2],
+    /// Clocks on which ADC 1 and ADC 2 clipped from the end of the record
+    /// before (from the start, for the first) to this record's last
+    /// sample (`crate::clip`): a clipped record's z holds the converter's
+    /// rail, not the rate, and so does the output for the filter's
+    /// settling after it.
+    pub clip_clocks: [u32; 2],
+}
+
+/// `records` records of `per_record` successive z samples each, with the
+/// ADC clip counts over each (one `ADC_CLIP` read per record).
 /// `before(board, i)` runs before sample i is waited for: the simulator's
 /// rate table turns its device there; on a real board it does nothing.
 pub fn read_records<B: Board + ?Sized>(
@@ -28,8 +42,9 @@ pub fn read_records<B: Board + ?Sized>(
     per_record: usize,
     records: usize,
     mut before: impl FnMut(&mut B, usize),
-) -> Result<Vec<[f64; 2]>, Error> {
+) -> Result<Vec<Record>, Error> {
     let mut last = board.read_z()?.count;
+    crate::clip::restart(board)?;
     let mut out = Vec::with_capacity(records);
     let mut sample = 0;
     for _ in 0..records {
@@ -41,7 +56,10 @@ pub fn read_records<B: Board + ?Sized>(
             batch.push(s);
             sample += 1;
         }
-        out.push(mean(&batch));
+        out.push(Record {
+            z: mean(&batch),
+            clip_clocks: crate::clip::counts(board)?,
+        });
     }
     Ok(out)
 }

@@ -150,13 +150,15 @@ pub fn csv(report: &FieldReport) -> String {
 /// The rate output under the profile, one row per record and step:
 /// scenario time (steps end to end), the step's temperature, the time in
 /// the profile, the applied rate, the self-calibrated and baseline rates
-/// and their errors (deg/s). `None` without a profile.
+/// and their errors (deg/s), whether the record is settled, and the
+/// clocks on which ADC 1 and ADC 2 clipped during it (self-calibrated
+/// run). `None` without a profile.
 pub fn rate_csv(report: &FieldReport) -> Option<String> {
     let duration = report.profile.as_ref()?.duration_s;
     let mut s = String::from(
         "scenario_time_s,temperature_c,time_s,true_rate_dps,selfcal_rate1_dps,selfcal_rate2_dps,\
          baseline_rate1_dps,baseline_rate2_dps,selfcal_error1_dps,selfcal_error2_dps,\
-         baseline_error1_dps,baseline_error2_dps,settled\n",
+         baseline_error1_dps,baseline_error2_dps,settled,adc1_clip_clocks,adc2_clip_clocks\n",
     );
     for (i, st) in report.steps.iter().enumerate() {
         let tr = st.profile.as_ref()?;
@@ -180,6 +182,8 @@ pub fn rate_csv(report: &FieldReport) -> Option<String> {
                 bl[0] - truth,
                 bl[1] - truth,
                 f64::from(u8::from(tr.settled[j])),
+                f64::from(tr.clip_clocks[j][0]),
+                f64::from(tr.clip_clocks[j][1]),
             ];
             let row: Vec<String> = values.iter().map(|v| format!("{v:e}")).collect();
             s.push_str(&row.join(","));

@@ -77,7 +77,7 @@ pub fn staircase(
             periods as usize,
             Signal::Periodic,
         )?);
-        clip::check(board, "calibration staircase")?;
+        clip::check(board, "calibration staircase", clip::CYCLE_DETAIL)?;
         clocks += settle + length as u64 + 2 * u64::from(r);
         cal_hz.push(real.cal_hz);
     }

@@ -22,7 +22,10 @@
 //! `settle_s` (default 0) before it or inside it: the RMS errors are over
 //! the settled records, so that the output's own step response (its
 //! bandwidth, not its calibration) does not swamp them; the time series
-//! keeps every record.
+//! keeps every record. Nor is a record settled when an ADC clipped during
+//! it or during the `settle_s` before it (`ADC_CLIP`, read once a record):
+//! its z holds the converter's rail, not the rate. The report says so in
+//! one line ([`ProfileRun::clipped`]).
 //!
 //! ```toml
 //! [profile]
@@ -210,9 +213,46 @@ pub struct ProfileRun {
     pub z: Vec<[f64; 2]>,
     /// Whether each record is settled (module header).
     pub settled: Vec<bool>,
+    /// Clocks on which ADC 1 and ADC 2 clipped, per record
+    /// (`gyrocal_host::rate::Record`).
+    pub clip_clocks: Vec<[u32; 2]>,
     /// Clocks it took.
     #[serde(skip)]
     pub clocks: u64,
+}
+
+impl ProfileRun {
+    /// Records during which an ADC clipped: (per ADC, how many; the
+    /// largest |applied rate| among them, deg/s), or None when none did.
+    pub fn clipped(&self) -> Option<([usize; 2], f64)> {
+        let records: [usize; 2] =
+            std::array::from_fn(|k| self.clip_clocks.iter().filter(|c| c[k] > 0).count());
+        let peak = self
+            .clip_clocks
+            .iter()
+            .zip(&self.true_rate_dps)
+            .filter(|(c, _)| c.iter().any(|&n| n > 0))
+            .map(|(_, r)| r.abs())
+            .fold(0.0, f64::max);
+        (records != [0, 0]).then_some((records, peak))
+    }
+}
+
+/// Whether each record is settled: no point of `profile` within settle_s
+/// before it or inside it, and no record whose ADCs clipped (`clip`) ending
+/// within settle_s before it or being it. `record_s` is a record's length.
+fn settled_records(profile: &Profile, clip: &[[u32; 2]], record_s: f64) -> Vec<bool> {
+    let mut last_clip_end: Option<f64> = None;
+    (0..clip.len())
+        .map(|i| {
+            let (t0, t1) = (i as f64 * record_s, (i + 1) as f64 * record_s);
+            if clip[i].iter().any(|&n| n > 0) {
+                last_clip_end = Some(t1);
+            }
+            let after_clip = last_clip_end.is_some_and(|end| end > t0 - profile.settle_s);
+            profile.is_settled(t0, t1) && !after_clip
+        })
+        .collect()
 }
 
 /// Apply `profile` through the rate table of `board` (already programmed
@@ -230,7 +270,7 @@ pub fn run_profile(
     let records = ((profile.duration_s / (per_record as f64 * sample_s)).floor() as usize).max(1);
     let start = board.cycle();
     let mut applied = Vec::with_capacity(records * per_record);
-    let z = gyrocal_host::rate::read_records(board, per_record, records, |b, sample| {
+    let read = gyrocal_host::rate::read_records(board, per_record, records, |b, sample| {
         let rate = profile.rate_dps_at((sample as f64 + 0.5) * sample_s);
         b.set_rate(rate.to_radians());
         applied.push(rate);
@@ -240,19 +280,16 @@ pub fn run_profile(
     let time_s: Vec<f64> = (0..records)
         .map(|i| (i as f64 + 0.5) * n * sample_s)
         .collect();
+    let clip_clocks: Vec<[u32; 2]> = read.iter().map(|r| r.clip_clocks).collect();
     Ok(ProfileRun {
         true_rate_dps: applied
             .chunks(per_record)
             .map(|c| c.iter().sum::<f64>() / n)
             .collect(),
-        settled: (0..records)
-            .map(|i| {
-                let t_first = i as f64 * n * sample_s;
-                profile.is_settled(t_first, t_first + n * sample_s)
-            })
-            .collect(),
+        settled: settled_records(profile, &clip_clocks, n * sample_s),
         time_s,
-        z,
+        z: read.iter().map(|r| r.z).collect(),
+        clip_clocks,
         clocks: board.cycle() - start,
     })
 }
@@ -288,11 +325,74 @@ pub struct RateTrace {
     /// RMS of baseline_rate - true_rate over the settled records (deg/s);
     /// null without a baseline.
     pub baseline_rms_error_dps: Option<[f64; 2]>,
+    /// The records during which an ADC clipped, if any did: left out of
+    /// the RMS errors with the settle_s after them (module header).
+    pub clipped: Option<ClippedRecords>,
+    /// Clocks on which ADC 1 and ADC 2 clipped during each record of the
+    /// self-calibrated run.
+    pub clip_clocks: Vec<[u32; 2]>,
     /// On the table core, the bound on the rate's RMS ripple from the
     /// carrier's spurs (`gyrocal_host::selfcal::spurs`) over these
     /// records (each line through its record's average): against
     /// `selfcal_rms_error_dps`, how much of it the carrier tables can be.
     pub spur_bound_dps: Option<[f64; 2]>,
+}
+
+/// The records of a step's profile runs during which an ADC clipped.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct ClippedRecords {
+    /// Records in a run.
+    pub records: usize,
+    /// Clipped records of the self-calibrated run, per ADC.
+    pub selfcal: [usize; 2],
+    /// Clipped records of the baseline's run at the factory's settings,
+    /// per ADC; null where that run is the self-calibrated one or absent.
+    pub baseline: Option<[usize; 2]>,
+    /// Largest |applied rate| over the clipped records of either run (deg/s).
+    pub peak_rate_dps: f64,
+}
+
+impl ClippedRecords {
+    /// Of the self-calibrated run and the baseline's (None where it is
+    /// the same run); None when no ADC clipped in either.
+    pub fn of(run: &ProfileRun, baseline: Option<&ProfileRun>) -> Option<Self> {
+        let own = run.clipped();
+        let base = baseline.and_then(ProfileRun::clipped);
+        if own.is_none() && base.is_none() {
+            return None;
+        }
+        Some(Self {
+            records: run.z.len(),
+            selfcal: own.map_or([0; 2], |c| c.0),
+            baseline: baseline.map(|_| base.map_or([0; 2], |c| c.0)),
+            peak_rate_dps: own.map_or(0.0, |c| c.1).max(base.map_or(0.0, |c| c.1)),
+        })
+    }
+
+    /// `at 25 deg C (ADC 2 in 40 of 150 records (baseline run: 40); the
+    /// profile there up to 100000 deg/s)`: a step's part of the report's
+    /// line.
+    pub fn describe(&self, temperature_c: f64) -> String {
+        let adcs: Vec<String> = (0..2)
+            .filter(|&k| self.selfcal[k] > 0 || self.baseline.is_some_and(|b| b[k] > 0))
+            .map(|k| {
+                let base = self
+                    .baseline
+                    .map_or(String::new(), |b| format!(" (baseline run: {})", b[k]));
+                format!(
+                    "ADC {} in {} of {} records{base}",
+                    k + 1,
+                    self.selfcal[k],
+                    self.records
+                )
+            })
+            .collect();
+        format!(
+            "at {temperature_c} deg C ({}; the profile there up to {} deg/s)",
+            adcs.join(", "),
+            self.peak_rate_dps
+        )
+    }
 }
 
 #[cfg(test)]
@@ -395,6 +495,47 @@ mod tests {
         assert_eq!(rms[0], 0.0);
         assert!((rms[1] - 5.0f64.hypot(5.0) / 2f64.sqrt()).abs() < 1e-12);
         assert_eq!(rms_error(&rate, &[5.0, 15.0], &[false, true])[1], 5.0);
+    }
+
+    #[test]
+    fn records_that_clipped_and_the_settling_after_them_are_not_settled() {
+        let p = profile("duration_s = 1\nrate_points = [[0, 0]]\nsettle_s = 0.025\n").unwrap();
+        let mut clip = vec![[0u32; 2]; 10];
+        clip[3] = [0, 7];
+        clip[4] = [1, 0];
+        let settled = settled_records(&p, &clip, 0.01);
+        // Records 0 to 2 start within 25 ms of the point at 0 s; 3 and 4
+        // clipped; 5 to 7 start within 25 ms of 4's end at 50 ms, 8 starts
+        // 30 ms after it.
+        let expected = [
+            false, false, false, false, false, false, false, false, true, true,
+        ];
+        assert_eq!(settled, expected);
+        let run = ProfileRun {
+            time_s: (0..10).map(|i| (f64::from(i) + 0.5) * 0.01).collect(),
+            true_rate_dps: (0..10).map(|i| 10.0 * f64::from(i) - 45.0).collect(),
+            z: vec![[0.0; 2]; 10],
+            settled,
+            clip_clocks: clip,
+            clocks: 0,
+        };
+        assert_eq!(run.clipped(), Some(([1, 1], 15.0)));
+        let c = ClippedRecords::of(&run, None).unwrap();
+        assert_eq!(
+            c.describe(25.0),
+            "at 25 deg C (ADC 1 in 1 of 10 records, ADC 2 in 1 of 10 records; the profile there up to 15 deg/s)"
+        );
+        let quiet = ProfileRun {
+            clip_clocks: vec![[0; 2]; 10],
+            ..run.clone()
+        };
+        assert_eq!(quiet.clipped(), None);
+        assert_eq!(ClippedRecords::of(&quiet, Some(&quiet)), None);
+        let c = ClippedRecords::of(&quiet, Some(&run)).unwrap();
+        assert_eq!(
+            c.describe(5.0),
+            "at 5 deg C (ADC 1 in 0 of 10 records (baseline run: 1), ADC 2 in 0 of 10 records (baseline run: 1); the profile there up to 15 deg/s)"
+        );
     }
 
     #[test]

@@ -28,7 +28,7 @@
 
 use super::board::{Board, SimBoard};
 use super::probe::DriveProbe;
-use super::profile::{self, Profile, ProfileRun, RateTrace};
+use super::profile::{self, ClippedRecords, Profile, ProfileRun, RateTrace};
 use crate::config::{self, Experiment};
 use crate::config::{Drive, Filter, Frontend, Points};
 use crate::drift::{DeviceAt, Drift};
@@ -42,11 +42,11 @@ use crate::noise::ThermalNoise;
 use crate::sweep::spread::Spread;
 use gyrocal_host::Knowns;
 use gyrocal_host::datasheet::Datasheet;
-use gyrocal_host::drive_ratio;
 use gyrocal_host::identify::{CouplingFigure, Estimate};
 use gyrocal_host::sampling::{Signal, mean_of_parts, part_means};
 use gyrocal_host::selfcal::StaticFold;
 use gyrocal_host::selfcal::{self, Operating, SelfCal};
+use gyrocal_host::{clip, drive_ratio};
 use gyrocal_regs::plan::{FOLD_CLEAR_CORNERS, nearest_fold};
 use rayon::prelude::*;
 use serde::Deserialize;
@@ -422,6 +422,25 @@ pub fn design_ratio_warning(steps: &[FieldStep], knowns: &Knowns) -> Option<Stri
     })
 }
 
+/// The steps whose profile runs clipped an ADC (`RateTrace::clipped`):
+/// one line naming them, where the profile went and what became of those
+/// records, or None.
+pub fn profile_clip_warning(steps: &[FieldStep]) -> Option<String> {
+    let parts: Vec<String> = steps
+        .iter()
+        .filter_map(|st| {
+            let clipped = st.profile.as_ref()?.clipped?;
+            Some(clipped.describe(st.temperature_c))
+        })
+        .collect();
+    (!parts.is_empty()).then(|| {
+        format!(
+            "warning: an ADC clipped under [profile] {}: a clipped record's z holds the converter's rail, not the rate, so it and the settle_s after it are left out of the RMS errors (their `settled` is false)",
+            parts.join("; ")
+        )
+    })
+}
+
 /// What a host programmed for `exp` would know: its `[datasheet]` over its
 /// `[gyro]` (the keys the datasheet leaves out), its drive, latencies,
 /// filter and points. The filter and first window are derived from the
@@ -541,6 +560,8 @@ fn table_point(
     let r = knowns.filter.decimation;
     let w = TABLE_WINDOWS;
     let length = (w as f64 * knowns.filter.min_window_s * knowns.clock_hz).ceil();
+    // The table's truth is a slope: a clipped window would bend it unseen.
+    clip::restart(&mut board)?;
     let parts = part_means(
         &mut board,
         r,
@@ -549,6 +570,10 @@ fn table_point(
         TABLE_PARTS * w,
         Signal::Steady,
     )?;
+    let detail = format!(
+        "at {rate_dps} deg/s; the cycle scaled its drives to keep the predicted peaks at every rate of [experiment] readout_rates_dps within range, and the device answers more than predicted (lower the largest rate, or check [datasheet] angular_gain)"
+    );
+    clip::check(&mut board, "rate table", &detail)?;
     Ok((parts, board.cycle()))
 }
 
@@ -869,7 +894,13 @@ pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldRepor
     if factory.is_none() && !steps.is_empty() {
         progress("no factory calibration (the first step failed): no step has a baseline");
     }
-    if let Some(w) = design_ratio_warning(&steps, &knowns) {
+    for w in [
+        design_ratio_warning(&steps, &knowns),
+        profile_clip_warning(&steps),
+    ]
+    .into_iter()
+    .flatten()
+    {
         progress(&w);
         warnings.push(w);
     }
@@ -950,6 +981,8 @@ fn field_step(c: Cycle, baseline: Option<Baseline>, knowns: &Knowns) -> FieldSte
                 &run.settled,
             ),
             baseline_rms_error_dps: base.as_ref().map(|b| b.1),
+            clipped: ClippedRecords::of(run, baseline.as_ref().and_then(|b| b.run)),
+            clip_clocks: run.clip_clocks.clone(),
             settled: run.settled.clone(),
             time_s: run.time_s.clone(),
             true_rate_dps: run.true_rate_dps.clone(),
@@ -1063,6 +1096,31 @@ mod tests {
         let f = CarrierFold::of(&operating_at(9638553.9975, &paper), &paper);
         assert!(f.in_passband && f.static_fold.is_none(), "{f:?}");
         assert!(f.clause().expect("a clause").contains("may ripple"));
+    }
+
+    /// A rate table whose window clips an ADC is an error naming the
+    /// table, the ADC and the rate, never a slope: the consumer device at
+    /// its configured (unscaled) drives clips ADC 2 at 100,000 deg/s, and
+    /// at 100 deg/s does not.
+    #[test]
+    fn a_rate_table_that_clips_is_refused_at_its_rate() {
+        let text = include_str!("../../../tests/data/field_consumer.toml");
+        let sc = parse("field_consumer.toml", text).expect("the consumer scenario parses");
+        let (fe, mut k) = build(&sc.exp).expect("the board and knowns");
+        let at = sc.drift.at(&sc.exp.gyro, 25.0);
+        let op = operating_at(sc.exp.drive.carrier_hz, &k);
+        k.rates_dps = vec![50.0, 100.0];
+        let (table, _) = rate_table(&sc.exp, &fe, &at, &k, &op).expect("within range");
+        assert!(table.sf_per_dps.iter().all(|s| s.is_finite() && *s != 0.0));
+        k.rates_dps = vec![50.0, 100_000.0];
+        let e = rate_table(&sc.exp, &fe, &at, &k, &op)
+            .expect_err("clipped")
+            .to_string();
+        assert!(
+            e.starts_with("rate table: ADC 2 clipped on ") && e.contains("(at 100000 deg/s;"),
+            "{e}"
+        );
+        assert!(!e.contains('\n'), "{e}");
     }
 
     /// The scenario's warnings with the host's knowns.
