@@ -71,31 +71,68 @@ fn named<T: std::fmt::Display>(items: &[T]) -> String {
 
 /// Each distinct warning of `parts` (index, the warnings of its field run)
 /// once, in the order first met, as one line: how many of the `total`
-/// parts carry it, and which.
+/// parts carry it, and which. Lines that differ only in the figures
+/// inside their parentheses (a part's own counts, as the profile's clip
+/// line gives them) are one warning, told in the first part's words and
+/// saying so; figures outside them (the temperatures a line names) keep
+/// lines apart.
 pub fn carried_warnings<'a>(
     parts: impl IntoIterator<Item = (u32, &'a [String])>,
     total: usize,
 ) -> Vec<String> {
-    let mut distinct: Vec<(&str, Vec<u32>)> = vec![];
+    // (key, the first part's text, whether another part's text differs, parts)
+    let mut distinct: Vec<(String, &str, bool, Vec<u32>)> = vec![];
     for (index, lines) in parts {
         for line in lines {
             let text = line.strip_prefix("warning: ").unwrap_or(line);
-            match distinct.iter_mut().find(|(t, _)| *t == text) {
-                Some((_, parts)) => parts.push(index),
-                None => distinct.push((text, vec![index])),
+            let key = figures_in_parentheses_blanked(text);
+            match distinct.iter_mut().find(|(k, ..)| *k == key) {
+                Some((_, first, differs, parts)) => {
+                    *differs |= *first != text;
+                    parts.push(index);
+                }
+                None => distinct.push((key, text, false, vec![index])),
             }
         }
     }
     distinct
         .into_iter()
-        .map(|(text, parts)| {
+        .map(|(_, text, differs, parts)| {
+            let words = if differs {
+                format!(", in device {}'s figures", parts[0])
+            } else {
+                String::new()
+            };
             format!(
-                "warning: {} of {total} parts (device {}): {text}",
+                "warning: {} of {total} parts (device {}){words}: {text}",
                 parts.len(),
                 named(&parts)
             )
         })
         .collect()
+}
+
+/// `text` with every run of digits (and the points between them) inside
+/// parentheses replaced by `#`.
+fn figures_in_parentheses_blanked(text: &str) -> String {
+    let mut depth = 0usize;
+    let mut out = String::with_capacity(text.len());
+    let mut in_figure = false;
+    for c in text.chars() {
+        match c {
+            '(' => depth += 1,
+            ')' => depth = depth.saturating_sub(1),
+            _ => {}
+        }
+        let figure = depth > 0 && (c.is_ascii_digit() || (in_figure && c == '.'));
+        if !figure {
+            out.push(c);
+        } else if !in_figure {
+            out.push('#');
+        }
+        in_figure = figure;
+    }
+    out
 }
 
 /// An error and its sigma: which part, step and output.
@@ -250,6 +287,33 @@ mod tests {
             ]
         );
         assert!(carried_warnings(std::iter::empty(), 3).is_empty());
+    }
+
+    #[test]
+    fn lines_that_differ_in_their_parenthesized_figures_are_one_warning() {
+        let clip = |n: u32| {
+            format!(
+                "warning: an ADC clipped at 25 deg C (ADC 2 in {n} of 96 records; up to 1e5 deg/s): left out"
+            )
+        };
+        let parts: Vec<(u32, Vec<String>)> = vec![
+            (3, vec![clip(64)]),
+            (4, vec![clip(64)]),
+            (7, vec![clip(12)]),
+            (8, vec!["warning: an ADC clipped at 5 deg C (ADC 2 in 9 of 96 records; up to 1e5 deg/s): left out".into()]),
+        ];
+        let lines = carried_warnings(parts.iter().map(|(i, w)| (*i, w.as_slice())), 9);
+        assert_eq!(
+            lines,
+            [
+                "warning: 3 of 9 parts (device 3, 4, 7), in device 3's figures: an ADC clipped at 25 deg C (ADC 2 in 64 of 96 records; up to 1e5 deg/s): left out",
+                "warning: 1 of 9 parts (device 8): an ADC clipped at 5 deg C (ADC 2 in 9 of 96 records; up to 1e5 deg/s): left out",
+            ]
+        );
+        assert_eq!(
+            figures_in_parentheses_blanked("at 2.5 K (x 1.25 of 3, [a] 7)."),
+            "at 2.5 K (x # of #, [a] #)."
+        );
     }
 
     /// A finished part with one step at 5 deg C: errors `t` times a sigma
