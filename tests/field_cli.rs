@@ -282,3 +282,43 @@ fn a_profile_that_clips_an_adc_is_said_and_left_out_of_the_rms() {
     let rms = trace["selfcal_rms_error_dps"][1].as_f64().unwrap();
     assert!(rms < 1.0, "the records at rest alone: {rms} deg/s RMS");
 }
+
+/// A device whose factory settings clip ADC 1 in the rate table at 35 deg C
+/// (mode 1 drifted nearer the factory's carrier): the step's own cycle
+/// stands, its baseline fields are null, nothing is counted as a failure,
+/// and one line says what an uncalibrated part does there. Before
+/// `ADC_CLIP` watched the table, the 35 deg C baseline error was a slope
+/// of a clipped converter's readings, reported as a figure.
+#[test]
+fn factory_settings_that_clip_are_said_and_leave_the_baseline_null() {
+    let run = gyrocal(&[
+        OsStr::new("field"),
+        OsStr::new("--config"),
+        OsStr::new("tests/data/field_factory_clips.toml"),
+        OsStr::new("--json"),
+    ]);
+    assert!(run.status.success(), "{}", common::stderr(&run));
+    let report: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+    assert_eq!(
+        report["failed"].as_array().unwrap().len(),
+        0,
+        "{}",
+        report["failed"]
+    );
+    let steps = report["steps"].as_array().unwrap();
+    assert_eq!(steps.len(), 2);
+    assert!(steps[0]["baseline_error"].is_array());
+    assert!(steps[1]["baseline_error"].is_null());
+    assert!(steps[1]["selfcal_error"][0].as_f64().unwrap().abs() < 0.01);
+    let line =
+        "warning: the factory's settings clip an ADC at 35 deg C (rate table: ADC 1 clipped on ";
+    let warned = report["warnings"].as_array().unwrap();
+    assert_eq!(
+        warned
+            .iter()
+            .filter(|w| w.as_str().unwrap().starts_with(line))
+            .count(),
+        1,
+        "{warned:?}"
+    );
+}

@@ -544,16 +544,29 @@ pub const TABLE_PARTS: usize = 8;
 /// 60% more clocks for no change in coverage.
 pub const TABLE_WINDOWS: usize = 2;
 
+/// Whose settings a rate-table point runs at, which decides what its
+/// clipping means.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum TableAt {
+    /// The step's own cycle's: its drives were scaled to the predicted
+    /// peaks, so a clip means the device answers more than predicted.
+    Cycle,
+    /// The factory's, on the device drifted to the step: a part left
+    /// uncalibrated clips there (`FieldReport::warnings` says so).
+    Factory,
+}
+
 /// One point of the rate table: readout at `op` on a fresh board (from
 /// power-up, as `experiment` runs its points), settled and averaged over
 /// the first window in `TABLE_PARTS` equal parts; returns the parts' z
-/// (z LSB; their mean is the window's) and the clocks.
+/// (z LSB; their mean is the window's) and the clocks. A window during
+/// which an ADC clipped is an error, never a slope.
 fn table_point(
     exp: &Experiment,
     fe: &FrontEnd,
     at: &DeviceAt,
     knowns: &Knowns,
-    op: &Operating,
+    (op, whose): (&Operating, TableAt),
     rate_dps: f64,
 ) -> Result<(Vec<[f64; 2]>, u64), FieldError> {
     let mut board = settled_readout_board(exp, fe, at, knowns, op, rate_dps)?;
@@ -570,9 +583,14 @@ fn table_point(
         TABLE_PARTS * w,
         Signal::Steady,
     )?;
-    let detail = format!(
-        "at {rate_dps} deg/s; the cycle scaled its drives to keep the predicted peaks at every rate of [experiment] readout_rates_dps within range, and the device answers more than predicted (lower the largest rate, or check [datasheet] angular_gain)"
-    );
+    let detail = match whose {
+        TableAt::Cycle => format!(
+            "at {rate_dps} deg/s; the cycle scaled its drives to keep the predicted peaks at every rate of [experiment] readout_rates_dps within range, and the device answers more than predicted (lower the largest rate, or check [datasheet] angular_gain)"
+        ),
+        TableAt::Factory => format!(
+            "at {rate_dps} deg/s, at the factory's carrier and drives on the device as it drifted here"
+        ),
+    };
     clip::check(&mut board, "rate table", &detail)?;
     Ok((parts, board.cycle()))
 }
@@ -646,7 +664,7 @@ pub fn rate_table(
     let points: Vec<(Vec<[f64; 2]>, u64)> = knowns
         .rates_dps
         .par_iter()
-        .map(|&rate| table_point(exp, fe, at, knowns, op, rate))
+        .map(|&rate| table_point(exp, fe, at, knowns, (op, TableAt::Cycle), rate))
         .collect::<Result<_, FieldError>>()?;
     let parts: Vec<Vec<[f64; 2]>> = points.iter().map(|p| p.0.clone()).collect();
     let clocks = points.iter().map(|p| p.1).sum();
@@ -807,7 +825,8 @@ fn run_jobs(
             let at = &cycles[job.step()].as_ref().map_err(Clone::clone)?.at;
             match *job {
                 Job::Factory { rate, .. } => {
-                    let (parts, n) = table_point(exp, fe, at, knowns, factory, rates[rate])?;
+                    let whose = (factory, TableAt::Factory);
+                    let (parts, n) = table_point(exp, fe, at, knowns, whose, rates[rate])?;
                     Ok((Done::Point(mean_of_parts(&parts)), n))
                 }
                 Job::BaselineProfile { .. } => {
@@ -861,6 +880,7 @@ pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldRepor
         None => (vec![], vec![]),
     };
     let mut failed = vec![];
+    let mut baseline_clips = vec![];
     let job_clocks: u64 = done.iter().flatten().map(|d| d.1).sum();
     let mut steps = vec![];
     for (i, c) in cycles.into_iter().enumerate() {
@@ -878,12 +898,17 @@ pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldRepor
         };
         let baseline = factory.as_ref().and_then(|f| {
             baseline_of(i, &c, f, &jobs, &done, rates)
-                .map_err(|error| {
-                    failed.push(StepFailure {
+                .map_err(|error| match error {
+                    // What a part left uncalibrated does here: a finding,
+                    // said in a line, not a failure of the run.
+                    FieldError::Host(gyrocal_host::Error::Clipped { .. }) => {
+                        baseline_clips.push(format!("at {t} deg C ({error})"));
+                    }
+                    _ => failed.push(StepFailure {
                         temperature_c: t,
                         stage: FAILED_BASELINE,
                         error: error.to_string(),
-                    })
+                    }),
                 })
                 .ok()
         });
@@ -894,9 +919,16 @@ pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldRepor
     if factory.is_none() && !steps.is_empty() {
         progress("no factory calibration (the first step failed): no step has a baseline");
     }
+    let baseline_clip_warning = (!baseline_clips.is_empty()).then(|| {
+        format!(
+            "warning: the factory's settings clip an ADC {}: a part left uncalibrated reads the converter's rail there, so those steps' baseline fields are null",
+            baseline_clips.join("; ")
+        )
+    });
     for w in [
         design_ratio_warning(&steps, &knowns),
         profile_clip_warning(&steps),
+        baseline_clip_warning,
     ]
     .into_iter()
     .flatten()
