@@ -10,6 +10,28 @@ const GOOD: &str = "[gyro]\nf1_hz = 25.1e3\nf2_hz = 25.8e3\nq1 = 3000\nq2 = 3000
 [drive]\ncarrier_hz = 25.1e3\nclock_hz = 1.2345e6\n\
 [experiment]\nreadout_rates_dps = [50, 100]\ncal_freqs_hz = [2, 4]\n";
 
+/// `gyrocal field --config CONFIG --json`, which must succeed: its report.
+fn field_json(config: &OsStr) -> serde_json::Value {
+    let run = gyrocal(&[
+        OsStr::new("field"),
+        OsStr::new("--config"),
+        config,
+        OsStr::new("--json"),
+    ]);
+    assert!(run.status.success(), "{}", common::stderr(&run));
+    serde_json::from_slice(&run.stdout).unwrap()
+}
+
+/// How many of a report's `warnings` start with `line`.
+fn warnings_starting(report: &serde_json::Value, line: &str) -> usize {
+    report["warnings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|w| w.as_str().unwrap().starts_with(line))
+        .count()
+}
+
 #[test]
 fn bad_scenario_files_are_refused_in_one_line() {
     let drift = "[drift]\ntemperatures_c = [25, 35]\ntcf1_ppm_per_k = -30\ntcf2_ppm_per_k = -30\n";
@@ -201,17 +223,11 @@ fn a_profile_beyond_the_rate_table_is_said() {
         1,
         "{text}"
     );
-    let run = gyrocal(&[
-        OsStr::new("field"),
-        OsStr::new("--config"),
-        config.as_os_str(),
-        OsStr::new("--json"),
-    ]);
-    let report: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
-    let warned = report["warnings"].as_array().unwrap();
+    let report = field_json(config.as_os_str());
     assert!(
-        warned.iter().any(|w| w.as_str().unwrap().starts_with(line)),
-        "{warned:?}"
+        warnings_starting(&report, line) > 0,
+        "{}",
+        report["warnings"]
     );
 }
 
@@ -231,22 +247,12 @@ fn a_profile_that_clips_an_adc_is_said_and_left_out_of_the_rms() {
     );
     std::fs::write(&config, text).unwrap();
     let line = "warning: an ADC clipped under [profile] at 25 deg C (ADC 2 in ";
-    let run = gyrocal(&[
-        OsStr::new("field"),
-        OsStr::new("--config"),
-        config.as_os_str(),
-        OsStr::new("--json"),
-    ]);
-    assert!(run.status.success(), "{}", common::stderr(&run));
-    let report: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
-    let warned = report["warnings"].as_array().unwrap();
+    let report = field_json(config.as_os_str());
     assert_eq!(
-        warned
-            .iter()
-            .filter(|w| w.as_str().unwrap().starts_with(line))
-            .count(),
+        warnings_starting(&report, line),
         1,
-        "{warned:?}"
+        "{}",
+        report["warnings"]
     );
     let trace = &report["steps"][0]["profile"];
     let clipped = &trace["clipped"];
@@ -291,14 +297,7 @@ fn a_profile_that_clips_an_adc_is_said_and_left_out_of_the_rms() {
 /// of a clipped converter's readings, reported as a figure.
 #[test]
 fn factory_settings_that_clip_are_said_and_leave_the_baseline_null() {
-    let run = gyrocal(&[
-        OsStr::new("field"),
-        OsStr::new("--config"),
-        OsStr::new("tests/data/field_factory_clips.toml"),
-        OsStr::new("--json"),
-    ]);
-    assert!(run.status.success(), "{}", common::stderr(&run));
-    let report: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+    let report = field_json(OsStr::new("tests/data/field_factory_clips.toml"));
     assert_eq!(
         report["failed"].as_array().unwrap().len(),
         0,
@@ -312,13 +311,10 @@ fn factory_settings_that_clip_are_said_and_leave_the_baseline_null() {
     assert!(steps[1]["selfcal_error"][0].as_f64().unwrap().abs() < 0.01);
     let line =
         "warning: the factory's settings clip an ADC at 35 deg C (rate table: ADC 1 clipped on ";
-    let warned = report["warnings"].as_array().unwrap();
     assert_eq!(
-        warned
-            .iter()
-            .filter(|w| w.as_str().unwrap().starts_with(line))
-            .count(),
+        warnings_starting(&report, line),
         1,
-        "{warned:?}"
+        "{}",
+        report["warnings"]
     );
 }
