@@ -8,7 +8,8 @@
 //! - `fusesoc run --target=sim` on the bus top: edalize's sim flow runs
 //!   every cocotb test of `tests/axi/test_gyro_axi.py` (cocotbext-axi
 //!   master and sink) in Icarus, each in a simulator of its own from
-//!   power-up (the core has no reset), as `tests/axi_bus.rs` does.
+//!   power-up (the core has no reset), as `tests/axi_bus.rs` does in
+//!   Verilator. These are the suite's Icarus runs of those cases.
 //! - The place-and-route tops and pin files the `synth_*` targets use are
 //!   what `gyrocal_verify` generates for its own figures.
 //!

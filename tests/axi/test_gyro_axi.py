@@ -5,7 +5,8 @@ The AXI4-Lite master and the AXI4-Stream sink are cocotbext-axi's
 hand except the golden-vector replay. The register map comes from the
 generated C header (GYRO_HEADER), so the header itself is under test.
 
-Environment (set by tests/axi_bus.rs through run.py):
+Environment (set by tests/axi_bus.rs through run.py, in Verilator, and by
+tests/fusesoc.rs through FuseSoC's sim target, in Icarus):
   GYRO_HEADER   path of verilog-out/gyro_interface_regs.h
   GYRO_PROGRAM  "offset word" lines: bus writes that program a working
                 frequency plan (from register_map::encode in Rust)
