@@ -26,7 +26,7 @@
 //!   `~/.cache/YoWASP`) and prints "Preparing to run ... This might take a
 //!   while..." before its own output: the version lines are found by
 //!   [`tools::parse_version`], which skips that banner
-//!   (`tests/yowasp_cold_start.rs` runs both tools on an empty cache).
+//!   (`tests/yowasp_cold_start.rs` runs nextpnr-ecp5 on an empty cache).
 //! * The two parts run in parallel threads; [`place_and_route`] runs one.
 
 use crate::pnr_log::{self, BelUse, CriticalPath, Fmax};
