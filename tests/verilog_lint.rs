@@ -115,8 +115,9 @@ fn every_waiver_has_a_reason_and_is_narrow() {
     }
 }
 
-/// Fails on a waiver that suppresses nothing, or whose removal brings back
-/// a warning of another rule.
+/// Fails on a waiver that suppresses nothing (`lint::waiver_usage_top`:
+/// no warning that it alone matches, its matcher held to Verilator's own
+/// lint with every waiver).
 fn assert_no_stale(uses: &[lint::WaiverUse]) {
     for u in uses {
         eprintln!(
@@ -136,15 +137,6 @@ fn assert_no_stale(uses: &[lint::WaiverUse]) {
         "stale waivers (they suppress nothing; remove them):\n{}",
         stale.join("\n")
     );
-    for u in uses {
-        for w in &u.suppressed {
-            assert_eq!(
-                w.rule, u.waiver.rule,
-                "removing waiver on line {} brought back a warning of another rule: {w}",
-                u.waiver.line
-            );
-        }
-    }
 }
 
 #[test]
