@@ -340,19 +340,7 @@ pub fn waiver_usage_top(
         .filter(|x| !all.iter().any(|w| w.matches(x)))
         .collect();
     let left: Vec<&LintWarning> = full.warnings.iter().collect();
-    if unmatched != left {
-        let differs = unmatched
-            .iter()
-            .zip(&left)
-            .find(|(a, b)| a != b)
-            .map(|(a, b)| format!("matcher leaves `{a}`, Verilator `{b}`"))
-            .unwrap_or_else(|| {
-                format!(
-                    "matcher leaves {} warnings, Verilator {}",
-                    unmatched.len(),
-                    left.len()
-                )
-            });
+    if let Some(differs) = disagreement(&unmatched, &left) {
         return Err(VerifyError::ToolFailed {
             command: describe_lint(verilog, &files),
             reason: format!("the waiver matcher disagrees with Verilator: {differs}"),
@@ -378,6 +366,24 @@ pub fn waiver_usage_top(
         })
         .collect();
     Ok(usage)
+}
+
+/// Where the warnings the matcher leaves (`unmatched`) differ from those
+/// Verilator leaves with every waiver (`left`): the first pair that
+/// differs, or the counts; `None` when they are the same.
+fn disagreement(unmatched: &[&LintWarning], left: &[&LintWarning]) -> Option<String> {
+    if unmatched == left {
+        return None;
+    }
+    let first = unmatched.iter().zip(left).find(|(a, b)| a != b);
+    Some(match first {
+        Some((a, b)) => format!("matcher leaves `{a}`, Verilator `{b}`"),
+        None => format!(
+            "matcher leaves {} warnings, Verilator {}",
+            unmatched.len(),
+            left.len()
+        ),
+    })
 }
 
 /// The lint of `verilog` with `waivers`, as a command line for messages.
@@ -427,6 +433,31 @@ pub fn wildmatch(text: &str, pattern: &str) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_matcher_that_disagrees_with_verilator_is_named() {
+        let warning = |name: &str| LintWarning {
+            rule: "UNUSEDSIGNAL".into(),
+            file: "/r/gyro_interface.v".into(),
+            line: 7,
+            column: 3,
+            message: format!("Signal is not used: '{name}'"),
+        };
+        let (a, b) = (warning("a"), warning("b"));
+        assert_eq!(disagreement(&[&a], &[&a]), None);
+        assert_eq!(disagreement(&[], &[]), None);
+        assert_eq!(
+            disagreement(&[&a], &[&b]).unwrap(),
+            "matcher leaves `%Warning-UNUSEDSIGNAL: gyro_interface.v:7:3: Signal is not used: 'a'`, \
+             Verilator `%Warning-UNUSEDSIGNAL: gyro_interface.v:7:3: Signal is not used: 'b'`"
+        );
+        // A waiver the matcher reads too widely: Verilator leaves a
+        // warning the matcher thought suppressed.
+        assert_eq!(
+            disagreement(&[], &[&a]).unwrap(),
+            "matcher leaves 0 warnings, Verilator 1"
+        );
+    }
 
     #[test]
     fn wildcards_match_as_verilators() {
