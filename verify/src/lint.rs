@@ -77,6 +77,8 @@ pub struct LintReport {
     pub errors: Vec<String>,
     /// Everything Verilator printed.
     pub output: String,
+    /// The command line that ran it.
+    pub command: String,
     /// Wall time.
     pub wall: Duration,
 }
@@ -138,6 +140,7 @@ pub fn lint_files(
         warnings,
         errors,
         output,
+        command: describe(&cmd),
         wall,
     })
 }
@@ -333,16 +336,26 @@ pub fn waiver_usage_top(
     let bare = lint_files(&[verilog], top, &[])?;
     let files: Vec<&Path> = kept.iter().copied().chain([waivers]).collect();
     let full = lint_files(&[verilog], top, &files)?;
+    // Per warning of the bare lint, the waivers (of `others` then
+    // `tested`) that match it.
     let all: Vec<&Waiver> = others.iter().chain(&tested).collect();
-    let unmatched: Vec<&LintWarning> = bare
+    let matching: Vec<Vec<usize>> = bare
         .warnings
         .iter()
-        .filter(|x| !all.iter().any(|w| w.matches(x)))
+        .map(|x| (0..all.len()).filter(|&k| all[k].matches(x)).collect())
         .collect();
-    let left: Vec<&LintWarning> = full.warnings.iter().collect();
-    if let Some(differs) = disagreement(&unmatched, &left) {
+    let only = |matched: &[usize]| -> Vec<LintWarning> {
+        bare.warnings
+            .iter()
+            .zip(&matching)
+            .filter(|(_, m)| m.as_slice() == matched)
+            .map(|(x, _)| x.clone())
+            .collect()
+    };
+    let unmatched = only(&[]);
+    if let Some(differs) = disagreement(&unmatched, &full.warnings) {
         return Err(VerifyError::ToolFailed {
-            command: describe_lint(verilog, &files),
+            command: full.command,
             reason: format!("the waiver matcher disagrees with Verilator: {differs}"),
             output: String::new(),
         });
@@ -350,19 +363,9 @@ pub fn waiver_usage_top(
     let usage = tested
         .iter()
         .enumerate()
-        .map(|(i, w)| {
-            let alone = |x: &&LintWarning| {
-                w.matches(x)
-                    && !others.iter().any(|o| o.matches(x))
-                    && !tested
-                        .iter()
-                        .enumerate()
-                        .any(|(j, o)| j != i && o.matches(x))
-            };
-            WaiverUse {
-                waiver: w.clone(),
-                suppressed: bare.warnings.iter().filter(alone).cloned().collect(),
-            }
+        .map(|(i, w)| WaiverUse {
+            waiver: w.clone(),
+            suppressed: only(&[others.len() + i]),
         })
         .collect();
     Ok(usage)
@@ -371,7 +374,7 @@ pub fn waiver_usage_top(
 /// Where the warnings the matcher leaves (`unmatched`) differ from those
 /// Verilator leaves with every waiver (`left`): the first pair that
 /// differs, or the counts; `None` when they are the same.
-fn disagreement(unmatched: &[&LintWarning], left: &[&LintWarning]) -> Option<String> {
+fn disagreement(unmatched: &[LintWarning], left: &[LintWarning]) -> Option<String> {
     if unmatched == left {
         return None;
     }
@@ -384,16 +387,6 @@ fn disagreement(unmatched: &[&LintWarning], left: &[&LintWarning]) -> Option<Str
             left.len()
         ),
     })
-}
-
-/// The lint of `verilog` with `waivers`, as a command line for messages.
-fn describe_lint(verilog: &Path, waivers: &[&Path]) -> String {
-    let files: Vec<String> = waivers
-        .iter()
-        .chain([&verilog])
-        .map(|p| p.display().to_string())
-        .collect();
-    format!("verilator --lint-only -Wall {}", files.join(" "))
 }
 
 impl Waiver {
@@ -444,17 +437,18 @@ mod tests {
             message: format!("Signal is not used: '{name}'"),
         };
         let (a, b) = (warning("a"), warning("b"));
-        assert_eq!(disagreement(&[&a], &[&a]), None);
+        let one = std::slice::from_ref(&a);
+        assert_eq!(disagreement(one, one), None);
         assert_eq!(disagreement(&[], &[]), None);
         assert_eq!(
-            disagreement(&[&a], &[&b]).unwrap(),
+            disagreement(one, &[b]).unwrap(),
             "matcher leaves `%Warning-UNUSEDSIGNAL: gyro_interface.v:7:3: Signal is not used: 'a'`, \
              Verilator `%Warning-UNUSEDSIGNAL: gyro_interface.v:7:3: Signal is not used: 'b'`"
         );
         // A waiver the matcher reads too widely: Verilator leaves a
         // warning the matcher thought suppressed.
         assert_eq!(
-            disagreement(&[], &[&a]).unwrap(),
+            disagreement(&[], one).unwrap(),
             "matcher leaves 0 warnings, Verilator 1"
         );
     }
