@@ -30,6 +30,8 @@ How a run works:
      check passed), or
      build error (the mutant does not compile: a broken list entry).
   4. The result table is written after every mutant (RESULTS.md).
+The proofs use the repository's YoWASP venv (.venv-fpga, or the one
+GYROCAL_FPGA_VENV names: scripts/fpga/install-venv.sh makes it).
 
 Usage:
   scripts/mutants/run.py                 all mutants; writes scripts/mutants/RESULTS.md
@@ -298,6 +300,11 @@ def run_all(checks, mutants, root, work, results, complete_list):
     # 18 s against 240 s on the project's loaded 2-core machine), and the
     # tests run as fast.
     env = dict(os.environ, CARGO_TARGET_DIR=str(work / "target"), CARGO_INCREMENTAL="1")
+    # The scratch tree has no .venv-fpga (ignored files are not copied):
+    # the proofs (check formal) use the repository's, or the one
+    # GYROCAL_FPGA_VENV names, taken from the repository as the tests take
+    # it (verify::tools::fpga_venv).
+    env["GYROCAL_FPGA_VENV"] = str(root / (os.environ.get("GYROCAL_FPGA_VENV") or ".venv-fpga"))
     baselines = {}
     for name in sorted({m.get("check", "hdl") for m in mutants if "equivalent" not in m}):
         print(f"baseline: check {name} on the unmutated tree ...", flush=True)
