@@ -327,21 +327,24 @@ mod tests {
 
     /// Feed one sample per schedule, `x` on channel 1 and `-x` on channel
     /// 2; return channel 1's z after each, having checked that channel 2
-    /// stays within the rounding of its mirror image.
+    /// stays within the rounding of its mirror image. z comes `LATENCY`
+    /// clocks after its strobe (`z_valid_follows_x_valid_by_the_latency_...`),
+    /// so a model that never publishes fails here instead of hanging.
     fn run(model: &mut Model, k: &Coefficients, x: &[i64]) -> Vec<i64> {
         x.iter()
-            .map(|&v| {
+            .enumerate()
+            .map(|(n, &v)| {
                 model.step((v, -v), true, k);
-                loop {
+                let z = (0..LATENCY).find_map(|_| {
                     let (z1, z2, valid) = model.step((0, 0), false, k);
-                    if valid {
-                        // Each channel is within 1 LSB of the float
-                        // recursion (below), so the integers z1 and -z2
-                        // differ by at most 1.
-                        assert!((z1 + z2).abs() <= 1, "{z1} vs {z2}");
-                        break z1;
-                    }
-                }
+                    valid.then_some((z1, z2))
+                });
+                let (z1, z2) =
+                    z.unwrap_or_else(|| panic!("sample {n}: no z within {LATENCY} clocks"));
+                // Each channel is within 1 LSB of the float recursion
+                // (below), so the integers z1 and -z2 differ by at most 1.
+                assert!((z1 + z2).abs() <= 1, "{z1} vs {z2}");
+                z1
             })
             .collect()
     }
