@@ -300,6 +300,12 @@ def run_all(checks, mutants, root, work, results, complete_list):
     # 18 s against 240 s on the project's loaded 2-core machine), and the
     # tests run as fast.
     env = dict(os.environ, CARGO_TARGET_DIR=str(work / "target"), CARGO_INCREMENTAL="1")
+    # A mutant needs its check to fail, not a minimal failing case: a
+    # property test that fails shrinks its case first, re-simulating
+    # thousands of clocks per shrink step. No shrinking, and no regression
+    # files written into the scratch tree for later mutants to replay:
+    # each check draws as its baseline did.
+    env.update(PROPTEST_MAX_SHRINK_ITERS="0", PROPTEST_DISABLE_FAILURE_PERSISTENCE="true")
     # The scratch tree has no .venv-fpga (ignored files are not copied):
     # the proofs (check formal) use the repository's, or the one
     # GYROCAL_FPGA_VENV names, taken from the repository as the tests take
