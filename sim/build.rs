@@ -35,7 +35,8 @@ const CORES: [Core; 2] = [
 /// code Verilator marks slow (constructor, initial blocks and settling,
 /// run once per instance; the fine core's ROM images make 2 MB of it) at
 /// -O0. The fine core's build takes 8 s instead of 43 s, the table
-/// core's 5 s instead of 17 s (one idle core each, g++ 12).
+/// core's 5 s instead of 17 s (g++ 12, `make -j 2` on an idle two-core
+/// machine, nearly all of it on one core).
 const SPEEDS: &str = "OPT_FAST=-O2 OPT_GLOBAL=-O2 OPT_SLOW=-O0";
 
 fn main() {
