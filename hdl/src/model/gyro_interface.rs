@@ -50,6 +50,29 @@ pub struct GyroInterface {
     iir: IirLowpass,
 }
 
+/// `GyroInterface::run_blocks` as a method compiled for the target
+/// features `$features` ([`super::isa`]), named `$name`.
+macro_rules! run_compiled_for {
+    ($(#[$doc:meta])* $name:ident, $features:literal) => {
+        $(#[$doc])*
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = $features)]
+        unsafe fn $name<A, Z>(
+            &mut self,
+            regs: &Registers,
+            clocks: u64,
+            analog: &mut A,
+            on_z: Z,
+        ) -> Outputs
+        where
+            A: AnalogSide,
+            Z: FnMut(u64, (i64, i64)),
+        {
+            self.run_blocks(regs, clocks, analog, on_z)
+        }
+    };
+}
+
 impl GyroInterface {
     /// The datapath at its power-up state (the table core).
     pub fn new() -> Self {
@@ -148,34 +171,36 @@ impl GyroInterface {
         Z: FnMut(u64, (i64, i64)),
     {
         #[cfg(target_arch = "x86_64")]
-        if isa == Isa::X86_64V3 && isa.supported() {
-            // SAFETY: the processor has every feature the function is
+        if isa.supported() {
+            // SAFETY: the processor has every feature each function is
             // compiled for (checked just above).
-            return unsafe { self.run_x86_64_v3(regs, clocks, analog, on_z) };
+            match isa {
+                Isa::X86_64V4 => return unsafe { self.run_x86_64_v4(regs, clocks, analog, on_z) },
+                Isa::X86_64V3 => return unsafe { self.run_x86_64_v3(regs, clocks, analog, on_z) },
+                Isa::Portable => {}
+            }
         }
         let _ = isa;
         self.run_blocks(regs, clocks, analog, on_z)
     }
 
-    /// `run_blocks` compiled for x86-64-v3.
-    ///
-    /// # Safety
-    /// The processor must have its features (`Isa::X86_64V3.supported()`).
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,movbe")]
-    unsafe fn run_x86_64_v3<A, Z>(
-        &mut self,
-        regs: &Registers,
-        clocks: u64,
-        analog: &mut A,
-        on_z: Z,
-    ) -> Outputs
-    where
-        A: AnalogSide,
-        Z: FnMut(u64, (i64, i64)),
-    {
-        self.run_blocks(regs, clocks, analog, on_z)
-    }
+    run_compiled_for!(
+        /// `run_blocks` compiled for x86-64-v4.
+        ///
+        /// # Safety
+        /// The processor must have its features (`Isa::X86_64V4.supported()`).
+        run_x86_64_v4,
+        "avx2,fma,bmi1,bmi2,lzcnt,movbe,avx512f,avx512bw,avx512cd,avx512dq,avx512vl"
+    );
+
+    run_compiled_for!(
+        /// `run_blocks` compiled for x86-64-v3.
+        ///
+        /// # Safety
+        /// The processor must have its features (`Isa::X86_64V3.supported()`).
+        run_x86_64_v3,
+        "avx2,fma,bmi1,bmi2,lzcnt,movbe"
+    );
 
     /// `run`'s blocks, as its documentation says.
     #[inline(always)]

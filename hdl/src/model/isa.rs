@@ -3,25 +3,34 @@
 //! chosen once per process at run time.
 //!
 //! The crate is built for the portable x86-64 baseline (SSE2), so that
-//! one binary runs on any machine. The block run is compiled a second time
-//! for x86-64-v3 (AVX2, FMA, BMI1/2, LZCNT, MOVBE), where the gyroscope's
-//! 4x4 products and the integer stages' passes take four lanes instead of
-//! two, and is called when the processor has those features.
+//! one binary runs on any machine. The block run is compiled twice more
+//! and called when the processor has the features:
 //!
-//! Both compile the same source, and neither changes a result: the integer
+//! - x86-64-v3 (AVX2, FMA, BMI1/2, LZCNT, MOVBE), where the gyroscope's
+//!   4x4 products and the integer stages' passes take four lanes instead
+//!   of two;
+//! - x86-64-v4 (x86-64-v3 and AVX-512 F, BW, CD, DQ, VL), whose packed
+//!   64-bit products (`vpmullq`) and arithmetic shifts (`vpsraq`), which
+//!   AVX2 lacks, keep more of the integer stages' i64 passes in vectors.
+//!
+//! All compile the same source, and none changes a result: the integer
 //! arithmetic is exact either way, and Rust never contracts a float
 //! multiply and add into an FMA nor reorders a float sum, so each float
-//! operation rounds the same in both. The run tests play every supported
+//! operation rounds the same in all. The run tests play every supported
 //! instruction set against the clock-by-clock `step`.
 //!
-//! `GYROCAL_ISA=portable` (or `x86-64-v3`) in the environment overrides
-//! the choice, to compare the two or to rule the wider one out.
+//! `GYROCAL_ISA=portable` (or `x86-64-v3`, `x86-64-v4`) in the
+//! environment overrides the choice, to compare them or to rule a wider
+//! one out.
 //!
 //! ```
 //! use gyrocal_hdl::model::isa::Isa;
 //! assert!(Isa::Portable.supported());
 //! assert!(Isa::supported_all().contains(&Isa::selected()));
 //! assert_eq!("x86-64-v3".parse::<Isa>(), Ok(Isa::X86_64V3));
+//! assert_eq!("x86-64-v4".parse::<Isa>(), Ok(Isa::X86_64V4));
+//! // x86-64-v4 includes x86-64-v3.
+//! assert!(!Isa::X86_64V4.supported() || Isa::X86_64V3.supported());
 //! ```
 
 use std::fmt;
@@ -38,6 +47,8 @@ pub enum Isa {
     Portable,
     /// x86-64-v3: AVX2, FMA, BMI1, BMI2, LZCNT, MOVBE.
     X86_64V3,
+    /// x86-64-v4: x86-64-v3 and AVX-512 (F, BW, CD, DQ, VL).
+    X86_64V4,
 }
 
 /// Why `GYROCAL_ISA` cannot be used.
@@ -76,13 +87,14 @@ impl std::error::Error for IsaError {}
 
 impl Isa {
     /// Every instruction set, narrowest first.
-    pub const ALL: [Isa; 2] = [Isa::Portable, Isa::X86_64V3];
+    pub const ALL: [Isa; 3] = [Isa::Portable, Isa::X86_64V3, Isa::X86_64V4];
 
     /// The name `GYROCAL_ISA` takes and reports print.
     pub fn name(self) -> &'static str {
         match self {
             Isa::Portable => "portable",
             Isa::X86_64V3 => "x86-64-v3",
+            Isa::X86_64V4 => "x86-64-v4",
         }
     }
 
@@ -102,8 +114,20 @@ impl Isa {
                         && std::is_x86_feature_detected!("movbe")
                 })
             }
+            #[cfg(target_arch = "x86_64")]
+            Isa::X86_64V4 => {
+                static V4: OnceLock<bool> = OnceLock::new();
+                *V4.get_or_init(|| {
+                    Isa::X86_64V3.supported()
+                        && std::is_x86_feature_detected!("avx512f")
+                        && std::is_x86_feature_detected!("avx512bw")
+                        && std::is_x86_feature_detected!("avx512cd")
+                        && std::is_x86_feature_detected!("avx512dq")
+                        && std::is_x86_feature_detected!("avx512vl")
+                })
+            }
             #[cfg(not(target_arch = "x86_64"))]
-            Isa::X86_64V3 => false,
+            Isa::X86_64V3 | Isa::X86_64V4 => false,
         }
     }
 
