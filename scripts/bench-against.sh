@@ -3,9 +3,10 @@
 # one built at a base revision (default 4afc731, issue 23's baseline), on
 # one core, runs alternated so that both see the same machine, then the
 # medians of each and their ratio (this tree over the base). This tree runs
-# twice per round: as it chooses (the widest instruction set the processor
-# runs) and with GYROCAL_ISA=portable (the x86-64 baseline the base was
-# built for), so the gain of each change shows apart from the wider build.
+# once per round for each instruction set the processor runs
+# (GYROCAL_ISA=portable, the x86-64 baseline the base was built for, then
+# x86-64-v3 and x86-64-v4 where supported; the widest is the one it
+# chooses), so the gain of each change shows apart from the wider builds.
 #
 # Usage: scripts/bench-against.sh [BASE_REV] [ROUNDS] [CPU]
 #   BASE_REV  a revision to build and compare with (default 4afc731)
@@ -59,6 +60,15 @@ base_bin=$base_dir/gyrocal
 
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
+# The instruction sets this processor runs: an unsupported GYROCAL_ISA
+# stops any command in one line, so a tiny bench tells.
+isas=portable
+for isa in x86-64-v3 x86-64-v4; do
+  if GYROCAL_ISA=$isa "$head_bin" bench --engines model --repetitions 1 --scale 0.001 \
+    --no-reproduce --json >/dev/null 2>&1; then
+    isas="$isas $isa"
+  fi
+done
 run() { # name binary round [VAR=value...]
   echo "round $3: $1" >&2
   taskset -c "$cpu" env RAYON_NUM_THREADS=1 "${@:4}" "$2" bench --engines model \
@@ -66,16 +76,18 @@ run() { # name binary round [VAR=value...]
 }
 for r in $(seq 1 "$rounds"); do
   run base "$base_bin" "$r"
-  run head "$head_bin" "$r"
-  run portable "$head_bin" "$r" GYROCAL_ISA=portable
+  for isa in $isas; do
+    run "$isa" "$head_bin" "$r" GYROCAL_ISA="$isa"
+  done
 done
 
-python3 - "$out" "$rounds" "$base_rev" "$(git rev-parse --short HEAD)" <<'EOF'
+python3 - "$out" "$rounds" "$base_rev" "$(git rev-parse --short HEAD)" $isas <<'EOF'
 import json, statistics, sys
 out, rounds, base_rev, head_rev = sys.argv[1], int(sys.argv[2]), sys.argv[3], sys.argv[4]
+isas = sys.argv[5:]
 # runs[name][r]: the measurements of round r (from 0), each file read once.
 runs = {name: [json.load(open(f"{out}/{name}.{r}.json")) for r in range(1, rounds + 1)]
-        for name in ("base", "head", "portable")}
+        for name in ["base"] + isas}
 def speeds(name):
     s = {False: [], True: []}
     for run in runs[name]:
@@ -91,19 +103,26 @@ def paired(name, gyro):
     ratios = [median_of(run, gyro) / median_of(base_run, gyro)
               for run, base_run in zip(runs[name], runs["base"])]
     return statistics.median(ratios), sum(x > 1 for x in ratios)
-base, head, portable = speeds("base"), speeds("head"), speeds("portable")
-isa = runs["head"][0]["model_isa"]
+for isa in isas:
+    ran = runs[isa][0]["model_isa"]
+    assert ran == isa, f"GYROCAL_ISA={isa} ran {ran}"
+speed = {name: speeds(name) for name in ["base"] + isas}
 print(f"model engine, one core, {rounds} alternated rounds of 3 repetitions (M clocks/s)")
-print(f"this tree {head_rev} as it chooses ({isa}) and with GYROCAL_ISA=portable")
-print(f"{'setting':<20} {'base ' + base_rev:>24} {'portable':>24} {isa:>24} {'ratios':>13}")
+print(f"this tree {head_rev} for each instruction set this processor runs"
+      f" (it chooses {isas[-1]})")
+print(f"{'setting':<20} {'base ' + base_rev:>24}" + "".join(f"{isa:>24}" for isa in isas)
+      + f"{'ratios':>{7 * len(isas)}}")
 cell = lambda v: f"{statistics.median(v) / 1e6:.2f} ({min(v) / 1e6:.1f}..{max(v) / 1e6:.1f})"
 for gyro, label in [(False, "datapath alone"), (True, "with the gyroscope")]:
-    b = statistics.median(base[gyro])
-    p, h = statistics.median(portable[gyro]), statistics.median(head[gyro])
-    cells = "".join(f"{cell(v):>24}" for v in (base[gyro], portable[gyro], head[gyro]))
-    print(f"{label:<20} {cells} {p / b:>6.3f} {h / b:>6.3f}")
+    b = statistics.median(speed["base"][gyro])
+    cells = "".join(f"{cell(speed[name][gyro]):>24}" for name in ["base"] + isas)
+    ratios = "".join(f"{statistics.median(speed[isa][gyro]) / b:>7.3f}" for isa in isas)
+    print(f"{label:<20} {cells}{ratios}")
 print(f"paired: the median over rounds of each round's ratio (rounds above 1 of {rounds})")
 for gyro, label in [(False, "datapath alone"), (True, "with the gyroscope")]:
-    (pp, pn), (hp, hn) = paired("portable", gyro), paired("head", gyro)
-    print(f"{label:<20} {'portable':>10} {pp:.3f} ({pn}) {isa:>12} {hp:.3f} ({hn})")
+    cells = ""
+    for isa in isas:
+        ratio, above = paired(isa, gyro)
+        cells += f" {isa:>10} {ratio:.3f} ({above})"
+    print(f"{label:<20}{cells}")
 EOF
