@@ -6,7 +6,7 @@ use super::carrier_nco::{CarrierNco, Carriers};
 use super::cic_decimator::CicDecimator;
 use super::demod_mux::DemodMux;
 use super::iir_lowpass::IirLowpass;
-use super::isa::Isa;
+use super::isa::{Isa, x86_64_v3_features, x86_64_v4_features};
 use super::modulation_nco::ModulationNco;
 use super::reference_alignment::ReferenceAlignment;
 pub use gyrocal_regs::Registers;
@@ -51,12 +51,13 @@ pub struct GyroInterface {
 }
 
 /// `GyroInterface::run_blocks` as a method compiled for the target
-/// features `$features` ([`super::isa`]), named `$name`.
+/// features `[$feature, ...]` (given by [`super::isa`]'s lists, which
+/// its processor check reads too), named `$name`.
 macro_rules! run_compiled_for {
-    ($(#[$doc:meta])* $name:ident, $features:literal) => {
+    ($(#[$doc:meta])* $name:ident, [$($feature:tt),*]) => {
         $(#[$doc])*
         #[cfg(target_arch = "x86_64")]
-        #[target_feature(enable = $features)]
+        $(#[target_feature(enable = $feature)])*
         unsafe fn $name<A, Z>(
             &mut self,
             regs: &Registers,
@@ -184,23 +185,21 @@ impl GyroInterface {
         self.run_blocks(regs, clocks, analog, on_z)
     }
 
-    run_compiled_for!(
+    x86_64_v4_features!(run_compiled_for!(
         /// `run_blocks` compiled for x86-64-v4.
         ///
         /// # Safety
         /// The processor must have its features (`Isa::X86_64V4.supported()`).
         run_x86_64_v4,
-        "avx2,fma,bmi1,bmi2,lzcnt,movbe,avx512f,avx512bw,avx512cd,avx512dq,avx512vl"
-    );
+    ));
 
-    run_compiled_for!(
+    x86_64_v3_features!(run_compiled_for!(
         /// `run_blocks` compiled for x86-64-v3.
         ///
         /// # Safety
         /// The processor must have its features (`Isa::X86_64V3.supported()`).
         run_x86_64_v3,
-        "avx2,fma,bmi1,bmi2,lzcnt,movbe"
-    );
+    ));
 
     /// `run`'s blocks, as its documentation says.
     #[inline(always)]

@@ -37,6 +37,40 @@ use std::fmt;
 use std::str::FromStr;
 use std::sync::OnceLock;
 
+/// Hands `$then!` its arguments followed by x86-64-v3's target features
+/// as a list of string literals. The processor check (`Isa::supported`)
+/// and the compiled copy of the block run
+/// (`super::gyro_interface::GyroInterface::run_x86_64_v3`) both expand
+/// this one list, so they cannot disagree: a copy that used a feature the
+/// check left out would stop a processor without it on an illegal
+/// instruction.
+macro_rules! x86_64_v3_features {
+    ($then:ident ! ( $($args:tt)* )) => {
+        $then! { $($args)* ["avx2", "fma", "bmi1", "bmi2", "lzcnt", "movbe"] }
+    };
+}
+pub(crate) use x86_64_v3_features;
+
+/// x86-64-v4's target features, as `x86_64_v3_features` gives v3's:
+/// x86-64-v3's and AVX-512 F, BW, CD, DQ and VL.
+macro_rules! x86_64_v4_features {
+    ($then:ident ! ( $($args:tt)* )) => {
+        $then! { $($args)* [
+            "avx2", "fma", "bmi1", "bmi2", "lzcnt", "movbe",
+            "avx512f", "avx512bw", "avx512cd", "avx512dq", "avx512vl"
+        ] }
+    };
+}
+pub(crate) use x86_64_v4_features;
+
+/// Whether the processor has every feature of the list.
+#[cfg(target_arch = "x86_64")]
+macro_rules! all_detected {
+    ([$($feature:tt),*]) => {
+        true $(&& std::is_x86_feature_detected!($feature))*
+    };
+}
+
 /// The variable that overrides the choice.
 pub const ENV: &str = "GYROCAL_ISA";
 
@@ -105,26 +139,12 @@ impl Isa {
             #[cfg(target_arch = "x86_64")]
             Isa::X86_64V3 => {
                 static V3: OnceLock<bool> = OnceLock::new();
-                *V3.get_or_init(|| {
-                    std::is_x86_feature_detected!("avx2")
-                        && std::is_x86_feature_detected!("fma")
-                        && std::is_x86_feature_detected!("bmi1")
-                        && std::is_x86_feature_detected!("bmi2")
-                        && std::is_x86_feature_detected!("lzcnt")
-                        && std::is_x86_feature_detected!("movbe")
-                })
+                *V3.get_or_init(|| x86_64_v3_features!(all_detected!()))
             }
             #[cfg(target_arch = "x86_64")]
             Isa::X86_64V4 => {
                 static V4: OnceLock<bool> = OnceLock::new();
-                *V4.get_or_init(|| {
-                    Isa::X86_64V3.supported()
-                        && std::is_x86_feature_detected!("avx512f")
-                        && std::is_x86_feature_detected!("avx512bw")
-                        && std::is_x86_feature_detected!("avx512cd")
-                        && std::is_x86_feature_detected!("avx512dq")
-                        && std::is_x86_feature_detected!("avx512vl")
-                })
+                *V4.get_or_init(|| x86_64_v4_features!(all_detected!()))
             }
             #[cfg(not(target_arch = "x86_64"))]
             Isa::X86_64V3 | Isa::X86_64V4 => false,
