@@ -17,7 +17,8 @@
 //!
 //! Each parameter is normal around its nominal value, with an absolute
 //! `sd` or a relative `rel_sd` (one of the two). A key left out does not
-//! spread.
+//! spread. A part 5 sigma out must still be a device the model takes
+//! ([`Spread::validate`]).
 //!
 //! **Device `i` depends only on `seed` and `i`.** Its generator
 //! (xoshiro256++) is seeded from a splitmix64 hash of the pair, and it draws
@@ -28,7 +29,7 @@
 //! after the parameters: each device has its own noise, as each part off a
 //! line does.
 
-use crate::gyro::GyroParams;
+use crate::gyro::{GyroParams, MAX_COUPLING_DPS};
 use rand_distr::{Distribution, StandardNormal};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use rand_xoshiro::rand_core::{Rng, SeedableRng};
@@ -99,20 +100,25 @@ fn default_tolerance() -> f64 {
 
 /// A `[spread]` key whose value is not allowed.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
-#[error("[spread] {key} = {value}: {allowed}")]
+#[error("[spread] {key}{}: {allowed}", shown(*.value))]
 pub struct SpreadError {
     /// The key (`q1.rel_sd`, `devices`, ...).
     pub key: String,
-    /// Its value.
-    pub value: f64,
+    /// Its value (`None` when the key's form is wrong, not its value).
+    pub value: Option<f64>,
     /// What is allowed.
     pub allowed: String,
+}
+
+/// ` = value`, or nothing when there is no one value to show.
+fn shown(value: Option<f64>) -> String {
+    value.map(|v| format!(" = {v}")).unwrap_or_default()
 }
 
 fn refuse(key: impl Into<String>, value: f64, allowed: impl Into<String>) -> SpreadError {
     SpreadError {
         key: key.into(),
-        value,
+        value: Some(value),
         allowed: allowed.into(),
     }
 }
@@ -152,7 +158,7 @@ impl Sd {
             )),
             _ => Err(SpreadError {
                 key: key.into(),
-                value: f64::NAN,
+                value: None,
                 allowed: "give exactly one of `sd` (absolute) or `rel_sd` (relative)".into(),
             }),
         }
@@ -221,17 +227,78 @@ impl Spread {
                 "a relative bound, greater than 0 and less than 1",
             ));
         }
-        let sds = self.sds(nominal)?;
-        // A frequency 5 sigma out must stay positive.
-        if 5.0 * sds[0] >= nominal.f1_hz {
+        self.five_sigma_stays_valid(nominal, &self.sds(nominal)?)
+    }
+
+    /// Every parameter 5 sigma out (one draw in 1.7 million) must still
+    /// be a device the model takes: the frequencies positive, Q and the
+    /// angular gain of the nominal's sign, the couplings within the
+    /// model's `MAX_COUPLING_DPS`. A spread wider than that would fail
+    /// parts for the model's sake, not the part's.
+    fn five_sigma_stays_valid(
+        &self,
+        nominal: &GyroParams,
+        sds: &[f64; 7],
+    ) -> Result<(), SpreadError> {
+        let [f1, split, q1, q2, gain, quadrature, damping] = *sds;
+        if 5.0 * f1 >= nominal.f1_hz {
             return Err(refuse(
                 "f1_hz.sd",
-                sds[0],
+                f1,
                 format!(
                     "less than a fifth of f1 ({} Hz), so that 5 sigma out stays positive",
                     nominal.f1_hz
                 ),
             ));
+        }
+        // f2 = f1 + split spreads by both, drawn independently.
+        if 5.0 * f1.hypot(split) >= nominal.f2_hz {
+            return Err(refuse(
+                "split_hz.sd",
+                split,
+                format!(
+                    "f2's sd, sqrt(f1_hz.sd^2 + split_hz.sd^2) = {:.6} Hz, must be less than a \
+                     fifth of f2 ({} Hz), so that 5 sigma out stays positive",
+                    f1.hypot(split),
+                    nominal.f2_hz
+                ),
+            ));
+        }
+        for (key, sd, value) in [
+            ("q1", q1, nominal.q1),
+            ("q2", q2, nominal.q2),
+            ("angular_gain", gain, nominal.angular_gain),
+        ] {
+            if 5.0 * sd > value.abs() {
+                return Err(refuse(
+                    format!("{key}.sd"),
+                    sd,
+                    format!(
+                        "at most a fifth of |{key}| ({}), so that 5 sigma out keeps the sign",
+                        value.abs()
+                    ),
+                ));
+            }
+        }
+        for (key, sd, value) in [
+            ("quadrature_dps", quadrature, nominal.quadrature_dps),
+            (
+                "damping_coupling_dps",
+                damping,
+                nominal.damping_coupling_dps,
+            ),
+        ] {
+            if value.abs() + 5.0 * sd > MAX_COUPLING_DPS {
+                return Err(refuse(
+                    format!("{key}.sd"),
+                    sd,
+                    format!(
+                        "allowed up to {:e} deg/s, so that |{key}| + 5 sd stays within the \
+                         model's {MAX_COUPLING_DPS:e} deg/s",
+                        ((MAX_COUPLING_DPS - value.abs()) / 5.0).max(0.0)
+                    ),
+                ));
+            }
         }
         Ok(())
     }
@@ -383,10 +450,45 @@ mod tests {
         assert!(err("devices = 0").contains("[spread] devices = 0: allowed 1..=100000"));
         assert!(err("devices = 2\nq1 = { rel_sd = 0.5 }").contains("q1.rel_sd = 0.5"));
         assert!(err("devices = 2\nq1 = { sd = -1 }").contains("q1.sd = -1"));
-        assert!(err("devices = 2\nq1 = { sd = 1, rel_sd = 0.1 }").contains("exactly one"));
+        let both = err("devices = 2\nq1 = { sd = 1, rel_sd = 0.1 }");
+        assert_eq!(
+            both,
+            "[spread] q1: give exactly one of `sd` (absolute) or `rel_sd` (relative)"
+        );
         assert!(err("devices = 2\nquadrature_dps = { rel_sd = 0.1 }").contains("give `sd`"));
         assert!(err("devices = 2\nf1_hz = { sd = 6000 }").contains("f1_hz.sd"));
         assert!(err("devices = 2\ntolerance = 0").contains("tolerance"));
         assert!(toml::from_str::<Spread>("devices = 2\nq3 = { sd = 1 }").is_err());
+    }
+
+    /// A spread that would draw devices the model refuses more often than
+    /// 5 sigma out is refused as a whole, naming the key, each just past
+    /// its bound; the bound itself is taken.
+    #[test]
+    fn a_spread_5_sigma_out_is_still_a_device() {
+        let n = nominal();
+        let check = |text: &str| spread(&format!("devices = 2\n{text}")).validate(&n);
+        let refused = |text: &str, key: &str| {
+            let e = check(text).unwrap_err().to_string();
+            assert!(e.starts_with(&format!("[spread] {key} = ")), "{text}: {e}");
+        };
+        // f2 = 25.8 kHz: sqrt(3000^2 + 4000^2) = 5000 Hz is 5 sigma = 25 kHz.
+        check("f1_hz = { sd = 3000.0 }\nsplit_hz = { sd = 4000.0 }").unwrap();
+        refused(
+            "f1_hz = { sd = 3000.0 }\nsplit_hz = { sd = 4200.0 }",
+            "split_hz.sd",
+        );
+        refused("split_hz = { sd = 5200.0 }", "split_hz.sd");
+        for (key, bound) in [("q1", 600.0), ("q2", 600.0), ("angular_gain", 0.16)] {
+            check(&format!("{key} = {{ sd = {bound} }}")).unwrap();
+            refused(
+                &format!("{key} = {{ sd = {} }}", bound * 1.001),
+                &format!("{key}.sd"),
+            );
+        }
+        for key in ["quadrature_dps", "damping_coupling_dps"] {
+            check(&format!("{key} = {{ sd = 2e4 }}")).unwrap();
+            refused(&format!("{key} = {{ sd = 2.001e4 }}"), &format!("{key}.sd"));
+        }
     }
 }
