@@ -318,3 +318,33 @@ fn factory_settings_that_clip_are_said_and_leave_the_baseline_null() {
         report["warnings"]
     );
 }
+
+/// A datasheet Q1 far below the part's (a 30th and a 50th of the
+/// consumer device's 3000, beyond what the search reaches): the step
+/// fails in one line that names the key to correct, whichever way the
+/// search failed (a bandwidth out of range, or three points too far apart
+/// to estimate one), and the run exits with status 1.
+#[test]
+fn a_datasheet_q_far_off_is_named_in_the_failed_step() {
+    let drift = "[drift]\ntemperatures_c = [25]\ntcf1_ppm_per_k = -30\ntcf2_ppm_per_k = -30\n";
+    let dir = tempfile::tempdir().unwrap();
+    for q1 in [100, 60] {
+        let config = dir.path().join("q_far_off.toml");
+        std::fs::write(&config, format!("{GOOD}{drift}[datasheet]\nq1 = {q1}\n")).unwrap();
+        let run = gyrocal(&[
+            OsStr::new("field"),
+            OsStr::new("--config"),
+            config.as_os_str(),
+            OsStr::new("--json"),
+        ]);
+        let stderr = common::stderr(&run);
+        assert_eq!(run.status.code(), Some(1), "{stderr}");
+        let report: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+        let error = report["failed"][0]["error"].as_str().unwrap();
+        assert!(
+            error.starts_with("identification of mode 1: ") && error.contains("[datasheet] q1"),
+            "q1 = {q1}: {error}"
+        );
+        assert!(!error.contains('\n'));
+    }
+}

@@ -49,6 +49,27 @@ fn board(modes: [(f64, f64, C64); 2]) -> Lorentzian {
     Lorentzian::new(50e6, modes, 1e-3)
 }
 
+/// A datasheet with the paper's lambda and mode 2's Q, no couplings.
+fn datasheet(f1_hz: f64, f2_hz: f64, q1: f64) -> GyroParams {
+    GyroParams {
+        f1_hz,
+        f2_hz,
+        q1,
+        q2: 55e3,
+        angular_gain: 0.6,
+        quadrature_dps: 0.0,
+        damping_coupling_dps: 0.0,
+    }
+}
+
+/// The error of an identification from `ds` that must fail.
+fn identification_error(truth: [(f64, f64, C64); 2], ds: &GyroParams) -> String {
+    let mut b = board(truth);
+    identify::identify(&mut b, &knowns(ds.clone()), ds)
+        .unwrap_err()
+        .to_string()
+}
+
 /// f1 off by the amounts the issue saw fail (+0.3%, -1.5%) and by the
 /// process spread's edge (+-4.9%), Q off by a factor of 2 either way, the
 /// split off by the whole of f1's error, with little z noise and with a
@@ -107,22 +128,28 @@ fn a_datasheet_off_by_the_process_spread_is_found_and_refined() {
 #[test]
 fn no_resonance_in_reach_is_one_clear_error() {
     let truth = paper_truth();
-    let ds = GyroParams {
-        f1_hz: truth[0].0 * 1.2,
-        f2_hz: truth[0].0 * 1.2 + 250.0,
-        q1: 55e3,
-        q2: 55e3,
-        angular_gain: 0.6,
-        quadrature_dps: 0.0,
-        damping_coupling_dps: 0.0,
-    };
-    let mut b = board(truth);
-    let e = identify::identify(&mut b, &knowns(ds.clone()), &ds)
-        .unwrap_err()
-        .to_string();
+    let ds = datasheet(truth[0].0 * 1.2, truth[0].0 * 1.2 + 250.0, 55e3);
+    let e = identification_error(truth, &ds);
     assert!(
         e.starts_with("identification of mode 1: no resonance found from"),
         "{e}"
     );
     assert!(!e.contains('\n'));
+}
+
+/// A datasheet Q far beyond the process spread (40 times the part's, or
+/// a 40th of it): the search cannot settle on the mode, and the one line
+/// says which key to correct, not a bare "did not settle" or "the fit
+/// diverged".
+#[test]
+fn a_datasheet_q_far_off_is_named() {
+    let truth = paper_truth();
+    for q_rel in [40.0, 1.0 / 40.0, 25.0, 1.0 / 25.0, 1.0 / 30.0] {
+        let ds = datasheet(truth[0].0 * 1.001, truth[1].0, 55e3 * q_rel);
+        let e = identification_error(truth, &ds);
+        eprintln!("Q x {q_rel}: {e}");
+        assert!(e.starts_with("identification of mode 1: "), "{e}");
+        assert!(e.contains("[datasheet] q1"), "Q x {q_rel}: {e}");
+        assert!(!e.contains('\n'));
+    }
 }

@@ -321,14 +321,14 @@ pub fn identify_mode(
     let bw = knowns.bandwidth_hz(k);
     let mut scanned = false;
     let found = match search::coarse(&mut probe, guess_hz, bw)? {
-        Some(found) => found,
-        None => {
+        Ok(found) => found,
+        Err(_) => {
             scanned = true;
             let start = search::scan(&mut probe, guess_hz, bw)?;
-            search::coarse(&mut probe, start, bw)?.ok_or_else(|| Error::Identification {
+            search::coarse(&mut probe, start, bw)?.map_err(|why| Error::Identification {
                 mode: k + 1,
                 reason: format!(
-                    "the scan of +-{}% around {guess_hz} Hz pointed at {start:.1} Hz, but the search from there did not settle",
+                    "the scan of +-{}% around {guess_hz:.1} Hz pointed at {start:.1} Hz, but the search from there did not settle: {why}",
                     100.0 * SCAN_SPAN
                 ),
             })?
@@ -357,7 +357,15 @@ pub fn identify_mode(
     )
     .map_err(|reason| Error::Identification {
         mode: k + 1,
-        reason: reason.to_string(),
+        reason: format!(
+            "the fine sweep around {centre:.1} Hz, {bk:.4} Hz a step (the coarse search's \
+             bandwidth; the datasheet's Q{} = {} gives {bw:.4} Hz), could not be fitted: \
+             {reason}; a datasheet Q far from the part's misleads the search: check \
+             [datasheet] q{}",
+            k + 1,
+            knowns.nominal.q(k),
+            k + 1
+        ),
     })?;
     fit.waited_s = probe.waited_s();
     fit.scanned = scanned;

@@ -73,6 +73,11 @@ impl<'a> Prober<'a> {
         self.k + 1
     }
 
+    /// The datasheet's Q of the mode.
+    pub(super) fn datasheet_q(&self) -> f64 {
+        self.knowns.nominal.q(self.k)
+    }
+
     /// The clock (Hz).
     pub(super) fn clock_hz(&self) -> f64 {
         self.knowns.clock_hz

@@ -8,47 +8,108 @@ use crate::error::Error;
 use crate::theory::hold_gain;
 
 /// A bandwidth the coarse search accepts, against the datasheet's: Q is
-/// within a factor of 20 of it (process spread is a factor of 2).
+/// within a factor of 20 of it (process spread is a factor of 2). The
+/// search reaches less than that when the datasheet's Q is too low: its
+/// carriers start a datasheet bandwidth apart and wait its time constant,
+/// too wide and too short for the part. Measured on the consumer device
+/// (Q 3000, `tests/field_cli.rs`'s): a datasheet Q1 from 350 (8.6 times
+/// low) to 60,000 (20 times high) is identified, 250 and 300 are not, and
+/// such a failure names `[datasheet] q` (`Unsettled`).
 const BANDWIDTH_RANGE: f64 = 20.0;
 
 /// Highest carrier the search probes, as a fraction of the clock (the
 /// plan's limit is below clock / 2).
 const MAX_CARRIER_RATIO: f64 = 0.45;
 
+/// Why the coarse search stopped without settling on a resonance.
+#[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
+pub(super) enum Unsettled {
+    /// A carrier it would probe lies outside (0, 0.45 clock).
+    #[error("a carrier it would probe lies outside 0 to {top:.1} Hz")]
+    Carrier { top: f64 },
+    /// Three points gave no finite, positive bandwidth. Their spacing
+    /// starts at the datasheet's bandwidth: a Q far too low spreads them
+    /// over the whole resonance and beyond.
+    #[error(
+        "three points {spacing:.4} Hz apart around {centre:.1} Hz gave no finite, positive \
+         bandwidth (the spacing starts at the bandwidth of the datasheet's Q{mode} = {q}: if \
+         the part's Q is far from it, correct [datasheet] q{mode})"
+    )]
+    NoEstimate {
+        mode: usize,
+        centre: f64,
+        spacing: f64,
+        q: f64,
+    },
+    /// The resonance found is `BANDWIDTH_RANGE` or more from the
+    /// datasheet's bandwidth: most likely the datasheet's Q is wrong.
+    #[error(
+        "the resonance near {fk:.1} Hz measured {found:.4} Hz wide, more than {BANDWIDTH_RANGE}x \
+         from the {datasheet:.4} Hz of the datasheet's Q{mode} = {q} (a Q that far off also \
+         misleads the measurement, through the carriers' spacing and the time waited at each): \
+         correct [datasheet] q{mode}"
+    )]
+    Bandwidth {
+        mode: usize,
+        fk: f64,
+        found: f64,
+        datasheet: f64,
+        q: f64,
+    },
+    /// `MAX_MOVES` moves without settling.
+    #[error("{MAX_MOVES} moves did not settle")]
+    Moves,
+}
+
 /// The coarse search from `start` with datasheet bandwidth `bw`: the
 /// centre of three carriers moves to the narrow-band estimate of fk, their
 /// spacing to a quarter of the move (at least one bandwidth), until the
-/// move is below a quarter bandwidth. `Ok(None)` when it cannot converge
-/// there: no finite positive bandwidth, a bandwidth `BANDWIDTH_RANGE` away
-/// from the datasheet's, a carrier outside (0, 0.45 clock), or
-/// `MAX_MOVES` moves. Returns (fk, bk).
-pub(super) fn coarse(probe: &mut Prober, start: f64, bw: f64) -> Result<Option<(f64, f64)>, Error> {
+/// move is below a quarter bandwidth. `Ok(Err(why))` when it cannot
+/// converge there: no finite positive bandwidth, a bandwidth
+/// `BANDWIDTH_RANGE` away from the datasheet's, a carrier outside (0, 0.45
+/// clock), or `MAX_MOVES` moves. Returns (fk, bk).
+pub(super) fn coarse(
+    probe: &mut Prober,
+    start: f64,
+    bw: f64,
+) -> Result<Result<(f64, f64), Unsettled>, Error> {
     let top = MAX_CARRIER_RATIO * probe.clock_hz();
     let mut centre = start;
     let mut spacing = bw;
     for _ in 0..MAX_MOVES {
         if centre - spacing <= 0.0 || centre + spacing >= top {
-            return Ok(None);
+            return Ok(Err(Unsettled::Carrier { top }));
         }
         let mut pts: Vec<(f64, C64)> = vec![];
         for s in [-1.0, 0.0, 1.0] {
             pts.push(probe.measure(centre + s * spacing)?);
         }
         let Some((fk, bk, peak)) = narrow_band(&pts) else {
-            return Ok(None);
+            return Ok(Err(Unsettled::NoEstimate {
+                mode: probe.mode(),
+                centre,
+                spacing,
+                q: probe.datasheet_q(),
+            }));
         };
         if !(bw / BANDWIDTH_RANGE..=bw * BANDWIDTH_RANGE).contains(&bk) {
-            return Ok(None);
+            return Ok(Err(Unsettled::Bandwidth {
+                mode: probe.mode(),
+                fk,
+                found: bk,
+                datasheet: bw,
+                q: probe.datasheet_q(),
+            }));
         }
         probe.set_amplitude_for_peak(peak);
         let moved = fk - centre;
         centre = fk;
         if moved.abs() < bk / 4.0 && spacing <= 2.0 * bk.max(bw) {
-            return Ok(Some((centre, bk)));
+            return Ok(Ok((centre, bk)));
         }
         spacing = (moved.abs() / 4.0).max(bk.min(bw));
     }
-    Ok(None)
+    Ok(Err(Unsettled::Moves))
 }
 
 /// The scan: `SCAN_POINTS` carriers evenly over +-`SCAN_SPAN` of `guess`
@@ -110,7 +171,7 @@ fn scan_once(probe: &mut Prober, lo: f64, hi: f64, guess: f64) -> Result<f64, Er
         _ => Err(Error::Identification {
             mode: probe.mode(),
             reason: format!(
-                "no resonance found from {lo:.1} to {hi:.1} Hz (scanning from the datasheet's {guess} Hz, +-{}%; the largest response was at {largest:.1} Hz): check the datasheet's frequency",
+                "no resonance found from {lo:.1} to {hi:.1} Hz (scanning from the datasheet's {guess:.1} Hz, +-{}%; the largest response was at {largest:.1} Hz): check the datasheet's frequency",
                 100.0 * SCAN_SPAN
             ),
         }),
