@@ -348,3 +348,37 @@ fn a_datasheet_q_far_off_is_named_in_the_failed_step() {
         assert!(!error.contains('\n'));
     }
 }
+
+/// A datasheet lambda 10% below the part's, claimed within 1%: the
+/// self-calibrated scale factors are off by many of their sigmas, and the
+/// report says so in one line naming each error and the input to check.
+/// With the datasheet's lambda right, the same run says nothing of it.
+#[test]
+fn an_error_its_sigma_does_not_cover_is_said() {
+    let drift = "[drift]\ntemperatures_c = [25]\ntcf1_ppm_per_k = -30\ntcf2_ppm_per_k = -30\n";
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("lambda_off.toml");
+    let line = "warning: 2 of 2 errors lie beyond 3 of their reported sigmas";
+    for (lambda, said) in [(0.72, true), (0.8, false)] {
+        let datasheet = format!(
+            "[datasheet]\nangular_gain = {lambda}\nangular_gain_uncertainty = 0.01\n\
+             drive_gain_ratio_uncertainty = 0.005\n"
+        );
+        std::fs::write(&config, format!("{GOOD}{drift}{datasheet}")).unwrap();
+        let report = field_json(config.as_os_str());
+        assert_eq!(
+            warnings_starting(&report, line),
+            usize::from(said),
+            "lambda {lambda}: {}",
+            report["warnings"]
+        );
+        if said {
+            let text = report["warnings"].to_string();
+            assert!(
+                text.contains("at 25 deg C output 1 (-")
+                    && text.contains("[datasheet] angular_gain"),
+                "{text}"
+            );
+        }
+    }
+}

@@ -165,6 +165,20 @@ fn shards_run_by_slurm_and_gnu_parallel_merge_into_the_unsharded_sweep() {
     }
 }
 
+/// The sweep of `SWEEP`'s first two parts with `extra` sections: its
+/// JSON report.
+fn two_parts_json(extra: &str) -> serde_json::Value {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("two_parts.toml");
+    std::fs::write(&config, SWEEP.replace("devices = 5", "devices = 2") + extra).unwrap();
+    json_object(gyrocal(&[
+        "sweep",
+        "--config",
+        config.to_str().unwrap(),
+        "--json",
+    ]))
+}
+
 /// A JSON list of strings.
 fn strings(v: &serde_json::Value) -> Vec<&str> {
     let list = v.as_array().unwrap_or_else(|| panic!("not a list: {v}"));
@@ -173,17 +187,9 @@ fn strings(v: &serde_json::Value) -> Vec<&str> {
 
 #[test]
 fn with_a_drift_every_part_runs_every_step() {
-    let dir = tempfile::tempdir().unwrap();
-    let config = dir.path().join("drift.toml");
-    let text = SWEEP.replace("devices = 5", "devices = 2")
-        + "[drift]\ntemperatures_c = [25, 40]\ntcf1_ppm_per_k = -30\ntcf2_ppm_per_k = -31\n";
-    std::fs::write(&config, text).unwrap();
-    let report = json_object(gyrocal(&[
-        "sweep",
-        "--config",
-        config.to_str().unwrap(),
-        "--json",
-    ]));
+    let report = two_parts_json(
+        "[drift]\ntemperatures_c = [25, 40]\ntcf1_ppm_per_k = -30\ntcf2_ppm_per_k = -31\n",
+    );
     assert_eq!(report["temperatures_c"], serde_json::json!([25.0, 40.0]));
     for d in report["devices"].as_array().unwrap() {
         let steps = d["steps"].as_array().unwrap();
@@ -337,4 +343,29 @@ fn bad_sweep_input_is_refused_in_one_line() {
     let o = gyrocal(&["field", "--config", config.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("missing [drift]"), "{}", stderr(&o));
+}
+
+/// Parts whose datasheet lambda is 10% low, claimed within 1%: every
+/// error lies beyond 3 sigma. The summary names them by part in its one
+/// line; the parts' own field line saying the same is not carried as well.
+#[test]
+fn uncovered_errors_are_named_once_by_part() {
+    let report = two_parts_json(
+        "[datasheet]\nangular_gain = 0.72\nangular_gain_uncertainty = 0.01\n\
+         drive_gain_ratio_uncertainty = 0.005\n",
+    );
+    let warnings = strings(&report["summary"]["warnings"]);
+    let beyond: Vec<&&str> = warnings
+        .iter()
+        .filter(|w| w.contains("lie beyond 3"))
+        .collect();
+    assert_eq!(beyond.len(), 1, "{warnings:#?}");
+    assert!(
+        beyond[0].starts_with("warning: 4 of 4 errors lie beyond 3")
+            && beyond[0].contains("device 0 at 25 deg C output 1 (-")
+            && beyond[0].contains("device 1 at 25 deg C output 2 (-"),
+        "{}",
+        beyond[0]
+    );
+    assert_eq!(report["summary"]["beyond_3_sigma"], 4);
 }

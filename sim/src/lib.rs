@@ -16,6 +16,7 @@ pub mod bench;
 pub mod budget;
 pub mod config;
 pub mod cosim;
+pub mod coverage;
 pub mod datasheet;
 pub mod drift;
 pub mod edf;

@@ -31,6 +31,7 @@ use super::probe::DriveProbe;
 use super::profile::{self, ClippedRecords, Profile, ProfileRun, RateTrace};
 use crate::config::{self, Experiment};
 use crate::config::{Drive, Filter, Frontend, Points};
+use crate::coverage::{Scored, beyond_three_sigma, uncovered_errors};
 use crate::drift::{DeviceAt, Drift};
 use crate::engine::Engine;
 use crate::error::{ConfigError, FieldError, RunError, ScenarioError};
@@ -418,6 +419,32 @@ pub fn design_ratio_warning(steps: &[FieldStep], knowns: &Knowns) -> Option<Stri
             "warning: at {} deg C the drive-gain ratio g2/g1 is the design's (no coupling at rest that measures it within {:e}, no [drive_probe]) and [datasheet] gives no drive_gain_ratio_uncertainty: a drive gain that drifted is not in the sigma",
             design.join(", "),
             selfcal::AT_REST_RATIO_SIGMA
+        )
+    })
+}
+
+/// The self-calibration errors (against the simulated truth) that lie
+/// beyond 3 of their reported sigmas: one line naming each by step and
+/// output, and the inputs outside the budget that most often put them
+/// there, or None. A run on a board has no truth to compare with; in the
+/// simulator a sigma that does not cover its error is said, never left
+/// to be read off the table.
+pub fn uncovered_error_warning(steps: &[FieldStep]) -> Option<String> {
+    let scored: Vec<Scored> = steps
+        .iter()
+        .flat_map(|st| {
+            (0..2).map(move |output| Scored {
+                device: None,
+                temperature_c: st.temperature_c,
+                output,
+                t: st.selfcal_error[output] / st.selfcal_error_uncertainty[output],
+            })
+        })
+        .collect();
+    uncovered_errors(&beyond_three_sigma(&scored), scored.len()).map(|line| {
+        format!(
+            "{line}; an input outside the budget is off: self-calibration takes lambda from \
+             [datasheet] angular_gain, within its angular_gain_uncertainty"
         )
     })
 }
@@ -929,6 +956,7 @@ pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldRepor
         design_ratio_warning(&steps, &knowns),
         profile_clip_warning(&steps),
         baseline_clip_warning,
+        uncovered_error_warning(&steps),
     ]
     .into_iter()
     .flatten()

@@ -280,7 +280,11 @@ impl Sweep {
             }),
             Ok(report) => {
                 clocks = report.clocks;
+                // The summary names every uncovered error of the spread
+                // itself (`summary::uncovered_errors`), by part.
+                let uncovered = scenario::uncovered_error_warning(&report.steps);
                 warnings = report.warnings;
+                warnings.retain(|w| Some(w) != uncovered.as_ref());
                 failed.extend(report.failed.into_iter().map(|f| DeviceFailure {
                     temperature_c: Some(f.temperature_c),
                     stage: f.stage.into(),

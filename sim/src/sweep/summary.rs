@@ -18,6 +18,7 @@
 //!   error is never left to a fraction alone.
 
 use super::DeviceResult;
+pub use crate::coverage::{NAMED, Scored, beyond_three_sigma, named, uncovered_errors};
 use serde::{Deserialize, Serialize};
 
 /// The percentiles reported, in percent.
@@ -48,25 +49,6 @@ pub struct Summary {
     /// One line each: the parts' distinct warnings ([`carried_warnings`]),
     /// then the errors beyond 3 sigma ([`uncovered_errors`]).
     pub warnings: Vec<String>,
-}
-
-/// At most this many parts, or errors, are named in a warning's line; the
-/// JSON's `devices` name them all.
-pub const NAMED: usize = 8;
-
-/// The first `NAMED` items, comma-separated, and ", ..." when there are
-/// more.
-fn named<T: std::fmt::Display>(items: &[T]) -> String {
-    let mut s = items
-        .iter()
-        .take(NAMED)
-        .map(T::to_string)
-        .collect::<Vec<_>>()
-        .join(", ");
-    if items.len() > NAMED {
-        s.push_str(", ...");
-    }
-    s
 }
 
 /// Each distinct warning of `parts` (index, the warnings of its field run)
@@ -135,49 +117,6 @@ fn figures_in_parentheses_blanked(text: &str) -> String {
     out
 }
 
-/// An error and its sigma: which part, step and output.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Scored {
-    /// The part's index.
-    pub device: u32,
-    /// The step's temperature (deg C).
-    pub temperature_c: f64,
-    /// The output, 0 or 1.
-    pub output: usize,
-    /// Error over its reported sigma.
-    pub t: f64,
-}
-
-impl std::fmt::Display for Scored {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "device {} at {} deg C output {} ({:+.3} sigma)",
-            self.device,
-            self.temperature_c,
-            self.output + 1,
-            self.t
-        )
-    }
-}
-
-/// The errors beyond 3 of their reported sigmas.
-pub fn beyond_three_sigma(scored: &[Scored]) -> Vec<Scored> {
-    scored.iter().filter(|s| s.t.abs() > 3.0).copied().collect()
-}
-
-/// One line naming `beyond` ([`beyond_three_sigma`] of `total` errors),
-/// or None when there are none.
-pub fn uncovered_errors(beyond: &[Scored], total: usize) -> Option<String> {
-    (!beyond.is_empty()).then(|| {
-        format!(
-            "warning: {} of {total} errors lie beyond 3 of their reported sigmas, which do not cover them: {}",
-            beyond.len(),
-            named(beyond)
-        )
-    })
-}
-
 /// Nearest-rank percentile `p` (0 < p <= 100) of sorted values.
 fn nearest_rank(sorted: &[f64], p: f64) -> f64 {
     let rank = ((p / 100.0) * sorted.len() as f64).ceil() as usize;
@@ -201,7 +140,7 @@ impl Summary {
             .flat_map(|d| d.steps.iter().map(move |s| (d.index, s)))
             .flat_map(|(device, s)| {
                 (0..2).map(move |output| Scored {
-                    device,
+                    device: Some(device),
                     temperature_c: s.temperature_c,
                     output,
                     t: s.sf_selfcal_error[output] / s.selfcal_error_uncertainty[output],
@@ -389,7 +328,7 @@ mod tests {
     #[test]
     fn errors_beyond_three_sigma_are_named_and_those_within_are_not() {
         let at = |device, t| Scored {
-            device,
+            device: Some(device),
             temperature_c: 5.0,
             output: 0,
             t,

@@ -1,0 +1,69 @@
+//! Whether reported sigmas cover their errors, in one line: the errors
+//! beyond 3 of their sigmas, each named by its step and output (and its
+//! part, in a sweep). `gyrocal field` says it for one device
+//! (`crate::field::scenario::uncovered_error_warning`), `gyrocal sweep`
+//! over the spread (`crate::sweep::summary`).
+
+/// At most this many parts, or errors, are named in a warning's line; the
+/// JSON's `devices` name them all.
+pub const NAMED: usize = 8;
+
+/// The first `NAMED` items, comma-separated, and ", ..." when there are
+/// more.
+pub fn named<T: std::fmt::Display>(items: &[T]) -> String {
+    let mut s = items
+        .iter()
+        .take(NAMED)
+        .map(T::to_string)
+        .collect::<Vec<_>>()
+        .join(", ");
+    if items.len() > NAMED {
+        s.push_str(", ...");
+    }
+    s
+}
+
+/// An error and its sigma: which part (in a sweep), step and output.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Scored {
+    /// The part's index (`None`: the one device of a field run).
+    pub device: Option<u32>,
+    /// The step's temperature (deg C).
+    pub temperature_c: f64,
+    /// The output, 0 or 1.
+    pub output: usize,
+    /// Error over its reported sigma.
+    pub t: f64,
+}
+
+impl std::fmt::Display for Scored {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if let Some(device) = self.device {
+            write!(f, "device {device} ")?;
+        }
+        write!(
+            f,
+            "at {} deg C output {} ({:+.3} sigma)",
+            self.temperature_c,
+            self.output + 1,
+            self.t
+        )
+    }
+}
+
+/// The errors beyond 3 of their reported sigmas.
+pub fn beyond_three_sigma(scored: &[Scored]) -> Vec<Scored> {
+    scored.iter().filter(|s| s.t.abs() > 3.0).copied().collect()
+}
+
+/// One line naming `beyond` ([`beyond_three_sigma`] of `total` errors),
+/// or None when there are none.
+pub fn uncovered_errors(beyond: &[Scored], total: usize) -> Option<String> {
+    (!beyond.is_empty()).then(|| {
+        format!(
+            "warning: {} of {total} errors lie beyond 3 of their reported sigmas, which do not cover them: {}",
+            beyond.len(),
+            named(beyond)
+        )
+    })
+}
