@@ -411,3 +411,44 @@ fn calibrate_says_when_the_drives_were_scaled_for_the_adcs() {
         "{line}"
     );
 }
+
+/// The in-process board's truth against a datasheet lambda 10% low,
+/// claimed within 1%: both self-calibrated scale factors lie many sigmas
+/// off, and the run says so in one line naming them and the input to
+/// check, as `gyrocal field` does. With the datasheet's lambda right the
+/// line is absent.
+#[test]
+fn an_error_its_sigma_does_not_cover_is_said_in_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("lambda.toml");
+    let line = "warning: 2 of 2 errors lie beyond 3 of their reported sigmas";
+    for (lambda, said) in [(0.63, true), (0.7, false)] {
+        let text = format!(
+            "{DEVICE}\n[datasheet]\nangular_gain = {lambda}\nangular_gain_uncertainty = 0.01\n\
+             drive_gain_ratio_uncertainty = 0.004\n"
+        );
+        std::fs::write(&config, text).unwrap();
+        let run = calibrate(&config, &[]);
+        let lines: Vec<&str> = run["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|w| w.as_str().unwrap())
+            .filter(|w| w.starts_with(line))
+            .collect();
+        assert_eq!(
+            lines.len(),
+            usize::from(said),
+            "lambda {lambda}: {}",
+            run["warnings"]
+        );
+        if said {
+            assert!(
+                lines[0].contains("at 25 deg C output 1 (-")
+                    && lines[0].contains("[datasheet] angular_gain"),
+                "{}",
+                lines[0]
+            );
+        }
+    }
+}

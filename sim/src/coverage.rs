@@ -67,3 +67,15 @@ pub fn uncovered_errors(beyond: &[Scored], total: usize) -> Option<String> {
         )
     })
 }
+
+/// `uncovered_errors` of self-calibration errors (against a simulated
+/// truth), with the input outside the budget that most often puts one
+/// there: lambda, which self-calibration takes from the datasheet.
+pub fn uncovered_selfcal_errors(scored: &[Scored]) -> Option<String> {
+    uncovered_errors(&beyond_three_sigma(scored), scored.len()).map(|line| {
+        format!(
+            "{line}; an input outside the budget is off: self-calibration takes lambda from \
+             [datasheet] angular_gain, within its angular_gain_uncertainty"
+        )
+    })
+}

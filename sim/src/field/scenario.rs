@@ -31,7 +31,7 @@ use super::probe::DriveProbe;
 use super::profile::{self, ClippedRecords, Profile, ProfileRun, RateTrace};
 use crate::config::{self, Experiment};
 use crate::config::{Drive, Filter, Frontend, Points};
-use crate::coverage::{Scored, beyond_three_sigma, uncovered_errors};
+use crate::coverage::{Scored, uncovered_selfcal_errors};
 use crate::drift::{DeviceAt, Drift};
 use crate::engine::Engine;
 use crate::error::{ConfigError, FieldError, RunError, ScenarioError};
@@ -441,12 +441,7 @@ pub fn uncovered_error_warning(steps: &[FieldStep]) -> Option<String> {
             })
         })
         .collect();
-    uncovered_errors(&beyond_three_sigma(&scored), scored.len()).map(|line| {
-        format!(
-            "{line}; an input outside the budget is off: self-calibration takes lambda from \
-             [datasheet] angular_gain, within its angular_gain_uncertainty"
-        )
-    })
+    uncovered_selfcal_errors(&scored)
 }
 
 /// The steps whose profile runs clipped an ADC (`RateTrace::clipped`):

@@ -161,17 +161,20 @@ fn in_process(
     let fe = file.front_end().map_err(Failure::run)?;
     let (table, clocks) =
         scenario::rate_table(&file.exp, &fe, &at, knowns, &cal.operating).map_err(Failure::run)?;
+    let truth = Truth {
+        device: at,
+        sf_true_per_dps: table.sf_per_dps,
+        sf_true_uncertainty: table.uncertainty,
+        clocks,
+    };
+    let mut warnings = cal.warnings(knowns);
+    warnings.extend(output::uncovered(&cal, &truth));
     Ok(Outcome {
         board: "in-process".into(),
-        warnings: cal.warnings(knowns),
+        warnings,
         cal,
         samples,
         wall_s,
-        truth: Some(Truth {
-            device: at,
-            sf_true_per_dps: table.sf_per_dps,
-            sf_true_uncertainty: table.uncertainty,
-            clocks,
-        }),
+        truth: Some(truth),
     })
 }

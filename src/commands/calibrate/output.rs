@@ -5,6 +5,7 @@
 use super::{Outcome, Truth};
 use gyrocal_host::identify::Estimate;
 use gyrocal_host::selfcal::{ScaledDrives, SelfCal};
+use gyrocal_sim::coverage::{Scored, uncovered_selfcal_errors};
 use serde_json::{Map, Value, json};
 use std::fmt::Write as _;
 
@@ -38,6 +39,25 @@ fn error(sf: [f64; 2], truth: [f64; 2]) -> [f64; 2] {
 /// measurements (as `field`'s `selfcal_error_uncertainty`).
 fn error_sigma(cal: &SelfCal, t: &Truth) -> [f64; 2] {
     std::array::from_fn(|k| cal.sf_selfcal_uncertainty.total[k].hypot(t.sf_true_uncertainty[k]))
+}
+
+/// The line naming the self-calibration errors beyond 3 of their sigmas
+/// against the in-process board's truth (as `gyrocal field` says it), or
+/// None.
+pub fn uncovered(cal: &SelfCal, t: &Truth) -> Option<String> {
+    let (e, sigma) = (
+        error(cal.sf_selfcal_per_dps, t.sf_true_per_dps),
+        error_sigma(cal, t),
+    );
+    let scored: Vec<Scored> = (0..2)
+        .map(|output| Scored {
+            device: None,
+            temperature_c: t.device.temperature_c,
+            output,
+            t: e[output] / sigma[output],
+        })
+        .collect();
+    uncovered_selfcal_errors(&scored)
 }
 
 /// The one JSON object of `--json`.
