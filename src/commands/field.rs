@@ -16,7 +16,8 @@
 //! one line each, also printed as progress and in the summary (ADC noise
 //! below half an ADC step, `gyrocal_sim::frontend::dithers`; a design
 //! drive-gain ratio that no `[datasheet] drive_gain_ratio_uncertainty`
-//! bounds, `design_ratio_warning`), and per step `carrier_fold`: the
+//! bounds, `design_ratio_warning`; self-cal errors beyond 3 of their
+//! sigmas, `uncovered_error_warning`), and per step `carrier_fold`: the
 //! nearest fold of the carrier tables' errors, whether it is in the
 //! passband, and `static_fold`, a short fold slower than a window, whose
 //! error no sigma sees. `--out` writes field.json, field.csv and

@@ -21,8 +21,9 @@
 //!   as in `gyrocal field`), one per output, `clocks`, `wall_s`, `samples`
 //!   (read and missed over the run), `warnings` (what the sigma leaves
 //!   out, one line each, also on stderr: a drive-gain ratio nothing
-//!   measured nor bounds, a carrier on a slow fold) and `truth` (null over
-//!   the wire). Progress goes to stderr.
+//!   measured nor bounds, a carrier on a slow fold; in process, self-cal
+//!   errors beyond 3 of their sigmas against the truth) and `truth` (null
+//!   over the wire). Progress goes to stderr.
 
 pub mod output;
 pub mod watch;
@@ -78,7 +79,8 @@ pub struct Outcome {
     /// The cycle's result.
     pub cal: SelfCal,
     /// What the cycle's sigma leaves out, one line each
-    /// (`SelfCal::warnings`).
+    /// (`SelfCal::warnings`), and in process the errors it does not cover
+    /// (`output::uncovered`).
     pub warnings: Vec<String>,
     /// z samples read and missed.
     pub samples: SampleCounts,
