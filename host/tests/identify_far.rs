@@ -137,19 +137,28 @@ fn no_resonance_in_reach_is_one_clear_error() {
     assert!(!e.contains('\n'));
 }
 
-/// A datasheet Q far beyond the process spread (40 times the part's, or
-/// a 40th of it): the search cannot settle on the mode, and the one line
-/// says which key to correct, not a bare "did not settle" or "the fit
-/// diverged".
+/// A datasheet Q a thousand times off the part's either way (a leaky
+/// package, a datasheet's minimum Q, another part's datasheet): each mode
+/// is still found within 3 of its sigmas, at the first search or from the
+/// Q a missed one measured (`identify::identify_mode`).
 #[test]
-fn a_datasheet_q_far_off_is_named() {
+fn a_datasheet_q_far_off_is_still_found() {
     let truth = paper_truth();
-    for q_rel in [40.0, 1.0 / 40.0, 25.0, 1.0 / 25.0, 1.0 / 30.0] {
+    for q_rel in [1000.0, 40.0, 1.0 / 40.0, 1.0 / 1000.0] {
         let ds = datasheet(truth[0].0 * 1.001, truth[1].0, 55e3 * q_rel);
-        let e = identification_error(truth, &ds);
-        eprintln!("Q x {q_rel}: {e}");
-        assert!(e.starts_with("identification of mode 1: "), "{e}");
-        assert!(e.contains("[datasheet] q1"), "Q x {q_rel}: {e}");
-        assert!(!e.contains('\n'));
+        let mut b = board(truth);
+        let id = identify::identify(&mut b, &knowns(ds.clone()), &ds)
+            .unwrap_or_else(|e| panic!("Q x {q_rel}: {e}"));
+        let (m, (fk, bk, _)) = (&id.modes[0], truth[0]);
+        assert!(
+            (m.f_hz.value - fk).abs() < 3.0 * m.f_hz.uncertainty,
+            "Q x {q_rel}: {:?}",
+            m.f_hz
+        );
+        assert!(
+            (m.q.value - fk / bk).abs() < 3.0 * m.q.uncertainty,
+            "Q x {q_rel}: {:?}",
+            m.q
+        );
     }
 }

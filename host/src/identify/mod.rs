@@ -310,28 +310,102 @@ impl Identified {
 /// scan when it cannot converge, then the fine sweep and its fit (the
 /// mode alone, no front-end slope, the residuals' sigmas: [`identify`]
 /// refits it with the front end's delay and completes the sigmas).
+///
+/// The search's carrier spacing and waits come from the datasheet's Q.
+/// When it misses the mode in a way a wrong Q explains (`Missed`), it
+/// tries again (`RETRIES` times at most) from the Q it measured there, or
+/// from ten times the Q it tried when it measured none; a success costs
+/// the clocks of every try and changes nothing else. A mode found at the
+/// first try takes exactly the path it took before the retries existed.
 pub fn identify_mode(
     board: &mut dyn Board,
     knowns: &Knowns,
     k: usize,
     guess_hz: f64,
 ) -> Result<(ModeFit, u64), Error> {
+    let first = match attempt(board, knowns, k, guess_hz)? {
+        Ok(found) => return Ok(found),
+        Err(missed) => missed,
+    };
+    let (mut last, mut clocks, mut tried) = (first.retry_q, first.clocks, vec![]);
+    let mut latest = None;
+    while let Some(q) = last.filter(|_| tried.len() < RETRIES) {
+        let mut retry = knowns.clone();
+        match k {
+            0 => retry.nominal.q1 = q,
+            _ => retry.nominal.q2 = q,
+        }
+        tried.push(format!("{q:.0}"));
+        match attempt(board, &retry, k, guess_hz)? {
+            Ok((fit, more)) => return Ok((fit, clocks + more)),
+            Err(missed) => {
+                (last, clocks) = (missed.retry_q, clocks + missed.clocks);
+                latest = Some(missed.reason);
+            }
+        }
+    }
+    let reason = match latest {
+        None => first.reason,
+        Some(latest) => format!(
+            "{}; tried again from Q{} = {}, the last time: {latest}",
+            first.reason,
+            k + 1,
+            tried.join(" and ")
+        ),
+    };
+    Err(Error::Identification {
+        mode: k + 1,
+        reason,
+    })
+}
+
+/// Second tries of [`identify_mode`] at most, each from the Q the last
+/// one measured (or ten times its own, `search::Unsettled::retry_q`):
+/// two reach a datasheet Q a hundred times low.
+const RETRIES: usize = 2;
+
+/// An attempt at a mode that missed it: why, the Q a second attempt
+/// starts from when a wrong datasheet Q explains the miss, and the clocks
+/// it spent.
+struct Missed {
+    reason: String,
+    retry_q: Option<f64>,
+    clocks: u64,
+}
+
+/// One attempt of [`identify_mode`] with `knowns`' Q: the fit, or how it
+/// missed (a board's error is an error).
+fn attempt(
+    board: &mut dyn Board,
+    knowns: &Knowns,
+    k: usize,
+    guess_hz: f64,
+) -> Result<Result<(ModeFit, u64), Missed>, Error> {
     let max = [knowns.amplitude.0, knowns.amplitude.1][k].abs();
     let mut probe = Prober::new(board, knowns, k, max / 8.0);
     let bw = knowns.bandwidth_hz(k);
+    let q = knowns.nominal.q(k);
+    let missed = |reason: String, retry_q: Option<f64>, clocks: u64| Missed {
+        reason,
+        retry_q,
+        clocks,
+    };
     let mut scanned = false;
     let found = match search::coarse(&mut probe, guess_hz, bw)? {
         Ok(found) => found,
         Err(_) => {
             scanned = true;
             let start = search::scan(&mut probe, guess_hz, bw)?;
-            search::coarse(&mut probe, start, bw)?.map_err(|why| Error::Identification {
-                mode: k + 1,
-                reason: format!(
-                    "the scan of +-{}% around {guess_hz:.1} Hz pointed at {start:.1} Hz, but the search from there did not settle: {why}",
-                    100.0 * SCAN_SPAN
-                ),
-            })?
+            match search::coarse(&mut probe, start, bw)? {
+                Ok(found) => found,
+                Err(why) => {
+                    let reason = format!(
+                        "the scan of +-{}% around {guess_hz:.1} Hz pointed at {start:.1} Hz, but the search from there did not settle: {why}",
+                        100.0 * SCAN_SPAN
+                    );
+                    return Ok(Err(missed(reason, why.retry_q(q), probe.clocks)));
+                }
+            }
         }
     };
     let (centre, bk) = found;
@@ -347,29 +421,35 @@ pub fn identify_mode(
         sweep.push(probe.measure(centre + s * bk)?);
     }
     let alone = fit::FrontSlope::default();
-    let mut fit = fit::fit_mode(
+    let fitted = fit::fit_mode(
         &sweep,
         centre,
         bk,
         Some(knowns.clock_hz),
         &fit::no_pull,
         alone,
-    )
-    .map_err(|reason| Error::Identification {
-        mode: k + 1,
-        reason: format!(
-            "the fine sweep around {centre:.1} Hz, {bk:.4} Hz a step (the coarse search's \
-             bandwidth; the datasheet's Q{} = {} gives {bw:.4} Hz), could not be fitted: \
-             {reason}; a datasheet Q far from the part's misleads the search: check \
-             [datasheet] q{}",
-            k + 1,
-            knowns.nominal.q(k),
-            k + 1
-        ),
-    })?;
+    );
+    let mut fit = match fitted {
+        Ok(fit) => fit,
+        Err(why) => {
+            let reason = format!(
+                "the fine sweep around {centre:.1} Hz, {bk:.4} Hz a step (the coarse search's \
+                 bandwidth; Q{} = {q:.0} gives {bw:.4} Hz), could not be fitted: \
+                 {why}; a datasheet Q far from the part's misleads the search: check \
+                 [datasheet] q{}",
+                k + 1,
+                k + 1
+            );
+            // The coarse search's bandwidth, when it is far from the
+            // datasheet's, is the better guess of Q.
+            let measured = centre / bk;
+            let far = !(0.5..=2.0).contains(&(measured / q));
+            return Ok(Err(missed(reason, far.then_some(measured), probe.clocks)));
+        }
+    };
     fit.waited_s = probe.waited_s();
     fit.scanned = scanned;
-    Ok((fit, probe.clocks))
+    Ok(Ok((fit, probe.clocks)))
 }
 
 /// Mode k's fine sweep fitted again, with the other mode's `pull` and

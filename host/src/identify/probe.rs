@@ -73,8 +73,9 @@ impl<'a> Prober<'a> {
         self.k + 1
     }
 
-    /// The datasheet's Q of the mode.
-    pub(super) fn datasheet_q(&self) -> f64 {
+    /// The Q of the mode the search starts from: the datasheet's, or a
+    /// second try's (`super::identify_mode`).
+    pub(super) fn q_guess(&self) -> f64 {
         self.knowns.nominal.q(self.k)
     }
 

@@ -7,14 +7,17 @@ use super::{C64, MAX_MOVES, SCAN_POINTS, SCAN_SPAN};
 use crate::error::Error;
 use crate::theory::hold_gain;
 
-/// A bandwidth the coarse search accepts, against the datasheet's: Q is
-/// within a factor of 20 of it (process spread is a factor of 2). The
-/// search reaches less than that when the datasheet's Q is too low: its
-/// carriers start a datasheet bandwidth apart and wait its time constant,
-/// too wide and too short for the part. Measured on the consumer device
-/// (Q 3000, `tests/field_cli.rs`'s): a datasheet Q1 from 350 (8.6 times
-/// low) to 60,000 (20 times high) is identified, 250 and 300 are not, and
-/// such a failure names `[datasheet] q` (`Unsettled`).
+/// A bandwidth the coarse search accepts, against the one of the Q it
+/// starts from: Q is within a factor of 20 of it (process spread is a
+/// factor of 2). A datasheet Q too low reaches less than that: the
+/// carriers start a bandwidth apart and wait its time constant, too wide
+/// and too short for the part. Then `Unsettled::retry_q` gives the Q a
+/// second search starts from (`super::identify_mode`). Measured on the
+/// consumer device (Q 3000, `tests/field_cli.rs`'s): one search alone
+/// identified a datasheet Q1 from 350 to 60,000; with the second tries,
+/// from 3 to 200,000 (the highest tried). At Q1 = 1 the first carriers,
+/// a 25 kHz bandwidth apart, leave the clock's range, and the step fails
+/// in one line that names `[datasheet] q`.
 const BANDWIDTH_RANGE: f64 = 20.0;
 
 /// Highest carrier the search probes, as a fraction of the clock (the
@@ -25,15 +28,25 @@ const MAX_CARRIER_RATIO: f64 = 0.45;
 #[derive(Clone, Copy, Debug, PartialEq, thiserror::Error)]
 pub(super) enum Unsettled {
     /// A carrier it would probe lies outside (0, 0.45 clock).
-    #[error("a carrier it would probe lies outside 0 to {top:.1} Hz")]
-    Carrier { top: f64 },
+    #[error(
+        "a carrier it would probe, {spacing:.1} Hz from {centre:.1} Hz, lies outside 0 to \
+         {top:.1} Hz (the spacing starts at the bandwidth of Q{mode} = {q:.0}: if the part's Q \
+         is far from it, correct [datasheet] q{mode})"
+    )]
+    Carrier {
+        mode: usize,
+        centre: f64,
+        spacing: f64,
+        top: f64,
+        q: f64,
+    },
     /// Three points gave no finite, positive bandwidth. Their spacing
     /// starts at the datasheet's bandwidth: a Q far too low spreads them
     /// over the whole resonance and beyond.
     #[error(
         "three points {spacing:.4} Hz apart around {centre:.1} Hz gave no finite, positive \
-         bandwidth (the spacing starts at the bandwidth of the datasheet's Q{mode} = {q}: if \
-         the part's Q is far from it, correct [datasheet] q{mode})"
+         bandwidth (the spacing starts at the bandwidth of Q{mode} = {q:.0}: if the part's Q \
+         is far from it, correct [datasheet] q{mode})"
     )]
     NoEstimate {
         mode: usize,
@@ -45,7 +58,7 @@ pub(super) enum Unsettled {
     /// datasheet's bandwidth: most likely the datasheet's Q is wrong.
     #[error(
         "the resonance near {fk:.1} Hz measured {found:.4} Hz wide, more than {BANDWIDTH_RANGE}x \
-         from the {datasheet:.4} Hz of the datasheet's Q{mode} = {q} (a Q that far off also \
+         from the {expected:.4} Hz of Q{mode} = {q:.0} (a Q that far off also \
          misleads the measurement, through the carriers' spacing and the time waited at each): \
          correct [datasheet] q{mode}"
     )]
@@ -53,13 +66,31 @@ pub(super) enum Unsettled {
         mode: usize,
         fk: f64,
         found: f64,
-        datasheet: f64,
+        expected: f64,
         q: f64,
     },
     /// `MAX_MOVES` moves without settling.
     #[error("{MAX_MOVES} moves did not settle")]
     Moves,
 }
+
+impl Unsettled {
+    /// The Q a second search starts from when a wrong datasheet Q `q`
+    /// explains this miss: the one measured, when the bandwidth was out of
+    /// range; ten times the datasheet's when three points a datasheet
+    /// bandwidth apart gave none (they spanned the resonance and beyond).
+    pub(super) fn retry_q(&self, q: f64) -> Option<f64> {
+        match *self {
+            Unsettled::Bandwidth { fk, found, .. } => Some(fk / found),
+            Unsettled::NoEstimate { .. } => Some(RETRY_Q_FACTOR * q),
+            Unsettled::Carrier { .. } | Unsettled::Moves => None,
+        }
+    }
+}
+
+/// How much higher than the datasheet's a second search takes Q when the
+/// first could estimate no bandwidth (`Unsettled::retry_q`).
+const RETRY_Q_FACTOR: f64 = 10.0;
 
 /// The coarse search from `start` with datasheet bandwidth `bw`: the
 /// centre of three carriers moves to the narrow-band estimate of fk, their
@@ -78,7 +109,13 @@ pub(super) fn coarse(
     let mut spacing = bw;
     for _ in 0..MAX_MOVES {
         if centre - spacing <= 0.0 || centre + spacing >= top {
-            return Ok(Err(Unsettled::Carrier { top }));
+            return Ok(Err(Unsettled::Carrier {
+                mode: probe.mode(),
+                centre,
+                spacing,
+                top,
+                q: probe.q_guess(),
+            }));
         }
         let mut pts: Vec<(f64, C64)> = vec![];
         for s in [-1.0, 0.0, 1.0] {
@@ -89,7 +126,7 @@ pub(super) fn coarse(
                 mode: probe.mode(),
                 centre,
                 spacing,
-                q: probe.datasheet_q(),
+                q: probe.q_guess(),
             }));
         };
         if !(bw / BANDWIDTH_RANGE..=bw * BANDWIDTH_RANGE).contains(&bk) {
@@ -97,8 +134,8 @@ pub(super) fn coarse(
                 mode: probe.mode(),
                 fk,
                 found: bk,
-                datasheet: bw,
-                q: probe.datasheet_q(),
+                expected: bw,
+                q: probe.q_guess(),
             }));
         }
         probe.set_amplitude_for_peak(peak);
