@@ -323,15 +323,15 @@ fn factory_settings_that_clip_are_said_and_leave_the_baseline_null() {
 /// consumer device's 3000, a datasheet's minimum Q): the search misses the
 /// mode with the datasheet's spacing and waits, tries again from the Q it
 /// measured or ten times its own, and identifies Q1 within 3 sigma; the
-/// scale factors then come within 3 sigma too. At Q1 = 1 the first
-/// carriers leave the clock's range: the step fails in one line naming
-/// the key to correct, with exit status 1.
+/// scale factors then come within 3 sigma too. At Q1 = 0.05 two more
+/// tries do not reach it: the step fails in one line naming the key to
+/// correct, with exit status 1.
 #[test]
 fn a_datasheet_q_far_off_is_found_or_named() {
     let drift = "[drift]\ntemperatures_c = [25]\ntcf1_ppm_per_k = -30\ntcf2_ppm_per_k = -30\n";
     let dir = tempfile::tempdir().unwrap();
     let config = dir.path().join("q_far_off.toml");
-    for q1 in [100, 20, 1] {
+    for q1 in [100.0, 20.0, 0.05] {
         std::fs::write(&config, format!("{GOOD}{drift}[datasheet]\nq1 = {q1}\n")).unwrap();
         let run = gyrocal(&[
             OsStr::new("field"),
@@ -341,7 +341,7 @@ fn a_datasheet_q_far_off_is_found_or_named() {
         ]);
         let stderr = common::stderr(&run);
         let report: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
-        if q1 > 1 {
+        if q1 > 1.0 {
             assert!(run.status.success(), "q1 = {q1}: {stderr}");
             let step = &report["steps"][0];
             let id = &step["identified"];

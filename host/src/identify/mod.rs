@@ -335,7 +335,7 @@ pub fn identify_mode(
             0 => retry.nominal.q1 = q,
             _ => retry.nominal.q2 = q,
         }
-        tried.push(format!("{q:.0}"));
+        tried.push(search::shown_q(q));
         match attempt(board, &retry, k, guess_hz)? {
             Ok((fit, more)) => return Ok((fit, clocks + more)),
             Err(missed) => {
@@ -434,10 +434,11 @@ fn attempt(
         Err(why) => {
             let reason = format!(
                 "the fine sweep around {centre:.1} Hz, {bk:.4} Hz a step (the coarse search's \
-                 bandwidth; Q{} = {q:.0} gives {bw:.4} Hz), could not be fitted: \
+                 bandwidth; Q{} = {} gives {bw:.4} Hz), could not be fitted: \
                  {why}; a datasheet Q far from the part's misleads the search: check \
                  [datasheet] q{}",
                 k + 1,
+                search::shown_q(q),
                 k + 1
             );
             // The coarse search's bandwidth, when it is far from the

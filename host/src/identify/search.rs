@@ -15,9 +15,9 @@ use crate::theory::hold_gain;
 /// second search starts from (`super::identify_mode`). Measured on the
 /// consumer device (Q 3000, `tests/field_cli.rs`'s): one search alone
 /// identified a datasheet Q1 from 350 to 60,000; with the second tries,
-/// from 3 to 200,000 (the highest tried). At Q1 = 1 the first carriers,
-/// a 25 kHz bandwidth apart, leave the clock's range, and the step fails
-/// in one line that names `[datasheet] q`.
+/// from 0.3 to 200,000 (the highest tried). At Q1 = 0.05 two more tries
+/// do not reach it, and the step fails in one line that names
+/// `[datasheet] q`.
 const BANDWIDTH_RANGE: f64 = 20.0;
 
 /// Highest carrier the search probes, as a fraction of the clock (the
@@ -30,8 +30,9 @@ pub(super) enum Unsettled {
     /// A carrier it would probe lies outside (0, 0.45 clock).
     #[error(
         "a carrier it would probe, {spacing:.1} Hz from {centre:.1} Hz, lies outside 0 to \
-         {top:.1} Hz (the spacing starts at the bandwidth of Q{mode} = {q:.0}: if the part's Q \
-         is far from it, correct [datasheet] q{mode})"
+         {top:.1} Hz (the spacing starts at the bandwidth of Q{mode} = {}: if the part's Q \
+         is far from it, correct [datasheet] q{mode})",
+        shown_q(*q)
     )]
     Carrier {
         mode: usize,
@@ -45,8 +46,9 @@ pub(super) enum Unsettled {
     /// over the whole resonance and beyond.
     #[error(
         "three points {spacing:.4} Hz apart around {centre:.1} Hz gave no finite, positive \
-         bandwidth (the spacing starts at the bandwidth of Q{mode} = {q:.0}: if the part's Q \
-         is far from it, correct [datasheet] q{mode})"
+         bandwidth (the spacing starts at the bandwidth of Q{mode} = {}: if the part's Q \
+         is far from it, correct [datasheet] q{mode})",
+        shown_q(*q)
     )]
     NoEstimate {
         mode: usize,
@@ -58,9 +60,10 @@ pub(super) enum Unsettled {
     /// datasheet's bandwidth: most likely the datasheet's Q is wrong.
     #[error(
         "the resonance near {fk:.1} Hz measured {found:.4} Hz wide, more than {BANDWIDTH_RANGE}x \
-         from the {expected:.4} Hz of Q{mode} = {q:.0} (a Q that far off also \
+         from the {expected:.4} Hz of Q{mode} = {} (a Q that far off also \
          misleads the measurement, through the carriers' spacing and the time waited at each): \
-         correct [datasheet] q{mode}"
+         correct [datasheet] q{mode}",
+        shown_q(*q)
     )]
     Bandwidth {
         mode: usize,
@@ -74,16 +77,25 @@ pub(super) enum Unsettled {
     Moves,
 }
 
+/// A Q as a message shows it: whole above 10, three decimals below.
+pub(super) fn shown_q(q: f64) -> String {
+    if q >= 10.0 {
+        format!("{q:.0}")
+    } else {
+        format!("{q:.3}")
+    }
+}
+
 impl Unsettled {
-    /// The Q a second search starts from when a wrong datasheet Q `q`
-    /// explains this miss: the one measured, when the bandwidth was out of
-    /// range; ten times the datasheet's when three points a datasheet
-    /// bandwidth apart gave none (they spanned the resonance and beyond).
+    /// The Q a second search starts from when a wrong Q `q` explains this
+    /// miss: the one measured, when the bandwidth was out of range; ten
+    /// times `q` when three points a bandwidth apart gave none (they
+    /// spanned the resonance and beyond) or would leave the clock's range.
     pub(super) fn retry_q(&self, q: f64) -> Option<f64> {
         match *self {
             Unsettled::Bandwidth { fk, found, .. } => Some(fk / found),
-            Unsettled::NoEstimate { .. } => Some(RETRY_Q_FACTOR * q),
-            Unsettled::Carrier { .. } | Unsettled::Moves => None,
+            Unsettled::NoEstimate { .. } | Unsettled::Carrier { .. } => Some(RETRY_Q_FACTOR * q),
+            Unsettled::Moves => None,
         }
     }
 }
