@@ -385,11 +385,6 @@ fn attempt(
     let mut probe = Prober::new(board, knowns, k, max / 8.0);
     let bw = knowns.bandwidth_hz(k);
     let q = knowns.nominal.q(k);
-    let missed = |reason: String, retry_q: Option<f64>, clocks: u64| Missed {
-        reason,
-        retry_q,
-        clocks,
-    };
     let mut scanned = false;
     let found = match search::coarse(&mut probe, guess_hz, bw)? {
         Ok(found) => found,
@@ -403,7 +398,11 @@ fn attempt(
                         "the scan of +-{}% around {guess_hz:.1} Hz pointed at {start:.1} Hz, but the search from there did not settle: {why}",
                         100.0 * SCAN_SPAN
                     );
-                    return Ok(Err(missed(reason, why.retry_q(q), probe.clocks)));
+                    return Ok(Err(Missed {
+                        reason,
+                        retry_q: why.retry_q(),
+                        clocks: probe.clocks,
+                    }));
                 }
             }
         }
@@ -445,7 +444,11 @@ fn attempt(
             // datasheet's, is the better guess of Q.
             let measured = centre / bk;
             let far = !(0.5..=2.0).contains(&(measured / q));
-            return Ok(Err(missed(reason, far.then_some(measured), probe.clocks)));
+            return Ok(Err(Missed {
+                reason,
+                retry_q: far.then_some(measured),
+                clocks: probe.clocks,
+            }));
         }
     };
     fit.waited_s = probe.waited_s();

@@ -87,14 +87,16 @@ pub(super) fn shown_q(q: f64) -> String {
 }
 
 impl Unsettled {
-    /// The Q a second search starts from when a wrong Q `q` explains this
-    /// miss: the one measured, when the bandwidth was out of range; ten
+    /// The Q a second search starts from when a wrong Q (the one it
+    /// started from, `q`) explains this miss: the one measured, when the bandwidth was out of range; ten
     /// times `q` when three points a bandwidth apart gave none (they
     /// spanned the resonance and beyond) or would leave the clock's range.
-    pub(super) fn retry_q(&self, q: f64) -> Option<f64> {
+    pub(super) fn retry_q(&self) -> Option<f64> {
         match *self {
             Unsettled::Bandwidth { fk, found, .. } => Some(fk / found),
-            Unsettled::NoEstimate { .. } | Unsettled::Carrier { .. } => Some(RETRY_Q_FACTOR * q),
+            Unsettled::NoEstimate { q, .. } | Unsettled::Carrier { q, .. } => {
+                Some(RETRY_Q_FACTOR * q)
+            }
             Unsettled::Moves => None,
         }
     }
