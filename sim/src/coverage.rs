@@ -36,6 +36,23 @@ pub struct Scored {
     pub t: f64,
 }
 
+impl Scored {
+    /// Both outputs of one step: each error over its reported sigma.
+    pub fn outputs(
+        device: Option<u32>,
+        temperature_c: f64,
+        error: [f64; 2],
+        sigma: [f64; 2],
+    ) -> [Scored; 2] {
+        std::array::from_fn(|output| Scored {
+            device,
+            temperature_c,
+            output,
+            t: error[output] / sigma[output],
+        })
+    }
+}
+
 impl std::fmt::Display for Scored {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         if let Some(device) = self.device {

@@ -433,12 +433,12 @@ pub fn uncovered_error_warning(steps: &[FieldStep]) -> Option<String> {
     let scored: Vec<Scored> = steps
         .iter()
         .flat_map(|st| {
-            (0..2).map(move |output| Scored {
-                device: None,
-                temperature_c: st.temperature_c,
-                output,
-                t: st.selfcal_error[output] / st.selfcal_error_uncertainty[output],
-            })
+            Scored::outputs(
+                None,
+                st.temperature_c,
+                st.selfcal_error,
+                st.selfcal_error_uncertainty,
+            )
         })
         .collect();
     uncovered_selfcal_errors(&scored)

@@ -139,12 +139,12 @@ impl Summary {
             .iter()
             .flat_map(|d| d.steps.iter().map(move |s| (d.index, s)))
             .flat_map(|(device, s)| {
-                (0..2).map(move |output| Scored {
-                    device: Some(device),
-                    temperature_c: s.temperature_c,
-                    output,
-                    t: s.sf_selfcal_error[output] / s.selfcal_error_uncertainty[output],
-                })
+                Scored::outputs(
+                    Some(device),
+                    s.temperature_c,
+                    s.sf_selfcal_error,
+                    s.selfcal_error_uncertainty,
+                )
             })
             .collect();
         let beyond = beyond_three_sigma(&scored);

@@ -45,18 +45,12 @@ fn error_sigma(cal: &SelfCal, t: &Truth) -> [f64; 2] {
 /// against the in-process board's truth (as `gyrocal field` says it), or
 /// None.
 pub fn uncovered(cal: &SelfCal, t: &Truth) -> Option<String> {
-    let (e, sigma) = (
+    let scored = Scored::outputs(
+        None,
+        t.device.temperature_c,
         error(cal.sf_selfcal_per_dps, t.sf_true_per_dps),
         error_sigma(cal, t),
     );
-    let scored: Vec<Scored> = (0..2)
-        .map(|output| Scored {
-            device: None,
-            temperature_c: t.device.temperature_c,
-            output,
-            t: e[output] / sigma[output],
-        })
-        .collect();
     uncovered_selfcal_errors(&scored)
 }
 
