@@ -123,11 +123,26 @@ fn refuse(key: impl Into<String>, value: f64, allowed: impl Into<String>) -> Spr
     }
 }
 
-/// A parameter of the spread: its key, its nominal value, its spread.
+/// A parameter of the spread: its key, its nominal value, its spread,
+/// and what it must stay 5 sigma out (`Spread::validate`).
 struct Param {
     key: &'static str,
     nominal: f64,
     spread: Option<Sd>,
+    limit: Limit,
+}
+
+/// What a parameter 5 sigma out must stay to be a device the model takes.
+#[derive(Clone, Copy)]
+enum Limit {
+    /// f1: positive.
+    Positive,
+    /// The split: f2 = f1 + split positive, f1's sd and its own together.
+    PositiveF2,
+    /// Q and lambda: the nominal's sign.
+    Sign,
+    /// A coupling: within `MAX_COUPLING_DPS`.
+    Coupling,
 }
 
 impl Sd {
@@ -186,26 +201,39 @@ fn mix(mut z: u64) -> u64 {
 
 impl Spread {
     fn params(&self, nominal: &GyroParams) -> [Param; 7] {
-        let p = |key, nominal, spread| Param {
+        let p = |key, nominal, spread, limit| Param {
             key,
             nominal,
             spread,
+            limit,
         };
         [
-            p("f1_hz", nominal.f1_hz, self.f1_hz),
-            p("split_hz", nominal.f2_hz - nominal.f1_hz, self.split_hz),
-            p("q1", nominal.q1, self.q1),
-            p("q2", nominal.q2, self.q2),
-            p("angular_gain", nominal.angular_gain, self.angular_gain),
+            p("f1_hz", nominal.f1_hz, self.f1_hz, Limit::Positive),
+            p(
+                "split_hz",
+                nominal.f2_hz - nominal.f1_hz,
+                self.split_hz,
+                Limit::PositiveF2,
+            ),
+            p("q1", nominal.q1, self.q1, Limit::Sign),
+            p("q2", nominal.q2, self.q2, Limit::Sign),
+            p(
+                "angular_gain",
+                nominal.angular_gain,
+                self.angular_gain,
+                Limit::Sign,
+            ),
             p(
                 "quadrature_dps",
                 nominal.quadrature_dps,
                 self.quadrature_dps,
+                Limit::Coupling,
             ),
             p(
                 "damping_coupling_dps",
                 nominal.damping_coupling_dps,
                 self.damping_coupling_dps,
+                Limit::Coupling,
             ),
         ]
     }
@@ -240,64 +268,57 @@ impl Spread {
         nominal: &GyroParams,
         sds: &[f64; 7],
     ) -> Result<(), SpreadError> {
-        let [f1, split, q1, q2, gain, quadrature, damping] = *sds;
-        if 5.0 * f1 >= nominal.f1_hz {
-            return Err(refuse(
-                "f1_hz.sd",
-                f1,
-                format!(
-                    "less than a fifth of f1 ({} Hz), so that 5 sigma out stays positive",
-                    nominal.f1_hz
-                ),
-            ));
-        }
-        // f2 = f1 + split spreads by both, drawn independently.
-        if 5.0 * f1.hypot(split) >= nominal.f2_hz {
-            return Err(refuse(
-                "split_hz.sd",
-                split,
-                format!(
-                    "f2's sd, sqrt(f1_hz.sd^2 + split_hz.sd^2) = {:.6} Hz, must be less than a \
-                     fifth of f2 ({} Hz), so that 5 sigma out stays positive",
-                    f1.hypot(split),
-                    nominal.f2_hz
-                ),
-            ));
-        }
-        for (key, sd, value) in [
-            ("q1", q1, nominal.q1),
-            ("q2", q2, nominal.q2),
-            ("angular_gain", gain, nominal.angular_gain),
-        ] {
-            if 5.0 * sd > value.abs() {
-                return Err(refuse(
-                    format!("{key}.sd"),
-                    sd,
-                    format!(
-                        "at most a fifth of |{key}| ({}), so that 5 sigma out keeps the sign",
-                        value.abs()
-                    ),
-                ));
-            }
-        }
-        for (key, sd, value) in [
-            ("quadrature_dps", quadrature, nominal.quadrature_dps),
-            (
-                "damping_coupling_dps",
-                damping,
-                nominal.damping_coupling_dps,
-            ),
-        ] {
-            if value.abs() + 5.0 * sd > MAX_COUPLING_DPS {
-                return Err(refuse(
-                    format!("{key}.sd"),
-                    sd,
-                    format!(
-                        "allowed up to {:e} deg/s, so that |{key}| + 5 sd stays within the \
-                         model's {MAX_COUPLING_DPS:e} deg/s",
-                        ((MAX_COUPLING_DPS - value.abs()) / 5.0).max(0.0)
-                    ),
-                ));
+        let f1_sd = sds[0];
+        for (p, &sd) in self.params(nominal).iter().zip(sds) {
+            let (key, value) = (format!("{}.sd", p.key), p.nominal);
+            match p.limit {
+                Limit::Positive if 5.0 * sd >= value => {
+                    return Err(refuse(
+                        key,
+                        sd,
+                        format!(
+                            "less than a fifth of f1 ({value} Hz), so that 5 sigma out stays \
+                             positive"
+                        ),
+                    ));
+                }
+                // f2 = f1 + split spreads by both, drawn independently.
+                Limit::PositiveF2 if 5.0 * f1_sd.hypot(sd) >= nominal.f2_hz => {
+                    return Err(refuse(
+                        key,
+                        sd,
+                        format!(
+                            "f2's sd, sqrt(f1_hz.sd^2 + split_hz.sd^2) = {:.6} Hz, must be less \
+                             than a fifth of f2 ({} Hz), so that 5 sigma out stays positive",
+                            f1_sd.hypot(sd),
+                            nominal.f2_hz
+                        ),
+                    ));
+                }
+                Limit::Sign if 5.0 * sd > value.abs() => {
+                    return Err(refuse(
+                        key,
+                        sd,
+                        format!(
+                            "at most a fifth of |{}| ({}), so that 5 sigma out keeps the sign",
+                            p.key,
+                            value.abs()
+                        ),
+                    ));
+                }
+                Limit::Coupling if value.abs() + 5.0 * sd > MAX_COUPLING_DPS => {
+                    return Err(refuse(
+                        key,
+                        sd,
+                        format!(
+                            "allowed up to {:e} deg/s, so that |{}| + 5 sd stays within the \
+                             model's {MAX_COUPLING_DPS:e} deg/s",
+                            ((MAX_COUPLING_DPS - value.abs()) / 5.0).max(0.0),
+                            p.key
+                        ),
+                    ));
+                }
+                _ => {}
             }
         }
         Ok(())
