@@ -452,3 +452,37 @@ fn an_error_its_sigma_does_not_cover_is_said_in_one_line() {
         }
     }
 }
+
+/// A datasheet Q beyond a part's spread (`datasheet::Q_SPREAD`, a factor
+/// of 2) of the one identified is said in one line naming the key, its
+/// factor and the identified value; within the spread nothing is. The
+/// device's Q1 is 800: 2000 is 2.5 times it, 1500 is 1.9 times.
+#[test]
+fn a_datasheet_q_beyond_a_parts_spread_is_said_in_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("q_off.toml");
+    for (q1, said) in [(2000, true), (1500, false)] {
+        std::fs::write(&config, format!("{DEVICE}\n[datasheet]\nq1 = {q1}\n")).unwrap();
+        let run = calibrate(&config, &[]);
+        let lines: Vec<&str> = run["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter_map(|w| {
+                w.as_str()
+                    .filter(|w| w.starts_with("warning: [datasheet] "))
+            })
+            .collect();
+        if said {
+            assert_eq!(lines.len(), 1, "{lines:?}");
+            let head = format!("warning: [datasheet] q1 = {q1} is 2.5 times the identified 800.0");
+            assert!(lines[0].starts_with(&head), "{}", lines[0]);
+            assert!(!lines[0].contains("q2") && !lines[0].contains("f1_hz"));
+        } else {
+            assert!(lines.is_empty(), "{lines:?}");
+        }
+        let q = number(&run, &["identified", "q1"]);
+        let sigma = number(&run, &["identified", "q1_uncertainty"]);
+        assert!((q - 800.0).abs() < 3.0 * sigma, "q1 = {q1}: {q} +- {sigma}");
+    }
+}

@@ -323,7 +323,8 @@ fn factory_settings_that_clip_are_said_and_leave_the_baseline_null() {
 /// consumer device's 3000, a datasheet's minimum Q): the search misses the
 /// mode with the datasheet's spacing and waits, tries again from the Q it
 /// measured or ten times its own, and identifies Q1 within 3 sigma; the
-/// scale factors then come within 3 sigma too. At Q1 = 0.05 two more
+/// scale factors then come within 3 sigma too, and the report names the
+/// datasheet's Q1 in one line (`datasheet_warning`). At Q1 = 0.05 two more
 /// tries do not reach it: the step fails in one line naming the key to
 /// correct, with exit status 1.
 #[test]
@@ -361,6 +362,14 @@ fn a_datasheet_q_far_off_is_found_or_named() {
                     "q1 = {q1}, output {k}: {e} +- {sigma}"
                 );
             }
+            // Found, and the datasheet named (`datasheet_warning`).
+            let head = format!("warning: [datasheet] q1 = {q1} is 0.0");
+            assert_eq!(
+                warnings_starting(&report, &head),
+                1,
+                "{}",
+                report["warnings"]
+            );
         } else {
             assert_eq!(run.status.code(), Some(1), "{stderr}");
             let error = report["failed"][0]["error"].as_str().unwrap();
@@ -394,6 +403,13 @@ fn an_error_its_sigma_does_not_cover_is_said() {
             warnings_starting(&report, line),
             usize::from(said),
             "lambda {lambda}: {}",
+            report["warnings"]
+        );
+        // Its f and Q are the part's: nothing said of them.
+        assert_eq!(
+            warnings_starting(&report, "warning: [datasheet]"),
+            0,
+            "{}",
             report["warnings"]
         );
         if said {

@@ -25,6 +25,15 @@
 use crate::device::GyroParams;
 use serde::{Deserialize, Serialize};
 
+/// A part's resonance spread about its datasheet's, relative: the 1 to 5%
+/// of process spread (module doc). An identified resonance farther than
+/// this from the datasheet's is said (`Identified::datasheet_departures`).
+pub const F_SPREAD: f64 = 0.05;
+/// A part's Q spread about its datasheet's, as a factor either way (module
+/// doc). An identified Q farther than this is said, as a lost vacuum or a
+/// datasheet for another part would show.
+pub const Q_SPREAD: f64 = 2.0;
+
 /// Largest relative 1-sigma of the angular gain.
 pub const MAX_ANGULAR_GAIN_UNCERTAINTY: f64 = 0.5;
 /// Largest relative 1-sigma of the drive-gain ratio.

@@ -76,6 +76,8 @@
 //! resonant part of the response into the output (13% of the detuned
 //! output of a 25 kHz device with 3 deg, measured).
 
+mod departures;
+pub use departures::datasheet_departures;
 mod fit;
 mod front;
 mod probe;

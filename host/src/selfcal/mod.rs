@@ -332,6 +332,7 @@ impl SelfCal {
     /// there is nothing to say.
     pub fn warnings(&self, knowns: &Knowns) -> Vec<String> {
         let mut lines: Vec<String> = knowns.carrier_off_the_modes().into_iter().collect();
+        lines.extend(self.identified.datasheet_departures(&knowns.nominal));
         if self.rests_on_design_ratio(knowns) {
             lines.push(format!(
                 "warning: the drive-gain ratio g2/g1 is the design's (no coupling at rest measured it within {AT_REST_RATIO_SIGMA:e}) and the datasheet gives no drive_gain_ratio_uncertainty: a drive gain that drifted is not in the sigma"

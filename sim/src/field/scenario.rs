@@ -372,8 +372,10 @@ pub struct FieldReport {
     /// printed as progress: ADCs the scenario leaves undithered, a
     /// carrier configured off both modes (`Knowns::carrier_off_the_modes`)
     /// and a profile beyond the rate table (`Profile::beyond_the_table`;
-    /// when the run starts), steps whose sigma leaves a drifted drive gain out
-    /// ([`design_ratio_warning`], when the steps are done).
+    /// when the run starts), a datasheet beyond a part's spread of what
+    /// was identified ([`datasheet_warning`]) and steps whose sigma leaves
+    /// a drifted drive gain out ([`design_ratio_warning`], when the steps
+    /// are done).
     pub warnings: Vec<String>,
     /// Clocks simulated, all steps.
     pub clocks: u64,
@@ -421,6 +423,18 @@ pub fn design_ratio_warning(steps: &[FieldStep], knowns: &Knowns) -> Option<Stri
             selfcal::AT_REST_RATIO_SIGMA
         )
     })
+}
+
+/// The datasheet's resonances and Qs beyond a part's spread from what the
+/// first step identified (`Identified::datasheet_departures`): one line,
+/// or None. The figures rest on the identified values; the line is for
+/// whoever wrote the datasheet or owns the part.
+pub fn datasheet_warning(steps: &[FieldStep], knowns: &Knowns) -> Option<String> {
+    let first = steps.first()?;
+    first
+        .selfcal
+        .identified
+        .datasheet_departures(&knowns.nominal)
 }
 
 /// The self-calibration errors (against the simulated truth) that lie
@@ -948,6 +962,7 @@ pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldRepor
         )
     });
     for w in [
+        datasheet_warning(&steps, &knowns),
         design_ratio_warning(&steps, &knowns),
         profile_clip_warning(&steps),
         baseline_clip_warning,
