@@ -124,17 +124,23 @@ fn a_datasheet_off_by_the_process_spread_is_found_and_refined() {
 }
 
 /// No resonance within +-5% of the datasheet: one line saying where the
-/// host looked, not a wrong figure.
+/// host looked and on which side the response grew, not a wrong figure.
 #[test]
 fn no_resonance_in_reach_is_one_clear_error() {
     let truth = paper_truth();
-    let ds = datasheet(truth[0].0 * 1.2, truth[0].0 * 1.2 + 250.0, 55e3);
-    let e = identification_error(truth, &ds);
-    assert!(
-        e.starts_with("identification of mode 1: no resonance found from"),
-        "{e}"
-    );
-    assert!(!e.contains('\n'));
+    for (off, side) in [(1.2, "below"), (0.8, "above")] {
+        let ds = datasheet(truth[0].0 * off, truth[0].0 * off + 250.0, 55e3);
+        let e = identification_error(truth, &ds);
+        assert!(
+            e.starts_with("identification of mode 1: no resonance found from"),
+            "{e}"
+        );
+        assert!(
+            e.contains(&format!("the resonance is likely {side}")),
+            "{e}"
+        );
+        assert!(!e.contains('\n'));
+    }
 }
 
 /// A datasheet Q a thousand times off the part's either way (a leaky

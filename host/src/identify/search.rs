@@ -215,14 +215,24 @@ fn scan_once(probe: &mut Prober, lo: f64, hi: f64, guess: f64) -> Result<f64, Er
     }
     let largest = pts
         .iter()
-        .max_by(|a, b| a.1.norm().total_cmp(&b.1.norm()))
-        .map_or(guess, |p| p.0);
+        .enumerate()
+        .max_by(|a, b| a.1.1.norm().total_cmp(&b.1.1.norm()));
+    // A response that only grows towards one end of the scan points past
+    // it: a resonance's skirt falls on both sides of its peak.
+    let (at, beyond) = match largest {
+        Some((0, p)) => (p.0, ", its low end: the resonance is likely below"),
+        Some((i, p)) if i + 1 == pts.len() => {
+            (p.0, ", its high end: the resonance is likely above")
+        }
+        Some((_, p)) => (p.0, ""),
+        None => (guess, ""),
+    };
     match scan_fit(&pts) {
         Some((fk, _)) if fk > lo - (hi - lo) && fk < hi + (hi - lo) => Ok(fk),
         _ => Err(Error::Identification {
             mode: probe.mode(),
             reason: format!(
-                "no resonance found from {lo:.1} to {hi:.1} Hz (scanning from the datasheet's {guess:.1} Hz, +-{}%; the largest response was at {largest:.1} Hz): check the datasheet's frequency",
+                "no resonance found from {lo:.1} to {hi:.1} Hz (scanning from the datasheet's {guess:.1} Hz, +-{}%; the largest response was at {at:.1} Hz{beyond}): check the datasheet's frequency",
                 100.0 * SCAN_SPAN
             ),
         }),
