@@ -32,7 +32,9 @@ use gyrocal_sim::field::scenario;
 use gyrocal_sim::serve::device;
 use serde_json::Value;
 use served::Served;
+use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
+use std::process::{Command, Stdio};
 
 const DEVICE: &str = "
 [gyro]
@@ -484,5 +486,69 @@ fn a_datasheet_q_beyond_a_parts_spread_is_said_in_one_line() {
         let q = number(&run, &["identified", "q1"]);
         let sigma = number(&run, &["identified", "q1_uncertainty"]);
         assert!((q - 800.0).abs() < 3.0 * sigma, "q1 = {q1}: {q} +- {sigma}");
+    }
+}
+
+/// A board that stops answering after identification (its server killed
+/// during the calibration staircase, as a cable pulled would): the run
+/// keeps what it identified, printed as its result with the stage that
+/// failed and its error in one line, exit status 1. The identified device
+/// is the served one's, within 3 of its sigmas.
+#[test]
+fn a_board_lost_after_identification_keeps_the_identification() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("device.toml");
+    std::fs::write(&config, DEVICE).unwrap();
+    let local = calibrate(&config, &["--temperature", "45"]);
+    // Paced, so the staircase takes long enough on the wire to be cut.
+    let pace = (2 * R).to_string();
+    let served = Served::start(&config, &["--temperature", "45", "--pace", &pace]);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_gyrocal"))
+        .args(["calibrate", "--json", "--board", &served.url, "--config"])
+        .arg(&config)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut stderr = BufReader::new(child.stderr.take().unwrap());
+    let mut seen = vec![];
+    loop {
+        let mut line = String::new();
+        assert!(
+            stderr.read_line(&mut line).unwrap() > 0,
+            "calibrate ended before its staircase: {seen:?}"
+        );
+        seen.push(line.trim_end().to_string());
+        if line.starts_with("identification done after") {
+            break;
+        }
+    }
+    drop(served);
+    let mut rest = String::new();
+    stderr.read_to_string(&mut rest).unwrap();
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(1), "{seen:?} {rest}");
+    let error_lines: Vec<&str> = rest.lines().filter(|l| l.starts_with("error: ")).collect();
+    assert_eq!(error_lines.len(), 1, "{rest}");
+    let run: Value = serde_json::from_slice(&out.stdout)
+        .unwrap_or_else(|e| panic!("{e}: {}", String::from_utf8_lossy(&out.stdout)));
+    assert_eq!(
+        run["failed"]["stage"],
+        "self-calibration after identification"
+    );
+    assert_eq!(
+        format!("error: {}", run["failed"]["error"].as_str().unwrap()),
+        error_lines[0]
+    );
+    assert!(run.get("sf_selfcal_per_dps").is_none(), "{run}");
+    for (name, true_key) in PARAMETERS {
+        let Some(key) = true_key else { continue };
+        let v = number(&run, &["identified", name]);
+        let sigma = number(&run, &["identified", &format!("{name}_uncertainty")]);
+        let t = number(&local["truth"], &[key]);
+        assert!(
+            (v - t).abs() <= 3.0 * sigma,
+            "{name}: {v} +- {sigma}, truth {t}"
+        );
     }
 }

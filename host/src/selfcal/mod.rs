@@ -560,14 +560,27 @@ fn nearer_bandwidth(id: &Identified, asked: f64) -> f64 {
     nearer.f_hz.value / nearer.q.value
 }
 
-/// One self-calibration cycle from a starting guess of the device. After
-/// identification every wait uses the identified modes, not the datasheet.
+/// One self-calibration cycle from a starting guess of the device:
+/// [`identify::identify`], then [`self_calibrate_from`] what it found.
 pub fn self_calibrate(
     board: &mut dyn Board,
     knowns: &Knowns,
     guess: &GyroParams,
 ) -> Result<SelfCal, Error> {
-    let mut identified = identify::identify(board, knowns, guess)?;
+    let identified = identify::identify(board, knowns, guess)?;
+    self_calibrate_from(board, knowns, identified)
+}
+
+/// The cycle after identification: the couplings at rest, the operating
+/// point, the calibration staircase and the predicted ratio. Every wait
+/// uses the identified modes, not the datasheet. A caller that keeps
+/// `identified` (a clone) still has it when this fails: a board that
+/// stops mid-staircase does not take the identification with it.
+pub fn self_calibrate_from(
+    board: &mut dyn Board,
+    knowns: &Knowns,
+    mut identified: Identified,
+) -> Result<SelfCal, Error> {
     // The quadrature coupling at rest, at the operating point of the
     // uncoupled device; then the operating point again with it (its
     // cross responses move the predicted ADC peaks).

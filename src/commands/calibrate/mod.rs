@@ -22,14 +22,21 @@
 //!   (read and missed over the run), `warnings` (what the sigma leaves
 //!   out, one line each, also on stderr: a drive-gain ratio nothing
 //!   measured nor bounds, a carrier on a slow fold; in process, self-cal
-//!   errors beyond 3 of their sigmas against the truth) and `truth` (null
-//!   over the wire). Progress goes to stderr.
+//!   errors beyond 3 of their sigmas against the truth), `failed` (null)
+//!   and `truth` (null over the wire). Progress goes to stderr.
+//! - A cycle that stops after identification (a board that stops
+//!   answering mid-staircase, a stage that fails) keeps what it
+//!   identified: that is printed (JSON: `board`, `identified`, `clocks`,
+//!   `wall_s`, `samples`, `warnings` and `failed`, the stage and its
+//!   error), then the error on stderr, with exit status 1. One that stops
+//!   before prints only the error.
 
 pub mod output;
 pub mod watch;
 
 use super::experiment::read_config;
 use crate::Failure;
+use gyrocal_host::identify::{self, Identified};
 use gyrocal_host::selfcal::{self, SelfCal};
 use gyrocal_host::{Board, Knowns, transport};
 use gyrocal_sim::drift::DeviceAt;
@@ -90,6 +97,21 @@ pub struct Outcome {
     pub truth: Option<Truth>,
 }
 
+/// A cycle that stopped: its error, and what identification found when
+/// it finished before the stop.
+pub struct Halted {
+    /// The board's URL, or "in-process".
+    pub board: String,
+    /// The identified device, when the cycle stopped after identification.
+    pub identified: Option<Box<Identified>>,
+    /// Why it stopped, one line.
+    pub error: String,
+    /// z samples read and missed.
+    pub samples: SampleCounts,
+    /// Wall time until the stop (s).
+    pub wall_s: f64,
+}
+
 /// Calibrate and print.
 pub fn run(args: &Args) -> Result<(), Failure> {
     let (name, text) = read_config(&args.config)?;
@@ -98,6 +120,10 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let outcome = match &args.board {
         Some(url) => over_the_wire(url, &knowns, args.temperature)?,
         None => in_process(&file, &knowns, args.temperature)?,
+    };
+    let outcome = match outcome {
+        Ok(outcome) => outcome,
+        Err(halted) => return stopped(args, &knowns, halted),
     };
     eprintln!(
         "cycle done in {:.1} s wall, {:.3e} clocks; {} z samples read, {} went by unread",
@@ -115,18 +141,64 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     Ok(())
 }
 
-/// The cycle on a watched board; its wall time.
-fn cycle(board: &mut dyn Board, knowns: &Knowns) -> Result<(SelfCal, SampleCounts, f64), Failure> {
+/// A cycle that stopped: what identification found, when it finished,
+/// printed as the run's result (JSON or table), then its error (exit
+/// status 1). Before identification finished there is nothing to print
+/// but the error.
+fn stopped(args: &Args, knowns: &Knowns, halted: Halted) -> Result<(), Failure> {
+    if let Some(id) = halted.identified.as_deref() {
+        eprintln!(
+            "the cycle stopped after identification ({:.1} s wall); what it identified follows",
+            halted.wall_s
+        );
+        let warnings: Vec<String> = id
+            .datasheet_departures(&knowns.nominal)
+            .into_iter()
+            .collect();
+        for w in &warnings {
+            eprintln!("{w}");
+        }
+        if args.json {
+            println!("{}", output::halted_json(&halted, id, &warnings));
+        } else {
+            print!("{}", output::halted_table(&halted, id, &warnings));
+        }
+    }
+    Err(Failure::Run(halted.error))
+}
+
+/// The cycle on a watched board (identification, then the rest from what
+/// it found, so a stop after it keeps it); its wall time.
+fn cycle(
+    board: &mut dyn Board,
+    board_name: &str,
+    knowns: &Knowns,
+) -> Result<(SelfCal, SampleCounts, f64), Halted> {
     let sample_s = f64::from(knowns.filter.decimation) / knowns.clock_hz;
     let start = Instant::now();
     let mut watched = Watched::new(board, sample_s);
-    let cal = selfcal::self_calibrate(&mut watched, knowns, &knowns.nominal);
+    let cal = match identify::identify(&mut watched, knowns, &knowns.nominal) {
+        Ok(id) => selfcal::self_calibrate_from(&mut watched, knowns, id.clone())
+            .map_err(|e| (Some(Box::new(id)), e)),
+        Err(e) => Err((None, e)),
+    };
     let samples = watched.finish();
-    let cal = cal.map_err(|e| Failure::Run(e.to_string()))?;
-    Ok((cal, samples, start.elapsed().as_secs_f64()))
+    let wall_s = start.elapsed().as_secs_f64();
+    cal.map(|cal| (cal, samples, wall_s))
+        .map_err(|(identified, e)| Halted {
+            board: board_name.into(),
+            identified,
+            error: e.to_string(),
+            samples,
+            wall_s,
+        })
 }
 
-fn over_the_wire(url: &str, knowns: &Knowns, temperature: Option<f64>) -> Result<Outcome, Failure> {
+fn over_the_wire(
+    url: &str,
+    knowns: &Knowns,
+    temperature: Option<f64>,
+) -> Result<Result<Outcome, Halted>, Failure> {
     if temperature.is_some() {
         return Err(Failure::Input(
             "--temperature: applies to the in-process board only (a served board's device is set by gyrocal serve --temperature)"
@@ -137,28 +209,34 @@ fn over_the_wire(url: &str, knowns: &Knowns, temperature: Option<f64>) -> Result
     let mut board =
         transport::open(url).map_err(|e| Failure::Run(format!("--board {url}: {e}")))?;
     eprintln!("calibrating the board at {url}");
-    let (cal, samples, wall_s) = cycle(board.as_mut(), knowns)?;
-    Ok(Outcome {
+    let (cal, samples, wall_s) = match cycle(board.as_mut(), url, knowns) {
+        Ok(done) => done,
+        Err(halted) => return Ok(Err(halted)),
+    };
+    Ok(Ok(Outcome {
         board: url.into(),
         warnings: cal.warnings(knowns),
         cal,
         samples,
         wall_s,
         truth: None,
-    })
+    }))
 }
 
 fn in_process(
     file: &DeviceFile,
     knowns: &Knowns,
     temperature: Option<f64>,
-) -> Result<Outcome, Failure> {
+) -> Result<Result<Outcome, Halted>, Failure> {
     let at = file
         .at(temperature)
         .map_err(|e| Failure::Input(format!("--{e}")))?;
     let mut board: SimBoard = file.board(&at).map_err(Failure::run)?;
     eprintln!("calibrating the in-process simulated board");
-    let (cal, samples, wall_s) = cycle(&mut board, knowns)?;
+    let (cal, samples, wall_s) = match cycle(&mut board, IN_PROCESS, knowns) {
+        Ok(done) => done,
+        Err(halted) => return Ok(Err(halted)),
+    };
     eprintln!("rate table at the calibrated carrier and phase (the truth)");
     let fe = file.front_end().map_err(Failure::run)?;
     let (table, clocks) =
@@ -171,12 +249,15 @@ fn in_process(
     };
     let mut warnings = cal.warnings(knowns);
     warnings.extend(output::uncovered(&cal, &truth));
-    Ok(Outcome {
-        board: "in-process".into(),
+    Ok(Ok(Outcome {
+        board: IN_PROCESS.into(),
         warnings,
         cal,
         samples,
         wall_s,
         truth: Some(truth),
-    })
+    }))
 }
+
+/// The board name of the in-process simulated board.
+const IN_PROCESS: &str = "in-process";

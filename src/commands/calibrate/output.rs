@@ -2,8 +2,8 @@
 //! factors are z LSB per deg/s, one per output; uncertainties 1 sigma
 //! (relative for the scale factors, as in `gyrocal field`).
 
-use super::{Outcome, Truth};
-use gyrocal_host::identify::Estimate;
+use super::{Halted, Outcome, Truth};
+use gyrocal_host::identify::{Estimate, Identified};
 use gyrocal_host::selfcal::{ScaledDrives, SelfCal};
 use gyrocal_sim::coverage::{Scored, uncovered_selfcal_errors};
 use serde_json::{Map, Value, json};
@@ -16,8 +16,7 @@ fn put(map: &mut Map<String, Value>, name: &str, e: Estimate) {
 }
 
 /// The identified parameters, in the order the table shows them.
-fn estimates(o: &Outcome) -> [(&'static str, Estimate); 6] {
-    let id = &o.cal.identified;
+fn estimates(id: &Identified) -> [(&'static str, Estimate); 6] {
     let [m1, m2] = &id.modes;
     [
         ("f1_hz", m1.f_hz),
@@ -54,12 +53,19 @@ pub fn uncovered(cal: &SelfCal, t: &Truth) -> Option<String> {
     uncovered_selfcal_errors(&scored)
 }
 
-/// The one JSON object of `--json`.
-pub fn json(o: &Outcome) -> Value {
+/// The identified parameters as JSON: each `name` with its
+/// `name_uncertainty`.
+fn identified_json(id: &Identified) -> Value {
     let mut identified = Map::new();
-    for (name, e) in estimates(o) {
+    for (name, e) in estimates(id) {
         put(&mut identified, name, e);
     }
+    Value::Object(identified)
+}
+
+/// The one JSON object of `--json`.
+pub fn json(o: &Outcome) -> Value {
+    let identified = identified_json(&o.cal.identified);
     let cal = &o.cal;
     let truth = o.truth.as_ref().map(|t| {
         let d = &t.device;
@@ -97,23 +103,55 @@ pub fn json(o: &Outcome) -> Value {
         "samples": {"read": o.samples.read, "missed": o.samples.missed},
         "carrier_spurs": cal.carrier_spurs,
         "warnings": o.warnings,
+        "failed": null,
         "truth": truth,
     })
 }
 
-/// The table.
-pub fn table(o: &Outcome) -> String {
+/// The JSON object of a cycle that stopped after identification: the
+/// board, what it identified, `failed` (the stage and its error), the
+/// clocks identification took, wall time, samples and warnings; the keys
+/// of the later stages are absent.
+pub fn halted_json(h: &Halted, id: &Identified, warnings: &[String]) -> Value {
+    json!({
+        "board": h.board,
+        "identified": identified_json(id),
+        "clocks": id.clocks,
+        "wall_s": h.wall_s,
+        "samples": {"read": h.samples.read, "missed": h.samples.missed},
+        "warnings": warnings,
+        "failed": {"stage": STOPPED_STAGE, "error": h.error},
+    })
+}
+
+/// What `failed.stage` names when a cycle stops after identification.
+pub const STOPPED_STAGE: &str = "self-calibration after identification";
+
+/// The table of a cycle that stopped after identification.
+pub fn halted_table(h: &Halted, id: &Identified, warnings: &[String]) -> String {
     let mut s = String::new();
-    let cal = &o.cal;
-    let _ = writeln!(s, "board: {}", o.board);
-    let truth = o.truth.as_ref().map(|t| &t.device.gyro);
-    let true_values = truth.map(|g| [g.f1_hz, g.f2_hz, g.q1, g.q2]);
+    let _ = writeln!(s, "board: {}", h.board);
+    identified_rows(&mut s, id, None);
+    for w in warnings {
+        let _ = writeln!(s, "{w}");
+    }
+    let _ = writeln!(s, "FAILED ({STOPPED_STAGE}): {}", h.error);
+    let _ = writeln!(
+        s,
+        "{:.3e} clocks, {:.1} s wall; {} z samples read, {} went by unread",
+        id.clocks as f64, h.wall_s, h.samples.read, h.samples.missed
+    );
+    s
+}
+
+/// The identified parameters' rows, with the truth's where it is known.
+fn identified_rows(s: &mut String, id: &Identified, true_values: Option<[f64; 4]>) {
     let _ = writeln!(
         s,
         "{:<16} {:>18} {:>12} {:>18}",
         "identified", "value", "1-sigma", "truth"
     );
-    for (i, (name, e)) in estimates(o).into_iter().enumerate() {
+    for (i, (name, e)) in estimates(id).into_iter().enumerate() {
         let t = true_values
             .and_then(|v| v.get(i).copied())
             .map_or(String::new(), |v| format!("{v:.6}"));
@@ -124,6 +162,19 @@ pub fn table(o: &Outcome) -> String {
         };
         let _ = writeln!(s, "{name:<16} {value:>18} {:>12.3e} {t:>18}", e.uncertainty);
     }
+}
+
+/// The table.
+pub fn table(o: &Outcome) -> String {
+    let mut s = String::new();
+    let cal = &o.cal;
+    let _ = writeln!(s, "board: {}", o.board);
+    let truth = o.truth.as_ref().map(|t| &t.device.gyro);
+    identified_rows(
+        &mut s,
+        &cal.identified,
+        truth.map(|g| [g.f1_hz, g.f2_hz, g.q1, g.q2]),
+    );
     let _ = writeln!(
         s,
         "operating: carrier {:.6} Hz, phase correction {:.5} deg",
