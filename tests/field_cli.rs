@@ -422,3 +422,65 @@ fn an_error_its_sigma_does_not_cover_is_said() {
         }
     }
 }
+
+/// A step whose cycle fails after identification keeps what it
+/// identified: the report's `failed` entry carries it, and the table
+/// prints it under the failure. The vehicle is an ADC whose own noise
+/// (3000 LSB RMS, a tenth of full scale) leaves the calibration drives no
+/// headroom: the staircase clips, the identification before it stands,
+/// within 3 of its sigmas of the device (f1 25.1 kHz, Q1 3000 at the
+/// factory temperature).
+#[test]
+fn a_step_that_fails_after_identification_keeps_it() {
+    let drift = "[drift]\ntemperatures_c = [25]\ntcf1_ppm_per_k = -30\ntcf2_ppm_per_k = -30\n";
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("noisy.toml");
+    std::fs::write(
+        &config,
+        format!("{GOOD}{drift}[frontend]\nnoise_lsb = 3000\n"),
+    )
+    .unwrap();
+    let args = |json: bool| {
+        let mut a = vec![
+            OsStr::new("field"),
+            OsStr::new("--config"),
+            config.as_os_str(),
+        ];
+        if json {
+            a.push(OsStr::new("--json"));
+        }
+        gyrocal(&a)
+    };
+    let run = args(true);
+    assert_eq!(run.status.code(), Some(1), "{}", common::stderr(&run));
+    let report: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+    let failed = &report["failed"][0];
+    assert_eq!(failed["stage"], "self-calibration cycle");
+    assert!(
+        failed["error"]
+            .as_str()
+            .unwrap()
+            .starts_with("calibration staircase: ADC"),
+        "{failed}"
+    );
+    let id = &failed["identified"];
+    for (key, truth) in [
+        ("f1_hz", 25.1e3),
+        ("f2_hz", 25.8e3),
+        ("q1", 3000.0),
+        ("q2", 3000.0),
+    ] {
+        let v = id[key]
+            .as_f64()
+            .unwrap_or_else(|| panic!("{key} in {failed}"));
+        let sigma = id[&format!("{key}_uncertainty")].as_f64().unwrap();
+        assert!((v - truth).abs() <= 3.0 * sigma, "{key}: {v} +- {sigma}");
+    }
+    // The couplings come after identification: not measured.
+    assert!(id["quadrature_dps"].is_null(), "{id}");
+    let table = String::from_utf8(args(false).stdout).unwrap();
+    assert!(
+        table.contains("   25.00  identified before it failed: f1 25"),
+        "{table}"
+    );
+}

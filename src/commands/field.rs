@@ -28,7 +28,8 @@
 //!
 //! A step that fails (its identification finds no resonance, its drive
 //! would clip, ...) is listed in `failed` (`temperature_c`, `stage`,
-//! `error`) and the other steps stand: the report is printed and written
+//! `error`, and `identified` when its cycle failed after identification,
+//! which the table prints too) and the other steps stand: the report is printed and written
 //! whole, then the command exits with status 1 and one line naming the
 //! failed steps. Without the first step (the factory calibration) no step
 //! has a baseline (its baseline fields are null).
@@ -330,6 +331,24 @@ pub fn summary(report: &FieldReport) -> String {
             "{:>8.2}  FAILED ({}): {}",
             f.temperature_c, f.stage, f.error
         );
+        // What finished before the failure stands (also in the JSON).
+        if let Some(id) = &f.identified {
+            let _ = writeln!(
+                s,
+                "{:>8.2}  identified before it failed: f1 {:.4} +- {:.2e} Hz, f2 {:.4} +- {:.2e} Hz, Q1 {:.1} +- {:.2e}, Q2 {:.1} +- {:.2e}, loop phase {:.4} +- {:.2e} deg",
+                f.temperature_c,
+                id.f1_hz,
+                id.f1_hz_uncertainty,
+                id.f2_hz,
+                id.f2_hz_uncertainty,
+                id.q1,
+                id.q1_uncertainty,
+                id.q2,
+                id.q2_uncertainty,
+                id.loop_phase_deg,
+                id.loop_phase_deg_uncertainty
+            );
+        }
     }
     let _ = writeln!(
         s,

@@ -43,7 +43,7 @@ use crate::noise::ThermalNoise;
 use crate::sweep::spread::Spread;
 use gyrocal_host::Knowns;
 use gyrocal_host::datasheet::Datasheet;
-use gyrocal_host::identify::{CouplingFigure, Estimate};
+use gyrocal_host::identify::{self, CouplingFigure, Estimate, Identified};
 use gyrocal_host::sampling::{Signal, mean_of_parts, part_means};
 use gyrocal_host::selfcal::StaticFold;
 use gyrocal_host::selfcal::{self, Operating, SelfCal};
@@ -312,9 +312,22 @@ pub struct IdentifiedJson {
 }
 
 impl From<&SelfCal> for IdentifiedJson {
+    /// What identification found, the couplings at rest and the
+    /// drive-gain ratio measured after it.
     fn from(cal: &SelfCal) -> Self {
-        let id = &cal.identified;
         let ratio = cal.drive_ratio.as_ref().map(|d| d.relative);
+        Self {
+            drive_gain_ratio: ratio.map(|r| r.value),
+            drive_gain_ratio_uncertainty: ratio.map(|r| r.uncertainty),
+            ..Self::from(&cal.identified)
+        }
+    }
+}
+
+impl From<&Identified> for IdentifiedJson {
+    /// What identification found; the couplings null until measured at
+    /// rest, the drive-gain ratio null.
+    fn from(id: &Identified) -> Self {
         let [m1, m2] = &id.modes;
         let none = Estimate {
             value: f64::NAN,
@@ -344,8 +357,8 @@ impl From<&SelfCal> for IdentifiedJson {
             quadrature_dps_uncertainty: quadrature.uncertainty,
             damping_coupling_dps: damping.value,
             damping_coupling_dps_uncertainty: damping.uncertainty,
-            drive_gain_ratio: ratio.map(|r| r.value),
-            drive_gain_ratio_uncertainty: ratio.map(|r| r.uncertainty),
+            drive_gain_ratio: None,
+            drive_gain_ratio_uncertainty: None,
         }
     }
 }
@@ -725,10 +738,47 @@ struct Cycle {
 /// Self-calibrate a fresh board at `t`; with a profile, then switch to
 /// readout, measure the null at rest and run the profile on that board.
 /// The rate table at the cycle's settings follows (its rates in parallel).
-fn cycle_at(sc: &Scenario, fe: &FrontEnd, knowns: &Knowns, t: f64) -> Result<Cycle, FieldError> {
+fn cycle_at(sc: &Scenario, fe: &FrontEnd, knowns: &Knowns, t: f64) -> Result<Cycle, CycleFailure> {
     let at = sc.drift.at(&sc.exp.gyro, t);
-    let mut board = board_at(&sc.exp, fe, &at)?;
-    let mut cal = selfcal::self_calibrate(&mut board, knowns, &knowns.nominal)?;
+    let mut board = board_at(&sc.exp, fe, &at).map_err(CycleFailure::before)?;
+    let identified = identify::identify(&mut board, knowns, &knowns.nominal)
+        .map_err(|e| CycleFailure::before(e.into()))?;
+    let kept = IdentifiedJson::from(&identified);
+    cycle_from(sc, fe, knowns, at, board, identified).map_err(|error| CycleFailure {
+        identified: Some(Box::new(kept)),
+        error,
+    })
+}
+
+/// A step's cycle that failed: its error, and what identification found
+/// when it finished before the failure.
+#[derive(Debug)]
+struct CycleFailure {
+    identified: Option<Box<IdentifiedJson>>,
+    error: FieldError,
+}
+
+impl CycleFailure {
+    /// A failure before identification finished.
+    fn before(error: FieldError) -> Self {
+        Self {
+            identified: None,
+            error,
+        }
+    }
+}
+
+/// `cycle_at` after identification: the rest of the self-calibration
+/// cycle, the drive probe, the profile and the rate table.
+fn cycle_from(
+    sc: &Scenario,
+    fe: &FrontEnd,
+    knowns: &Knowns,
+    at: DeviceAt,
+    mut board: SimBoard,
+    identified: Identified,
+) -> Result<Cycle, FieldError> {
+    let mut cal = selfcal::self_calibrate_from(&mut board, knowns, identified)?;
     if let Some(probe) = &sc.drive_probe {
         board.set_rate(probe.rate_dps.to_radians());
         let measured = drive_ratio::measure(&mut board, knowns, &cal.operating, &cal.identified)?;
@@ -783,7 +833,7 @@ enum Done {
 
 /// Every step but the first (at T0 the factory's settings are its own)
 /// whose own cycle finished.
-fn jobs(cycles: &[Result<Cycle, FieldError>], rates: usize, with_profile: bool) -> Vec<Job> {
+fn jobs(cycles: &[Result<Cycle, CycleFailure>], rates: usize, with_profile: bool) -> Vec<Job> {
     let mut jobs = vec![];
     for step in (1..cycles.len()).filter(|&i| cycles[i].is_ok()) {
         jobs.extend((0..rates).map(|rate| Job::Factory { step, rate }));
@@ -804,6 +854,9 @@ pub struct StepFailure {
     pub stage: &'static str,
     /// The error, one line.
     pub error: String,
+    /// What the step's identification found, when the cycle failed after
+    /// it (null otherwise): a step that fails keeps what finished.
+    pub identified: Option<IdentifiedJson>,
 }
 
 /// [`StepFailure::stage`] of a self-calibration cycle (or its rate table).
@@ -825,7 +878,7 @@ fn run_cycles(
     fe: &FrontEnd,
     knowns: &Knowns,
     progress: &(dyn Fn(&str) + Sync),
-) -> Vec<Result<Cycle, FieldError>> {
+) -> Vec<Result<Cycle, CycleFailure>> {
     sc.drift
         .temperatures_c
         .par_iter()
@@ -837,7 +890,7 @@ fn run_cycles(
                     100.0 * (c.cal.sf_selfcal_per_dps[0] / c.truth.sf_per_dps[0] - 1.0),
                     100.0 * (c.cal.sf_selfcal_per_dps[1] / c.truth.sf_per_dps[1] - 1.0),
                 )),
-                Err(e) => progress(&format!("{t} deg C: FAILED: {e}")),
+                Err(e) => progress(&format!("{t} deg C: FAILED: {}", e.error)),
             }
             c
         })
@@ -851,14 +904,14 @@ fn run_jobs(
     fe: &FrontEnd,
     knowns: &Knowns,
     factory: &Operating,
-    cycles: &[Result<Cycle, FieldError>],
+    cycles: &[Result<Cycle, CycleFailure>],
     jobs: &[Job],
 ) -> Vec<Result<(Done, u64), FieldError>> {
     let exp = &sc.exp;
     let rates = &knowns.rates_dps;
     jobs.par_iter()
         .map(|job| -> Result<(Done, u64), FieldError> {
-            let at = &cycles[job.step()].as_ref().map_err(Clone::clone)?.at;
+            let at = &cycles[job.step()].as_ref().map_err(|f| f.error.clone())?.at;
             match *job {
                 Job::Factory { rate, .. } => {
                     let whose = (factory, TableAt::Factory);
@@ -923,11 +976,12 @@ pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldRepor
         let t = drift.temperatures_c[i];
         let c = match c {
             Ok(c) => c,
-            Err(error) => {
+            Err(CycleFailure { identified, error }) => {
                 failed.push(StepFailure {
                     temperature_c: t,
                     stage: FAILED_CYCLE,
                     error: error.to_string(),
+                    identified: identified.map(|id| *id),
                 });
                 continue;
             }
@@ -944,6 +998,7 @@ pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldRepor
                         temperature_c: t,
                         stage: FAILED_BASELINE,
                         error: error.to_string(),
+                        identified: None,
                     }),
                 })
                 .ok()
