@@ -65,7 +65,7 @@ pub fn datasheet_departures(
     }
     (!parts.is_empty()).then(|| {
         format!(
-            "warning: [datasheet] {}, beyond a part's spread ({}% in f, a factor of {Q_SPREAD} in Q): the figures rest on the identified values, but the datasheet's Q sets the search's steps and waits; correct the datasheet, or check the part (a Q far below its datasheet's is what a lost vacuum shows)",
+            "warning: [datasheet] {}, beyond a part's spread ({}% in f, a factor of {Q_SPREAD} in Q): the figures rest on the identified values; correct the datasheet (its f sets where the search starts, its Q the search's steps and waits), or check the part (a Q far below its datasheet's is what a lost vacuum shows)",
             parts.join("; "),
             100.0 * F_SPREAD
         )
