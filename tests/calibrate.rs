@@ -552,3 +552,65 @@ fn a_board_lost_after_identification_keeps_the_identification() {
         );
     }
 }
+
+/// A device that turns during the cycle (`--rate`, in process), which
+/// assumes rest: the couplings' windows read the rate from the Coriolis
+/// term (`cycle_rate_dps`), and the run says so in one line. At rest nothing
+/// is said and the reading is 0 within 3 of its sigmas. At 5 and -2 deg/s
+/// the reading lies within the at-rest reading's offset (0.038 deg/s
+/// here, 2.3 sigma: the batches' noise) plus 3 of its own sigmas of the
+/// rate.
+#[test]
+fn a_device_turning_during_the_cycle_is_said_in_one_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("device.toml");
+    std::fs::write(&config, DEVICE).unwrap();
+    let head = "warning: the device turned during the cycle: its cross responses read a rate of ";
+    let mut at_rest = 0.0;
+    for rate in [0.0, 5.0, -2.0] {
+        let run = calibrate(&config, &["--rate", &rate.to_string()]);
+        let lines: Vec<&str> = run["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter_map(|w| w.as_str().filter(|w| w.starts_with(head)))
+            .collect();
+        let read = number(&run, &["identified", "cycle_rate_dps"]);
+        let sigma = number(&run, &["identified", "cycle_rate_dps_uncertainty"]);
+        if rate == 0.0 {
+            assert!(lines.is_empty(), "{lines:?}");
+            assert!(read.abs() < 3.0 * sigma, "at rest: {read} +- {sigma}");
+            at_rest = read.abs();
+        } else {
+            assert_eq!(lines.len(), 1, "{}", run["warnings"]);
+            assert!(
+                (read - rate).abs() <= at_rest + 3.0 * sigma,
+                "{rate} deg/s read {read} +- {sigma} (at rest {at_rest})"
+            );
+        }
+    }
+    refused(
+        &[
+            "calibrate",
+            "--config",
+            "tests/data/field_consumer.toml",
+            "--rate",
+            "1e9",
+        ],
+        2,
+        "--rate 1000000000: allowed -100000..=100000 deg/s",
+    );
+    refused(
+        &[
+            "calibrate",
+            "--board",
+            "etherbone://127.0.0.1:1",
+            "--config",
+            "tests/data/field_consumer.toml",
+            "--rate",
+            "5",
+        ],
+        2,
+        "--rate: applies to the in-process board only",
+    );
+}

@@ -284,6 +284,11 @@ pub struct Identified {
     /// The damping coupling Omega_d (deg/s, the sign convention of
     /// `[gyro] damping_coupling_dps`), measured with it; `None` until then.
     pub damping_coupling_dps: Option<CouplingFigure>,
+    /// The rate the device turned at during the couplings' windows
+    /// (deg/s, `coupling::rate_from_windows`); `None` until measured.
+    /// The cycle assumes rest: a rate beyond its sigma is said
+    /// (`SelfCal::warnings`).
+    pub cycle_rate_dps: Option<Estimate>,
     /// Clocks the identification took.
     pub clocks: u64,
 }
@@ -644,6 +649,7 @@ pub fn identify(
         group_delay_s,
         quadrature_dps: None,
         damping_coupling_dps: None,
+        cycle_rate_dps: None,
         clocks,
     })
 }

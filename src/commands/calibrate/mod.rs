@@ -7,7 +7,8 @@
 //!   `uio:///dev/uioN`, `mem:///dev/mem?base=0xADDR`), time measured by
 //!   SAMPLE_COUNT. Without it: the file's device on the in-process
 //!   simulated board (model engine, powered up), at `--temperature` when
-//!   the file has `[drift]`; the truth is then given too: the device, the
+//!   the file has `[drift]`, turning at `--rate` deg/s during the cycle
+//!   (default 0: at rest, as the cycle assumes); the truth is then given too: the device, the
 //!   rate table's scale factor at the cycle's settings with its own
 //!   uncertainty, and the self-calibration's error against it with the
 //!   two sigmas in quadrature (`selfcal_error_uncertainty`, as in
@@ -42,6 +43,7 @@ use gyrocal_host::{Board, Knowns, transport};
 use gyrocal_sim::drift::DeviceAt;
 use gyrocal_sim::field::board::SimBoard;
 use gyrocal_sim::field::scenario;
+use gyrocal_sim::gyro::MAX_COUPLING_DPS;
 use gyrocal_sim::serve::device::{self, DeviceFile};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -65,6 +67,10 @@ pub struct Args {
     /// default the first step).
     #[arg(long, allow_negative_numbers = true)]
     pub temperature: Option<f64>,
+    /// In process: the board turns at this rate (deg/s) during the cycle,
+    /// as a device not held still would (default 0, at rest).
+    #[arg(long, allow_negative_numbers = true)]
+    pub rate: Option<f64>,
 }
 
 /// What no board tells: the simulated device and its rate table.
@@ -118,8 +124,8 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     let file = device::parse(&name, &text).map_err(Failure::input)?;
     let knowns = file.knowns().map_err(Failure::input)?;
     let outcome = match &args.board {
-        Some(url) => over_the_wire(url, &knowns, args.temperature)?,
-        None => in_process(&file, &knowns, args.temperature)?,
+        Some(url) => over_the_wire(url, &knowns, args)?,
+        None => in_process(&file, &knowns, args)?,
     };
     let outcome = match outcome {
         Ok(outcome) => outcome,
@@ -197,11 +203,17 @@ fn cycle(
 fn over_the_wire(
     url: &str,
     knowns: &Knowns,
-    temperature: Option<f64>,
+    args: &Args,
 ) -> Result<Result<Outcome, Halted>, Failure> {
-    if temperature.is_some() {
+    if args.temperature.is_some() {
         return Err(Failure::Input(
             "--temperature: applies to the in-process board only (a served board's device is set by gyrocal serve --temperature)"
+                .into(),
+        ));
+    }
+    if args.rate.is_some() {
+        return Err(Failure::Input(
+            "--rate: applies to the in-process board only (a real board turns as it is turned)"
                 .into(),
         ));
     }
@@ -226,12 +238,19 @@ fn over_the_wire(
 fn in_process(
     file: &DeviceFile,
     knowns: &Knowns,
-    temperature: Option<f64>,
+    args: &Args,
 ) -> Result<Result<Outcome, Halted>, Failure> {
     let at = file
-        .at(temperature)
+        .at(args.temperature)
         .map_err(|e| Failure::Input(format!("--{e}")))?;
     let mut board: SimBoard = file.board(&at).map_err(Failure::run)?;
+    let rate = args.rate.unwrap_or(0.0);
+    if !rate.is_finite() || rate.abs() > MAX_COUPLING_DPS {
+        return Err(Failure::Input(format!(
+            "--rate {rate}: allowed -{MAX_COUPLING_DPS}..={MAX_COUPLING_DPS} deg/s"
+        )));
+    }
+    board.set_rate(rate.to_radians());
     eprintln!("calibrating the in-process simulated board");
     let (cal, samples, wall_s) = match cycle(&mut board, IN_PROCESS, knowns) {
         Ok(done) => done,

@@ -60,6 +60,9 @@ fn identified_json(id: &Identified) -> Value {
     for (name, e) in estimates(id) {
         put(&mut identified, name, e);
     }
+    if let Some(t) = id.cycle_rate_dps {
+        put(&mut identified, "cycle_rate_dps", t);
+    }
     Value::Object(identified)
 }
 
