@@ -45,7 +45,7 @@
 //! M_21), and c has the damping term's form j w d: output 1's D reads
 //! d - 2 lambda Omega, output 2's d + 2 lambda Omega. Their mean is the
 //! damping coupling; half their difference, in the same units, is the
-//! rate ([`rate_from_windows`]). On five devices at rest it read within
+//! rate (`rate_from_windows`). On five devices at rest it read within
 //! 2.3 of its sigmas of 0 (about 0.02 deg/s), at 5 and -2 deg/s within
 //! 1.7% of the rate; the cycle then says the device turned
 //! (`selfcal::CYCLE_RATE_SEEN`).
