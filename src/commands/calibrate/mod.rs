@@ -16,13 +16,16 @@
 //! - The file's `[gyro]` is the datasheet the host starts from, `[drive]`
 //!   and `[experiment]` its settings (`serve::device::DeviceFile::knowns`).
 //! - Output: a table, or with `--json` one object on stdout: `identified`
-//!   (f1_hz, f2_hz, q1, q2, loop_phase_deg, group_delay_s, each with an
-//!   `_uncertainty` twin, 1 sigma), `sf_cal_per_dps`, `ratio`,
+//!   (f1_hz, f2_hz, q1, q2, loop_phase_deg, group_delay_s, and
+//!   cycle_rate_dps, the rate the device turned at during the cycle, each
+//!   with an `_uncertainty` twin, 1 sigma), `sf_cal_per_dps`, `ratio`,
 //!   `sf_selfcal_per_dps` and `sf_selfcal_uncertainty` (relative 1 sigma,
 //!   as in `gyrocal field`), one per output, `clocks`, `wall_s`, `samples`
 //!   (read and missed over the run), `warnings` (what the sigma leaves
 //!   out, one line each, also on stderr: a drive-gain ratio nothing
-//!   measured nor bounds, a carrier on a slow fold; in process, self-cal
+//!   measured nor bounds, a carrier on a slow fold, a datasheet f or Q
+//!   beyond a part's spread, a device that turned during the cycle
+//!   (`SelfCal::warnings`); in process, self-cal
 //!   errors beyond 3 of their sigmas against the truth), `failed` (null)
 //!   and `truth` (null over the wire). Progress goes to stderr.
 //! - A cycle that stops after identification (a board that stops
