@@ -34,6 +34,17 @@ pub const F_SPREAD: f64 = 0.05;
 /// datasheet for another part would show.
 pub const Q_SPREAD: f64 = 2.0;
 
+/// Whether two Qs whose ratio is `ratio` lie farther apart than a part's
+/// spread ([`Q_SPREAD`] either way).
+///
+/// ```
+/// use gyrocal_host::datasheet::q_beyond_spread;
+/// assert!(!q_beyond_spread(2.0) && !q_beyond_spread(0.5) && q_beyond_spread(0.49));
+/// ```
+pub fn q_beyond_spread(ratio: f64) -> bool {
+    !(1.0 / Q_SPREAD..=Q_SPREAD).contains(&ratio)
+}
+
 /// Largest relative 1-sigma of the angular gain.
 pub const MAX_ANGULAR_GAIN_UNCERTAINTY: f64 = 0.5;
 /// Largest relative 1-sigma of the drive-gain ratio.

@@ -7,7 +7,7 @@
 //! what a package that lost its vacuum shows.
 
 use super::{Estimate, Identified, search::shown_q};
-use crate::datasheet::{F_SPREAD, Q_SPREAD};
+use crate::datasheet::{F_SPREAD, Q_SPREAD, q_beyond_spread};
 use crate::device::GyroParams;
 
 impl Identified {
@@ -53,7 +53,7 @@ pub fn datasheet_departures(
         }
         let q_said = nominal.q(k);
         let factor = q_said / q[k].value;
-        if !(1.0 / Q_SPREAD..=Q_SPREAD).contains(&factor) {
+        if q_beyond_spread(factor) {
             parts.push(format!(
                 "q{} = {} is {} times the identified {}",
                 k + 1,

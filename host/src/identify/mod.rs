@@ -447,10 +447,10 @@ fn attempt(
                 search::shown_q(q),
                 k + 1
             );
-            // The coarse search's bandwidth, when it is far from the
-            // datasheet's, is the better guess of Q.
+            // The coarse search's bandwidth, when it is farther than a
+            // part's spread from the datasheet's, is the better guess of Q.
             let measured = centre / bk;
-            let far = !(0.5..=2.0).contains(&(measured / q));
+            let far = crate::datasheet::q_beyond_spread(measured / q);
             return Ok(Err(Missed {
                 reason,
                 retry_q: far.then_some(measured),
