@@ -149,12 +149,13 @@ struct Norm {
 }
 
 /// The coupling's part of the response `H = M^-1` at one frequency, times
-/// wb^2 (`M = [[d1, kap], [kap, d2]]` at rest, module header).
+/// wb^2 (`M = [[d1, kap - c], [kap + c, d2]]`, module header; `c = j w 2
+/// lam Omz`, 0 at rest).
 struct Coupling {
-    /// `kap^2 / (dk det)`: what the coupling adds to `Hkk = 1/dk`.
+    /// `(kap^2 - c^2) / (dk det)`: what the coupling adds to `Hkk = 1/dk`.
     extra: [C64; 2],
-    /// `H12 = H21 = -kap / det`.
-    cross: C64,
+    /// `[H12, H21] = [-(kap - c), -(kap + c)] / det` (equal at rest).
+    cross: [C64; 2],
 }
 
 impl Norm {
@@ -187,15 +188,20 @@ impl Norm {
         C64::new(self.k, (self.wb + dw) / self.wb * self.d)
     }
 
-    /// The coupling's part of the response at rest at `wb + dw` (exactly
-    /// zero without coupling).
-    fn coupling(&self, dw: f64) -> Coupling {
+    /// The coupling's part of the response at `wb + dw` with the device
+    /// turning at `c_wb` = 2 lam Omz / wb (0 at rest; exactly zero
+    /// without coupling and rate, and at rest the same bits as without
+    /// the rate's terms).
+    fn coupling(&self, dw: f64, c_wb: f64) -> Coupling {
         let d = [self.d(0, dw), self.d(1, dw)];
         let kap = self.kappa(dw);
-        let det = d[0] * d[1] - kap * kap;
+        // c / wb^2 = j w 2 lam Omz / wb^2 at w = wb + dw.
+        let c = C64::new(0.0, (self.wb + dw) / self.wb * c_wb);
+        let pair = kap * kap - c * c;
+        let det = d[0] * d[1] - pair;
         Coupling {
-            extra: d.map(|dk| kap * kap / (dk * det)),
-            cross: -kap / det,
+            extra: d.map(|dk| pair / (dk * det)),
+            cross: [-(kap - c) / det, -(kap + c) / det],
         }
     }
 }
@@ -238,8 +244,8 @@ pub fn calibration_z(dev: &Device, f_cal_hz: f64) -> [f64; 2] {
     let k = dev.f1_force * dev.f2_force * om / (4.0 * n.wb.powi(3));
     let (f1, f2) = (dev.f1_force, dev.f2_force);
     // The coupling's part (module header): H12's sum, the kap^2 terms' difference.
-    let [lo, hi] = [-om, om].map(|dw| n.coupling(dw));
-    let cross = (lo.cross + hi.cross) / 2.0;
+    let [lo, hi] = [-om, om].map(|dw| n.coupling(dw, 0.0));
+    let cross = (lo.cross[0] + hi.cross[0]) / 2.0;
     let extra = |m: usize| (lo.extra[m] - hi.extra[m]) / 2.0;
     let coupled = [
         f2 * (f1 * extra(0) + f2 * cross),
@@ -299,6 +305,33 @@ pub fn calibration_z_lagged(
     sideband_gain: [f64; 2],
     lag_rad: f64,
 ) -> [f64; 2] {
+    calibration_z_turning(
+        dev,
+        f_cal_hz,
+        envelope_lead_rad,
+        sideband_gain,
+        lag_rad,
+        0.0,
+    )
+}
+
+/// [`calibration_z_lagged`] with the device turning at `omz_rad_s`
+/// during the calibration (at 0 the same bits). The Coriolis term enters
+/// the two cross responses with opposite signs (`H12 = -(kap - c) /
+/// det`, `H21 = -(kap + c) / det`, `c = j w 2 lam Omz`): output k's own
+/// reference mixes drive k's sidebands that reach x_k through mode 1 - k,
+/// a term linear in the rate. On a detuned output it is the resonant
+/// response of the other mode, far above the calibration signal: the
+/// consumer device's (`tests/data/field_consumer.toml`) output 2 moves by
+/// 4.6% per deg/s.
+pub fn calibration_z_turning(
+    dev: &Device,
+    f_cal_hz: f64,
+    envelope_lead_rad: f64,
+    sideband_gain: [f64; 2],
+    lag_rad: f64,
+    omz_rad_s: f64,
+) -> [f64; 2] {
     let n = Norm::new(dev);
     let rot = C64::from_polar(1.0, -lag_rad);
     let om = TAU * f_cal_hz;
@@ -317,12 +350,13 @@ pub fn calibration_z_lagged(
         [f2 / 2.0 * lead.conj(), -f2 / 2.0 * lead],
     ];
     let dw = [-om, om];
-    let coupling = dw.map(|dw| n.coupling(dw));
+    let c_wb = 2.0 * dev.angular_gain * omz_rad_s / n.wb;
+    let coupling = dw.map(|dw| n.coupling(dw, c_wb));
     let z = |k: usize| {
         (0..2)
             .map(|s| {
                 let own = (1.0 / (n.d(k, dw[s]) * wb2) + coupling[s].extra[k] / wb2) * rot;
-                let cross = coupling[s].cross / wb2 * rot;
+                let cross = coupling[s].cross[k] / wb2 * rot;
                 let x = own * drive[k][s] + cross * drive[1 - k][s];
                 0.5 * (x * reference[1 - k][s].conj()).re
             })
@@ -458,15 +492,22 @@ pub fn readout_peak_displacement(dev: &Device, omz_rad_s: f64) -> [f64; 2] {
 /// is at most the sum of the moduli of the responses, `|Hkk| <= 1/|Dk| +
 /// |kap^2/(Dk det)|`.
 pub fn calibration_peak_displacement(dev: &Device, f_cal_hz: f64) -> [f64; 2] {
+    calibration_peak_turning(dev, f_cal_hz, 0.0)
+}
+
+/// [`calibration_peak_displacement`] with the device turning at
+/// `omz_rad_s` (the cross responses `calibration_z_turning` has).
+pub fn calibration_peak_turning(dev: &Device, f_cal_hz: f64, omz_rad_s: f64) -> [f64; 2] {
     let n = Norm::new(dev);
     let om = TAU * f_cal_hz;
     let wb2 = n.wb * n.wb;
     let force = [dev.f1_force, dev.f2_force];
-    let coupling = [-om, om].map(|dw| n.coupling(dw));
+    let c_wb = 2.0 * dev.angular_gain * omz_rad_s / n.wb;
+    let coupling = [-om, om].map(|dw| n.coupling(dw, c_wb));
     let peak = |k: usize, f: f64| {
         let coupled: f64 = coupling
             .iter()
-            .map(|c| 0.5 * (f * c.extra[k].norm() + force[1 - k] * c.cross.norm()))
+            .map(|c| 0.5 * (f * c.extra[k].norm() + force[1 - k] * c.cross[k].norm()))
             .sum();
         (0.5 * f * (1.0 / n.d(k, -om).norm() + 1.0 / n.d(k, om).norm()) + coupled) / wb2
     };
@@ -542,6 +583,66 @@ mod tests {
             quadrature_dps: 2000.0,
             damping_coupling_dps: 20.0,
             ..dev
+        }
+    }
+
+    /// The calibration of a turning device against the 2x2 system
+    /// inverted directly at each sideband, in physical units: `M(w) =
+    /// [[D1, kap - j w 2 lam Omz], [kap + j w 2 lam Omz, D2]]` (the
+    /// equations of motion in the module header), the drives' and
+    /// references' sideband phasors as `calibration_z_turning` documents
+    /// them, and z_k the mean of x_k times reference 1 - k. With and
+    /// without couplings, lead, lag and sideband gains; at rest the same
+    /// bits as `calibration_z_lagged`.
+    #[test]
+    fn a_turning_device_is_the_direct_inverse() {
+        use nalgebra::Matrix2;
+        let j = C64::i();
+        for (dev, f_cal, omz) in [
+            (device(-37.0, [5e4, 3e4], 12.0), 2.5, 0.3),
+            (coupled(device(-37.0, [5e4, 3e4], 12.0)), 2.5, -0.05),
+            (coupled(device(1e3, [200.0, 200.0], 0.0)), 300.0, 2.0),
+        ] {
+            let (lead, gains, lag) = (0.01, [1.0, 0.99], 0.2);
+            let got = calibration_z_turning(&dev, f_cal, lead, gains, lag, omz);
+            let (wb, om) = (TAU * dev.carrier_hz, TAU * f_cal);
+            let gyro = dev.gyro_params();
+            let (k, d) = (gyro.quadrature_stiffness(), gyro.damping_coupling());
+            let wk = [TAU * dev.f1_hz, TAU * dev.f2_hz];
+            let bk = [wk[0] / dev.q1, wk[1] / dev.q2];
+            let (f1, f2) = (dev.f1_force, dev.f2_force);
+            let lead = C64::from_polar(1.0, lead);
+            let drive = [
+                [f1 / 2.0 * gains[0], f1 / 2.0 * gains[1]],
+                [f2 / 2.0 * gains[0], -f2 / 2.0 * gains[1]],
+            ];
+            let reference = [
+                [f1 / 2.0 * lead.conj(), f1 / 2.0 * lead],
+                [f2 / 2.0 * lead.conj(), -f2 / 2.0 * lead],
+            ];
+            let mut want = [0.0; 2];
+            for (s, dw) in [-om, om].into_iter().enumerate() {
+                let w = wb + dw;
+                let dk = |m: usize| wk[m] * wk[m] - w * w + j * w * bk[m];
+                let (kap, c) = (k + j * w * d, j * w * 2.0 * dev.angular_gain * omz);
+                let m = Matrix2::new(dk(0), kap - c, kap + c, dk(1));
+                let h = m.try_inverse().unwrap();
+                let x = h * nalgebra::Vector2::new(C64::from(drive[0][s]), C64::from(drive[1][s]));
+                for (kk, want) in want.iter_mut().enumerate() {
+                    let x = x[kk] * C64::from_polar(1.0, -lag);
+                    *want += 0.5 * (x * reference[1 - kk][s].conj()).re;
+                }
+            }
+            let size = want[0].abs().max(want[1].abs());
+            for kk in 0..2 {
+                assert!(
+                    (got[kk] - want[kk]).abs() <= 1e-9 * size,
+                    "{dev:?} {omz}: {got:?} {want:?}"
+                );
+            }
+            let rest = calibration_z_turning(&dev, f_cal, 0.01, gains, lag, 0.0);
+            let lagged = calibration_z_lagged(&dev, f_cal, 0.01, gains, lag);
+            assert_eq!(rest.map(f64::to_bits), lagged.map(f64::to_bits));
         }
     }
 
