@@ -184,6 +184,7 @@ fn rounding_moves_the_resonant_outputs_rate_table() {
             static_fold: None,
             spur_move: None,
             scaled_drives: None,
+            cycle_rate_dps: 0.0,
         };
         let sf0 = scenario::rate_table(&sc.exp, &fe, &at, &knowns, &op)
             .unwrap()

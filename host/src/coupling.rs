@@ -45,10 +45,12 @@
 //! M_21), and c has the damping term's form j w d: output 1's D reads
 //! d - 2 lambda Omega, output 2's d + 2 lambda Omega. Their mean is the
 //! damping coupling; half their difference, in the same units, is the
-//! rate (`rate_from_windows`). On five devices at rest it read within
+//! rate (`Coupling::rate_dps`). On five devices at rest it read within
 //! 2.3 of its sigmas of 0 (about 0.02 deg/s), at 5 and -2 deg/s within
-//! 1.7% of the rate; the cycle then says the device turned
-//! (`selfcal::CYCLE_RATE_SEEN`).
+//! 1.7% of the rate. The cycle predicts the calibration at it
+//! (`selfcal::Operating::cycle_rate_dps`), fits the modes with its pull
+//! (`uncouple`) and, beyond `selfcal::CYCLE_RATE_SEEN` of its sigmas, says
+//! the device turned.
 //!
 //! # Images
 //!
@@ -123,6 +125,11 @@ pub struct Coupling {
     /// `[gyro] damping_coupling_dps`), from the same estimate's imaginary
     /// part.
     pub damping_dps: Estimate,
+    /// The rate the device turned at during the windows (deg/s, the sign
+    /// of `SimBoard::set_rate`'s): the two outputs' D in opposition
+    /// (`coupling_hz2`, module header), in the damping coupling's units; 0
+    /// within its sigma at rest.
+    pub rate_dps: Estimate,
     /// Clocks the measurement took.
     pub clocks: u64,
 }
@@ -225,9 +232,10 @@ impl Reading {
     }
 }
 
-/// The coupling from the cross-response windows measured at rest at the
-/// operating point `op` of identification `id`: one round, which the
-/// cycle iterates with [`uncouple`] (`selfcal`).
+/// The coupling from the cross-response windows measured at the
+/// operating point `op` of identification `id`, and the rate the device
+/// turned at meanwhile: one round, which the cycle iterates with
+/// [`uncouple`] (`selfcal`).
 ///
 /// `spur_lines`: the table core's lines in the windows' means
 /// ([`spur_lines`]), which the batches' spread does not see.
@@ -239,47 +247,38 @@ pub(crate) fn from_windows(
     spur_lines: Option<&[TurningLine]>,
 ) -> Result<Coupling, Error> {
     let reading = Reading::new(knowns, op, id);
-    let in_dps = |w: &CrossWindows, b: Option<usize>| reading.read(w, b).0;
-    let batches: Vec<C64> = (0..BATCHES).map(|b| in_dps(windows, Some(b))).collect();
-    if batches.iter().any(|k| !k.re.is_finite()) {
+    let to_damping = reading.to_damping;
+    // The real part is Omega_q (k = 2 lambda w1 Omega_q); the imaginary
+    // part w_c d with d = 2 lambda Omega_d, so Omega_d is it times f1 / fc;
+    // the rate term likewise. As one complex number per batch: the
+    // coupling (Omega_q + j Omega_d) and the rate.
+    let in_dps = |w: &CrossWindows, b: Option<usize>| {
+        let (kappa, rate) = reading.read(w, b);
+        [
+            C64::new(kappa.re, kappa.im * to_damping),
+            C64::new(rate * to_damping, 0.0),
+        ]
+    };
+    let batches: Vec<[C64; 2]> = (0..BATCHES).map(|b| in_dps(windows, Some(b))).collect();
+    if batches.iter().any(|[k, _]| !k.re.is_finite()) {
         return Err(Error::Measurement {
             what: "quadrature coupling",
             reason: "a direct response (P_1 or Q_2) read zero".into(),
         });
     }
-    // The real part is Omega_q (k = 2 lambda w1 Omega_q); the imaginary
-    // part w_c d with d = 2 lambda Omega_d, so Omega_d is it times f1 / fc.
-    let spurs = spur_lines.map_or(C64::new(0.0, 0.0), |lines| {
-        spur_sigma(windows, lines, |w| in_dps(w, None))
-    });
-    let to_damping = reading.to_damping;
-    let re: Vec<f64> = batches.iter().map(|k| k.re).collect();
-    let im: Vec<f64> = batches.iter().map(|k| k.im * to_damping).collect();
+    let spurs = |part: usize| {
+        spur_lines.map_or(C64::new(0.0, 0.0), |lines| {
+            spur_sigma(windows, lines, |w| in_dps(w, None)[part])
+        })
+    };
+    let (coupling_spurs, rate_spurs) = (spurs(0), spurs(1));
+    let of = |f: fn(&[C64; 2]) -> f64| batches.iter().map(f).collect::<Vec<f64>>();
     Ok(Coupling {
-        quadrature_dps: reading.estimate(&re, spurs.re),
-        damping_dps: reading.estimate(&im, spurs.im * to_damping),
+        quadrature_dps: reading.estimate(&of(|b| b[0].re), coupling_spurs.re),
+        damping_dps: reading.estimate(&of(|b| b[0].im), coupling_spurs.im),
+        rate_dps: reading.estimate(&of(|b| b[1].re), rate_spurs.re),
         clocks: windows.clocks,
     })
-}
-
-/// The rate the device turned at during the windows (deg/s, the sign of
-/// `SimBoard::set_rate`'s): the two outputs' D in opposition
-/// (`coupling_hz2`), in the damping coupling's units; 0 within its sigma
-/// at rest. Measured once, at the cycle's last round of the couplings.
-pub(crate) fn rate_from_windows(
-    windows: &CrossWindows,
-    knowns: &Knowns,
-    op: &Operating,
-    id: &Identified,
-    spur_lines: Option<&[TurningLine]>,
-) -> Estimate {
-    let reading = Reading::new(knowns, op, id);
-    let to_dps = |w: &CrossWindows, b: Option<usize>| reading.read(w, b).1 * reading.to_damping;
-    let batches: Vec<f64> = (0..BATCHES).map(|b| to_dps(windows, Some(b))).collect();
-    let spurs = spur_lines.map_or(0.0, |lines| {
-        spur_sigma(windows, lines, |w| C64::new(to_dps(w, None), 0.0)).re
-    });
-    reading.estimate(&batches, spurs)
 }
 
 /// The table core's carrier spur lines in the windows' means at the cross
@@ -413,8 +412,8 @@ const UNCOUPLE_ROUNDS: usize = 20;
 pub const MAX_MIXING: f64 = 0.02;
 
 /// The uncoupled modes behind the `apparent` identified ones, for the
-/// couplings `[Omega_q, Omega_d]` (deg/s; kappa^2 in place of k^2 below
-/// when there is a damping coupling): each mode's fit sees its direct
+/// `coupling`'s Omega_q, Omega_d and rate (deg/s; kappa^2 - c^2 in place
+/// of k^2 below when there is a damping coupling or a rate): each mode's fit sees its direct
 /// response M_kk = 1 / (1/G_k - k^2 G_(1-k)), a resonator whose 1/G is
 /// pulled by k^2 G_(1-k)(f), the other mode's uncoupled response. Each
 /// mode's fine sweep is fitted again with that pull in the model
@@ -432,33 +431,43 @@ pub const MAX_MIXING: f64 = 0.02;
 /// f_1^2) / 2 f_1), which its detuned output's scale factor feels.
 pub fn uncouple(
     apparent: &Identified,
-    coupling_dps: [f64; 2],
+    coupling: &Coupling,
     angular_gain: f64,
     clock_hz: f64,
     carrier_hz: f64,
 ) -> Result<Identified, Error> {
     let [m1, m2] = &apparent.modes;
     let fa = [m1.f_hz.value, m2.f_hz.value];
-    let [quadrature_dps, damping_dps] = coupling_dps;
+    let quadrature_dps = coupling.quadrature_dps.value;
+    let [damping_dps, rate_dps] = [coupling.damping_dps, coupling.rate_dps].map(|e| e.value);
     // kappa(f) = k + j w d in Hz^2 (`crate::theory`): k from Omega_q at f1,
-    // the damping term j f (lambda Omega_d / 180) at f.
-    let kappa = |f: f64| {
-        C64::new(
+    // the damping term j f (lambda Omega_d / 180) at f. A rate adds the
+    // Coriolis term c = j f (lambda Omega / 180) with opposite signs to
+    // the two cross terms (module header), whose product is then kappa^2 -
+    // c^2: that is the pull (below, "kappa^2").
+    let kappa_squared = |f: f64| {
+        let kappa = C64::new(
             quadrature_dps * angular_gain * fa[0] / 180.0,
             damping_dps * angular_gain * f / 180.0,
-        )
+        );
+        let c = C64::new(0.0, rate_dps * angular_gain * f / 180.0);
+        kappa * kappa - c * c
+    };
+    // Named by what couples them: the rate, where it is the larger.
+    let by = if rate_dps.abs() > quadrature_dps.abs().max(damping_dps.abs()) {
+        format!("a rate of {rate_dps:.1} deg/s during the cycle (its Coriolis coupling)")
+    } else {
+        format!("{quadrature_dps:.1} deg/s")
     };
     let too_strong = |reason: String| Error::Measurement {
         what: "quadrature coupling",
-        reason: format!(
-            "{quadrature_dps:.1} deg/s couples the modes too strongly to separate: {reason}"
-        ),
+        reason: format!("{by} couples the modes too strongly to separate: {reason}"),
     };
     // The other mode's pull on mode i, from the other's current estimate.
     let pull_on = |modes: &[ModeFit; 2], i: usize| {
         let o = &modes[1 - i];
         let (fo, qo) = (o.f_hz.value, o.q.value);
-        move |v: f64| kappa(v).powi(2) * resonator(fo, qo, v)
+        move |v: f64| kappa_squared(v) * resonator(fo, qo, v)
     };
     let values = |modes: &[ModeFit; 2]| {
         (
@@ -491,7 +500,7 @@ pub fn uncouple(
     let (f, q) = values(&modes);
     for i in 0..2 {
         let g = [resonator(f[0], q[0], f[i]), resonator(f[1], q[1], f[i])];
-        let mixing = (g[0] * g[1] * kappa(f[i]).powi(2)).norm();
+        let mixing = (g[0] * g[1] * kappa_squared(f[i])).norm();
         if mixing > MAX_MIXING {
             return Err(too_strong(format!(
                 "k^2 |G_1 G_2| = {mixing:.2} at mode {}, at most {MAX_MIXING}",

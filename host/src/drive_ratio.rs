@@ -412,6 +412,41 @@ pub fn measure(
     Ok(from_windows(&windows, knowns, op, id))
 }
 
+/// What a rate during the windows does to the at-rest estimate's
+/// magnitude, taken out: the estimate is the ratio squared times M_12 /
+/// M_21, 1 at rest, and with the device turning M_12 = -(kappa - c) /
+/// det and M_21 = -(kappa + c) / det (`crate::coupling` module header; c
+/// = j w 2 lambda Omega, kappa = k + j w d). With a stiffness coupling
+/// alone |kappa - c| = |kappa + c|; with a damping coupling too they
+/// differ at first order in the rate (`tests/data/field_coupled.toml`
+/// with 10 deg/s of damping coupling at 50 deg/s: its output 2 was 9.6
+/// sigma off, and 3 deg/s, 0.46% on the estimate, 2.8 sigma). So |kappa + c| / |kappa - c|, from the identified couplings
+/// and the rate the prediction is at (`selfcal::predicted_rate`), in
+/// the units of the couplings (deg/s: Omega_q + j fc / f1 (Omega_d +-
+/// Omega)); 1 at rest.
+fn turning_factor(id: &Identified, carrier_hz: f64) -> f64 {
+    let (kappa, c) = cross_terms(id, carrier_hz);
+    let (plus, minus) = ((kappa + c).norm(), (kappa - c).norm());
+    if minus > 0.0 { plus / minus } else { 1.0 }
+}
+
+/// The cross responses' two terms at the carrier from the
+/// identification, in the couplings' units (deg/s, `turning_factor`):
+/// kappa = Omega_q + j fc / f1 Omega_d and the Coriolis c = j fc / f1
+/// Omega, Omega the rate the prediction is at (`selfcal::predicted_rate`).
+pub(crate) fn cross_terms(id: &Identified, carrier_hz: f64) -> (C64, C64) {
+    let value = |e: Option<crate::identify::CouplingFigure>| e.map_or(0.0, |c| c.value);
+    let to_carrier = carrier_hz / id.modes[0].f_hz.value;
+    let kappa = C64::new(
+        value(id.quadrature_dps),
+        to_carrier * value(id.damping_coupling_dps),
+    );
+    let rate = id
+        .cycle_rate_dps
+        .map_or(0.0, |r| crate::selfcal::predicted_rate(r).value);
+    (kappa, C64::new(0.0, to_carrier * rate))
+}
+
 /// g_2 / g_1 from measured windows. With a quadrature coupling k the
 /// cross responses are M_12 = -(k - c) / det and M_21 = -(k + c) / det
 /// (`crate::coupling`), so the identity of the module header reads
@@ -419,7 +454,8 @@ pub fn measure(
 /// (g_2 / g_1)^2. For a stiffness k (real) and the Coriolis c (imaginary)
 /// that factor has magnitude 1: |g_2 / g_1| stays exact while turning, at
 /// rest (c = 0, when k is large enough to see) or both; only the phase
-/// moves.
+/// moves. A damping coupling makes kappa complex, and the magnitude moves
+/// with the rate ([`turning_factor`], taken out).
 pub(crate) fn from_windows(
     windows: &CrossWindows,
     knowns: &Knowns,
@@ -435,7 +471,11 @@ pub(crate) fn from_windows(
         })
         .collect();
     let design = knowns.force_full_scale[1] / knowns.force_full_scale[0];
-    let magnitude: Vec<f64> = squared.iter().map(|v| v.norm().sqrt() / design).collect();
+    let turning = turning_factor(id, op.carrier_hz);
+    let magnitude: Vec<f64> = squared
+        .iter()
+        .map(|v| (v.norm() * turning).sqrt() / design)
+        .collect();
     // Phases about the batches' mean (at rest with a coupling they sit at
     // +-180 deg, where a plain mean of arguments would wrap).
     let centre = squared.iter().sum::<C64>();

@@ -104,8 +104,8 @@ pub fn readout_images(dev: &Device, clock_hz: f64, omz_rad_s: f64, front: ImageF
     })
 }
 
-/// What the images add to `theory::calibration_z_of_datapath(dev, cal_hz,
-/// lead_rad, sideband_gain)`, through the `front` end.
+/// What the images add to `theory::calibration_z_turning(dev, cal_hz,
+/// lead_rad, sideband_gain, 0, omz_rad_s)`, through the `front` end.
 pub fn calibration_images(
     dev: &Device,
     clock_hz: f64,
@@ -113,6 +113,7 @@ pub fn calibration_images(
     lead_rad: f64,
     sideband_gain: [f64; 2],
     front: ImageFront,
+    omz_rad_s: f64,
 ) -> [f64; 2] {
     let fc = dev.carrier_hz;
     shifts(clock_hz).fold([0.0; 2], |sum, shift| {
@@ -121,7 +122,8 @@ pub fn calibration_images(
             let f = fc + [-cal_hz, cal_hz][s];
             front_gain * sideband_gain[s] * f / (f + shift)
         });
-        let z = theory::calibration_z_lagged(&moved(dev, shift), cal_hz, lead_rad, gain, lag);
+        let moved = moved(dev, shift);
+        let z = theory::calibration_z_turning(&moved, cal_hz, lead_rad, gain, lag, omz_rad_s);
         [sum[0] + z[0], sum[1] + z[1]]
     })
 }

@@ -21,7 +21,15 @@ impl Plan {
                 let gain = [-1.0, 1.0]
                     .map(|s| hold_gain(self.carrier_hz + s * p.cal_hz, clock) / self.hold_gain);
                 let lead = envelope_lead_rad(p.cal_hz, clock);
-                calibration_images(&dev, clock, p.cal_hz, lead, gain, ImageFront::default())
+                calibration_images(
+                    &dev,
+                    clock,
+                    p.cal_hz,
+                    lead,
+                    gain,
+                    ImageFront::default(),
+                    0.0,
+                )
             }
         };
         z.map(|z| z * self.hold_gain)
@@ -145,8 +153,8 @@ mod tests {
         let h = hold(dev.carrier_hz);
         let gain = [-1.0, 1.0].map(|s| hold(dev.carrier_hz + s * cal) / h);
         let exact = theory::calibration_z_of_datapath(&dev, cal, 0.0, gain).map(|z| z * h);
-        let images =
-            calibration_images(&dev, CLOCK, cal, 0.0, gain, ImageFront::default()).map(|z| z * h);
+        let images = calibration_images(&dev, CLOCK, cal, 0.0, gain, ImageFront::default(), 0.0)
+            .map(|z| z * h);
         assert_closed(sim, exact, images);
     }
 }

@@ -285,7 +285,7 @@ pub struct Identified {
     /// `[gyro] damping_coupling_dps`), measured with it; `None` until then.
     pub damping_coupling_dps: Option<CouplingFigure>,
     /// The rate the device turned at during the couplings' windows
-    /// (deg/s, `coupling::rate_from_windows`); `None` until measured.
+    /// (deg/s, `coupling::Coupling::rate_dps`); `None` until measured.
     /// The cycle assumes rest: a rate beyond its sigma is said
     /// (`SelfCal::warnings`).
     pub cycle_rate_dps: Option<Estimate>,

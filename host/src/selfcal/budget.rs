@@ -35,6 +35,13 @@ pub struct SfUncertainty {
     /// The drive-gain ratio's: the measured ratio's sigma, or without a
     /// measurement the datasheet's on the design ratio.
     pub drive_ratio: [f64; 2],
+    /// The rate the device turned at during the cycle: the prediction,
+    /// at the rate `super::predicted_rate` gives (the couplings' windows'
+    /// reading where it is seen, else 0), moved by that rate's sigma. A
+    /// detuned output's calibration moves with the rate (the consumer
+    /// device's output 2 by 4.6% per deg/s), so on such a device this
+    /// term is there at rest too.
+    pub cycle_rate: [f64; 2],
     /// All of them in quadrature.
     pub total: [f64; 2],
 }
@@ -48,6 +55,7 @@ impl SfUncertainty {
                 self.identified[k],
                 self.angular_gain[k],
                 self.drive_ratio[k],
+                self.cycle_rate[k],
             ]
             .into_iter()
             .fold(0.0, f64::hypot)
@@ -180,8 +188,36 @@ pub(super) fn angular_gain(
     datasheet_term(knowns.angular_gain_uncertainty, ratio, |u| {
         let mut g = gyro.clone();
         g.angular_gain *= 1.0 + u;
-        predicted_ratio(knowns, &g, op, cal_hz)
+        // The windows measured the Coriolis term 2 lambda Omega, read in
+        // deg/s with the datasheet's lambda: it stays what they measured.
+        let o = Operating {
+            cycle_rate_dps: op.cycle_rate_dps / (1.0 + u),
+            ..op.clone()
+        };
+        predicted_ratio(knowns, &g, &o, cal_hz)
     })
+}
+
+/// The predicted ratio's relative 1-sigma from the rate read during the
+/// cycle (`SfUncertainty::cycle_rate`): the prediction with the rate
+/// moved by its sigma (`super::predicted_rate`); no term before the rate
+/// is read.
+pub(super) fn cycle_rate(
+    knowns: &Knowns,
+    id: &Identified,
+    op: &Operating,
+    cal_hz: &[f64],
+    ratio: &Ratio,
+) -> Result<[f64; 2], Error> {
+    let Some(reading) = id.cycle_rate_dps else {
+        return Ok([0.0; 2]);
+    };
+    let o = Operating {
+        cycle_rate_dps: op.cycle_rate_dps + super::predicted_rate(reading).uncertainty,
+        ..op.clone()
+    };
+    let moved = predicted_ratio(knowns, &id.gyro(&knowns.nominal), &o, cal_hz)?;
+    Ok(spread(&[moved], ratio))
 }
 
 /// The predicted ratio's relative 1-sigma from the design drive-gain

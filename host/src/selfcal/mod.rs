@@ -104,6 +104,7 @@
 //! window (a beat's residual in a window's mean falls as the beats grow),
 //! or, if that move is too far, `plan::STATIC_FOLD_BEATS` times, within
 //! the same reach and `STATIC_FOLD_SF_CHANGE`.
+mod at_rest;
 mod budget;
 mod predict;
 pub(crate) mod spurs;
@@ -119,7 +120,7 @@ pub use staircase::{Staircase, staircase};
 use crate::board::Board;
 use crate::coupling;
 use crate::device::GyroParams;
-use crate::drive_ratio::{self, CrossWindows, DriveRatio};
+use crate::drive_ratio::{CrossWindows, DriveRatio};
 use crate::error::Error;
 use crate::identify::{self, CouplingFigure, Estimate, Identified};
 use crate::knowns::Knowns;
@@ -181,6 +182,13 @@ pub struct Operating {
     /// moved to where its spur bound (`spurs`) is lowest within the
     /// allowance, and that bound before and after ([`SpurMove`]).
     pub spur_move: Option<SpurMove>,
+    /// The rate the device turned at during the cycle (deg/s): the
+    /// couplings' windows' reading ([`Identified::cycle_rate_dps`]) where
+    /// it is seen, else 0 ([`predicted_rate`]). The calibration responses
+    /// are predicted at it (`theory::calibration_z_turning`), since on a
+    /// detuned output a rate during the staircase moves the calibration
+    /// scale factor (`CYCLE_RATE_SEEN`).
+    pub cycle_rate_dps: f64,
 }
 
 /// A table-core carrier moved to lower its spur bound (`operating`).
@@ -348,13 +356,15 @@ impl SelfCal {
     }
 
     /// One line when the couplings' windows read a rate beyond
-    /// [`CYCLE_RATE_SEEN`] of its sigmas: the device turned during the cycle,
-    /// which assumes rest.
+    /// [`CYCLE_RATE_SEEN`] of its sigmas: the device turned during the
+    /// cycle. The figures are predicted at that rate
+    /// ([`Operating::cycle_rate_dps`]); a rate that changed between the
+    /// windows and the staircase is in no sigma.
     pub fn cycle_rate_warning(&self) -> Option<String> {
         let t = self.identified.cycle_rate_dps?;
-        (t.value.abs() > CYCLE_RATE_SEEN * t.uncertainty).then(|| {
+        rate_seen(t).then(|| {
             format!(
-                "warning: the device turned during the cycle: its cross responses read a rate of {:.3} +- {:.3} deg/s (their Coriolis coupling); the cycle assumes rest and no sigma includes a rate (on a detuned output 5 deg/s can move the scale factor by tens of percent): repeat it with the device still",
+                "warning: the device turned during the cycle: its cross responses read a rate of {:.3} +- {:.3} deg/s (their Coriolis coupling); the scale factors are predicted at that rate, which holds if it stayed steady through the cycle: a rate that changed is in no sigma",
                 t.value, t.uncertainty
             )
         })
@@ -379,6 +389,7 @@ pub fn operating(knowns: &Knowns, id: &Identified) -> Result<Operating, Error> {
             static_fold: static_fold(knowns, real.carrier_hz),
             spur_move: None,
             scaled_drives: None,
+            cycle_rate_dps: id.cycle_rate_dps.map_or(0.0, |r| predicted_rate(r).value),
         })
     };
     let mut op = at(asked)?;
@@ -612,8 +623,9 @@ pub fn self_calibrate_from(
         knowns.nominal.angular_gain,
     )?;
     // The same windows give the drive-gain ratio when the coupling makes
-    // it observable (`drive_ratio::from_windows`), applied below.
-    let at_rest = drive_ratio::from_windows(&windows, &first, &op, &identified);
+    // it observable (`drive_ratio::from_windows`), applied below, and the
+    // couplings and the rate read again at it (`at_rest`).
+    let (identified, at_rest) = at_rest::ratio_at_rest(&windows, &first, &op, identified);
     let gyro = identified.gyro(&knowns.nominal);
     let measured = knowns.with_device(&gyro);
     let op = operating(&measured, &identified)?;
@@ -631,6 +643,7 @@ pub fn self_calibrate_from(
         angular_gain: budget::angular_gain(knowns, &gyro, &op, &cal_hz, &ratio)?,
         // The design ratio's own; a measured ratio replaces it below.
         drive_ratio: budget::design_drive_ratio(knowns, &gyro, &op, &cal_hz, &ratio)?,
+        cycle_rate: budget::cycle_rate(knowns, &identified, &op, &cal_hz, &ratio)?,
         ..SfUncertainty::default()
     }
     .with_total();
@@ -651,20 +664,7 @@ pub fn self_calibrate_from(
         sf_selfcal_uncertainty: uncertainty,
         carrier_spurs: None,
     };
-    if at_rest.relative.uncertainty < AT_REST_RATIO_SIGMA {
-        // The coupling's estimate carried (r + 1/r) / 2 of the ratio r
-        // against the design (`coupling` header): take it out.
-        let r = at_rest.relative.value;
-        let id = &mut cal.identified;
-        for c in [&mut id.quadrature_dps, &mut id.damping_coupling_dps] {
-            if let Some(c) = c.as_mut() {
-                let measured = Estimate {
-                    value: c.value * 2.0 / (r + 1.0 / r),
-                    ..c.measured()
-                };
-                *c = CouplingFigure::new(measured, knowns.angular_gain_uncertainty);
-            }
-        }
+    if let Some(at_rest) = at_rest {
         apply_drive_ratio(knowns, &mut cal, at_rest)?;
     }
     cal.carrier_spurs = spurs(knowns, &cal.identified, &cal.operating)?;
@@ -700,14 +700,7 @@ fn uncoupled(
     let spur_lines = spur_lines.as_deref();
     let mut c = coupling::from_windows(windows, knowns, op, &id, spur_lines)?;
     let uncouple = |c: &coupling::Coupling| {
-        let values = [c.quadrature_dps.value, c.damping_dps.value];
-        coupling::uncouple(
-            &apparent,
-            values,
-            angular_gain,
-            knowns.clock_hz,
-            op.carrier_hz,
-        )
+        coupling::uncouple(&apparent, c, angular_gain, knowns.clock_hz, op.carrier_hz)
     };
     for _ in 0..COUPLING_ROUNDS {
         id = uncouple(&c)?;
@@ -727,20 +720,44 @@ fn uncoupled(
     let figure = |e| CouplingFigure::new(e, knowns.angular_gain_uncertainty);
     id.quadrature_dps = Some(figure(c.quadrature_dps));
     id.damping_coupling_dps = Some(figure(c.damping_dps));
-    id.cycle_rate_dps = Some(coupling::rate_from_windows(
-        windows, knowns, op, &id, spur_lines,
-    ));
+    id.cycle_rate_dps = Some(c.rate_dps);
     Ok(id)
 }
 
 /// A rate read in the couplings' windows beyond this many of its sigmas
-/// is said (`SelfCal::warnings`): the cycle assumes the device at rest,
-/// and a rate during it moves a detuned output's scale factor far beyond
-/// its sigma (the consumer device's output 2: -23% at 5 deg/s, +9.2% at
-/// -2). At rest five devices (the paper's, the consumer, the coupled, the
-/// high-Q and a 47 kHz one) read within 2.3 of their sigmas of 0; 5 deg/s
-/// and -2 deg/s read within 1.7% of the rate.
+/// is seen: the calibration is predicted at it ([`predicted_rate`]) and
+/// the run says the device turned (`SelfCal::warnings`). A rate during
+/// the cycle moves a detuned output's calibration (the consumer device's
+/// output 2 by 4.6% per deg/s: predicted at rest, -23% at 5 deg/s, +9.2%
+/// at -2). At rest five devices (the paper's, the consumer, the coupled,
+/// the high-Q and a 47 kHz one) read within 2.3 of their sigmas of 0; 5
+/// deg/s and -2 deg/s read within 1.7% of the rate.
 pub const CYCLE_RATE_SEEN: f64 = 5.0;
+
+/// The windows' rate `reading` is beyond [`CYCLE_RATE_SEEN`] of its sigmas.
+fn rate_seen(reading: Estimate) -> bool {
+    reading.value.abs() > CYCLE_RATE_SEEN * reading.uncertainty
+}
+
+/// The rate the calibration is predicted at ([`Operating::cycle_rate_dps`])
+/// and its sigma (`SfUncertainty::cycle_rate`), from the couplings'
+/// windows' `reading`: the reading where it is seen; else 0, with the
+/// reading's value and sigma in quadrature as its sigma (what an unseen
+/// rate could leave), as an unseen damping coupling (`DAMPING_SEEN`).
+/// Predicting at an unseen reading would put its noise into the figure:
+/// the consumer device's output 2 moves by 4.6e-4 per 0.01 deg/s, and the
+/// reading's rounding alone moved by that much when the converters' gains
+/// did (`tests/field.rs`, `adc_and_common_drive_gains_cancel`).
+pub fn predicted_rate(reading: Estimate) -> Estimate {
+    if rate_seen(reading) {
+        reading
+    } else {
+        Estimate {
+            value: 0.0,
+            uncertainty: reading.value.hypot(reading.uncertainty),
+        }
+    }
+}
 
 /// `knowns` with drive 2's force gain moved by `relative` (g_2 / g_1 over
 /// the design ratio).

@@ -82,7 +82,7 @@ pub fn adc_peaks(knowns: &Knowns, id: &Identified, op: &Operating) -> Result<[f6
     let cals = knowns
         .cal_freqs_hz
         .iter()
-        .map(|&f| theory::calibration_peak_displacement(&cal, f));
+        .map(|&f| theory::calibration_peak_turning(&cal, f, op.cycle_rate_dps.to_radians()));
     for x in rates.chain(cals) {
         for k in 0..2 {
             peak[k] = peak[k].max(gain[k] * x[k] / CONVERTER_FULL_SCALE);
@@ -158,9 +158,10 @@ pub(super) fn predicted_ratio_lagged(
             // The response's envelope comes late by the group delay: the
             // references' envelope leads it by that much more.
             let lead = envelope_lead_rad(f, clock) + TAU * f * op.envelope_delay_s;
+            let turning = op.cycle_rate_dps * rad;
             add(
-                theory::calibration_z_lagged(&dev_cal, f, lead, sidebands, lag_rad),
-                images::calibration_images(&dev_cal, clock, f, lead, sidebands, front),
+                theory::calibration_z_turning(&dev_cal, f, lead, sidebands, lag_rad, turning),
+                images::calibration_images(&dev_cal, clock, f, lead, sidebands, front, turning),
             )
         })
         .collect();

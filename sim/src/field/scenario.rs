@@ -1188,6 +1188,7 @@ mod tests {
             static_fold: static_fold(knowns, carrier_hz),
             spur_move: None,
             scaled_drives: None,
+            cycle_rate_dps: 0.0,
         }
     }
 

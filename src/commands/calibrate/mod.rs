@@ -8,7 +8,8 @@
 //!   SAMPLE_COUNT. Without it: the file's device on the in-process
 //!   simulated board (model engine, powered up), at `--temperature` when
 //!   the file has `[drift]`, turning at `--rate` deg/s during the cycle
-//!   (default 0: at rest, as the cycle assumes); the truth is then given too: the device, the
+//!   (default 0: at rest; the cycle reads a steady rate and predicts at
+//!   it); the truth is then given too: the device, the
 //!   rate table's scale factor at the cycle's settings with its own
 //!   uncertainty, and the self-calibration's error against it with the
 //!   two sigmas in quadrature (`selfcal_error_uncertainty`, as in
