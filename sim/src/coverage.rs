@@ -28,7 +28,8 @@ pub fn named<T: std::fmt::Display>(items: &[T]) -> String {
 pub struct Scored {
     /// The part's index (`None`: the one device of a field run).
     pub device: Option<u32>,
-    /// The step's temperature (deg C).
+    /// The step's temperature (deg C; NaN for a device without one,
+    /// `gyrocal calibrate` of a file without `[drift]`: not named).
     pub temperature_c: f64,
     /// The output, 0 or 1.
     pub output: usize,
@@ -58,13 +59,10 @@ impl std::fmt::Display for Scored {
         if let Some(device) = self.device {
             write!(f, "device {device} ")?;
         }
-        write!(
-            f,
-            "at {} deg C output {} ({:+.3} sigma)",
-            self.temperature_c,
-            self.output + 1,
-            self.t
-        )
+        if self.temperature_c.is_finite() {
+            write!(f, "at {} deg C ", self.temperature_c)?;
+        }
+        write!(f, "output {} ({:+.3} sigma)", self.output + 1, self.t)
     }
 }
 
@@ -95,4 +93,24 @@ pub fn uncovered_selfcal_errors(scored: &[Scored]) -> Option<String> {
              [datasheet] angular_gain, within its angular_gain_uncertainty"
         )
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A step is named by its temperature where it has one, never as "at
+    /// NaN deg C".
+    #[test]
+    fn a_step_without_temperature_is_named_by_its_output() {
+        let [one, two] = Scored::outputs(None, f64::NAN, [4e-3, 1e-4], [1e-3, 1e-3]);
+        assert_eq!(one.to_string(), "output 1 (+4.000 sigma)");
+        let line = uncovered_errors(&beyond_three_sigma(&[one, two]), 2).unwrap();
+        assert!(!line.contains("NaN"), "{line}");
+        let [at, _] = Scored::outputs(Some(3), 35.0, [4e-3, 1e-4], [1e-3, 1e-3]);
+        assert_eq!(
+            at.to_string(),
+            "device 3 at 35 deg C output 1 (+4.000 sigma)"
+        );
+    }
 }
