@@ -211,11 +211,14 @@ impl Reading {
         }
     }
 
-    /// kappa (deg/s: Omega_q + j fc/f1 Omega_d) and the rate term
-    /// (deg/s times fc/f1) of batch `b` (`None`: every sample).
-    fn read(&self, w: &CrossWindows, b: Option<usize>) -> (C64, f64) {
+    /// `[Omega_q, Omega_d, Omega]` (deg/s) of batch `b` (`None`: every
+    /// sample). The real part of kappa is Omega_q (k = 2 lambda w1
+    /// Omega_q); its imaginary part w_c d with d = 2 lambda Omega_d, so
+    /// Omega_d is it times f1 / fc; the rate term likewise.
+    fn read(&self, w: &CrossWindows, b: Option<usize>) -> [f64; 3] {
         let (kappa, rate) = coupling_hz2(w.lines(b), w.w1, &self.folded, self.rho, self.carrier_hz);
-        (self.per_hz2 * kappa, self.per_hz2 * rate)
+        let (kappa, rate) = (self.per_hz2 * kappa, self.per_hz2 * rate);
+        [kappa.re, kappa.im * self.to_damping, rate * self.to_damping]
     }
 
     /// The batches' mean and its sigma: their spread, the resonators'
@@ -247,36 +250,26 @@ pub(crate) fn from_windows(
     spur_lines: Option<&[TurningLine]>,
 ) -> Result<Coupling, Error> {
     let reading = Reading::new(knowns, op, id);
-    let to_damping = reading.to_damping;
-    // The real part is Omega_q (k = 2 lambda w1 Omega_q); the imaginary
-    // part w_c d with d = 2 lambda Omega_d, so Omega_d is it times f1 / fc;
-    // the rate term likewise. As one complex number per batch: the
-    // coupling (Omega_q + j Omega_d) and the rate.
-    let in_dps = |w: &CrossWindows, b: Option<usize>| {
-        let (kappa, rate) = reading.read(w, b);
-        [
-            C64::new(kappa.re, kappa.im * to_damping),
-            C64::new(rate * to_damping, 0.0),
-        ]
-    };
-    let batches: Vec<[C64; 2]> = (0..BATCHES).map(|b| in_dps(windows, Some(b))).collect();
-    if batches.iter().any(|[k, _]| !k.re.is_finite()) {
+    let batches: Vec<[f64; 3]> = (0..BATCHES)
+        .map(|b| reading.read(windows, Some(b)))
+        .collect();
+    if batches.iter().any(|[k, ..]| !k.is_finite()) {
         return Err(Error::Measurement {
             what: "quadrature coupling",
             reason: "a direct response (P_1 or Q_2) read zero".into(),
         });
     }
-    let spurs = |part: usize| {
-        spur_lines.map_or(C64::new(0.0, 0.0), |lines| {
-            spur_sigma(windows, lines, |w| in_dps(w, None)[part])
-        })
-    };
-    let (coupling_spurs, rate_spurs) = (spurs(0), spurs(1));
-    let of = |f: fn(&[C64; 2]) -> f64| batches.iter().map(f).collect::<Vec<f64>>();
+    let spurs = spur_lines.map_or([0.0; 3], |lines| {
+        spur_sigma(windows, lines, |w| reading.read(w, None))
+    });
+    let [quadrature_dps, damping_dps, rate_dps] = std::array::from_fn(|part| {
+        let v: Vec<f64> = batches.iter().map(|b| b[part]).collect();
+        reading.estimate(&v, spurs[part])
+    });
     Ok(Coupling {
-        quadrature_dps: reading.estimate(&of(|b| b[0].re), coupling_spurs.re),
-        damping_dps: reading.estimate(&of(|b| b[0].im), coupling_spurs.im),
-        rate_dps: reading.estimate(&of(|b| b[1].re), rate_spurs.re),
+        quadrature_dps,
+        damping_dps,
+        rate_dps,
         clocks: windows.clocks,
     })
 }
@@ -331,8 +324,9 @@ fn turning(windows: &CrossWindows, lines: &[RelativeLine]) -> Vec<TurningLine> {
         .collect()
 }
 
-/// The 1-sigma of the estimate `estimate` (deg/s; the real and the
-/// imaginary part) from the spur `lines` (module header, "Uncertainty").
+/// The 1-sigma of each of the estimate `estimate`'s `N` parts (deg/s)
+/// from the spur `lines` (module header, "Uncertainty"), all parts from
+/// one pass over the lines.
 /// A line of relative amplitude rho on output k multiplies its signal by
 /// 1 + rho e^(j(Omega t + phi)): window (s, q) at time t_sq reads the part
 /// q of Z_sk (1 + rho e^(j(Omega t_sq + phi))). With a and b the
@@ -344,21 +338,23 @@ fn turning(windows: &CrossWindows, lines: &[RelativeLine]) -> Vec<TurningLine> {
 /// added in power. A line that barely moves over the measurement is a
 /// common complex gain on an output's windows, which the estimate's
 /// ratios cancel.
-fn spur_sigma(
+fn spur_sigma<const N: usize>(
     windows: &CrossWindows,
     lines: &[TurningLine],
-    estimate: impl Fn(&CrossWindows) -> C64,
-) -> C64 {
-    // slope[s][q][k]: the estimate's derivative by window (s, q)'s
+    estimate: impl Fn(&CrossWindows) -> [f64; N],
+) -> [f64; N] {
+    // slope[s][q][k][part]: the estimate's derivative by window (s, q)'s
     // output-k mean.
-    let mut slope = [[[C64::new(0.0, 0.0); 2]; 2]; 2];
+    let mut slope = [[[[0.0; N]; 2]; 2]; 2];
     for (s, by_q) in slope.iter_mut().enumerate() {
         for (q, by_k) in by_q.iter_mut().enumerate() {
             for (k, d) in by_k.iter_mut().enumerate() {
                 let h = 1e-6 * windows.mean(s, k).norm();
-                *d = (estimate(&windows.shifted(s, q, k, h))
-                    - estimate(&windows.shifted(s, q, k, -h)))
-                    / (2.0 * h);
+                let (up, down) = (
+                    estimate(&windows.shifted(s, q, k, h)),
+                    estimate(&windows.shifted(s, q, k, -h)),
+                );
+                *d = std::array::from_fn(|part| (up[part] - down[part]) / (2.0 * h));
             }
         }
     }
@@ -370,27 +366,26 @@ fn spur_sigma(
     // zeros, which |S_k|^2 squares away.
     let turned =
         |a: f64, b: f64, [x, y]: [C64; 2]| C64::new(a * x.re + b * y.im, a * x.im - b * y.re);
-    let mut variance = [0.0; 2];
+    let mut variance = [0.0; N];
     for line in lines {
-        let mut worst = [0.0f64; 2];
+        let mut worst = [0.0f64; N];
         for turn in &line.turn {
-            let mut v = [0.0; 2];
+            let mut v = [0.0; N];
             for (part, v) in v.iter_mut().enumerate() {
-                let of = |d: C64| if part == 0 { d.re } else { d.im };
                 for (k, rho) in line.rho.iter().enumerate() {
                     let term = |s: usize| {
-                        let (a, b) = (of(slope[s][0][k]), of(slope[s][1][k]));
+                        let (a, b) = (slope[s][0][k][part], slope[s][1][k][part]);
                         turned(a, b, turn[s]) * mean[s][k]
                     };
                     let s_k = term(0) + term(1);
                     *v += rho * rho * s_k.norm_sqr() / 2.0;
                 }
             }
-            worst = [worst[0].max(v[0]), worst[1].max(v[1])];
+            worst = std::array::from_fn(|part| worst[part].max(v[part]));
         }
-        variance = [variance[0] + worst[0], variance[1] + worst[1]];
+        variance = std::array::from_fn(|part| variance[part] + worst[part]);
     }
-    C64::new(variance[0].sqrt(), variance[1].sqrt())
+    variance.map(f64::sqrt)
 }
 
 /// Fixed-point rounds of [`uncouple`] at most (each mode's pull is
@@ -602,7 +597,10 @@ mod tests {
         let times = [[0.05, 0.09], [0.17, 0.21]];
         let windows = CrossWindows::constant([z(w2[0]), z(w2[1])], w1, w2, times);
         let folded = [0, 1].map(|k| Folded::phasor(g, k, f));
-        let estimate = |w: &CrossWindows| coupling_hz2(w.lines(None), w.w1, &folded, 1.0, f).0;
+        let estimate = |w: &CrossWindows| {
+            let kappa = coupling_hz2(w.lines(None), w.w1, &folded, 1.0, f).0;
+            [kappa.re, kappa.im]
+        };
         let line = |offset_hz: f64| RelativeLine {
             offset_hz,
             rho: [3e-4, 1e-3],
@@ -628,21 +626,22 @@ mod tests {
                         moved = moved.shifted(s, 1, k, ripple(1).im);
                     }
                 }
-                let e = estimate(&moved) - clean;
-                sum[0] += e.re * e.re;
-                sum[1] += e.im * e.im;
+                let e = estimate(&moved);
+                for (sum, (e, clean)) in sum.iter_mut().zip(e.iter().zip(&clean)) {
+                    *sum += (e - clean).powi(2);
+                }
             }
             rms = [0, 1].map(|p| rms[p].max((sum[p] / f64::from(draws)).sqrt()));
         }
-        let ratio = [rms[0] / sigma.re, rms[1] / sigma.im];
+        let ratio = [rms[0] / sigma[0], rms[1] / sigma[1]];
         assert!(
             ratio.iter().all(|r| (r - 1.0).abs() <= 0.05),
-            "RMS over sigma {ratio:?}, sigma {sigma}"
+            "RMS over sigma {ratio:?}, sigma {sigma:?}"
         );
         let slow = spur_sigma(&windows, &turning(&windows, &[line(1e-4)]), estimate);
         assert!(
-            slow.re < 1e-3 * sigma.re && slow.im < 1e-3 * sigma.im,
-            "{slow} against {sigma}"
+            slow[0] < 1e-3 * sigma[0] && slow[1] < 1e-3 * sigma[1],
+            "{slow:?} against {sigma:?}"
         );
     }
 
