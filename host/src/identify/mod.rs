@@ -154,6 +154,20 @@ pub struct Estimate {
     pub uncertainty: f64,
 }
 
+impl Estimate {
+    /// An estimate within its noise taken as none: 0, with the value and
+    /// its sigma in quadrature as the sigma (what an unseen one could
+    /// leave). The cycle does so with a damping coupling
+    /// (`selfcal::DAMPING_SEEN`) and the rate during it
+    /// (`selfcal::predicted_rate`).
+    pub fn as_unseen(self) -> Estimate {
+        Estimate {
+            value: 0.0,
+            uncertainty: self.value.hypot(self.uncertainty),
+        }
+    }
+}
+
 /// A mode coupling measured at rest ([`crate::coupling`]), in deg/s at
 /// the datasheet's lambda: the host measures a stiffness (Hz^2) and turns
 /// it into deg/s with that lambda, so the figure is off by lambda's error

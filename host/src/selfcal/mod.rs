@@ -710,10 +710,7 @@ fn uncoupled(
     if damping.value.abs() < DAMPING_SEEN * damping.uncertainty {
         // Not seen: predict without it, and let its sigma say what an
         // unseen one could leave.
-        c.damping_dps = Estimate {
-            value: 0.0,
-            uncertainty: damping.value.hypot(damping.uncertainty),
-        };
+        c.damping_dps = damping.as_unseen();
     }
     id = uncouple(&c)?;
     // Figures in deg/s: lambda's 1-sigma is the datasheet's.
@@ -752,10 +749,7 @@ pub fn predicted_rate(reading: Estimate) -> Estimate {
     if rate_seen(reading) {
         reading
     } else {
-        Estimate {
-            value: 0.0,
-            uncertainty: reading.value.hypot(reading.uncertainty),
-        }
+        reading.as_unseen()
     }
 }
 
