@@ -420,10 +420,9 @@ pub fn measure(
 /// alone |kappa - c| = |kappa + c|; with a damping coupling too they
 /// differ at first order in the rate (`tests/data/field_coupled.toml`
 /// with 10 deg/s of damping coupling at 50 deg/s: its output 2 was 9.6
-/// sigma off, and 3 deg/s, 0.46% on the estimate, 2.8 sigma). So |kappa + c| / |kappa - c|, from the identified couplings
-/// and the rate the prediction is at (`selfcal::predicted_rate`), in
-/// the units of the couplings (deg/s: Omega_q + j fc / f1 (Omega_d +-
-/// Omega)); 1 at rest.
+/// sigma off, and 3 deg/s, 0.46% on the estimate, 2.8 sigma). So
+/// |kappa + c| / |kappa - c|, from the identified couplings and the rate
+/// the prediction is at ([`cross_terms`]); 1 at rest.
 fn turning_factor(id: &Identified, carrier_hz: f64) -> f64 {
     let (kappa, c) = cross_terms(id, carrier_hz);
     let (plus, minus) = ((kappa + c).norm(), (kappa - c).norm());
