@@ -314,7 +314,7 @@ fn compare_over_the_wire(pace_r: u64) -> (f64, f64) {
 
 /// The rate table at the settings a run's JSON reports (`operating`), on
 /// the device at 45 deg C: the truth `gyrocal calibrate` gives in process,
-/// for a run that has none.
+/// for a run that has none (judging the run's own sigmas, as it does).
 fn rate_table_at(run: &Value) -> scenario::RateTable {
     let file = device::parse("device.toml", DEVICE).unwrap();
     let knowns = file.knowns().unwrap();
@@ -335,7 +335,8 @@ fn rate_table_at(run: &Value) -> scenario::RateTable {
         scaled_drives: None,
         cycle_rate_dps: 0.0,
     };
-    scenario::rate_table(&file.exp, &fe, &at, &knowns, &operating)
+    let judged = Some(pair(run, "sf_selfcal_uncertainty"));
+    scenario::rate_table(&file.exp, &fe, &at, &knowns, &operating, judged)
         .unwrap()
         .0
 }

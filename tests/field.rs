@@ -186,13 +186,13 @@ fn rounding_moves_the_resonant_outputs_rate_table() {
             scaled_drives: None,
             cycle_rate_dps: 0.0,
         };
-        let sf0 = scenario::rate_table(&sc.exp, &fe, &at, &knowns, &op)
+        let sf0 = scenario::rate_table(&sc.exp, &fe, &at, &knowns, &op, None)
             .unwrap()
             .0
             .sf_per_dps;
         for level in [0.99, 0.98, 0.9, 0.5] {
             at.adc_gain = [level; 2];
-            let sf = scenario::rate_table(&sc.exp, &fe, &at, &knowns, &op)
+            let sf = scenario::rate_table(&sc.exp, &fe, &at, &knowns, &op, None)
                 .unwrap()
                 .0
                 .sf_per_dps;

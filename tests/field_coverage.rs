@@ -31,28 +31,46 @@
 //!
 //! Assertions, and why they can fail:
 //! - Between 90% and 99.5% of all t within 2 (95.4% for normal errors
-//!   over honest sigmas; the truth's part spread has 15 degrees of
-//!   freedom and carries its coverage factor). A systematic the budget
+//!   over honest sigmas; the truth's part spread carries the coverage
+//!   factor of its degrees of freedom, 15 or 63). A systematic the budget
 //!   misses, of the size of the sigma, puts a normal's 81% within 2;
 //!   sigmas twice too large put 99.99% within 2. The four figures of a
 //!   device share its identification, so the 160 count as 40 to 160
 //!   trials: at 96% a binomial standard deviation of 1.5 to 3%.
-//! - Every t within 3. The pinned devices hold it (99.4% within 2, largest
-//!   |t| 2.21, RMS 0.73); seeds up to 2100 (85 devices, 340 figures) give
-//!   97.6% within 2 and one beyond 3 (0.9 are expected in 340 figures of
-//!   honest normal sigmas): seed 2096 (Q 154, 3.8 clocks per carrier),
-//!   output 1 at 35 deg C, -0.049% +- 0.014% (-3.4 sigma). Single runs
-//!   at other front-end lags (-0.013, -0.019, -0.049, -0.045, -0.040% at
-//!   0 to 4 deg) looked erratic; averaged over noise seeds 1 to 12 the
-//!   error follows the lag: -0.1e-4, -0.3e-4, -1.45e-4 (mean t -0.97)
-//!   and -3.3e-4 (mean t -2.15) at 0, 1, 2 and 4 deg. It was the front
-//!   end's gain slope across the calibration's sidebands, which the
-//!   budget now carries (`selfcal::budget::front_slope`; docs/field.md has
-//!   the table): mean t -0.86 and -0.94 at 2 and 4 deg, and seed 2096
-//!   reads -3.0 sigma, the -2 sigma draw left. Before the front end's
-//!   delay was in the identification it read -0.026% +- 0.026%, covered
-//!   by a Q sigma the delay's misfit had inflated. Other seeds may need a
-//!   look before they are pinned.
+//! - Every t within 4, and every t beyond 3 a draw, not a bias: that
+//!   device run again at dither seeds 2 to 5 (`REDRAWS`) puts the
+//!   figure's mean t within 1.5 (`beyond_three_are_draws`). Not every t
+//!   within 3: an honest sigma leaves a figure beyond 3 with probability
+//!   0.27%, so 160 figures hold none beyond in only 65% of draws (0.9973
+//!   ^ 160), a bound that inflated sigmas pass and honest ones fail a
+//!   third of the time. It held while the truth's part spread, over two
+//!   windows, was short on some outputs and long on others; since the
+//!   table runs to eight windows where its sigma weighs
+//!   (`TABLE_EXTENDED_WINDOWS`), the pinned devices read 97.5% within
+//!   2, largest |t| 2.56, RMS 0.79 (99.4%, 2.21 and 0.73 before), and
+//!   seed 2013 with its damping coupling
+//!   (Q 574 / 459, 300 deg/s) reads -3.39 at 25 deg C on output 1. Over
+//!   dither seeds 1 to 12 its rate table scattered 4.8e-5 against a
+//!   quoted 4.3e-5 and the self-calibration 9.7e-6 against 2.1e-5; seed
+//!   1's table is 2.9 of its own sigma from their mean: a draw (at seeds
+//!   2 to 5 it reads +0.66, -0.00, -1.24 and -0.71). The mean
+//!   of four more t has a standard deviation of 0.5 over an honest sigma,
+//!   beyond 1.5 in 0.27% of draws; a bias of 2 sigma, as seed 2096 had
+//!   (below), lies beyond it 90% of the time. A t beyond 4 (6e-5 per
+//!   honest figure, 1% over 160) fails outright. Seed 2096 (Q 154, 3.8
+//!   clocks per carrier), output 1 at 35 deg C, read -0.049% +- 0.014%
+//!   (-3.4 sigma) over seeds up to 2100 (85 devices, 340 figures, 97.6%
+//!   within 2). Single runs at other front-end lags (-0.013, -0.019,
+//!   -0.049, -0.045, -0.040% at 0 to 4 deg) looked erratic; averaged
+//!   over noise seeds 1 to 12 the error follows the lag: -0.1e-4,
+//!   -0.3e-4, -1.45e-4 (mean t -0.97) and -3.3e-4 (mean t -2.15) at 0, 1,
+//!   2 and 4 deg. It was the front end's gain slope across the
+//!   calibration's sidebands, which the budget now carries
+//!   (`selfcal::budget::front_slope`; docs/field.md has the table): mean
+//!   t -0.86 and -0.94 at 2 and 4 deg, and seed 2096 reads -3.0 sigma,
+//!   the -2 sigma draw left. Before the front end's delay was in the
+//!   identification it read -0.026% +- 0.026%, covered by a Q sigma the
+//!   delay's misfit had inflated.
 //! - Not inflated: the RMS of t at least 0.3 (an honest set gives about
 //!   0.85 to 1).
 //! - Every step finishes: a failed step is a clear error, but these
@@ -321,9 +339,9 @@ fn named(id_t: &[Named], name: &str) -> Vec<f64> {
 /// The `DEVICES` coverage devices' field runs, with their damping
 /// couplings when `damping`, each described on stderr: every step's
 /// self-calibration t, every identified parameter's t, and the
-/// self-calibration t's (share within 2, largest |t|, RMS).
-fn coverage_runs(damping: bool) -> (Vec<f64>, Vec<Named>, (f64, f64, f64)) {
-    let runs: Vec<(RandomDevice, Arc<FieldReport>)> = (FIRST_SEED..)
+/// self-calibration t's (share within 2, largest |t|, RMS); and the runs.
+fn coverage_runs(damping: bool) -> Coverage {
+    let runs: Vec<Run> = (FIRST_SEED..)
         .filter_map(|s| field(s, damping))
         .take(DEVICES)
         .collect();
@@ -348,19 +366,86 @@ fn coverage_runs(damping: bool) -> (Vec<f64>, Vec<Named>, (f64, f64, f64)) {
         t.len(),
         100.0 * in2
     );
-    (t, id_t, (in2, worst, rms))
+    Coverage {
+        t,
+        id_t,
+        in2,
+        rms,
+        runs,
+    }
+}
+
+/// A coverage device and its field report.
+type Run = (RandomDevice, Arc<FieldReport>);
+
+/// What `coverage_runs` found.
+struct Coverage {
+    /// Every self-calibration t, step by step, output by output.
+    t: Vec<f64>,
+    /// Every identified parameter's t (`identified_t`).
+    id_t: Vec<Named>,
+    /// The share of `t` within 2.
+    in2: f64,
+    /// The RMS of `t`.
+    rms: f64,
+    /// The devices and their reports.
+    runs: Vec<Run>,
+}
+
+/// Dither seeds a figure beyond 3 sigma is drawn again at
+/// (`beyond_three_are_draws`).
+const REDRAWS: std::ops::RangeInclusive<u64> = 2..=5;
+
+/// The bound on the mean t of a figure's `REDRAWS` (module header).
+const REDRAWN_MEAN_T: f64 = 1.5;
+
+/// Every self-calibration t within 4, and each one beyond 3 a draw, not a
+/// bias: its device run again at the `REDRAWS` dither seeds (`[frontend]
+/// seed`; the first run is seed 1) puts that figure's mean t within
+/// `REDRAWN_MEAN_T` (module header: why not every t within 3).
+fn beyond_three_are_draws(runs: &[Run], damping: bool) {
+    for (d, r) in runs {
+        for (i, t) in t_values(r).into_iter().enumerate() {
+            if t.abs() <= 3.0 {
+                continue;
+            }
+            let (step, output) = (i / 2, i % 2 + 1);
+            let at = format!("seed {} step {step} output {output}", d.seed);
+            assert!(t.abs() <= 4.0, "{at} at {t:.2} sigma");
+            let couplings = (
+                coupling_of(d.seed),
+                if damping { damping_of(d) } else { 0.0 },
+            );
+            let again = under_noise_seeds(d, couplings, &drift(LAG.0, LAG.1), REDRAWS);
+            let redrawn: Vec<f64> = again.iter().map(|(_, r)| t_values(r)[i]).collect();
+            let mean = redrawn.iter().sum::<f64>() / redrawn.len() as f64;
+            eprintln!(
+                "{at} at {t:+.2} sigma; at dither seeds {REDRAWS:?}: {redrawn:+.2?}, mean {mean:+.2}"
+            );
+            assert!(
+                mean.abs() <= REDRAWN_MEAN_T,
+                "{at} at {t:.2} sigma, and at mean t {mean:.2} over dither seeds {REDRAWS:?}: a bias its sigma misses"
+            );
+        }
+    }
 }
 
 #[test]
 fn self_calibrated_scale_factors_lie_within_their_sigmas_as_promised() {
-    let (t, id_t, (in2, worst, rms)) = coverage_runs(false);
+    let Coverage {
+        t,
+        id_t,
+        in2,
+        rms,
+        runs,
+    } = coverage_runs(false);
     assert_eq!(t.len(), 4 * DEVICES);
     assert!(
         (0.90..=0.995).contains(&in2),
         "{:.1}% within 2 sigma",
         100.0 * in2
     );
-    assert!(worst <= 3.0, "a figure at {worst:.2} sigma");
+    beyond_three_are_draws(&runs, false);
     assert!(rms >= 0.3, "RMS t {rms:.2}: sigmas inflated");
     identified_coverage(&id_t);
 }
@@ -489,11 +574,14 @@ fn damping_coverage(id_t: &[Named]) {
 
 /// The same devices with their damping couplings (`damping_of`: half of
 /// them, 1e-3 to 0.3 of the stability limit, up to 300 deg/s): the
-/// identified coupling covers its truth (`damping_coverage`), and every
-/// self-calibrated scale factor lies within 3 of its sigma and at least
-/// 90% within 2. Not asserted here, and why:
-/// - the 99.5% ceiling on the scale factors: these 160 read 100% within
-///   2 (largest |t| 1.95, RMS t 0.72), where seeds 2001..2400 with their
+/// identified coupling covers its truth (`damping_coverage`), and of the
+/// self-calibrated scale factors at least 90% lie within 2 of their
+/// sigmas, every one within 4, and those beyond 3 are draws
+/// (`beyond_three_are_draws`; seed 2013's -3.39, module header). Not
+/// asserted here, and why:
+/// - the 99.5% ceiling on the scale factors: these 160 read 95.6% within
+///   2 (largest |t| 3.39, RMS t 0.87; before the truth ran on to eight
+///   windows, 100%, largest 1.95, RMS 0.72), where seeds 2001..2400 with their
 ///   damping couplings (1328 figures) give 97.8%, of which 160 figures
 ///   (40 to 160 trials) show none beyond 2 in 3% to 40% of draws. The
 ///   devices that carry one read RMS t 0.79 there against 0.96 for the
@@ -505,9 +593,15 @@ fn damping_coverage(id_t: &[Named]) {
 ///   3e-5 Hz some draws exceed, left as found.
 #[test]
 fn damping_couplings_lie_within_their_sigmas_as_promised() {
-    let (_, id_t, (in2, worst, rms)) = coverage_runs(true);
+    let Coverage {
+        id_t,
+        in2,
+        rms,
+        runs,
+        ..
+    } = coverage_runs(true);
     assert!(in2 >= 0.90, "{:.1}% within 2 sigma", 100.0 * in2);
-    assert!(worst <= 3.0, "a figure at {worst:.2} sigma");
+    beyond_three_are_draws(&runs, true);
     assert!(rms >= 0.3, "RMS t {rms:.2}: sigmas inflated");
     damping_coverage(&id_t);
 }

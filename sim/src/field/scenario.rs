@@ -231,6 +231,8 @@ pub struct FieldStep {
     /// Its own relative 1-sigma uncertainty ([`RateTable::uncertainty`]):
     /// the truth is a measurement too.
     pub sf_true_uncertainty: [f64; 2],
+    /// Windows each rate of that table averaged ([`RateTable::windows`]).
+    pub sf_true_windows: usize,
     /// SF_cal x ratio(identified) (z LSB per deg/s).
     pub sf_selfcal_per_dps: [f64; 2],
     /// Its relative 1-sigma uncertainty (`selfcal.sf_selfcal_uncertainty`
@@ -590,8 +592,34 @@ pub const TABLE_PARTS: usize = 8;
 /// Two windows with the coverage factor left that seed at 2.1 sigma and
 /// the ten seeds at |t| <= 1.1 (`tests/field_coverage.rs` measures the
 /// coverage over random devices); four windows cost the paper scenario
-/// 60% more clocks for no change in coverage.
+/// 60% more clocks for no change in coverage. Where the truth's sigma
+/// weighs in the comparison the table runs on to
+/// [`TABLE_EXTENDED_WINDOWS`].
 pub const TABLE_WINDOWS: usize = 2;
+
+/// Windows a rate-table point runs in all when, after `TABLE_WINDOWS`,
+/// the truth's sigma exceeds [`TABLE_EXTEND_SHARE`] of the sigma it is
+/// compared with on either output.
+///
+/// Two windows' part spread misses a slow part of the table's noise. The
+/// rates share their dither, so what is left in the slope is the ADC's
+/// rounding flipping between rates (its size did not change with the
+/// dither from 0.5 to 2 LSB), and some of it wanders over about two
+/// windows: the part spread, taken within them, cannot see it. On a
+/// resonant output whose rate term is small against its offset the
+/// truth's sigma is then short. Measured on a 76.5 kHz device (Q 1964 and
+/// 2666, output 1 at 19 z LSB per deg/s against an offset of -20,000,
+/// rates 50, 150 and 300 deg/s) over 48 dither seeds: the slope scattered
+/// 1.23 times the part spread with two windows (t RMS 1.26, 2 of 48 beyond
+/// 3), 1.17 with four, 0.94 with eight (t RMS 0.95, none beyond 3).
+/// Eight windows double the paper scenario's time, so the table pays for
+/// them only where its sigma matters.
+pub const TABLE_EXTENDED_WINDOWS: usize = 8;
+
+/// The share of the compared sigma (the self-calibration's) beyond which
+/// the truth's sigma matters. Below it a truth's sigma 1.25 times short
+/// moves the quadrature sum of the two by at most 4%.
+pub const TABLE_EXTEND_SHARE: f64 = 0.5;
 
 /// Whose settings a rate-table point runs at, which decides what its
 /// clipping means.
@@ -605,31 +633,27 @@ enum TableAt {
     Factory,
 }
 
-/// One point of the rate table: readout at `op` on a fresh board (from
-/// power-up, as `experiment` runs its points), settled and averaged over
-/// the first window in `TABLE_PARTS` equal parts; returns the parts' z
-/// (z LSB; their mean is the window's) and the clocks. A window during
-/// which an ADC clipped is an error, never a slope.
-fn table_point(
-    exp: &Experiment,
-    fe: &FrontEnd,
-    at: &DeviceAt,
+/// `windows` more windows of one rate-table point on its settled `board`,
+/// `TABLE_PARTS` parts each: the parts' z (z LSB; their mean is the
+/// windows'). A window during which an ADC clipped is an error, never a
+/// slope.
+fn table_windows(
+    board: &mut SimBoard,
     knowns: &Knowns,
-    (op, whose): (&Operating, TableAt),
+    windows: usize,
+    whose: TableAt,
     rate_dps: f64,
-) -> Result<(Vec<[f64; 2]>, u64), FieldError> {
-    let mut board = settled_readout_board(exp, fe, at, knowns, op, rate_dps)?;
+) -> Result<Vec<[f64; 2]>, FieldError> {
     let r = knowns.filter.decimation;
-    let w = TABLE_WINDOWS;
-    let length = (w as f64 * knowns.filter.min_window_s * knowns.clock_hz).ceil();
+    let length = (windows as f64 * knowns.filter.min_window_s * knowns.clock_hz).ceil();
     // The table's truth is a slope: a clipped window would bend it unseen.
-    clip::restart(&mut board)?;
+    clip::restart(board)?;
     let parts = part_means(
-        &mut board,
+        board,
         r,
         f64::from(r),
         length,
-        TABLE_PARTS * w,
+        TABLE_PARTS * windows,
         Signal::Steady,
     )?;
     let detail = match whose {
@@ -640,8 +664,25 @@ fn table_point(
             "at {rate_dps} deg/s, at the factory's carrier and drives on the device as it drifted here"
         ),
     };
-    clip::check(&mut board, "rate table", &detail)?;
-    Ok((parts, board.cycle()))
+    clip::check(board, "rate table", &detail)?;
+    Ok(parts)
+}
+
+/// One point of the rate table: readout at `op` on a fresh board (from
+/// power-up, as `experiment` runs its points), settled, then
+/// `TABLE_WINDOWS` windows ([`table_windows`]); returns the board, to run
+/// on, and the parts.
+fn table_point(
+    exp: &Experiment,
+    fe: &FrontEnd,
+    at: &DeviceAt,
+    knowns: &Knowns,
+    (op, whose): (&Operating, TableAt),
+    rate_dps: f64,
+) -> Result<(SimBoard, Vec<[f64; 2]>), FieldError> {
+    let mut board = settled_readout_board(exp, fe, at, knowns, op, rate_dps)?;
+    let parts = table_windows(&mut board, knowns, TABLE_WINDOWS, whose, rate_dps)?;
+    Ok((board, parts))
 }
 
 /// Least-squares slopes of the table's z against its rates (z LSB per deg/s).
@@ -659,13 +700,17 @@ pub struct RateTable {
     /// Least-squares slopes of z against the rates (z LSB per deg/s).
     pub sf_per_dps: [f64; 2],
     /// Their relative 1-sigma uncertainty: the spread of the slopes
-    /// fitted part by part (`TABLE_PARTS` x `TABLE_WINDOWS` parts, part i
-    /// of every rate together) over sqrt(parts), times the coverage factor
-    /// of its degrees of freedom (`fit::coverage_factor`, 1.2 at 15). Noise common to the rates
+    /// fitted part by part (`TABLE_PARTS` parts a window, part i of every
+    /// rate together) over sqrt(parts), times the coverage factor of its
+    /// degrees of freedom (`fit::coverage_factor`: 1.2 at 15, two windows;
+    /// 1.03 at 63, eight). Noise common to the rates
     /// (every board starts from the same seed) cancels in it as it does in
     /// the slope; it does not see the carrier spurs' beats, which repeat
     /// from power-up at every rate (`rate_table`).
     pub uncertainty: [f64; 2],
+    /// Windows each rate averaged: `TABLE_WINDOWS`, or
+    /// `TABLE_EXTENDED_WINDOWS` where the truth's sigma weighed in.
+    pub windows: usize,
 }
 
 impl RateTable {
@@ -688,12 +733,17 @@ impl RateTable {
         Self {
             sf_per_dps: sf,
             uncertainty,
+            windows: n / TABLE_PARTS,
         }
     }
 }
 
 /// The rate table: readout at `op` on a fresh board per rate, the rates in
 /// parallel; returns the slopes with their uncertainty, and the clocks.
+/// `compared_with` is the relative sigma of the figures the table will
+/// judge (the self-calibration's, per output), if any: where the table's
+/// own sigma after `TABLE_WINDOWS` exceeds `TABLE_EXTEND_SHARE` of it,
+/// every point runs on to `TABLE_EXTENDED_WINDOWS` windows.
 ///
 /// Fresh boards, not one board stepping through the rates: the carrier
 /// table's residual spurs (below -80 dBc; 90 dBc measured) mix with the resonant output's
@@ -709,15 +759,42 @@ pub fn rate_table(
     at: &DeviceAt,
     knowns: &Knowns,
     op: &Operating,
+    compared_with: Option<[f64; 2]>,
 ) -> Result<(RateTable, u64), FieldError> {
-    let points: Vec<(Vec<[f64; 2]>, u64)> = knowns
-        .rates_dps
+    let rates = &knowns.rates_dps;
+    let mut points: Vec<(SimBoard, Vec<[f64; 2]>)> = rates
         .par_iter()
         .map(|&rate| table_point(exp, fe, at, knowns, (op, TableAt::Cycle), rate))
         .collect::<Result<_, FieldError>>()?;
-    let parts: Vec<Vec<[f64; 2]>> = points.iter().map(|p| p.0.clone()).collect();
-    let clocks = points.iter().map(|p| p.1).sum();
-    Ok((RateTable::from_parts(&knowns.rates_dps, &parts), clocks))
+    let parts = |points: &[(SimBoard, Vec<[f64; 2]>)]| -> Vec<Vec<[f64; 2]>> {
+        points.iter().map(|p| p.1.clone()).collect()
+    };
+    let mut table = RateTable::from_parts(rates, &parts(&points));
+    if needs_more_windows(&table, compared_with) {
+        points
+            .par_iter_mut()
+            .zip(rates)
+            .try_for_each(|((board, parts), &rate)| {
+                let more = TABLE_EXTENDED_WINDOWS - TABLE_WINDOWS;
+                let run = table_windows(board, knowns, more, TableAt::Cycle, rate)?;
+                parts.extend(run);
+                Ok::<(), FieldError>(())
+            })?;
+        table = RateTable::from_parts(rates, &parts(&points));
+    }
+    let clocks = points.iter().map(|p| p.0.cycle()).sum();
+    Ok((table, clocks))
+}
+
+/// Whether the table's sigma exceeds `TABLE_EXTEND_SHARE` of the compared
+/// sigma on either output ([`TABLE_EXTENDED_WINDOWS`]).
+fn needs_more_windows(table: &RateTable, compared_with: Option<[f64; 2]>) -> bool {
+    compared_with.is_some_and(|c| {
+        (0..2).any(|k| {
+            table.windows < TABLE_EXTENDED_WINDOWS
+                && table.uncertainty[k] > TABLE_EXTEND_SHARE * c[k]
+        })
+    })
 }
 
 fn ratio_error(a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
@@ -793,13 +870,11 @@ fn cycle_from(
             let r = knowns.filter.decimation;
             let length = (knowns.filter.min_window_s * knowns.clock_hz).ceil();
             let null = profile::readout_null(&mut board, r, length)?;
-            Some((
-                null,
-                profile::run_profile(&mut board, p, r, knowns.clock_hz)?,
-            ))
+            Some((null, profile::run_profile(&mut board, p, r, knowns.clock_hz)?))
         }
     };
-    let (truth, table_clocks) = rate_table(&sc.exp, fe, &at, knowns, &cal.operating)?;
+    let judged = Some(cal.sf_selfcal_uncertainty.total);
+    let (truth, table_clocks) = rate_table(&sc.exp, fe, &at, knowns, &cal.operating, judged)?;
     Ok(Cycle {
         at,
         cal,
@@ -915,8 +990,8 @@ fn run_jobs(
             match *job {
                 Job::Factory { rate, .. } => {
                     let whose = (factory, TableAt::Factory);
-                    let (parts, n) = table_point(exp, fe, at, knowns, whose, rates[rate])?;
-                    Ok((Done::Point(mean_of_parts(&parts)), n))
+                    let (board, parts) = table_point(exp, fe, at, knowns, whose, rates[rate])?;
+                    Ok((Done::Point(mean_of_parts(&parts)), board.cycle()))
                 }
                 Job::BaselineProfile { .. } => {
                     let p = sc.profile.as_ref().ok_or(FieldError::NoProfile)?;
@@ -1128,6 +1203,7 @@ fn field_step(c: Cycle, baseline: Option<Baseline>, knowns: &Knowns) -> FieldSte
         truth: c.at,
         sf_true_per_dps: sf_true,
         sf_true_uncertainty: c.truth.uncertainty,
+        sf_true_windows: c.truth.windows,
         sf_selfcal_per_dps: c.cal.sf_selfcal_per_dps,
         sf_selfcal_uncertainty: c.cal.sf_selfcal_uncertainty.total,
         sf_eq56_per_dps: c.cal.sf_eq56_per_dps,
@@ -1224,22 +1300,29 @@ mod tests {
         assert!(f.clause().expect("a clause").contains("may ripple"));
     }
 
-    /// A rate table whose window clips an ADC is an error naming the
-    /// table, the ADC and the rate, never a slope: the consumer device at
-    /// its configured (unscaled) drives clips ADC 2 at 100,000 deg/s, and
-    /// at 100 deg/s does not.
-    #[test]
-    fn a_rate_table_that_clips_is_refused_at_its_rate() {
+    /// The consumer scenario at 25 deg C, its factory operating point and
+    /// its knowns with the rates 50 and 100 deg/s: a rate table's setting.
+    fn consumer_table() -> (Scenario, FrontEnd, Knowns, DeviceAt, Operating) {
         let text = include_str!("../../../tests/data/field_consumer.toml");
         let sc = parse("field_consumer.toml", text).expect("the consumer scenario parses");
         let (fe, mut k) = build(&sc.exp).expect("the board and knowns");
         let at = sc.drift.at(&sc.exp.gyro, 25.0);
         let op = operating_at(sc.exp.drive.carrier_hz, &k);
         k.rates_dps = vec![50.0, 100.0];
-        let (table, _) = rate_table(&sc.exp, &fe, &at, &k, &op).expect("within range");
+        (sc, fe, k, at, op)
+    }
+
+    /// A rate table whose window clips an ADC is an error naming the
+    /// table, the ADC and the rate, never a slope: the consumer device at
+    /// its configured (unscaled) drives clips ADC 2 at 100,000 deg/s, and
+    /// at 100 deg/s does not.
+    #[test]
+    fn a_rate_table_that_clips_is_refused_at_its_rate() {
+        let (sc, fe, mut k, at, op) = consumer_table();
+        let (table, _) = rate_table(&sc.exp, &fe, &at, &k, &op, None).expect("within range");
         assert!(table.sf_per_dps.iter().all(|s| s.is_finite() && *s != 0.0));
         k.rates_dps = vec![50.0, 100_000.0];
-        let e = rate_table(&sc.exp, &fe, &at, &k, &op)
+        let e = rate_table(&sc.exp, &fe, &at, &k, &op, None)
             .expect_err("clipped")
             .to_string();
         assert!(
@@ -1247,6 +1330,37 @@ mod tests {
             "{e}"
         );
         assert!(!e.contains('\n'), "{e}");
+    }
+
+    /// The table runs on to `TABLE_EXTENDED_WINDOWS` where its sigma after
+    /// `TABLE_WINDOWS` exceeds `TABLE_EXTEND_SHARE` of the compared sigma
+    /// on either output, and only there, on the boards it settled.
+    #[test]
+    fn a_rate_table_runs_on_where_its_sigma_weighs() {
+        let (sc, fe, k, at, op) = consumer_table();
+        let table = |judged| rate_table(&sc.exp, &fe, &at, &k, &op, judged).expect("in range");
+        let (short, clocks) = table(None);
+        assert_eq!(short.windows, TABLE_WINDOWS);
+        // Just covered on both outputs: the same table.
+        let share = |u: [f64; 2], f: f64| u.map(|u| u / TABLE_EXTEND_SHARE * f);
+        assert_eq!(table(Some(share(short.uncertainty, 1.01))), (short, clocks));
+        // Each of the two rates' boards runs on by the added windows (and
+        // the few samples a window's start waits for), not from power-up.
+        let window = k.filter.min_window_s * k.clock_hz;
+        let more = ((TABLE_EXTENDED_WINDOWS - TABLE_WINDOWS) * 2) as f64 * window;
+        for out in 0..2 {
+            // Just beyond on output `out` alone.
+            let mut judged = share(short.uncertainty, 1.01);
+            judged[out] = share(short.uncertainty, 0.99)[out];
+            let (long, long_clocks) = table(Some(judged));
+            assert_eq!(long.windows, TABLE_EXTENDED_WINDOWS, "output {}", out + 1);
+            let added = (long_clocks - clocks) as f64;
+            assert!(
+                (added - more).abs() < 0.01 * more,
+                "{added} clocks for {more}"
+            );
+            assert_ne!(long.sf_per_dps, short.sf_per_dps);
+        }
     }
 
     /// The scenario's warnings with the host's knowns.

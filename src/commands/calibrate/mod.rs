@@ -46,7 +46,7 @@ use gyrocal_host::selfcal::{self, SelfCal};
 use gyrocal_host::{Board, Knowns, transport};
 use gyrocal_sim::drift::DeviceAt;
 use gyrocal_sim::field::board::SimBoard;
-use gyrocal_sim::field::scenario;
+use gyrocal_sim::field::scenario::{self, RateTable};
 use gyrocal_sim::gyro::MAX_COUPLING_DPS;
 use gyrocal_sim::serve::device::{self, DeviceFile};
 use std::path::PathBuf;
@@ -81,10 +81,9 @@ pub struct Args {
 pub struct Truth {
     /// The device and front end on the board.
     pub device: DeviceAt,
-    /// Rate-table slope at the cycle's carrier and phase (z LSB per deg/s).
-    pub sf_true_per_dps: [f64; 2],
-    /// Its own relative 1-sigma uncertainty (`scenario::RateTable`).
-    pub sf_true_uncertainty: [f64; 2],
+    /// The rate table at the cycle's carrier and phase: its slopes (z LSB
+    /// per deg/s), their own relative 1-sigma and the windows it ran.
+    pub table: RateTable,
     /// Clocks the rate table simulated.
     pub clocks: u64,
 }
@@ -262,12 +261,12 @@ fn in_process(
     };
     eprintln!("rate table at the calibrated carrier and phase (the truth)");
     let fe = file.front_end().map_err(Failure::run)?;
-    let (table, clocks) =
-        scenario::rate_table(&file.exp, &fe, &at, knowns, &cal.operating).map_err(Failure::run)?;
+    let judged = Some(cal.sf_selfcal_uncertainty.total);
+    let (table, clocks) = scenario::rate_table(&file.exp, &fe, &at, knowns, &cal.operating, judged)
+        .map_err(Failure::run)?;
     let truth = Truth {
         device: at,
-        sf_true_per_dps: table.sf_per_dps,
-        sf_true_uncertainty: table.uncertainty,
+        table,
         clocks,
     };
     let mut warnings = cal.warnings(knowns);

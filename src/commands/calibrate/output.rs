@@ -37,7 +37,7 @@ fn error(sf: [f64; 2], truth: [f64; 2]) -> [f64; 2] {
 /// factor's and the rate table's in quadrature, two independent
 /// measurements (as `field`'s `selfcal_error_uncertainty`).
 fn error_sigma(cal: &SelfCal, t: &Truth) -> [f64; 2] {
-    std::array::from_fn(|k| cal.sf_selfcal_uncertainty.total[k].hypot(t.sf_true_uncertainty[k]))
+    std::array::from_fn(|k| cal.sf_selfcal_uncertainty.total[k].hypot(t.table.uncertainty[k]))
 }
 
 /// The line naming the self-calibration errors beyond 3 of their sigmas
@@ -47,7 +47,7 @@ pub fn uncovered(cal: &SelfCal, t: &Truth) -> Option<String> {
     let scored = Scored::outputs(
         None,
         t.device.temperature_c,
-        error(cal.sf_selfcal_per_dps, t.sf_true_per_dps),
+        error(cal.sf_selfcal_per_dps, t.table.sf_per_dps),
         error_sigma(cal, t),
     );
     uncovered_selfcal_errors(&scored)
@@ -82,9 +82,10 @@ pub fn json(o: &Outcome) -> Value {
             "front_end_phase_deg": d.front_end_phase_deg,
             "adc_gain": d.adc_gain,
             "drive_gain": d.drive_gain,
-            "sf_true_per_dps": t.sf_true_per_dps,
-            "sf_true_uncertainty": t.sf_true_uncertainty,
-            "selfcal_error": error(cal.sf_selfcal_per_dps, t.sf_true_per_dps),
+            "sf_true_per_dps": t.table.sf_per_dps,
+            "sf_true_uncertainty": t.table.uncertainty,
+            "sf_true_windows": t.table.windows,
+            "selfcal_error": error(cal.sf_selfcal_per_dps, t.table.sf_per_dps),
             "selfcal_error_uncertainty": combined,
             "clocks": t.clocks,
         })
@@ -215,11 +216,11 @@ pub fn table(o: &Outcome) -> String {
     row("SF_selfcal", cal.sf_selfcal_per_dps, false);
     row("SF_selfcal 1-sigma", cal.sf_selfcal_uncertainty.total, true);
     if let Some(t) = &o.truth {
-        row("SF_true (rate table)", t.sf_true_per_dps, false);
-        row("SF_true 1-sigma", t.sf_true_uncertainty, true);
+        row("SF_true (rate table)", t.table.sf_per_dps, false);
+        row("SF_true 1-sigma", t.table.uncertainty, true);
         row(
             "self-cal error",
-            error(cal.sf_selfcal_per_dps, t.sf_true_per_dps),
+            error(cal.sf_selfcal_per_dps, t.table.sf_per_dps),
             true,
         );
         row("self-cal error 1-sigma", error_sigma(cal, t), true);
