@@ -456,13 +456,17 @@ fn a_step_that_fails_after_identification_keeps_it() {
     let report: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
     let failed = &report["failed"][0];
     assert_eq!(failed["stage"], "self-calibration cycle");
+    // The line names both causes a count cannot tell apart, with the
+    // predicted peak and the room it left, in one line.
+    let error = failed["error"].as_str().unwrap();
+    assert!(error.starts_with("calibration staircase: ADC"), "{failed}");
     assert!(
-        failed["error"]
-            .as_str()
-            .unwrap()
-            .starts_with("calibration staircase: ADC"),
-        "{failed}"
+        error.contains("of the window's clocks; the identified response puts ADC")
+            && error.contains("the device answers more than identified")
+            && error.contains("the converter's own noise reaches over the"),
+        "{error}"
     );
+    assert!(!error.contains('\n'), "{error}");
     let id = &failed["identified"];
     for (key, truth) in [
         ("f1_hz", 25.1e3),

@@ -629,13 +629,14 @@ pub fn self_calibrate_from(
     let gyro = identified.gyro(&knowns.nominal);
     let measured = knowns.with_device(&gyro);
     let op = operating(&measured, &identified)?;
+    let peaks = adc_peaks(&measured, &identified, &op)?;
     let Staircase {
         cal_hz,
         z: cal_z,
         sf_per_dps: sf_cal,
         sf_uncertainty: sf_cal_sd,
         clocks,
-    } = staircase(board, &measured, &op)?;
+    } = staircase(board, &measured, &op, peaks)?;
     let ratio = predicted_ratio(knowns, &gyro, &op, &cal_hz)?;
     let uncertainty = SfUncertainty {
         staircase: std::array::from_fn(|k| (sf_cal_sd[k] / sf_cal[k]).abs()),

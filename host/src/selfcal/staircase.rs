@@ -28,7 +28,10 @@ pub struct Staircase {
 
 /// The calibration staircase at `op`: each f_cal settles, then is averaged
 /// over a whole number (at least `MIN_RIPPLE_PERIODS`) of ripple periods
-/// 1 / (2 f_cal) spanning at least the first window.
+/// 1 / (2 f_cal) spanning at least the first window. `peaks` are the ADC
+/// peaks the identified response predicts at `op` (fraction of full
+/// scale, [`super::adc_peaks`]), which a window that clipped quotes
+/// ([`clip::cycle_detail`]).
 ///
 /// Uncertainty: each period's mean cancels the ripple's shape, so the
 /// spread of a window's period means is its noise; pooled over the windows
@@ -46,6 +49,7 @@ pub fn staircase(
     board: &mut dyn Board,
     knowns: &Knowns,
     op: &Operating,
+    peaks: [f64; 2],
 ) -> Result<Staircase, Error> {
     let clock = knowns.clock_hz;
     let r = knowns.filter.decimation;
@@ -77,7 +81,9 @@ pub fn staircase(
             periods as usize,
             Signal::Periodic,
         )?);
-        clip::check(board, "calibration staircase", clip::CYCLE_DETAIL)?;
+        clip::check_with(board, "calibration staircase", |adc, n| {
+            clip::cycle_detail(adc, n, length, peaks[adc - 1])
+        })?;
         clocks += settle + length as u64 + 2 * u64::from(r);
         cal_hz.push(real.cal_hz);
     }
