@@ -467,6 +467,12 @@ fn a_step_that_fails_after_identification_keeps_it() {
         "{error}"
     );
     assert!(!error.contains('\n'), "{error}");
+    // Its board's clocks are the run's, though no step finished.
+    assert!(
+        report["clocks"].as_f64().unwrap() > 1e6,
+        "{}",
+        report["clocks"]
+    );
     let id = &failed["identified"];
     for (key, truth) in [
         ("f1_hz", 25.1e3),

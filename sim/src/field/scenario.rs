@@ -392,7 +392,7 @@ pub struct FieldReport {
     /// a drifted drive gain out ([`design_ratio_warning`], when the steps
     /// are done).
     pub warnings: Vec<String>,
-    /// Clocks simulated, all steps.
+    /// Clocks simulated, all steps (a failed step's cycle too).
     pub clocks: u64,
     /// Wall time (s).
     pub wall_s: f64,
@@ -817,30 +817,34 @@ struct Cycle {
 /// The rate table at the cycle's settings follows (its rates in parallel).
 fn cycle_at(sc: &Scenario, fe: &FrontEnd, knowns: &Knowns, t: f64) -> Result<Cycle, CycleFailure> {
     let at = sc.drift.at(&sc.exp.gyro, t);
-    let mut board = board_at(&sc.exp, fe, &at).map_err(CycleFailure::before)?;
+    let mut board = board_at(&sc.exp, fe, &at).map_err(|e| CycleFailure::before(e, 0))?;
     let identified = identify::identify(&mut board, knowns, &knowns.nominal)
-        .map_err(|e| CycleFailure::before(e.into()))?;
+        .map_err(|e| CycleFailure::before(e.into(), board.cycle()))?;
     let kept = IdentifiedJson::from(&identified);
-    cycle_from(sc, fe, knowns, at, board, identified).map_err(|error| CycleFailure {
+    cycle_from(sc, fe, knowns, at, &mut board, identified).map_err(|error| CycleFailure {
         identified: Some(Box::new(kept)),
         error,
+        clocks: board.cycle(),
     })
 }
 
-/// A step's cycle that failed: its error, and what identification found
-/// when it finished before the failure.
+/// A step's cycle that failed: its error, what identification found
+/// when it finished before the failure, and the clocks its board ran (a
+/// rate table that failed does not count its own boards').
 #[derive(Debug)]
 struct CycleFailure {
     identified: Option<Box<IdentifiedJson>>,
     error: FieldError,
+    clocks: u64,
 }
 
 impl CycleFailure {
-    /// A failure before identification finished.
-    fn before(error: FieldError) -> Self {
+    /// A failure before identification finished, after `clocks`.
+    fn before(error: FieldError, clocks: u64) -> Self {
         Self {
             identified: None,
             error,
+            clocks,
         }
     }
 }
@@ -852,25 +856,25 @@ fn cycle_from(
     fe: &FrontEnd,
     knowns: &Knowns,
     at: DeviceAt,
-    mut board: SimBoard,
+    board: &mut SimBoard,
     identified: Identified,
 ) -> Result<Cycle, FieldError> {
-    let mut cal = selfcal::self_calibrate_from(&mut board, knowns, identified)?;
+    let mut cal = selfcal::self_calibrate_from(board, knowns, identified)?;
     if let Some(probe) = &sc.drive_probe {
         board.set_rate(probe.rate_dps.to_radians());
-        let measured = drive_ratio::measure(&mut board, knowns, &cal.operating, &cal.identified)?;
+        let measured = drive_ratio::measure(board, knowns, &cal.operating, &cal.identified)?;
         board.set_rate(0.0);
         selfcal::apply_drive_ratio(knowns, &mut cal, measured)?;
     }
     let readout = match &sc.profile {
         None => None,
         Some(p) => {
-            program_readout(&mut board, knowns, &cal.operating)?;
+            program_readout(board, knowns, &cal.operating)?;
             board.wait_clocks(knowns.settle_clocks(TABLE_FIRST_TAUS))?;
             let r = knowns.filter.decimation;
             let length = (knowns.filter.min_window_s * knowns.clock_hz).ceil();
-            let null = profile::readout_null(&mut board, r, length)?;
-            Some((null, profile::run_profile(&mut board, p, r, knowns.clock_hz)?))
+            let null = profile::readout_null(board, r, length)?;
+            Some((null, profile::run_profile(board, p, r, knowns.clock_hz)?))
         }
     };
     let judged = Some(cal.sf_selfcal_uncertainty.total);
@@ -1046,12 +1050,18 @@ pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldRepor
     let mut failed = vec![];
     let mut baseline_clips = vec![];
     let job_clocks: u64 = done.iter().flatten().map(|d| d.1).sum();
+    let mut failed_clocks = 0;
     let mut steps = vec![];
     for (i, c) in cycles.into_iter().enumerate() {
         let t = drift.temperatures_c[i];
         let c = match c {
             Ok(c) => c,
-            Err(CycleFailure { identified, error }) => {
+            Err(CycleFailure {
+                identified,
+                error,
+                clocks,
+            }) => {
+                failed_clocks += clocks;
                 failed.push(StepFailure {
                     temperature_c: t,
                     stage: FAILED_CYCLE,
@@ -1104,7 +1114,7 @@ pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldRepor
         progress(&w);
         warnings.push(w);
     }
-    let clocks = job_clocks + steps.iter().map(|s| s.clocks).sum::<u64>();
+    let clocks = job_clocks + failed_clocks + steps.iter().map(|s| s.clocks).sum::<u64>();
     Ok(FieldReport {
         knowns,
         sf_factory_per_dps: factory.as_ref().map(|f| f.sf_per_dps),
