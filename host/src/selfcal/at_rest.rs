@@ -133,10 +133,7 @@ impl Figures {
                 let sigma = (a * d.measurement_uncertainty).hypot(h * r.uncertainty);
                 figure(a * m + b * h, sigma)
             }),
-            rate: self.rate.map(|c| Estimate {
-                value: a * h + b * m,
-                uncertainty: (a * c.uncertainty).hypot(m * r.uncertainty),
-            }),
+            rate: self.rate.map(|c| drive_ratio::at_ratio(c, m, r)),
         }
     }
 }
