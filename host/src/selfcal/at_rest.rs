@@ -57,12 +57,16 @@ const RATIO_ROUNDS: usize = 3;
 /// `read` (the couplings and the rate as the windows read them, at the
 /// design ratio) at the drive-gain ratio the same windows give, and that
 /// ratio where it is observable at rest (module header).
+///
+/// Returns the figures as the windows read them, too: a ratio measured
+/// later (`[drive_probe]`) reads them again at its own
+/// (`selfcal::apply_drive_ratio`).
 pub(super) fn ratio_at_rest(
     windows: &CrossWindows,
     knowns: &Knowns,
     op: &Operating,
     read: Identified,
-) -> (Identified, Option<DriveRatio>) {
+) -> (Identified, Option<DriveRatio>, Figures) {
     let figures = Figures::of(&read);
     let lambda = knowns.angular_gain_uncertainty;
     let mut id = read;
@@ -75,20 +79,20 @@ pub(super) fn ratio_at_rest(
                 uncertainty: knowns.drive_gain_ratio_uncertainty,
             };
             figures.at_ratio(design, lambda).put(&mut id);
-            return (id, None);
+            return (id, None, figures);
         }
         figures.at_ratio(ratio.relative, lambda).put(&mut id);
         ratio = drive_ratio::from_windows(windows, knowns, op, &id);
     }
     figures.at_ratio(ratio.relative, lambda).put(&mut id);
-    (id, Some(ratio))
+    (id, Some(ratio), figures)
 }
 
 /// What the couplings' windows read: the two couplings and the rate
 /// (`Identified`'s `quadrature_dps`, `damping_coupling_dps` and
 /// `cycle_rate_dps`).
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct Figures {
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Figures {
     quadrature: Option<CouplingFigure>,
     damping: Option<CouplingFigure>,
     rate: Option<Estimate>,
@@ -103,7 +107,7 @@ impl Figures {
         }
     }
 
-    fn put(self, id: &mut Identified) {
+    pub(super) fn put(self, id: &mut Identified) {
         id.quadrature_dps = self.quadrature;
         id.damping_coupling_dps = self.damping;
         id.cycle_rate_dps = self.rate;
@@ -114,7 +118,7 @@ impl Figures {
     /// sigma scaled by a, and r's sigma carried into d and C by their
     /// slopes there (h and m at r = 1). `lambda`: the datasheet's
     /// relative 1-sigma of lambda, for the couplings' figures.
-    fn at_ratio(self, r: Estimate, lambda: f64) -> Self {
+    pub(super) fn at_ratio(self, r: Estimate, lambda: f64) -> Self {
         let (a, b) = (
             (r.value + 1.0 / r.value) / 2.0,
             (r.value - 1.0 / r.value) / 2.0,

@@ -320,6 +320,11 @@ pub struct SelfCal {
     pub carrier_spurs: Option<Spurs>,
     /// Clocks of the whole cycle.
     pub clocks: u64,
+    /// The couplings and the rate as the cycle's windows read them at the
+    /// design ratio, which a measured ratio reads again
+    /// ([`apply_drive_ratio`]).
+    #[serde(skip)]
+    pub(crate) at_rest_reading: at_rest::Figures,
 }
 
 impl SelfCal {
@@ -625,7 +630,8 @@ pub fn self_calibrate_from(
     // The same windows give the drive-gain ratio when the coupling makes
     // it observable (`drive_ratio::from_windows`), applied below, and the
     // couplings and the rate read again at it (`at_rest`).
-    let (identified, at_rest) = at_rest::ratio_at_rest(&windows, &first, &op, identified);
+    let (identified, at_rest, at_rest_reading) =
+        at_rest::ratio_at_rest(&windows, &first, &op, identified);
     let gyro = identified.gyro(&knowns.nominal);
     let measured = knowns.with_device(&gyro);
     let op = operating(&measured, &identified)?;
@@ -664,6 +670,7 @@ pub fn self_calibrate_from(
         sf_design_ratio_per_dps: sf_selfcal_per_dps,
         sf_selfcal_uncertainty: uncertainty,
         carrier_spurs: None,
+        at_rest_reading,
     };
     if let Some(at_rest) = at_rest {
         apply_drive_ratio(knowns, &mut cal, at_rest)?;
@@ -771,6 +778,14 @@ pub fn apply_drive_ratio(
     cal: &mut SelfCal,
     measured: DriveRatio,
 ) -> Result<(), Error> {
+    // The couplings and the rate the cycle's windows read, read again at
+    // this ratio (`at_rest`): where the drives part, a damping coupling
+    // reads as a rate -b d, at which the calibration would be predicted.
+    let lambda = knowns.angular_gain_uncertainty;
+    let reading = cal.at_rest_reading.at_ratio(measured.relative, lambda);
+    reading.put(&mut cal.identified);
+    cal.operating.cycle_rate_dps =
+        (cal.identified.cycle_rate_dps).map_or(0.0, |r| predicted_rate(r).value);
     let gyro = cal.identified.gyro(&knowns.nominal);
     let predict = |relative: f64| {
         predicted_ratio(
@@ -785,6 +800,11 @@ pub fn apply_drive_ratio(
     let moved = predict(rho.value + rho.uncertainty)?;
     cal.sf_selfcal_uncertainty.drive_ratio =
         std::array::from_fn(|k| (moved.exact[k] / ratio.exact[k] - 1.0).abs());
+    // The terms of the figures read again, at the measured ratio.
+    let at = with_drive_ratio(knowns, rho.value);
+    let (id, op, cal_hz) = (&cal.identified, &cal.operating, &cal.cal_hz);
+    cal.sf_selfcal_uncertainty.identified = budget::identified(&at, id, op, cal_hz, &ratio)?;
+    cal.sf_selfcal_uncertainty.cycle_rate = budget::cycle_rate(&at, id, op, cal_hz, &ratio)?;
     cal.sf_selfcal_uncertainty = cal.sf_selfcal_uncertainty.with_total();
     cal.sf_selfcal_per_dps = std::array::from_fn(|k| cal.sf_cal_per_dps[k] * ratio.exact[k]);
     cal.sf_eq56_per_dps = std::array::from_fn(|k| cal.sf_cal_per_dps[k] * ratio.eq56[k]);
