@@ -309,7 +309,7 @@ pub(crate) struct TurningLine {
 }
 
 /// `lines` as `windows` read them, at their `times_s`.
-fn turning(windows: &CrossWindows, lines: &[RelativeLine]) -> Vec<TurningLine> {
+pub(crate) fn turning(windows: &CrossWindows, lines: &[RelativeLine]) -> Vec<TurningLine> {
     let phasors = |omega: f64| {
         windows
             .times_s
@@ -338,7 +338,7 @@ fn turning(windows: &CrossWindows, lines: &[RelativeLine]) -> Vec<TurningLine> {
 /// added in power. A line that barely moves over the measurement is a
 /// common complex gain on an output's windows, which the estimate's
 /// ratios cancel.
-fn spur_sigma<const N: usize>(
+pub(crate) fn spur_sigma<const N: usize>(
     windows: &CrossWindows,
     lines: &[TurningLine],
     estimate: impl Fn(&CrossWindows) -> [f64; N],
@@ -517,7 +517,7 @@ pub fn uncouple(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use rand_xoshiro::Xoshiro256PlusPlus;
     use rand_xoshiro::rand_core::{Rng, SeedableRng};
@@ -578,6 +578,46 @@ mod tests {
         }
     }
 
+    /// The RMS error of `estimate` over 4000 draws of `line`'s phases
+    /// (one per output), at the side of the carrier that gives the larger
+    /// (`spur_sigma`'s premise, its doc comment): each output's signal
+    /// times 1 + rho_k e^(j(Omega t + phi_k)), each window reading it at
+    /// its own time.
+    pub(crate) fn line_error_rms<const N: usize>(
+        windows: &CrossWindows,
+        line: &RelativeLine,
+        estimate: impl Fn(&CrossWindows) -> [f64; N],
+    ) -> [f64; N] {
+        let clean = estimate(windows);
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(2258);
+        // A phase uniform over a turn, from the top 53 bits.
+        let mut phase = || (rng.next_u64() >> 11) as f64 / 2f64.powi(53) * std::f64::consts::TAU;
+        let draws = 4000;
+        let mut rms = [0.0f64; N];
+        for side in [1.0, -1.0] {
+            let omega = side * std::f64::consts::TAU * line.offset_hz;
+            let mut sum = [0.0; N];
+            for _ in 0..draws {
+                let mut moved = windows.clone();
+                for (k, rho) in line.rho.iter().enumerate() {
+                    let phi = phase();
+                    for (s, at) in windows.times_s.iter().enumerate() {
+                        let zk = windows.mean(s, k);
+                        let ripple = |q: usize| zk * C64::from_polar(*rho, omega * at[q] + phi);
+                        moved = moved.shifted(s, 0, k, ripple(0).re);
+                        moved = moved.shifted(s, 1, k, ripple(1).im);
+                    }
+                }
+                let e = estimate(&moved);
+                for (sum, (e, clean)) in sum.iter_mut().zip(e.iter().zip(&clean)) {
+                    *sum += (e - clean).powi(2);
+                }
+            }
+            rms = std::array::from_fn(|p| rms[p].max((sum[p] / f64::from(draws)).sqrt()));
+        }
+        rms
+    }
+
     /// `spur_sigma` against its premise (its doc comment): one line of
     /// relative amplitudes rho_k multiplying each output's signal by 1 +
     /// rho_k e^(j(Omega t + phi_k)), each window reading it at its own
@@ -606,33 +646,7 @@ mod tests {
             rho: [3e-4, 1e-3],
         };
         let sigma = spur_sigma(&windows, &turning(&windows, &[line(2.8)]), estimate);
-        let clean = estimate(&windows);
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(2258);
-        // A phase uniform over a turn, from the top 53 bits.
-        let mut phase = || (rng.next_u64() >> 11) as f64 / 2f64.powi(53) * std::f64::consts::TAU;
-        let draws = 4000;
-        let mut rms = [0.0f64; 2];
-        for side in [1.0, -1.0] {
-            let omega = side * std::f64::consts::TAU * 2.8;
-            let mut sum = [0.0; 2];
-            for _ in 0..draws {
-                let mut moved = windows.clone();
-                for (k, rho) in line(2.8).rho.iter().enumerate() {
-                    let phi = phase();
-                    for (s, at) in times.iter().enumerate() {
-                        let zk = windows.mean(s, k);
-                        let ripple = |q: usize| zk * C64::from_polar(*rho, omega * at[q] + phi);
-                        moved = moved.shifted(s, 0, k, ripple(0).re);
-                        moved = moved.shifted(s, 1, k, ripple(1).im);
-                    }
-                }
-                let e = estimate(&moved);
-                for (sum, (e, clean)) in sum.iter_mut().zip(e.iter().zip(&clean)) {
-                    *sum += (e - clean).powi(2);
-                }
-            }
-            rms = [0, 1].map(|p| rms[p].max((sum[p] / f64::from(draws)).sqrt()));
-        }
+        let rms = line_error_rms(&windows, &line(2.8), estimate);
         let ratio = [rms[0] / sigma[0], rms[1] / sigma[1]];
         assert!(
             ratio.iter().all(|r| (r - 1.0).abs() <= 0.05),

@@ -188,39 +188,48 @@ impl Knowns {
     }
 }
 
+/// Knowns for unit tests: the device `nominal`, known exactly, at a clock
+/// and a carrier, equal drive full scales, converter latencies of 2 and 3
+/// clocks.
+#[cfg(test)]
+pub(crate) fn for_tests(nominal: GyroParams, clock_hz: f64, carrier_hz: f64) -> Knowns {
+    Knowns {
+        clock_hz,
+        nominal,
+        angular_gain_uncertainty: 0.0,
+        drive_gain_ratio_uncertainty: 0.0,
+        amplitude: (0.9, 0.9),
+        force_full_scale: [1.0, 1.0],
+        dac_latency: 2,
+        adc_latency: 3,
+        filter: Derived {
+            decimation: 100,
+            butterworth_hz: 50.0,
+            rc_hz: 200.0,
+            min_window_s: 0.1,
+        },
+        carrier_hz,
+        rates_dps: vec![10.0],
+        cal_freqs_hz: vec![3.0],
+        carrier_profile: CarrierProfile::Table,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn knowns(carrier_hz: f64) -> Knowns {
-        Knowns {
-            clock_hz: 1.6e6,
-            nominal: GyroParams {
-                f1_hz: 34_155.0,
-                f2_hz: 34_570.0,
-                q1: 1e4,
-                q2: 1e4,
-                angular_gain: 0.7,
-                quadrature_dps: 0.0,
-                damping_coupling_dps: 0.0,
-            },
-            angular_gain_uncertainty: 0.0,
-            drive_gain_ratio_uncertainty: 0.0,
-            amplitude: (0.9, 0.9),
-            force_full_scale: [1.0, 1.0],
-            dac_latency: 2,
-            adc_latency: 3,
-            filter: Derived {
-                decimation: 100,
-                butterworth_hz: 50.0,
-                rc_hz: 200.0,
-                min_window_s: 0.1,
-            },
-            carrier_hz,
-            rates_dps: vec![10.0],
-            cal_freqs_hz: vec![3.0],
-            carrier_profile: CarrierProfile::Table,
-        }
+        let nominal = GyroParams {
+            f1_hz: 34_155.0,
+            f2_hz: 34_570.0,
+            q1: 1e4,
+            q2: 1e4,
+            angular_gain: 0.7,
+            quadrature_dps: 0.0,
+            damping_coupling_dps: 0.0,
+        };
+        for_tests(nominal, 1.6e6, carrier_hz)
     }
 
     /// At a mode, between the two, or beyond one by less than the split

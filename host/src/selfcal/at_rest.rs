@@ -47,6 +47,7 @@
 //! rounds, each moving the ratio by a second-order term of the last.
 
 use super::{AT_REST_RATIO_SIGMA, Operating};
+use crate::coupling::TurningLine;
 use crate::drive_ratio::{self, CrossWindows, DriveRatio};
 use crate::identify::{CouplingFigure, Estimate, Identified};
 use crate::knowns::Knowns;
@@ -56,7 +57,9 @@ const RATIO_ROUNDS: usize = 3;
 
 /// `read` (the couplings and the rate as the windows read them, at the
 /// design ratio) at the drive-gain ratio the same windows give, and that
-/// ratio where it is observable at rest (module header).
+/// ratio where it is observable at rest (module header). `spur_lines`:
+/// the table core's lines in the windows (`coupling::spur_lines`), in the
+/// ratio's sigma.
 ///
 /// Returns the figures as the windows read them, too: a ratio measured
 /// later (`[drive_probe]`) reads them again at its own
@@ -66,11 +69,12 @@ pub(super) fn ratio_at_rest(
     knowns: &Knowns,
     op: &Operating,
     read: Identified,
+    spur_lines: Option<&[TurningLine]>,
 ) -> (Identified, Option<DriveRatio>, Figures) {
     let figures = Figures::of(&read);
     let lambda = knowns.angular_gain_uncertainty;
     let mut id = read;
-    let mut ratio = drive_ratio::from_windows(windows, knowns, op, &id);
+    let mut ratio = drive_ratio::from_windows(windows, knowns, op, &id, spur_lines);
     for _ in 0..RATIO_ROUNDS {
         let (kappa, c) = drive_ratio::cross_terms(&id, op.carrier_hz);
         if ratio.relative.uncertainty >= AT_REST_RATIO_SIGMA || c.norm() > kappa.norm() {
@@ -82,7 +86,7 @@ pub(super) fn ratio_at_rest(
             return (id, None, figures);
         }
         figures.at_ratio(ratio.relative, lambda).put(&mut id);
-        ratio = drive_ratio::from_windows(windows, knowns, op, &id);
+        ratio = drive_ratio::from_windows(windows, knowns, op, &id, spur_lines);
     }
     figures.at_ratio(ratio.relative, lambda).put(&mut id);
     (id, Some(ratio), figures)

@@ -620,18 +620,21 @@ pub fn self_calibrate_from(
     let op = operating(&first, &identified)?;
     let windows = CrossWindows::measure(board, &first, &op)?;
     identified.clocks += windows.clocks;
+    let spur_lines = coupling::spur_lines(&windows, &first, &op, &identified)?;
+    let spur_lines = spur_lines.as_deref();
     let identified = uncoupled(
         &windows,
         &first,
         &op,
         identified,
         knowns.nominal.angular_gain,
+        spur_lines,
     )?;
     // The same windows give the drive-gain ratio when the coupling makes
     // it observable (`drive_ratio::from_windows`), applied below, and the
     // couplings and the rate read again at it (`at_rest`).
     let (identified, at_rest, at_rest_reading) =
-        at_rest::ratio_at_rest(&windows, &first, &op, identified);
+        at_rest::ratio_at_rest(&windows, &first, &op, identified, spur_lines);
     let gyro = identified.gyro(&knowns.nominal);
     let measured = knowns.with_device(&gyro);
     let op = operating(&measured, &identified)?;
@@ -695,17 +698,17 @@ const COUPLING_ROUNDS: usize = 8;
 pub const DAMPING_SEEN: f64 = 4.0;
 
 /// The identified modes uncoupled by the coupling measured in `windows`,
-/// which they carry.
+/// which they carry; `spur_lines`, the table core's lines in the windows
+/// (`coupling::spur_lines`), in the couplings' sigmas.
 fn uncoupled(
     windows: &CrossWindows,
     knowns: &Knowns,
     op: &Operating,
     apparent: Identified,
     angular_gain: f64,
+    spur_lines: Option<&[coupling::TurningLine]>,
 ) -> Result<Identified, Error> {
     let mut id = apparent.clone();
-    let spur_lines = coupling::spur_lines(windows, knowns, op, &id)?;
-    let spur_lines = spur_lines.as_deref();
     let mut c = coupling::from_windows(windows, knowns, op, &id, spur_lines)?;
     let uncouple = |c: &coupling::Coupling| {
         coupling::uncouple(&apparent, c, angular_gain, knowns.clock_hz, op.carrier_hz)
