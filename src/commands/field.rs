@@ -15,7 +15,7 @@
 //! an `_uncertainty` twin), and `warnings`: inputs that no sigma covers,
 //! one line each, also printed as progress and in the summary (ADC noise
 //! below half an ADC step, `gyrocal_sim::frontend::dithers`; a datasheet
-//! resonance or Q beyond a part's spread of the identified one,
+//! resonance, split or Q beyond a part's spread of the identified one,
 //! `datasheet_warning`, which moves no figure but names the input; a design
 //! drive-gain ratio that no `[datasheet] drive_gain_ratio_uncertainty`
 //! bounds, `design_ratio_warning`; self-cal errors beyond 3 of their

@@ -440,7 +440,7 @@ pub fn design_ratio_warning(steps: &[FieldStep], knowns: &Knowns) -> Option<Stri
     })
 }
 
-/// The datasheet's resonances and Qs beyond a part's spread from what the
+/// The datasheet's resonances, split and Qs beyond a part's spread from what the
 /// first step identified (`Identified::datasheet_departures`): one line,
 /// or None. The figures rest on the identified values; the line is for
 /// whoever wrote the datasheet or owns the part.

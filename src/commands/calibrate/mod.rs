@@ -24,8 +24,8 @@
 //!   as in `gyrocal field`), one per output, `clocks`, `wall_s`, `samples`
 //!   (read and missed over the run), `warnings` (what the sigma leaves
 //!   out, one line each, also on stderr: a drive-gain ratio nothing
-//!   measured nor bounds, a carrier on a slow fold, a datasheet f or Q
-//!   beyond a part's spread, a device that turned during the cycle
+//!   measured nor bounds, a carrier on a slow fold, a datasheet f, split
+//!   or Q beyond a part's spread, a device that turned during the cycle
 //!   (`SelfCal::warnings`); in process, self-cal
 //!   errors beyond 3 of their sigmas against the truth), `failed` (null)
 //!   and `truth` (null over the wire). Progress goes to stderr.
