@@ -426,30 +426,52 @@ pub fn measure(
     let lines = lines.as_deref();
     let read = crate::coupling::from_windows(&windows, knowns, op, id, lines)?;
     let mut probe = id.clone();
-    let mut ratio = from_windows(&windows, knowns, op, &probe, lines);
-    for _ in 0..PROBE_MAX_ROUNDS {
+    let first = from_windows(&windows, knowns, op, &probe, lines);
+    let settled = settled(first, |ratio| {
         let rate = at_ratio(read.rate_dps, read.damping_dps.value, ratio.relative);
         probe.cycle_rate_dps = Some(rate);
-        let next = from_windows(&windows, knowns, op, &probe, lines);
+        Ok::<_, std::convert::Infallible>(from_windows(&windows, knowns, op, &probe, lines))
+    });
+    let Ok(ratio) = settled;
+    Ok(ratio)
+}
+
+/// A drive-gain ratio read from windows and the figures read again at it,
+/// round after round: `round(r)` puts the figures at the ratio `r` and
+/// reads the windows' ratio with them (the ratio's magnitude moves with
+/// the rate where there is a damping coupling, [`turning_factor`], and
+/// the rate the windows read moves with the ratio, [`at_ratio`]), until a
+/// round moves the ratio by at most [`RATIO_CONVERGED`] of its sigma, at
+/// most [`RATIO_MAX_ROUNDS`]. Both the probe ([`measure`]) and the ratio
+/// at rest (`selfcal::at_rest`) iterate so; an `Err` from `round` stops
+/// the rounds with it. Where the rate is not seen at rest it is predicted
+/// at 0 and the ratio does not move: one round.
+pub(crate) fn settled<E>(
+    first: DriveRatio,
+    mut round: impl FnMut(&DriveRatio) -> Result<DriveRatio, E>,
+) -> Result<DriveRatio, E> {
+    let mut ratio = first;
+    for _ in 0..RATIO_MAX_ROUNDS {
+        let next = round(&ratio)?;
         let step = (next.relative.value - ratio.relative.value).abs();
         ratio = next;
-        if step <= PROBE_CONVERGED * ratio.relative.uncertainty {
+        if step <= RATIO_CONVERGED * ratio.relative.uncertainty {
             break;
         }
     }
     Ok(ratio)
 }
 
-/// Most rounds of the probe's ratio and the rate read at it ([`measure`]).
+/// Most rounds of a ratio and the figures read at it ([`settled`]).
 /// Each round shrinks the ratio's error by a factor that grows as the
 /// coupling nears the rate: on the coupled device (250 deg/s of
 /// stiffness, -200 of damping) probed at 200 deg/s, 6 (1.064, 1.0115,
 /// 1.0020, 1.00034 for 1), where four rounds left it 10.7 sigma off.
-const PROBE_MAX_ROUNDS: usize = 64;
+const RATIO_MAX_ROUNDS: usize = 64;
 
-/// The probe's rounds stop once a round moves the ratio by less than
-/// this share of its sigma.
-const PROBE_CONVERGED: f64 = 1e-3;
+/// The rounds stop once a round moves the ratio by less than this share
+/// of its sigma ([`settled`]).
+const RATIO_CONVERGED: f64 = 1e-3;
 
 /// The rate C the windows read as h (their outputs' half difference) and
 /// m (their mean damping term) at the design ratio, read again at the
@@ -519,7 +541,7 @@ fn turning_sigma(id: &Identified, carrier_hz: f64) -> f64 {
 /// kappa = Omega_q + j fc / f1 Omega_d and the Coriolis c = j fc / f1
 /// Omega, Omega the rate the prediction is at (`selfcal::predicted_rate`).
 pub(crate) fn cross_terms(id: &Identified, carrier_hz: f64) -> (C64, C64) {
-    let value = |e: Option<crate::identify::CouplingFigure>| e.map_or(0.0, |c| c.value);
+    let value = |e: Option<CouplingFigure>| e.map_or(0.0, |c| c.value);
     let to_carrier = carrier_hz / id.modes[0].f_hz.value;
     let kappa = C64::new(
         value(id.quadrature_dps),

@@ -43,17 +43,17 @@
 //!
 //! The ratio's estimate itself moves with the rate where there is a
 //! damping coupling (`drive_ratio::turning_factor`, which reads the rate
-//! off the identification), so the two are iterated: `RATIO_ROUNDS`
-//! rounds, each moving the ratio by a second-order term of the last.
+//! off the identification), so the two are iterated until the ratio
+//! settles (`drive_ratio::settled`, which the probe's rounds share). At
+//! rest the rate is not seen and is predicted at 0, so the ratio does not
+//! move and one round settles it: on `tests/data/field_coupled.toml` at
+//! each temperature eight rounds read the same ratio to the last digit.
 
 use super::{AT_REST_RATIO_SIGMA, Operating};
 use crate::coupling::TurningLine;
 use crate::drive_ratio::{self, CrossWindows, DriveRatio};
 use crate::identify::{CouplingFigure, Estimate, Identified};
 use crate::knowns::Knowns;
-
-/// Rounds of the ratio and the rate read at it (module header).
-const RATIO_ROUNDS: usize = 3;
 
 /// `read` (the couplings and the rate as the windows read them, at the
 /// design ratio) at the drive-gain ratio the same windows give, and that
@@ -74,28 +74,42 @@ pub(super) fn ratio_at_rest(
     let figures = Figures::of(&read);
     let lambda = knowns.angular_gain_uncertainty;
     let mut id = read;
-    let mut ratio = drive_ratio::from_windows(windows, knowns, op, &id, spur_lines);
-    for _ in 0..RATIO_ROUNDS {
+    let first = drive_ratio::from_windows(windows, knowns, op, &id, spur_lines);
+    let settled = drive_ratio::settled(first, |ratio| {
         let (kappa, c) = drive_ratio::cross_terms(&id, op.carrier_hz);
         if ratio.relative.uncertainty >= AT_REST_RATIO_SIGMA || c.norm() > kappa.norm() {
+            return Err(Unobservable);
+        }
+        figures.at_ratio(ratio.relative, lambda).put(&mut id);
+        Ok(drive_ratio::from_windows(
+            windows, knowns, op, &id, spur_lines,
+        ))
+    });
+    match settled {
+        Ok(ratio) => {
+            figures.at_ratio(ratio.relative, lambda).put(&mut id);
+            (id, Some(ratio), figures)
+        }
+        Err(Unobservable) => {
             let design = Estimate {
                 value: 1.0,
                 uncertainty: knowns.drive_gain_ratio_uncertainty,
             };
             figures.at_ratio(design, lambda).put(&mut id);
-            return (id, None, figures);
+            (id, None, figures)
         }
-        figures.at_ratio(ratio.relative, lambda).put(&mut id);
-        ratio = drive_ratio::from_windows(windows, knowns, op, &id, spur_lines);
     }
-    figures.at_ratio(ratio.relative, lambda).put(&mut id);
-    (id, Some(ratio), figures)
 }
+
+/// The ratio is not observable at rest: its sigma beyond
+/// `AT_REST_RATIO_SIGMA`, or the rate's Coriolis term the larger of the
+/// cross responses' two (module header).
+struct Unobservable;
 
 /// What the couplings' windows read: the two couplings and the rate
 /// (`Identified`'s `quadrature_dps`, `damping_coupling_dps` and
 /// `cycle_rate_dps`).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Figures {
     quadrature: Option<CouplingFigure>,
     damping: Option<CouplingFigure>,
