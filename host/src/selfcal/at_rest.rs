@@ -75,16 +75,20 @@ pub(super) fn ratio_at_rest(
     let lambda = knowns.angular_gain_uncertainty;
     let mut id = read;
     let first = drive_ratio::from_windows(windows, knowns, op, &id, spur_lines);
-    let settled = drive_ratio::settled(first, |ratio| {
-        let (kappa, c) = drive_ratio::cross_terms(&id, op.carrier_hz);
-        if ratio.relative.uncertainty >= AT_REST_RATIO_SIGMA || c.norm() > kappa.norm() {
-            return Err(Unobservable);
-        }
-        figures.at_ratio(ratio.relative, lambda).put(&mut id);
-        Ok(drive_ratio::from_windows(
-            windows, knowns, op, &id, spur_lines,
-        ))
-    });
+    let settled = drive_ratio::settled(
+        first,
+        |ratio| {
+            let (kappa, c) = drive_ratio::cross_terms(&id, op.carrier_hz);
+            if ratio.relative.uncertainty >= AT_REST_RATIO_SIGMA || c.norm() > kappa.norm() {
+                return Err(Unobservable);
+            }
+            figures.at_ratio(ratio.relative, lambda).put(&mut id);
+            Ok(drive_ratio::from_windows(
+                windows, knowns, op, &id, spur_lines,
+            ))
+        },
+        |_, _| Unobservable,
+    );
     match settled {
         Ok(ratio) => {
             figures.at_ratio(ratio.relative, lambda).put(&mut id);
@@ -102,8 +106,9 @@ pub(super) fn ratio_at_rest(
 }
 
 /// The ratio is not observable at rest: its sigma beyond
-/// `AT_REST_RATIO_SIGMA`, or the rate's Coriolis term the larger of the
-/// cross responses' two (module header).
+/// `AT_REST_RATIO_SIGMA`, the rate's Coriolis term the larger of the
+/// cross responses' two (module header), or its rounds, with a rate seen
+/// near a damping coupling's, do not settle (`drive_ratio::settled`).
 struct Unobservable;
 
 /// What the couplings' windows read: the two couplings and the rate

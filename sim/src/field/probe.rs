@@ -12,6 +12,10 @@ use serde::{Deserialize, Serialize};
 /// [drive_probe]
 /// rate_dps = 200      # required: any non-zero rate within the rate limit
 /// ```
+///
+/// A rate near the device's damping coupling (a few times it or less)
+/// leaves the ratio unsettled, and the step fails in one line
+/// (`drive_ratio::measure`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DriveProbe {
