@@ -216,47 +216,62 @@ fn a_drive_probe_takes_a_damping_couplings_turning_out() {
     assert!(worst <= 3.0, "a figure at {worst:.2} sigma");
 }
 
-/// A probe near the damping coupling's own rate: the probe's rounds (its
+/// A probe near the damping coupling's own rate. The probe's rounds (its
 /// ratio, the rate read again at it, `drive_ratio::settled`) swing
 /// without end there, and after 64 rounds the last ratio was taken as the
 /// figure: the device with 4.4 deg/s of damping coupling probed at 5
 /// deg/s read g2/g1 0.44 for 1 at 25 deg C (27 sigma), its scale factors
-/// 22 and 24 of their sigmas off, and nothing was said. Now that step
-/// fails with one line naming the probe's rate and the coupling, keeping
-/// its identification; the step at 60 deg C, whose rounds settle, stands
-/// within 3 of its sigmas.
+/// 22 and 24 of their sigmas off, and nothing was said. Nearer still the
+/// rounds can settle on a second root, where the rate read at that ratio
+/// is 0 and nothing is taken out: a random device with -2.30 deg/s of
+/// coupling probed at -2.19 read 0.17 for 1, 38 sigma off. Now the step
+/// at 25 deg C fails with one line naming the probe's rate and the
+/// coupling, keeping its identification: rounds that do not settle, or
+/// a root whose rate is not seen, though the probe turned. The step at
+/// 60 deg C (17.5 deg/s of stiffness coupling by then) stands within 3 of
+/// its sigmas.
 #[test]
 fn a_probe_near_the_damping_couplings_rate_fails_in_one_line() {
-    let mut sc = coupled();
-    sc.exp.gyro.quadrature_dps = 0.0;
-    sc.exp.gyro.damping_coupling_dps = 4.4;
-    sc.drift.temperatures_c = vec![25.0, 60.0];
-    sc.drive_probe = Some(DriveProbe { rate_dps: 5.0 });
-    let report = scenario::run(&sc, &|_| {}).unwrap();
-    let [failed] = &report.failed[..] else {
-        panic!("one step fails: {:?}", report.failed);
-    };
-    eprintln!("{} deg C: {}", failed.temperature_c, failed.error);
-    assert_eq!(failed.temperature_c, 25.0);
-    assert!(failed.identified.is_some(), "the identification is kept");
-    for says in [
-        "drive-gain ratio: [drive_probe]'s rounds did not settle",
-        "is too near the damping coupling, read 4.4",
+    for (damping, rate, says) in [
+        (
+            4.4,
+            5.0,
+            "drive-gain ratio: [drive_probe]'s rounds did not settle",
+        ),
+        (
+            -2.3,
+            -2.19,
+            "drive-gain ratio: [drive_probe]'s rounds settled on g2/g1 0.1",
+        ),
     ] {
+        let mut sc = coupled();
+        sc.exp.gyro.quadrature_dps = 0.0;
+        sc.exp.gyro.damping_coupling_dps = damping;
+        sc.drift.temperatures_c = vec![25.0, 60.0];
+        sc.drive_probe = Some(DriveProbe { rate_dps: rate });
+        let report = scenario::run(&sc, &|_| {}).unwrap();
+        let [failed] = &report.failed[..] else {
+            panic!("{rate} deg/s: one step fails: {:?}", report.failed);
+        };
+        eprintln!("{} deg C: {}", failed.temperature_c, failed.error);
+        assert_eq!(failed.temperature_c, 25.0);
+        assert!(failed.identified.is_some(), "the identification is kept");
         assert!(failed.error.contains(says), "{}", failed.error);
-    }
-    assert!(!failed.error.contains('\n'));
-    for s in &report.steps {
-        let m = s.selfcal.drive_ratio.as_ref().unwrap();
-        let t = (m.relative.value - s.drive_gain_ratio_true) / m.relative.uncertainty;
-        assert!(
-            t.abs() <= 3.0,
-            "{} deg C: g2/g1 at {t:.2} sigma",
-            s.temperature_c
-        );
-        for k in 0..2 {
-            let sf_t = s.selfcal_error[k] / s.selfcal_error_uncertainty[k];
-            assert!(sf_t.abs() <= 3.0, "output {}: {sf_t:.2} sigma", k + 1);
+        let coupling = format!("the damping coupling, read {}", &damping.to_string()[..3]);
+        assert!(failed.error.contains(&coupling), "{}", failed.error);
+        assert!(!failed.error.contains('\n'));
+        for s in &report.steps {
+            let m = s.selfcal.drive_ratio.as_ref().unwrap();
+            let t = (m.relative.value - s.drive_gain_ratio_true) / m.relative.uncertainty;
+            let at = s.temperature_c;
+            assert!(
+                t.abs() <= 3.0,
+                "{rate} deg/s at {at} deg C: g2/g1 at {t:.2} sigma"
+            );
+            for k in 0..2 {
+                let sf_t = s.selfcal_error[k] / s.selfcal_error_uncertainty[k];
+                assert!(sf_t.abs() <= 3.0, "output {}: {sf_t:.2} sigma", k + 1);
+            }
         }
     }
 }

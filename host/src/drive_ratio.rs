@@ -415,6 +415,12 @@ impl CrossWindows {
 /// of 0.3 deg/s or more read g2/g1 39 to 517 of its sigmas off (a 4.4
 /// deg/s coupling probed at -24.5 deg/s: 1.2001 for 1), and its scale
 /// factors up to 290.
+///
+/// Near the damping coupling's own rate, or below it, the rounds swing
+/// without end (`settled`) or settle on the identity's second root,
+/// where the rate read at that ratio is 0 and no turning is taken out
+/// (r^2 = (m - h) / (m + h) with no stiffness coupling): each is an error
+/// in one line, never a figure.
 pub fn measure(
     board: &mut dyn Board,
     knowns: &Knowns,
@@ -428,7 +434,7 @@ pub fn measure(
     let mut probe = id.clone();
     let first = from_windows(&windows, knowns, op, &probe, lines);
     let damping = read.damping_dps.value;
-    settled(
+    let ratio = settled(
         first,
         |ratio| {
             let rate = at_ratio(read.rate_dps, damping, ratio.relative);
@@ -442,7 +448,25 @@ pub fn measure(
                 last.relative.value, last.relative.uncertainty, read.rate_dps.value
             ),
         },
-    )
+    )?;
+    // With a damping coupling the identity has a second root, where the
+    // rate read at that ratio is 0 and so no turning is taken out; the
+    // probe turned, so a root whose rate is not seen is that one.
+    let settled_rate = probe.cycle_rate_dps.unwrap_or(read.rate_dps);
+    if !crate::selfcal::rate_seen(settled_rate) {
+        return Err(Error::Measurement {
+            what: "drive-gain ratio",
+            reason: format!(
+                "[drive_probe]'s rounds settled on g2/g1 {:.4} +- {:.1e}, where the rate reads {:.3} +- {:.3} deg/s: the identity's second root with a damping coupling, not the turn, read {:.3} deg/s at the design ratio; the probe's rate is too near the damping coupling, read {damping:.3} deg/s: probe at a rate several times the coupling (rate_dps)",
+                ratio.relative.value,
+                ratio.relative.uncertainty,
+                settled_rate.value,
+                settled_rate.uncertainty,
+                read.rate_dps.value
+            ),
+        });
+    }
+    Ok(ratio)
 }
 
 /// A drive-gain ratio read from windows and the figures read again at it,

@@ -743,7 +743,7 @@ fn uncoupled(
 pub const CYCLE_RATE_SEEN: f64 = 5.0;
 
 /// The windows' rate `reading` is beyond [`CYCLE_RATE_SEEN`] of its sigmas.
-fn rate_seen(reading: Estimate) -> bool {
+pub(crate) fn rate_seen(reading: Estimate) -> bool {
     reading.value.abs() > CYCLE_RATE_SEEN * reading.uncertainty
 }
 

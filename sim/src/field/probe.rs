@@ -13,9 +13,10 @@ use serde::{Deserialize, Serialize};
 /// rate_dps = 200      # required: any non-zero rate within the rate limit
 /// ```
 ///
-/// A rate near the device's damping coupling (a few times it or less)
-/// leaves the ratio unsettled, and the step fails in one line
-/// (`drive_ratio::measure`).
+/// A rate near the device's damping coupling, or below it, leaves the
+/// ratio unsettled or on the identity's second root, and the step fails
+/// in one line (`drive_ratio::measure`): probe several times faster than
+/// the coupling.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DriveProbe {
