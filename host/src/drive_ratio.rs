@@ -589,9 +589,7 @@ pub(crate) fn cross_terms(id: &Identified, carrier_hz: f64) -> (C64, C64) {
         value(id.quadrature_dps),
         to_carrier * value(id.damping_coupling_dps),
     );
-    let rate = id
-        .cycle_rate_dps
-        .map_or(0.0, |r| crate::selfcal::predicted_rate(r).value);
+    let rate = crate::selfcal::prediction_rate_dps(id);
     (kappa, C64::new(0.0, to_carrier * rate))
 }
 

@@ -1,8 +1,8 @@
 //! What identification found against what the datasheet said: a resonance,
 //! the modes' split or a Q beyond a part's spread (`datasheet::F_SPREAD`,
-//! `SPLIT_SPREAD`, `Q_SPREAD`) is said in one line. The figures rest on the identified values and do not
-//! move; the line is for the person who wrote the datasheet or owns the
-//! part. A datasheet Q sets the search's carrier steps and waits, so a
+//! `SPLIT_SPREAD`, `Q_SPREAD`) is said in one line. The figures rest on
+//! the identified values and do not move; the line is for the person who
+//! wrote the datasheet or owns the part. A datasheet Q sets the search's carrier steps and waits, so a
 //! wrong one costs retries and time, and a Q far below its datasheet's is
 //! what a package that lost its vacuum shows.
 

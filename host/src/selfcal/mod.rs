@@ -394,7 +394,7 @@ pub fn operating(knowns: &Knowns, id: &Identified) -> Result<Operating, Error> {
             static_fold: static_fold(knowns, real.carrier_hz),
             spur_move: None,
             scaled_drives: None,
-            cycle_rate_dps: id.cycle_rate_dps.map_or(0.0, |r| predicted_rate(r).value),
+            cycle_rate_dps: prediction_rate_dps(id),
         })
     };
     let mut op = at(asked)?;
@@ -764,6 +764,14 @@ pub fn predicted_rate(reading: Estimate) -> Estimate {
     }
 }
 
+/// The rate the calibration is predicted at for the identification `id`
+/// ([`predicted_rate`] of its windows' reading; 0 without one): what
+/// [`Operating::cycle_rate_dps`] holds and the cross responses' Coriolis
+/// term (`drive_ratio::cross_terms`) takes.
+pub(crate) fn prediction_rate_dps(id: &Identified) -> f64 {
+    id.cycle_rate_dps.map_or(0.0, |r| predicted_rate(r).value)
+}
+
 /// `knowns` with drive 2's force gain moved by `relative` (g_2 / g_1 over
 /// the design ratio).
 fn with_drive_ratio(knowns: &Knowns, relative: f64) -> Knowns {
@@ -787,8 +795,7 @@ pub fn apply_drive_ratio(
     let lambda = knowns.angular_gain_uncertainty;
     let reading = cal.at_rest_reading.at_ratio(measured.relative, lambda);
     reading.put(&mut cal.identified);
-    cal.operating.cycle_rate_dps =
-        (cal.identified.cycle_rate_dps).map_or(0.0, |r| predicted_rate(r).value);
+    cal.operating.cycle_rate_dps = prediction_rate_dps(&cal.identified);
     let gyro = cal.identified.gyro(&knowns.nominal);
     let predict = |relative: f64| {
         predicted_ratio(
