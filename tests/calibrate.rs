@@ -217,6 +217,27 @@ fn compare_over_the_wire(pace_r: u64) -> (f64, f64) {
     for run in [&local, &wire] {
         assert_eq!(design_ratio_lines(run), 1, "{}", run["warnings"]);
     }
+    // A real board's oscillator is off by some ppm the host cannot see;
+    // the file gives no tolerance, so the wire's run says so. The
+    // in-process board's clock is exact unless `clock_error_ppm` moves it.
+    let clock_lines = |run: &Value| {
+        run["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|w| {
+                w.as_str()
+                    .unwrap()
+                    .starts_with("warning: [drive] clock_tolerance_ppm")
+            })
+            .count()
+    };
+    assert_eq!(
+        (clock_lines(&local), clock_lines(&wire)),
+        (0, 1),
+        "{}",
+        wire["warnings"]
+    );
 
     println!(
         "{:<16} {:>24} {:>24} {:>16}",
@@ -452,6 +473,94 @@ fn an_error_its_sigma_does_not_cover_is_said_in_one_line() {
                     && lines[0].contains("[datasheet] angular_gain"),
                 "{}",
                 lines[0]
+            );
+        }
+    }
+}
+
+/// A 25.1 kHz device (Q 3391 / 1117, split -184 Hz, a -6.4 deg/s damping
+/// coupling): device 4 of `scripts/coverage/turning.py 614`, whose output
+/// 1 curves over the table's rates.
+const CLOCK_DEVICE: &str = "
+[gyro]
+f1_hz = 25097.492
+f2_hz = 24913.394
+q1 = 3390.9
+q2 = 1116.6
+angular_gain = 0.72
+damping_coupling_dps = -6.389
+
+[drive]
+carrier_hz = 25097.492
+clock_hz = 895440.6
+
+[experiment]
+readout_rates_dps = [50, 150, 300]
+cal_freqs_hz = [3, 5, 8]
+";
+
+/// A board whose clock runs off `clock_hz` (`[drive] clock_error_ppm`,
+/// here +5000 ppm) is invisible to the host: everything it measures runs
+/// on that clock. The self-calibrated scale factors move by (1 + Q) e
+/// (`selfcal::budget::clock`: 1 for the rate's unit, Q for the readout
+/// slope's curvature over the table's rates, 1.46 on output 1 here).
+/// Without a tolerance the errors (1.23% and 0.51%) lie 250 and 50 sigma
+/// off and the run says an input outside the budget may be the clock.
+/// With `clock_tolerance_ppm = 5000` the sigma holds the term: the errors
+/// lie within 3 sigma (at the bound's edge, sqrt(3)), and each is the
+/// term's bound (its sigma times sqrt(3)) within 3 of the other sources'
+/// sigma (1e-4), on the side of the clock's error.
+#[test]
+fn a_clock_off_its_frequency_is_in_the_sigma_its_tolerance_gives() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("clock.toml");
+    let line = "beyond 3 of their reported sigmas";
+    for tolerance in [0.0, 5000.0] {
+        let drive = format!(
+            "clock_hz = 895440.6\nclock_error_ppm = 5000\nclock_tolerance_ppm = {tolerance}"
+        );
+        std::fs::write(&config, CLOCK_DEVICE.replace("clock_hz = 895440.6", &drive)).unwrap();
+        let run = calibrate(&config, &[]);
+        let truth = &run["truth"];
+        let (error, sigma) = (
+            pair(truth, "selfcal_error"),
+            pair(truth, "selfcal_error_uncertainty"),
+        );
+        let clock = pair(&run["sf_selfcal_uncertainty_sources"], "clock");
+        let said: Vec<&str> = run["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|w| w.as_str().unwrap())
+            .filter(|w| w.contains(line))
+            .collect();
+        if tolerance == 0.0 {
+            assert_eq!(clock, [0.0, 0.0]);
+            assert!(
+                (0..2).all(|k| error[k] / sigma[k] > 3.0),
+                "{error:?} {sigma:?}"
+            );
+            assert!(
+                said.len() == 1 && said[0].contains("clock_tolerance_ppm"),
+                "{}",
+                run["warnings"]
+            );
+            continue;
+        }
+        assert!(said.is_empty(), "{said:?}");
+        for k in 0..2 {
+            let bound = clock[k] * 3f64.sqrt();
+            let others = (sigma[k].powi(2) - clock[k].powi(2)).sqrt();
+            assert!(
+                (error[k] / sigma[k]).abs() <= 3.0 && error[k] > 0.0,
+                "output {}: {error:?} {sigma:?}",
+                k + 1
+            );
+            assert!(
+                (error[k] - bound).abs() <= 3.0 * others,
+                "output {}: error {} against the clock's bound {bound} +- {others}",
+                k + 1,
+                error[k]
             );
         }
     }

@@ -34,6 +34,10 @@ pub const FILTER_SETTLE: f64 = 1e-6;
 pub struct Knowns {
     /// FPGA clock (Hz).
     pub clock_hz: f64,
+    /// Relative bound of the clock's error (the oscillator's +-
+    /// tolerance; 0: none given): the self-calibrated scale factors carry
+    /// it (`selfcal::budget::clock`).
+    pub clock_tolerance: f64,
     /// Datasheet device (at the factory temperature).
     pub nominal: GyroParams,
     /// Relative 1-sigma uncertainty of the datasheet's angular gain
@@ -103,6 +107,17 @@ impl Knowns {
         let (mut regs, realized) = plan::registers(&plan)?;
         regs.ref_phase = regs.ref_phase.wrapping_add(phase_word(-ref_lag_deg));
         Ok((regs, realized))
+    }
+
+    /// One line when no clock tolerance was given for a real board: the
+    /// host cannot see its oscillator's error (everything it measures
+    /// runs on that clock), which moves the self-calibrated scale factors
+    /// by one to two and a half times the error (`selfcal::budget::clock`)
+    /// and is then in no sigma.
+    pub fn clock_tolerance_missing(&self) -> Option<String> {
+        (self.clock_tolerance == 0.0).then(|| {
+            "warning: [drive] clock_tolerance_ppm is not given: the board's oscillator error, which the host cannot see, moves the scale factors by one to two and a half times itself (50 ppm: up to 1.2e-4) and is in no sigma; give the oscillator's +- tolerance".to_string()
+        })
     }
 
     /// Clocks for the output filter to settle to `FILTER_SETTLE` (the
@@ -195,6 +210,7 @@ impl Knowns {
 pub(crate) fn for_tests(nominal: GyroParams, clock_hz: f64, carrier_hz: f64) -> Knowns {
     Knowns {
         clock_hz,
+        clock_tolerance: 0.0,
         nominal,
         angular_gain_uncertainty: 0.0,
         drive_gain_ratio_uncertainty: 0.0,

@@ -24,6 +24,7 @@ fn paper_truth() -> [(f64, f64, C64); 2] {
 fn knowns(datasheet: GyroParams) -> Knowns {
     Knowns {
         clock_hz: 50e6,
+        clock_tolerance: 0.0,
         angular_gain_uncertainty: 0.0,
         drive_gain_ratio_uncertainty: 0.0,
         amplitude: (0.9, 0.9),

@@ -6,7 +6,9 @@
 //!               # quadrature_dps, damping_coupling_dps (0): mode couplings
 //! [drive]       # required: carrier_hz, clock_hz
 //!               # amplitude1, amplitude2 (0.9), force_full_scale1_n_per_kg,
-//!               # force_full_scale2_n_per_kg (1.0)
+//!               # force_full_scale2_n_per_kg (1.0), clock_tolerance_ppm
+//!               # (0: the oscillator's bound the host is told),
+//!               # clock_error_ppm (0: the simulated board's oscillator)
 //! [frontend]    # dac_latency (2), adc_latency (3), dac_bits, adc_bits (16),
 //!               # adc_headroom (0.9), adc_per_meter1, adc_per_meter2 (from
 //!               # adc_headroom), noise_lsb (1), seed (1)
@@ -117,7 +119,33 @@ pub struct Drive {
         skip_serializing_if = "carrier_profile::is_default"
     )]
     pub carrier_profile: CarrierProfile,
+    /// The bound of the board oscillator's frequency error the host is
+    /// told (+- ppm of `clock_hz`; 0, the default: none). Everything the
+    /// host measures runs on that clock, so it cannot see the error; it
+    /// enters the self-calibrated scale factors' sigma
+    /// (`SfUncertainty::clock`). 0 <= bound <= [`MAX_CLOCK_PPM`].
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub clock_tolerance_ppm: f64,
+    /// How far the simulated board's oscillator runs from `clock_hz`
+    /// (ppm; 0, the default): the simulator's board alone, never what the
+    /// host knows, as `[gyro]` is to `[datasheet]`. |error| <=
+    /// [`MAX_CLOCK_PPM`].
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub clock_error_ppm: f64,
 }
+
+/// An unset clock key is left out of a written configuration, as it was
+/// before the keys existed.
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
+}
+
+/// The largest oscillator error `[drive]` takes (ppm): a crystal or MEMS
+/// oscillator stays within +-100 ppm over temperature and life. The
+/// budget's clock term is first order in the error (its second order is
+/// the square, 1e-4 of the term at 1%); an FPGA's internal RC oscillator
+/// (+-10% on an iCE40's) is beyond it and beyond any 0.1% figure.
+pub const MAX_CLOCK_PPM: f64 = 10_000.0;
 
 /// `[drive] carrier_profile` through its name (`CarrierProfile`'s `FromStr`).
 mod carrier_profile {
@@ -156,7 +184,14 @@ impl Drive {
             force_full_scale1_n_per_kg: Self::default_force(),
             force_full_scale2_n_per_kg: Self::default_force(),
             carrier_profile: CarrierProfile::default(),
+            clock_tolerance_ppm: 0.0,
+            clock_error_ppm: 0.0,
         }
+    }
+    /// The simulated board's clock (Hz): `clock_hz` moved by
+    /// `clock_error_ppm`.
+    pub fn board_clock_hz(&self) -> f64 {
+        self.clock_hz * (1.0 + self.clock_error_ppm * 1e-6)
     }
     /// (amplitude1, amplitude2).
     pub fn amplitude(&self) -> (f64, f64) {
@@ -557,6 +592,20 @@ impl Experiment {
             d.carrier_hz > 0.0 && d.carrier_hz < nyquist,
             &below,
         )?;
+        check(
+            "drive",
+            "clock_tolerance_ppm",
+            d.clock_tolerance_ppm,
+            (0.0..=MAX_CLOCK_PPM).contains(&d.clock_tolerance_ppm),
+            &format!("allowed 0 to {MAX_CLOCK_PPM} (+- ppm of clock_hz)"),
+        )?;
+        check(
+            "drive",
+            "clock_error_ppm",
+            d.clock_error_ppm,
+            d.clock_error_ppm.abs() <= MAX_CLOCK_PPM,
+            &format!("allowed -{MAX_CLOCK_PPM} to {MAX_CLOCK_PPM} (ppm of clock_hz)"),
+        )?;
         let amp = "allowed -1 <= amplitude < 1 (fraction of DAC full scale), not 0";
         for (key, a) in [("amplitude1", d.amplitude1), ("amplitude2", d.amplitude2)] {
             check("drive", key, a, (-1.0..1.0).contains(&a) && a != 0.0, amp)?;
@@ -910,6 +959,39 @@ mod tests {
                 && err.contains("\"fine\""),
             "{err}"
         );
+    }
+
+    /// The clock's keys default to an exact clock, round-trip, and a value
+    /// out of range is one line naming the key and what is allowed.
+    #[test]
+    fn the_clock_keys_default_to_zero_and_name_a_bad_value() {
+        let e = parse("c.toml", REQUIRED).unwrap();
+        assert_eq!(
+            [e.drive.clock_tolerance_ppm, e.drive.clock_error_ppm],
+            [0.0, 0.0]
+        );
+        assert_eq!(e.drive.board_clock_hz(), e.drive.clock_hz);
+        let set = |keys: &str| REQUIRED.replace("[drive]\n", &format!("[drive]\n{keys}\n"));
+        let e = parse(
+            "c.toml",
+            &set("clock_tolerance_ppm = 50\nclock_error_ppm = -20"),
+        )
+        .unwrap();
+        assert_eq!(e.drive.board_clock_hz(), e.drive.clock_hz * (1.0 - 20e-6));
+        assert_eq!(parse("c.toml", &toml::to_string(&e).unwrap()).unwrap(), e);
+        for (keys, says) in [
+            (
+                "clock_tolerance_ppm = -1",
+                "[drive] clock_tolerance_ppm = -1: allowed 0 to 10000",
+            ),
+            (
+                "clock_error_ppm = 20000",
+                "[drive] clock_error_ppm = 20000: allowed -10000 to 10000",
+            ),
+        ] {
+            let err = parse("c.toml", &set(keys)).unwrap_err().to_string();
+            assert!(!err.contains('\n') && err.starts_with(says), "{err}");
+        }
     }
 
     #[test]

@@ -90,7 +90,8 @@ pub fn uncovered_selfcal_errors(scored: &[Scored]) -> Option<String> {
     uncovered_errors(&beyond_three_sigma(scored), scored.len()).map(|line| {
         format!(
             "{line}; an input outside the budget is off: self-calibration takes lambda from \
-             [datasheet] angular_gain, within its angular_gain_uncertainty"
+             [datasheet] angular_gain, within its angular_gain_uncertainty, and the board's \
+             clock as [drive] clock_hz, within clock_tolerance_ppm"
         )
     })
 }

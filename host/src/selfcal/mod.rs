@@ -654,6 +654,7 @@ pub fn self_calibrate_from(
         // The design ratio's own; a measured ratio replaces it below.
         drive_ratio: budget::design_drive_ratio(knowns, &gyro, &op, &cal_hz, &ratio)?,
         cycle_rate: budget::cycle_rate(knowns, &identified, &op, &cal_hz, &ratio)?,
+        clock: budget::clock(knowns, &gyro, &op, &cal_hz, &ratio)?,
         ..SfUncertainty::default()
     }
     .with_total();
@@ -815,6 +816,7 @@ pub fn apply_drive_ratio(
     let (id, op, cal_hz) = (&cal.identified, &cal.operating, &cal.cal_hz);
     cal.sf_selfcal_uncertainty.identified = budget::identified(&at, id, op, cal_hz, &ratio)?;
     cal.sf_selfcal_uncertainty.cycle_rate = budget::cycle_rate(&at, id, op, cal_hz, &ratio)?;
+    cal.sf_selfcal_uncertainty.clock = budget::clock(&at, &gyro, op, cal_hz, &ratio)?;
     cal.sf_selfcal_uncertainty = cal.sf_selfcal_uncertainty.with_total();
     cal.sf_selfcal_per_dps = std::array::from_fn(|k| cal.sf_cal_per_dps[k] * ratio.exact[k]);
     cal.sf_eq56_per_dps = std::array::from_fn(|k| cal.sf_cal_per_dps[k] * ratio.eq56[k]);

@@ -504,6 +504,7 @@ pub fn knowns(exp: &Experiment) -> Result<Knowns, ConfigError> {
     };
     Ok(Knowns {
         clock_hz: exp.drive.clock_hz,
+        clock_tolerance: exp.drive.clock_tolerance_ppm * 1e-6,
         nominal: nominal.gyro,
         angular_gain_uncertainty: nominal.angular_gain_uncertainty,
         drive_gain_ratio_uncertainty: nominal.drive_gain_ratio_uncertainty,
@@ -539,11 +540,13 @@ pub fn board_on<E: Engine>(
     at: &DeviceAt,
 ) -> Result<SimBoard<E>, FieldError> {
     let reference = 0.5 * (exp.gyro.f1_hz + exp.gyro.f2_hz);
+    // The board's own oscillator (`[drive] clock_error_ppm`); the host
+    // programs it as if it ran at `clock_hz`.
     let mut board = SimBoard::new(
         at,
         fe,
         &exp.noise,
-        exp.drive.clock_hz,
+        exp.drive.board_clock_hz(),
         reference,
         exp.drive.carrier_profile,
     )?;

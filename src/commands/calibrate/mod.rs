@@ -26,8 +26,9 @@
 //!   out, one line each, also on stderr: a drive-gain ratio nothing
 //!   measured nor bounds, a carrier on a slow fold, a datasheet f, split
 //!   or Q beyond a part's spread, a device that turned during the cycle
-//!   (`SelfCal::warnings`); in process, self-cal
-//!   errors beyond 3 of their sigmas against the truth), `failed` (null)
+//!   (`SelfCal::warnings`); over the wire, a config that gives no
+//!   `[drive] clock_tolerance_ppm` for the board's oscillator; in process,
+//!   self-cal errors beyond 3 of their sigmas against the truth), `failed` (null)
 //!   and `truth` (null over the wire). Progress goes to stderr.
 //! - A cycle that stops after identification (a board that stops
 //!   answering mid-staircase, a stage that fails) keeps what it
@@ -228,9 +229,11 @@ fn over_the_wire(
         Ok(done) => done,
         Err(halted) => return Ok(Err(halted)),
     };
+    let mut warnings = cal.warnings(knowns);
+    warnings.extend(knowns.clock_tolerance_missing());
     Ok(Ok(Outcome {
         board: url.into(),
-        warnings: cal.warnings(knowns),
+        warnings,
         cal,
         samples,
         wall_s,
