@@ -369,3 +369,62 @@ fn uncovered_errors_are_named_once_by_part() {
     );
     assert_eq!(report["summary"]["beyond_3_sigma"], 4);
 }
+
+/// Each part's board runs its own oscillator (`[spread] clock_error_ppm`,
+/// sd 250 ppm around an exact clock) within the 1000 ppm the host is told
+/// (`[drive] clock_tolerance_ppm`): each part records its draw (the same
+/// with the tolerance or without), its sigmas grow by the clock's term
+/// (`selfcal::budget::clock`), and every figure lies within 3 of them.
+#[test]
+fn a_spread_of_oscillators_is_in_each_parts_sigma() {
+    let run = |tolerance: f64| {
+        let dir = tempfile::tempdir().unwrap();
+        let config = dir.path().join("clocks.toml");
+        let text = SWEEP.replace("devices = 5", "devices = 2").replace(
+            "clock_hz = 1.2345e6",
+            &format!("clock_hz = 1.2345e6\nclock_tolerance_ppm = {tolerance}"),
+        ) + "clock_error_ppm = { sd = 250.0 }\n";
+        std::fs::write(&config, text).unwrap();
+        let report = json_object(gyrocal(&[
+            "sweep",
+            "--config",
+            config.to_str().unwrap(),
+            "--json",
+        ]));
+        let devices = report["devices"].as_array().unwrap().clone();
+        let clocks: Vec<f64> = devices
+            .iter()
+            .map(|d| d["clock_error_ppm"].as_f64().unwrap())
+            .collect();
+        let figures: Vec<(f64, f64)> = devices
+            .iter()
+            .flat_map(|d| d["steps"].as_array().unwrap().clone())
+            .flat_map(|s| {
+                (0..2)
+                    .map(|k| {
+                        (
+                            s["sf_selfcal_error"][k].as_f64().unwrap(),
+                            s["selfcal_error_uncertainty"][k].as_f64().unwrap(),
+                        )
+                    })
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        (clocks, figures)
+    };
+    let (clocks, told) = run(1000.0);
+    let (same, untold) = run(0.0);
+    assert_eq!(clocks, same);
+    assert!(
+        clocks.iter().all(|c| *c != 0.0 && c.abs() < 1000.0) && clocks[0] != clocks[1],
+        "{clocks:?}"
+    );
+    assert_eq!(told.len(), 4);
+    for ((e, sigma), (_, without)) in told.iter().zip(&untold) {
+        assert!(sigma > without, "{told:?} {untold:?}");
+        assert!(
+            e.abs() <= 3.0 * sigma,
+            "{e} at {sigma}, clocks {clocks:?} ppm"
+        );
+    }
+}

@@ -180,7 +180,7 @@ fn emit(report: &SweepReport, name: &str, out: &Output) -> Result<(), Failure> {
 pub fn csv(report: &SweepReport) -> String {
     let mut s = String::from(
         "index,f1_hz,f2_hz,split_hz,q1,q2,angular_gain,quadrature_dps,damping_coupling_dps,\
-         temperature_c,selfcal_error1,selfcal_error2,selfcal_error_uncertainty1,\
+         clock_error_ppm,temperature_c,selfcal_error1,selfcal_error2,selfcal_error_uncertainty1,\
          selfcal_error_uncertainty2,identified_f1_hz,identified_f2_hz,identified_q1,\
          identified_q2,identified_loop_phase_deg,failure\n",
     );
@@ -195,6 +195,7 @@ pub fn csv(report: &SweepReport) -> String {
             g.angular_gain,
             g.quadrature_dps,
             g.damping_coupling_dps,
+            d.clock_error_ppm,
         ]
         .map(|v| format!("{v:e}"))
         .join(",");

@@ -24,6 +24,7 @@
 pub mod spread;
 pub mod summary;
 
+use crate::config::MAX_CLOCK_PPM;
 use crate::error::{FieldError, ScenarioError};
 use crate::field::scenario::{self, IdentifiedJson, Scenario};
 use crate::gyro::GyroParams;
@@ -79,12 +80,23 @@ pub struct Sweep {
 pub fn parse(name: &str, text: &str) -> Result<Sweep, SweepError> {
     let (scenario, spread, _) = scenario::parse_file(name, text)?;
     let spread = spread.ok_or_else(|| SweepError::NoSpread(name.into()))?;
-    spread
-        .validate(&scenario.exp.gyro)
-        .map_err(|source| SweepError::Spread {
-            name: name.into(),
-            source,
-        })?;
+    let refused = |source| SweepError::Spread {
+        name: name.into(),
+        source,
+    };
+    spread.validate(&scenario.exp.gyro).map_err(refused)?;
+    let clock = scenario.exp.drive.clock_error_ppm;
+    let sd = spread.clock_sd().map_err(refused)?;
+    if clock.abs() + 5.0 * sd > MAX_CLOCK_PPM {
+        return Err(refused(SpreadError {
+            key: "clock_error_ppm.sd".into(),
+            value: Some(sd),
+            allowed: format!(
+                "|[drive] clock_error_ppm| ({}) + 5 sd must stay within {MAX_CLOCK_PPM} ppm",
+                clock.abs()
+            ),
+        }));
+    }
     Ok(Sweep {
         scenario,
         spread,
@@ -184,6 +196,10 @@ pub struct DeviceResult {
     pub frontend_seed: u64,
     /// Its `[noise] seed`.
     pub noise_seed: u64,
+    /// Its board oscillator's error from `[drive] clock_error_ppm` (ppm;
+    /// `[spread] clock_error_ppm`).
+    #[serde(default)]
+    pub clock_error_ppm: f64,
     /// Temperature of the worst step: the one with the largest |error|
     /// (either output); null when no step finished.
     pub worst_temperature_c: Option<f64>,
@@ -252,6 +268,7 @@ impl Sweep {
         sc.exp.gyro = drawn.gyro.clone();
         sc.exp.frontend.seed = drawn.frontend_seed;
         sc.exp.noise.seed = drawn.noise_seed;
+        sc.exp.drive.clock_error_ppm += drawn.clock_error_ppm;
         sc
     }
 
@@ -367,6 +384,7 @@ impl DeviceResult {
             device: drawn.gyro,
             frontend_seed: drawn.frontend_seed,
             noise_seed: drawn.noise_seed,
+            clock_error_ppm: drawn.clock_error_ppm,
             worst_temperature_c: worst.map(|s| s.temperature_c),
             sf_selfcal_error: worst.map(|s| s.sf_selfcal_error),
             sf_selfcal_uncertainty: worst.map(|s| s.sf_selfcal_uncertainty),
@@ -468,5 +486,40 @@ mod tests {
                 assert_eq!(holders, 1);
             }
         }
+    }
+
+    const FILE: &str = "[gyro]\nf1_hz = 25.1e3\nf2_hz = 25.8e3\nq1 = 3000\nq2 = 3000\n\
+        angular_gain = 0.8\n[drive]\ncarrier_hz = 25.1e3\nclock_hz = 1.2345e6\n\
+        clock_error_ppm = 30\n[experiment]\nreadout_rates_dps = [50, 100]\n\
+        cal_freqs_hz = [2, 4]\n[spread]\ndevices = 4\n";
+
+    /// A part's board runs at the file's oscillator error plus its own
+    /// draw; a spread whose 5 sigma passes `MAX_CLOCK_PPM` with the file's
+    /// error added is refused in one line.
+    #[test]
+    fn each_parts_board_takes_its_drawn_oscillator() {
+        let sweep = parse(
+            "s.toml",
+            &format!("{FILE}clock_error_ppm = {{ sd = 100.0 }}\n"),
+        )
+        .unwrap();
+        let nominal = &sweep.scenario.exp.gyro;
+        for i in 0..4 {
+            let drawn = sweep.spread.draw(nominal, i).unwrap();
+            assert_ne!(drawn.clock_error_ppm, 0.0);
+            let sc = sweep.device_scenario(&drawn);
+            assert_eq!(sc.exp.drive.clock_error_ppm, 30.0 + drawn.clock_error_ppm);
+        }
+        let err = parse(
+            "s.toml",
+            &format!("{FILE}clock_error_ppm = {{ sd = 1995.0 }}\n"),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            !err.contains('\n')
+                && err.starts_with("s.toml: [spread] clock_error_ppm.sd = 1995: |[drive] clock_error_ppm| (30) + 5 sd"),
+            "{err}"
+        );
     }
 }

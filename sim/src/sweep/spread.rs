@@ -13,6 +13,7 @@
 //! angular_gain = { rel_sd = 0.02 }
 //! quadrature_dps = { sd = 50.0 }
 //! damping_coupling_dps = { sd = 5.0 }
+//! clock_error_ppm = { sd = 20.0 }  # each board's oscillator, around [drive]'s
 //! ```
 //!
 //! Each parameter is normal around its nominal value, with an absolute
@@ -27,8 +28,11 @@
 //! section does not move the other parameters' draws. The device's noise
 //! seeds (`[frontend] seed`, `[noise] seed`) come from the same generator,
 //! after the parameters: each device has its own noise, as each part off a
-//! line does.
+//! line does. Its board's oscillator error (`clock_error_ppm`, an `sd` in
+//! ppm around `[drive] clock_error_ppm`) is drawn last, after the seeds,
+//! so the key leaves every other draw where it was.
 
+use crate::config::MAX_CLOCK_PPM;
 use crate::gyro::{GyroParams, MAX_COUPLING_DPS};
 use rand_distr::{Distribution, StandardNormal};
 use rand_xoshiro::Xoshiro256PlusPlus;
@@ -88,6 +92,10 @@ pub struct Spread {
     /// The damping coupling (deg/s).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub damping_coupling_dps: Option<Sd>,
+    /// The board oscillator's error (ppm), around `[drive]
+    /// clock_error_ppm`: an `sd` alone (its nominal is usually 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub clock_error_ppm: Option<Sd>,
 }
 
 fn default_seed() -> u64 {
@@ -189,6 +197,10 @@ pub struct Drawn {
     pub frontend_seed: u64,
     /// Its `[noise] seed` (Brownian noise).
     pub noise_seed: u64,
+    /// Its board oscillator's error from `[drive] clock_error_ppm` (ppm;
+    /// 0 without `[spread] clock_error_ppm`).
+    #[serde(default)]
+    pub clock_error_ppm: f64,
 }
 
 /// The splitmix64 finalizer (Steele, Lea, Flood 2014).
@@ -255,7 +267,40 @@ impl Spread {
                 "a relative bound, greater than 0 and less than 1",
             ));
         }
-        self.five_sigma_stays_valid(nominal, &self.sds(nominal)?)
+        self.five_sigma_stays_valid(nominal, &self.sds(nominal)?)?;
+        self.clock_sd().map(|_| ())
+    }
+
+    /// `clock_error_ppm`'s sd (ppm; 0 without it): an `sd` alone, 5 of it
+    /// within `MAX_CLOCK_PPM` (`Sweep`'s parse checks it with `[drive]
+    /// clock_error_ppm` added).
+    pub fn clock_sd(&self) -> Result<f64, SpreadError> {
+        let key = "clock_error_ppm";
+        let Some(s) = self.clock_error_ppm else {
+            return Ok(0.0);
+        };
+        let sd = match (s.sd, s.rel_sd) {
+            (Some(sd), None) => sd,
+            _ => {
+                return Err(SpreadError {
+                    key: key.into(),
+                    value: None,
+                    allowed: "give `sd` (ppm; a board's oscillator spreads around an exact clock)"
+                        .into(),
+                });
+            }
+        };
+        let most = MAX_CLOCK_PPM / 5.0;
+        if !(sd.is_finite() && (0.0..=most).contains(&sd)) {
+            return Err(refuse(
+                format!("{key}.sd"),
+                sd,
+                format!(
+                    "allowed 0..={most} ppm, so that 5 sigma out stays within {MAX_CLOCK_PPM} ppm"
+                ),
+            ));
+        }
+        Ok(sd)
     }
 
     /// Every parameter 5 sigma out (one draw in 1.7 million) must still
@@ -380,6 +425,10 @@ impl Spread {
             },
             frontend_seed: rng.next_u64(),
             noise_seed: rng.next_u64(),
+            clock_error_ppm: {
+                let z: f64 = StandardNormal.sample(&mut rng);
+                self.clock_sd()? * z
+            },
         })
     }
 }
@@ -440,6 +489,43 @@ mod tests {
         assert_eq!(a.gyro.f1_hz, b.gyro.f1_hz);
         assert_ne!(a.gyro.q2, b.gyro.q2);
         assert_eq!(a.noise_seed, b.noise_seed);
+    }
+
+    /// The board's oscillator spreads after the seeds: the key leaves the
+    /// part and its noise where they were; its draws have the asked sd
+    /// around 0 (2000 devices: within 5% of it, 3.2 of its standard
+    /// errors of 1.6%, the mean within 5 standard errors); `rel_sd` and an
+    /// sd whose 5 sigma passes `MAX_CLOCK_PPM` are refused by name.
+    #[test]
+    fn the_clock_spreads_after_everything_else() {
+        let n = nominal();
+        let base = "devices = 2000\nf1_hz = { sd = 40.0 }";
+        let (a, b) = (
+            spread(base),
+            spread(&format!("{base}\nclock_error_ppm = {{ sd = 20.0 }}")),
+        );
+        b.validate(&n).unwrap();
+        let drawn: Vec<_> = (0..2000)
+            .map(|i| (a.draw(&n, i).unwrap(), b.draw(&n, i).unwrap()))
+            .collect();
+        for (x, y) in &drawn {
+            assert_eq!(
+                (x.gyro.clone(), x.frontend_seed, x.noise_seed),
+                (y.gyro.clone(), y.frontend_seed, y.noise_seed)
+            );
+            assert_eq!(x.clock_error_ppm, 0.0);
+        }
+        let v: Vec<f64> = drawn.iter().map(|d| d.1.clock_error_ppm).collect();
+        let m = v.iter().sum::<f64>() / 2000.0;
+        let sd = (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / 1999.0).sqrt();
+        assert!(m.abs() < 5.0 * 20.0 / 2000f64.sqrt(), "{m}");
+        assert!((sd / 20.0 - 1.0).abs() < 0.05, "{sd}");
+        let err = |text: &str| spread(text).validate(&n).unwrap_err().to_string();
+        assert!(err("devices = 2\nclock_error_ppm = { rel_sd = 0.1 }").contains("give `sd`"));
+        assert!(
+            err("devices = 2\nclock_error_ppm = { sd = 2001 }")
+                .starts_with("[spread] clock_error_ppm.sd = 2001: allowed 0..=2000 ppm")
+        );
     }
 
     #[test]
