@@ -24,7 +24,6 @@
 pub mod spread;
 pub mod summary;
 
-use crate::config::MAX_CLOCK_PPM;
 use crate::error::{FieldError, ScenarioError};
 use crate::field::scenario::{self, IdentifiedJson, Scenario};
 use crate::gyro::GyroParams;
@@ -85,18 +84,9 @@ pub fn parse(name: &str, text: &str) -> Result<Sweep, SweepError> {
         source,
     };
     spread.validate(&scenario.exp.gyro).map_err(refused)?;
-    let clock = scenario.exp.drive.clock_error_ppm;
-    let sd = spread.clock_sd().map_err(refused)?;
-    if clock.abs() + 5.0 * sd > MAX_CLOCK_PPM {
-        return Err(refused(SpreadError {
-            key: "clock_error_ppm.sd".into(),
-            value: Some(sd),
-            allowed: format!(
-                "|[drive] clock_error_ppm| ({}) + 5 sd must stay within {MAX_CLOCK_PPM} ppm",
-                clock.abs()
-            ),
-        }));
-    }
+    spread
+        .clock_sd(scenario.exp.drive.clock_error_ppm)
+        .map_err(refused)?;
     Ok(Sweep {
         scenario,
         spread,
@@ -518,7 +508,10 @@ mod tests {
         .to_string();
         assert!(
             !err.contains('\n')
-                && err.starts_with("s.toml: [spread] clock_error_ppm.sd = 1995: |[drive] clock_error_ppm| (30) + 5 sd"),
+                && err.starts_with(
+                    "s.toml: [spread] clock_error_ppm.sd = 1995: allowed 0..=1994 ppm, so that 5 \
+                     sigma out from [drive] clock_error_ppm = 30 stays within 10000 ppm"
+                ),
             "{err}"
         );
     }

@@ -268,13 +268,14 @@ impl Spread {
             ));
         }
         self.five_sigma_stays_valid(nominal, &self.sds(nominal)?)?;
-        self.clock_sd().map(|_| ())
+        self.clock_sd(0.0).map(|_| ())
     }
 
-    /// `clock_error_ppm`'s sd (ppm; 0 without it): an `sd` alone, 5 of it
-    /// within `MAX_CLOCK_PPM` (`Sweep`'s parse checks it with `[drive]
-    /// clock_error_ppm` added).
-    pub fn clock_sd(&self) -> Result<f64, SpreadError> {
+    /// `clock_error_ppm`'s sd (ppm; 0 without it), checked: an `sd` alone,
+    /// 5 of it out from `around_ppm` (the file's `[drive]
+    /// clock_error_ppm`, which `Sweep`'s parse gives) within
+    /// `MAX_CLOCK_PPM`.
+    pub fn clock_sd(&self, around_ppm: f64) -> Result<f64, SpreadError> {
         let key = "clock_error_ppm";
         let Some(s) = self.clock_error_ppm else {
             return Ok(0.0);
@@ -290,13 +291,19 @@ impl Spread {
                 });
             }
         };
-        let most = MAX_CLOCK_PPM / 5.0;
+        let most = (MAX_CLOCK_PPM - around_ppm.abs()) / 5.0;
         if !(sd.is_finite() && (0.0..=most).contains(&sd)) {
+            let around = if around_ppm == 0.0 {
+                String::new()
+            } else {
+                format!(" from [drive] clock_error_ppm = {around_ppm}")
+            };
             return Err(refuse(
                 format!("{key}.sd"),
                 sd,
                 format!(
-                    "allowed 0..={most} ppm, so that 5 sigma out stays within {MAX_CLOCK_PPM} ppm"
+                    "allowed 0..={most} ppm, so that 5 sigma out{around} stays within \
+                     {MAX_CLOCK_PPM} ppm"
                 ),
             ));
         }
@@ -427,7 +434,7 @@ impl Spread {
             noise_seed: rng.next_u64(),
             clock_error_ppm: {
                 let z: f64 = StandardNormal.sample(&mut rng);
-                self.clock_sd()? * z
+                self.clock_sd(0.0)? * z
             },
         })
     }
