@@ -83,18 +83,22 @@ fn calibrate(config: &Path, extra: &[&str]) -> Value {
     json_object(gyrocal(&args))
 }
 
-/// How many of a run's `warnings` say its drive-gain ratio is the
-/// design's with no bound.
-fn design_ratio_lines(run: &Value) -> usize {
+/// A run's `warnings`, one line each.
+fn warnings(run: &Value) -> Vec<&str> {
     run["warnings"]
         .as_array()
         .unwrap_or_else(|| panic!("no warnings list in {run}"))
         .iter()
-        .filter(|w| {
-            w.as_str()
-                .unwrap()
-                .starts_with("warning: the drive-gain ratio g2/g1 is the design's")
-        })
+        .map(|w| w.as_str().unwrap())
+        .collect()
+}
+
+/// How many of a run's `warnings` say its drive-gain ratio is the
+/// design's with no bound.
+fn design_ratio_lines(run: &Value) -> usize {
+    warnings(run)
+        .iter()
+        .filter(|w| w.starts_with("warning: the drive-gain ratio g2/g1 is the design's"))
         .count()
 }
 
@@ -221,15 +225,9 @@ fn compare_over_the_wire(pace_r: u64) -> (f64, f64) {
     // the file gives no tolerance, so the wire's run says so. The
     // in-process board's clock is exact unless `clock_error_ppm` moves it.
     let clock_lines = |run: &Value| {
-        run["warnings"]
-            .as_array()
-            .unwrap()
+        warnings(run)
             .iter()
-            .filter(|w| {
-                w.as_str()
-                    .unwrap()
-                    .starts_with("warning: [drive] clock_tolerance_ppm")
-            })
+            .filter(|w| w.starts_with("warning: [drive] clock_tolerance_ppm"))
             .count()
     };
     assert_eq!(
@@ -454,11 +452,8 @@ fn an_error_its_sigma_does_not_cover_is_said_in_one_line() {
         );
         std::fs::write(&config, text).unwrap();
         let run = calibrate(&config, &[]);
-        let lines: Vec<&str> = run["warnings"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|w| w.as_str().unwrap())
+        let lines: Vec<&str> = warnings(&run)
+            .into_iter()
             .filter(|w| w.starts_with(line))
             .collect();
         assert_eq!(
@@ -527,11 +522,8 @@ fn a_clock_off_its_frequency_is_in_the_sigma_its_tolerance_gives() {
             pair(truth, "selfcal_error_uncertainty"),
         );
         let clock = pair(&run["sf_selfcal_uncertainty_sources"], "clock");
-        let said: Vec<&str> = run["warnings"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|w| w.as_str().unwrap())
+        let said: Vec<&str> = warnings(&run)
+            .into_iter()
             .filter(|w| w.contains(line))
             .collect();
         if tolerance == 0.0 {
@@ -568,14 +560,9 @@ fn a_clock_off_its_frequency_is_in_the_sigma_its_tolerance_gives() {
 
 /// The run's `[datasheet]` warnings.
 fn datasheet_lines(run: &Value) -> Vec<&str> {
-    run["warnings"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .filter_map(|w| {
-            w.as_str()
-                .filter(|w| w.starts_with("warning: [datasheet] "))
-        })
+    warnings(run)
+        .into_iter()
+        .filter(|w| w.starts_with("warning: [datasheet] "))
         .collect()
 }
 
@@ -731,14 +718,8 @@ fn a_device_turning_during_the_cycle_is_calibrated_at_its_rate_and_said() {
     let config = dir.path().join("device.toml");
     std::fs::write(&config, DEVICE).unwrap();
     let head = "warning: the device turned during the cycle: its cross responses read a rate of ";
-    let lines = |run: &Value| -> usize {
-        run["warnings"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .filter(|w| w.as_str().is_some_and(|w| w.starts_with(head)))
-            .count()
-    };
+    let lines =
+        |run: &Value| -> usize { warnings(run).iter().filter(|w| w.starts_with(head)).count() };
     let within_3_sigma = |run: &Value, what: &str| {
         let error = pair(&run["truth"], "selfcal_error");
         let sigma = pair(&run["truth"], "selfcal_error_uncertainty");
