@@ -14,11 +14,10 @@ per device (the tolerance, the error, both self-calibration errors in
 their sigmas and the clock term's share of each sigma), then the summary
 line. $GYROCAL runs another revision's binary side by side.
 """
-import json
 import os
 import sys
 
-from common import Draw, runs, summary, write
+from common import Draw, calibrations, summary, write
 
 
 def devices(seed, n, out):
@@ -39,15 +38,8 @@ def main():
     os.makedirs(out, exist_ok=True)
     ts = []
     jobs = list(devices(seed, n, out))
-    for (i, path, tol, err), rc, so, se in runs(jobs, lambda j: ["calibrate", "--config", j[1], "--json"]):
-        try:
-            d = json.loads(so)
-        except json.JSONDecodeError:
-            print(f"{i:3d} exit {rc}: {se.strip().splitlines()[-1:]}")
-            continue
-        if d.get("failed") or not d.get("truth"):
-            print(f"{i:3d} failed: {(d.get('failed') or {}).get('error')}")
-            continue
+    calibrate = lambda j: ["calibrate", "--config", j[1], "--json"]
+    for (i, path, tol, err), d in calibrations(jobs, calibrate, lambda j: f"{j[0]:3d}"):
         t = d["truth"]
         tv = [t["selfcal_error"][k] / t["selfcal_error_uncertainty"][k] for k in range(2)]
         clock = d["sf_selfcal_uncertainty_sources"]["clock"]

@@ -4,6 +4,7 @@ order, so a script's extra draws after them leave the devices as they
 were), the gyrocal they run, their parallel runs and their summary line.
 """
 import concurrent.futures as cf
+import json
 import math
 import os
 import random
@@ -62,6 +63,22 @@ def runs(jobs, args):
 
     with cf.ThreadPoolExecutor(int(os.environ.get("JOBS", "2"))) as ex:
         yield from ex.map(one, jobs)
+
+
+def calibrations(jobs, args, label):
+    """Each job's (job, report) from `gyrocal calibrate --json` runs
+    (`runs`) whose report has a truth, in order; a run that printed no
+    report or failed gets one line instead, `label(job)` first."""
+    for job, rc, so, se in runs(jobs, args):
+        try:
+            d = json.loads(so)
+        except json.JSONDecodeError:
+            print(f"{label(job)} exit {rc}: {se.strip().splitlines()[-1:]}")
+            continue
+        if d.get("failed") or not d.get("truth"):
+            print(f"{label(job)} failed: {(d.get('failed') or {}).get('error')}")
+            continue
+        yield job, d
 
 
 def summary(name, ts):

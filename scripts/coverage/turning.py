@@ -16,11 +16,10 @@ figures within 2 sigma, how many lie beyond 3 and the RMS. Runs
 target/release/gyrocal (`cargo build --release`), or the binary $GYROCAL
 (another revision's, side by side).
 """
-import json
 import os
 import sys
 
-from common import Draw, runs, summary, write
+from common import Draw, calibrations, summary, write
 
 
 def devices(seed, n, out):
@@ -39,15 +38,8 @@ def main():
     ts = []
     jobs = list(devices(seed, n, out))
     calibrate = lambda j: ["calibrate", "--config", j[1], "--rate", repr(j[2]), "--json"]
-    for (i, path, rate), rc, so, se in runs(jobs, calibrate):
-        try:
-            d = json.loads(so)
-        except json.JSONDecodeError:
-            print(f"{i:3d} rate {rate:+9.4f} exit {rc}: {se.strip().splitlines()[-1:]}")
-            continue
-        if d.get("failed") or not d.get("truth"):
-            print(f"{i:3d} rate {rate:+9.4f} failed: {(d.get('failed') or {}).get('error')}")
-            continue
+    label = lambda j: f"{j[0]:3d} rate {j[2]:+9.4f}"
+    for (i, path, rate), d in calibrations(jobs, calibrate, label):
         t = d["truth"]
         tv = [t["selfcal_error"][k] / t["selfcal_error_uncertainty"][k] for k in range(2)]
         ts += tv
