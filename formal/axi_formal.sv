@@ -51,11 +51,14 @@ module axi_formal (
     input wire f_pick
 );
     localparam [1:0] OKAY = 2'b00, SLVERR = 2'b10;
-    localparam [31:0] ID_WORD = 32'h4759524f, VERSION_WORD = 32'h00010001;
+    localparam [31:0] ID_WORD = 32'h4759524f, VERSION_WORD = 32'h00010002;
+    // PROFILE of the bus proven here, the table core's (gyro_interface_axi.v).
+    localparam [31:0] PROFILE_WORD = 32'd0;
     localparam [8:0] FIFO_DEPTH = 9'd256;
     // Word indices (byte offset / 4) of REGISTERS.md.
     localparam [5:0] I_STREAM_ENABLE = 6'd16, I_STREAM_OVERFLOW = 6'd17, I_SAMPLE_COUNT = 6'd18,
-        I_Z1_LO = 6'd19, I_Z1_HI = 6'd20, I_Z2_LO = 6'd21, I_Z2_HI = 6'd22, I_ADC_CLIP = 6'd23;
+        I_Z1_LO = 6'd19, I_Z1_HI = 6'd20, I_Z2_LO = 6'd21, I_Z2_HI = 6'd22, I_ADC_CLIP = 6'd23,
+        I_PROFILE = 6'd24;
     localparam [15:0] CLIP_MAX = 16'hffff;
 
     wire s_axil_awready, s_axil_wready, s_axil_bvalid, s_axil_arready, s_axil_rvalid;
@@ -114,7 +117,7 @@ module axi_formal (
     function automatic [1:0] kind(input [5:0] idx);
         if (idx <= 6'd1) kind = 2'd2;
         else if (idx <= 6'd16) kind = 2'd1;
-        else if (idx <= I_ADC_CLIP) kind = 2'd2;
+        else if (idx <= I_PROFILE) kind = 2'd2;
         else kind = 2'd0;
     endfunction
     // The bits a setting keeps.
@@ -344,6 +347,7 @@ module axi_formal (
             I_Z2_LO: expect_word = snap2_cur[31:0];
             I_Z2_HI: expect_word = sext8(snap2_cur[39:32]);
             I_ADC_CLIP: expect_word = {clip2_cur, clip1_cur};
+            I_PROFILE: expect_word = PROFILE_WORD;
             default: ;
         endcase
     end

@@ -6,7 +6,10 @@
 #define GYRO_INTERFACE_REGS_H
 
 #define GYRO_ID_VALUE 0x4759524fu
-#define GYRO_VERSION_VALUE 0x00010001u
+#define GYRO_VERSION_VALUE 0x00010002u
+/* PROFILE's values: the carrier profile the core was built with. */
+#define GYRO_PROFILE_TABLE 0u
+#define GYRO_PROFILE_FINE 1u
 /* Samples the AXI4-Stream FIFO holds before it drops one. */
 #define GYRO_STREAM_FIFO_DEPTH 256u
 /* Clocks after configuration before the drives leave 0: the core fills its
@@ -147,6 +150,11 @@
 #define GYRO_ADC_CLIP_OFFSET 0x5cu
 #define GYRO_ADC_CLIP_BITS 32u
 #define GYRO_ADC_CLIP_MASK 0xffffffffu
+
+/* PROFILE: read-only, 1 bits. The core's carrier profile, fixed at build: 0 table (`gyro_interface.v`, an iCE40 UltraPlus), 1 fine (`ecp5/gyro_interface.v`). The host's predictions depend on it; a host reads it before it calibrates. */
+#define GYRO_PROFILE_OFFSET 0x60u
+#define GYRO_PROFILE_BITS 1u
+#define GYRO_PROFILE_MASK 0x00000001u
 
 /* z from the snapshot: read SAMPLE_COUNT first (it latches the set), then
  * z = ((int64_t)(int32_t)Z1_HI << 32) | Z1_LO, in 1/256 mixer LSB. */

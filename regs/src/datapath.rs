@@ -79,6 +79,28 @@ impl CarrierProfile {
     /// Both profiles.
     pub const ALL: [CarrierProfile; 2] = [CarrierProfile::Table, CarrierProfile::Fine];
 
+    /// The PROFILE register's field for this core (`map::PROFILE`):
+    /// 0 table, 1 fine.
+    pub fn word(self) -> u32 {
+        match self {
+            CarrierProfile::Table => 0,
+            CarrierProfile::Fine => 1,
+        }
+    }
+
+    /// The profile a PROFILE register's word names, if any.
+    ///
+    /// ```
+    /// use gyrocal_regs::datapath::CarrierProfile;
+    /// for p in CarrierProfile::ALL {
+    ///     assert_eq!(CarrierProfile::from_word(p.word()), Some(p));
+    /// }
+    /// assert_eq!(CarrierProfile::from_word(2), None);
+    /// ```
+    pub fn from_word(word: u32) -> Option<Self> {
+        Self::ALL.into_iter().find(|p| p.word() == word)
+    }
+
     /// The name in configuration files.
     pub fn name(self) -> &'static str {
         match self {

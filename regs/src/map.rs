@@ -33,7 +33,7 @@
 //! assert_eq!(bank.read(register_map::AMP1.offset), Ok(-5i32 as u32));
 //! ```
 
-use crate::datapath::{DELAY_BITS, DRIVE_START_CLOCKS, FIFO_DEPTH, Z_BITS};
+use crate::datapath::{CarrierProfile, DELAY_BITS, DRIVE_START_CLOCKS, FIFO_DEPTH, Z_BITS};
 use crate::registers::{Coefficients, Registers};
 
 /// Width of the AXI4-Lite byte address (a 256-byte window).
@@ -44,8 +44,11 @@ pub const WORD_INDEX_BITS: usize = ADDRESS_BITS - 2;
 pub const DATA_BITS: usize = 32;
 /// The identification word: ASCII "GYRO".
 pub const ID_WORD: u32 = 0x4759_524f;
-/// Register map version: major in bits 31..16, minor in 15..0.
-pub const VERSION_WORD: u32 = 0x0001_0001;
+/// Register map version: major in bits 31..16, minor in 15..0. Minor 2
+/// added PROFILE; a host reads it only from a core whose minor says so.
+pub const VERSION_WORD: u32 = 0x0001_0002;
+/// The first minor version with the PROFILE register.
+pub const PROFILE_SINCE_MINOR: u32 = 2;
 
 /// Who may write a register.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -369,8 +372,17 @@ pub const ADC_CLIP: Register = Register {
     )
 };
 
+/// The core's carrier profile, fixed when the core is built.
+pub const PROFILE: Register = status(
+    "PROFILE",
+    0x60,
+    1,
+    false,
+    "The core's carrier profile, fixed at build: 0 table (`gyro_interface.v`, an iCE40 UltraPlus), 1 fine (`ecp5/gyro_interface.v`). The host's predictions depend on it; a host reads it before it calibrates.",
+);
+
 /// Every register, in offset order.
-pub const REGISTERS: [Register; 24] = [
+pub const REGISTERS: [Register; 25] = [
     ID,
     VERSION,
     SELECT,
@@ -395,6 +407,7 @@ pub const REGISTERS: [Register; 24] = [
     Z2_LO,
     Z2_HI,
     ADC_CLIP,
+    PROFILE,
 ];
 
 /// The register at a byte offset (bits 1..0 ignored), if any.
@@ -455,8 +468,20 @@ pub struct RegisterBank {
 }
 
 impl RegisterBank {
-    /// Every setting at its power-up value.
+    /// Every setting at its power-up value, in the table core (PROFILE 0).
     pub fn power_up() -> Self {
+        Self::power_up_for(CarrierProfile::Table)
+    }
+
+    /// Every setting at its power-up value, in the core with this carrier
+    /// profile (PROFILE reads its word).
+    pub fn power_up_for(profile: CarrierProfile) -> Self {
+        let mut bank = Self::power_up_fields();
+        bank.fields[Self::slot(PROFILE.offset).expect("PROFILE is mapped")] = profile.word();
+        bank
+    }
+
+    fn power_up_fields() -> Self {
         let mut fields = [0; REGISTERS.len()];
         for (f, r) in fields.iter_mut().zip(&REGISTERS) {
             *f = r.power_up & r.mask();
@@ -639,6 +664,12 @@ pub fn c_header() -> String {
     h.push_str(&format!("#define GYRO_ID_VALUE 0x{ID_WORD:08x}u\n"));
     h.push_str(&format!(
         "#define GYRO_VERSION_VALUE 0x{VERSION_WORD:08x}u\n"
+    ));
+    h.push_str(&format!(
+        "/* PROFILE's values: the carrier profile the core was built with. */\n\
+         #define GYRO_PROFILE_TABLE {}u\n#define GYRO_PROFILE_FINE {}u\n",
+        CarrierProfile::Table.word(),
+        CarrierProfile::Fine.word()
     ));
     h.push_str(&format!(
         "/* Samples the AXI4-Stream FIFO holds before it drops one. */\n\

@@ -35,7 +35,7 @@ use gyrocal_hdl::host::register_map::{
     self, BusError, RegisterAccess, RegisterBank, SAMPLE_COUNT, STREAM_OVERFLOW, Z1_HI, Z1_LO,
     Z2_HI, Z2_LO,
 };
-use gyrocal_hdl::model::gyro_interface::{Outputs, Registers, Words};
+use gyrocal_hdl::model::gyro_interface::{CarrierProfile, Outputs, Registers, Words};
 
 /// Engine, converters and gyroscope in a loop.
 pub struct CoSim<E: Engine> {
@@ -49,13 +49,20 @@ pub struct CoSim<E: Engine> {
 }
 
 impl<E: Engine> CoSim<E> {
-    /// A loop at power-up with the gyroscope at rest.
+    /// A loop at power-up with the gyroscope at rest, the engine's core
+    /// of carrier profile `profile` (PROFILE reads it).
     /// The registers are programmed through the register map.
-    pub fn new(engine: E, converters: Converters, gyro: GyroModel, regs: Registers) -> Self {
+    pub fn new(
+        engine: E,
+        profile: CarrierProfile,
+        converters: Converters,
+        gyro: GyroModel,
+        regs: Registers,
+    ) -> Self {
         let mut sim = Self {
             engine,
             analog: Analog::new(converters, gyro, None),
-            host: HostRegisters::power_up(),
+            host: HostRegisters::power_up(profile),
             outputs: Outputs::default(),
             adc: (0, 0),
             cycle: 0,
@@ -173,9 +180,10 @@ pub struct HostRegisters {
 }
 
 impl HostRegisters {
-    /// Every register at its power-up value.
-    pub fn power_up() -> Self {
-        let bank = RegisterBank::power_up();
+    /// Every register at its power-up value, in the core with this
+    /// carrier profile.
+    pub fn power_up(profile: CarrierProfile) -> Self {
+        let bank = RegisterBank::power_up_for(profile);
         Self {
             bank,
             regs: bank.registers(),

@@ -704,12 +704,8 @@ pub fn point_loop<E: Engine>(
 ) -> Result<CoSim<E>, RunError> {
     let gyro = GyroModel::new(&exp.gyro, exp.drive.clock_hz)?.with_thermal_noise(&exp.noise)?;
     let converters = Converters::new(&plan.front_end)?;
-    let mut sim = CoSim::new(
-        E::power_up(exp.drive.carrier_profile)?,
-        converters,
-        gyro,
-        point.regs,
-    );
+    let profile = exp.drive.carrier_profile;
+    let mut sim = CoSim::new(E::power_up(profile)?, profile, converters, gyro, point.regs);
     sim.set_rate(point.omz_rad_s);
     Ok(sim)
 }

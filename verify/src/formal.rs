@@ -423,17 +423,24 @@ mod tests {
     use super::*;
 
     /// The proofs read the table core's export; with the core cut out,
-    /// the fine core's (ECP5) export has the same modules, so they hold
-    /// for its bus wrapper too. The two files order their modules
+    /// the fine core's (ECP5) export has the same modules but for one
+    /// constant, the PROFILE word (1 for 0), which only the read data of
+    /// PROFILE shows: so they hold for its bus wrapper too, with
+    /// `PROFILE_WORD` 1 in the harness. The two files order their modules
     /// differently and differ in their header comment, so the modules are
-    /// compared as a set.
+    /// compared as a set, the fine one's PROFILE constant put back to 0.
     #[test]
     fn both_cores_exports_have_the_same_bus_wrapper() {
-        let fine = crate::verilog_out_dir().join(gyrocal_hdl::export::axi_verilog_file(
-            gyrocal_hdl::model::gyro_interface::CarrierProfile::Fine,
-        ));
+        use gyrocal_hdl::model::gyro_interface::CarrierProfile::{Fine, Table};
+        let fine = crate::verilog_out_dir().join(gyrocal_hdl::export::axi_verilog_file(Fine));
         let fine = bus_verilog(&std::fs::read_to_string(fine).unwrap()).unwrap();
+        let word = |p: gyrocal_hdl::model::gyro_interface::CarrierProfile| {
+            format!("localparam  profile_word = 32'h{:x};", p.word())
+        };
+        assert_eq!(fine.matches(&word(Fine)).count(), 1, "the fine PROFILE word");
+        let fine = fine.replace(&word(Fine), &word(Table));
         let table = committed_bus_verilog().unwrap();
+        assert_eq!(table.matches(&word(Table)).count(), 1, "the table PROFILE word");
         let modules = |text: &str| {
             let mut m: Vec<String> = text
                 .split("\nmodule ")

@@ -30749,7 +30749,8 @@ module gyro_interface_axi__registers(clock,reset,write,write_index,write_data,wr
 
     // Constant declarations
     localparam  id_word = 32'h4759524f;
-    localparam  version_word = 32'h10001;
+    localparam  version_word = 32'h10002;
+    localparam  profile_word = 32'h1;
 
     // Stub signals
     reg  settings$0$clock;
@@ -30953,6 +30954,10 @@ module gyro_interface_axi__registers(clock,reset,write,write_index,write_data,wr
     reg  [5:0] status$8$read_index;
     wire  status$8$read_hit;
     wire  [31:0] status$8$read_word;
+    reg  [31:0] status$9$live;
+    reg  [5:0] status$9$read_index;
+    wire  status$9$read_hit;
+    wire  [31:0] status$9$read_word;
     reg  counters$clock;
     reg  counters$reset;
     reg signed [39:0] counters$z1;
@@ -31225,6 +31230,12 @@ module gyro_interface_axi__registers(clock,reset,write,write_index,write_data,wr
         .read_hit(status$8$read_hit),
         .read_word(status$8$read_word)
     );
+    gyro_interface_axi__registers__status__9 status$9(
+        .live(status$9$live),
+        .read_index(status$9$read_index),
+        .read_hit(status$9$read_hit),
+        .read_word(status$9$read_word)
+    );
     gyro_interface_axi__registers__counters counters(
         .clock(counters$clock),
         .reset(counters$reset),
@@ -31493,6 +31504,7 @@ module gyro_interface_axi__registers(clock,reset,write,write_index,write_data,wr
         status$6$live = counters$z2_low;
         status$7$live = counters$z2_high;
         status$8$live = counters$clip;
+        status$9$live = profile_word;
         status$0$read_index = read_index;
         if (status$0$read_hit) begin
             read_hit = 1'b1;
@@ -31537,6 +31549,11 @@ module gyro_interface_axi__registers(clock,reset,write,write_index,write_data,wr
         if (status$8$read_hit) begin
             read_hit = 1'b1;
             read_word = status$8$read_word;
+        end
+        status$9$read_index = read_index;
+        if (status$9$read_hit) begin
+            read_hit = 1'b1;
+            read_word = status$9$read_word;
         end
         counters$snapshot = read & status$3$read_hit;
         stream_enable = settings$14$value[32'h0];
@@ -33810,3 +33827,33 @@ module gyro_interface_axi__registers__status__8(live,read_index,read_hit,read_wo
     end
 
 endmodule // gyro_interface_axi__registers__status__8
+
+
+module gyro_interface_axi__registers__status__9(live,read_index,read_hit,read_word);
+
+    // Module arguments
+    input wire  [31:0] live;
+    input wire  [5:0] read_index;
+    output reg  read_hit;
+    output reg  [31:0] read_word;
+
+    // Constant declarations
+    localparam  index = 6'b11000;
+    localparam  field_mask = 32'h1;
+    localparam  sign_bit = 32'h0;
+    localparam  extension = 32'h0;
+
+    // Local signals
+    reg  [31:0] field;
+
+    // Update code
+    always @(*) begin
+        field = live & field_mask;
+        read_hit = read_index == index;
+        read_word = field;
+        if (|(field & sign_bit)) begin
+            read_word = field | extension;
+        end
+    end
+
+endmodule // gyro_interface_axi__registers__status__9

@@ -50,12 +50,13 @@ pub use super::register_file::{SETTINGS, STATUS};
 use super::register_map::{ADDRESS_BITS, DATA_BITS};
 use super::sample_fifo::{SAMPLE_BITS, SampleFifo};
 use crate::gyro_interface::{FineGyroInterface, GyroInterface};
+use gyrocal_regs::datapath::CarrierProfile;
 use rust_hdl::prelude::*;
 
 /// Declares a bus-attached top around the given datapath core: the struct,
 /// its constructor and its wiring, written once for both cores.
 macro_rules! axi_top {
-    ($(#[$meta:meta])* $name:ident, $core:ident) => {
+    ($(#[$meta:meta])* $name:ident, $core:ident, $profile:expr) => {
         $(#[$meta])*
         #[derive(LogicBlock)]
         pub struct $name {
@@ -155,7 +156,7 @@ macro_rules! axi_top {
                     core: $core::new(),
                     axil_write: AxilWrite::new(),
                     axil_read: AxilRead::new(),
-                    registers: RegisterFile::new(),
+                    registers: RegisterFile::new($profile),
                     fifo: SampleFifo::new(),
                     reset: Default::default(),
                 }
@@ -257,7 +258,8 @@ axi_top!(
     /// The datapath with an AXI4-Lite register slave and an AXI4-Stream z
     /// master: the table core, which fits an iCE40 UltraPlus.
     GyroInterfaceAxi,
-    GyroInterface
+    GyroInterface,
+    CarrierProfile::Table
 );
 
 axi_top!(
@@ -265,5 +267,6 @@ axi_top!(
     /// (`crate::gyro_interface::FineGyroInterface`): the ECP5 top. Same
     /// ports, registers and timing.
     FineGyroInterfaceAxi,
-    FineGyroInterface
+    FineGyroInterface,
+    CarrierProfile::Fine
 );

@@ -104,11 +104,14 @@ struct Wrapper {
     write: WriteChannels,
     read: ReadChannels,
     counters: Counters,
+    /// The core's carrier profile (PROFILE reads its word).
+    profile: CarrierProfile,
 }
 
 impl Wrapper {
-    fn power_up() -> Self {
+    fn power_up(profile: CarrierProfile) -> Self {
         Self {
+            profile,
             bank: RegisterBank::power_up(),
             write: WriteChannels::default(),
             read: ReadChannels::default(),
@@ -124,7 +127,7 @@ impl Wrapper {
         if reg.access == Access::ReadWrite {
             return self.bank.read(reg.offset);
         }
-        let live = status_live(&self.counters.words(z_valid));
+        let live = status_live(&self.counters.words(z_valid), self.profile);
         let i = STATUS
             .iter()
             .position(|s| s.offset == reg.offset)
@@ -159,7 +162,7 @@ impl GyroInterfaceAxi {
     pub fn with_profile(profile: CarrierProfile) -> Self {
         Self {
             core: GyroInterface::with_profile(profile),
-            bus: Wrapper::power_up(),
+            bus: Wrapper::power_up(profile),
             fifo: Fifo::default(),
         }
     }
@@ -230,7 +233,7 @@ impl GyroInterfaceAxi {
         };
         next.counters.step(&status);
         if !i.aresetn {
-            *next = Wrapper::power_up();
+            *next = Wrapper::power_up(next.profile);
             self.fifo = Fifo::default();
         }
         self.core.step(i.adc, &regs);
@@ -250,6 +253,43 @@ mod tests {
     use super::super::register_map::{Z1_HI, Z1_LO, Z2_HI, Z2_LO};
     use super::*;
 
+    /// A bus read of the word at `offset`: AR held until accepted, then
+    /// the cycles to RVALID; the data and response.
+    fn bus_read(top: &mut GyroInterfaceAxi, offset: u32) -> (u32, u8) {
+        let ar = BusInputs {
+            arvalid: true,
+            araddr: offset as u8,
+            ..BusInputs::default()
+        };
+        let (idle, mut accepted) = (BusInputs::default(), false);
+        for _ in 0..8 {
+            let before = top.outputs();
+            if before.rvalid {
+                top.step(&idle);
+                return (before.rdata, before.rresp);
+            }
+            top.step(if accepted { &idle } else { &ar });
+            accepted |= before.arready;
+        }
+        panic!("no read response in 8 cycles");
+    }
+
+    /// PROFILE reads the core's carrier profile, in either top, also after
+    /// a reset: the word a host checks before it calibrates.
+    #[test]
+    fn profile_reads_the_cores_carrier_profile() {
+        use super::super::register_map::PROFILE;
+        for profile in CarrierProfile::ALL {
+            let mut top = GyroInterfaceAxi::with_profile(profile);
+            assert_eq!(bus_read(&mut top, PROFILE.offset), (profile.word(), 0));
+            top.step(&BusInputs {
+                aresetn: false,
+                ..BusInputs::default()
+            });
+            assert_eq!(bus_read(&mut top, PROFILE.offset), (profile.word(), 0));
+        }
+    }
+
     /// Z1_HI:Z1_LO and Z2_HI:Z2_LO give back any 40-bit snapshot, sign
     /// included: the register map's contract for a host that reads z. The
     /// bus tests' traffic keeps |z| far below 2^31, where the high word is
@@ -257,7 +297,7 @@ mod tests {
     /// rails and across bit 31.
     #[test]
     fn the_z_words_give_back_any_snapshot() {
-        let mut w = Wrapper::power_up();
+        let mut w = Wrapper::power_up(CarrierProfile::Table);
         let rails = [
             0i64,
             1,

@@ -8,8 +8,8 @@
 //!                                      write_hit ◄┘    (MOD_STEP_LO staged until MOD_STEP_HI)
 //!  z1, z2, z_valid, dropped, adc1, adc2 ──► StatusCounters ──► beat (stream)
 //!                               counts, z snapshot, clip counts ──┐
-//!  ID, VERSION ───────────────────────────────────────────────────┴──► StatusWord x9
-//!  read_index ──► SettingRegister x15 / StatusWord x9 ──► read_hit, read_word
+//!  ID, VERSION, PROFILE ──────────────────────────────────────────┴──► StatusWord x10
+//!  read_index ──► SettingRegister x15 / StatusWord x10 ──► read_hit, read_word
 //!  read ──► a read of SAMPLE_COUNT latches the snapshot, of ADC_CLIP clears the clip counts
 //! ```
 //!
@@ -25,8 +25,9 @@
 use super::clip_counter::COUNT_BITS;
 use super::register_map::{
     ADC_CLIP, AMP1, AMP2, CARRIER_STEP, CIC_DECIMATION, CIC_SHIFT, DATA_BITS, ID, IIR_ALPHA,
-    IIR_K0, IIR_K1, IIR_K2, MOD_STEP_HI, MOD_STEP_LO, REF_DELAY, REF_PHASE, Register, SAMPLE_COUNT,
-    SELECT, STREAM_ENABLE, STREAM_OVERFLOW, VERSION, WORD_INDEX_BITS, Z1_HI, Z1_LO, Z2_HI, Z2_LO,
+    IIR_K0, IIR_K1, IIR_K2, MOD_STEP_HI, MOD_STEP_LO, PROFILE, REF_DELAY, REF_PHASE, Register,
+    SAMPLE_COUNT, SELECT, STREAM_ENABLE, STREAM_OVERFLOW, VERSION, WORD_INDEX_BITS, Z1_HI, Z1_LO,
+    Z2_HI, Z2_LO,
 };
 use super::sample_fifo::SAMPLE_BITS;
 use super::setting_register::SettingRegister;
@@ -35,6 +36,7 @@ use super::status_word::StatusWord;
 use super::{Z_BITS, register_map};
 use crate::cic_decimator::{DECIMATION_BITS, SHIFT_BITS};
 use crate::reference_alignment::DELAY_BITS;
+use gyrocal_regs::datapath::CarrierProfile;
 use rust_hdl::prelude::*;
 
 /// The settings in the order of `RegisterFile::settings` (the wiring in
@@ -58,7 +60,7 @@ pub const SETTINGS: [Register; 15] = [
 ];
 
 /// The status words in the order of `RegisterFile::status`.
-pub const STATUS: [Register; 9] = [
+pub const STATUS: [Register; 10] = [
     ID,
     VERSION,
     STREAM_OVERFLOW,
@@ -68,13 +70,15 @@ pub const STATUS: [Register; 9] = [
     Z2_LO,
     Z2_HI,
     ADC_CLIP,
+    PROFILE,
 ];
 
 /// The model of the status words' sources, as `update` wires them: the
 /// live value of each word of `STATUS`, in its order, from the counters'
-/// words of the cycle (`StatusCounters`' model). Each `StatusWord` then
-/// returns its field (`Register::extend`).
-pub fn status_live(counters: &CounterWords) -> [u32; STATUS.len()] {
+/// words of the cycle (`StatusCounters`' model), in the core with this
+/// carrier profile. Each `StatusWord` then returns its field
+/// (`Register::extend`).
+pub fn status_live(counters: &CounterWords, profile: CarrierProfile) -> [u32; STATUS.len()] {
     let c = counters;
     [
         ID.power_up,
@@ -86,6 +90,7 @@ pub fn status_live(counters: &CounterWords) -> [u32; STATUS.len()] {
         c.z2_low,
         c.z2_high,
         c.clip,
+        profile.word(),
     ]
 }
 
@@ -162,16 +167,18 @@ pub struct RegisterFile {
     /// IIR_ALPHA.
     pub iir_alpha: Signal<Out, Signed<32>>,
     settings: [SettingRegister; 15],
-    status: [StatusWord; 9],
+    status: [StatusWord; 10],
     counters: StatusCounters,
     mod_step_low: DFF<Bits<DATA_BITS>>,
     id_word: Constant<Bits<DATA_BITS>>,
     version_word: Constant<Bits<DATA_BITS>>,
+    profile_word: Constant<Bits<DATA_BITS>>,
 }
 
 impl RegisterFile {
-    /// The register file at power-up.
-    pub fn new() -> Self {
+    /// The register file at power-up, in the core with this carrier
+    /// profile (PROFILE reads its word).
+    pub fn new(profile: CarrierProfile) -> Self {
         Self {
             clock: Default::default(),
             reset: Default::default(),
@@ -211,13 +218,15 @@ impl RegisterFile {
             mod_step_low: Default::default(),
             id_word: Constant::new(u64::from(ID.power_up).into()),
             version_word: Constant::new(u64::from(VERSION.power_up).into()),
+            profile_word: Constant::new(u64::from(profile.word()).into()),
         }
     }
 }
 
 impl Default for RegisterFile {
+    /// The table core's.
     fn default() -> Self {
-        Self::new()
+        Self::new(CarrierProfile::Table)
     }
 }
 
@@ -274,8 +283,9 @@ impl Logic for RegisterFile {
         self.status[6].live.next = self.counters.z2_low.val();
         self.status[7].live.next = self.counters.z2_high.val();
         self.status[8].live.next = self.counters.clip.val();
+        self.status[9].live.next = self.profile_word.val();
         // Reads: the one word that decodes the index, else none (0).
-        for i in 0..9 {
+        for i in 0..10 {
             self.status[i].read_index.next = self.read_index.val();
             if self.status[i].read_hit.val() {
                 self.read_hit.next = true;

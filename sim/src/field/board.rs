@@ -72,7 +72,7 @@ impl<E: Engine> SimBoard<E> {
                 GyroModel::new(&at.gyro, clock_hz)?.with_thermal_noise(noise)?,
                 phase,
             ),
-            host: HostRegisters::power_up(),
+            host: HostRegisters::power_up(profile),
             outputs: Outputs::default(),
             samples: 0,
             cycle: 0,
