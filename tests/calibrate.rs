@@ -182,7 +182,7 @@ const PARAMETERS: [(&str, Option<&str>); 6] = [
 
 #[test]
 fn over_the_wire_agrees_with_in_process_and_the_truth() {
-    let (read, missed) = compare_over_the_wire(2);
+    let (read, missed) = compare_over_the_wire(2, None);
     assert!(
         missed > 0.0 && missed <= read,
         "paced at 2 R: at most one missed per read ({missed} of {read})"
@@ -194,26 +194,46 @@ fn over_the_wire_agrees_with_in_process_and_the_truth() {
 /// means are fitted across the gaps (`gyrocal_host::sampling`), and the
 /// figures still agree with in process and the truth. Interpolating, as
 /// with every sample, was off by +188% / +74% here (docs/real-board.md).
+/// The host's file names the fine core for the served table core: the host
+/// takes the board's PROFILE and says so.
 #[test]
 fn a_wire_that_misses_31_of_32_samples_still_agrees() {
-    let (read, missed) = compare_over_the_wire(32);
+    let (read, missed) = compare_over_the_wire(32, Some("fine"));
     assert!(
         missed >= 30.0 * read,
         "paced at 32 R: 31 missed per read ({missed} of {read})"
     );
 }
 
-/// Calibrate in process and over a wire paced at `pace_r` R; compare every
-/// identified parameter and sf_selfcal with each other and the truth.
-/// Returns the wire's (read, missed) sample counts.
-fn compare_over_the_wire(pace_r: u64) -> (f64, f64) {
+/// Calibrate in process and over a wire paced at `pace_r` R, the host's
+/// file naming `host_profile` for the served core (the table core);
+/// compare every identified parameter and sf_selfcal with each other and
+/// the truth. Returns the wire's (read, missed) sample counts.
+fn compare_over_the_wire(pace_r: u64, host_profile: Option<&str>) -> (f64, f64) {
     let dir = tempfile::tempdir().unwrap();
     let config = dir.path().join("device.toml");
     std::fs::write(&config, DEVICE).unwrap();
+    let host_config = dir.path().join("host.toml");
+    let drive = match host_profile {
+        Some(p) => format!("[drive]\ncarrier_profile = \"{p}\"\n"),
+        None => "[drive]\n".into(),
+    };
+    std::fs::write(&host_config, DEVICE.replace("[drive]\n", &drive)).unwrap();
     let local = calibrate(&config, &["--temperature", "45"]);
     let pace = (pace_r * R).to_string();
     let served = Served::start(&config, &["--temperature", "45", "--pace", &pace]);
-    let wire = calibrate(&config, &["--board", &served.url]);
+    let wire = calibrate(&host_config, &["--board", &served.url]);
+    // The board's PROFILE is taken over the file's, and a difference said.
+    let profile_lines = warnings(&wire)
+        .iter()
+        .filter(|w| w.starts_with("warning: the board's core is the table profile (PROFILE reads 0), not [drive] carrier_profile = \"fine\""))
+        .count();
+    assert_eq!(
+        profile_lines,
+        usize::from(host_profile == Some("fine")),
+        "{}",
+        wire["warnings"]
+    );
     let truth = &local["truth"];
     assert!(wire["truth"].is_null());
     // No coupling at rest measures this device's drive-gain ratio and the

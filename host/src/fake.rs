@@ -46,7 +46,7 @@ impl Lorentzian {
     /// each (fk Hz, bandwidth bk Hz, C), with `noise` z LSB of uniform noise.
     pub fn new(clock_hz: f64, modes: [(f64, f64, C64); 2], noise: f64) -> Self {
         Self {
-            bank: RegisterBank::power_up(),
+            bank: RegisterBank::power_up_for(CarrierProfile::Fine),
             clock_hz,
             cycle: 0,
             modes,

@@ -7,6 +7,7 @@ use crate::device::GyroParams;
 use crate::error::Error;
 use gyrocal_regs::Registers;
 use gyrocal_regs::datapath::CarrierProfile;
+use gyrocal_regs::map::{BusError, PROFILE_SINCE_MINOR, RegisterAccess};
 use gyrocal_regs::plan::{self, FrequencyPlan, Realized};
 use serde::Serialize;
 use std::f64::consts::{PI, TAU};
@@ -117,6 +118,31 @@ impl Knowns {
     pub fn clock_tolerance_missing(&self) -> Option<String> {
         (self.clock_tolerance == 0.0).then(|| {
             "warning: [drive] clock_tolerance_ppm is not given: the board's oscillator error, which the host cannot see, moves the scale factors by one to two and a half times itself (50 ppm: up to 1.2e-4) and is in no sigma; give the oscillator's +- tolerance".to_string()
+        })
+    }
+
+    /// The board's word on its core over the configuration's: sets
+    /// `carrier_profile` to the profile the board's PROFILE register reads
+    /// (`transport::core_profile`). Returns one line where that overrides
+    /// the configured profile, or where the core (a register map older
+    /// than PROFILE) cannot say and the configured one stands.
+    pub fn take_board_profile(
+        &mut self,
+        board: &mut (impl RegisterAccess + ?Sized),
+    ) -> Result<Option<String>, BusError> {
+        let configured = self.carrier_profile;
+        Ok(match crate::transport::core_profile(board)? {
+            Some(built) if built == configured => None,
+            Some(built) => {
+                self.carrier_profile = built;
+                Some(format!(
+                    "warning: the board's core is the {built} profile (PROFILE reads {}), not [drive] carrier_profile = \"{configured}\": the predictions take the board's",
+                    built.word()
+                ))
+            }
+            None => Some(format!(
+                "warning: the board's core (register map older than 1.{PROFILE_SINCE_MINOR}) does not say its carrier profile: [drive] carrier_profile = \"{configured}\" is assumed"
+            )),
         })
     }
 
@@ -269,6 +295,71 @@ mod tests {
         assert!(
             line.contains("is +430.0 Hz from the datasheet's f2 (34570.0 Hz)"),
             "{line}"
+        );
+    }
+
+    /// A core's register bank that answers VERSION with `version`.
+    struct Core(gyrocal_regs::map::RegisterBank, u32);
+
+    impl RegisterAccess for Core {
+        fn write_register(&mut self, offset: u32, word: u32) -> Result<(), BusError> {
+            self.0.write(offset, word, 0xf)
+        }
+        fn read_register(&mut self, offset: u32) -> Result<u32, BusError> {
+            if offset == gyrocal_regs::map::VERSION.offset {
+                Ok(self.1)
+            } else {
+                self.0.read(offset)
+            }
+        }
+    }
+
+    /// The board's PROFILE over the configured profile: the same, nothing
+    /// said; another, taken and said in one line; a core of map 1.1, which
+    /// has no PROFILE, the configured one kept and said; a core of
+    /// another major version, an error.
+    #[test]
+    fn the_boards_profile_is_taken_and_a_difference_said() {
+        use gyrocal_regs::map::{RegisterBank, VERSION_WORD};
+        let core = |p| RegisterBank::power_up_for(p);
+        for built in CarrierProfile::ALL {
+            for configured in CarrierProfile::ALL {
+                let mut k = knowns(34_155.0);
+                k.carrier_profile = configured;
+                let said = k.take_board_profile(&mut Core(core(built), VERSION_WORD));
+                assert_eq!(k.carrier_profile, built);
+                let said = said.unwrap();
+                assert_eq!(said.is_some(), built != configured, "{built} {configured}");
+                if let Some(line) = said {
+                    assert!(
+                        line.contains(&format!(
+                            "the board's core is the {built} profile (PROFILE reads {})",
+                            built.word()
+                        )) && line.contains(&format!("carrier_profile = \"{configured}\"")),
+                        "{line}"
+                    );
+                }
+            }
+        }
+        let mut k = knowns(34_155.0);
+        k.carrier_profile = CarrierProfile::Fine;
+        let line = k
+            .take_board_profile(&mut Core(core(CarrierProfile::Table), 0x0001_0001))
+            .unwrap()
+            .unwrap();
+        assert_eq!(k.carrier_profile, CarrierProfile::Fine);
+        assert!(
+            line.contains(
+                "does not say its carrier profile: [drive] carrier_profile = \"fine\" is assumed"
+            ),
+            "{line}"
+        );
+        let other = k.take_board_profile(&mut Core(core(CarrierProfile::Table), 0x0002_0000));
+        assert!(
+            other
+                .unwrap_err()
+                .to_string()
+                .starts_with("VERSION reads 2.0 (0x00020000)")
         );
     }
 }

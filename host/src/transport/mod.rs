@@ -14,7 +14,10 @@ pub mod etherbone;
 pub mod mmap;
 
 use crate::board::{Board, Polled};
-use gyrocal_regs::map::{BusError, ID, ID_WORD, RegisterAccess};
+use gyrocal_regs::datapath::CarrierProfile;
+use gyrocal_regs::map::{
+    BusError, ID, ID_WORD, PROFILE, PROFILE_SINCE_MINOR, RegisterAccess, VERSION, VERSION_WORD,
+};
 use std::path::Path;
 
 /// A board URL that cannot be used: what is wrong and what is allowed.
@@ -126,7 +129,65 @@ pub fn check_id(bus: &mut impl RegisterAccess) -> Result<(), BusError> {
     }
 }
 
-/// Open the board a URL names, check its ID, and give it a clock from
+/// The register map's minor version the core reports, once its major is
+/// this host's: a core of another major version lays its registers out
+/// otherwise, and every figure from it would be wrong.
+pub fn check_version(bus: &mut (impl RegisterAccess + ?Sized)) -> Result<u32, BusError> {
+    let version = bus.read_register(VERSION.offset)?;
+    let (major, minor) = (version >> 16, version & 0xffff);
+    if major == VERSION_WORD >> 16 {
+        Ok(minor)
+    } else {
+        Err(BusError::Transport(format!(
+            "VERSION reads {major}.{minor} (0x{version:08x}): this host speaks register map {}.x",
+            VERSION_WORD >> 16
+        )))
+    }
+}
+
+/// The carrier profile the core was built with, from PROFILE; `None` from
+/// a core of a map older than PROFILE (minor below
+/// [`PROFILE_SINCE_MINOR`]), which cannot say.
+///
+/// ```
+/// use gyrocal_host::transport::core_profile;
+/// use gyrocal_regs::datapath::CarrierProfile;
+/// use gyrocal_regs::map::{BusError, PROFILE, RegisterAccess, RegisterBank, VERSION};
+///
+/// /// A bank answering VERSION with `version`.
+/// struct Core(RegisterBank, u32);
+/// impl RegisterAccess for Core {
+///     fn write_register(&mut self, o: u32, w: u32) -> Result<(), BusError> {
+///         self.0.write(o, w, 0xf)
+///     }
+///     fn read_register(&mut self, o: u32) -> Result<u32, BusError> {
+///         if o == VERSION.offset { Ok(self.1) } else { self.0.read(o) }
+///     }
+/// }
+/// let fine = RegisterBank::power_up_for(CarrierProfile::Fine);
+/// assert_eq!(core_profile(&mut Core(fine, 0x0001_0002))?, Some(CarrierProfile::Fine));
+/// assert_eq!(core_profile(&mut Core(fine, 0x0001_0001))?, None);
+/// let newer = core_profile(&mut Core(fine, 0x0002_0000)).unwrap_err();
+/// assert!(newer.to_string().contains("this host speaks register map 1.x"));
+/// # Ok::<(), BusError>(())
+/// ```
+pub fn core_profile(
+    bus: &mut (impl RegisterAccess + ?Sized),
+) -> Result<Option<CarrierProfile>, BusError> {
+    if check_version(bus)? < PROFILE_SINCE_MINOR {
+        return Ok(None);
+    }
+    let word = bus.read_register(PROFILE.offset)?;
+    CarrierProfile::from_word(word).map(Some).ok_or_else(|| {
+        BusError::Transport(format!(
+            "PROFILE reads {word}: allowed {} (table) or {} (fine)",
+            CarrierProfile::Table.word(),
+            CarrierProfile::Fine.word()
+        ))
+    })
+}
+
+/// Open the board a URL names, check its ID and version, and give it a clock from
 /// SAMPLE_COUNT.
 ///
 /// ```
@@ -135,7 +196,8 @@ pub fn check_id(bus: &mut impl RegisterAccess) -> Result<(), BusError> {
 /// use std::io::Write;
 ///
 /// // A stand-in for litex_server with the core at 0x4000_0000: its
-/// // greeting, then each read record answered (ID at the base, 0 elsewhere).
+/// // greeting, then each read record answered (ID at the base, VERSION
+/// // after it, 0 elsewhere).
 /// let listener = std::net::TcpListener::bind("127.0.0.1:0")?;
 /// let url = format!("etherbone://{}?base=0x40000000", listener.local_addr()?);
 /// std::thread::spawn(move || -> std::io::Result<()> {
@@ -146,13 +208,18 @@ pub fn check_id(bus: &mut impl RegisterAccess) -> Result<(), BusError> {
 ///         if reads.is_empty() {
 ///             continue; // a write: not answered
 ///         }
-///         let writes = reads.iter().map(|&a| if a == 0x4000_0000 { 0x4759_524f } else { 0 });
+///         let word = |a| match a {
+///             0x4000_0000 => 0x4759_524f,
+///             0x4000_0004 => 0x0001_0002,
+///             _ => 0,
+///         };
+///         let writes = reads.iter().map(|&a| word(a));
 ///         let answer = Record { writes: writes.collect(), ..Record::default() };
 ///         s.write_all(&answer.encode().unwrap())?;
 ///     }
 ///     Ok(())
 /// });
-/// let mut board = transport::open(&url)?; // connects, checks ID, clocks by SAMPLE_COUNT
+/// let mut board = transport::open(&url)?; // connects, checks ID and VERSION, clocks by SAMPLE_COUNT
 /// assert_eq!(board.read_register(0)?, 0x4759_524f);
 ///
 /// // Nothing listens on port 1 here, and an unknown scheme names the allowed ones.
@@ -168,11 +235,13 @@ pub fn open(url: &str) -> Result<Box<dyn Board + Send>, crate::Error> {
         Target::Etherbone { address, base } => {
             let mut t = etherbone::Etherbone::connect(&address, base)?;
             check_id(&mut t)?;
+            check_version(&mut t)?;
             Box::new(Polled::new(t)?)
         }
         Target::Mapped { path, base } => {
             let mut t = mmap::Mapped::open(Path::new(&path), base)?;
             check_id(&mut t)?;
+            check_version(&mut t)?;
             Box::new(Polled::new(t)?)
         }
     })

@@ -120,6 +120,8 @@ pub struct Halted {
     pub samples: SampleCounts,
     /// Wall time until the stop (s).
     pub wall_s: f64,
+    /// What the host found before the cycle (the board's profile).
+    pub warnings: Vec<String>,
 }
 
 /// Calibrate and print.
@@ -156,15 +158,18 @@ pub fn run(args: &Args) -> Result<(), Failure> {
 /// status 1). Before identification finished there is nothing to print
 /// but the error.
 fn stopped(args: &Args, knowns: &Knowns, halted: Halted) -> Result<(), Failure> {
+    if halted.identified.is_none() {
+        for w in &halted.warnings {
+            eprintln!("{w}");
+        }
+    }
     if let Some(id) = halted.identified.as_deref() {
         eprintln!(
             "the cycle stopped after identification ({:.1} s wall); what it identified follows",
             halted.wall_s
         );
-        let warnings: Vec<String> = id
-            .datasheet_departures(&knowns.nominal)
-            .into_iter()
-            .collect();
+        let mut warnings = halted.warnings.clone();
+        warnings.extend(id.datasheet_departures(&knowns.nominal));
         for w in &warnings {
             eprintln!("{w}");
         }
@@ -201,6 +206,7 @@ fn cycle(
             error: e.to_string(),
             samples,
             wall_s,
+            warnings: vec![],
         })
 }
 
@@ -224,12 +230,21 @@ fn over_the_wire(
     transport::parse(url).map_err(|e| Failure::Input(format!("--board: {e}")))?;
     let mut board =
         transport::open(url).map_err(|e| Failure::Run(format!("--board {url}: {e}")))?;
+    let mut knowns = knowns.clone();
+    let profile = knowns
+        .take_board_profile(board.as_mut())
+        .map_err(|e| Failure::Run(format!("--board {url}: {e}")))?;
+    let knowns = &knowns;
     eprintln!("calibrating the board at {url}");
     let (cal, samples, wall_s) = match cycle(board.as_mut(), url, knowns) {
         Ok(done) => done,
-        Err(halted) => return Ok(Err(halted)),
+        Err(mut halted) => {
+            halted.warnings.extend(profile);
+            return Ok(Err(halted));
+        }
     };
     let mut warnings = cal.warnings(knowns);
+    warnings.extend(profile);
     warnings.extend(knowns.clock_tolerance_missing());
     Ok(Ok(Outcome {
         board: url.into(),
