@@ -95,6 +95,7 @@ fn run_cocotb(simulator: &str, profile: CarrierProfile) {
             ("GYRO_HEADER", header.as_path()),
             ("GYRO_PROGRAM", &program_file),
             ("GYRO_VECTORS", &vectors_file),
+            ("GYRO_PROFILE", Path::new(profile.name())),
         ],
     );
 }

@@ -65,6 +65,12 @@ def drive_start():
 DRIVE_START = drive_start()
 
 
+def header_value(name):
+    """A #define's value (decimal or 0x hex, with its u) from the C header."""
+    with open(os.environ["GYRO_HEADER"]) as f:
+        return int(re.search(rf"#define {name} (0x[0-9a-f]+|\d+)u", f.read()).group(1), 0)
+
+
 def extend(reg, field):
     """The word a read returns for a field value."""
     field &= reg["mask"]
@@ -139,6 +145,15 @@ async def identification_and_power_up_values(dut):
         if reg["rw"]:
             assert word == reg["power_up"], f"{name}: 0x{word:08x}"
     assert (await read(axil, "ID"))[0] == 0x4759524F
+    assert (await read(axil, "VERSION"))[0] == header_value("GYRO_VERSION_VALUE")
+    # PROFILE: the core's carrier profile (GYRO_PROFILE names the top under
+    # test where the runner knows it; FuseSoC's sim target runs the table top).
+    profile = os.environ.get("GYRO_PROFILE")
+    word = (await read(axil, "PROFILE"))[0]
+    allowed = {header_value(f"GYRO_PROFILE_{p}") for p in ("TABLE", "FINE")}
+    assert word in allowed, f"PROFILE: {word}"
+    if profile is not None:
+        assert word == header_value(f"GYRO_PROFILE_{profile.upper()}"), f"PROFILE: {word}"
 
 
 @cocotb.test()
