@@ -437,10 +437,18 @@ mod tests {
         let word = |p: gyrocal_hdl::model::gyro_interface::CarrierProfile| {
             format!("localparam  profile_word = 32'h{:x};", p.word())
         };
-        assert_eq!(fine.matches(&word(Fine)).count(), 1, "the fine PROFILE word");
+        assert_eq!(
+            fine.matches(&word(Fine)).count(),
+            1,
+            "the fine PROFILE word"
+        );
         let fine = fine.replace(&word(Fine), &word(Table));
         let table = committed_bus_verilog().unwrap();
-        assert_eq!(table.matches(&word(Table)).count(), 1, "the table PROFILE word");
+        assert_eq!(
+            table.matches(&word(Table)).count(),
+            1,
+            "the table PROFILE word"
+        );
         let modules = |text: &str| {
             let mut m: Vec<String> = text
                 .split("\nmodule ")
