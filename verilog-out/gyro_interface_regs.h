@@ -7,9 +7,11 @@
 
 #define GYRO_ID_VALUE 0x4759524fu
 #define GYRO_VERSION_VALUE 0x00010002u
-/* PROFILE's values: the carrier profile the core was built with. */
+/* PROFILE's values: the carrier profile the core was built with; a core
+ * reports it from this minor version of the map on. */
 #define GYRO_PROFILE_TABLE 0u
 #define GYRO_PROFILE_FINE 1u
+#define GYRO_PROFILE_SINCE_MINOR 2u
 /* Samples the AXI4-Stream FIFO holds before it drops one. */
 #define GYRO_STREAM_FIFO_DEPTH 256u
 /* Clocks after configuration before the drives leave 0: the core fills its

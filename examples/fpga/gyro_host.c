@@ -35,6 +35,18 @@ int gyro_probe(volatile uint32_t *base)
            (gyro_rd(base, GYRO_VERSION_OFFSET) >> 16) == (GYRO_VERSION_VALUE >> 16);
 }
 
+/* The carrier profile the core was built with (GYRO_PROFILE_TABLE or
+ * GYRO_PROFILE_FINE), or -1 from a core of a map older than PROFILE, which
+ * cannot say. The words gyro_plan.h's device predicts depend on it: compare
+ * it with the profile `gyrocal registers` planned for. */
+int gyro_profile(volatile uint32_t *base)
+{
+    if ((gyro_rd(base, GYRO_VERSION_OFFSET) & 0xffffu) < GYRO_PROFILE_SINCE_MINOR) {
+        return -1;
+    }
+    return (int)(gyro_rd(base, GYRO_PROFILE_OFFSET) & GYRO_PROFILE_MASK);
+}
+
 /* Write a block of gyro_plan.h, in order. */
 void gyro_program(volatile uint32_t *base, const unsigned long (*writes)[2], size_t n)
 {
@@ -92,6 +104,17 @@ int main(void)
         puts("probe failed");
         failures++;
     }
+    fake[GYRO_PROFILE_OFFSET / 4u] = GYRO_PROFILE_FINE;
+    if (gyro_profile(base) != (int)GYRO_PROFILE_FINE) {
+        puts("PROFILE not read");
+        failures++;
+    }
+    fake[GYRO_VERSION_OFFSET / 4u] = (GYRO_VERSION_VALUE & 0xffff0000u) | (GYRO_PROFILE_SINCE_MINOR - 1u);
+    if (gyro_profile(base) != -1 || !gyro_probe(base)) {
+        puts("an older minor version: PROFILE read, or the core refused");
+        failures++;
+    }
+    fake[GYRO_VERSION_OFFSET / 4u] = GYRO_VERSION_VALUE;
     GYRO_PROGRAM(base, gyro_readout);
     for (i = 0; i < sizeof(gyro_readout) / sizeof(gyro_readout[0]); i++) {
         if (fake[gyro_readout[i][0] / 4u] != (uint32_t)gyro_readout[i][1]) {

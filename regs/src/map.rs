@@ -666,8 +666,10 @@ pub fn c_header() -> String {
         "#define GYRO_VERSION_VALUE 0x{VERSION_WORD:08x}u\n"
     ));
     h.push_str(&format!(
-        "/* PROFILE's values: the carrier profile the core was built with. */\n\
-         #define GYRO_PROFILE_TABLE {}u\n#define GYRO_PROFILE_FINE {}u\n",
+        "/* PROFILE's values: the carrier profile the core was built with; a core\n \
+         * reports it from this minor version of the map on. */\n\
+         #define GYRO_PROFILE_TABLE {}u\n#define GYRO_PROFILE_FINE {}u\n\
+         #define GYRO_PROFILE_SINCE_MINOR {PROFILE_SINCE_MINOR}u\n",
         CarrierProfile::Table.word(),
         CarrierProfile::Fine.word()
     ));
