@@ -231,18 +231,20 @@ pub fn core_profile(
 /// ```
 pub fn open(url: &str) -> Result<Box<dyn Board + Send>, crate::Error> {
     let target = parse(url).map_err(|e| BusError::Transport(e.to_string()))?;
-    Ok(match target {
+    match target {
         Target::Etherbone { address, base } => {
-            let mut t = etherbone::Etherbone::connect(&address, base)?;
-            check_id(&mut t)?;
-            check_version(&mut t)?;
-            Box::new(Polled::new(t)?)
+            checked(etherbone::Etherbone::connect(&address, base)?)
         }
-        Target::Mapped { path, base } => {
-            let mut t = mmap::Mapped::open(Path::new(&path), base)?;
-            check_id(&mut t)?;
-            check_version(&mut t)?;
-            Box::new(Polled::new(t)?)
-        }
-    })
+        Target::Mapped { path, base } => checked(mmap::Mapped::open(Path::new(&path), base)?),
+    }
+}
+
+/// A transport's core checked (ID, then VERSION), as a board clocked by
+/// SAMPLE_COUNT: what `open` does with every transport.
+fn checked<T: RegisterAccess + Send + 'static>(
+    mut t: T,
+) -> Result<Box<dyn Board + Send>, crate::Error> {
+    check_id(&mut t)?;
+    check_version(&mut t)?;
+    Ok(Box::new(Polled::new(t)?))
 }
