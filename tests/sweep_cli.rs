@@ -81,6 +81,29 @@ fn shards_run_by_slurm_and_gnu_parallel_merge_into_the_unsharded_sweep() {
     let summary = &report["summary"];
     assert_eq!(summary["yield_both"].as_f64().unwrap(), within as f64 / 5.0);
     assert_eq!(summary["error_percentiles"].as_array().unwrap().len(), 4);
+    // Each output's coverage is its steps' (error over sigma), and each
+    // step's budget sums to its sigma.
+    for k in 0..2 {
+        let t: Vec<f64> = devices
+            .iter()
+            .flat_map(|d| d["steps"].as_array().unwrap())
+            .map(|s| {
+                let total = s["sf_selfcal_budget"]["total"][k].as_f64().unwrap();
+                assert_eq!(total, s["sf_selfcal_uncertainty"][k].as_f64().unwrap());
+                s["sf_selfcal_error"][k].as_f64().unwrap()
+                    / s["selfcal_error_uncertainty"][k].as_f64().unwrap()
+            })
+            .collect();
+        let c = &summary["coverage_per_output"][k];
+        let rms = (t.iter().map(|t| t * t).sum::<f64>() / t.len() as f64).sqrt();
+        assert!((c["rms_t"].as_f64().unwrap() - rms).abs() < 1e-12, "{c}");
+        assert_eq!(
+            (c["errors"].as_u64(), c["parts"].as_u64()),
+            (Some(5), Some(5))
+        );
+        let within = t.iter().filter(|t| t.abs() <= 2.0).count() as f64 / 5.0;
+        assert_eq!(c["within_2_sigma"].as_f64().unwrap(), within);
+    }
     assert!(report["shard"].is_null());
     let csv = read(&full_dir.join("sweep.csv"));
     assert_eq!(csv.lines().count(), 1 + 5, "a header and a row per device");

@@ -2,7 +2,11 @@
 //! beyond 3 of their sigmas, each named by its step and output (and its
 //! part, in a sweep). `gyrocal field` says it for one device
 //! (`crate::field::scenario::uncovered_error_warning`), `gyrocal sweep`
-//! over the spread (`crate::sweep::summary`).
+//! over the spread (`crate::sweep::summary`), which also says, per output,
+//! whether the sigmas are the size of their errors ([`OutputCoverage`]).
+
+use serde::{Deserialize, Serialize};
+use statrs::distribution::{ChiSquared, ContinuousCDF};
 
 /// At most this many parts, or errors, are named in a warning's line; the
 /// JSON's `devices` name them all.
@@ -96,9 +100,196 @@ pub fn uncovered_selfcal_errors(scored: &[Scored]) -> Option<String> {
     })
 }
 
+/// How one output's errors sit within their reported sigmas over many
+/// steps: the promise is 90 to 99.5% within 2 sigma and none beyond 3,
+/// and a sigma much wider than its errors breaks it too.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct OutputCoverage {
+    /// The output, 0 or 1.
+    pub output: usize,
+    /// How many errors (steps).
+    pub errors: u32,
+    /// How many parts they come from: the degrees of freedom of
+    /// [`OutputCoverage::rms_band`], since one part's steps share its
+    /// identification and need not be independent.
+    pub parts: u32,
+    /// Fraction of the errors within 2 of their sigmas.
+    pub within_2_sigma: f64,
+    /// RMS of error / sigma: 1 where each sigma is its error's spread.
+    pub rms_t: f64,
+}
+
+/// Probability of each side of [`OutputCoverage::rms_band`]: a standard
+/// normal's within 3, so that for one part the upper side is |t| <= 3,
+/// the promise itself; the band narrows as the parts grow.
+pub const RMS_BAND_PROBABILITY: f64 = 0.997_300_203_936_74;
+
+/// Where an output's sigmas lie against its errors' spread.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SigmaFit {
+    /// Within [`OutputCoverage::rms_band`]: the sigma is the errors' size.
+    Fits,
+    /// The RMS of error / sigma below the band: the sigma is wider than
+    /// the errors (it covers them, and promises less than the device does).
+    Wider,
+    /// Above it: the sigma is narrower than the errors.
+    Narrower,
+}
+
+impl OutputCoverage {
+    /// Output `output`'s coverage over `scored` (None without an error of
+    /// it).
+    pub fn of(scored: &[Scored], output: usize) -> Option<Self> {
+        let t: Vec<&Scored> = scored.iter().filter(|s| s.output == output).collect();
+        if t.is_empty() {
+            return None;
+        }
+        let n = t.len() as f64;
+        let mut parts: Vec<Option<u32>> = t.iter().map(|s| s.device).collect();
+        parts.sort_unstable();
+        parts.dedup();
+        Some(Self {
+            output,
+            errors: t.len() as u32,
+            parts: parts.len() as u32,
+            within_2_sigma: t.iter().filter(|s| s.t.abs() <= 2.0).count() as f64 / n,
+            rms_t: (t.iter().map(|s| s.t * s.t).sum::<f64>() / n).sqrt(),
+        })
+    }
+
+    /// The band that the RMS of error / sigma over `parts` independent
+    /// errors, each a standard normal t (every sigma the spread of its
+    /// error), lies below, and above, each with probability P =
+    /// [`RMS_BAND_PROBABILITY`]: sqrt(chi2(p) / n) for p = 1 - P and P,
+    /// n = `parts` (an honest set falls outside it 0.54% of the time). Taking the
+    /// parts, not the steps, as the degrees of freedom widens it where a
+    /// part's steps move together.
+    ///
+    /// ```
+    /// use gyrocal_sim::coverage::OutputCoverage;
+    /// let c = OutputCoverage { output: 1, errors: 100, parts: 100, within_2_sigma: 1.0, rms_t: 0.24 };
+    /// let (low, high) = c.rms_band();
+    /// assert!((low - 0.807).abs() < 1e-3 && (high - 1.199).abs() < 1e-3, "{low} {high}");
+    /// let one = OutputCoverage { parts: 1, ..c };
+    /// assert!((one.rms_band().1 - 3.0).abs() < 1e-9, "{:?}", one.rms_band());
+    /// ```
+    pub fn rms_band(&self) -> (f64, f64) {
+        let n = f64::from(self.parts.max(1));
+        let chi2 = ChiSquared::new(n).expect("n >= 1");
+        let tail = 1.0 - RMS_BAND_PROBABILITY;
+        let at = |p: f64| (chi2.inverse_cdf(p) / n).sqrt();
+        (at(tail), at(1.0 - tail))
+    }
+
+    /// Whether the sigmas fit the errors' spread ([`OutputCoverage::rms_band`]).
+    pub fn fit(&self) -> SigmaFit {
+        let (low, high) = self.rms_band();
+        if self.rms_t < low {
+            SigmaFit::Wider
+        } else if self.rms_t > high {
+            SigmaFit::Narrower
+        } else {
+            SigmaFit::Fits
+        }
+    }
+
+    /// One line when the sigmas do not fit ([`OutputCoverage::fit`]): a
+    /// warning where they are narrower than the errors, a note where wider,
+    /// with `largest`, the budget terms that were each step's largest and
+    /// at how many steps, most first.
+    pub fn line(&self, largest: &[(&str, u32)]) -> Option<String> {
+        let (kind, size) = match self.fit() {
+            SigmaFit::Fits => return None,
+            SigmaFit::Wider => ("note", "wider"),
+            SigmaFit::Narrower => ("warning", "narrower"),
+        };
+        let (low, high) = self.rms_band();
+        let terms = largest
+            .iter()
+            .map(|(name, steps)| format!("{name} at {steps}"))
+            .collect::<Vec<_>>()
+            .join(", ");
+        Some(format!(
+            "{kind}: output {}'s sigmas are {size} than its errors: RMS error/sigma {:.2} over {} errors \
+             of {} parts ({low:.2} to {high:.2} if each sigma were its error's spread), {:.1}% within 2 sigma; \
+             the largest term of its sigma: {terms}",
+            self.output + 1,
+            self.rms_t,
+            self.errors,
+            self.parts,
+            100.0 * self.within_2_sigma,
+        ))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn scored(device: u32, output: usize, t: f64) -> Scored {
+        Scored {
+            device: Some(device),
+            temperature_c: 25.0,
+            output,
+            t,
+        }
+    }
+
+    /// The band holds honest errors, and says wider or narrower sigmas:
+    /// 100 t drawn standard normal fit; the same t over sigmas 4 times too
+    /// wide, or 2 times too narrow, do not.
+    #[test]
+    fn the_rms_band_tells_sigmas_wider_or_narrower_than_their_errors() {
+        use rand_distr::{Distribution, StandardNormal};
+        use rand_xoshiro::rand_core::SeedableRng;
+        let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(5);
+        let t: Vec<f64> = (0..100).map(|_| StandardNormal.sample(&mut rng)).collect();
+        let at = |scale: f64| {
+            let s: Vec<Scored> = t
+                .iter()
+                .enumerate()
+                .map(|(i, &t)| scored(i as u32, 1, scale * t))
+                .collect();
+            OutputCoverage::of(&s, 1).unwrap()
+        };
+        assert_eq!(at(1.0).fit(), SigmaFit::Fits, "{:?}", at(1.0));
+        assert_eq!(at(1.0).line(&[]), None);
+        assert_eq!(at(0.25).fit(), SigmaFit::Wider);
+        assert_eq!(at(2.0).fit(), SigmaFit::Narrower);
+        let wider = at(0.25)
+            .line(&[("cycle_rate", 61), ("identified", 39)])
+            .unwrap();
+        assert!(
+            wider.starts_with("note: output 2's sigmas are wider than its errors"),
+            "{wider}"
+        );
+        assert!(
+            wider.ends_with("cycle_rate at 61, identified at 39"),
+            "{wider}"
+        );
+        assert!(
+            at(2.0)
+                .line(&[])
+                .unwrap()
+                .starts_with("warning: output 2's sigmas are narrower")
+        );
+        assert_eq!(OutputCoverage::of(&[scored(0, 0, 1.0)], 1), None);
+    }
+
+    /// The degrees of freedom are the parts: ten steps of one part whose
+    /// t are all 0.3 are one part's error, which may sit anywhere.
+    #[test]
+    fn one_parts_steps_are_one_degree_of_freedom() {
+        let s: Vec<Scored> = (0..10).map(|_| scored(7, 0, 0.3)).collect();
+        let c = OutputCoverage::of(&s, 0).unwrap();
+        assert_eq!((c.errors, c.parts), (10, 1));
+        assert_eq!(c.fit(), SigmaFit::Fits);
+        let apart: Vec<Scored> = (0..10).map(|i| scored(i, 0, 0.3)).collect();
+        assert_eq!(
+            OutputCoverage::of(&apart, 0).unwrap().fit(),
+            SigmaFit::Wider
+        );
+    }
 
     /// A step is named by its temperature where it has one, never as "at
     /// NaN deg C".

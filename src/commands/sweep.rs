@@ -279,6 +279,19 @@ pub fn summary(report: &SweepReport) -> String {
             sm.beyond_3_sigma
         );
     }
+    if let [Some(one), Some(two)] = &sm.coverage_per_output {
+        let _ = writeln!(
+            s,
+            "  per output: {:.1}% / {:.1}% within 2 sigma, RMS error/sigma {:.2} / {:.2}",
+            100.0 * one.within_2_sigma,
+            100.0 * two.within_2_sigma,
+            one.rms_t,
+            two.rms_t
+        );
+    }
+    for n in &sm.notes {
+        let _ = writeln!(s, "{n}");
+    }
     for d in report.devices.iter().filter(|d| !d.failed.is_empty()) {
         let _ = writeln!(s, "{}", device_line(d));
     }

@@ -9,7 +9,7 @@ use crate::device::GyroParams;
 use crate::error::Error;
 use crate::identify::Identified;
 use crate::knowns::Knowns;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Relative 1-sigma uncertainties of the self-calibrated scale factors,
 /// per output, by source, and their quadrature sum.
@@ -17,7 +17,7 @@ use serde::Serialize;
 /// A drive-gain ratio the cycle could not measure (no quadrature coupling
 /// at rest, no `[drive_probe]`) is the design's, with the datasheet's
 /// `drive_gain_ratio_uncertainty` in `drive_ratio`.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct SfUncertainty {
     /// The staircase slope's noise (`staircase`), with the coverage
     /// factor of its degrees of freedom.
@@ -51,19 +51,44 @@ pub struct SfUncertainty {
 }
 
 impl SfUncertainty {
+    /// The sources' names, in the order [`SfUncertainty::terms`] gives
+    /// them: the JSON's keys.
+    pub const TERMS: [&'static str; 6] = [
+        "staircase",
+        "identified",
+        "angular_gain",
+        "drive_ratio",
+        "cycle_rate",
+        "clock",
+    ];
+
+    /// Output `k`'s terms, named as [`SfUncertainty::TERMS`].
+    ///
+    /// ```
+    /// use gyrocal_host::selfcal::SfUncertainty;
+    /// let u = SfUncertainty { cycle_rate: [0.0, 3e-3], staircase: [1e-4, 4e-3], ..Default::default() }
+    ///     .with_total();
+    /// assert_eq!(u.terms(1)[4], ("cycle_rate", 3e-3));
+    /// assert!((u.total[1] - 5e-3).abs() < 1e-15);
+    /// ```
+    pub fn terms(&self, k: usize) -> [(&'static str, f64); 6] {
+        let values = [
+            self.staircase[k],
+            self.identified[k],
+            self.angular_gain[k],
+            self.drive_ratio[k],
+            self.cycle_rate[k],
+            self.clock[k],
+        ];
+        std::array::from_fn(|i| (Self::TERMS[i], values[i]))
+    }
+
     /// The quadrature sum into `total`.
     pub fn with_total(mut self) -> Self {
         self.total = std::array::from_fn(|k| {
-            [
-                self.staircase[k],
-                self.identified[k],
-                self.angular_gain[k],
-                self.drive_ratio[k],
-                self.cycle_rate[k],
-                self.clock[k],
-            ]
-            .into_iter()
-            .fold(0.0, f64::hypot)
+            self.terms(k)
+                .into_iter()
+                .fold(0.0, |sum: f64, (_, term)| sum.hypot(term))
         });
         self
     }

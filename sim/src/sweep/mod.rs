@@ -27,6 +27,7 @@ pub mod summary;
 use crate::error::{FieldError, ScenarioError};
 use crate::field::scenario::{self, IdentifiedJson, Scenario};
 use crate::gyro::GyroParams;
+use gyrocal_host::selfcal::SfUncertainty;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use spread::{Drawn, Spread, SpreadError};
@@ -150,6 +151,9 @@ pub struct DeviceStep {
     pub sf_selfcal_uncertainty: [f64; 2],
     /// The error's own 1-sigma (the truth's in quadrature).
     pub selfcal_error_uncertainty: [f64; 2],
+    /// `sf_selfcal_uncertainty` by source (the field step's
+    /// `selfcal.sf_selfcal_uncertainty`).
+    pub sf_selfcal_budget: SfUncertainty,
     /// The truth: the rate table's slope (z LSB per deg/s).
     pub sf_true_per_dps: [f64; 2],
     /// What the host identified.
@@ -302,6 +306,7 @@ impl Sweep {
                     sf_selfcal_error: st.selfcal_error,
                     sf_selfcal_uncertainty: st.sf_selfcal_uncertainty,
                     selfcal_error_uncertainty: st.selfcal_error_uncertainty,
+                    sf_selfcal_budget: st.selfcal.sf_selfcal_uncertainty,
                     sf_true_per_dps: st.sf_true_per_dps,
                     identified: st.identified,
                 }));

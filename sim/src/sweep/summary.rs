@@ -11,6 +11,14 @@
 //! - **Coverage**: over every finished step and output, the fraction of
 //!   |error| within 2 of its reported sigmas (`selfcal_error_uncertainty`),
 //!   and how many lie beyond 3.
+//! - **Per output**, the same and the RMS of error / sigma
+//!   ([`OutputCoverage`]); where that RMS lies outside the band honest
+//!   sigmas leave it in, a line says so and names the budget's term that
+//!   was largest at most steps: a warning where the sigmas are narrower
+//!   than the errors, a note where they are wider (they cover, and promise
+//!   less than the parts do: the consumer example's output 2, whose sigma
+//!   allows for a rate or a damping coupling too small to see, which
+//!   parts at rest do not have).
 //! - **Warnings**, one line each: every distinct warning of the parts'
 //!   field runs (an input no sigma covers, as `gyrocal field` prints it)
 //!   with how many parts and which carry it, and the errors that lie
@@ -18,7 +26,10 @@
 //!   error is never left to a fraction alone.
 
 use super::DeviceResult;
-pub use crate::coverage::{NAMED, Scored, beyond_three_sigma, named, uncovered_errors};
+pub use crate::coverage::{
+    NAMED, OutputCoverage, Scored, SigmaFit, beyond_three_sigma, named, uncovered_errors,
+};
+use gyrocal_host::selfcal::SfUncertainty;
 use serde::{Deserialize, Serialize};
 
 /// The percentiles reported, in percent.
@@ -46,9 +57,46 @@ pub struct Summary {
     pub within_2_sigma: Option<f64>,
     /// How many |error| lie beyond 3 reported sigmas.
     pub beyond_3_sigma: u32,
+    /// Each output's coverage (null when none of its steps finished).
+    pub coverage_per_output: [Option<OutputCoverage>; 2],
     /// One line each: the parts' distinct warnings ([`carried_warnings`]),
-    /// then the errors beyond 3 sigma ([`uncovered_errors`]).
+    /// then the errors beyond 3 sigma ([`uncovered_errors`]), then an
+    /// output whose sigmas are narrower than its errors
+    /// ([`OutputCoverage::line`]).
     pub warnings: Vec<String>,
+    /// One line each: an output whose sigmas are wider than its errors
+    /// ([`OutputCoverage::line`]).
+    pub notes: Vec<String>,
+}
+
+/// The name of the largest term of a step's error sigma for output `k`:
+/// one of `budget`'s sources ([`SfUncertainty::TERMS`]) or "truth", the
+/// rate table's own sigma (`error_sigma`'s part beyond `budget.total`).
+fn largest_term(budget: &SfUncertainty, error_sigma: f64, k: usize) -> &'static str {
+    let truth = (error_sigma.powi(2) - budget.total[k].powi(2))
+        .max(0.0)
+        .sqrt();
+    budget
+        .terms(k)
+        .into_iter()
+        .chain([("truth", truth)])
+        .fold(("truth", -1.0), |a, b| if b.1 > a.1 { b } else { a })
+        .0
+}
+
+/// For output `k`, each term that was the largest ([`largest_term`]) at
+/// some finished step, and at how many, most first.
+fn largest_terms(devices: &[DeviceResult], k: usize) -> Vec<(&'static str, u32)> {
+    let mut counts: Vec<(&'static str, u32)> = vec![];
+    for st in devices.iter().flat_map(|d| &d.steps) {
+        let name = largest_term(&st.sf_selfcal_budget, st.selfcal_error_uncertainty[k], k);
+        match counts.iter_mut().find(|(n, _)| *n == name) {
+            Some((_, c)) => *c += 1,
+            None => counts.push((name, 1)),
+        }
+    }
+    counts.sort_by_key(|c| std::cmp::Reverse(c.1));
+    counts
 }
 
 /// Each distinct warning of `parts` (index, the warnings of its field run)
@@ -153,6 +201,16 @@ impl Summary {
             devices.len(),
         );
         warnings.extend(uncovered_errors(&beyond, scored.len()));
+        let coverage_per_output = [0, 1].map(|k| OutputCoverage::of(&scored, k));
+        let mut notes = vec![];
+        for c in coverage_per_output.iter().flatten() {
+            let line = c.line(&largest_terms(devices, c.output));
+            match c.fit() {
+                SigmaFit::Fits => {}
+                SigmaFit::Wider => notes.extend(line),
+                SigmaFit::Narrower => warnings.extend(line),
+            }
+        }
         let has = !sorted[0].is_empty();
         Self {
             devices: devices.len() as u32,
@@ -179,7 +237,9 @@ impl Summary {
                 within as f64 / scored.len() as f64
             }),
             beyond_3_sigma: beyond.len() as u32,
+            coverage_per_output,
             warnings,
+            notes,
         }
     }
 }
@@ -280,6 +340,7 @@ mod tests {
             "sf_selfcal_error": [1e-4 * t[0], 1e-4 * t[1]],
             "sf_selfcal_uncertainty": [1e-4, 1e-4],
             "selfcal_error_uncertainty": [1e-4, 1e-4],
+            "sf_selfcal_budget": SfUncertainty { staircase: [1e-4; 2], ..Default::default() }.with_total(),
             "sf_true_per_dps": [1.0, 1.0],
             "identified": identified,
         });
@@ -318,11 +379,60 @@ mod tests {
                  (-3.200 sigma)",
             ]
         );
+        // Output 1's RMS error/sigma, 2.12 over three parts, is within
+        // what three honest sigmas give (up to 2.18): no line.
+        let one = sm.coverage_per_output[0].unwrap();
+        assert!((one.rms_t - 2.1213).abs() < 1e-4);
+        assert!(
+            (one.rms_band().1 - 2.18).abs() < 0.01,
+            "{:?}",
+            one.rms_band()
+        );
+        assert!(sm.notes.is_empty());
         assert!(
             Summary::of(&[part(0, [0.5, 2.9], &[])], 1e-3)
                 .warnings
                 .is_empty()
         );
+    }
+
+    /// Forty parts whose output 2 errors are a tenth of their sigmas: a
+    /// note names the output and the term, and output 1 (errors the size
+    /// of their sigmas) has no line.
+    #[test]
+    fn an_output_whose_sigmas_are_wider_than_its_errors_is_noted() {
+        let parts: Vec<DeviceResult> = (0..40)
+            .map(|i| {
+                let t = if i % 2 == 0 { 1.0 } else { -1.0 };
+                part(i, [t, 0.1 * t], &[])
+            })
+            .collect();
+        let sm = Summary::of(&parts, 1e-3);
+        assert!(sm.warnings.is_empty(), "{:?}", sm.warnings);
+        let [one, two] = sm.coverage_per_output.map(Option::unwrap);
+        assert_eq!((one.rms_t, one.parts, two.errors), (1.0, 40, 40));
+        assert!((two.rms_t - 0.1).abs() < 1e-12 && two.within_2_sigma == 1.0);
+        assert_eq!(
+            sm.notes,
+            [
+                "note: output 2's sigmas are wider than its errors: RMS error/sigma 0.10 over 40 \
+              errors of 40 parts (0.70 to 1.32 if each sigma were its error's spread), 100.0% \
+              within 2 sigma; the largest term of its sigma: staircase at 40"
+            ]
+        );
+    }
+
+    /// The truth's own sigma is named where it is the largest.
+    #[test]
+    fn the_largest_term_may_be_the_truths() {
+        let b = SfUncertainty {
+            cycle_rate: [3e-4, 0.0],
+            staircase: [1e-4, 0.0],
+            ..Default::default()
+        }
+        .with_total();
+        assert_eq!(largest_term(&b, b.total[0], 0), "cycle_rate");
+        assert_eq!(largest_term(&b, 5e-4, 0), "truth");
     }
 
     #[test]
