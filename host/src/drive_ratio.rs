@@ -727,6 +727,67 @@ mod tests {
         (knowns, op, id)
     }
 
+    /// `settled` stops where a round moves the ratio by at most
+    /// `RATIO_CONVERGED` of its sigma, and a swing that never settles is
+    /// `unsettled`'s error with the last move, never the last ratio:
+    /// - rounds that halve the distance to 1.02 settle within the rounds;
+    /// - rounds that swing between 0.44 and 2.27 (the probe near a damping
+    ///   coupling's rate, the doc comment's case) end in the error after
+    ///   `RATIO_MAX_ROUNDS`, its step the swing in sigmas;
+    /// - a round's own error stops the rounds at once.
+    #[test]
+    fn rounds_that_do_not_settle_are_an_error_not_a_figure() {
+        let at = |value: f64| DriveRatio {
+            relative: Estimate {
+                value,
+                uncertainty: 1e-4,
+            },
+            phase_deg: Estimate {
+                value: 0.0,
+                uncertainty: 0.1,
+            },
+            cross_over_direct: 0.1,
+            clocks: 0,
+        };
+        let mut rounds = 0;
+        let halving = settled(
+            at(1.1),
+            |r| {
+                rounds += 1;
+                Ok::<_, f64>(at(1.02 + (r.relative.value - 1.02) / 2.0))
+            },
+            |_, step| step,
+        )
+        .unwrap();
+        assert!((halving.relative.value - 1.02).abs() <= 1e-7, "{halving:?}");
+        assert!(rounds < RATIO_MAX_ROUNDS, "{rounds} rounds");
+        let mut rounds = 0;
+        let swing = settled(
+            at(2.27),
+            |r| {
+                rounds += 1;
+                Ok::<_, f64>(at(if r.relative.value > 1.0 { 0.44 } else { 2.27 }))
+            },
+            |last, step| {
+                assert!(last.relative.value == 0.44 || last.relative.value == 2.27);
+                step
+            },
+        );
+        assert_eq!(rounds, RATIO_MAX_ROUNDS);
+        let step = swing.unwrap_err();
+        assert!((step - 1.83e4).abs() < 1.0, "{step}");
+        let mut rounds = 0;
+        let stopped = settled(
+            at(1.0),
+            |_| {
+                rounds += 1;
+                Err(-1.0)
+            },
+            |_, step| step,
+        );
+        assert_eq!((stopped.unwrap_err(), rounds), (-1.0, 1));
+    }
+
     /// The ratio's spur share (`from_windows` with the lines) against the
     /// error a line leaves on it (`coupling::tests::line_error_rms`: 4000
     /// draws of its phases, the RMS of 4000 draws scattering by about
