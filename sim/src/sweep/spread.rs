@@ -28,7 +28,9 @@
 //! section does not move the other parameters' draws. The device's noise
 //! seeds (`[frontend] seed`, `[noise] seed`) come from the same generator,
 //! after the parameters: each device has its own noise, as each part off a
-//! line does. Its board's oscillator error (`clock_error_ppm`, an `sd` in
+//! line does. They are below 2^63, so each fits a TOML integer (an i64)
+//! and the part's field file (`Sweep::part_file`) holds them as they are.
+//! Its board's oscillator error (`clock_error_ppm`, an `sd` in
 //! ppm around `[drive] clock_error_ppm`) is drawn last, after the seeds,
 //! so the key leaves every other draw where it was.
 
@@ -186,6 +188,13 @@ impl Sd {
             }),
         }
     }
+}
+
+/// A drawn seed as a TOML integer holds it: its top 63 bits (TOML integers
+/// are i64, and a seed at or above 2^63 would make the part's field file
+/// unreadable).
+fn toml_seed(bits: u64) -> u64 {
+    bits >> 1
 }
 
 /// What device `i` is: its parameters and its noise seeds.
@@ -430,8 +439,8 @@ impl Spread {
                 quadrature_dps,
                 damping_coupling_dps,
             },
-            frontend_seed: rng.next_u64(),
-            noise_seed: rng.next_u64(),
+            frontend_seed: toml_seed(rng.next_u64()),
+            noise_seed: toml_seed(rng.next_u64()),
             clock_error_ppm: {
                 let z: f64 = StandardNormal.sample(&mut rng);
                 self.clock_sd(0.0)? * z
@@ -482,6 +491,21 @@ mod tests {
         }
         let other = Spread { seed: 8, ..s };
         assert_ne!(other.draw(&n, 0).unwrap().gyro.q1, a[0].gyro.q1);
+    }
+
+    /// Every seed fits a TOML integer (an i64), so a part's field file
+    /// holds it: over 2000 seeds a draw of the full 64 bits would have put
+    /// about 1000 at or above 2^63.
+    #[test]
+    fn seeds_fit_a_toml_integer() {
+        let s = spread("devices = 1000\nf1_hz = { sd = 40.0 }");
+        let n = nominal();
+        for i in 0..1000 {
+            let d = s.draw(&n, i).unwrap();
+            for seed in [d.frontend_seed, d.noise_seed] {
+                assert!(i64::try_from(seed).is_ok(), "device {i}: seed {seed}");
+            }
+        }
     }
 
     #[test]
