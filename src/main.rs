@@ -45,7 +45,8 @@ enum Command {
     /// or without --board the file's device simulated in process.
     Calibrate(commands::calibrate::Args),
     /// Self-calibrate a production spread of devices (TOML with `[spread]`),
-    /// whole or one shard (`--shard I/N`); `sweep merge` joins the shards.
+    /// whole or one shard (`--shard I/N`); `sweep merge` joins the shards,
+    /// `sweep part` prints one part as a `field` file.
     Sweep(commands::sweep::Args),
     /// Measure an IEEE 952/1431-style datasheet: ARW, bias instability,
     /// rate random walk, Allan deviation with confidence intervals, scale

@@ -384,23 +384,38 @@ fn a_datasheet_q_far_off_is_found_or_named() {
 
 /// A datasheet lambda 10% below the part's, claimed within 1%: the
 /// self-calibrated scale factors are off by many of their sigmas, and the
-/// report says so in one line naming each error and the input to check.
-/// With the datasheet's lambda right, the same run says nothing of it.
+/// report says so in one line naming each error and the input to check;
+/// the quadrature coupling (30 deg/s), read in deg/s through that lambda,
+/// is off too, and a second line names it. With the datasheet's lambda
+/// right, the same run says nothing of either.
 #[test]
 fn an_error_its_sigma_does_not_cover_is_said() {
     let drift = "[drift]\ntemperatures_c = [25]\ntcf1_ppm_per_k = -30\ntcf2_ppm_per_k = -30\n";
+    let gyro = GOOD.replacen(
+        "angular_gain = 0.8\n",
+        "angular_gain = 0.8\nquadrature_dps = 30\n",
+        1,
+    );
     let dir = tempfile::tempdir().unwrap();
     let config = dir.path().join("lambda_off.toml");
     let line = "warning: 2 of 2 errors lie beyond 3 of their reported sigmas";
+    let quadrature = "warning: 1 of 5 identified parameters lie beyond 3 of their reported sigmas, \
+                      which do not cover them: at 25 deg C quadrature (+";
     for (lambda, said) in [(0.72, true), (0.8, false)] {
         let datasheet = format!(
             "[datasheet]\nangular_gain = {lambda}\nangular_gain_uncertainty = 0.01\n\
              drive_gain_ratio_uncertainty = 0.005\n"
         );
-        std::fs::write(&config, format!("{GOOD}{drift}{datasheet}")).unwrap();
+        std::fs::write(&config, format!("{gyro}{drift}{datasheet}")).unwrap();
         let report = field_json(config.as_os_str());
         assert_eq!(
             warnings_starting(&report, line),
+            usize::from(said),
+            "lambda {lambda}: {}",
+            report["warnings"]
+        );
+        assert_eq!(
+            warnings_starting(&report, quadrature),
             usize::from(said),
             "lambda {lambda}: {}",
             report["warnings"]

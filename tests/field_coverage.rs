@@ -85,6 +85,7 @@
 mod random_device;
 
 use gyrocal_hdl::host::traffic::Rng;
+use gyrocal_sim::coverage::{Figure, Parameter};
 use gyrocal_sim::field::scenario::{self, FieldReport};
 use random_device::{FAST, RandomDevice};
 use std::collections::HashMap;
@@ -236,40 +237,27 @@ fn t_values(r: &FieldReport) -> Vec<f64> {
         .collect()
 }
 
-/// The identified parameters with a truth, as `identified_t` names them.
+/// The identified parameters with a truth (`Parameter::ALL`), as
+/// `identified_t` names them.
 const IDENTIFIED: [&str; 6] = ["f1", "f2", "Q1", "Q2", "quadrature", "damping"];
 
 /// Those whose coverage the test asserts (`identified_coverage`).
 const ASSERTED: [&str; 4] = ["f1", "f2", "Q1", "Q2"];
 
 /// The identified parameters that have a truth, as (name, t = error /
-/// sigma) for each step: f1, f2, Q1, Q2 and the quadrature coupling
-/// against the device at that step.
-fn identified_t(r: &FieldReport) -> Vec<(&'static str, f64)> {
+/// sigma) for each step, against the device at that step: what the
+/// sweep's summary scores (`IdentifiedJson::scored`; the damping coupling
+/// only on a device that has one).
+fn identified_t(r: &FieldReport) -> Vec<Named> {
     r.steps
         .iter()
-        .flat_map(|s| {
-            let (id, g) = (&s.identified, &s.truth.gyro);
-            [
-                ("f1", (id.f1_hz - g.f1_hz) / id.f1_hz_uncertainty),
-                ("f2", (id.f2_hz - g.f2_hz) / id.f2_hz_uncertainty),
-                ("Q1", (id.q1 - g.q1) / id.q1_uncertainty),
-                ("Q2", (id.q2 - g.q2) / id.q2_uncertainty),
-                (
-                    "quadrature",
-                    (id.quadrature_dps - g.quadrature_dps) / id.quadrature_dps_uncertainty,
-                ),
-                (
-                    "damping",
-                    (id.damping_coupling_dps - g.damping_coupling_dps)
-                        / id.damping_coupling_dps_uncertainty,
-                ),
-            ]
-            .into_iter()
-            // A damping coupling seen as none is reported as exactly 0
-            // (`selfcal::DAMPING_SEEN`): on a device without one its t is
-            // 0 by construction and says nothing of the sigma.
-            .filter(|p| p.0 != "damping" || g.damping_coupling_dps != 0.0)
+        .flat_map(|s| s.identified.scored(None, s.temperature_c, &s.truth.gyro))
+        .map(|s| match s.figure {
+            Figure::Parameter(p) => {
+                let i = Parameter::ALL.iter().position(|&q| q == p).unwrap();
+                (IDENTIFIED[i], s.t)
+            }
+            Figure::Output(_) => unreachable!("scored identifies parameters only"),
         })
         .collect()
 }

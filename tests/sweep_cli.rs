@@ -104,6 +104,29 @@ fn shards_run_by_slurm_and_gnu_parallel_merge_into_the_unsharded_sweep() {
         let within = t.iter().filter(|t| t.abs() <= 2.0).count() as f64 / 5.0;
         assert_eq!(c["within_2_sigma"].as_f64().unwrap(), within);
     }
+    // Each identified parameter's coverage is its steps' identified value
+    // against the step's truth, over its sigma.
+    for (key, name) in [("f2_hz", "f2"), ("q1", "q1")] {
+        let t: Vec<f64> = devices
+            .iter()
+            .flat_map(|d| d["steps"].as_array().unwrap())
+            .map(|s| {
+                let id = &s["identified"];
+                (id[key].as_f64().unwrap() - s["truth"][key].as_f64().unwrap())
+                    / id[format!("{key}_uncertainty")].as_f64().unwrap()
+            })
+            .collect();
+        let c = summary["coverage_per_parameter"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|c| c["parameter"] == name)
+            .unwrap_or_else(|| panic!("{name} in {summary}"));
+        let rms = (t.iter().map(|t| t * t).sum::<f64>() / t.len() as f64).sqrt();
+        assert!((c["rms_t"].as_f64().unwrap() - rms).abs() < 1e-12, "{c}");
+        let beyond = t.iter().filter(|t| t.abs() > 3.0).count();
+        assert!(beyond as u64 <= summary["parameters_beyond_3_sigma"].as_u64().unwrap());
+    }
     assert!(report["shard"].is_null());
     let csv = read(&full_dir.join("sweep.csv"));
     assert_eq!(csv.lines().count(), 1 + 5, "a header and a row per device");
@@ -206,6 +229,55 @@ fn two_parts_json(extra: &str) -> serde_json::Value {
 fn strings(v: &serde_json::Value) -> Vec<&str> {
     let list = v.as_array().unwrap_or_else(|| panic!("not a list: {v}"));
     list.iter().map(|w| w.as_str().unwrap()).collect()
+}
+
+/// Any part of a sweep runs again alone: `gyrocal sweep part` prints it as
+/// a field file, and `gyrocal field` on that file gives the figures the
+/// sweep gave the part, to the bit, at every step: its device, its noise
+/// (seeds below 2^63, which a TOML integer holds) and its oscillator.
+#[test]
+fn a_part_printed_by_sweep_part_runs_alone_to_the_sweeps_figures() {
+    let drift = "[drift]\ntemperatures_c = [25, 40]\ntcf1_ppm_per_k = -30\ntcf2_ppm_per_k = -31\n";
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("two_parts.toml");
+    let text = SWEEP.replace(
+        "devices = 5",
+        "devices = 2\nclock_error_ppm = { sd = 50.0 }",
+    );
+    std::fs::write(&config, text + drift).unwrap();
+    let config = config.to_str().unwrap();
+    let report = json_object(gyrocal(&["sweep", "--config", config, "--json"]));
+    let o = gyrocal(&["sweep", "part", "--config", config, "--index", "1"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let part = dir.path().join("part1.toml");
+    std::fs::write(&part, &o.stdout).unwrap();
+    let field = json_object(gyrocal(&[
+        "field",
+        "--config",
+        part.to_str().unwrap(),
+        "--json",
+    ]));
+    let swept = report["devices"][1]["steps"].as_array().unwrap();
+    let alone = field["steps"].as_array().unwrap();
+    assert_eq!(swept.len(), 2);
+    assert_eq!(alone.len(), 2);
+    for (s, f) in swept.iter().zip(alone) {
+        assert_eq!(s["temperature_c"], f["temperature_c"]);
+        assert_eq!(s["sf_selfcal_error"], f["selfcal_error"], "{s}\n{f}");
+        for key in ["sf_selfcal_uncertainty", "sf_true_per_dps"] {
+            assert_eq!(s[key], f[key], "{key}");
+        }
+    }
+    // A part the spread does not have: one line, exit status 2, no file.
+    let o = gyrocal(&["sweep", "part", "--config", config, "--index", "2"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(o.stdout.is_empty());
+    let err = stderr(&o);
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(
+        err.contains("--index 2: the spread has parts 0 to 1"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -371,6 +443,8 @@ fn bad_sweep_input_is_refused_in_one_line() {
 /// Parts whose datasheet lambda is 10% low, claimed within 1%: every
 /// error lies beyond 3 sigma. The summary names them by part in its one
 /// line; the parts' own field line saying the same is not carried as well.
+/// The quadrature coupling, read in deg/s through that lambda, lies
+/// beyond 3 too, and its line names the datasheet's lambda.
 #[test]
 fn uncovered_errors_are_named_once_by_part() {
     let report = two_parts_json(
@@ -378,9 +452,22 @@ fn uncovered_errors_are_named_once_by_part() {
          drive_gain_ratio_uncertainty = 0.005\n",
     );
     let warnings = strings(&report["summary"]["warnings"]);
+    let parameters: Vec<&&str> = warnings
+        .iter()
+        .filter(|w| w.contains("identified parameters lie beyond 3"))
+        .collect();
+    assert_eq!(parameters.len(), 1, "{warnings:#?}");
+    assert!(
+        parameters[0].contains("device 0 at 25 deg C quadrature (+")
+            && parameters[0].contains("device 1 at 25 deg C quadrature (+")
+            && parameters[0]
+                .ends_with("through [datasheet] angular_gain, within its angular_gain_uncertainty"),
+        "{}",
+        parameters[0]
+    );
     let beyond: Vec<&&str> = warnings
         .iter()
-        .filter(|w| w.contains("lie beyond 3"))
+        .filter(|w| w.contains("errors lie beyond 3"))
         .collect();
     assert_eq!(beyond.len(), 1, "{warnings:#?}");
     assert!(

@@ -1,9 +1,10 @@
 //! Whether reported sigmas cover their errors, in one line: the errors
-//! beyond 3 of their sigmas, each named by its step and output (and its
-//! part, in a sweep). `gyrocal field` says it for one device
+//! beyond 3 of their sigmas, each named by its step and figure (an output,
+//! or an identified parameter; and its part, in a sweep). `gyrocal field`
+//! says it for one device
 //! (`crate::field::scenario::uncovered_error_warning`), `gyrocal sweep`
-//! over the spread (`crate::sweep::summary`), which also says, per output,
-//! whether the sigmas are the size of their errors ([`OutputCoverage`]).
+//! over the spread (`crate::sweep::summary`), which also says, per figure,
+//! whether the sigmas are the size of their errors ([`Coverage`]).
 
 use serde::{Deserialize, Serialize};
 use statrs::distribution::{ChiSquared, ContinuousCDF};
@@ -27,7 +28,71 @@ pub fn named<T: std::fmt::Display>(items: &[T]) -> String {
     s
 }
 
-/// An error and its sigma: which part (in a sweep), step and output.
+/// An identified parameter that has a truth to score it against.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Parameter {
+    /// Mode 1's frequency.
+    F1,
+    /// Mode 2's frequency.
+    F2,
+    /// Mode 1's Q.
+    Q1,
+    /// Mode 2's Q.
+    Q2,
+    /// The quadrature (stiffness) coupling, measured at rest.
+    Quadrature,
+    /// The damping coupling.
+    Damping,
+}
+
+impl Parameter {
+    /// Every parameter, in the order the summary lists them.
+    pub const ALL: [Parameter; 6] = [
+        Parameter::F1,
+        Parameter::F2,
+        Parameter::Q1,
+        Parameter::Q2,
+        Parameter::Quadrature,
+        Parameter::Damping,
+    ];
+}
+
+impl std::fmt::Display for Parameter {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Parameter::F1 => "f1",
+            Parameter::F2 => "f2",
+            Parameter::Q1 => "Q1",
+            Parameter::Q2 => "Q2",
+            Parameter::Quadrature => "quadrature",
+            Parameter::Damping => "damping coupling",
+        })
+    }
+}
+
+/// What an error is of: an output's self-calibrated scale factor, or an
+/// identified parameter. In JSON one key, `"output": 0` or `"parameter":
+/// "f2"`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Figure {
+    /// Output 0 or 1's scale factor.
+    Output(usize),
+    /// An identified parameter.
+    Parameter(Parameter),
+}
+
+impl std::fmt::Display for Figure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Figure::Output(k) => write!(f, "output {}", k + 1),
+            Figure::Parameter(p) => write!(f, "{p}"),
+        }
+    }
+}
+
+/// An error and its sigma: which part (in a sweep), step and figure.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Scored {
     /// The part's index (`None`: the one device of a field run).
@@ -35,8 +100,8 @@ pub struct Scored {
     /// The step's temperature (deg C; NaN for a device without one,
     /// `gyrocal calibrate` of a file without `[drift]`: not named).
     pub temperature_c: f64,
-    /// The output, 0 or 1.
-    pub output: usize,
+    /// What the error is of.
+    pub figure: Figure,
     /// Error over its reported sigma.
     pub t: f64,
 }
@@ -52,7 +117,7 @@ impl Scored {
         std::array::from_fn(|output| Scored {
             device,
             temperature_c,
-            output,
+            figure: Figure::Output(output),
             t: error[output] / sigma[output],
         })
     }
@@ -66,7 +131,7 @@ impl std::fmt::Display for Scored {
         if self.temperature_c.is_finite() {
             write!(f, "at {} deg C ", self.temperature_c)?;
         }
-        write!(f, "output {} ({:+.3} sigma)", self.output + 1, self.t)
+        write!(f, "{} ({:+.3} sigma)", self.figure, self.t)
     }
 }
 
@@ -78,9 +143,36 @@ pub fn beyond_three_sigma(scored: &[Scored]) -> Vec<Scored> {
 /// One line naming `beyond` ([`beyond_three_sigma`] of `total` errors),
 /// or None when there are none.
 pub fn uncovered_errors(beyond: &[Scored], total: usize) -> Option<String> {
+    uncovered(beyond, total, "errors")
+}
+
+/// [`uncovered_errors`] of identified parameters against the truth: the
+/// line names each parameter, and where a coupling is among them, the
+/// input outside the budget that most often puts it there: the couplings
+/// are read in deg/s through lambda, which is the datasheet's.
+pub fn uncovered_parameters(beyond: &[Scored], total: usize) -> Option<String> {
+    let coupling = beyond.iter().any(|s| {
+        matches!(
+            s.figure,
+            Figure::Parameter(Parameter::Quadrature | Parameter::Damping)
+        )
+    });
+    uncovered(beyond, total, "identified parameters").map(|line| {
+        if coupling {
+            format!(
+                "{line}; the couplings are read in deg/s through [datasheet] angular_gain, \
+                 within its angular_gain_uncertainty"
+            )
+        } else {
+            line
+        }
+    })
+}
+
+fn uncovered(beyond: &[Scored], total: usize, what: &str) -> Option<String> {
     (!beyond.is_empty()).then(|| {
         format!(
-            "warning: {} of {total} errors lie beyond 3 of their reported sigmas, which do not cover them: {}",
+            "warning: {} of {total} {what} lie beyond 3 of their reported sigmas, which do not cover them: {}",
             beyond.len(),
             named(beyond)
         )
@@ -100,17 +192,19 @@ pub fn uncovered_selfcal_errors(scored: &[Scored]) -> Option<String> {
     })
 }
 
-/// How one output's errors sit within their reported sigmas over many
-/// steps: the promise is 90 to 99.5% within 2 sigma and none beyond 3,
-/// and a sigma much wider than its errors breaks it too.
+/// How one figure's errors (an output's, or an identified parameter's)
+/// sit within their reported sigmas over many steps: the promise is 90 to
+/// 99.5% within 2 sigma and none beyond 3, and a sigma much wider than its
+/// errors breaks it too.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct OutputCoverage {
-    /// The output, 0 or 1.
-    pub output: usize,
+pub struct Coverage {
+    /// What the errors are of (JSON: `output` or `parameter`).
+    #[serde(flatten)]
+    pub figure: Figure,
     /// How many errors (steps).
     pub errors: u32,
     /// How many parts they come from: the degrees of freedom of
-    /// [`OutputCoverage::rms_band`], since one part's steps share its
+    /// [`Coverage::rms_band`], since one part's steps share its
     /// identification and need not be independent.
     pub parts: u32,
     /// Fraction of the errors within 2 of their sigmas.
@@ -119,15 +213,15 @@ pub struct OutputCoverage {
     pub rms_t: f64,
 }
 
-/// Probability of each side of [`OutputCoverage::rms_band`]: a standard
+/// Probability of each side of [`Coverage::rms_band`]: a standard
 /// normal's within 3, so that for one part the upper side is |t| <= 3,
 /// the promise itself; the band narrows as the parts grow.
 pub const RMS_BAND_PROBABILITY: f64 = 0.997_300_203_936_74;
 
-/// Where an output's sigmas lie against its errors' spread.
+/// Where a figure's sigmas lie against its errors' spread.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SigmaFit {
-    /// Within [`OutputCoverage::rms_band`]: the sigma is the errors' size.
+    /// Within [`Coverage::rms_band`]: the sigma is the errors' size.
     Fits,
     /// The RMS of error / sigma below the band: the sigma is wider than
     /// the errors (it covers them, and promises less than the device does).
@@ -136,11 +230,10 @@ pub enum SigmaFit {
     Narrower,
 }
 
-impl OutputCoverage {
-    /// Output `output`'s coverage over `scored` (None without an error of
-    /// it).
-    pub fn of(scored: &[Scored], output: usize) -> Option<Self> {
-        let t: Vec<&Scored> = scored.iter().filter(|s| s.output == output).collect();
+impl Coverage {
+    /// `figure`'s coverage over `scored` (None without an error of it).
+    pub fn of(scored: &[Scored], figure: Figure) -> Option<Self> {
+        let t: Vec<&Scored> = scored.iter().filter(|s| s.figure == figure).collect();
         if t.is_empty() {
             return None;
         }
@@ -149,7 +242,7 @@ impl OutputCoverage {
         parts.sort_unstable();
         parts.dedup();
         Some(Self {
-            output,
+            figure,
             errors: t.len() as u32,
             parts: parts.len() as u32,
             within_2_sigma: t.iter().filter(|s| s.t.abs() <= 2.0).count() as f64 / n,
@@ -166,11 +259,11 @@ impl OutputCoverage {
     /// part's steps move together.
     ///
     /// ```
-    /// use gyrocal_sim::coverage::OutputCoverage;
-    /// let c = OutputCoverage { output: 1, errors: 100, parts: 100, within_2_sigma: 1.0, rms_t: 0.24 };
+    /// use gyrocal_sim::coverage::{Coverage, Figure};
+    /// let c = Coverage { figure: Figure::Output(1), errors: 100, parts: 100, within_2_sigma: 1.0, rms_t: 0.24 };
     /// let (low, high) = c.rms_band();
     /// assert!((low - 0.807).abs() < 1e-3 && (high - 1.199).abs() < 1e-3, "{low} {high}");
-    /// let one = OutputCoverage { parts: 1, ..c };
+    /// let one = Coverage { parts: 1, ..c };
     /// assert!((one.rms_band().1 - 3.0).abs() < 1e-9, "{:?}", one.rms_band());
     /// ```
     pub fn rms_band(&self) -> (f64, f64) {
@@ -181,7 +274,7 @@ impl OutputCoverage {
         (at(tail), at(1.0 - tail))
     }
 
-    /// Whether the sigmas fit the errors' spread ([`OutputCoverage::rms_band`]).
+    /// Whether the sigmas fit the errors' spread ([`Coverage::rms_band`]).
     pub fn fit(&self) -> SigmaFit {
         let (low, high) = self.rms_band();
         if self.rms_t < low {
@@ -193,10 +286,10 @@ impl OutputCoverage {
         }
     }
 
-    /// One line when the sigmas do not fit ([`OutputCoverage::fit`]): a
+    /// One line when the sigmas do not fit ([`Coverage::fit`]): a
     /// warning where they are narrower than the errors, a note where wider,
-    /// with `largest`, the budget terms that were each step's largest and
-    /// at how many steps, most first.
+    /// with `largest` (where not empty), the budget terms that were each
+    /// step's largest and at how many steps, most first.
     pub fn line(&self, largest: &[(&str, u32)]) -> Option<String> {
         let (kind, size) = match self.fit() {
             SigmaFit::Fits => return None,
@@ -209,11 +302,16 @@ impl OutputCoverage {
             .map(|(name, steps)| format!("{name} at {steps}"))
             .collect::<Vec<_>>()
             .join(", ");
+        let terms = if terms.is_empty() {
+            terms
+        } else {
+            format!("; the largest term of its sigma: {terms}")
+        };
         Some(format!(
-            "{kind}: output {}'s sigmas are {size} than its errors: RMS error/sigma {:.2} over {} errors \
-             of {} parts ({low:.2} to {high:.2} if each sigma were its error's spread), {:.1}% within 2 sigma; \
-             the largest term of its sigma: {terms}",
-            self.output + 1,
+            "{kind}: {}'s sigmas are {size} than its errors: RMS error/sigma {:.2} over {} errors \
+             of {} parts ({low:.2} to {high:.2} if each sigma were its error's spread), {:.1}% within 2 sigma\
+             {terms}",
+            self.figure,
             self.rms_t,
             self.errors,
             self.parts,
@@ -230,7 +328,7 @@ mod tests {
         Scored {
             device: Some(device),
             temperature_c: 25.0,
-            output,
+            figure: Figure::Output(output),
             t,
         }
     }
@@ -250,7 +348,7 @@ mod tests {
                 .enumerate()
                 .map(|(i, &t)| scored(i as u32, 1, scale * t))
                 .collect();
-            OutputCoverage::of(&s, 1).unwrap()
+            Coverage::of(&s, Figure::Output(1)).unwrap()
         };
         assert_eq!(at(1.0).fit(), SigmaFit::Fits, "{:?}", at(1.0));
         assert_eq!(at(1.0).line(&[]), None);
@@ -273,7 +371,7 @@ mod tests {
                 .unwrap()
                 .starts_with("warning: output 2's sigmas are narrower")
         );
-        assert_eq!(OutputCoverage::of(&[scored(0, 0, 1.0)], 1), None);
+        assert_eq!(Coverage::of(&[scored(0, 0, 1.0)], Figure::Output(1)), None);
     }
 
     /// The degrees of freedom are the parts: ten steps of one part whose
@@ -281,12 +379,12 @@ mod tests {
     #[test]
     fn one_parts_steps_are_one_degree_of_freedom() {
         let s: Vec<Scored> = (0..10).map(|_| scored(7, 0, 0.3)).collect();
-        let c = OutputCoverage::of(&s, 0).unwrap();
+        let c = Coverage::of(&s, Figure::Output(0)).unwrap();
         assert_eq!((c.errors, c.parts), (10, 1));
         assert_eq!(c.fit(), SigmaFit::Fits);
         let apart: Vec<Scored> = (0..10).map(|i| scored(i, 0, 0.3)).collect();
         assert_eq!(
-            OutputCoverage::of(&apart, 0).unwrap().fit(),
+            Coverage::of(&apart, Figure::Output(0)).unwrap().fit(),
             SigmaFit::Wider
         );
     }

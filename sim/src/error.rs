@@ -267,6 +267,10 @@ pub enum ScenarioError {
         "{0}: missing [drift]: `gyrocal field` needs its temperature steps (temperatures_c, tcf1_ppm_per_k, tcf2_ppm_per_k)"
     )]
     NoDrift(String),
+    /// A scenario that TOML cannot hold (the serializer's message), as a
+    /// seed of 2^63 or more would be.
+    #[error("the scenario cannot be written as a field file: {0}")]
+    Unwritable(String),
 }
 
 /// What the device of a `gyrocal serve` or `gyrocal calibrate` file

@@ -19,7 +19,8 @@
 //! `datasheet_warning`, which moves no figure but names the input; a design
 //! drive-gain ratio that no `[datasheet] drive_gain_ratio_uncertainty`
 //! bounds, `design_ratio_warning`; self-cal errors beyond 3 of their
-//! sigmas, `uncovered_error_warning`), and per step `carrier_fold`: the
+//! sigmas, `uncovered_error_warning`, and identified parameters beyond 3
+//! of theirs, `uncovered_parameter_warning`), and per step `carrier_fold`: the
 //! nearest fold of the carrier tables' errors, whether it is in the
 //! passband, and `static_fold`, a short fold slower than a window, whose
 //! error no sigma sees. `--out` writes field.json, field.csv and

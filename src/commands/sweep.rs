@@ -1,7 +1,8 @@
 //! `gyrocal sweep --config FILE [--shard I/N] [--json] [--out DIR]`:
 //! self-calibration over a production spread (`gyrocal_sim::sweep`), and
 //! `gyrocal sweep merge PARTS... [--json] [--out DIR]`, which joins the
-//! shards' JSON reports into the unsharded one.
+//! shards' JSON reports into the unsharded one, and `gyrocal sweep part
+//! --config FILE --index I`, which prints part I as a `gyrocal field` file.
 //!
 //! The file holds the sections of `gyrocal field` (`[drift]` optional:
 //! without it each device is calibrated at the factory temperature alone)
@@ -59,6 +60,20 @@ pub enum Sub {
     /// Join the JSON reports of a sweep's shards (`--shard I/N --json`) into
     /// the report of the unsharded sweep.
     Merge(MergeArgs),
+    /// Print part I of a sweep as a `gyrocal field` file (TOML on stdout):
+    /// `gyrocal field` runs it again alone, to the sweep's figures.
+    Part(PartArgs),
+}
+
+/// Options of `gyrocal sweep part`.
+#[derive(clap::Args)]
+pub struct PartArgs {
+    /// The sweep's file (with `[spread]`).
+    #[arg(long)]
+    pub config: PathBuf,
+    /// The part, as the sweep's `index` (from 0).
+    #[arg(long)]
+    pub index: u32,
 }
 
 /// Options of `gyrocal sweep merge`.
@@ -73,8 +88,10 @@ pub struct MergeArgs {
 
 /// Run the sweep, or merge.
 pub fn run(args: &Args) -> Result<(), Failure> {
-    if let Some(Sub::Merge(m)) = &args.merge {
-        return merge(m);
+    match &args.merge {
+        Some(Sub::Merge(m)) => return merge(m),
+        Some(Sub::Part(p)) => return part(p),
+        None => {}
     }
     let Some(path) = &args.config else {
         return Err(Failure::Input(
@@ -134,6 +151,19 @@ fn device_line(d: &sweep::DeviceResult) -> String {
         (_, Some(f)) => format!("device {}: FAILED ({}): {}", d.index, f.stage, f.error),
         (None, None) => format!("device {}: no step", d.index),
     }
+}
+
+/// `gyrocal sweep part`: the part's field file, printed whole or not at all.
+fn part(p: &PartArgs) -> Result<(), Failure> {
+    let (name, text) = super::experiment::read_config(&p.config)?;
+    let sw = sweep::parse(&name, &text).map_err(Failure::input)?;
+    let file = sw.part_file(p.index).map_err(Failure::input)?;
+    print!(
+        "# Part {} of the sweep {name} (`gyrocal sweep part`): run it alone with\n\
+         # `gyrocal field --config FILE`.\n{file}",
+        p.index
+    );
+    Ok(())
 }
 
 fn merge(m: &MergeArgs) -> Result<(), Failure> {
@@ -287,6 +317,26 @@ pub fn summary(report: &SweepReport) -> String {
             100.0 * two.within_2_sigma,
             one.rms_t,
             two.rms_t
+        );
+    }
+    if !sm.coverage_per_parameter.is_empty() {
+        let c = &sm.coverage_per_parameter;
+        let figures: u32 = c.iter().map(|c| c.errors).sum();
+        let within: f64 = c
+            .iter()
+            .map(|c| c.within_2_sigma * f64::from(c.errors))
+            .sum();
+        let rms = c
+            .iter()
+            .map(|c| format!("{} {:.2}", c.figure, c.rms_t))
+            .collect::<Vec<_>>()
+            .join(", ");
+        let _ = writeln!(
+            s,
+            "identified parameters against the truth: {:.1}% of {figures} within 2 sigma, {} beyond 3; \
+             RMS error/sigma {rms}",
+            100.0 * within / f64::from(figures),
+            sm.parameters_beyond_3_sigma
         );
     }
     for n in &sm.notes {

@@ -31,7 +31,7 @@ use super::probe::DriveProbe;
 use super::profile::{self, ClippedRecords, Profile, ProfileRun, RateTrace};
 use crate::config::{self, Experiment};
 use crate::config::{Drive, Filter, Frontend, Points};
-use crate::coverage::{Scored, uncovered_selfcal_errors};
+use crate::coverage::{Scored, beyond_three_sigma, uncovered_parameters, uncovered_selfcal_errors};
 use crate::drift::{DeviceAt, Drift};
 use crate::engine::Engine;
 use crate::error::{ConfigError, FieldError, RunError, ScenarioError};
@@ -64,7 +64,7 @@ const TABLE_FIRST_TAUS: f64 = 30.0;
 
 /// A scenario file: the sections of `gyrocal run` plus `[drift]` and,
 /// optionally, `[profile]` and `[drive_probe]`.
-#[derive(Deserialize)]
+#[derive(Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 struct ScenarioFile {
     gyro: GyroParams,
@@ -76,15 +76,15 @@ struct ScenarioFile {
     experiment: Points,
     #[serde(default)]
     noise: ThermalNoise,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     drift: Option<Drift>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     profile: Option<Profile>,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     drive_probe: Option<DriveProbe>,
     #[serde(default)]
     datasheet: Datasheet,
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     spread: Option<Spread>,
 }
 
@@ -154,6 +154,28 @@ pub(crate) fn parse_file(
 pub const FACTORY_C: f64 = 25.0;
 
 impl Scenario {
+    /// The scenario as a `gyrocal field` file: [`parse`] reads it back to
+    /// this scenario, every value to the bit (floats are written in their
+    /// shortest round-trip form). How `gyrocal sweep part` hands a user one
+    /// part of a spread to run again alone.
+    pub fn to_toml(&self) -> Result<String, ScenarioError> {
+        let exp = self.exp.clone();
+        let file = ScenarioFile {
+            gyro: exp.gyro,
+            drive: exp.drive,
+            frontend: exp.frontend,
+            filter: exp.filter,
+            experiment: exp.points,
+            noise: exp.noise,
+            drift: Some(self.drift.clone()),
+            profile: self.profile.clone(),
+            drive_probe: self.drive_probe.clone(),
+            datasheet: exp.datasheet,
+            spread: None,
+        };
+        toml::to_string(&file).map_err(|e| ScenarioError::Unwritable(e.to_string()))
+    }
+
     /// Checks the experiment (as `gyrocal run` does), the drift over the
     /// device, the profile and the drive probe: one line naming the key.
     pub fn validate(&self) -> Result<(), ConfigError> {
@@ -311,6 +333,51 @@ pub struct IdentifiedJson {
     pub drive_gain_ratio: Option<f64>,
     /// Its 1-sigma uncertainty (null without it).
     pub drive_gain_ratio_uncertainty: Option<f64>,
+}
+
+impl IdentifiedJson {
+    /// Each parameter that has a truth, its error against `truth` (the
+    /// device at the step) over its reported sigma: f1, f2, Q1, Q2, the
+    /// quadrature coupling, and the damping coupling where the device has
+    /// one (one seen as none is reported as exactly 0,
+    /// `selfcal::DAMPING_SEEN`: on a device without it that t is 0 by
+    /// construction and says nothing of the sigma). A figure not measured
+    /// (a null coupling) is left out.
+    pub fn scored(
+        &self,
+        device: Option<u32>,
+        temperature_c: f64,
+        truth: &GyroParams,
+    ) -> Vec<Scored> {
+        use crate::coverage::{Figure, Parameter};
+        let g = truth;
+        [
+            (Parameter::F1, self.f1_hz - g.f1_hz, self.f1_hz_uncertainty),
+            (Parameter::F2, self.f2_hz - g.f2_hz, self.f2_hz_uncertainty),
+            (Parameter::Q1, self.q1 - g.q1, self.q1_uncertainty),
+            (Parameter::Q2, self.q2 - g.q2, self.q2_uncertainty),
+            (
+                Parameter::Quadrature,
+                self.quadrature_dps - g.quadrature_dps,
+                self.quadrature_dps_uncertainty,
+            ),
+            (
+                Parameter::Damping,
+                self.damping_coupling_dps - g.damping_coupling_dps,
+                self.damping_coupling_dps_uncertainty,
+            ),
+        ]
+        .into_iter()
+        .filter(|p| p.0 != Parameter::Damping || g.damping_coupling_dps != 0.0)
+        .filter(|p| p.1.is_finite() && p.2.is_finite())
+        .map(|(p, error, sigma)| Scored {
+            device,
+            temperature_c,
+            figure: Figure::Parameter(p),
+            t: error / sigma,
+        })
+        .collect()
+    }
 }
 
 impl From<&SelfCal> for IdentifiedJson {
@@ -471,6 +538,17 @@ pub fn uncovered_error_warning(steps: &[FieldStep]) -> Option<String> {
         })
         .collect();
     uncovered_selfcal_errors(&scored)
+}
+
+/// The identified parameters (against the simulated truth) that lie
+/// beyond 3 of their reported sigmas ([`IdentifiedJson::scored`]): one
+/// line naming each by step and parameter, or None.
+pub fn uncovered_parameter_warning(steps: &[FieldStep]) -> Option<String> {
+    let scored: Vec<Scored> = steps
+        .iter()
+        .flat_map(|st| st.identified.scored(None, st.temperature_c, &st.truth.gyro))
+        .collect();
+    uncovered_parameters(&beyond_three_sigma(&scored), scored.len())
 }
 
 /// The steps whose profile runs clipped an ADC (`RateTrace::clipped`):
@@ -1110,6 +1188,7 @@ pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldRepor
         profile_clip_warning(&steps),
         baseline_clip_warning,
         uncovered_error_warning(&steps),
+        uncovered_parameter_warning(&steps),
     ]
     .into_iter()
     .flatten()

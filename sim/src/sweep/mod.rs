@@ -60,6 +60,14 @@ pub enum SweepError {
     /// Shard reports that do not make one sweep.
     #[error("merge: {0}")]
     Merge(String),
+    /// A part asked of `gyrocal sweep part` that the spread does not have.
+    #[error("--index {index}: the spread has parts 0 to {last} (`devices` = {devices})", last = devices - 1)]
+    NoSuchPart {
+        /// The part asked.
+        index: u32,
+        /// The spread's `devices` (at least 1).
+        devices: u32,
+    },
 }
 
 /// A checked sweep: the scenario every device runs (around the nominal
@@ -158,6 +166,9 @@ pub struct DeviceStep {
     pub sf_true_per_dps: [f64; 2],
     /// What the host identified.
     pub identified: IdentifiedJson,
+    /// The device at this step (never seen by the host): what `identified`
+    /// is scored against ([`IdentifiedJson::scored`]).
+    pub truth: GyroParams,
 }
 
 impl DeviceStep {
@@ -266,6 +277,25 @@ impl Sweep {
         sc
     }
 
+    /// Part `index` as a `gyrocal field` file: its drawn parameters, its
+    /// seeds, its oscillator and the one datasheet of the nominal device,
+    /// so that `gyrocal field` runs it again alone and gets the figures
+    /// the sweep gave it. A scenario without `[drift]` gets the single step
+    /// at the factory temperature its sweep ran.
+    pub fn part_file(&self, index: u32) -> Result<String, SweepError> {
+        if index >= self.spread.devices {
+            return Err(SweepError::NoSuchPart {
+                index,
+                devices: self.spread.devices,
+            });
+        }
+        let drawn = self
+            .spread
+            .draw(&self.scenario.exp.gyro, index)
+            .expect("the spread was validated by `parse`");
+        Ok(self.device_scenario(&drawn).to_toml()?)
+    }
+
     /// Run device `index`: draw it, run its field scenario, keep every
     /// step and every failure.
     pub fn run_device(&self, index: u32) -> DeviceResult {
@@ -291,11 +321,15 @@ impl Sweep {
             }),
             Ok(report) => {
                 clocks = report.clocks;
-                // The summary names every uncovered error of the spread
-                // itself (`summary::uncovered_errors`), by part.
-                let uncovered = scenario::uncovered_error_warning(&report.steps);
+                // The summary names every uncovered error, and identified
+                // parameter, of the spread itself
+                // (`summary::uncovered_errors`), by part.
+                let uncovered = [
+                    scenario::uncovered_error_warning(&report.steps),
+                    scenario::uncovered_parameter_warning(&report.steps),
+                ];
                 warnings = report.warnings;
-                warnings.retain(|w| Some(w) != uncovered.as_ref());
+                warnings.retain(|w| !uncovered.contains(&Some(w.clone())));
                 failed.extend(report.failed.into_iter().map(|f| DeviceFailure {
                     temperature_c: Some(f.temperature_c),
                     stage: f.stage.into(),
@@ -309,6 +343,7 @@ impl Sweep {
                     sf_selfcal_budget: st.selfcal.sf_selfcal_uncertainty,
                     sf_true_per_dps: st.sf_true_per_dps,
                     identified: st.identified,
+                    truth: st.truth.gyro,
                 }));
             }
         }
@@ -518,6 +553,35 @@ mod tests {
                      sigma out from [drive] clock_error_ppm = 30 stays within 10000 ppm"
                 ),
             "{err}"
+        );
+    }
+
+    /// `part_file` gives each part's scenario back through `gyrocal
+    /// field`'s parser, to the bit: its drawn device, seeds (below 2^63,
+    /// which TOML's i64 holds), oscillator, datasheet and the single
+    /// factory step of a file without `[drift]`. A part beyond `devices`
+    /// is one line.
+    #[test]
+    fn a_parts_field_file_reads_back_to_its_scenario() {
+        let text = format!(
+            "{FILE}f1_hz = {{ sd = 40.0 }}\nq1 = {{ rel_sd = 0.1 }}\n\
+             angular_gain = {{ rel_sd = 0.02 }}\nclock_error_ppm = {{ sd = 100.0 }}\n"
+        );
+        let sweep = parse("s.toml", &text).unwrap();
+        let nominal = &sweep.scenario.exp.gyro;
+        for i in 0..4 {
+            let file = sweep.part_file(i).unwrap();
+            let back =
+                scenario::parse("part.toml", &file).unwrap_or_else(|e| panic!("{e}\n{file}"));
+            let drawn = sweep.spread.draw(nominal, i).unwrap();
+            assert_eq!(back, sweep.device_scenario(&drawn), "{file}");
+            assert_eq!(back.exp.frontend.seed, drawn.frontend_seed);
+            assert_eq!(back.drift.temperatures_c, [scenario::FACTORY_C]);
+        }
+        let err = sweep.part_file(4).unwrap_err().to_string();
+        assert_eq!(
+            err,
+            "--index 4: the spread has parts 0 to 3 (`devices` = 4)"
         );
     }
 }

@@ -12,7 +12,7 @@
 //!   |error| within 2 of its reported sigmas (`selfcal_error_uncertainty`),
 //!   and how many lie beyond 3.
 //! - **Per output**, the same and the RMS of error / sigma
-//!   ([`OutputCoverage`]); where that RMS lies outside the band honest
+//!   ([`Coverage`]); where that RMS lies outside the band honest
 //!   sigmas leave it in, a line says so and names the budget's term that
 //!   was largest at most steps: a warning where the sigmas are narrower
 //!   than the errors, a note where they are wider (they cover, and promise
@@ -24,10 +24,17 @@
 //!   with how many parts and which carry it, and the errors that lie
 //!   beyond 3 of their sigmas, each named. A sigma that does not cover its
 //!   error is never left to a fraction alone.
+//! - **Identified parameters** (f1, f2, Q1, Q2, the couplings) against
+//!   each step's device ([`IdentifiedJson::scored`]): per parameter the
+//!   same coverage, the ones beyond 3 sigma named in a warning, and a line
+//!   where a parameter's sigmas are not the size of its errors.
+//!
+//! [`IdentifiedJson::scored`]: crate::field::scenario::IdentifiedJson::scored
 
 use super::DeviceResult;
 pub use crate::coverage::{
-    NAMED, OutputCoverage, Scored, SigmaFit, beyond_three_sigma, named, uncovered_errors,
+    Coverage, Figure, NAMED, Parameter, Scored, SigmaFit, beyond_three_sigma, named,
+    uncovered_errors, uncovered_parameters,
 };
 use gyrocal_host::selfcal::SfUncertainty;
 use serde::{Deserialize, Serialize};
@@ -58,14 +65,20 @@ pub struct Summary {
     /// How many |error| lie beyond 3 reported sigmas.
     pub beyond_3_sigma: u32,
     /// Each output's coverage (null when none of its steps finished).
-    pub coverage_per_output: [Option<OutputCoverage>; 2],
+    pub coverage_per_output: [Option<Coverage>; 2],
+    /// Each identified parameter's coverage against the truth, for the
+    /// parameters that have figures ([`Parameter::ALL`] order).
+    pub coverage_per_parameter: Vec<Coverage>,
+    /// How many identified parameters lie beyond 3 of their sigmas.
+    pub parameters_beyond_3_sigma: u32,
     /// One line each: the parts' distinct warnings ([`carried_warnings`]),
     /// then the errors beyond 3 sigma ([`uncovered_errors`]), then an
     /// output whose sigmas are narrower than its errors
-    /// ([`OutputCoverage::line`]).
+    /// ([`Coverage::line`]), then the same of the identified parameters
+    /// ([`uncovered_parameters`]).
     pub warnings: Vec<String>,
-    /// One line each: an output whose sigmas are wider than its errors
-    /// ([`OutputCoverage::line`]).
+    /// One line each: an output, or an identified parameter, whose sigmas
+    /// are wider than its errors ([`Coverage::line`]).
     pub notes: Vec<String>,
 }
 
@@ -201,15 +214,17 @@ impl Summary {
             devices.len(),
         );
         warnings.extend(uncovered_errors(&beyond, scored.len()));
-        let coverage_per_output = [0, 1].map(|k| OutputCoverage::of(&scored, k));
+        let coverage_per_output = [0, 1].map(|k| Coverage::of(&scored, Figure::Output(k)));
         let mut notes = vec![];
-        for c in coverage_per_output.iter().flatten() {
-            let line = c.line(&largest_terms(devices, c.output));
-            match c.fit() {
-                SigmaFit::Fits => {}
-                SigmaFit::Wider => notes.extend(line),
-                SigmaFit::Narrower => warnings.extend(line),
+        for (k, c) in coverage_per_output.iter().enumerate() {
+            if let Some(c) = c {
+                sort_line(c, &largest_terms(devices, k), &mut warnings, &mut notes);
             }
+        }
+        let parameters = ParameterScores::of(devices);
+        warnings.extend(parameters.uncovered);
+        for c in &parameters.coverage {
+            sort_line(c, &[], &mut warnings, &mut notes);
         }
         let has = !sorted[0].is_empty();
         Self {
@@ -238,8 +253,59 @@ impl Summary {
             }),
             beyond_3_sigma: beyond.len() as u32,
             coverage_per_output,
+            coverage_per_parameter: parameters.coverage,
+            parameters_beyond_3_sigma: parameters.beyond,
             warnings,
             notes,
+        }
+    }
+}
+
+/// `c`'s line ([`Coverage::line`]), if any, into `warnings` where its
+/// sigmas are narrower than its errors, into `notes` where wider.
+fn sort_line(
+    c: &Coverage,
+    largest: &[(&str, u32)],
+    warnings: &mut Vec<String>,
+    notes: &mut Vec<String>,
+) {
+    let line = c.line(largest);
+    match c.fit() {
+        SigmaFit::Fits => {}
+        SigmaFit::Wider => notes.extend(line),
+        SigmaFit::Narrower => warnings.extend(line),
+    }
+}
+
+/// The identified parameters of every finished step against its truth.
+struct ParameterScores {
+    /// Per parameter with figures, in [`Parameter::ALL`] order.
+    coverage: Vec<Coverage>,
+    /// How many lie beyond 3 sigma.
+    beyond: u32,
+    /// The line naming them.
+    uncovered: Option<String>,
+}
+
+impl ParameterScores {
+    fn of(devices: &[DeviceResult]) -> Self {
+        let scored: Vec<Scored> = devices
+            .iter()
+            .flat_map(|d| {
+                d.steps.iter().flat_map(|s| {
+                    s.identified
+                        .scored(Some(d.index), s.temperature_c, &s.truth)
+                })
+            })
+            .collect();
+        let beyond = beyond_three_sigma(&scored);
+        Self {
+            coverage: Parameter::ALL
+                .iter()
+                .filter_map(|&p| Coverage::of(&scored, Figure::Parameter(p)))
+                .collect(),
+            beyond: beyond.len() as u32,
+            uncovered: uncovered_parameters(&beyond, scored.len()),
         }
     }
 }
@@ -316,19 +382,31 @@ mod tests {
     }
 
     /// A finished part with one step at 5 deg C: errors `t` times a sigma
-    /// of 1e-4, and its field run's `warnings`.
+    /// of 1e-4, and its field run's `warnings`. Its identified parameters
+    /// lie one sigma off the truth, high on an even part, low on an odd
+    /// one: honest sigmas, without a line.
     fn part(index: u32, t: [f64; 2], warnings: &[&str]) -> DeviceResult {
+        let off = if index % 2 == 0 { 0.1 } else { -0.1 };
+        part_identified(index, t, warnings, [off; 5])
+    }
+
+    /// `part` whose f1, f2, Q1, Q2 and quadrature lie `off` from the
+    /// truth, each with a sigma of 0.1.
+    fn part_identified(index: u32, t: [f64; 2], warnings: &[&str], off: [f64; 5]) -> DeviceResult {
+        let truth = [1e4, 1.01e4, 1e3, 1e3, 0.0, 0.0, 0.0];
         let identified: serde_json::Map<String, serde_json::Value> = [
             "f1_hz",
             "f2_hz",
             "q1",
             "q2",
-            "loop_phase_deg",
             "quadrature_dps",
+            "loop_phase_deg",
             "damping_coupling_dps",
         ]
         .iter()
-        .flat_map(|k| [(k.to_string(), 1.0), (format!("{k}_uncertainty"), 0.1)])
+        .zip(truth)
+        .zip(off.iter().chain(&[0.0; 2]))
+        .flat_map(|((k, v), off)| [(k.to_string(), v + off), (format!("{k}_uncertainty"), 0.1)])
         .map(|(k, v)| (k, serde_json::json!(v)))
         .chain(
             ["drive_gain_ratio", "drive_gain_ratio_uncertainty"]
@@ -343,6 +421,7 @@ mod tests {
             "sf_selfcal_budget": SfUncertainty { staircase: [1e-4; 2], ..Default::default() }.with_total(),
             "sf_true_per_dps": [1.0, 1.0],
             "identified": identified,
+            "truth": { "f1_hz": 1e4, "f2_hz": 1.01e4, "q1": 1e3, "q2": 1e3, "angular_gain": 0.8 },
         });
         serde_json::from_value(serde_json::json!({
             "index": index,
@@ -422,6 +501,57 @@ mod tests {
         );
     }
 
+    /// An identified parameter beyond 3 of its sigmas is named, by part,
+    /// step and parameter; one whose sigmas are far wider than its errors
+    /// is noted; the rest, a sigma off, have no line.
+    #[test]
+    fn identified_parameters_beyond_three_sigma_are_named() {
+        let mut parts: Vec<DeviceResult> = (0..40)
+            .map(|i| {
+                let (off, t) = if i % 2 == 0 { (0.1, 1.0) } else { (-0.1, -1.0) };
+                // Q2's sigma is ten times its error.
+                part_identified(i, [t, t], &[], [off, off, off, 0.1 * off, off])
+            })
+            .collect();
+        parts[7] = part_identified(7, [-1.0, -1.0], &[], [-0.1, -0.34, -0.1, -0.01, -0.1]);
+        let sm = Summary::of(&parts, 1e-3);
+        assert_eq!(sm.parameters_beyond_3_sigma, 1);
+        assert_eq!(
+            sm.warnings,
+            [
+                "warning: 1 of 200 identified parameters lie beyond 3 of their reported sigmas, \
+                 which do not cover them: device 7 at 5 deg C f2 (-3.400 sigma)"
+            ]
+        );
+        let names: Vec<String> = sm
+            .coverage_per_parameter
+            .iter()
+            .map(|c| c.figure.to_string())
+            .collect();
+        assert_eq!(
+            names,
+            ["f1", "f2", "Q1", "Q2", "quadrature"],
+            "no damping coupling to score"
+        );
+        let q2 = sm.coverage_per_parameter[3];
+        assert_eq!((q2.errors, q2.parts), (40, 40));
+        assert!((q2.rms_t - 0.1).abs() < 1e-9, "{q2:?}");
+        assert_eq!(sm.notes.len(), 1, "{:?}", sm.notes);
+        assert!(
+            sm.notes[0]
+                .starts_with("note: Q2's sigmas are wider than its errors: RMS error/sigma 0.10")
+                && sm.notes[0].ends_with("100.0% within 2 sigma"),
+            "{}",
+            sm.notes[0]
+        );
+        // In JSON each coverage names its figure in one key.
+        let json = serde_json::to_value(&sm).unwrap();
+        assert_eq!(json["coverage_per_parameter"][1]["parameter"], "f2");
+        assert_eq!(json["coverage_per_output"][1]["output"], 1);
+        let back: Summary = serde_json::from_value(json).unwrap();
+        assert_eq!(back, sm);
+    }
+
     /// The truth's own sigma is named where it is the largest.
     #[test]
     fn the_largest_term_may_be_the_truths() {
@@ -440,7 +570,7 @@ mod tests {
         let at = |device, t| Scored {
             device: Some(device),
             temperature_c: 5.0,
-            output: 0,
+            figure: Figure::Output(0),
             t,
         };
         let uncovered =
