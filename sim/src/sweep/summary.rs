@@ -386,7 +386,7 @@ mod tests {
     /// lie one sigma off the truth, high on an even part, low on an odd
     /// one: honest sigmas, without a line.
     fn part(index: u32, t: [f64; 2], warnings: &[&str]) -> DeviceResult {
-        let off = if index % 2 == 0 { 0.1 } else { -0.1 };
+        let off = if index.is_multiple_of(2) { 0.1 } else { -0.1 };
         part_identified(index, t, warnings, [off; 5])
     }
 
@@ -506,9 +506,13 @@ mod tests {
     /// is noted; the rest, a sigma off, have no line.
     #[test]
     fn identified_parameters_beyond_three_sigma_are_named() {
-        let mut parts: Vec<DeviceResult> = (0..40)
+        let mut parts: Vec<DeviceResult> = (0..40u32)
             .map(|i| {
-                let (off, t) = if i % 2 == 0 { (0.1, 1.0) } else { (-0.1, -1.0) };
+                let (off, t) = if i.is_multiple_of(2) {
+                    (0.1, 1.0)
+                } else {
+                    (-0.1, -1.0)
+                };
                 // Q2's sigma is ten times its error.
                 part_identified(i, [t, t], &[], [off, off, off, 0.1 * off, off])
             })
