@@ -85,7 +85,7 @@
 mod random_device;
 
 use gyrocal_hdl::host::traffic::Rng;
-use gyrocal_sim::coverage::{Figure, Parameter};
+use gyrocal_sim::coverage::Figure;
 use gyrocal_sim::field::scenario::{self, FieldReport};
 use random_device::{FAST, RandomDevice};
 use std::collections::HashMap;
@@ -237,8 +237,8 @@ fn t_values(r: &FieldReport) -> Vec<f64> {
         .collect()
 }
 
-/// The identified parameters with a truth (`Parameter::ALL`), as
-/// `identified_t` names them.
+/// The identified parameters with a truth, in `Parameter`'s order (its
+/// discriminant is the index), as `identified_t` names them.
 const IDENTIFIED: [&str; 6] = ["f1", "f2", "Q1", "Q2", "quadrature", "damping"];
 
 /// Those whose coverage the test asserts (`identified_coverage`).
@@ -253,10 +253,7 @@ fn identified_t(r: &FieldReport) -> Vec<Named> {
         .iter()
         .flat_map(|s| s.identified.scored(None, s.temperature_c, &s.truth.gyro))
         .map(|s| match s.figure {
-            Figure::Parameter(p) => {
-                let i = Parameter::ALL.iter().position(|&q| q == p).unwrap();
-                (IDENTIFIED[i], s.t)
-            }
+            Figure::Parameter(p) => (IDENTIFIED[p as usize], s.t),
             Figure::Output(_) => unreachable!("scored identifies parameters only"),
         })
         .collect()

@@ -289,21 +289,20 @@ impl Sweep {
                 devices: self.spread.devices,
             });
         }
-        let drawn = self
-            .spread
+        Ok(self.device_scenario(&self.drawn(index)).to_toml()?)
+    }
+
+    /// Part `index` as the spread draws it around the nominal device.
+    fn drawn(&self, index: u32) -> Drawn {
+        self.spread
             .draw(&self.scenario.exp.gyro, index)
-            .expect("the spread was validated by `parse`");
-        Ok(self.device_scenario(&drawn).to_toml()?)
+            .expect("the spread was validated by `parse`")
     }
 
     /// Run device `index`: draw it, run its field scenario, keep every
     /// step and every failure.
     pub fn run_device(&self, index: u32) -> DeviceResult {
-        let nominal = &self.scenario.exp.gyro;
-        let drawn = self
-            .spread
-            .draw(nominal, index)
-            .expect("the spread was validated by `parse`");
+        let drawn = self.drawn(index);
         let sc = self.device_scenario(&drawn);
         let mut failed = vec![];
         let mut steps = vec![];
@@ -329,7 +328,7 @@ impl Sweep {
                     scenario::uncovered_parameter_warning(&report.steps),
                 ];
                 warnings = report.warnings;
-                warnings.retain(|w| !uncovered.contains(&Some(w.clone())));
+                warnings.retain(|w| !uncovered.iter().flatten().any(|u| u == w));
                 failed.extend(report.failed.into_iter().map(|f| DeviceFailure {
                     temperature_c: Some(f.temperature_c),
                     stage: f.stage.into(),
