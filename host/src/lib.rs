@@ -30,6 +30,7 @@
 
 pub mod average;
 pub mod board;
+mod carrier_lines;
 pub mod clip;
 pub mod coupling;
 pub mod datasheet;
