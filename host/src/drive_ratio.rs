@@ -688,6 +688,7 @@ mod tests {
             scanned: false,
             sweep: vec![],
             waited_s: 0.0,
+            spur_sd: vec![],
             c: C64::new(1.0, 0.0),
             front: Default::default(),
             residual_sd: 0.0,

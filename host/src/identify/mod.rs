@@ -59,12 +59,13 @@
 //!    bandwidths each side of each mode), and a phase sloping across a
 //!    resonance narrows it (2 deg of pick-off lag
 //!    had put Q 0.86 phi high on every device, and its misfit had doubled
-//!    fk's sigma). Uncertainties: the larger of the residuals' (variance
+//!    fk's sigma). Uncertainties: the largest of the residuals' (variance
 //!    times the inverse normal matrix, propagated to Qk = fk / bk and
-//!    phi = -arg C) and a jackknife over the carriers, then in quadrature
-//!    the waits' bounds, the delay's sigma, the bound of the front end's
-//!    unmeasurable gain slope and its weighting of the DAC's images
-//!    (`with_uncertainty`).
+//!    phi = -arg C), a jackknife over the carriers, and the table core's
+//!    carrier lines in each point with the noise the residuals leave
+//!    beside them (`spurs`), then in quadrature the waits' sigmas, the
+//!    delay's sigma, the bound of the front end's unmeasurable gain slope
+//!    and its weighting of the DAC's images (`with_uncertainty`).
 //!
 //! The loop phase is read off the line through the two modes' phi at the
 //! operating carrier (both references go through one REF_PHASE, so one
@@ -82,6 +83,8 @@ mod fit;
 mod front;
 mod probe;
 mod search;
+mod spurs;
+pub use spurs::point_spur_sd;
 
 use crate::board::Board;
 use crate::device::GyroParams;
@@ -130,6 +133,12 @@ pub fn settling_residue(bk_hz: f64, waited_s: f64) -> f64 {
 /// 0.519 at worst over C's phase and seven modes, from the fit itself
 /// (`fit::tests::the_ref_phase_residue_moves_the_estimates_within_its_bound`).
 pub const REF_STEP_PULL: [f64; 3] = [0.2, 0.4, 0.55];
+/// The same pulls' RMS over C's phase, which no sweep chooses, and the
+/// seven modes: 0.131, 0.261 and 0.500 (the same test). What the
+/// uncertainty takes as the residue's 1-sigma (`sweep_uncertainty`): the
+/// pull of fk and Q turns with C's phase as a sine does (RMS the peak
+/// over sqrt 2), the phase's hardly at all.
+pub const REF_STEP_SD: [f64; 3] = [0.14, 0.28, 0.52];
 /// Most coarse-search moves before giving up.
 pub const MAX_MOVES: usize = 12;
 /// Half-width of the fallback scan, relative to the guessed frequency:
@@ -242,6 +251,12 @@ pub struct ModeFit {
     /// bound (`settling_residue`).
     #[serde(skip)]
     pub waited_s: f64,
+    /// The 1-sigma per real component of the error the table core's
+    /// carrier lines can put on each `sweep` point (ADC LSB per drive LSB,
+    /// [`point_spur_sd`]); empty on the fine core or for a sweep not
+    /// measured here.
+    #[serde(skip)]
+    pub spur_sd: Vec<f64>,
     /// C of the fitted form (ADC LSB per drive LSB, times Hz^2).
     #[serde(skip)]
     pub c: C64,
@@ -474,6 +489,23 @@ fn attempt(
     };
     fit.waited_s = probe.waited_s();
     fit.scanned = scanned;
+    // The amplitude only falls during the sweep (`Prober::measure`): its
+    // last value is the smallest, whose lines are the largest part of Y.
+    // Each carrier is measured twice (up and down): its lines once.
+    let amplitude = probe.amplitude();
+    let mut relative: Vec<(f64, f64)> = Vec::with_capacity(FINE_POINTS);
+    fit.spur_sd = Vec::with_capacity(sweep.len());
+    for &(f, y) in &sweep {
+        let sd = match relative.iter().find(|r| r.0 == f) {
+            Some(&(_, sd)) => sd,
+            None => {
+                let sd = point_spur_sd(knowns, k, f, amplitude, centre, bk)?;
+                relative.push((f, sd));
+                sd
+            }
+        };
+        fit.spur_sd.push(sd * y.norm());
+    }
     Ok(Ok((fit, probe.clocks)))
 }
 
@@ -502,6 +534,7 @@ pub(crate) fn refit(
         reason: reason.to_string(),
     })?;
     fit.waited_s = mode.waited_s;
+    fit.spur_sd = mode.spur_sd.clone();
     fit.scanned = mode.scanned;
     fit.probe = mode.probe.clone();
     fit.probed_delay_s = front::probed_delay(&fit, clock_hz, pull);
@@ -513,8 +546,15 @@ pub(crate) fn refit(
 /// takes every point's noise as alike, the jackknife over carriers
 /// (`fit::jackknife`, with the front end's `slope` the fit took) sees noise
 /// that differs from point to point and misfits that move with the
-/// carrier, and the larger of the two is taken; then in quadrature the
-/// waits' bounds (`settling_residue`, `REF_STEP_PULL`).
+/// carrier, and the larger of the two is taken, or the larger still
+/// that the sweep's noise and the table core's carrier lines give through
+/// the fit (`spur_sd`, `fit::noise_and_lines`: the lines counted once,
+/// where the residuals saw them or not); then in quadrature the waits'
+/// terms: the filter's residue after the REF_PHASE step at its RMS over
+/// C's phase (`REF_STEP_SD`), and the resonator's settling residue, a
+/// bound (`settling_residue`) on a bias that lies anywhere within it (the
+/// up and down sweeps cancel it to first order), at the 1-sigma of a
+/// rectangular distribution over it, the bound over sqrt 3 (GUM 4.3.7).
 pub(crate) fn sweep_uncertainty(
     fit: &ModeFit,
     clock_hz: f64,
@@ -523,11 +563,13 @@ pub(crate) fn sweep_uncertainty(
 ) -> [f64; 3] {
     let jk = fit::jackknife(&fit.sweep, fit, Some(clock_hz), pull, slope);
     let (bk, q) = (fit.f_hz.value / fit.q.value, fit.q.value);
-    let settle = settling_residue(bk, fit.waited_s);
-    let waits = REF_STEP_PULL.map(|p| settle + p * FILTER_SETTLE);
+    let settle = settling_residue(bk, fit.waited_s) / 3f64.sqrt();
+    let waits = REF_STEP_SD.map(|p| settle.hypot(p * FILTER_SETTLE));
     let waits = [waits[0] * bk, waits[1] * q, waits[2].to_degrees()];
     let own = [fit.f_hz, fit.q, fit.phase_deg].map(|e| e.uncertainty);
-    std::array::from_fn(|i| own[i].max(jk[i]).hypot(waits[i]))
+    let lines = fit::noise_and_lines(fit, &fit.spur_sd, Some(clock_hz), pull, slope);
+    let lines = lines.unwrap_or([0.0; 3]);
+    std::array::from_fn(|i| own[i].max(jk[i]).max(lines[i]).hypot(waits[i]))
 }
 
 /// `fit` (fitted with `pull` and `front`, [`refit`]) with each

@@ -68,6 +68,11 @@ impl<'a> Prober<'a> {
         }
     }
 
+    /// The drive amplitude in use (fraction of full scale).
+    pub(super) fn amplitude(&self) -> f64 {
+        self.amplitude
+    }
+
     /// The mode (1 or 2), for messages.
     pub(super) fn mode(&self) -> usize {
         self.k + 1
