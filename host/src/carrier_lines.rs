@@ -103,29 +103,117 @@ pub const SEARCH: Depth = Depth(1 << 12, 4);
 /// Harmonics m >= 2 (the fundamental's images to `depth.0`, the others'
 /// to `depth.1`) that the carrier step `step` samples within `reach`
 /// steps of +-step, each with its signed offset from the carrier (NCO
-/// steps; the line at -step + delta is the carrier's at -delta).
+/// steps; the line at -step + delta is the carrier's at -delta), in the
+/// order of m's enumeration: the fundamental's images kN -+ 1 by k, then
+/// each odd m0 < N's images m0 + kN by k.
+///
+/// Every image of m0 is sampled at a + k S, a = m0 step and S = N step
+/// (wrapping): S's low 15 bits are zero, so the image's top 17 bits step
+/// by s = step mod 2^17 and its low 15 bits are a's. Only the top-17-bit
+/// values of the two windows of +-`reach` around +-step can land there,
+/// and each one's k solves h0 + k s = h (mod 2^17) directly
+/// ([`images_within`]): some hundred values a harmonic instead of its
+/// 1024 images (the brute enumeration was a fifth of a field step on a
+/// slow clock). The test holds it to the brute enumeration, pair for pair.
 pub(crate) fn candidates(step: u32, reach: u32, depth: Depth) -> Vec<(u64, i32)> {
-    let near = |m: u64| -> Option<i32> {
-        let nu = (m as u32).wrapping_mul(step);
-        let above = nu.wrapping_sub(step) as i32;
-        let below = nu.wrapping_add(step) as i32;
-        if above.unsigned_abs() <= reach {
-            Some(above)
-        } else if below.unsigned_abs() <= reach {
-            Some(-below)
-        } else {
-            None
+    let mut found = vec![];
+    let mut keep = |m: u64| {
+        if let Some(s) = near(step, reach, m) {
+            found.push((m, s));
         }
     };
-    let fundamental = (1..depth.0).flat_map(|k| [k * TURN - 1, k * TURN + 1]);
+    // kN - 1 is sampled at -step + k S, kN + 1 at step + k S.
+    let mut ks = images_within(step.wrapping_neg(), step, reach, 1..depth.0);
+    ks.extend(images_within(step, step, reach, 1..depth.0));
+    ks.sort_unstable();
+    ks.dedup();
+    for k in ks {
+        keep(k * TURN - 1);
+        keep(k * TURN + 1);
+    }
     // Odd harmonics only: the turn's second half is the first negated.
-    let others = (3..TURN - 1)
-        .step_by(2)
-        .flat_map(move |m0| (0..depth.1).map(move |k| m0 + k * TURN));
-    fundamental
-        .chain(others)
-        .filter_map(|m| near(m).map(|s| (m, s)))
-        .collect()
+    for m0 in (3..TURN - 1).step_by(2) {
+        let a = (m0 as u32).wrapping_mul(step);
+        for k in images_within(a, step, reach, 0..depth.1) {
+            keep(m0 + k * TURN);
+        }
+    }
+    found
+}
+
+/// Harmonic m's signed offset from the carrier (NCO steps) when the
+/// carrier step `step` samples it within `reach` of +-step.
+fn near(step: u32, reach: u32, m: u64) -> Option<i32> {
+    let nu = (m as u32).wrapping_mul(step);
+    let above = nu.wrapping_sub(step) as i32;
+    let below = nu.wrapping_add(step) as i32;
+    if above.unsigned_abs() <= reach {
+        Some(above)
+    } else if below.unsigned_abs() <= reach {
+        Some(-below)
+    } else {
+        None
+    }
+}
+
+/// Top 17 bits of a 32-bit phase.
+const TOP: u32 = (1 << 17) - 1;
+
+/// The k of `ks`, ascending, whose image a + k S (S = `step` << 15,
+/// wrapping) may lie within `reach` of +-`step`: every k that does, and
+/// some that only share its top 17 bits with such a phase ([`candidates`]
+/// tests each exactly).
+fn images_within(a: u32, step: u32, reach: u32, ks: std::ops::Range<u64>) -> Vec<u64> {
+    let all = || ks.clone().collect();
+    let s = step & TOP;
+    if s == 0 || reach >= 1 << 30 {
+        return all();
+    }
+    // The top-17-bit values of each window [c - reach, c + reach].
+    let windows = [step, step.wrapping_neg()].map(|c| {
+        let low = c.wrapping_sub(reach) >> 15;
+        let count = ((c.wrapping_add(reach) >> 15).wrapping_sub(low) & TOP) + 1;
+        (low, count)
+    });
+    // s = 2^e u, u odd: h0 + k s = h has a solution iff 2^e divides
+    // h - h0, and then one k in each period 2^(17 - e).
+    let e = s.trailing_zeros();
+    let period = 1u64 << (17 - e);
+    let per_target = ks.end.div_ceil(period);
+    let targets: u64 = windows.iter().map(|w| u64::from(w.1)).sum();
+    if targets * per_target >= ks.end - ks.start {
+        return all();
+    }
+    let inverse = odd_inverse(s >> e);
+    let h0 = a >> 15;
+    let mut found = vec![];
+    for (low, count) in windows {
+        for i in 0..count {
+            let d = (low.wrapping_add(i).wrapping_sub(h0)) & TOP;
+            if d & ((1 << e) - 1) != 0 {
+                continue;
+            }
+            let first = (u64::from(d >> e) * u64::from(inverse)) & (period - 1);
+            found.extend(
+                (first..ks.end)
+                    .step_by(period as usize)
+                    .filter(|k| *k >= ks.start),
+            );
+        }
+    }
+    found.sort_unstable();
+    found.dedup();
+    found
+}
+
+/// The inverse of odd `u` modulo 2^32 (Newton's iteration, each step
+/// doubling the bits that are right: 3, 6, 12, 24, 48).
+fn odd_inverse(u: u32) -> u32 {
+    let mut x = u;
+    for _ in 0..4 {
+        x = x.wrapping_mul(2u32.wrapping_sub(u.wrapping_mul(x)));
+    }
+    x
 }
 
 /// Harmonic m's line against the fundamental of the words whose
@@ -183,6 +271,62 @@ mod tests {
                     omega.map(|o| (o - expected).abs() < 1e-3),
                     (expected <= 1000.0).then_some(true),
                     "harmonic {m}: {omega:?} Hz, expected {expected} Hz"
+                );
+            }
+        }
+    }
+
+    /// The brute enumeration `candidates` replaced: every image tested.
+    fn candidates_by_brute_force(step: u32, reach: u32, depth: Depth) -> Vec<(u64, i32)> {
+        let fundamental = (1..depth.0).flat_map(|k| [k * TURN - 1, k * TURN + 1]);
+        let others = (3..TURN - 1)
+            .step_by(2)
+            .flat_map(move |m0| (0..depth.1).map(move |k| m0 + k * TURN));
+        fundamental
+            .chain(others)
+            .filter_map(|m| near(step, reach, m).map(|s| (m, s)))
+            .collect()
+    }
+
+    /// `candidates` finds what testing every image finds, in the same
+    /// order: on the carriers of the field scenarios' clocks (the paper's
+    /// 30 deg C carrier on 50 MHz, the consumer's on 1.2345 MHz), a step
+    /// exactly on a fold (of period 64: s = 0, every image shares a's top
+    /// bits), steps whose low bits are zero (s = 2^e u, e up to 15),
+    /// reaches from one step to 2^30, and 60 random steps and reaches,
+    /// at the search's depth and the full one.
+    #[test]
+    fn candidates_are_the_brute_enumerations() {
+        use rand_xoshiro::Xoshiro256PlusPlus;
+        use rand_xoshiro::rand_core::{Rng, SeedableRng};
+        let of = |f: f64, clock: f64| (f / clock * 2f64.powi(32)).round() as u32;
+        let mut cases = vec![
+            (
+                of(9_638_553.73, 50e6),
+                (1000.0 / (50e6 / 2f64.powi(32))) as u32,
+            ),
+            (
+                of(25_028.5, 1.2345e6),
+                (480.0 / (1.2345e6 / 2f64.powi(32))) as u32,
+            ),
+            (3 << 26, 1 << 20),
+            (0x8000_0000 / 24, 5000),
+            (0x1234_0000, 1 << 18),
+            (0x0002_0000 * 7, 1 << 16),
+            (0x0001_8000, 1),
+            (0x7fff_ffff, 1 << 30),
+        ];
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(5);
+        for _ in 0..60 {
+            let reach = 1u32 << (rng.next_u32() % 26);
+            cases.push((rng.next_u32(), reach + rng.next_u32() % reach));
+        }
+        for (step, reach) in cases {
+            for depth in [SEARCH, FULL] {
+                assert_eq!(
+                    candidates(step, reach, depth),
+                    candidates_by_brute_force(step, reach, depth),
+                    "step {step:#x}, reach {reach}, {depth:?}"
                 );
             }
         }
