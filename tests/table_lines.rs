@@ -7,8 +7,8 @@
 //!
 //! Before the lines were in the sigma (`identify::sweep_uncertainty`),
 //! f2 read mean t -0.58 +- 0.16 with a spread of 1.01 over these seeds:
-//! RMS t 1.16, and seed 1021 at -3.20. Now: mean -0.48, spread 0.81,
-//! RMS 0.93, largest |t| 2.30. On the fine core, whose rounding is fed
+//! RMS t 1.16, and seed 1021 at -3.20. Now: mean -0.48, spread 0.82,
+//! RMS 0.94, largest |t| 2.34. On the fine core, whose rounding is fed
 //! back away from the carrier, the spread was 0.41 (docs/sweep.md).
 //!
 //! Asserted, and why each can fail:

@@ -688,6 +688,8 @@ mod tests {
             scanned: false,
             sweep: vec![],
             waited_s: 0.0,
+            window_s: 0.0,
+            filter_decay_per_s: 0.0,
             spur_sd: vec![],
             c: C64::new(1.0, 0.0),
             front: Default::default(),

@@ -149,10 +149,15 @@ impl Knowns {
     /// Clocks for the output filter to settle to `FILTER_SETTLE` (the
     /// slowest Butterworth pole, the RC pole, the CIC's 4 R).
     pub fn filter_settle_clocks(&self) -> u64 {
+        let t = (1.0 / FILTER_SETTLE).ln() / self.filter_decay_per_s();
+        (t * self.clock_hz).ceil() as u64 + 5 * u64::from(self.filter.decimation)
+    }
+
+    /// The output filter's slowest decay rate (1/s): the Butterworth
+    /// poles' real part or the RC pole, the smaller.
+    pub fn filter_decay_per_s(&self) -> f64 {
         let f = &self.filter;
-        let sigma = (TAU * f.butterworth_hz / 2f64.sqrt()).min(TAU * f.rc_hz);
-        let t = (1.0 / FILTER_SETTLE).ln() / sigma;
-        (t * self.clock_hz).ceil() as u64 + 5 * u64::from(f.decimation)
+        (TAU * f.butterworth_hz / 2f64.sqrt()).min(TAU * f.rc_hz)
     }
 
     /// Amplitude time constant of mode k from the datasheet, with a 20%

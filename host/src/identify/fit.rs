@@ -309,6 +309,8 @@ fn mode_fit(
         },
         relative_rms: (rss / n as f64).sqrt() / peak,
         waited_s: 0.0,
+        window_s: 0.0,
+        filter_decay_per_s: 0.0,
         spur_sd: vec![],
         gain_hz2: c.norm() * clock_hz.map_or(1.0, |fs| hold_gain(fk, fs)),
         scanned: false,

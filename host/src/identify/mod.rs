@@ -251,6 +251,14 @@ pub struct ModeFit {
     /// bound (`settling_residue`).
     #[serde(skip)]
     pub waited_s: f64,
+    /// The length of each I and Q window (s): the transients the waits
+    /// leave decay further within it (`window_mean`).
+    #[serde(skip)]
+    pub window_s: f64,
+    /// The output filter's slowest decay rate (1/s,
+    /// `Knowns::filter_decay_per_s`).
+    #[serde(skip)]
+    pub filter_decay_per_s: f64,
     /// The 1-sigma per real component of the error the table core's
     /// carrier lines can put on each `sweep` point (ADC LSB per drive LSB,
     /// [`point_spur_sd`]); empty on the fine core or for a sweep not
@@ -488,6 +496,8 @@ fn attempt(
         }
     };
     fit.waited_s = probe.waited_s();
+    fit.window_s = probe.window_s();
+    fit.filter_decay_per_s = knowns.filter_decay_per_s();
     fit.scanned = scanned;
     // The amplitude only falls during the sweep (`Prober::measure`): its
     // last value is the smallest, whose lines are the largest part of Y.
@@ -534,6 +544,8 @@ pub(crate) fn refit(
         reason: reason.to_string(),
     })?;
     fit.waited_s = mode.waited_s;
+    fit.window_s = mode.window_s;
+    fit.filter_decay_per_s = mode.filter_decay_per_s;
     fit.spur_sd = mode.spur_sd.clone();
     fit.scanned = mode.scanned;
     fit.probe = mode.probe.clone();
@@ -555,6 +567,8 @@ pub(crate) fn refit(
 /// bound (`settling_residue`) on a bias that lies anywhere within it (the
 /// up and down sweeps cancel it to first order), at the 1-sigma of a
 /// rectangular distribution over it, the bound over sqrt 3 (GUM 4.3.7).
+/// Each is its residue at its window's start, which decays on through
+/// the window its mean is taken over (`window_mean`).
 pub(crate) fn sweep_uncertainty(
     fit: &ModeFit,
     clock_hz: f64,
@@ -563,13 +577,31 @@ pub(crate) fn sweep_uncertainty(
 ) -> [f64; 3] {
     let jk = fit::jackknife(&fit.sweep, fit, Some(clock_hz), pull, slope);
     let (bk, q) = (fit.f_hz.value / fit.q.value, fit.q.value);
-    let settle = settling_residue(bk, fit.waited_s) / 3f64.sqrt();
-    let waits = REF_STEP_SD.map(|p| settle.hypot(p * FILTER_SETTLE));
+    let settle = settling_residue(bk, fit.waited_s) * window_mean(PI * bk, fit.window_s);
+    let settle = settle / 3f64.sqrt();
+    let filter = FILTER_SETTLE * window_mean(fit.filter_decay_per_s, fit.window_s);
+    let waits = REF_STEP_SD.map(|p| settle.hypot(p * filter));
     let waits = [waits[0] * bk, waits[1] * q, waits[2].to_degrees()];
     let own = [fit.f_hz, fit.q, fit.phase_deg].map(|e| e.uncertainty);
     let lines = fit::noise_and_lines(fit, &fit.spur_sd, Some(clock_hz), pull, slope);
     let lines = lines.unwrap_or([0.0; 3]);
     std::array::from_fn(|i| own[i].max(jk[i]).max(lines[i]).hypot(waits[i]))
+}
+
+/// What the mean over a window of `window_s` keeps of a transient that
+/// decays at `rate` (1/s) from its value at the window's start:
+/// (1 - e^(-rate T)) / (rate T), the envelope's mean, which bounds the
+/// mean of an oscillating transient under it (1 for an empty window).
+///
+/// ```
+/// use gyrocal_host::identify::window_mean;
+/// assert_eq!(window_mean(10.0, 0.0), 1.0);
+/// // A window of 14 time constants keeps a fourteenth.
+/// assert!((window_mean(14.0, 1.0) - 1.0 / 14.0).abs() < 1e-7);
+/// ```
+pub fn window_mean(rate: f64, window_s: f64) -> f64 {
+    let x = rate * window_s;
+    if x < 1e-9 { 1.0 } else { -(-x).exp_m1() / x }
 }
 
 /// `fit` (fitted with `pull` and `front`, [`refit`]) with each

@@ -16,7 +16,8 @@
 //! unrelated phases, but a pair's phases come back from run to run with
 //! the sweep's timing, and with powers part 54's f2 read RMS error /
 //! sigma 1.06 over 40 noise seeds (largest 2.83) against 0.93 with the
-//! bound (`tests/table_lines.rs`).
+//! bound (`tests/table_lines.rs`; both with the waits' residues taken at
+//! their windows' starts, `super::window_mean`).
 //! Each line's phase in a window is the line's phase at the window's time,
 //! which no sweep controls: a line is a cosine of random phase in each of
 //! I and Q, of variance a^2 / 2. A point's error per component has the
