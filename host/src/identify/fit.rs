@@ -335,17 +335,9 @@ fn linearized(
 ) -> Option<(DMatrix<f64>, Vec<f64>)> {
     let shape = |fk: f64, bk: f64, f: f64| shape(fk, bk, f, clock_hz, pull, front);
     let (fk, bk) = (m.f_hz.value, m.f_hz.value / m.q.value);
-    let (j, _) = jacobian(&m.sweep, &[m.c.re, m.c.im, fk, bk], &shape);
-    let scale: Vec<f64> = (0..4).map(|c| j.column(c).norm()).collect();
-    let mut js = j.clone();
-    for (c, s) in scale.iter().enumerate() {
-        js.column_mut(c).scale_mut(1.0 / s);
-    }
-    let inv = (js.transpose() * &js).try_inverse()?;
-    let mut a = inv * js.transpose();
-    for (r, s) in scale.iter().enumerate() {
-        a.row_mut(r).scale_mut(1.0 / s);
-    }
+    let (j, r) = jacobian(&m.sweep, &[m.c.re, m.c.im, fk, bk], &shape);
+    let (_, cov) = scaled_solve(&j, &r)?;
+    let a = cov * j.transpose();
     let hat = (0..j.nrows())
         .map(|r| (0..4).map(|p| j[(r, p)] * a[(p, r)]).sum())
         .collect();

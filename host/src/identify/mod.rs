@@ -114,6 +114,11 @@ pub const FINE_POINTS: usize = 5;
 pub const FINE_SPAN: f64 = 1.5;
 /// z samples averaged for each of I and Q.
 pub const SAMPLES_PER_PHASE: u64 = 128;
+
+/// The length of each I and Q window (s): `SAMPLES_PER_PHASE` z samples.
+fn window_s(knowns: &Knowns) -> f64 {
+    SAMPLES_PER_PHASE as f64 * f64::from(knowns.filter.decimation) / knowns.clock_hz
+}
 /// What the waits leave of a step in the response, relative to the peak
 /// response: the resonator's transient e^(-pi bk t) after the `waited_s`
 /// from a carrier step to the I window, with the fitted bandwidth bk (the
@@ -496,7 +501,7 @@ fn attempt(
         }
     };
     fit.waited_s = probe.waited_s();
-    fit.window_s = probe.window_s();
+    fit.window_s = window_s(knowns);
     fit.filter_decay_per_s = knowns.filter_decay_per_s();
     fit.scanned = scanned;
     // The amplitude only falls during the sweep (`Prober::measure`): its

@@ -36,12 +36,6 @@ impl Prober<'_> {
     pub(super) fn waited_s(&self) -> f64 {
         self.settle_clocks() as f64 / self.knowns.clock_hz
     }
-
-    /// The length of each of the I and Q windows (s).
-    pub(super) fn window_s(&self) -> f64 {
-        let kn = self.knowns;
-        SAMPLES_PER_PHASE as f64 * f64::from(kn.filter.decimation) / kn.clock_hz
-    }
 }
 
 /// What one measurement saw.

@@ -38,7 +38,7 @@
 //! On the fine core the rounding is fed back away from the carrier: no
 //! term.
 
-use super::{C64, SAMPLES_PER_PHASE};
+use super::{C64, window_s};
 use crate::carrier_lines::{
     FULL, SPUR_BAND_CORNERS, candidates, harmonics, output_gain, record_gain, relative,
 };
@@ -99,7 +99,7 @@ pub fn point_spur_sd(
     let spectrum = harmonics(i32::from(q15_product(word, PEAK as i16)));
     let per_step = knowns.clock_hz / 2f64.powi(32);
     let band = SPUR_BAND_CORNERS * knowns.filter.butterworth_hz;
-    let record_s = SAMPLES_PER_PHASE as f64 * f64::from(knowns.filter.decimation) / knowns.clock_hz;
+    let record = window_s(knowns);
     let f = real.carrier_hz;
     let response = |f: f64| 1.0 / C64::new(fk_hz * fk_hz - f * f, f * bk_hz).norm();
     let here = response(f);
@@ -110,7 +110,7 @@ pub fn point_spur_sd(
             let a = relative(&spectrum, m)
                 * (1.0 + response(f + omega) / here)
                 * output_gain(&knowns.filter, omega.abs())
-                * record_gain(omega.abs(), record_s);
+                * record_gain(omega.abs(), record);
             a * a / 2.0
         })
         .sum();
