@@ -231,6 +231,44 @@ impl CouplingFigure {
     }
 }
 
+/// The timing of a fine sweep's points, which bounds what the resonator's
+/// and the filter's transients leave in each point's window.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Waits {
+    /// Time from each carrier step to its I window (s), for the settling
+    /// bound (`settling_residue`).
+    pub waited_s: f64,
+    /// The length of each I and Q window (s): the transients the waits
+    /// leave decay further within it (`window_mean`).
+    pub window_s: f64,
+    /// The output filter's slowest decay rate (1/s,
+    /// `Knowns::filter_decay_per_s`).
+    pub filter_decay_per_s: f64,
+}
+
+impl Waits {
+    /// The resonator's settling residue over the window's mean, relative
+    /// to the peak response, for a mode of bandwidth `bk_hz`: the bound
+    /// `settling_residue` after `waited_s`, decayed on through the window
+    /// (`window_mean`).
+    ///
+    /// ```
+    /// use gyrocal_host::identify::{Waits, settling_residue};
+    /// let w = Waits { waited_s: 0.5, window_s: 0.0, filter_decay_per_s: 100.0 };
+    /// assert_eq!(w.settling(8.0), settling_residue(8.0, 0.5));
+    /// ```
+    pub fn settling(&self, bk_hz: f64) -> f64 {
+        settling_residue(bk_hz, self.waited_s) * window_mean(PI * bk_hz, self.window_s)
+    }
+
+    /// The filter's residue after the REF_PHASE step over the Q window's
+    /// mean: `FILTER_SETTLE` of the step at the window's start, decayed on
+    /// through it at the filter's slowest rate.
+    pub fn filter(&self) -> f64 {
+        FILTER_SETTLE * window_mean(self.filter_decay_per_s, self.window_s)
+    }
+}
+
 /// One mode's fitted response.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ModeFit {
@@ -252,18 +290,10 @@ pub struct ModeFit {
     /// Sweep points (carrier Hz) and responses (ADC LSB per drive LSB).
     #[serde(skip)]
     pub sweep: Vec<(f64, C64)>,
-    /// Time from each carrier step to its I window (s), for the settling
-    /// bound (`settling_residue`).
+    /// The sweep's waits and windows, for what the waits leave in each
+    /// point ([`Waits`]); all 0 for a sweep not measured here.
     #[serde(skip)]
-    pub waited_s: f64,
-    /// The length of each I and Q window (s): the transients the waits
-    /// leave decay further within it (`window_mean`).
-    #[serde(skip)]
-    pub window_s: f64,
-    /// The output filter's slowest decay rate (1/s,
-    /// `Knowns::filter_decay_per_s`).
-    #[serde(skip)]
-    pub filter_decay_per_s: f64,
+    pub waits: Waits,
     /// The 1-sigma per real component of the error the table core's
     /// carrier lines can put on each `sweep` point (ADC LSB per drive LSB,
     /// [`point_spur_sd`]); empty on the fine core or for a sweep not
@@ -422,8 +452,18 @@ struct Missed {
     clocks: u64,
 }
 
+impl Missed {
+    /// The same miss, having spent `clocks`.
+    fn after(self, clocks: u64) -> Self {
+        Self { clocks, ..self }
+    }
+}
+
 /// One attempt of [`identify_mode`] with `knowns`' Q: the fit, or how it
-/// missed (a board's error is an error).
+/// missed (a board's error is an error). The mode is located
+/// ([`locate`]), swept ([`fine_sweep`]) and fitted alone; the fit then
+/// carries the sweep's waits and each point's carrier lines
+/// ([`lines_per_point`]).
 fn attempt(
     board: &mut dyn Board,
     knowns: &Knowns,
@@ -432,42 +472,18 @@ fn attempt(
 ) -> Result<Result<(ModeFit, u64), Missed>, Error> {
     let max = [knowns.amplitude.0, knowns.amplitude.1][k].abs();
     let mut probe = Prober::new(board, knowns, k, max / 8.0);
-    let bw = knowns.bandwidth_hz(k);
-    let q = knowns.nominal.q(k);
-    let mut scanned = false;
-    let found = match search::coarse(&mut probe, guess_hz, bw)? {
+    let Located {
+        centre,
+        bk,
+        scanned,
+    } = match locate(&mut probe, guess_hz, knowns.bandwidth_hz(k))? {
         Ok(found) => found,
-        Err(_) => {
-            scanned = true;
-            let start = search::scan(&mut probe, guess_hz, bw)?;
-            match search::coarse(&mut probe, start, bw)? {
-                Ok(found) => found,
-                Err(why) => {
-                    let reason = format!(
-                        "the scan of +-{}% around {guess_hz:.1} Hz pointed at {start:.1} Hz, but the search from there did not settle: {why}",
-                        100.0 * SCAN_SPAN
-                    );
-                    return Ok(Err(Missed {
-                        reason,
-                        retry_q: why.retry_q(),
-                        clocks: probe.clocks,
-                    }));
-                }
-            }
-        }
+        Err(reason) => return Ok(Err(reason.after(probe.clocks))),
     };
-    let (centre, bk) = found;
     // The mode's own time constant 1 / (pi bk), with the datasheet's 20%
     // margin for the narrow-band estimate of bk.
     probe.tau_s = TAU_MARGIN / (PI * bk);
-    let offsets: Vec<f64> = (0..FINE_POINTS)
-        .map(|i| FINE_SPAN * (2.0 * i as f64 / (FINE_POINTS - 1) as f64 - 1.0))
-        .collect();
-    let order = offsets.iter().chain(offsets.iter().rev());
-    let mut sweep = vec![];
-    for s in order {
-        sweep.push(probe.measure(centre + s * bk)?);
-    }
+    let sweep = fine_sweep(&mut probe, centre, bk)?;
     let alone = fit::FrontSlope::default();
     let fitted = fit::fit_mode(
         &sweep,
@@ -479,38 +495,112 @@ fn attempt(
     );
     let mut fit = match fitted {
         Ok(fit) => fit,
-        Err(why) => {
-            let reason = format!(
-                "the fine sweep around {centre:.1} Hz, {bk:.4} Hz a step (the coarse search's \
-                 bandwidth; Q{} = {} gives {bw:.4} Hz), could not be fitted: \
-                 {why}; a datasheet Q far from the part's misleads the search: check \
-                 [datasheet] q{}",
-                k + 1,
-                search::shown_q(q),
-                k + 1
-            );
-            // The coarse search's bandwidth, when it is farther than a
-            // part's spread from the datasheet's, is the better guess of Q.
-            let measured = centre / bk;
-            let far = crate::datasheet::q_beyond_spread(measured / q);
-            return Ok(Err(Missed {
-                reason,
-                retry_q: far.then_some(measured),
-                clocks: probe.clocks,
-            }));
-        }
+        Err(why) => return Ok(Err(unfitted(knowns, k, (centre, bk), why, probe.clocks))),
     };
-    fit.waited_s = probe.waited_s();
-    fit.window_s = window_s(knowns);
-    fit.filter_decay_per_s = knowns.filter_decay_per_s();
+    fit.waits = Waits {
+        waited_s: probe.waited_s(),
+        window_s: window_s(knowns),
+        filter_decay_per_s: knowns.filter_decay_per_s(),
+    };
     fit.scanned = scanned;
     // The amplitude only falls during the sweep (`Prober::measure`): its
     // last value is the smallest, whose lines are the largest part of Y.
-    // Each carrier is measured twice (up and down): its lines once.
-    let amplitude = probe.amplitude();
+    fit.spur_sd = lines_per_point(knowns, k, &sweep, probe.amplitude(), (centre, bk))?;
+    Ok(Ok((fit, probe.clocks)))
+}
+
+/// Where the coarse search found a mode.
+struct Located {
+    /// Its centre (Hz).
+    centre: f64,
+    /// Its bandwidth (Hz).
+    bk: f64,
+    /// The scan over +-`SCAN_SPAN` had to find it first: the datasheet
+    /// was off.
+    scanned: bool,
+}
+
+/// Where mode k lies near `guess_hz`, with the datasheet's bandwidth
+/// `bw`, or why neither the search nor the scan settled (its clocks filled
+/// in by the caller).
+fn locate(probe: &mut Prober, guess_hz: f64, bw: f64) -> Result<Result<Located, Missed>, Error> {
+    let located = |(centre, bk), scanned| Located {
+        centre,
+        bk,
+        scanned,
+    };
+    if let Ok(found) = search::coarse(probe, guess_hz, bw)? {
+        return Ok(Ok(located(found, false)));
+    }
+    let start = search::scan(probe, guess_hz, bw)?;
+    Ok(match search::coarse(probe, start, bw)? {
+        Ok(found) => Ok(located(found, true)),
+        Err(why) => Err(Missed {
+            reason: format!(
+                "the scan of +-{}% around {guess_hz:.1} Hz pointed at {start:.1} Hz, but the search from there did not settle: {why}",
+                100.0 * SCAN_SPAN
+            ),
+            retry_q: why.retry_q(),
+            clocks: 0,
+        }),
+    })
+}
+
+/// The fine sweep: `FINE_POINTS` carriers over +-`FINE_SPAN` bandwidths
+/// `bk` around `centre`, up then down.
+fn fine_sweep(probe: &mut Prober, centre: f64, bk: f64) -> Result<Vec<(f64, C64)>, Error> {
+    let offsets: Vec<f64> = (0..FINE_POINTS)
+        .map(|i| FINE_SPAN * (2.0 * i as f64 / (FINE_POINTS - 1) as f64 - 1.0))
+        .collect();
+    let order = offsets.iter().chain(offsets.iter().rev());
+    order.map(|s| probe.measure(centre + s * bk)).collect()
+}
+
+/// The miss of a fine sweep around the coarse search's `(centre, bk)`
+/// that could not be fitted (`why`): a datasheet Q far from the part's
+/// misleads the search, so the coarse search's bandwidth, when it lies
+/// farther than a part's spread from the datasheet's, is the Q to try
+/// again from.
+fn unfitted(
+    knowns: &Knowns,
+    k: usize,
+    (centre, bk): (f64, f64),
+    why: impl std::fmt::Display,
+    clocks: u64,
+) -> Missed {
+    let (q, bw) = (knowns.nominal.q(k), knowns.bandwidth_hz(k));
+    let reason = format!(
+        "the fine sweep around {centre:.1} Hz, {bk:.4} Hz a step (the coarse search's \
+         bandwidth; Q{} = {} gives {bw:.4} Hz), could not be fitted: \
+         {why}; a datasheet Q far from the part's misleads the search: check \
+         [datasheet] q{}",
+        k + 1,
+        search::shown_q(q),
+        k + 1
+    );
+    let measured = centre / bk;
+    let far = crate::datasheet::q_beyond_spread(measured / q);
+    Missed {
+        reason,
+        retry_q: far.then_some(measured),
+        clocks,
+    }
+}
+
+/// The 1-sigma the table core's carrier lines put on each point of
+/// `sweep` (absolute, [`point_spur_sd`] times |Y|), at the drive
+/// `amplitude`, for mode k about `(centre, bk)`. Each carrier is measured
+/// twice (up and down): its lines are worked out once.
+fn lines_per_point(
+    knowns: &Knowns,
+    k: usize,
+    sweep: &[(f64, C64)],
+    amplitude: f64,
+    (centre, bk): (f64, f64),
+) -> Result<Vec<f64>, Error> {
     let mut relative: Vec<(f64, f64)> = Vec::with_capacity(FINE_POINTS);
-    fit.spur_sd = Vec::with_capacity(sweep.len());
-    for &(f, y) in &sweep {
+    let mut out = Vec::with_capacity(sweep.len());
+    for &(f, y) in sweep {
         let sd = match relative.iter().find(|r| r.0 == f) {
             Some(&(_, sd)) => sd,
             None => {
@@ -519,9 +609,9 @@ fn attempt(
                 sd
             }
         };
-        fit.spur_sd.push(sd * y.norm());
+        out.push(sd * y.norm());
     }
-    Ok(Ok((fit, probe.clocks)))
+    Ok(out)
 }
 
 /// Mode k's fine sweep fitted again, with the other mode's `pull` and
@@ -548,9 +638,7 @@ pub(crate) fn refit(
         mode: k + 1,
         reason: reason.to_string(),
     })?;
-    fit.waited_s = mode.waited_s;
-    fit.window_s = mode.window_s;
-    fit.filter_decay_per_s = mode.filter_decay_per_s;
+    fit.waits = mode.waits;
     fit.spur_sd = mode.spur_sd.clone();
     fit.scanned = mode.scanned;
     fit.probe = mode.probe.clone();
@@ -582,9 +670,8 @@ pub(crate) fn sweep_uncertainty(
 ) -> [f64; 3] {
     let jk = fit::jackknife(&fit.sweep, fit, Some(clock_hz), pull, slope);
     let (bk, q) = (fit.f_hz.value / fit.q.value, fit.q.value);
-    let settle = settling_residue(bk, fit.waited_s) * window_mean(PI * bk, fit.window_s);
-    let settle = settle / 3f64.sqrt();
-    let filter = FILTER_SETTLE * window_mean(fit.filter_decay_per_s, fit.window_s);
+    let settle = fit.waits.settling(bk) / 3f64.sqrt();
+    let filter = fit.waits.filter();
     let waits = REF_STEP_SD.map(|p| settle.hypot(p * filter));
     let waits = [waits[0] * bk, waits[1] * q, waits[2].to_degrees()];
     let own = [fit.f_hz, fit.q, fit.phase_deg].map(|e| e.uncertainty);
