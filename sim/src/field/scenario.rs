@@ -1113,7 +1113,6 @@ pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldRepor
         sf_per_dps: c.truth.sf_per_dps,
         null_z: c.readout.as_ref().map(|r| r.0),
     });
-    let rates = &knowns.rates_dps;
     let (jobs, done) = match &factory {
         Some(f) => {
             progress(&format!(
@@ -1122,57 +1121,24 @@ pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldRepor
                 f.operating.carrier_hz,
                 f.operating.ref_lag_deg
             ));
-            let jobs = jobs(&cycles, rates.len(), sc.profile.is_some());
+            let jobs = jobs(&cycles, knowns.rates_dps.len(), sc.profile.is_some());
             let done = run_jobs(sc, &fe, &knowns, &f.operating, &cycles, &jobs);
             (jobs, done)
         }
         None => (vec![], vec![]),
     };
-    let mut failed = vec![];
-    let mut baseline_clips = vec![];
     let job_clocks: u64 = done.iter().flatten().map(|d| d.1).sum();
-    let mut failed_clocks = 0;
-    let mut steps = vec![];
-    for (i, c) in cycles.into_iter().enumerate() {
-        let t = drift.temperatures_c[i];
-        let c = match c {
-            Ok(c) => c,
-            Err(CycleFailure {
-                identified,
-                error,
-                clocks,
-            }) => {
-                failed_clocks += clocks;
-                failed.push(StepFailure {
-                    temperature_c: t,
-                    stage: FAILED_CYCLE,
-                    error: error.to_string(),
-                    identified: identified.map(|id| *id),
-                });
-                continue;
-            }
-        };
-        let baseline = factory.as_ref().and_then(|f| {
-            baseline_of(i, &c, f, &jobs, &done, rates)
-                .map_err(|error| match error {
-                    // What a part left uncalibrated does here: a finding,
-                    // said in a line, not a failure of the run.
-                    FieldError::Host(gyrocal_host::Error::Clipped { .. }) => {
-                        baseline_clips.push(format!("at {t} deg C ({error})"));
-                    }
-                    _ => failed.push(StepFailure {
-                        temperature_c: t,
-                        stage: FAILED_BASELINE,
-                        error: error.to_string(),
-                        identified: None,
-                    }),
-                })
-                .ok()
-        });
-        let step = field_step(c, baseline, &knowns);
-        progress(&step_line(&step));
-        steps.push(step);
-    }
+    let at_factory = factory.as_ref().map(|factory| AtFactory {
+        factory,
+        jobs: &jobs,
+        done: &done,
+    });
+    let Steps {
+        steps,
+        failed,
+        baseline_clips,
+        failed_clocks,
+    } = steps_of(cycles, drift, at_factory, &knowns, progress);
     if factory.is_none() && !steps.is_empty() {
         progress("no factory calibration (the first step failed): no step has a baseline");
     }
@@ -1209,6 +1175,85 @@ pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldRepor
         clocks,
         wall_s: start.elapsed().as_secs_f64(),
     })
+}
+
+/// The factory calibration with its jobs and what each did.
+struct AtFactory<'a> {
+    factory: &'a Factory,
+    jobs: &'a [Job],
+    done: &'a [Result<(Done, u64), FieldError>],
+}
+
+/// The steps of a run as its cycles and the factory's jobs left them.
+struct Steps {
+    /// The steps whose cycle finished, in temperature order.
+    steps: Vec<FieldStep>,
+    /// The stages that failed, each with its step's temperature.
+    failed: Vec<StepFailure>,
+    /// The steps whose baseline clipped at the factory's settings (a
+    /// finding about a part left uncalibrated, said in one warning).
+    baseline_clips: Vec<String>,
+    /// Clocks the failed cycles ran.
+    failed_clocks: u64,
+}
+
+/// Each cycle made a step, with its baseline from the factory's jobs
+/// (`at_factory`: the factory, its jobs and what they did) where the
+/// factory calibration exists; `progress` gets one line per step.
+fn steps_of(
+    cycles: Vec<Result<Cycle, CycleFailure>>,
+    drift: &Drift,
+    at_factory: Option<AtFactory>,
+    knowns: &Knowns,
+    progress: &(dyn Fn(&str) + Sync),
+) -> Steps {
+    let mut out = Steps {
+        steps: vec![],
+        failed: vec![],
+        baseline_clips: vec![],
+        failed_clocks: 0,
+    };
+    for (i, c) in cycles.into_iter().enumerate() {
+        let t = drift.temperatures_c[i];
+        let c = match c {
+            Ok(c) => c,
+            Err(CycleFailure {
+                identified,
+                error,
+                clocks,
+            }) => {
+                out.failed_clocks += clocks;
+                out.failed.push(StepFailure {
+                    temperature_c: t,
+                    stage: FAILED_CYCLE,
+                    error: error.to_string(),
+                    identified: identified.map(|id| *id),
+                });
+                continue;
+            }
+        };
+        let baseline = at_factory.as_ref().and_then(|f| {
+            baseline_of(i, &c, f.factory, f.jobs, f.done, &knowns.rates_dps)
+                .map_err(|error| match error {
+                    // What a part left uncalibrated does here: a finding,
+                    // said in a line, not a failure of the run.
+                    FieldError::Host(gyrocal_host::Error::Clipped { .. }) => {
+                        out.baseline_clips.push(format!("at {t} deg C ({error})"));
+                    }
+                    _ => out.failed.push(StepFailure {
+                        temperature_c: t,
+                        stage: FAILED_BASELINE,
+                        error: error.to_string(),
+                        identified: None,
+                    }),
+                })
+                .ok()
+        });
+        let step = field_step(c, baseline, knowns);
+        progress(&step_line(&step));
+        out.steps.push(step);
+    }
+    out
 }
 
 /// Step `i`'s measurements at the factory's settings: the rate table's
