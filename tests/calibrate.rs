@@ -833,3 +833,69 @@ fn a_device_turning_during_the_cycle_is_calibrated_at_its_rate_and_said() {
         "--rate: applies to the in-process board only",
     );
 }
+
+/// `[experiment] rest_bound_dps`: a device said to rest on a fixed fixture
+/// (Earth's rate at most) has its unseen cycle rate taken within the bound,
+/// which narrows the detuned output's `cycle_rate` term; a device that
+/// turns beyond the bound during the cycle is said in one line and keeps
+/// the reading's own sigma. Either way the error stays within 3 sigma.
+#[test]
+fn a_rest_bound_narrows_the_unseen_rate_and_a_turning_device_contradicts_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let consumer = std::fs::read_to_string("tests/data/field_consumer.toml").unwrap();
+    let bounded = consumer.replacen(
+        "cal_freqs_hz = [2, 4, 6]\n",
+        "cal_freqs_hz = [2, 4, 6]\nrest_bound_dps = 0.0042\n",
+        1,
+    );
+    assert_ne!(bounded, consumer);
+    let config = dir.path().join("resting.toml");
+    std::fs::write(&config, bounded).unwrap();
+    let head = "warning: [experiment] rest_bound_dps = 0.0042 says the device rests, but";
+    let said = |run: &Value| warnings(run).iter().filter(|w| w.starts_with(head)).count();
+    let term = |run: &Value| pair(&run["sf_selfcal_uncertainty_sources"], "cycle_rate");
+    let covered = |run: &Value, what: &str| {
+        let error = pair(&run["truth"], "selfcal_error");
+        let sigma = pair(&run["truth"], "selfcal_error_uncertainty");
+        for k in 0..2 {
+            assert!(
+                error[k].abs() <= 3.0 * sigma[k],
+                "{what}, output {}: error {:e} against sigma {:e}",
+                k + 1,
+                error[k],
+                sigma[k]
+            );
+        }
+    };
+    let free = calibrate(
+        Path::new("tests/data/field_consumer.toml"),
+        &["--rate", "0"],
+    );
+    let resting = calibrate(&config, &["--rate", "0"]);
+    covered(&resting, "resting within the bound");
+    assert_eq!(said(&resting), 0, "{}", resting["warnings"]);
+    // The same cycle (the bound moves no measurement), its output 2's term
+    // now from the bound: b / sqrt 3 where the reading's allowance was
+    // hypot(reading, sigma), some 0.02 deg/s on this device.
+    let read = number(&resting, &["identified", "cycle_rate_dps"]);
+    let sd = number(&resting, &["identified", "cycle_rate_dps_uncertainty"]);
+    assert_eq!(read, number(&free, &["identified", "cycle_rate_dps"]));
+    let allowance = read.hypot(sd);
+    assert!(allowance > 0.0042, "reading {read} +- {sd}");
+    let (bounded_term, free_term) = (term(&resting)[1], term(&free)[1]);
+    let expected = free_term * 0.0042 / 3f64.sqrt() / allowance;
+    assert!(
+        (bounded_term / expected - 1.0).abs() < 0.05,
+        "output 2's cycle_rate term {bounded_term:e}, the bound's share of the free run's {free_term:e}: {expected:e}"
+    );
+    // Turning at 0.2 deg/s, fifty times the bound: said, and predicted at
+    // the reading as without a bound.
+    let turning = calibrate(&config, &["--rate", "0.2"]);
+    covered(&turning, "turning beyond the bound");
+    assert_eq!(said(&turning), 1, "{}", turning["warnings"]);
+    let free_turning = calibrate(
+        Path::new("tests/data/field_consumer.toml"),
+        &["--rate", "0.2"],
+    );
+    assert_eq!(term(&turning), term(&free_turning));
+}

@@ -71,7 +71,17 @@ pub struct Knowns {
     /// at their realized amplitudes (`gyrocal_regs::datapath::readout_word`).
     #[serde(serialize_with = "profile_name")]
     pub carrier_profile: CarrierProfile,
+    /// The most the device turns about its sensitive axis during the
+    /// self-calibration cycle (deg/s), when the user knows it rests: on a
+    /// fixed fixture, Earth's rate at most ([`EARTH_RATE_DPS`]). None: the
+    /// cycle knows only what its couplings' windows read
+    /// (`selfcal::predicted_rate`).
+    pub rest_bound_dps: Option<f64>,
 }
+
+/// Earth's rotation rate (deg/s, 15.04 deg/h): the most a device resting
+/// on a fixed fixture turns about any axis.
+pub const EARTH_RATE_DPS: f64 = 4.178e-3;
 
 fn profile_name<S: serde::Serializer>(p: &CarrierProfile, s: S) -> Result<S::Ok, S::Error> {
     s.serialize_str(p.name())
@@ -259,6 +269,7 @@ pub(crate) fn for_tests(nominal: GyroParams, clock_hz: f64, carrier_hz: f64) -> 
         rates_dps: vec![10.0],
         cal_freqs_hz: vec![3.0],
         carrier_profile: CarrierProfile::Table,
+        rest_bound_dps: None,
     }
 }
 

@@ -43,6 +43,7 @@ fn knowns(datasheet: GyroParams) -> Knowns {
         nominal: datasheet,
         // The fake board's words are the exact product.
         carrier_profile: gyrocal_regs::datapath::CarrierProfile::Fine,
+        rest_bound_dps: None,
     }
 }
 

@@ -14,7 +14,8 @@
 //!               # adc_headroom), noise_lsb (1), seed (1)
 //! [filter]      # decimation, butterworth_hz, rc_hz: derived when unset
 //! [experiment]  # required: readout_rates_dps, cal_freqs_hz
-//!               # tolerance (1e-4), min_window_s (derived), budget_s (60)
+//!               # tolerance (1e-4), min_window_s (derived), budget_s (60),
+//!               # rest_bound_dps (none: the device may turn during the cycle)
 //! [noise]       # Brownian force noise: mass_kg (1e-8), temperature_k
 //!               # (0: off), seed (1); and, read by `gyrocal datasheet`
 //!               # alone ([`NoiseModel`]), the rate noises
@@ -289,6 +290,13 @@ pub struct Points {
     /// (`(0, MAX_BUDGET_S]`).
     #[serde(default = "Points::default_budget")]
     pub budget_s: f64,
+    /// The device rests during the self-calibration cycle, turning at
+    /// most this fast about its sensitive axis (deg/s, `(0,
+    /// MAX_REST_BOUND_DPS]`): 0.0042 on a fixed fixture, Earth's rate
+    /// (`gyrocal_host::knowns::EARTH_RATE_DPS`). The cycle's sigma then
+    /// takes an unseen rate within it (`gyrocal_host::selfcal::predicted_rate`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rest_bound_dps: Option<f64>,
 }
 
 impl Points {
@@ -306,6 +314,7 @@ impl Points {
             tolerance: Self::default_tolerance(),
             min_window_s: None,
             budget_s: Self::default_budget(),
+            rest_bound_dps: None,
         }
     }
 }
@@ -320,6 +329,11 @@ pub const MAX_TOLERANCE: f64 = 0.1;
 pub const MAX_WINDOW_S: f64 = 100.0;
 /// Largest wall-time budget (s).
 pub const MAX_BUDGET_S: f64 = 86_400.0;
+/// Largest `[experiment] rest_bound_dps` (deg/s): a bound beyond what the
+/// couplings' windows read to (hundredths of a deg/s on the consumer
+/// device) says nothing the reading does not, and a device turning at a
+/// degree a second does not rest.
+pub const MAX_REST_BOUND_DPS: f64 = 1.0;
 /// z samples per period of the calibration ripple (2 f_cal) at least: the
 /// window average integrates the interpolated samples, with an error below
 /// 1e-4 of the ripple from 20 samples per period on (`average.rs`).
@@ -737,6 +751,17 @@ impl Experiment {
                 &format!("allowed 0 < min_window_s <= {MAX_WINDOW_S} s"),
             )?;
         }
+        if let Some(b) = p.rest_bound_dps {
+            check(
+                "experiment",
+                "rest_bound_dps",
+                b,
+                b > 0.0 && b <= MAX_REST_BOUND_DPS,
+                &format!(
+                    "allowed 0 < rest_bound_dps <= {MAX_REST_BOUND_DPS} deg/s (a device on a fixed fixture turns at Earth's rate, 0.0042 deg/s, at most)"
+                ),
+            )?;
+        }
         check(
             "experiment",
             "budget_s",
@@ -1081,6 +1106,14 @@ mod tests {
             (
                 REQUIRED.replace("cal_freqs_hz", "budget_s = 0\ncal_freqs_hz"),
                 "[experiment] budget_s = 0: allowed",
+            ),
+            (
+                REQUIRED.replace("cal_freqs_hz", "rest_bound_dps = 0\ncal_freqs_hz"),
+                "[experiment] rest_bound_dps = 0: allowed 0 < rest_bound_dps <= 1 deg/s",
+            ),
+            (
+                REQUIRED.replace("cal_freqs_hz", "rest_bound_dps = 5\ncal_freqs_hz"),
+                "[experiment] rest_bound_dps = 5: allowed 0 < rest_bound_dps <= 1 deg/s",
             ),
             (
                 format!("{REQUIRED}[frontend]\nadc_per_meter1 = 1e9\n"),

@@ -793,7 +793,7 @@ pub(crate) fn resolved(modes: &[ModeFit; 2]) -> bool {
 ///     filter: Derived { decimation: 1000, butterworth_hz: 500.0, rc_hz: 2000.0,
 ///         min_window_s: 0.05 },
 ///     carrier_hz: 1.003 * f1, rates_dps: vec![1.0, 20.0], cal_freqs_hz: vec![10.0, 15.0],
-///     nominal: datasheet.clone(), carrier_profile: CarrierProfile::Fine,
+///     nominal: datasheet.clone(), carrier_profile: CarrierProfile::Fine, rest_bound_dps: None,
 /// };
 /// let id = identify::identify(&mut board, &knowns, &datasheet).unwrap();
 /// let mode1 = &id.modes[0];

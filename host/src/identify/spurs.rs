@@ -65,7 +65,7 @@ use gyrocal_regs::datapath::{CarrierProfile, PEAK, q15_product};
 /// #     filter: Derived { decimation: 643, butterworth_hz: 48.0, rc_hz: 192.0,
 /// #         min_window_s: 0.27 },
 /// #     carrier_hz: 25.1e3, rates_dps: vec![50.0], cal_freqs_hz: vec![2.0],
-/// #     nominal: gyro, carrier_profile: CarrierProfile::Table,
+/// #     nominal: gyro, carrier_profile: CarrierProfile::Table, rest_bound_dps: None,
 /// # };
 /// use gyrocal_host::identify::point_spur_sd;
 /// // Mode 2 half a bandwidth above the clock's 1 / 48 (25718.75 Hz),

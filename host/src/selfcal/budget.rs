@@ -243,7 +243,8 @@ pub(super) fn cycle_rate(
         return Ok([0.0; 2]);
     };
     let o = Operating {
-        cycle_rate_dps: op.cycle_rate_dps + super::predicted_rate(reading).uncertainty,
+        cycle_rate_dps: op.cycle_rate_dps
+            + super::predicted_rate(reading, knowns.rest_bound_dps).uncertainty,
         ..op.clone()
     };
     let moved = predicted_ratio(knowns, &id.gyro(&knowns.nominal), &o, cal_hz)?;

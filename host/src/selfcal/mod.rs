@@ -357,7 +357,22 @@ impl SelfCal {
             lines.push(format!("warning: {fold}"));
         }
         lines.extend(self.cycle_rate_warning());
+        lines.extend(self.rest_warning(knowns));
         lines
+    }
+
+    /// One line when the user said the device rests (`[experiment]
+    /// rest_bound_dps`) and the couplings' windows read it turning beyond
+    /// that bound ([`rest_contradicted`]): the device did not rest or the
+    /// bound is wrong, and the rate's sigma is the reading's alone.
+    pub fn rest_warning(&self, knowns: &Knowns) -> Option<String> {
+        let (t, b) = (self.identified.cycle_rate_dps?, knowns.rest_bound_dps?);
+        rest_contradicted(t, b).then(|| {
+            format!(
+                "warning: [experiment] rest_bound_dps = {b} says the device rests, but its cross responses read it turning at {:.4} +- {:.4} deg/s during the cycle: it did not rest, or the bound is wrong; the rate's sigma is the reading's, not the bound's",
+                t.value, t.uncertainty
+            )
+        })
     }
 
     /// One line when the couplings' windows read a rate beyond
@@ -757,20 +772,58 @@ pub(crate) fn rate_seen(reading: Estimate) -> bool {
 /// the consumer device's output 2 moves by 4.6e-4 per 0.01 deg/s, and the
 /// reading's rounding alone moved by that much when the converters' gains
 /// did (`tests/field.rs`, `adc_and_common_drive_gains_cancel`).
-pub fn predicted_rate(reading: Estimate) -> Estimate {
+///
+/// Where the user says the device rests (`rest_bound_dps`, a bound b on
+/// its rate) and the reading agrees ([`rest_contradicted`]), an unseen rate
+/// lies within +-b, anywhere in it: its sigma is b / sqrt 3, the
+/// rectangular distribution's (GUM 4.3.7), when that is the smaller.
+///
+/// ```
+/// use gyrocal_host::identify::Estimate;
+/// use gyrocal_host::selfcal::predicted_rate;
+/// let reading = Estimate { value: 0.012, uncertainty: 0.015 };
+/// // Unseen: 0, its sigma the reading's value and sigma together.
+/// assert_eq!(predicted_rate(reading, None).uncertainty, 0.012f64.hypot(0.015));
+/// // Resting on a fixture: Earth's rate at most.
+/// let rest = predicted_rate(reading, Some(0.0042));
+/// assert_eq!((rest.value, rest.uncertainty), (0.0, 0.0042 / 3f64.sqrt()));
+/// // A reading that the bound cannot explain keeps its own sigma.
+/// let turning = Estimate { value: 0.06, uncertainty: 0.015 };
+/// assert_eq!(predicted_rate(turning, Some(0.0042)), predicted_rate(turning, None));
+/// ```
+pub fn predicted_rate(reading: Estimate, rest_bound_dps: Option<f64>) -> Estimate {
     if rate_seen(reading) {
-        reading
-    } else {
-        reading.as_unseen()
+        return reading;
     }
+    let unseen = reading.as_unseen();
+    match rest_bound_dps {
+        Some(b) if !rest_contradicted(reading, b) => Estimate {
+            value: 0.0,
+            uncertainty: unseen.uncertainty.min(b / 3f64.sqrt()),
+        },
+        _ => unseen,
+    }
+}
+
+/// A reading beyond the rest bound b by more than this many of its sigmas
+/// says the device did not rest (or b is wrong): the bound is then not
+/// used, and the run says so (`SelfCal::rest_warning`).
+pub const REST_CONTRADICTED: f64 = 3.0;
+
+/// The windows' rate `reading` lies farther from +-`bound_dps` than
+/// [`REST_CONTRADICTED`] of its sigmas.
+pub fn rest_contradicted(reading: Estimate, bound_dps: f64) -> bool {
+    reading.value.abs() > bound_dps + REST_CONTRADICTED * reading.uncertainty
 }
 
 /// The rate the calibration is predicted at for the identification `id`
 /// ([`predicted_rate`] of its windows' reading; 0 without one): what
 /// [`Operating::cycle_rate_dps`] holds and the cross responses' Coriolis
-/// term (`drive_ratio::cross_terms`) takes.
+/// term (`drive_ratio::cross_terms`) takes. A rest bound moves the
+/// sigma alone, never the rate predicted at.
 pub(crate) fn prediction_rate_dps(id: &Identified) -> f64 {
-    id.cycle_rate_dps.map_or(0.0, |r| predicted_rate(r).value)
+    id.cycle_rate_dps
+        .map_or(0.0, |r| predicted_rate(r, None).value)
 }
 
 /// `knowns` with drive 2's force gain moved by `relative` (g_2 / g_1 over

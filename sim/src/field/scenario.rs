@@ -595,6 +595,7 @@ pub fn knowns(exp: &Experiment) -> Result<Knowns, ConfigError> {
         rates_dps: exp.points.readout_rates_dps.clone(),
         cal_freqs_hz: exp.points.cal_freqs_hz.clone(),
         carrier_profile: exp.drive.carrier_profile,
+        rest_bound_dps: exp.points.rest_bound_dps,
     })
 }
 
