@@ -83,6 +83,22 @@ fn calibrate(config: &Path, extra: &[&str]) -> Value {
     json_object(gyrocal(&args))
 }
 
+/// Each output's self-calibration error against the rate table lies
+/// within 3 of its sigmas.
+fn within_3_sigma(run: &Value, what: &str) {
+    let error = pair(&run["truth"], "selfcal_error");
+    let sigma = pair(&run["truth"], "selfcal_error_uncertainty");
+    for k in 0..2 {
+        assert!(
+            error[k].abs() <= 3.0 * sigma[k],
+            "{what}, output {}: error {:e} against sigma {:e}",
+            k + 1,
+            error[k],
+            sigma[k]
+        );
+    }
+}
+
 /// A run's `warnings`, one line each.
 fn warnings(run: &Value) -> Vec<&str> {
     run["warnings"]
@@ -740,19 +756,6 @@ fn a_device_turning_during_the_cycle_is_calibrated_at_its_rate_and_said() {
     let head = "warning: the device turned during the cycle: its cross responses read a rate of ";
     let lines =
         |run: &Value| -> usize { warnings(run).iter().filter(|w| w.starts_with(head)).count() };
-    let within_3_sigma = |run: &Value, what: &str| {
-        let error = pair(&run["truth"], "selfcal_error");
-        let sigma = pair(&run["truth"], "selfcal_error_uncertainty");
-        for k in 0..2 {
-            assert!(
-                error[k].abs() <= 3.0 * sigma[k],
-                "{what}, output {}: error {:e} against sigma {:e}",
-                k + 1,
-                error[k],
-                sigma[k]
-            );
-        }
-    };
     let mut at_rest = 0.0;
     for rate in [0.0, 5.0, -2.0] {
         let run = calibrate(&config, &["--rate", &rate.to_string()]);
@@ -854,25 +857,12 @@ fn a_rest_bound_narrows_the_unseen_rate_and_a_turning_device_contradicts_it() {
     let head = "warning: [experiment] rest_bound_dps = 0.0042 says the device rests, but";
     let said = |run: &Value| warnings(run).iter().filter(|w| w.starts_with(head)).count();
     let term = |run: &Value| pair(&run["sf_selfcal_uncertainty_sources"], "cycle_rate");
-    let covered = |run: &Value, what: &str| {
-        let error = pair(&run["truth"], "selfcal_error");
-        let sigma = pair(&run["truth"], "selfcal_error_uncertainty");
-        for k in 0..2 {
-            assert!(
-                error[k].abs() <= 3.0 * sigma[k],
-                "{what}, output {}: error {:e} against sigma {:e}",
-                k + 1,
-                error[k],
-                sigma[k]
-            );
-        }
-    };
     let free = calibrate(
         Path::new("tests/data/field_consumer.toml"),
         &["--rate", "0"],
     );
     let resting = calibrate(&config, &["--rate", "0"]);
-    covered(&resting, "resting within the bound");
+    within_3_sigma(&resting, "resting within the bound");
     assert_eq!(said(&resting), 0, "{}", resting["warnings"]);
     // The same cycle (the bound moves no measurement), its output 2's term
     // now from the bound: b / sqrt 3 where the reading's allowance was
@@ -891,7 +881,7 @@ fn a_rest_bound_narrows_the_unseen_rate_and_a_turning_device_contradicts_it() {
     // Turning at 0.2 deg/s, fifty times the bound: said, and predicted at
     // the reading as without a bound.
     let turning = calibrate(&config, &["--rate", "0.2"]);
-    covered(&turning, "turning beyond the bound");
+    within_3_sigma(&turning, "turning beyond the bound");
     assert_eq!(said(&turning), 1, "{}", turning["warnings"]);
     let free_turning = calibrate(
         Path::new("tests/data/field_consumer.toml"),
