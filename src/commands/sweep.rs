@@ -279,6 +279,22 @@ pub fn summary(report: &SweepReport) -> String {
         100.0 * yield_both
     );
     let sm = &report.summary;
+    errors_block(&mut s, sm);
+    coverage_block(&mut s, sm);
+    for n in &sm.notes {
+        let _ = writeln!(s, "{n}");
+    }
+    for d in report.devices.iter().filter(|d| !d.failed.is_empty()) {
+        let _ = writeln!(s, "{}", device_line(d));
+    }
+    for w in &sm.warnings {
+        let _ = writeln!(s, "{w}");
+    }
+    s
+}
+
+/// The summary's worst-error percentiles per output, and the maximum.
+fn errors_block(s: &mut String, sm: &Summary) {
     if !sm.error_percentiles.is_empty() {
         let _ = writeln!(
             s,
@@ -301,6 +317,11 @@ pub fn summary(report: &SweepReport) -> String {
             );
         }
     }
+}
+
+/// The summary's coverage: the errors and, per output and per identified
+/// parameter, the share within 2 sigma and the RMS of error / sigma.
+fn coverage_block(s: &mut String, sm: &Summary) {
     if let Some(w) = sm.within_2_sigma {
         let _ = writeln!(
             s,
@@ -339,14 +360,4 @@ pub fn summary(report: &SweepReport) -> String {
             sm.parameters_beyond_3_sigma
         );
     }
-    for n in &sm.notes {
-        let _ = writeln!(s, "{n}");
-    }
-    for d in report.devices.iter().filter(|d| !d.failed.is_empty()) {
-        let _ = writeln!(s, "{}", device_line(d));
-    }
-    for w in &sm.warnings {
-        let _ = writeln!(s, "{w}");
-    }
-    s
 }
