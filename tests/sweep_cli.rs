@@ -538,3 +538,27 @@ fn a_spread_of_oscillators_is_in_each_parts_sigma() {
         );
     }
 }
+
+/// Every example spread (`examples/sweep/*.toml`) is accepted: its first
+/// part is drawn and printed as a field file that `gyrocal field` would
+/// take (`sweep part`), so an example cannot rot unseen.
+#[test]
+fn every_example_spread_gives_its_parts() {
+    let mut examples: Vec<_> = std::fs::read_dir(root().join("examples/sweep"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    examples.sort();
+    assert!(examples.len() >= 2, "{examples:?}");
+    for example in examples {
+        let config = example.to_str().unwrap();
+        let o = gyrocal(&["sweep", "part", "--config", config, "--index", "0"]);
+        assert!(o.status.success(), "{config}: {}", stderr(&o));
+        let part = String::from_utf8(o.stdout).unwrap();
+        assert!(
+            part.contains("[gyro]") && part.contains("[experiment]"),
+            "{config}: {part}"
+        );
+    }
+}
