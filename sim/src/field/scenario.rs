@@ -1234,7 +1234,7 @@ fn steps_of(
             }
         };
         let baseline = at_factory.as_ref().and_then(|f| {
-            baseline_of(i, &c, f.factory, f.jobs, f.done, &knowns.rates_dps)
+            f.baseline(i, &c, &knowns.rates_dps)
                 .map_err(|error| match error {
                     // What a part left uncalibrated does here: a finding,
                     // said in a line, not a failure of the run.
@@ -1267,37 +1267,35 @@ struct Baseline<'a> {
     null_factory: Option<[f64; 2]>,
 }
 
-fn baseline_of<'a>(
-    i: usize,
-    c: &Cycle,
-    f: &Factory,
-    jobs: &[Job],
-    done: &'a [Result<(Done, u64), FieldError>],
-    rates: &[f64],
-) -> Result<Baseline<'a>, FieldError> {
-    if i == 0 {
-        return Ok(Baseline {
-            sf_fixed: c.truth.sf_per_dps,
-            run: None,
+impl<'a> AtFactory<'a> {
+    /// Step `i`'s [`Baseline`] for its finished cycle `c`, from the
+    /// factory's jobs at the table's `rates`; a job's error is the step's.
+    fn baseline(&self, i: usize, c: &Cycle, rates: &[f64]) -> Result<Baseline<'a>, FieldError> {
+        let (f, jobs, done) = (self.factory, self.jobs, self.done);
+        if i == 0 {
+            return Ok(Baseline {
+                sf_fixed: c.truth.sf_per_dps,
+                run: None,
+                sf_factory: f.sf_per_dps,
+                null_factory: f.null_z,
+            });
+        }
+        let mut z = vec![[0.0; 2]; rates.len()];
+        let mut run = None;
+        for (job, d) in jobs.iter().zip(done).filter(|(j, _)| j.step() == i) {
+            match (job, &d.as_ref().map_err(Clone::clone)?.0) {
+                (Job::Factory { rate, .. }, Done::Point(v)) => z[*rate] = *v,
+                (Job::BaselineProfile { .. }, Done::Profile(r)) => run = Some(r),
+                _ => unreachable!("a job's result is of its kind"),
+            }
+        }
+        Ok(Baseline {
+            sf_fixed: table_slopes(rates, &z),
+            run,
             sf_factory: f.sf_per_dps,
             null_factory: f.null_z,
-        });
+        })
     }
-    let mut z = vec![[0.0; 2]; rates.len()];
-    let mut run = None;
-    for (job, d) in jobs.iter().zip(done).filter(|(j, _)| j.step() == i) {
-        match (job, &d.as_ref().map_err(Clone::clone)?.0) {
-            (Job::Factory { rate, .. }, Done::Point(v)) => z[*rate] = *v,
-            (Job::BaselineProfile { .. }, Done::Profile(r)) => run = Some(r),
-            _ => unreachable!("a job's result is of its kind"),
-        }
-    }
-    Ok(Baseline {
-        sf_fixed: table_slopes(rates, &z),
-        run,
-        sf_factory: f.sf_per_dps,
-        null_factory: f.null_z,
-    })
 }
 
 /// The report's entry of a finished cycle, with its baseline when the
