@@ -562,3 +562,39 @@ fn every_example_spread_gives_its_parts() {
         );
     }
 }
+
+/// A family no sigma was tuned on (`examples/sweep/low_q_wide_split.toml`,
+/// docs/sweep.md, "Two more families not tuned on"): 40 low-Q parts split
+/// by 19 to 28 of their mean bandwidth, 35 of them beyond the 20 that
+/// `tests/supported_ranges.rs` plans, with quadrature couplings of some
+/// tens of deg/s. Every part is identified and calibrated; no output
+/// error and no identified figure lies beyond 3 of its sigmas; at least
+/// 90% of the 80 output errors lie within 2. Why each can fail: honest
+/// sigmas put 95.4% within 2, so fewer than 72 of 80 (2.3 binomial
+/// deviations below the 76.3 expected) about 1% of the time; and a figure
+/// beyond 3 with 0.27% each, so the 80 outputs and 240 identified figures
+/// (f, Q, couplings) hold none beyond in 42% of draws. These draws are
+/// fixed, and they hold (measured 97.5% within 2, largest |t| 2.5); a
+/// sigma that loses a term shows here as a figure beyond 3.
+#[test]
+fn a_low_q_family_split_beyond_the_planned_range_is_covered() {
+    let config = root().join("examples/sweep/low_q_wide_split.toml");
+    let v = json_object(gyrocal(&[
+        "sweep",
+        "--config",
+        config.to_str().unwrap(),
+        "--json",
+    ]));
+    let summary = &v["summary"];
+    assert_eq!(summary["devices"], 40, "{summary}");
+    assert_eq!(summary["failed"], 0, "{summary}");
+    assert_eq!(summary["beyond_3_sigma"], 0, "{summary}");
+    assert_eq!(summary["parameters_beyond_3_sigma"], 0, "{summary}");
+    let within = summary["within_2_sigma"].as_f64().unwrap();
+    assert!(within >= 0.9, "{within} of the outputs within 2 sigma");
+    let parameters = summary["coverage_per_parameter"].as_array().unwrap();
+    assert_eq!(parameters.len(), 6, "{parameters:?}");
+    for p in parameters {
+        assert_eq!(p["parts"], 40, "{p}");
+    }
+}
