@@ -431,89 +431,140 @@ pub fn uncouple(
     clock_hz: f64,
     carrier_hz: f64,
 ) -> Result<Identified, Error> {
-    let [m1, m2] = &apparent.modes;
-    let fa = [m1.f_hz.value, m2.f_hz.value];
-    let quadrature_dps = coupling.quadrature_dps.value;
-    let [damping_dps, rate_dps] = [coupling.damping_dps, coupling.rate_dps].map(|e| e.value);
-    // kappa(f) = k + j w d in Hz^2 (`crate::theory`): k from Omega_q at f1,
-    // the damping term j f (lambda Omega_d / 180) at f. A rate adds the
-    // Coriolis term c = j f (lambda Omega / 180) with opposite signs to
-    // the two cross terms (module header), whose product is then kappa^2 -
-    // c^2: that is the pull (below, "kappa^2").
-    let kappa_squared = |f: f64| {
-        let kappa = C64::new(
-            quadrature_dps * angular_gain * fa[0] / 180.0,
-            damping_dps * angular_gain * f / 180.0,
-        );
-        let c = C64::new(0.0, rate_dps * angular_gain * f / 180.0);
-        kappa * kappa - c * c
-    };
-    // Named by what couples them: the rate, where it is the larger.
-    let by = if rate_dps.abs() > quadrature_dps.abs().max(damping_dps.abs()) {
-        format!("a rate of {rate_dps:.1} deg/s during the cycle (its Coriolis coupling)")
-    } else {
-        format!("{quadrature_dps:.1} deg/s")
-    };
-    let too_strong = |reason: String| Error::Measurement {
-        what: "quadrature coupling",
-        reason: format!("{by} couples the modes too strongly to separate: {reason}"),
-    };
-    // The other mode's pull on mode i, from the other's current estimate.
-    let pull_on = |modes: &[ModeFit; 2], i: usize| {
-        let o = &modes[1 - i];
-        let (fo, qo) = (o.f_hz.value, o.q.value);
-        move |v: f64| kappa_squared(v) * resonator(fo, qo, v)
-    };
-    let values = |modes: &[ModeFit; 2]| {
-        (
-            [modes[0].f_hz.value, modes[1].f_hz.value],
-            [modes[0].q.value, modes[1].q.value],
-        )
-    };
-    let mut modes = apparent.modes.clone();
-    let mut converged = false;
-    for _ in 0..UNCOUPLE_ROUNDS {
-        let (before, _) = values(&modes);
-        let front = FrontEnd::of(&modes, carrier_hz);
-        for i in 0..2 {
-            let pull = pull_on(&modes, i);
-            modes[i] = identify::refit(&apparent.modes[i], i, clock_hz, &pull, &front)
-                .map_err(|e| too_strong(format!("no uncoupled modes behind the fits ({e})")))?;
-        }
-        let (f, q) = values(&modes);
-        if !(f.iter().chain(&q).all(|v| v.is_finite() && *v > 0.0)) {
-            return Err(too_strong("no uncoupled modes behind the fits".into()));
-        }
-        // Settled when no frequency moves by a thousandth of its
-        // (residuals') sigma.
-        let settled = (0..2).all(|i| (f[i] - before[i]).abs() < 1e-3 * modes[i].f_hz.uncertainty);
-        if settled {
-            converged = true;
-            break;
-        }
-    }
-    let (f, q) = values(&modes);
-    for i in 0..2 {
-        let g = [resonator(f[0], q[0], f[i]), resonator(f[1], q[1], f[i])];
-        let mixing = (g[0] * g[1] * kappa_squared(f[i])).norm();
-        if mixing > MAX_MIXING {
-            return Err(too_strong(format!(
-                "k^2 |G_1 G_2| = {mixing:.2} at mode {}, at most {MAX_MIXING}",
-                i + 1
-            )));
-        }
-    }
-    if !converged {
-        return Err(too_strong("the uncoupled modes did not converge".into()));
-    }
+    let pull = Pull::new(coupling, angular_gain, apparent.modes[0].f_hz.value);
+    let modes = pull.fixed_point(&apparent.modes, clock_hz, carrier_hz)?;
     // The uncertainties once, at the fixed point (each mode's jackknife
     // refits its sweep five times).
-    let (pull1, pull2) = (pull_on(&modes, 0), pull_on(&modes, 1));
+    let (pull1, pull2) = (pull.on(&modes, 0), pull.on(&modes, 1));
     let modes = FrontEnd::complete(&modes, carrier_hz, clock_hz, [&pull1, &pull2])?;
     let mut id = apparent.clone();
     (id.loop_phase_deg, id.group_delay_s) = identify::loop_phase(&modes, carrier_hz);
     id.modes = modes;
     Ok(id)
+}
+
+/// What couples the modes in [`uncouple`]: the quadrature and damping
+/// couplings and the rate (deg/s) through lambda, as the pull
+/// kappa^2 - c^2 (Hz^4) that one mode's response puts on the other's.
+struct Pull {
+    /// Omega_q (deg/s).
+    quadrature_dps: f64,
+    /// Omega_d (deg/s).
+    damping_dps: f64,
+    /// The rate during the cycle (deg/s).
+    rate_dps: f64,
+    /// lambda, the datasheet's.
+    angular_gain: f64,
+    /// Mode 1's apparent frequency, where k is taken (Hz).
+    f1_hz: f64,
+}
+
+impl Pull {
+    fn new(coupling: &Coupling, angular_gain: f64, f1_hz: f64) -> Self {
+        Self {
+            quadrature_dps: coupling.quadrature_dps.value,
+            damping_dps: coupling.damping_dps.value,
+            rate_dps: coupling.rate_dps.value,
+            angular_gain,
+            f1_hz,
+        }
+    }
+
+    /// kappa(f) = k + j w d in Hz^2 (`crate::theory`): k from Omega_q at
+    /// f1, the damping term j f (lambda Omega_d / 180) at f. A rate adds
+    /// the Coriolis term c = j f (lambda Omega / 180) with opposite signs
+    /// to the two cross terms (module header), whose product is then
+    /// kappa^2 - c^2: that is the pull ("kappa^2" in [`uncouple`]).
+    fn kappa_squared(&self, f: f64) -> C64 {
+        let kappa = C64::new(
+            self.quadrature_dps * self.angular_gain * self.f1_hz / 180.0,
+            self.damping_dps * self.angular_gain * f / 180.0,
+        );
+        let c = C64::new(0.0, self.rate_dps * self.angular_gain * f / 180.0);
+        kappa * kappa - c * c
+    }
+
+    /// The other mode's pull on mode i, from the other's estimate in
+    /// `modes`.
+    fn on(&self, modes: &[ModeFit; 2], i: usize) -> impl Fn(f64) -> C64 + '_ {
+        let o = &modes[1 - i];
+        let (fo, qo) = (o.f_hz.value, o.q.value);
+        move |v: f64| self.kappa_squared(v) * resonator(fo, qo, v)
+    }
+
+    /// The error of modes too strongly coupled to separate, named by
+    /// what couples them: the rate, where it is the larger.
+    fn too_strong(&self, reason: impl std::fmt::Display) -> Error {
+        let (q, d, r) = (self.quadrature_dps, self.damping_dps, self.rate_dps);
+        let by = if r.abs() > q.abs().max(d.abs()) {
+            format!("a rate of {r:.1} deg/s during the cycle (its Coriolis coupling)")
+        } else {
+            format!("{q:.1} deg/s")
+        };
+        Error::Measurement {
+            what: "quadrature coupling",
+            reason: format!("{by} couples the modes too strongly to separate: {reason}"),
+        }
+    }
+
+    /// The uncoupled modes behind the `apparent` fits: each refitted with
+    /// the other's pull, from the other's last refit, until no frequency
+    /// moves by a thousandth of its (residuals') sigma; then the mixing
+    /// k^2 |G_1 G_2| at each mode held to `MAX_MIXING`. Uncertainties are
+    /// the residuals' until [`FrontEnd::complete`].
+    fn fixed_point(
+        &self,
+        apparent: &[ModeFit; 2],
+        clock_hz: f64,
+        carrier_hz: f64,
+    ) -> Result<[ModeFit; 2], Error> {
+        let mut modes = apparent.clone();
+        let mut converged = false;
+        for _ in 0..UNCOUPLE_ROUNDS {
+            let (before, _) = values(&modes);
+            let front = FrontEnd::of(&modes, carrier_hz);
+            for i in 0..2 {
+                let pull = self.on(&modes, i);
+                modes[i] =
+                    identify::refit(&apparent[i], i, clock_hz, &pull, &front).map_err(|e| {
+                        self.too_strong(format!("no uncoupled modes behind the fits ({e})"))
+                    })?;
+            }
+            let (f, q) = values(&modes);
+            if !(f.iter().chain(&q).all(|v| v.is_finite() && *v > 0.0)) {
+                return Err(self.too_strong("no uncoupled modes behind the fits"));
+            }
+            let settled =
+                (0..2).all(|i| (f[i] - before[i]).abs() < 1e-3 * modes[i].f_hz.uncertainty);
+            if settled {
+                converged = true;
+                break;
+            }
+        }
+        let (f, q) = values(&modes);
+        for i in 0..2 {
+            let g = [resonator(f[0], q[0], f[i]), resonator(f[1], q[1], f[i])];
+            let mixing = (g[0] * g[1] * self.kappa_squared(f[i])).norm();
+            if mixing > MAX_MIXING {
+                return Err(self.too_strong(format!(
+                    "k^2 |G_1 G_2| = {mixing:.2} at mode {}, at most {MAX_MIXING}",
+                    i + 1
+                )));
+            }
+        }
+        if !converged {
+            return Err(self.too_strong("the uncoupled modes did not converge"));
+        }
+        Ok(modes)
+    }
+}
+
+/// The two modes' frequencies and Qs.
+fn values(modes: &[ModeFit; 2]) -> ([f64; 2], [f64; 2]) {
+    (
+        [modes[0].f_hz.value, modes[1].f_hz.value],
+        [modes[0].q.value, modes[1].q.value],
+    )
 }
 
 #[cfg(test)]
