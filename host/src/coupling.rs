@@ -431,7 +431,11 @@ pub fn uncouple(
     clock_hz: f64,
     carrier_hz: f64,
 ) -> Result<Identified, Error> {
-    let pull = Pull::new(coupling, angular_gain, apparent.modes[0].f_hz.value);
+    let pull = Pull {
+        coupling,
+        angular_gain,
+        f1_hz: apparent.modes[0].f_hz.value,
+    };
     let modes = pull.fixed_point(&apparent.modes, clock_hz, carrier_hz)?;
     // The uncertainties once, at the fixed point (each mode's jackknife
     // refits its sweep five times).
@@ -446,28 +450,20 @@ pub fn uncouple(
 /// What couples the modes in [`uncouple`]: the quadrature and damping
 /// couplings and the rate (deg/s) through lambda, as the pull
 /// kappa^2 - c^2 (Hz^4) that one mode's response puts on the other's.
-struct Pull {
-    /// Omega_q (deg/s).
-    quadrature_dps: f64,
-    /// Omega_d (deg/s).
-    damping_dps: f64,
-    /// The rate during the cycle (deg/s).
-    rate_dps: f64,
+struct Pull<'a> {
+    /// Omega_q, Omega_d and the rate during the cycle, as measured.
+    coupling: &'a Coupling,
     /// lambda, the datasheet's.
     angular_gain: f64,
     /// Mode 1's apparent frequency, where k is taken (Hz).
     f1_hz: f64,
 }
 
-impl Pull {
-    fn new(coupling: &Coupling, angular_gain: f64, f1_hz: f64) -> Self {
-        Self {
-            quadrature_dps: coupling.quadrature_dps.value,
-            damping_dps: coupling.damping_dps.value,
-            rate_dps: coupling.rate_dps.value,
-            angular_gain,
-            f1_hz,
-        }
+impl Pull<'_> {
+    /// The measured values of Omega_q, Omega_d and the rate (deg/s).
+    fn dps(&self) -> [f64; 3] {
+        let c = self.coupling;
+        [c.quadrature_dps, c.damping_dps, c.rate_dps].map(|e| e.value)
     }
 
     /// kappa(f) = k + j w d in Hz^2 (`crate::theory`): k from Omega_q at
@@ -476,11 +472,12 @@ impl Pull {
     /// to the two cross terms (module header), whose product is then
     /// kappa^2 - c^2: that is the pull ("kappa^2" in [`uncouple`]).
     fn kappa_squared(&self, f: f64) -> C64 {
+        let [quadrature, damping, rate] = self.dps();
         let kappa = C64::new(
-            self.quadrature_dps * self.angular_gain * self.f1_hz / 180.0,
-            self.damping_dps * self.angular_gain * f / 180.0,
+            quadrature * self.angular_gain * self.f1_hz / 180.0,
+            damping * self.angular_gain * f / 180.0,
         );
-        let c = C64::new(0.0, self.rate_dps * self.angular_gain * f / 180.0);
+        let c = C64::new(0.0, rate * self.angular_gain * f / 180.0);
         kappa * kappa - c * c
     }
 
@@ -495,7 +492,7 @@ impl Pull {
     /// The error of modes too strongly coupled to separate, named by
     /// what couples them: the rate, where it is the larger.
     fn too_strong(&self, reason: impl std::fmt::Display) -> Error {
-        let (q, d, r) = (self.quadrature_dps, self.damping_dps, self.rate_dps);
+        let [q, d, r] = self.dps();
         let by = if r.abs() > q.abs().max(d.abs()) {
             format!("a rate of {r:.1} deg/s during the cycle (its Coriolis coupling)")
         } else {
