@@ -713,7 +713,7 @@ mod tests {
             quadrature_dps: 0.0,
             damping_coupling_dps: 0.0,
         };
-        let knowns = crate::knowns::for_tests(nominal, 1e9, f);
+        let knowns = Knowns::exact(nominal, 1e9, f);
         let op = Operating {
             carrier_hz: f,
             ref_lag_deg: 0.0,

@@ -93,6 +93,55 @@ pub fn phase_word(deg: f64) -> u32 {
 }
 
 impl Knowns {
+    /// A board and device known exactly: the datasheet `nominal` with no
+    /// uncertainty on lambda, the drive-gain ratio or the clock, readout
+    /// drives at 0.9 of full scale with equal design force gains,
+    /// converter latencies of 2 and 3 clocks, the table core, one readout
+    /// rate (10 deg/s) and one calibration frequency (3 Hz), an output
+    /// filter decimating by 100 with 50 Hz Butterworth and 200 Hz RC
+    /// cut-offs and a 0.1 s first window, and no rest bound. What tests,
+    /// examples and fake boards start from, each setting what differs by
+    /// struct update; a real board's knowns come from its configuration
+    /// (`gyrocal_sim::field::scenario`).
+    ///
+    /// ```
+    /// use gyrocal_host::GyroParams;
+    /// use gyrocal_host::knowns::Knowns;
+    /// let gyro = GyroParams { f1_hz: 25.1e3, f2_hz: 25.8e3, q1: 3e3, q2: 3e3,
+    ///     angular_gain: 0.8, quadrature_dps: 0.0, damping_coupling_dps: 0.0 };
+    /// let knowns = Knowns {
+    ///     rates_dps: vec![50.0, 100.0],
+    ///     ..Knowns::exact(gyro, 1.2345e6, 25.1e3)
+    /// };
+    /// assert_eq!(knowns.bandwidth_hz(0), 25.1e3 / 3e3);
+    /// // 0.1 s of z samples at 1.2345 MHz / 100.
+    /// assert_eq!(knowns.window_samples(), 1235);
+    /// ```
+    pub fn exact(nominal: GyroParams, clock_hz: f64, carrier_hz: f64) -> Self {
+        Self {
+            clock_hz,
+            clock_tolerance: 0.0,
+            nominal,
+            angular_gain_uncertainty: 0.0,
+            drive_gain_ratio_uncertainty: 0.0,
+            amplitude: (0.9, 0.9),
+            force_full_scale: [1.0, 1.0],
+            dac_latency: 2,
+            adc_latency: 3,
+            filter: Derived {
+                decimation: 100,
+                butterworth_hz: 50.0,
+                rc_hz: 200.0,
+                min_window_s: 0.1,
+            },
+            carrier_hz,
+            rates_dps: vec![10.0],
+            cal_freqs_hz: vec![3.0],
+            carrier_profile: CarrierProfile::Table,
+            rest_bound_dps: None,
+        }
+    }
+
     /// Registers for a carrier, calibration frequency (`None`: readout),
     /// drive amplitudes and a reference phase lag (deg) on top of the
     /// aligned value.
@@ -244,35 +293,6 @@ impl Knowns {
     }
 }
 
-/// Knowns for unit tests: the device `nominal`, known exactly, at a clock
-/// and a carrier, equal drive full scales, converter latencies of 2 and 3
-/// clocks.
-#[cfg(test)]
-pub(crate) fn for_tests(nominal: GyroParams, clock_hz: f64, carrier_hz: f64) -> Knowns {
-    Knowns {
-        clock_hz,
-        clock_tolerance: 0.0,
-        nominal,
-        angular_gain_uncertainty: 0.0,
-        drive_gain_ratio_uncertainty: 0.0,
-        amplitude: (0.9, 0.9),
-        force_full_scale: [1.0, 1.0],
-        dac_latency: 2,
-        adc_latency: 3,
-        filter: Derived {
-            decimation: 100,
-            butterworth_hz: 50.0,
-            rc_hz: 200.0,
-            min_window_s: 0.1,
-        },
-        carrier_hz,
-        rates_dps: vec![10.0],
-        cal_freqs_hz: vec![3.0],
-        carrier_profile: CarrierProfile::Table,
-        rest_bound_dps: None,
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -287,7 +307,7 @@ mod tests {
             quadrature_dps: 0.0,
             damping_coupling_dps: 0.0,
         };
-        for_tests(nominal, 1.6e6, carrier_hz)
+        Knowns::exact(nominal, 1.6e6, carrier_hz)
     }
 
     /// At a mode, between the two, or beyond one by less than the split

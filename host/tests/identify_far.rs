@@ -23,27 +23,15 @@ fn paper_truth() -> [(f64, f64, C64); 2] {
 
 fn knowns(datasheet: GyroParams) -> Knowns {
     Knowns {
-        clock_hz: 50e6,
-        clock_tolerance: 0.0,
-        angular_gain_uncertainty: 0.0,
-        drive_gain_ratio_uncertainty: 0.0,
-        amplitude: (0.9, 0.9),
-        force_full_scale: [1.0, 1.0],
-        dac_latency: 2,
-        adc_latency: 3,
         filter: Derived {
             decimation: 1000,
             butterworth_hz: 500.0,
             rc_hz: 2000.0,
             min_window_s: 0.05,
         },
-        carrier_hz: 9.64e6,
-        rates_dps: vec![1.0, 20.0],
-        cal_freqs_hz: vec![10.0, 15.0],
-        nominal: datasheet,
         // The fake board's words are the exact product.
         carrier_profile: gyrocal_regs::datapath::CarrierProfile::Fine,
-        rest_bound_dps: None,
+        ..Knowns::exact(datasheet, 50e6, 9.64e6)
     }
 }
 

@@ -787,13 +787,10 @@ pub(crate) fn resolved(modes: &[ModeFit; 2]) -> bool {
 /// let datasheet = GyroParams { f1_hz: 1.003 * f1, f2_hz: 1.003 * f1 + 250.0, q1: 55e3,
 ///     q2: 55e3, angular_gain: 0.6, quadrature_dps: 0.0, damping_coupling_dps: 0.0 };
 /// let knowns = Knowns {
-///     clock_hz: 50e6, clock_tolerance: 0.0, angular_gain_uncertainty: 0.0,
-///     drive_gain_ratio_uncertainty: 0.0, amplitude: (0.9, 0.9),
-///     force_full_scale: [1.0, 1.0], dac_latency: 2, adc_latency: 3,
 ///     filter: Derived { decimation: 1000, butterworth_hz: 500.0, rc_hz: 2000.0,
 ///         min_window_s: 0.05 },
-///     carrier_hz: 1.003 * f1, rates_dps: vec![1.0, 20.0], cal_freqs_hz: vec![10.0, 15.0],
-///     nominal: datasheet.clone(), carrier_profile: CarrierProfile::Fine, rest_bound_dps: None,
+///     carrier_profile: CarrierProfile::Fine,
+///     ..Knowns::exact(datasheet.clone(), 50e6, 1.003 * f1)
 /// };
 /// let id = identify::identify(&mut board, &knowns, &datasheet).unwrap();
 /// let mode1 = &id.modes[0];

@@ -59,13 +59,10 @@ use gyrocal_regs::datapath::{CarrierProfile, PEAK, q15_product};
 /// # let gyro = GyroParams { f1_hz: 25.1e3, f2_hz: 25.8e3, q1: 3e3, q2: 3e3,
 /// #     angular_gain: 0.8, quadrature_dps: 0.0, damping_coupling_dps: 0.0 };
 /// # let mut knowns = Knowns {
-/// #     clock_hz: 1.2345e6, clock_tolerance: 0.0, angular_gain_uncertainty: 0.0,
-/// #     drive_gain_ratio_uncertainty: 0.0, amplitude: (0.9, 0.9),
-/// #     force_full_scale: [1.0, 1.0], dac_latency: 2, adc_latency: 3,
 /// #     filter: Derived { decimation: 643, butterworth_hz: 48.0, rc_hz: 192.0,
 /// #         min_window_s: 0.27 },
-/// #     carrier_hz: 25.1e3, rates_dps: vec![50.0], cal_freqs_hz: vec![2.0],
-/// #     nominal: gyro, carrier_profile: CarrierProfile::Table, rest_bound_dps: None,
+/// #     rates_dps: vec![50.0], cal_freqs_hz: vec![2.0],
+/// #     ..Knowns::exact(gyro, 1.2345e6, 25.1e3)
 /// # };
 /// use gyrocal_host::identify::point_spur_sd;
 /// // Mode 2 half a bandwidth above the clock's 1 / 48 (25718.75 Hz),
