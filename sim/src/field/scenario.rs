@@ -961,8 +961,11 @@ fn cycle_from(
 ) -> Result<Cycle, FieldError> {
     let mut cal = selfcal::self_calibrate_from(board, knowns, identified)?;
     if let Some(probe) = &sc.drive_probe {
+        // The probe's waits are the identified modes', as the cycle's are
+        // (`selfcal::self_calibrate_from`), not the datasheet's.
+        let device = knowns.with_device(&cal.identified.gyro(&knowns.nominal));
         board.set_rate(probe.rate_dps.to_radians());
-        let measured = drive_ratio::measure(board, knowns, &cal.operating, &cal.identified)?;
+        let measured = drive_ratio::measure(board, &device, &cal.operating, &cal.identified)?;
         board.set_rate(0.0);
         selfcal::apply_drive_ratio(knowns, &mut cal, measured)?;
     }
