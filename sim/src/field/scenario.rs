@@ -663,11 +663,7 @@ fn settled_readout_board(
 /// constants are 4.5 of the part's) read its truth 0.3% to 1.1% off, 4.7
 /// of its sigma and more.
 fn settle_clocks_at(knowns: &Knowns, at: &DeviceAt) -> u64 {
-    let device = Knowns {
-        nominal: at.gyro.clone(),
-        ..knowns.clone()
-    };
-    device.settle_clocks(TABLE_FIRST_TAUS)
+    knowns.with_device(&at.gyro).settle_clocks(TABLE_FIRST_TAUS)
 }
 
 fn program_readout(
