@@ -11,6 +11,20 @@
 //! (`angular_gain_uncertainty`): a host cannot know a part's lambda better
 //! than the process makes it, and the reported sigma must say so.
 //!
+//! **One board for every part.** The line builds one board, for the
+//! nominal device: unless the file gives `[frontend] adc_per_meter1/2`,
+//! [`parse`] writes in the ADC gains `experiment::plan` sizes for the
+//! nominal `[gyro]` at the configured carrier, and every part runs with
+//! them (its `gyrocal sweep part` file carries them). A part that answers
+//! more than the nominal fills its ADCs further and its cycle scales its
+//! drives down; one that answers less reads smaller words. Sized on each
+//! part, as `gyrocal field` sizes a file without them, a part some
+//! bandwidths off the carrier got gains that many times larger and ran
+//! its drives at a fraction of full scale: part 0 of
+//! `examples/sweep/fork_32khz.toml` at 0.23% to 0.28%, its output 2's
+//! sigma 1.0 to 2.4% where it is now 0.06 to 0.29% (docs/sweep.md,
+//! "Every part on the nominal's board").
+//!
 //! **Sharding.** A sweep can be cut in N shards ([`Shard`], `--shard I/N`,
 //! I from 1): shard I runs the devices whose index i has i mod N = I - 1.
 //! Device i is drawn from the seed and i alone ([`spread::Spread::draw`]),
@@ -24,7 +38,8 @@
 pub mod spread;
 pub mod summary;
 
-use crate::error::{FieldError, ScenarioError};
+use crate::error::{FieldError, RunError, ScenarioError};
+use crate::experiment;
 use crate::field::scenario::{self, IdentifiedJson, Scenario};
 use crate::gyro::GyroParams;
 use gyrocal_host::selfcal::SfUncertainty;
@@ -68,6 +83,14 @@ pub enum SweepError {
         /// The spread's `devices` (at least 1).
         devices: u32,
     },
+    /// The nominal device's board could not be sized.
+    #[error("{name}: the nominal device's board (its ADC gains): {source}")]
+    Board {
+        /// The file.
+        name: String,
+        /// Why.
+        source: Box<RunError>,
+    },
 }
 
 /// A checked sweep: the scenario every device runs (around the nominal
@@ -96,11 +119,30 @@ pub fn parse(name: &str, text: &str) -> Result<Sweep, SweepError> {
     spread
         .clock_sd(scenario.exp.drive.clock_error_ppm)
         .map_err(refused)?;
+    let mut scenario = scenario;
+    nominal_board(&mut scenario).map_err(|source| SweepError::Board {
+        name: name.into(),
+        source: Box::new(source),
+    })?;
     Ok(Sweep {
         scenario,
         spread,
         fingerprint: format!("{:016x}", fnv1a(text.as_bytes())),
     })
+}
+
+/// The one board of the line (module header): the ADC gains sized for the
+/// nominal device, written into `scenario`'s `[frontend]` unless the file
+/// gave its own.
+fn nominal_board(scenario: &mut Scenario) -> Result<(), RunError> {
+    let fe = &scenario.exp.frontend;
+    if fe.adc_per_meter1.is_some() || fe.adc_per_meter2.is_some() {
+        return Ok(());
+    }
+    let [a1, a2] = experiment::plan(&scenario.exp)?.front_end.adc_per_meter;
+    let fe = &mut scenario.exp.frontend;
+    (fe.adc_per_meter1, fe.adc_per_meter2) = (Some(a1), Some(a2));
+    Ok(())
 }
 
 fn fnv1a(bytes: &[u8]) -> u64 {
@@ -497,6 +539,7 @@ pub fn merge(parts: Vec<SweepReport>) -> Result<SweepReport, SweepError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::config::{Experiment, Frontend};
 
     #[test]
     fn shards_parse_and_cover_every_device_once() {
@@ -521,6 +564,50 @@ mod tests {
         angular_gain = 0.8\n[drive]\ncarrier_hz = 25.1e3\nclock_hz = 1.2345e6\n\
         clock_error_ppm = 30\n[experiment]\nreadout_rates_dps = [50, 100]\n\
         cal_freqs_hz = [2, 4]\n[spread]\ndevices = 4\n";
+
+    /// Every part runs on the nominal device's board (module header): its
+    /// scenario, and its `sweep part` file, carry the ADC gains sized for
+    /// the nominal `[gyro]`, which sized on the part would differ (ADC 1's
+    /// 2.4 to 10.7 times on this file's four parts). A file's own gains
+    /// are kept.
+    #[test]
+    fn every_part_runs_on_the_nominal_devices_board() {
+        let text = format!("{FILE}f1_hz = {{ sd = 40.0 }}\nsplit_hz = {{ sd = 25.0 }}\n");
+        let sweep = parse("s.toml", &text).unwrap();
+        let board = experiment::plan(&sweep.scenario.exp)
+            .unwrap()
+            .front_end
+            .adc_per_meter;
+        let fe = &sweep.scenario.exp.frontend;
+        assert_eq!([fe.adc_per_meter1, fe.adc_per_meter2], board.map(Some));
+        for i in 0..4 {
+            let sc = sweep.device_scenario(&sweep.drawn(i));
+            assert_eq!(sc.exp.adc_per_meter(), Some(board));
+            let back = scenario::parse("part.toml", &sweep.part_file(i).unwrap()).unwrap();
+            assert_eq!(back.exp.adc_per_meter(), Some(board));
+            let on_the_part = Experiment {
+                frontend: Frontend {
+                    adc_per_meter1: None,
+                    adc_per_meter2: None,
+                    ..sc.exp.frontend.clone()
+                },
+                ..sc.exp.clone()
+            };
+            let own = experiment::plan(&on_the_part)
+                .unwrap()
+                .front_end
+                .adc_per_meter;
+            let ratio: [f64; 2] = std::array::from_fn(|k| own[k] / board[k]);
+            eprintln!("part {i}: sized on itself, {ratio:?} times the nominal's board");
+            assert!(
+                ratio.iter().any(|r| (r - 1.0).abs() > 0.05),
+                "part {i}: {ratio:?}"
+            );
+        }
+        let given = format!("{text}[frontend]\nadc_per_meter1 = 1e9\nadc_per_meter2 = 2e9\n");
+        let own = parse("s.toml", &given).unwrap();
+        assert_eq!(own.scenario.exp.adc_per_meter(), Some([1e9, 2e9]));
+    }
 
     /// A part's board runs at the file's oscillator error plus its own
     /// draw; a spread whose 5 sigma passes `MAX_CLOCK_PPM` with the file's
