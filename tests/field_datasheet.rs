@@ -18,8 +18,11 @@
 //! where the datasheet's lambda is right. Cost: three single-step scenarios, in parallel (about 2 minutes
 //! of CPU, most of it the scans of the first).
 
+mod common;
+
+use common::outputs_within_three_sigma;
 use gyrocal_sim::field::probe::DriveProbe;
-use gyrocal_sim::field::scenario::{self, FieldReport, FieldStep};
+use gyrocal_sim::field::scenario::{self, FieldReport};
 
 /// The paper scenario at 25 deg C alone, without its profile, with `datasheet`.
 fn scenario_with(datasheet: &str) -> scenario::Scenario {
@@ -29,20 +32,6 @@ fn scenario_with(datasheet: &str) -> scenario::Scenario {
     sc.drift.temperatures_c = vec![25.0];
     sc.profile = None;
     sc
-}
-
-/// The promise of a sigma: each output's self-calibration error against
-/// the rate table within 3 of its sigma (the self-calibration's and the
-/// table's own in quadrature, `selfcal_error_uncertainty`).
-fn outputs_within_three_sigma(name: &str, st: &FieldStep) {
-    for k in 0..2 {
-        let (e, s) = (st.selfcal_error[k], st.selfcal_error_uncertainty[k]);
-        assert!(
-            e.abs() <= 3.0 * s,
-            "{name}: output {}: {e} at sigma {s}",
-            k + 1
-        );
-    }
 }
 
 fn check(name: &str, report: &FieldReport, lambda_right: bool) {

@@ -29,3 +29,18 @@ pub fn json_object(o: Output) -> serde_json::Value {
     );
     serde_json::from_str(&text).unwrap()
 }
+
+/// The promise of a sigma: each output's self-calibration error against
+/// the rate table within 3 of its sigma (the self-calibration's and the
+/// table's own in quadrature, `selfcal_error_uncertainty`); `name` labels
+/// the failure.
+pub fn outputs_within_three_sigma(name: &str, st: &gyrocal_sim::field::scenario::FieldStep) {
+    for k in 0..2 {
+        let (e, s) = (st.selfcal_error[k], st.selfcal_error_uncertainty[k]);
+        assert!(
+            e.abs() <= 3.0 * s,
+            "{name}: output {}: {e} at sigma {s}",
+            k + 1
+        );
+    }
+}

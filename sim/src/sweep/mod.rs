@@ -135,8 +135,7 @@ pub fn parse(name: &str, text: &str) -> Result<Sweep, SweepError> {
 /// nominal device, written into `scenario`'s `[frontend]` unless the file
 /// gave its own.
 fn nominal_board(scenario: &mut Scenario) -> Result<(), RunError> {
-    let fe = &scenario.exp.frontend;
-    if fe.adc_per_meter1.is_some() || fe.adc_per_meter2.is_some() {
+    if scenario.exp.adc_per_meter().is_some() {
         return Ok(());
     }
     let [a1, a2] = experiment::plan(&scenario.exp)?.front_end.adc_per_meter;
