@@ -144,6 +144,15 @@ pub const REF_STEP_PULL: [f64; 3] = [0.2, 0.4, 0.55];
 /// pull of fk and Q turns with C's phase as a sine does (RMS the peak
 /// over sqrt 2), the phase's hardly at all.
 pub const REF_STEP_SD: [f64; 3] = [0.14, 0.28, 0.52];
+/// How far the resonator's settling residue (`Waits::settling`, relative
+/// to the carrier step) moves fk (in bk), Q (relative) and the phase
+/// (rad), per unit of residue, at its RMS over the transient's turn during
+/// the wait, which no sweep chooses: the up and down sweeps cancel its
+/// first order in fk, not in Q, whose pull comes from the sweep's ends
+/// (`fit::tests::the_settling_residue_moves_the_estimates_by_settle_sd`).
+/// What the uncertainty takes as the residue's 1-sigma
+/// (`sweep_uncertainty`).
+pub const SETTLE_SD: [f64; 3] = [0.09, 0.8, 0.18];
 /// Most coarse-search moves before giving up.
 pub const MAX_MOVES: usize = 12;
 /// Half-width of the fallback scan, relative to the guessed frequency:
@@ -656,12 +665,12 @@ pub(crate) fn refit(
 /// the fit (`spur_sd`, `fit::noise_and_lines`: the lines counted once,
 /// where the residuals saw them or not); then in quadrature the waits'
 /// terms: the filter's residue after the REF_PHASE step at its RMS over
-/// C's phase (`REF_STEP_SD`), and the resonator's settling residue, a
-/// bound (`settling_residue`) on a bias that lies anywhere within it (the
-/// up and down sweeps cancel it to first order), at the 1-sigma of a
-/// rectangular distribution over it, the bound over sqrt 3 (GUM 4.3.7).
-/// Each is its residue at its window's start, which decays on through
-/// the window its mean is taken over (`window_mean`).
+/// C's phase (`REF_STEP_SD`), and the resonator's settling residue
+/// (`settling_residue`, the bound after the wait) through the fit at its
+/// RMS over the transient's turn (`SETTLE_SD`: the up and down sweeps
+/// cancel its first order in fk, not in Q). Each is its residue at its
+/// window's start, which decays on through the window its mean is taken
+/// over (`window_mean`).
 pub(crate) fn sweep_uncertainty(
     fit: &ModeFit,
     clock_hz: f64,
@@ -670,9 +679,9 @@ pub(crate) fn sweep_uncertainty(
 ) -> [f64; 3] {
     let jk = fit::jackknife(&fit.sweep, fit, Some(clock_hz), pull, slope);
     let (bk, q) = (fit.f_hz.value / fit.q.value, fit.q.value);
-    let settle = fit.waits.settling(bk) / 3f64.sqrt();
-    let filter = fit.waits.filter();
-    let waits = REF_STEP_SD.map(|p| settle.hypot(p * filter));
+    let (settle, filter) = (fit.waits.settling(bk), fit.waits.filter());
+    let waits: [f64; 3] =
+        std::array::from_fn(|i| (SETTLE_SD[i] * settle).hypot(REF_STEP_SD[i] * filter));
     let waits = [waits[0] * bk, waits[1] * q, waits[2].to_degrees()];
     let own = [fit.f_hz, fit.q, fit.phase_deg].map(|e| e.uncertainty);
     let lines = fit::noise_and_lines(fit, &fit.spur_sd, Some(clock_hz), pull, slope);
