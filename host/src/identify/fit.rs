@@ -667,6 +667,16 @@ mod tests {
         }
     }
 
+    /// The fine sweep's order, which the tests below play: five carriers
+    /// 0.75 bandwidths apart, up, then the same down.
+    #[test]
+    fn the_fine_sweep_goes_up_then_down() {
+        assert_eq!(
+            super::super::fine_offsets(),
+            [-1.5, -0.75, 0.0, 0.75, 1.5, 1.5, 0.75, 0.0, -0.75, -1.5]
+        );
+    }
+
     /// What the resonator's settling residue does to the fit. The fine
     /// sweep steps up, then down (`super::fine_sweep`), each point
     /// starting from the one before (the first from the coarse search's
@@ -687,7 +697,7 @@ mod tests {
     #[test]
     fn the_settling_residue_moves_the_estimates_by_settle_sd() {
         let eps = 1e-6;
-        let offsets = [-1.5, -0.75, 0.0, 0.75, 1.5, 1.5, 0.75, 0.0, -0.75, -1.5];
+        let offsets = super::super::fine_offsets();
         let mut squares = [0.0f64; 3];
         let mut count = 0.0;
         for (fk, q, fs) in PULL_MODES {
@@ -746,7 +756,7 @@ mod tests {
         let (fk, bk, fs) = (25722.4, 7.0, 1.2345e6);
         let c = C64::from_polar(3.0e9, -0.3);
         let truth = |f: f64| c * shape(fk, bk, f, Some(fs), &no_pull, FrontSlope::default()).0;
-        let offsets = [-1.5, -0.75, 0.0, 0.75, 1.5, 1.5, 0.75, 0.0, -0.75, -1.5];
+        let offsets = super::super::fine_offsets();
         let carriers: Vec<f64> = offsets.iter().map(|s| fk + s * bk).collect();
         let peak = c.norm() / (fk * bk);
         let scale = [1.0, 4.0, 2.0, 1.0, 1.0, 1.0, 1.0, 2.0, 4.0, 1.0];

@@ -556,13 +556,21 @@ fn locate(probe: &mut Prober, guess_hz: f64, bw: f64) -> Result<Result<Located, 
 }
 
 /// The fine sweep: `FINE_POINTS` carriers over +-`FINE_SPAN` bandwidths
-/// `bk` around `centre`, up then down.
+/// `bk` around `centre`, up then down ([`fine_offsets`]).
 fn fine_sweep(probe: &mut Prober, centre: f64, bk: f64) -> Result<Vec<(f64, C64)>, Error> {
-    let offsets: Vec<f64> = (0..FINE_POINTS)
+    (fine_offsets().iter())
+        .map(|s| probe.measure(centre + s * bk))
+        .collect()
+}
+
+/// The fine sweep's carriers in the order it visits them, in bandwidths
+/// from its centre: `FINE_POINTS` over +-`FINE_SPAN` up, then the same
+/// down (the fit's tests play this order too).
+fn fine_offsets() -> Vec<f64> {
+    let up: Vec<f64> = (0..FINE_POINTS)
         .map(|i| FINE_SPAN * (2.0 * i as f64 / (FINE_POINTS - 1) as f64 - 1.0))
         .collect();
-    let order = offsets.iter().chain(offsets.iter().rev());
-    order.map(|s| probe.measure(centre + s * bk)).collect()
+    up.iter().chain(up.iter().rev()).copied().collect()
 }
 
 /// The miss of a fine sweep around the coarse search's `(centre, bk)`
