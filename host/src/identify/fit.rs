@@ -475,6 +475,7 @@ pub(super) fn scan_fit(points: &[(f64, C64)]) -> Option<(f64, f64)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::PI;
 
     #[test]
     fn narrow_band_and_the_fit_recover_a_lorentzian() {
@@ -677,34 +678,36 @@ mod tests {
         );
     }
 
-    /// What the resonator's settling residue does to the fit. The fine
-    /// sweep steps up, then down (`super::fine_sweep`), each point
-    /// starting from the one before (the first from the coarse search's
-    /// centre, the sixth from the same carrier). A point a step from f'
-    /// to f keeps eps (Y(f') - Y(f)) e^(-j 2 pi (f - fk) T) of the step,
-    /// eps the settling bound relative to the step (`super::Waits::settling`,
-    /// at most the peak's 0.83 on this grid): the transient turns at the
-    /// detuning over the wait T, and the same T at every carrier turns the
-    /// up and down points' residues alike, so the first-order parts cancel.
-    /// No sweep chooses the turn 2 pi bk T (the wait is the coarse
-    /// search's bandwidth's, rounded, and bk is the unknown): over it and
-    /// seven modes, fk moves by RMS 0.085 eps bk, Q by 0.768 eps of
-    /// itself and the phase by 0.167 eps radians, each within 10% below
-    /// `super::SETTLE_SD`, which `super::sweep_uncertainty` takes as the
-    /// residue's 1-sigma. Until 2026-12-04 it took the bound over sqrt 3
-    /// for all three (a bias anywhere within the bound): 6.8 times the fk
-    /// pull, 3.5 times the phase's, and 0.75 of Q's.
-    #[test]
-    fn the_settling_residue_moves_the_estimates_by_settle_sd() {
+    /// What the resonator's settling residue does to the fit, at a delay
+    /// u = pi bk D from the I window to the Q window (`super::settle_sd`),
+    /// per unit of residue: the RMS over the transient's turn and the
+    /// seven modes of fk's pull (in bk), Q's (relative) and the phase's
+    /// (rad).
+    ///
+    /// The fine sweep steps up, then down (`super::fine_sweep`), each
+    /// point starting from the one before (the first from the coarse
+    /// search's centre, the sixth from the same carrier). A point a step
+    /// from f' to f keeps eps (Y(f') - Y(f)) e^(-j 2 pi (f - fk) T) of the
+    /// step in its I window, eps the settling bound relative to the step
+    /// (`super::Waits::settling`, at most the peak's 0.83 on this grid):
+    /// the transient turns at the detuning over the wait T, and the same T
+    /// at every carrier turns the up and down points' residues alike, so
+    /// the first-order parts cancel. The Q window starts D later
+    /// (`super::Waits::quarter_s`): its part of Y keeps e^-u of the
+    /// residue, turned on by 2 u (f - fk) / bk. No sweep chooses the turn
+    /// 2 pi bk T (the wait is the coarse search's bandwidth's, rounded,
+    /// and bk is the unknown), so the RMS is over it: 400 turns from 0 to
+    /// 404 rad.
+    fn settling_pull_rms(u: f64) -> [f64; 3] {
         let eps = 1e-6;
         let offsets = super::super::fine_offsets();
+        let later = |s: f64| C64::from_polar((-u).exp(), -2.0 * u * s);
         let mut squares = [0.0f64; 3];
         let mut count = 0.0;
         for (fk, q, fs) in PULL_MODES {
             let bk = fk / q;
             let c = C64::from_polar(2.0e9, 0.3);
             let y = |f: f64| c * hold_gain(f, fs) / C64::new((fk - f) * (fk + f), f * bk);
-            // 2 pi bk T over 0 to 400 rad in steps no multiple of pi.
             for turn in (0..400).map(|i| 1.0137 * f64::from(i)) {
                 let fit = |e: f64| {
                     let mut from = fk;
@@ -712,9 +715,10 @@ mod tests {
                         .iter()
                         .map(|s| {
                             let f = fk + s * bk;
-                            let left = (y(from) - y(f)) * C64::from_polar(e, -turn * s);
+                            let in_i = (y(from) - y(f)) * C64::from_polar(e, -turn * s);
+                            let in_q = in_i * later(*s);
                             from = f;
-                            (f, y(f) + left)
+                            (f, y(f) + C64::new(in_i.re, in_q.im))
                         })
                         .collect();
                     fit_mode(&points, fk, bk, Some(fs), &no_pull, FrontSlope::default()).unwrap()
@@ -725,15 +729,73 @@ mod tests {
                 count += 1.0;
             }
         }
-        let rms = squares.map(|s| (s / count).sqrt());
-        // Each constant within 10% above its RMS: not below it (the sigma
-        // would be short), not far above (it would be inflated again).
-        for (r, sd) in rms.iter().zip(super::super::SETTLE_SD) {
-            assert!(
-                *r <= sd && sd <= 1.1 * r,
-                "RMS {rms:?} against {:?}",
-                super::super::SETTLE_SD
-            );
+        squares.map(|s| (s / count).sqrt())
+    }
+
+    /// `super::settle_sd`, which `super::sweep_uncertainty` takes as the
+    /// settling residue's 1-sigma, within 10% above the pulls' RMS
+    /// (`settling_pull_rms`) at each of its delays, halfway between them
+    /// (where it interpolates) and beyond the last (where it holds): not
+    /// below (the sigma would be short), not far above (inflated). Q's
+    /// pull falls with the delay (0.768 at none, 0.21 from u = 2.4: the
+    /// residue has gone from the Q window), fk's rises (0.085 to 0.107).
+    /// Until 2026-12-04 (stop 71) the I and Q windows took the same
+    /// residue (u = 0) and until stop 71 the bound over sqrt 3 for all
+    /// three: 6.8 times the fk pull, 3.5 times the phase's.
+    #[test]
+    fn the_settling_residue_moves_the_estimates_by_settle_sd() {
+        let grid = super::super::SETTLE_SD.map(|(u, _)| u);
+        let halves = grid.windows(2).map(|w| 0.5 * (w[0] + w[1]));
+        let beyond = [grid[grid.len() - 1] * 2.0, 20.0];
+        for u in grid.into_iter().chain(halves).chain(beyond) {
+            let (rms, sd) = (settling_pull_rms(u), super::super::settle_sd(u));
+            for (r, s) in rms.iter().zip(sd) {
+                assert!(*r <= s && s <= 1.1 * r, "u {u}: RMS {rms:?} against {sd:?}");
+            }
+        }
+    }
+
+    /// `super::sweep_uncertainty`'s settling term is `super::settle_sd` at
+    /// the sweep's own delay from the I window to the Q window
+    /// (`super::Waits::quarter_s`, u = pi bk D): on a noise-free sweep (no
+    /// residuals, no jackknife spread, no lines) with the filter's residue
+    /// made nil, each sigma is the settling residue times its pull at u.
+    /// Q's pull is 0.8 with no delay and 0.222 at u = 2.4, fk's 0.09 and
+    /// 0.111: a sigma read at the wrong delay is off by 3.6 times or 19%.
+    #[test]
+    fn the_settling_sigma_reads_the_q_windows_delay() {
+        let (fk, q, fs) = PULL_MODES[0];
+        let bk = fk / q;
+        let c = C64::from_polar(2.0e9, 0.3);
+        let y = |f: f64| c * hold_gain(f, fs) / C64::new((fk - f) * (fk + f), f * bk);
+        let points: Vec<(f64, C64)> = (super::super::fine_offsets().iter())
+            .map(|s| (fk + s * bk, y(fk + s * bk)))
+            .collect();
+        let front = FrontSlope::default();
+        let mut m = fit_mode(&points, fk, bk, Some(fs), &no_pull, front).unwrap();
+        let (bk, q) = (m.f_hz.value / m.q.value, m.q.value);
+        for u in [0.0, 2.4] {
+            m.waits = super::super::Waits {
+                waited_s: 3.0 / (PI * bk),
+                window_s: 1.0,
+                filter_decay_per_s: 1e15,
+                quarter_s: u / (PI * bk),
+            };
+            let settle = m.waits.settling(bk);
+            let pull = super::super::settle_sd(u);
+            let expected = [
+                pull[0] * settle * bk,
+                pull[1] * settle * q,
+                pull[2] * settle,
+            ];
+            let expected = [expected[0], expected[1], expected[2].to_degrees()];
+            let got = super::super::sweep_uncertainty(&m, fs, &no_pull, front);
+            for (g, e) in got.iter().zip(expected) {
+                assert!(
+                    (g / e - 1.0).abs() < 1e-6,
+                    "u {u}: {got:?} against {expected:?}"
+                );
+            }
         }
     }
 

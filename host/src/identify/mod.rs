@@ -124,11 +124,12 @@ fn window_s(knowns: &Knowns) -> f64 {
 /// from a carrier step to the I window, with the fitted bandwidth bk (the
 /// wait is `SETTLE_TAUS` time constants of the coarse search's bandwidth
 /// with the 20% `TAU_MARGIN`, so some e^-14.4 when that bandwidth was
-/// right, e^-12 when it was 20% high). It is a bias, not noise (the fit's
-/// residuals do not see it when it repeats from point to point), and it
-/// moves the fitted phase by at most this many radians, fk and bk by this
-/// times bk, and Q by this fraction (a bound: the up and down sweeps
-/// cancel it to first order).
+/// right, e^-12 when it was 20% high). It is a bias, not noise: it moves
+/// fk by [`settle_sd`] times this times bk, Q by that fraction and the
+/// phase by that many radians, the up and down sweeps cancelling its
+/// first order in fk. (The residuals see the part that differs between a
+/// carrier's two visits: on a fork part with no ADC noise, twice the wait
+/// halved Q1's residual sigma.)
 pub fn settling_residue(bk_hz: f64, waited_s: f64) -> f64 {
     (-PI * bk_hz * waited_s).exp()
 }
@@ -147,12 +148,49 @@ pub const REF_STEP_SD: [f64; 3] = [0.14, 0.28, 0.52];
 /// How far the resonator's settling residue (`Waits::settling`, relative
 /// to the carrier step) moves fk (in bk), Q (relative) and the phase
 /// (rad), per unit of residue, at its RMS over the transient's turn during
-/// the wait, which no sweep chooses: the up and down sweeps cancel its
-/// first order in fk, not in Q, whose pull comes from the sweep's ends
+/// the wait, which no sweep chooses, against the delay u = pi bk D from
+/// the I window to the Q window (`Waits::quarter_s`): the Q window sees
+/// e^-u of the residue. The up and down sweeps cancel the first order in
+/// fk, not in Q, whose pull comes from the sweep's ends, and which the
+/// delay takes out of the Q window (0.768 at u = 0, 0.21 from 2.4); fk's
+/// rises from 0.085 to 0.107
 /// (`fit::tests::the_settling_residue_moves_the_estimates_by_settle_sd`).
 /// What the uncertainty takes as the residue's 1-sigma
-/// (`sweep_uncertainty`).
-pub const SETTLE_SD: [f64; 3] = [0.09, 0.8, 0.18];
+/// (`sweep_uncertainty`, through [`settle_sd`]).
+pub const SETTLE_SD: [(f64, [f64; 3]); 12] = [
+    (0.0, [0.09, 0.8, 0.18]),
+    (0.1, [0.09, 0.72, 0.17]),
+    (0.2, [0.092, 0.65, 0.165]),
+    (0.3, [0.094, 0.59, 0.162]),
+    (0.4, [0.096, 0.535, 0.16]),
+    (0.6, [0.097, 0.45, 0.155]),
+    (0.8, [0.097, 0.39, 0.151]),
+    (1.2, [0.098, 0.33, 0.145]),
+    (1.6, [0.103, 0.285, 0.145]),
+    (2.4, [0.111, 0.222, 0.143]),
+    (3.2, [0.111, 0.226, 0.13]),
+    (5.0, [0.111, 0.216, 0.13]),
+];
+
+/// [`SETTLE_SD`] at the delay `u` (pi bk times the time from the I
+/// window's start to the Q window's): linear between its delays, its
+/// last beyond them (the residue has left the Q window).
+///
+/// ```
+/// use gyrocal_host::identify::{SETTLE_SD, settle_sd};
+/// assert_eq!(settle_sd(0.0), SETTLE_SD[0].1);
+/// assert_eq!(settle_sd(1e3), SETTLE_SD[SETTLE_SD.len() - 1].1);
+/// ```
+pub fn settle_sd(u: f64) -> [f64; 3] {
+    let last = SETTLE_SD[SETTLE_SD.len() - 1];
+    match SETTLE_SD.windows(2).find(|w| u < w[1].0) {
+        Some([(u0, a), (u1, b)]) => {
+            let x = ((u - u0) / (u1 - u0)).max(0.0);
+            std::array::from_fn(|i| a[i] + x * (b[i] - a[i]))
+        }
+        _ => last.1,
+    }
+}
 /// Most coarse-search moves before giving up.
 pub const MAX_MOVES: usize = 12;
 /// Half-width of the fallback scan, relative to the guessed frequency:
@@ -253,6 +291,11 @@ pub struct Waits {
     /// The output filter's slowest decay rate (1/s,
     /// `Knowns::filter_decay_per_s`).
     pub filter_decay_per_s: f64,
+    /// Time from each point's I window's start to its Q window's (s): the
+    /// window and the filter's wait after the REF_PHASE step. The Q
+    /// window sees the resonator's residue that much later
+    /// ([`settle_sd`]).
+    pub quarter_s: f64,
 }
 
 impl Waits {
@@ -263,7 +306,7 @@ impl Waits {
     ///
     /// ```
     /// use gyrocal_host::identify::{Waits, settling_residue};
-    /// let w = Waits { waited_s: 0.5, window_s: 0.0, filter_decay_per_s: 100.0 };
+    /// let w = Waits { waited_s: 0.5, window_s: 0.0, filter_decay_per_s: 100.0, quarter_s: 0.1 };
     /// assert_eq!(w.settling(8.0), settling_residue(8.0, 0.5));
     /// ```
     pub fn settling(&self, bk_hz: f64) -> f64 {
@@ -510,6 +553,7 @@ fn attempt(
         waited_s: probe.waited_s(),
         window_s: window_s(knowns),
         filter_decay_per_s: knowns.filter_decay_per_s(),
+        quarter_s: probe.quarter_s(),
     };
     fit.scanned = scanned;
     // The amplitude only falls during the sweep (`Prober::measure`): its
@@ -675,10 +719,11 @@ pub(crate) fn refit(
 /// terms: the filter's residue after the REF_PHASE step at its RMS over
 /// C's phase (`REF_STEP_SD`), and the resonator's settling residue
 /// (`settling_residue`, the bound after the wait) through the fit at its
-/// RMS over the transient's turn (`SETTLE_SD`: the up and down sweeps
-/// cancel its first order in fk, not in Q). Each is its residue at its
-/// window's start, which decays on through the window its mean is taken
-/// over (`window_mean`).
+/// RMS over the transient's turn, at the sweep's delay from the I window
+/// to the Q window ([`settle_sd`]: the up and down sweeps cancel its first
+/// order in fk, not in Q, and the Q window sees less of it the later it
+/// comes). Each is its residue at its window's start, which decays on
+/// through the window its mean is taken over (`window_mean`).
 pub(crate) fn sweep_uncertainty(
     fit: &ModeFit,
     clock_hz: f64,
@@ -688,8 +733,9 @@ pub(crate) fn sweep_uncertainty(
     let jk = fit::jackknife(&fit.sweep, fit, Some(clock_hz), pull, slope);
     let (bk, q) = (fit.f_hz.value / fit.q.value, fit.q.value);
     let (settle, filter) = (fit.waits.settling(bk), fit.waits.filter());
+    let settle_sd = settle_sd(PI * bk * fit.waits.quarter_s);
     let waits: [f64; 3] =
-        std::array::from_fn(|i| (SETTLE_SD[i] * settle).hypot(REF_STEP_SD[i] * filter));
+        std::array::from_fn(|i| (settle_sd[i] * settle).hypot(REF_STEP_SD[i] * filter));
     let waits = [waits[0] * bk, waits[1] * q, waits[2].to_degrees()];
     let own = [fit.f_hz, fit.q, fit.phase_deg].map(|e| e.uncertainty);
     let lines = fit::noise_and_lines(fit, &fit.spur_sd, Some(clock_hz), pull, slope);

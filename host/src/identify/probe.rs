@@ -36,6 +36,15 @@ impl Prober<'_> {
     pub(super) fn waited_s(&self) -> f64 {
         self.settle_clocks() as f64 / self.knowns.clock_hz
     }
+
+    /// Seconds from a point's I window's start to its Q window's: the I
+    /// window and the filter's wait after the REF_PHASE step
+    /// (`measure_once`).
+    pub(super) fn quarter_s(&self) -> f64 {
+        let kn = self.knowns;
+        let window = SAMPLES_PER_PHASE * u64::from(kn.filter.decimation);
+        (window + kn.filter_settle_clocks()) as f64 / kn.clock_hz
+    }
 }
 
 /// What one measurement saw.
