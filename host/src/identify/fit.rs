@@ -739,9 +739,9 @@ mod tests {
     /// below (the sigma would be short), not far above (inflated). Q's
     /// pull falls with the delay (0.768 at none, 0.21 from u = 2.4: the
     /// residue has gone from the Q window), fk's rises (0.085 to 0.107).
-    /// Until 2026-12-04 (stop 71) the I and Q windows took the same
-    /// residue (u = 0) and until stop 71 the bound over sqrt 3 for all
-    /// three: 6.8 times the fk pull, 3.5 times the phase's.
+    /// Stop 71's constants put the same residue in both windows (u = 0);
+    /// before them the sigma was the bound over sqrt 3 for all three: 6.8
+    /// times the fk pull, 3.5 times the phase's.
     #[test]
     fn the_settling_residue_moves_the_estimates_by_settle_sd() {
         let grid = super::super::SETTLE_SD.map(|(u, _)| u);

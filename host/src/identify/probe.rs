@@ -171,3 +171,96 @@ impl<'a> Prober<'a> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::board::ZSample;
+    use crate::device::GyroParams;
+    use crate::fake::Lorentzian;
+    use crate::knowns::Derived;
+    use gyrocal_regs::Registers;
+    use gyrocal_regs::datapath::CarrierProfile;
+    use gyrocal_regs::map::{BusError, RegisterAccess};
+
+    /// A fake board that notes the count of the first sample read after
+    /// each programming: the start of each window a measurement reads.
+    struct Timed {
+        board: Lorentzian,
+        programs: usize,
+        firsts: Vec<u32>,
+    }
+
+    impl RegisterAccess for Timed {
+        fn write_register(&mut self, offset: u32, word: u32) -> Result<(), BusError> {
+            self.board.write_register(offset, word)
+        }
+        fn read_register(&mut self, offset: u32) -> Result<u32, BusError> {
+            self.board.read_register(offset)
+        }
+    }
+
+    impl Board for Timed {
+        fn wait_clocks(&mut self, clocks: u64) -> Result<(), BusError> {
+            self.board.wait_clocks(clocks)
+        }
+        fn next_sample(&mut self, after: u32) -> Result<ZSample, BusError> {
+            let s = self.board.next_sample(after)?;
+            if self.firsts.len() < self.programs {
+                self.firsts.push(s.count);
+            }
+            Ok(s)
+        }
+        fn program(&mut self, regs: &Registers) -> Result<(), BusError> {
+            self.programs += 1;
+            self.board.program(regs)
+        }
+    }
+
+    /// `Prober::quarter_s`, which the settling sigma reads
+    /// (`super::super::settle_sd`), is the time a board sees from a
+    /// point's I window's first sample to its Q window's, within one
+    /// sample (R clocks): both windows' samples counted on a fake board
+    /// while `measure_once` reads them.
+    #[test]
+    fn the_q_window_starts_quarter_s_after_the_i_window() {
+        let c = C64::from_polar(2.0e9, -0.05);
+        let (f1, f2, clock_hz) = (9.64e6, 9.64025e6, 50e6);
+        let board = Lorentzian::new(clock_hz, [(f1, 175.3, c), (f2, 175.3, c)], 0.0);
+        let mut board = Timed {
+            board,
+            programs: 0,
+            firsts: vec![],
+        };
+        let datasheet = GyroParams {
+            f1_hz: f1,
+            f2_hz: f2,
+            q1: 55e3,
+            q2: 55e3,
+            angular_gain: 0.6,
+            quadrature_dps: 0.0,
+            damping_coupling_dps: 0.0,
+        };
+        let knowns = Knowns {
+            filter: Derived {
+                decimation: 1000,
+                butterworth_hz: 500.0,
+                rc_hz: 2000.0,
+                min_window_s: 0.05,
+            },
+            carrier_profile: CarrierProfile::Fine,
+            ..Knowns::exact(datasheet, clock_hz, f1)
+        };
+        let mut prober = Prober::new(&mut board, &knowns, 0, 0.1);
+        prober.measure_once(f1).unwrap();
+        let quarter = prober.quarter_s() * clock_hz;
+        let r = f64::from(knowns.filter.decimation);
+        let firsts = &board.firsts;
+        assert_eq!(firsts.len(), 2, "two windows: {firsts:?}");
+        let seen = f64::from(firsts[1] - firsts[0]) * r;
+        assert!(
+            (seen - quarter).abs() <= r,
+            "the board saw {seen} clocks, quarter_s says {quarter}"
+        );
+    }
+}
