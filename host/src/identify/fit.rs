@@ -597,6 +597,12 @@ mod tests {
         (2e6, 300.0, 6e6),
     ];
 
+    /// The response C / ((fk - f)(fk + f) + j f bk) through the DAC hold's
+    /// gain at the clock `fs`: the waits' pull tests' mode.
+    fn held(c: C64, fk: f64, bk: f64, fs: f64) -> impl Fn(f64) -> C64 {
+        move |f| c * hold_gain(f, fs) / C64::new((fk - f) * (fk + f), f * bk)
+    }
+
     /// How far a residue of size `eps` moves fk (in `bk`), Q (relative)
     /// and the phase (rad), per unit of `eps`: `fit(eps)` against `fit(0)`,
     /// the same points without it, so the model's own misfit (no images
@@ -632,7 +638,7 @@ mod tests {
             let mut worst = [0.0f64; 3];
             for deg in (0..360).step_by(10) {
                 let c = C64::from_polar(2.0e9, f64::from(deg).to_radians());
-                let y = |f: f64| c * hold_gain(f, fs) / C64::new((fk - f) * (fk + f), f * bk);
+                let y = held(c, fk, bk, fs);
                 let fit = |e: f64| {
                     let points: Vec<(f64, C64)> = (0..5)
                         .map(|i| fk + bk * 1.5 * (i as f64 / 2.0 - 1.0))
@@ -707,7 +713,7 @@ mod tests {
         for (fk, q, fs) in PULL_MODES {
             let bk = fk / q;
             let c = C64::from_polar(2.0e9, 0.3);
-            let y = |f: f64| c * hold_gain(f, fs) / C64::new((fk - f) * (fk + f), f * bk);
+            let y = held(c, fk, bk, fs);
             for turn in (0..400).map(|i| 1.0137 * f64::from(i)) {
                 let fit = |e: f64| {
                     let mut from = fk;
@@ -767,7 +773,7 @@ mod tests {
         let (fk, q, fs) = PULL_MODES[0];
         let bk = fk / q;
         let c = C64::from_polar(2.0e9, 0.3);
-        let y = |f: f64| c * hold_gain(f, fs) / C64::new((fk - f) * (fk + f), f * bk);
+        let y = held(c, fk, bk, fs);
         let points: Vec<(f64, C64)> = (super::super::fine_offsets().iter())
             .map(|s| (fk + s * bk, y(fk + s * bk)))
             .collect();

@@ -733,9 +733,9 @@ pub(crate) fn sweep_uncertainty(
     let jk = fit::jackknife(&fit.sweep, fit, Some(clock_hz), pull, slope);
     let (bk, q) = (fit.f_hz.value / fit.q.value, fit.q.value);
     let (settle, filter) = (fit.waits.settling(bk), fit.waits.filter());
-    let settle_sd = settle_sd(PI * bk * fit.waits.quarter_s);
+    let settle_pull = settle_sd(PI * bk * fit.waits.quarter_s);
     let waits: [f64; 3] =
-        std::array::from_fn(|i| (settle_sd[i] * settle).hypot(REF_STEP_SD[i] * filter));
+        std::array::from_fn(|i| (settle_pull[i] * settle).hypot(REF_STEP_SD[i] * filter));
     let waits = [waits[0] * bk, waits[1] * q, waits[2].to_degrees()];
     let own = [fit.f_hz, fit.q, fit.phase_deg].map(|e| e.uncertainty);
     let lines = fit::noise_and_lines(fit, &fit.spur_sd, Some(clock_hz), pull, slope);

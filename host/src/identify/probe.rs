@@ -42,8 +42,7 @@ impl Prober<'_> {
     /// (`measure_once`).
     pub(super) fn quarter_s(&self) -> f64 {
         let kn = self.knowns;
-        let window = SAMPLES_PER_PHASE * u64::from(kn.filter.decimation);
-        (window + kn.filter_settle_clocks()) as f64 / kn.clock_hz
+        super::window_s(kn) + kn.filter_settle_clocks() as f64 / kn.clock_hz
     }
 }
 
