@@ -1,10 +1,13 @@
 //! A fake board for examples and tests without the simulator: two
 //! Lorentzian modes behind the register map, z their exact steady state
-//! (no transient) through the DAC hold's gain, each mode seen only
-//! through its own drive as the gateware's readout sees it (`identify`
-//! module header). It runs in microseconds per measurement, so the host's
-//! logic can be shown and tested alone; the simulated board
-//! (`gyrocal-sim`) is the real check.
+//! through the DAC hold's gain, each mode seen only through its own drive
+//! as the gateware's readout sees it (`identify` module header). With
+//! [`Lorentzian::ringing`] each mode also rings after a step of its drive,
+//! from the state the step found, through the output filter of the
+//! registers' coefficients (the filter's own transients are left out). It
+//! runs in microseconds per measurement, so the host's logic can be shown
+//! and tested alone; the simulated board (`gyrocal-sim`) is the real
+//! check.
 //!
 //! ```
 //! use gyrocal_host::fake::Lorentzian;
@@ -17,6 +20,8 @@
 //! ```
 
 use crate::board::{Board, ZSample};
+use crate::device::GyroParams;
+use crate::knowns::{Derived, Knowns};
 use crate::theory::hold_gain;
 use gyrocal_regs::datapath::{CarrierProfile, readout_word};
 use gyrocal_regs::filter_design::cic_bit_growth;
@@ -28,6 +33,37 @@ use std::f64::consts::TAU;
 
 type C64 = Complex<f64>;
 
+/// A datasheet like the paper's device's: modes at `f1_hz` and `f2_hz`,
+/// Q 55,000 both, lambda 0.6, no couplings.
+pub fn paper_datasheet(f1_hz: f64, f2_hz: f64) -> GyroParams {
+    GyroParams {
+        f1_hz,
+        f2_hz,
+        q1: 55e3,
+        q2: 55e3,
+        angular_gain: 0.6,
+        quadrature_dps: 0.0,
+        damping_coupling_dps: 0.0,
+    }
+}
+
+/// What the host knows of a board like the paper's on this fake: the
+/// `datasheet`, a 50 MHz clock with the carrier at 9.64 MHz, the paper's
+/// filter (R 1000, Butterworth 500 Hz, RC 2 kHz) and the fine core, whose
+/// words are the exact products this board takes.
+pub fn paper_knowns(datasheet: GyroParams) -> Knowns {
+    Knowns {
+        filter: Derived {
+            decimation: 1000,
+            butterworth_hz: 500.0,
+            rc_hz: 2000.0,
+            min_window_s: 0.05,
+        },
+        carrier_profile: CarrierProfile::Fine,
+        ..Knowns::exact(datasheet, 50e6, 9.64e6)
+    }
+}
+
 /// Two modes, each seen only through its own drive, behind the register map.
 pub struct Lorentzian {
     bank: RegisterBank,
@@ -37,6 +73,12 @@ pub struct Lorentzian {
     modes: [(f64, f64, C64); 2],
     /// Additive noise on z (z LSB, uniform +-).
     pub noise: f64,
+    /// Each mode rings after a step of its drive (module header).
+    pub ringing: bool,
+    /// Per mode: the carrier (Hz) and readout word since its last step,
+    /// the ringing's amplitude then (z's units over the word and dc / 2)
+    /// and the step's cycle.
+    rings: [(f64, f64, C64, u64); 2],
     state: u64,
     snapshot: [f64; 2],
 }
@@ -51,9 +93,79 @@ impl Lorentzian {
             cycle: 0,
             modes,
             noise,
+            ringing: false,
+            rings: [(0.0, 0.0, C64::new(0.0, 0.0), 0); 2],
             state: 1,
             snapshot: [0.0; 2],
         }
+    }
+
+    /// The carrier (Hz) and each drive's readout word the registers set.
+    fn drives(&self) -> (f64, [f64; 2]) {
+        let r = self.bank.registers();
+        let f = f64::from(r.carrier_step) * self.clock_hz / 2f64.powi(32);
+        let w = [r.amp.0, r.amp.1].map(|a| readout_word(CarrierProfile::Fine, a));
+        (f, w)
+    }
+
+    /// Mode m's steady response at `f` per drive LSB.
+    fn steady(&self, m: usize, f: f64) -> C64 {
+        let (fk, bk, c) = self.modes[m];
+        hold_gain(f, self.clock_hz) * c / C64::new((fk - f) * (fk + f), f * bk)
+    }
+
+    /// Mode m's ringing now, in its carrier's frame (z's units over the
+    /// word and dc / 2), and its complex frequency there (1/s).
+    fn ring(&self, m: usize) -> (C64, C64) {
+        let (fk, bk, _) = self.modes[m];
+        let (f, _, a, t0) = self.rings[m];
+        let s = C64::new(-std::f64::consts::PI * bk, TAU * (fk - f));
+        let t = (self.cycle - t0) as f64 / self.clock_hz;
+        (a * (s * t).exp(), s)
+    }
+
+    /// A step of the drives: each mode's state now, its new steady
+    /// response and its ringing the difference (the carrier's phase goes
+    /// on through the step, so its frame does too).
+    fn stepped(&mut self) {
+        let (f, w) = self.drives();
+        for (m, w) in w.into_iter().enumerate() {
+            let (f0, w0, _, _) = self.rings[m];
+            let driven = if w0 > 0.0 {
+                self.steady(m, f0) * w0
+            } else {
+                C64::new(0.0, 0.0)
+            };
+            let now = driven + self.ring(m).0;
+            self.rings[m] = (f, w, now - self.steady(m, f) * w, self.cycle);
+        }
+    }
+
+    /// The output filter's response at `s` (1/s) over its DC gain, from
+    /// the registers: the CIC's four stages of R at the clock, the biquad
+    /// 1 + z^-1 squared over 1 + a1 z^-1 + a2 z^-2 (a1 = -2 - k1, a2 = 1 -
+    /// k2) and the RC pole alpha / (1 - (1 - alpha) z^-1) at the output
+    /// rate.
+    fn filter_at(&self, s: C64) -> C64 {
+        let r = self.bank.registers();
+        let rr = f64::from(r.cic_decimation);
+        let one = C64::new(1.0, 0.0);
+        let x = s / self.clock_hz;
+        let cic = if x.norm() == 0.0 {
+            one
+        } else {
+            (one - (-x * rr).exp()) / ((one - (-x).exp()) * rr)
+        };
+        let scale = f64::from(1u32 << 30);
+        let (a1, a2) = (
+            -2.0 - f64::from(r.iir.k1) / scale,
+            1.0 - f64::from(r.iir.k2) / scale,
+        );
+        let alpha = f64::from(r.iir.alpha) / scale;
+        let zi = (-x * rr).exp();
+        let biquad = (one + zi).powi(2) / (one + zi * a1 + zi * zi * a2) * ((1.0 + a1 + a2) / 4.0);
+        let rc = alpha / (one - zi * (1.0 - alpha));
+        cic.powi(4) * biquad * rc
     }
 
     fn z_now(&mut self) -> [f64; 2] {
@@ -67,10 +179,13 @@ impl Lorentzian {
         let dc = cic * 4.0 * f64::from(k.k0) / -(f64::from(k.k1) + f64::from(k.k2));
         let amps = [r.amp.0, r.amp.1];
         std::array::from_fn(|m| {
-            let (fk, bk, c) = self.modes[m];
-            let y = hold_gain(f, self.clock_hz) * c / C64::new((fk - f) * (fk + f), f * bk);
+            let mut y = self.steady(m, f);
             // Exact products, as the fine core's words are.
             let w = readout_word(CarrierProfile::Fine, amps[m]);
+            if self.ringing && w > 0.0 {
+                let (ring, s) = self.ring(m);
+                y += ring * self.filter_at(s) / w;
+            }
             self.state = self.state.wrapping_mul(6364136223846793005).wrapping_add(1);
             let n = ((self.state >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 2.0 * self.noise;
             dc / 2.0 * w * w * (y * C64::from_polar(1.0, -theta)).re + n
@@ -89,7 +204,12 @@ fn words(z: f64) -> (u32, u32) {
 
 impl RegisterAccess for Lorentzian {
     fn write_register(&mut self, offset: u32, word: u32) -> Result<(), BusError> {
-        self.bank.write(offset, word, 0xf)
+        let before = self.drives();
+        self.bank.write(offset, word, 0xf)?;
+        if self.drives() != before {
+            self.stepped();
+        }
+        Ok(())
     }
 
     fn read_register(&mut self, offset: u32) -> Result<u32, BusError> {

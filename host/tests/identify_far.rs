@@ -7,7 +7,7 @@
 use gyrocal_host::GyroParams;
 use gyrocal_host::fake::Lorentzian;
 use gyrocal_host::identify;
-use gyrocal_host::knowns::{Derived, Knowns};
+use gyrocal_host::knowns::Knowns;
 use nalgebra::Complex;
 
 type C64 = Complex<f64>;
@@ -22,17 +22,7 @@ fn paper_truth() -> [(f64, f64, C64); 2] {
 }
 
 fn knowns(datasheet: GyroParams) -> Knowns {
-    Knowns {
-        filter: Derived {
-            decimation: 1000,
-            butterworth_hz: 500.0,
-            rc_hz: 2000.0,
-            min_window_s: 0.05,
-        },
-        // The fake board's words are the exact product.
-        carrier_profile: gyrocal_regs::datapath::CarrierProfile::Fine,
-        ..Knowns::exact(datasheet, 50e6, 9.64e6)
-    }
+    gyrocal_host::fake::paper_knowns(datasheet)
 }
 
 fn board(modes: [(f64, f64, C64); 2]) -> Lorentzian {

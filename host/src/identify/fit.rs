@@ -786,6 +786,7 @@ mod tests {
                 window_s: 1.0,
                 filter_decay_per_s: 1e15,
                 quarter_s: u / (PI * bk),
+                kept: 1.0,
             };
             let settle = m.waits.settling(bk);
             let pull = super::super::settle_sd(u);

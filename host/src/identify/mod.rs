@@ -52,7 +52,11 @@
 //!    constant; the datasheet's until then, each with a 20% margin) and the
 //!    filter's settling after a REF_PHASE step.
 //! 3. Gauss-Newton fit (`fit`) of the exact form above (4 real unknowns: C, fk, bk)
-//!    from the narrow-band solution, each mode alone.
+//!    from the narrow-band solution, each mode alone; then again without
+//!    what the waits leave of the resonator's ringing after each carrier
+//!    step, which that fit and the sweep's timing predict (`settling`:
+//!    the SAMPLE_COUNT reads either side of each step and each window's
+//!    sample counts).
 //! 4. Both fits again with the front end's group delay in the model
 //!    (`front`): the line through the two modes' phases gives it (with
 //!    the modes not resolved, one more measurement `front::PROBE_SPAN`
@@ -83,6 +87,8 @@ mod fit;
 mod front;
 mod probe;
 mod search;
+pub mod settling;
+pub use settling::filter_response;
 mod spurs;
 pub use spurs::point_spur_sd;
 
@@ -129,7 +135,8 @@ fn window_s(knowns: &Knowns) -> f64 {
 /// phase by that many radians, the up and down sweeps cancelling its
 /// first order in fk. (The residuals see the part that differs between a
 /// carrier's two visits: on a fork part with no ADC noise, twice the wait
-/// halved Q1's residual sigma.)
+/// halved Q1's residual sigma.) The fit takes the residue off each point
+/// ([`settling`]); what it may leave is this times `Waits::kept`.
 pub fn settling_residue(bk_hz: f64, waited_s: f64) -> f64 {
     (-PI * bk_hz * waited_s).exp()
 }
@@ -296,21 +303,28 @@ pub struct Waits {
     /// window sees the resonator's residue that much later
     /// ([`settle_sd`]).
     pub quarter_s: f64,
+    /// The fraction of the resonator's residue that its correction may
+    /// leave in the points (`settling::kept`; 1 for points not corrected,
+    /// 0 for points with no residue).
+    pub kept: f64,
 }
 
 impl Waits {
     /// The resonator's settling residue over the window's mean, relative
-    /// to the peak response, for a mode of bandwidth `bk_hz`: the bound
-    /// `settling_residue` after `waited_s`, decayed on through the window
-    /// (`window_mean`).
+    /// to the peak response, for a mode of bandwidth `bk_hz`, that the
+    /// correction may leave: the bound `settling_residue` after
+    /// `waited_s`, decayed on through the window (`window_mean`), times
+    /// `kept`.
     ///
     /// ```
     /// use gyrocal_host::identify::{Waits, settling_residue};
-    /// let w = Waits { waited_s: 0.5, window_s: 0.0, filter_decay_per_s: 100.0, quarter_s: 0.1 };
+    /// let w = Waits { waited_s: 0.5, window_s: 0.0, filter_decay_per_s: 100.0, quarter_s: 0.1, kept: 1.0 };
     /// assert_eq!(w.settling(8.0), settling_residue(8.0, 0.5));
+    /// let corrected = Waits { kept: 0.01, ..w };
+    /// assert_eq!(corrected.settling(8.0), 0.01 * settling_residue(8.0, 0.5));
     /// ```
     pub fn settling(&self, bk_hz: f64) -> f64 {
-        settling_residue(bk_hz, self.waited_s) * window_mean(PI * bk_hz, self.window_s)
+        settling_residue(bk_hz, self.waited_s) * window_mean(PI * bk_hz, self.window_s) * self.kept
     }
 
     /// The filter's residue after the REF_PHASE step over the Q window's
@@ -535,31 +549,49 @@ fn attempt(
     // The mode's own time constant 1 / (pi bk), with the datasheet's 20%
     // margin for the narrow-band estimate of bk.
     probe.tau_s = TAU_MARGIN / (PI * bk);
-    let sweep = fine_sweep(&mut probe, centre, bk)?;
-    let alone = fit::FrontSlope::default();
-    let fitted = fit::fit_mode(
-        &sweep,
-        centre,
-        bk,
-        Some(knowns.clock_hz),
-        &fit::no_pull,
-        alone,
-    );
-    let mut fit = match fitted {
+    let mut fit = match fine_fit(&mut probe, centre, bk)? {
         Ok(fit) => fit,
         Err(why) => return Ok(Err(unfitted(knowns, k, (centre, bk), why, probe.clocks))),
-    };
-    fit.waits = Waits {
-        waited_s: probe.waited_s(),
-        window_s: window_s(knowns),
-        filter_decay_per_s: knowns.filter_decay_per_s(),
-        quarter_s: probe.quarter_s(),
     };
     fit.scanned = scanned;
     // The amplitude only falls during the sweep (`Prober::measure`): its
     // last value is the smallest, whose lines are the largest part of Y.
-    fit.spur_sd = lines_per_point(knowns, k, &sweep, probe.amplitude(), (centre, bk))?;
+    let amplitude = probe.amplitude();
+    fit.spur_sd = lines_per_point(knowns, k, &fit.sweep, amplitude, (centre, bk))?;
     Ok(Ok((fit, probe.clocks)))
+}
+
+/// The fine sweep around `(centre, bk)` ([`fine_sweep`]) fitted, then
+/// fitted again without what the waits leave of the resonator's ringing
+/// after each carrier step (`settling`: the first fit's resonance and the
+/// sweep's timing predict it), with the sweep's [`Waits`]; or why it could
+/// not be fitted.
+fn fine_fit(
+    probe: &mut Prober,
+    centre: f64,
+    bk: f64,
+) -> Result<Result<ModeFit, fit::FitError>, Error> {
+    let knowns = probe.knowns();
+    let (sweep, arrivals) = fine_sweep(probe, centre, bk)?;
+    let (clock_hz, filter) = (knowns.clock_hz, &knowns.filter);
+    let alone = |points: &[(f64, C64)], (fk, bk)| {
+        let front = fit::FrontSlope::default();
+        fit::fit_mode(points, fk, bk, Some(clock_hz), &fit::no_pull, front)
+    };
+    let fitted = alone(&sweep, (centre, bk)).and_then(|first| {
+        let points = settling::corrected(&first, &sweep, &arrivals, clock_hz, filter);
+        let start = (first.f_hz.value, first.f_hz.value / first.q.value);
+        let mut fit = alone(&points, start)?;
+        fit.waits = Waits {
+            waited_s: probe.waited_s(),
+            window_s: window_s(knowns),
+            filter_decay_per_s: knowns.filter_decay_per_s(),
+            quarter_s: probe.quarter_s(),
+            kept: settling::kept(&first, &sweep, &arrivals),
+        };
+        Ok(fit)
+    });
+    Ok(fitted)
 }
 
 /// Where the coarse search found a mode.
@@ -599,12 +631,21 @@ fn locate(probe: &mut Prober, guess_hz: f64, bw: f64) -> Result<Result<Located, 
     })
 }
 
+/// A fine sweep's points (carrier Hz, Y) and what the resonator carried
+/// into each.
+type Swept = (Vec<(f64, C64)>, Vec<settling::Arrival>);
+
 /// The fine sweep: `FINE_POINTS` carriers over +-`FINE_SPAN` bandwidths
-/// `bk` around `centre`, up then down ([`fine_offsets`]).
-fn fine_sweep(probe: &mut Prober, centre: f64, bk: f64) -> Result<Vec<(f64, C64)>, Error> {
-    (fine_offsets().iter())
-        .map(|s| probe.measure(centre + s * bk))
-        .collect()
+/// `bk` around `centre`, up then down ([`fine_offsets`]), and what the
+/// resonator carried into each point.
+fn fine_sweep(probe: &mut Prober, centre: f64, bk: f64) -> Result<Swept, Error> {
+    let mut swept: Swept = (vec![], vec![]);
+    for s in fine_offsets() {
+        let (f, y, arrival) = probe.measure_arriving(centre + s * bk)?;
+        swept.0.push((f, y));
+        swept.1.push(arrival);
+    }
+    Ok(swept)
 }
 
 /// The fine sweep's carriers in the order it visits them, in bandwidths
@@ -717,13 +758,14 @@ pub(crate) fn refit(
 /// the fit (`spur_sd`, `fit::noise_and_lines`: the lines counted once,
 /// where the residuals saw them or not); then in quadrature the waits'
 /// terms: the filter's residue after the REF_PHASE step at its RMS over
-/// C's phase (`REF_STEP_SD`), and the resonator's settling residue
-/// (`settling_residue`, the bound after the wait) through the fit at its
-/// RMS over the transient's turn, at the sweep's delay from the I window
-/// to the Q window ([`settle_sd`]: the up and down sweeps cancel its first
-/// order in fk, not in Q, and the Q window sees less of it the later it
-/// comes). Each is its residue at its window's start, which decays on
-/// through the window its mean is taken over (`window_mean`).
+/// C's phase (`REF_STEP_SD`), and what the correction may leave of the
+/// resonator's settling residue (`settling_residue`, the bound after the
+/// wait, times `Waits::kept`) through the fit at its RMS over the
+/// transient's turn, at the sweep's delay from the I window to the Q
+/// window ([`settle_sd`]: the up and down sweeps cancel its first order
+/// in fk, not in Q, and the Q window sees less of it the later it comes).
+/// Each is its residue at its window's start, which decays on through the
+/// window its mean is taken over (`window_mean`).
 pub(crate) fn sweep_uncertainty(
     fit: &ModeFit,
     clock_hz: f64,
