@@ -21,9 +21,9 @@
 
 use crate::board::{Board, ZSample};
 use crate::device::GyroParams;
+use crate::identify::settling::Resonance;
 use crate::knowns::{Derived, Knowns};
-use crate::theory::hold_gain;
-use gyrocal_regs::datapath::{CarrierProfile, readout_word};
+use gyrocal_regs::datapath::{CIC_STAGES, COEFFICIENT_FRACTION_BITS, CarrierProfile, readout_word};
 use gyrocal_regs::filter_design::cic_bit_growth;
 use gyrocal_regs::map::{
     BusError, RegisterAccess, RegisterBank, SAMPLE_COUNT, Z1_HI, Z1_LO, Z2_HI, Z2_LO,
@@ -110,8 +110,13 @@ impl Lorentzian {
 
     /// Mode m's steady response at `f` per drive LSB.
     fn steady(&self, m: usize, f: f64) -> C64 {
-        let (fk, bk, c) = self.modes[m];
-        hold_gain(f, self.clock_hz) * c / C64::new((fk - f) * (fk + f), f * bk)
+        let (f_hz, bandwidth_hz, c) = self.modes[m];
+        let mode = Resonance {
+            f_hz,
+            bandwidth_hz,
+            c,
+        };
+        mode.at(f, self.clock_hz)
     }
 
     /// Mode m's ringing now, in its carrier's frame (z's units over the
@@ -144,7 +149,8 @@ impl Lorentzian {
     /// The output filter's response at `s` (1/s) over its DC gain, from
     /// the registers: the CIC's four stages of R at the clock, the biquad
     /// 1 + z^-1 squared over 1 + a1 z^-1 + a2 z^-2 (a1 = -2 - k1, a2 = 1 -
-    /// k2) and the RC pole alpha / (1 - (1 - alpha) z^-1) at the output
+    /// k2), written apart from `identify::filter_response`, which it checks,
+    /// and the RC pole alpha / (1 - (1 - alpha) z^-1) at the output
     /// rate.
     fn filter_at(&self, s: C64) -> C64 {
         let r = self.bank.registers();
@@ -156,7 +162,7 @@ impl Lorentzian {
         } else {
             (one - (-x * rr).exp()) / ((one - (-x).exp()) * rr)
         };
-        let scale = f64::from(1u32 << 30);
+        let scale = f64::from(1u32 << COEFFICIENT_FRACTION_BITS);
         let (a1, a2) = (
             -2.0 - f64::from(r.iir.k1) / scale,
             1.0 - f64::from(r.iir.k2) / scale,
@@ -165,23 +171,22 @@ impl Lorentzian {
         let zi = (-x * rr).exp();
         let biquad = (one + zi).powi(2) / (one + zi * a1 + zi * zi * a2) * ((1.0 + a1 + a2) / 4.0);
         let rc = alpha / (one - zi * (1.0 - alpha));
-        cic.powi(4) * biquad * rc
+        cic.powi(CIC_STAGES as i32) * biquad * rc
     }
 
     fn z_now(&mut self) -> [f64; 2] {
         let r = self.bank.registers();
-        let f = f64::from(r.carrier_step) * self.clock_hz / 2f64.powi(32);
+        // Exact products, as the fine core's words are.
+        let (f, words) = self.drives();
         let theta =
             f64::from(r.ref_phase.wrapping_sub(r.carrier_step.div_ceil(2))) * TAU / 2f64.powi(32);
         let rr = f64::from(r.cic_decimation);
         let cic = rr.powi(4) / 2f64.powi(cic_bit_growth(u32::from(r.cic_decimation)) as i32);
         let k = r.iir;
         let dc = cic * 4.0 * f64::from(k.k0) / -(f64::from(k.k1) + f64::from(k.k2));
-        let amps = [r.amp.0, r.amp.1];
         std::array::from_fn(|m| {
             let mut y = self.steady(m, f);
-            // Exact products, as the fine core's words are.
-            let w = readout_word(CarrierProfile::Fine, amps[m]);
+            let w = words[m];
             if self.ringing && w > 0.0 {
                 let (ring, s) = self.ring(m);
                 y += ring * self.filter_at(s) / w;

@@ -163,6 +163,13 @@ pub struct Resonance {
 }
 
 impl Resonance {
+    /// Y at carrier `f` on a clock of `clock_hz`: the mode's resonant
+    /// response through the DAC hold's gain.
+    pub fn at(&self, f: f64, clock_hz: f64) -> C64 {
+        let (fk, bk) = (self.f_hz, self.bandwidth_hz);
+        self.c * hold_gain(f, clock_hz) / C64::new((fk - f) * (fk + f), f * bk)
+    }
+
     /// The resonance of a fitted mode.
     pub(crate) fn of(m: &ModeFit) -> Self {
         Self {
@@ -184,14 +191,12 @@ pub fn ringing_seen(
     clock_hz: f64,
     filter: &Derived,
 ) -> [C64; 2] {
-    let (fk, bk, c) = (m.f_hz, m.bandwidth_hz, m.c);
-    let y = |v: f64| c * hold_gain(v, clock_hz) / C64::new((fk - v) * (fk + v), v * bk);
     let before = match a.from_scale {
         0.0 => C64::new(0.0, 0.0),
-        scale => y(a.from_hz) * scale,
+        scale => m.at(a.from_hz, clock_hz) * scale,
     };
-    let s = ringing(fk, bk, f);
-    let seen = (before - y(f)) * filter_response(filter, clock_hz, s);
+    let s = ringing(m.f_hz, m.bandwidth_hz, f);
+    let seen = (before - m.at(f, clock_hz)) * filter_response(filter, clock_hz, s);
     let mean =
         |times: &[f64]| times.iter().map(|t| (s * t).exp()).sum::<C64>() / times.len() as f64;
     [seen * mean(&a.i_s), seen * mean(&a.q_s)]
@@ -231,6 +236,7 @@ pub(crate) fn kept(m: &ModeFit, sweep: &[(f64, C64)], arrivals: &[Arrival]) -> f
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::knowns::Knowns;
 
     /// The output filter played sample by sample: the CIC's four running
     /// sums of R at the clock, kept every R clocks, then the Butterworth
@@ -295,7 +301,7 @@ mod tests {
     /// The paper's modes on a fake board (9.64 MHz and 250 Hz above, Q
     /// 55,000, a 3 deg front end), ringing or not, with no noise, and
     /// what the host knows of it.
-    fn paper_board(ringing: bool) -> (crate::fake::Lorentzian, crate::knowns::Knowns) {
+    fn paper_board(ringing: bool) -> (crate::fake::Lorentzian, Knowns) {
         let c = C64::from_polar(2.0e9, -3f64.to_radians());
         let (f1, f2) = (9.64e6, 9.64e6 + 250.0);
         let mut board =
