@@ -11,7 +11,9 @@
 # Usage: scripts/bench-against.sh [BASE_REV] [ROUNDS] [CPU]
 #   BASE_REV  a revision to build and compare with (default 4afc731)
 #   ROUNDS    alternations (default 3); each runs both binaries'
-#             `gyrocal bench --engines model --repetitions 3 --no-reproduce`
+#             `gyrocal bench --engines model --repetitions 3 --no-reproduce`,
+#             then both binaries' `gyrocal reproduce` (issue 23's own
+#             measure: its wall time on one core, the figures written)
 #   CPU       the core both run on (default the last one)
 #
 # The base is built once in a git worktree under target/bench-base/REV
@@ -55,8 +57,8 @@ if [ ! -x "$base_dir/gyrocal" ]; then
 fi
 echo "building this tree" >&2
 cargo build --release --quiet --bin gyrocal >&2
-head_bin=target/release/gyrocal
-base_bin=$base_dir/gyrocal
+head_bin=$PWD/target/release/gyrocal
+base_bin=$PWD/$base_dir/gyrocal
 
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
@@ -74,11 +76,24 @@ run() { # name binary round [VAR=value...]
   taskset -c "$cpu" env RAYON_NUM_THREADS=1 "${@:4}" "$2" bench --engines model \
     --repetitions 3 --no-reproduce --json >"$out/$1.$3.json"
 }
+# Issue 23's own measure: `gyrocal reproduce` on one core, wall to wall
+# (the figures written), each binary in a directory of its own.
+reproduce() { # name binary round
+  echo "round $3: $1 reproduce" >&2
+  mkdir -p "$out/$1.reproduce.$3"
+  local start end
+  start=$(date +%s%N)
+  (cd "$out/$1.reproduce.$3" && taskset -c "$cpu" env RAYON_NUM_THREADS=1 "$2" reproduce --quiet >/dev/null)
+  end=$(date +%s%N)
+  echo $((end - start)) >"$out/$1.reproduce.$3.ns"
+}
 for r in $(seq 1 "$rounds"); do
   run base "$base_bin" "$r"
   for isa in $isas; do
     run "$isa" "$head_bin" "$r" GYROCAL_ISA="$isa"
   done
+  reproduce base "$base_bin" "$r"
+  reproduce head "$head_bin" "$r"
 done
 
 python3 - "$out" "$rounds" "$base_rev" "$(git rev-parse --short HEAD)" $isas <<'EOF'
@@ -92,10 +107,15 @@ def speeds(name):
     s = {False: [], True: []}
     for run in runs[name]:
         for m in run["measurements"]:
-            s[m["with_gyro"]].extend(m["samples"])
+            if m.get("lanes", 1) == 1:
+                s[m["with_gyro"]].extend(m["samples"])
     return s
 def median_of(run, gyro):
-    return next(m["median_clocks_per_s"] for m in run["measurements"] if m["with_gyro"] == gyro)
+    return next(m["median_clocks_per_s"] for m in run["measurements"]
+                if m["with_gyro"] == gyro and m.get("lanes", 1) == 1)
+def lanes_of(run):
+    # The lanes measurement (a base from before lanes has none).
+    return next((m for m in run["measurements"] if m.get("lanes", 1) > 1), None)
 def paired(name, gyro):
     # Each round's median over the base's median in the same round: on a
     # machine whose speed drifts over minutes, the ratio of runs seconds
@@ -125,4 +145,17 @@ for gyro, label in [(False, "datapath alone"), (True, "with the gyroscope")]:
         ratio, above = paired(isa, gyro)
         cells += f" {isa:>10} {ratio:.3f} ({above})"
     print(f"{label:<20}{cells}")
+lanes = [lanes_of(run) for run in runs[isas[-1]]]
+if all(lanes):
+    n = lanes[0]["lanes"]
+    ratios = [m["median_clocks_per_s"] / median_of(b, True) for m, b in zip(lanes, runs["base"])]
+    each = statistics.median(x for m in lanes for x in m["samples"])
+    print(f"in {n} lanes ({isas[-1]}, lane clocks/s): {each / 1e6:.2f} M, paired over the base"
+          f" with the gyroscope {statistics.median(ratios):.3f} ({sum(x > 1 for x in ratios)})")
+wall = {name: [int(open(f"{out}/{name}.reproduce.{r}.ns").read()) / 1e9 for r in range(1, rounds + 1)]
+        for name in ["base", "head"]}
+ratios = [b / h for b, h in zip(wall["base"], wall["head"])]
+print(f"gyrocal reproduce, one core, wall (s): base {' '.join(f'{t:.2f}' for t in wall['base'])};"
+      f" this tree {' '.join(f'{t:.2f}' for t in wall['head'])}; paired ratio"
+      f" {statistics.median(ratios):.3f} ({sum(x > 1 for x in ratios)} of {rounds} above 1)")
 EOF

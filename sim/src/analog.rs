@@ -15,6 +15,7 @@
 use crate::frontend::{Converters, PickoffPhase};
 use crate::gyro::GyroModel;
 use gyrocal_hdl::model::gyro_interface::{AnalogSide, BLOCK, Words};
+use gyrocal_hdl::model::lanes::AnalogLanes;
 
 /// DACs, gyroscope, pick-off phase lag and ADCs.
 #[derive(Clone, Debug)]
@@ -87,31 +88,152 @@ impl AnalogSide for Analog {
     /// The DAC forces of the block in one pass, then the gyroscope's
     /// clocks in another (`GyroModel::steps`).
     #[inline(always)]
-    fn advance_block(&mut self, dac: impl Iterator<Item = Words>, mut beside: impl FnMut(usize)) {
-        self.forces.resize(BLOCK, (0.0, 0.0));
-        let clocks = self.converters.dac_block(dac, &mut self.forces);
-        self.forces.truncate(clocks);
-        let start = self.pending.len();
-        self.pending.resize(start + self.forces.len(), (0.0, 0.0));
-        let phase = self.phase;
-        self.gyro
-            .steps(&self.forces, &mut self.pending[start..], |t, s| {
-                beside(t);
-                sense(phase, s)
-            });
+    fn advance_block(&mut self, dac: impl Iterator<Item = Words>, beside: impl FnMut(usize)) {
+        let mut forces = std::mem::take(&mut self.forces);
+        self.converters.forces_block(dac, &mut forces);
+        self.advance_under(&forces, beside);
+        self.forces = forces;
     }
 
     #[inline(always)]
     fn convert(&mut self, adc: &mut [Words]) {
-        debug_assert_eq!(adc.len(), self.pending.len());
         let mut noise = std::mem::take(&mut self.noise);
-        if !self.converters.draw_noise(adc.len(), &mut noise) {
-            noise.clear();
-            noise.resize(2 * adc.len(), 0.0);
-        }
-        self.converters.adc_block(&self.pending, &noise, adc);
-        self.pending.clear();
+        self.converters.noise_block(adc.len(), &mut noise);
+        self.convert_with(&noise, adc);
         self.noise = noise;
+    }
+}
+
+impl Analog {
+    /// The gyroscope's clocks under `forces` (`GyroModel::steps`), what
+    /// the ADCs see at each edge kept, `beside(t)` at clock t.
+    #[inline(always)]
+    fn advance_under(&mut self, forces: &[(f64, f64)], mut beside: impl FnMut(usize)) {
+        let start = self.pending.len();
+        self.pending.resize(start + forces.len(), (0.0, 0.0));
+        let phase = self.phase;
+        self.gyro.steps(forces, &mut self.pending[start..], |t, s| {
+            beside(t);
+            sense(phase, s)
+        });
+    }
+
+    /// The ADC words of the edges advanced, with their standard normal
+    /// draws `noise` (two a clock).
+    #[inline(always)]
+    fn convert_with(&mut self, noise: &[f64], adc: &mut [Words]) {
+        debug_assert_eq!(adc.len(), self.pending.len());
+        self.converters.adc_block(&self.pending, noise, adc);
+        self.pending.clear();
+    }
+}
+
+/// Analog sides in lanes (`gyrocal_hdl::model::lanes`): each lane its own
+/// gyroscope and pick-off (one device at several rates: a rate table), the
+/// converters' settings, DAC words in flight and noise generator equal in
+/// every lane (`Converters::shares_with`). The DAC words are the lanes'
+/// one set, so one pass makes the forces, and each lane would draw the
+/// same noise alone, so one block of draws serves them all; each lane then
+/// advances its own gyroscope and converts its own ADC words. Every lane's
+/// words are those its own `Analog` gives alone.
+pub struct Lanes<'a, W: FnMut(usize, &[Words]) = fn(usize, &[Words])> {
+    analogs: &'a mut [Analog],
+    forces: Vec<(f64, f64)>,
+    noise: Vec<f64>,
+    /// Sees each lane's ADC words once converted (lane, words).
+    watch: W,
+}
+
+/// Why analog sides cannot run as lanes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LanesError {
+    /// No analog side.
+    Empty,
+    /// This lane does not share its converters' settings and state with
+    /// the first (`Converters::shares_with`).
+    NotShared(usize),
+}
+
+impl std::fmt::Display for LanesError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            LanesError::Empty => write!(f, "analog lanes: none given (allowed 1 or more)"),
+            LanesError::NotShared(l) => write!(
+                f,
+                "analog lanes: lane {l}'s converters differ from lane 0's (settings, DAC words in flight or noise state); lanes must share them"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for LanesError {}
+
+impl<'a> Lanes<'a> {
+    /// `analogs` as lanes, or why they cannot be.
+    pub fn new(analogs: &'a mut [Analog]) -> Result<Self, LanesError> {
+        Lanes::watched(analogs, |_, _| {})
+    }
+}
+
+impl<'a, W: FnMut(usize, &[Words])> Lanes<'a, W> {
+    /// `analogs` as lanes, `watch(lane, words)` seeing each lane's ADC
+    /// words once converted (the clip counters); or why they cannot be.
+    pub fn watched(analogs: &'a mut [Analog], watch: W) -> Result<Self, LanesError> {
+        let (lead, rest) = analogs.split_first().ok_or(LanesError::Empty)?;
+        if let Some(l) = rest
+            .iter()
+            .position(|a| !a.converters.shares_with(&lead.converters))
+        {
+            return Err(LanesError::NotShared(l + 1));
+        }
+        Ok(Self {
+            analogs,
+            forces: Vec::with_capacity(BLOCK),
+            noise: vec![],
+            watch,
+        })
+    }
+}
+
+impl<W: FnMut(usize, &[Words])> AnalogLanes for Lanes<'_, W> {
+    #[inline(always)]
+    fn lanes(&self) -> usize {
+        self.analogs.len()
+    }
+
+    /// The forces once, from the first lane's converters; every lane's
+    /// gyroscope under them, `beside` beside the first's.
+    #[inline(always)]
+    fn advance_block(&mut self, dac: impl Iterator<Item = Words>, beside: impl FnMut(usize)) {
+        let (lead, rest) = self
+            .analogs
+            .split_first_mut()
+            .expect("lanes are never empty");
+        lead.converters.forces_block(dac, &mut self.forces);
+        lead.advance_under(&self.forces, beside);
+        for analog in rest {
+            analog.advance_under(&self.forces, |_| {});
+        }
+    }
+
+    /// The block's noise drawn by the first lane's converters when it
+    /// converts, the same draws for the others, which then take on its
+    /// DAC words and generator (`Converters::follow`).
+    #[inline(always)]
+    fn convert(&mut self, lane: usize, adc: &mut [Words]) {
+        let (lead, rest) = self
+            .analogs
+            .split_first_mut()
+            .expect("lanes are never empty");
+        if lane == 0 {
+            lead.converters.noise_block(adc.len(), &mut self.noise);
+            lead.convert_with(&self.noise, adc);
+        } else {
+            let analog = &mut rest[lane - 1];
+            analog.converters.follow(&lead.converters);
+            analog.convert_with(&self.noise, adc);
+        }
+        (self.watch)(lane, adc);
     }
 }
 

@@ -5,13 +5,18 @@
 //! gyroscope model (`CoSim`), each repeated and reported as the median with
 //! its spread. Both run as the experiments do, through `Engine::run` (the
 //! model engine in blocks, the others clock by clock). Stimulus: the
-//! paper's device, calibration at 12 Hz (every block busy). Optionally, the
+//! paper's device, calibration at 12 Hz (every block busy). The model
+//! engine also runs the closed loop in [`RATE_LANES`] lanes (the device at
+//! as many rates, `CoSimLanes`), counted in lane clocks. Optionally, the
 //! whole `reproduce` experiment, timed wall to wall on all cores, with the
 //! process's peak resident memory.
 
+use crate::cosim::CoSimLanes;
 use crate::engine::{Engine, EngineKind, ModelEngine, RtlEngine};
 use crate::error::RunError;
 use crate::experiment::{self, Experiment, Plan};
+use crate::frontend::Converters;
+use crate::gyro::GyroModel;
 use gyrocal_hdl::model::gyro_interface::{AnalogSide, Words};
 use gyrocal_hdl::model::isa::Isa;
 use serde::Serialize;
@@ -25,6 +30,11 @@ pub struct Measurement {
     pub engine: String,
     /// True when the gyroscope model and converters were in the loop.
     pub with_gyro: bool,
+    /// Lanes played together (`gyrocal_hdl::model::lanes`: one device at
+    /// several rates, as a readout sweep or a rate table runs it): 1, or
+    /// [`RATE_LANES`] on the model engine; `clocks` and the speeds count
+    /// every lane's clocks.
+    pub lanes: usize,
     /// Clocks per repetition.
     pub clocks: u64,
     /// Clocks per second of each repetition.
@@ -102,17 +112,21 @@ fn stimulus_plan() -> (Experiment, Plan) {
     (exp, plan)
 }
 
+/// The stimulus's point: the plan's first calibration point.
+fn stimulus_point(plan: &Plan) -> &experiment::PointPlan {
+    plan.points
+        .iter()
+        .find(|p| p.mode == experiment::Mode::Calibration)
+        .expect("a calibration point")
+}
+
 fn measure<E: Engine>(
     name: &str,
     clocks: u64,
     repetitions: usize,
 ) -> Result<[Measurement; 2], RunError> {
     let (exp, plan) = stimulus_plan();
-    let point = plan
-        .points
-        .iter()
-        .find(|p| p.mode == experiment::Mode::Calibration)
-        .expect("a calibration point");
+    let point = stimulus_point(&plan);
     // ADC words for the datapath-alone runs: what the loop itself produces.
     let adc: Vec<(i16, i16)> = {
         let mut sim = experiment::point_loop::<ModelEngine>(&exp, &plan, point)?;
@@ -150,11 +164,52 @@ fn measure<E: Engine>(
     let make = |with_gyro: bool, samples: Vec<f64>| Measurement {
         engine: name.into(),
         with_gyro,
+        lanes: 1,
         clocks,
         median_clocks_per_s: median(&samples),
         samples,
     };
     Ok([make(false, alone), make(true, looped)])
+}
+
+/// Lanes of the model engine's lane measurement.
+pub const RATE_LANES: usize = 8;
+
+/// The closed loop of `measure` in [`RATE_LANES`] lanes, the device at
+/// rates from 0 to 7 deg/s: `clocks` lane clocks a repetition.
+fn measure_lanes(clocks: u64, repetitions: usize) -> Result<Measurement, RunError> {
+    let (exp, plan) = stimulus_plan();
+    let point = stimulus_point(&plan);
+    let per_lane = (clocks / RATE_LANES as u64).max(1);
+    let mut samples = vec![];
+    for _ in 0..repetitions {
+        let gyros = (0..RATE_LANES)
+            .map(|l| {
+                let mut gyro = GyroModel::new(&exp.gyro, exp.drive.clock_hz)?;
+                gyro.set_rate((l as f64).to_radians());
+                Ok(gyro)
+            })
+            .collect::<Result<Vec<_>, RunError>>()?;
+        let converters = Converters::new(&plan.front_end)?;
+        let profile = exp.drive.carrier_profile;
+        let mut sim =
+            CoSimLanes::new(profile, converters, gyros, point.regs).expect("RATE_LANES is not 0");
+        let start = Instant::now();
+        let mut check = 0i64;
+        sim.run(per_lane, |l, n, z| {
+            check = check.wrapping_add(z.0 ^ (n + l as u64) as i64)
+        });
+        black_box(check);
+        samples.push((per_lane * RATE_LANES as u64) as f64 / start.elapsed().as_secs_f64());
+    }
+    Ok(Measurement {
+        engine: "model".into(),
+        with_gyro: true,
+        lanes: RATE_LANES,
+        clocks: per_lane * RATE_LANES as u64,
+        median_clocks_per_s: median(&samples),
+        samples,
+    })
 }
 
 /// Clocks per repetition for an engine: a fraction of a second each.
@@ -190,7 +245,12 @@ pub fn run(
             kind.name()
         ));
         let m = match kind {
-            EngineKind::Model => measure::<ModelEngine>("model", clocks, repetitions)?,
+            EngineKind::Model => {
+                let [alone, looped] = measure::<ModelEngine>("model", clocks, repetitions)?;
+                let lanes = measure_lanes(clocks, repetitions)?;
+                measurements.extend([alone, looped, lanes]);
+                continue;
+            }
             EngineKind::Rtl => measure::<RtlEngine>("rtl", clocks, repetitions)?,
             #[cfg(feature = "verilator")]
             EngineKind::Verilator => {
@@ -204,7 +264,7 @@ pub fn run(
     let speed = |name: &str| {
         measurements
             .iter()
-            .find(|m| m.engine == name && m.with_gyro)
+            .find(|m| m.engine == name && m.with_gyro && m.lanes == 1)
             .map(|m| m.median_clocks_per_s)
     };
     let model_over_verilator_with_gyro = speed("model").zip(speed("verilator")).map(|(a, b)| a / b);
@@ -250,7 +310,9 @@ mod tests {
             &|_| {},
         )
         .unwrap();
-        assert_eq!(r.measurements.len(), 4);
+        assert_eq!(r.measurements.len(), 5);
+        let lanes: Vec<usize> = r.measurements.iter().map(|m| m.lanes).collect();
+        assert_eq!(lanes, [1, 1, RATE_LANES, 1, 1]);
         assert!(
             r.measurements
                 .iter()

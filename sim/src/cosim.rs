@@ -27,7 +27,7 @@
 //! clock). `CoSim` implements `RegisterAccess`, reads included: the z
 //! snapshot is latched by a SAMPLE_COUNT read, as in the hardware.
 
-use crate::analog::{Analog, Watched};
+use crate::analog::{self, Analog, Watched};
 use crate::engine::Engine;
 use crate::frontend::Converters;
 use crate::gyro::GyroModel;
@@ -35,7 +35,11 @@ use gyrocal_hdl::host::register_map::{
     self, BusError, RegisterAccess, RegisterBank, SAMPLE_COUNT, STREAM_OVERFLOW, Z1_HI, Z1_LO,
     Z2_HI, Z2_LO,
 };
-use gyrocal_hdl::model::gyro_interface::{CarrierProfile, Outputs, Registers, Words};
+use gyrocal_hdl::model::gyro_interface::{
+    CarrierProfile, GyroInterface, Outputs, Registers, Words,
+};
+use gyrocal_hdl::model::isa::Isa;
+use gyrocal_hdl::model::lanes::{Lanes, NoLane};
 
 /// Engine, converters and gyroscope in a loop.
 pub struct CoSim<E: Engine> {
@@ -155,6 +159,82 @@ impl<E: Engine> CoSim<E> {
     }
 }
 
+/// Co-simulations in lanes on the model engine
+/// (`gyrocal_hdl::model::lanes`, `crate::analog::Lanes`): one datapath
+/// from power-up, one set of registers and converters, and a gyroscope per
+/// lane (one device at several rates: a readout sweep's points). Each
+/// lane plays the clocks a `CoSim` of its own gyroscope plays, bit for
+/// bit, where the drive half, the DAC forces and the ADC noise are worked
+/// out once for all.
+pub struct CoSimLanes {
+    datapaths: Lanes,
+    analogs: Vec<Analog>,
+    host: HostRegisters,
+    isa: Isa,
+    cycle: u64,
+}
+
+impl CoSimLanes {
+    /// A lane per gyroscope, each with `converters` and the datapath
+    /// `CoSim::new` makes, programmed with `regs`; or why not (none).
+    pub fn new(
+        profile: CarrierProfile,
+        converters: Converters,
+        gyros: Vec<GyroModel>,
+        regs: Registers,
+    ) -> Result<Self, NoLane> {
+        let datapaths = Lanes::new(GyroInterface::with_profile(profile), gyros.len())?;
+        let analogs = gyros
+            .into_iter()
+            .map(|gyro| Analog::new(converters.clone(), gyro, None))
+            .collect();
+        let mut host = HostRegisters::power_up(profile);
+        for (offset, word) in register_map::encode(&regs) {
+            host.write(offset, word)
+                .expect("the register map's own writes are accepted");
+        }
+        Ok(Self {
+            datapaths,
+            analogs,
+            host,
+            isa: Isa::selected(),
+            cycle: 0,
+        })
+    }
+
+    /// `CoSim::run` on every lane: `on_z(l, n, z)` when lane `l`'s clock
+    /// `n` (numbered as `CoSim` numbers them) publishes z.
+    pub fn run(&mut self, clocks: u64, mut on_z: impl FnMut(usize, u64, (i64, i64))) {
+        if clocks == 0 {
+            return;
+        }
+        let mut analogs =
+            analog::Lanes::new(&mut self.analogs).expect("the lanes share one set of converters");
+        let first = self.cycle + 1;
+        let regs = self.host.registers();
+        self.datapaths
+            .run(self.isa, regs, clocks, &mut analogs, |l, i, z| {
+                on_z(l, first + i, z)
+            });
+        self.cycle += clocks;
+    }
+
+    /// Clocks played since power-up.
+    pub fn cycle(&self) -> u64 {
+        self.cycle
+    }
+
+    /// Lane `lane`'s gyroscope.
+    pub fn gyro(&self, lane: usize) -> &GyroModel {
+        &self.analogs[lane].gyro
+    }
+
+    /// Sets the instruction set the lanes run on (`ModelEngine::set_isa`).
+    pub fn set_isa(&mut self, isa: Isa) {
+        self.isa = isa;
+    }
+}
+
 impl<E: Engine> RegisterAccess for CoSim<E> {
     /// A write between two clocks: acts from the next clock on.
     fn write_register(&mut self, offset: u32, word: u32) -> Result<(), BusError> {
@@ -232,6 +312,8 @@ mod tests {
     use super::*;
     use crate::engine::ModelEngine;
     use crate::experiment::{Experiment, plan, point_loop};
+    use crate::frontend::Converters;
+    use crate::gyro::GyroModel;
     use gyrocal_hdl::host::register_map::{CIC_DECIMATION, ID, ID_WORD};
     use gyrocal_hdl::model::isa::Isa;
 
@@ -336,6 +418,64 @@ mod tests {
                 "{mode:?}: {} samples",
                 blocked.samples
             );
+        }
+    }
+
+    /// Lanes play what each point's `CoSim` plays alone: three rates on a
+    /// calibration and a readout point (ADC noise on, so the lanes' shared
+    /// draws must be each one's own), runs of lengths around a block's,
+    /// compiled for every instruction set this processor runs; every z at
+    /// the same cycle and the same gyroscope state after each run. The
+    /// rates' z differ (else the lanes could be mixed up unseen).
+    #[test]
+    fn lanes_play_what_each_cosim_plays_alone() {
+        let exp = Experiment::paper();
+        let plan = plan(&exp).unwrap();
+        use crate::experiment::Mode;
+        let rates = [0.3, -0.1, 0.05];
+        for (mode, isa) in [Mode::Calibration, Mode::Readout]
+            .into_iter()
+            .flat_map(|m| Isa::supported_all().into_iter().map(move |i| (m, i)))
+        {
+            let point = plan.points.iter().find(|p| p.mode == mode).unwrap();
+            let gyros = rates.map(|r| {
+                let mut gyro = GyroModel::new(&exp.gyro, exp.drive.clock_hz).unwrap();
+                gyro.set_rate(r);
+                gyro
+            });
+            let converters = Converters::new(&plan.front_end).unwrap();
+            let profile = exp.drive.carrier_profile;
+            let mut lanes =
+                CoSimLanes::new(profile, converters, gyros.to_vec(), point.regs).unwrap();
+            lanes.set_isa(isa);
+            let mut alone: Vec<CoSim<ModelEngine>> = rates
+                .iter()
+                .map(|&r| {
+                    let mut sim = point_loop::<ModelEngine>(&exp, &plan, point).unwrap();
+                    sim.set_rate(r);
+                    sim.engine_mut().set_isa(isa);
+                    sim
+                })
+                .collect();
+            let mut last = vec![vec![]; rates.len()];
+            for clocks in [1u64, 255, 257, 100_000, 7, 60_001] {
+                let mut z_lanes = vec![vec![]; rates.len()];
+                lanes.run(clocks, |l, n, z| z_lanes[l].push((n, z)));
+                for (l, sim) in alone.iter_mut().enumerate() {
+                    let mut z = vec![];
+                    sim.run(clocks, |n, v| z.push((n, v)));
+                    assert_eq!(z_lanes[l], z, "{mode:?} ({isa}), lane {l}, {clocks} clocks");
+                    assert_eq!(
+                        lanes.gyro(l).state(),
+                        sim.gyro().state(),
+                        "{mode:?} ({isa})"
+                    );
+                    assert_eq!(lanes.cycle(), sim.cycle());
+                    last[l] = z;
+                }
+            }
+            assert!(last[0].len() > 10, "{mode:?}: {} z", last[0].len());
+            assert_ne!(last[0], last[1], "{mode:?}: two rates read the same z");
         }
     }
 }

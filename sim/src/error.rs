@@ -164,6 +164,9 @@ pub enum RunError {
     /// A drive amplitude that rounds to no DAC word.
     #[error("[drive] amplitude1, amplitude2: both drives need at least one DAC LSB")]
     DrivesBelowOneLsb,
+    /// Lanes of no point or board (`gyrocal_hdl::model::lanes`).
+    #[error(transparent)]
+    NoLane(#[from] gyrocal_hdl::model::lanes::NoLane),
 }
 
 /// What the Allan deviation and the noise fit of a rate series refuse

@@ -78,7 +78,7 @@
 use crate::average::window_mean;
 use crate::config::Derived;
 pub use crate::config::Experiment;
-use crate::cosim::CoSim;
+use crate::cosim::{CoSim, CoSimLanes};
 use crate::engine::{Engine, EngineKind, ModelEngine, RtlEngine};
 use crate::error::RunError;
 use crate::fit::{
@@ -712,6 +712,7 @@ pub fn point_loop<E: Engine>(
 
 /// The z samples of one point from just before its window, and a thinned
 /// trace of all of them.
+#[derive(Clone)]
 struct Samples {
     t: Vec<f64>,
     z: [Vec<f64>; 2],
@@ -722,6 +723,21 @@ struct Samples {
 }
 
 impl Samples {
+    /// A point's samples to be (`run_point`), and the clock its run ends.
+    fn for_point(plan: &Plan, point: &PointPlan, units: u32) -> (Self, u64) {
+        let r = plan.filter.decimation;
+        let end = point.cycles_for(units, r);
+        let samples = Samples {
+            t: vec![],
+            z: [vec![], vec![]],
+            trace: vec![],
+            trace_every: (end / u64::from(r) / 2000).max(1),
+            count: 0,
+            first_kept: point.settle_cycles.saturating_sub(2 * u64::from(r)),
+        };
+        (samples, end)
+    }
+
     /// Most trace samples kept; beyond, every other one is dropped.
     const TRACE_MAX: usize = 4000;
 
@@ -815,17 +831,69 @@ pub fn run_point<E: Engine>(
     progress: &(dyn Fn(Tick) + Sync),
 ) -> Result<PointResult, RunError> {
     let mut sim = point_loop::<E>(exp, plan, point)?;
-    let r = plan.filter.decimation;
-    let end = point.cycles_for(units, r);
-    let mut samples = Samples {
-        t: vec![],
-        z: [vec![], vec![]],
-        trace: vec![],
-        trace_every: (end / u64::from(r) / 2000).max(1),
-        count: 0,
-        first_kept: point.settle_cycles.saturating_sub(2 * u64::from(r)),
-    };
+    let (mut samples, end) = Samples::for_point(plan, point, units);
     advance(&mut sim, &mut samples, end, progress);
+    Ok(point_result(exp, plan, point, units, samples))
+}
+
+/// Points that differ only in their rate, simulated in lanes
+/// (`CoSimLanes`): each the result `run_point` on the model engine gives
+/// it alone, bit for bit, where the drive half, the DAC forces and the
+/// ADC noise are worked out once for all. The caller groups them
+/// ([`lane_key`]); `progress` receives ticks.
+pub fn run_points_in_lanes(
+    exp: &Experiment,
+    plan: &Plan,
+    points: &[&PointPlan],
+    units: u32,
+    progress: &(dyn Fn(Tick) + Sync),
+) -> Result<Vec<PointResult>, RunError> {
+    let Some(&first) = points.first() else {
+        return Ok(vec![]);
+    };
+    debug_assert!(points.iter().all(|p| lane_key(p) == lane_key(first)));
+    let gyros = points
+        .iter()
+        .map(|p| {
+            let gyro = GyroModel::new(&exp.gyro, exp.drive.clock_hz)?;
+            let mut gyro = gyro.with_thermal_noise(&exp.noise)?;
+            gyro.set_rate(p.omz_rad_s);
+            Ok(gyro)
+        })
+        .collect::<Result<Vec<_>, RunError>>()?;
+    let converters = Converters::new(&plan.front_end)?;
+    let profile = exp.drive.carrier_profile;
+    let mut sim = CoSimLanes::new(profile, converters, gyros, first.regs)?;
+    let (samples, end) = Samples::for_point(plan, first, units);
+    let mut samples = vec![samples; points.len()];
+    const CHUNK: u64 = 1 << 20;
+    while sim.cycle() < end {
+        let clocks = (end - sim.cycle()).min(CHUNK);
+        sim.run(clocks, |l, n, z| samples[l].push(n, z));
+        progress(Tick::Clocks(clocks * points.len() as u64));
+    }
+    let results = points.iter().zip(samples);
+    Ok(results
+        .map(|(p, s)| point_result(exp, plan, p, units, s))
+        .collect())
+}
+
+/// What points must share to run in lanes (`run_points_in_lanes`): the
+/// registers, the settling and the mode (a readout sweep's points share
+/// them; their rates differ).
+pub fn lane_key(point: &PointPlan) -> (Mode, Registers, u64) {
+    (point.mode, point.regs, point.settle_cycles)
+}
+
+/// A point's result from its z samples (`run_point`).
+fn point_result(
+    exp: &Experiment,
+    plan: &Plan,
+    point: &PointPlan,
+    units: u32,
+    mut samples: Samples,
+) -> PointResult {
+    let end = point.cycles_for(units, plan.filter.decimation);
     let batch = point.batch_cycles(units);
     if point.mode == Mode::Calibration {
         let t0 = point.settle_cycles as f64;
@@ -843,7 +911,7 @@ pub fn run_point<E: Engine>(
     let per_lsb = plan.z_per_lsb(point.mode);
     let clock = exp.drive.clock_hz;
     let window_s = point.window_cycles(units) / clock;
-    Ok(PointResult {
+    PointResult {
         mode: point.mode,
         rate_dps: point.rate_dps,
         cal_hz: point.cal_hz,
@@ -871,7 +939,7 @@ pub fn run_point<E: Engine>(
             .into_iter()
             .map(|[n, a, b]| [n / clock, a * per_lsb[0], b * per_lsb[1]])
             .collect(),
-    })
+    }
 }
 
 /// Lines of each output against the rate over one sweep, from the points'
@@ -1015,7 +1083,10 @@ pub fn run_points(
             EngineKind::Rtl => run_point::<RtlEngine>(exp, plan, p, u, progress),
             EngineKind::Verilator => run_verilator(exp, plan, p, u, progress),
         };
-        let points: Vec<PointResult> = jobs.par_iter().map(run).collect::<Result<_, _>>()?;
+        let points: Vec<PointResult> = match engine {
+            EngineKind::Model => run_model_points(exp, plan, &jobs, progress)?,
+            _ => jobs.par_iter().map(run).collect::<Result<_, _>>()?,
+        };
         let round_cycles: u64 = points.iter().map(|p| p.cycles).sum();
         cycles += round_cycles;
         rounds += 1;
@@ -1070,6 +1141,48 @@ pub fn run_points(
         length = [length[0] * grow[0], length[1] * grow[1]];
         progress(Tick::Planned(next_cycles(&units)));
     }
+}
+
+/// The points of one round on the model engine: those that may share
+/// lanes ([`lane_key`], and the same units) in as many lane groups as
+/// there are threads, each group in lanes (`run_points_in_lanes`); the
+/// same results in the same order as one `run_point` each.
+fn run_model_points(
+    exp: &Experiment,
+    plan: &Plan,
+    jobs: &[(&PointPlan, u32)],
+    progress: &(dyn Fn(Tick) + Sync),
+) -> Result<Vec<PointResult>, RunError> {
+    let mut groups: Vec<Vec<usize>> = vec![];
+    let key = |i: usize| (lane_key(jobs[i].0), jobs[i].1);
+    for i in 0..jobs.len() {
+        match groups.iter_mut().find(|g| key(g[0]) == key(i)) {
+            Some(g) => g.push(i),
+            None => groups.push(vec![i]),
+        }
+    }
+    let threads = rayon::current_num_threads().max(1);
+    let lanes: Vec<&[usize]> = groups
+        .iter()
+        .flat_map(|g| g.chunks(g.len().div_ceil(threads)))
+        .collect();
+    let results: Vec<Vec<PointResult>> = lanes
+        .par_iter()
+        .map(|lane| {
+            let points: Vec<&PointPlan> = lane.iter().map(|&i| jobs[i].0).collect();
+            run_points_in_lanes(exp, plan, &points, jobs[lane[0]].1, progress)
+        })
+        .collect::<Result<_, _>>()?;
+    let mut ordered: Vec<Option<PointResult>> = vec![None; jobs.len()];
+    for (lane, results) in lanes.iter().zip(results) {
+        for (&i, r) in lane.iter().zip(results) {
+            ordered[i] = Some(r);
+        }
+    }
+    Ok(ordered
+        .into_iter()
+        .map(|r| r.expect("every point ran"))
+        .collect())
 }
 
 #[cfg(feature = "verilator")]
@@ -1146,6 +1259,46 @@ mod tests {
     use rand_distr::{Distribution, StandardNormal};
     use rand_xoshiro::Xoshiro256PlusPlus;
     use rand_xoshiro::rand_core::SeedableRng;
+
+    /// Points in lanes are the points run alone: three of the paper's
+    /// readout points (ADC noise on) and, as a lane group of one, a
+    /// calibration point, each `PointResult` the same field for field as
+    /// `run_point`'s on the model engine; `run_model_points` gives every
+    /// round's points back in the plan's order.
+    #[test]
+    fn points_in_lanes_are_the_points_alone() {
+        let exp = Experiment::paper();
+        let plan = plan(&exp).unwrap();
+        let quiet = |_: Tick| {};
+        let readout: Vec<&PointPlan> = plan
+            .points
+            .iter()
+            .filter(|p| p.mode == Mode::Readout)
+            .step_by(7)
+            .collect();
+        assert_eq!(readout.len(), 3);
+        assert!(readout.iter().all(|p| lane_key(p) == lane_key(readout[0])));
+        let lanes = run_points_in_lanes(&exp, &plan, &readout, 1, &quiet).unwrap();
+        for (p, lane) in readout.iter().zip(&lanes) {
+            let alone = run_point::<ModelEngine>(&exp, &plan, p, 1, &quiet).unwrap();
+            assert_eq!(*lane, alone, "the point at {} deg/s", p.rate_dps);
+        }
+        assert_ne!(lanes[0].z, lanes[1].z);
+        let cal = plan
+            .points
+            .iter()
+            .find(|p| p.mode == Mode::Calibration)
+            .unwrap();
+        let jobs: Vec<(&PointPlan, u32)> = vec![(readout[2], 1), (cal, 2), (readout[0], 1)];
+        let round = run_model_points(&exp, &plan, &jobs, &quiet).unwrap();
+        let cal_alone = run_point::<ModelEngine>(&exp, &plan, cal, 2, &quiet).unwrap();
+        assert!(
+            cal_alone.z.iter().all(|z| z.is_finite()),
+            "{:?}",
+            cal_alone.z
+        );
+        assert_eq!(round, vec![lanes[2].clone(), cal_alone, lanes[0].clone()]);
+    }
 
     /// Samples of DC + a ripple 10 times larger at 2 f + a sharp shape that
     /// repeats every ripple period + white noise, from `t0` (clocks).

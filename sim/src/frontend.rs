@@ -162,6 +162,45 @@ impl Converters {
         }
     }
 
+    /// Whether `other` holds what these converters share with it in lanes
+    /// (`crate::analog::Lanes`): the same settings, DAC words in flight
+    /// and noise generator state, so that its DAC forces and noise draws
+    /// would be these ones's. The ADC words in flight are each lane's own.
+    pub fn shares_with(&self, other: &Converters) -> bool {
+        self.config == other.config && self.dac_ring == other.dac_ring && self.noise == other.noise
+    }
+
+    /// Takes on `lead`'s shared state ([`Converters::shares_with`]): after
+    /// `lead` played the lanes' DAC words and drew their noise, this lane
+    /// is where its own run would have left it.
+    pub fn follow(&mut self, lead: &Converters) {
+        self.dac_ring = lead.dac_ring;
+        self.noise.clone_from(&lead.noise);
+    }
+
+    /// `draw_noise` for a block of `clocks`, zeros without noise: the
+    /// draws `adc_block` takes.
+    #[inline(always)]
+    pub fn noise_block(&mut self, clocks: usize, out: &mut Vec<f64>) {
+        if !self.draw_noise(clocks, out) {
+            out.clear();
+            out.resize(2 * clocks, 0.0);
+        }
+    }
+
+    /// `dac_block` over all of `dac`'s words (at most `BLOCK`), `forces`
+    /// resized to them.
+    #[inline(always)]
+    pub fn forces_block(
+        &mut self,
+        dac: impl Iterator<Item = (i16, i16)>,
+        forces: &mut Vec<(f64, f64)>,
+    ) {
+        forces.resize(gyrocal_hdl::model::gyro_interface::BLOCK, (0.0, 0.0));
+        let clocks = self.dac_block(dac, forces);
+        forces.truncate(clocks);
+    }
+
     /// One ADC conversion of the displacement `x` (m) on `channel` (0, 1)
     /// with the standard normal draw `g`. Without noise `g` is 0 and so is
     /// `noise_lsb` (the generator exists exactly when it is positive), and
@@ -273,7 +312,7 @@ impl Converters {
 /// A converter's latency: the words of the last `MAX_LATENCY + 1` clocks.
 /// Small and `Copy`, so a block can keep it in locals (`adc_block`,
 /// `dac_block`) while a clock's step updates it in place.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 struct LatencyRing {
     words: [(i16, i16); MAX_LATENCY as usize + 1],
     head: usize,
@@ -371,7 +410,7 @@ impl PickoffPhase {
 /// samples per clock must cost little beside the datapath model (about
 /// 27 ns per clock): the ziggurat takes a few ns where Box-Muller's
 /// logarithm and sine took about 15.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 struct Gaussian {
     rng: Xoshiro256PlusPlus,
 }

@@ -62,16 +62,20 @@ pub fn run(args: &Args) -> Result<(), Failure> {
     }
     println!("model engine compiled for {}", report.model_isa);
     println!(
-        "{:<10} {:<14} {:>16} {:>24}",
+        "{:<10} {:<16} {:>16} {:>24}",
         "engine", "gyro in loop", "median clocks/s", "min .. max"
     );
     for m in &report.measurements {
         let lo = m.samples.iter().cloned().fold(f64::MAX, f64::min);
         let hi = m.samples.iter().cloned().fold(0.0, f64::max);
         println!(
-            "{:<10} {:<14} {:>16.4e} {:>11.3e} .. {:.3e}",
+            "{:<10} {:<16} {:>16.4e} {:>11.3e} .. {:.3e}",
             m.engine,
-            if m.with_gyro { "yes" } else { "no" },
+            match (m.with_gyro, m.lanes) {
+                (false, _) => "no".into(),
+                (true, 1) => "yes".into(),
+                (true, n) => format!("yes, {n} lanes"),
+            },
             m.median_clocks_per_s,
             lo,
             hi

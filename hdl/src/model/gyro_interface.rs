@@ -6,7 +6,8 @@ use super::carrier_nco::{CarrierNco, Carriers};
 use super::cic_decimator::CicDecimator;
 use super::demod_mux::DemodMux;
 use super::iir_lowpass::IirLowpass;
-use super::isa::{Isa, x86_64_v3_features, x86_64_v4_features};
+use super::isa::Isa;
+use super::lanes::One;
 use super::modulation_nco::ModulationNco;
 use super::reference_alignment::ReferenceAlignment;
 pub use gyrocal_regs::Registers;
@@ -41,37 +42,13 @@ pub struct Probes {
 /// Cycle-true model of the whole datapath.
 #[derive(Clone, Debug, Default)]
 pub struct GyroInterface {
-    carrier_nco: CarrierNco,
-    modulation_nco: ModulationNco,
-    am_mixer: AmMixer,
-    reference_alignment: ReferenceAlignment,
-    demod_mux: DemodMux,
-    cic: CicDecimator,
-    iir: IirLowpass,
-}
-
-/// `GyroInterface::run_blocks` as a method compiled for the target
-/// features `[$feature, ...]` (given by [`super::isa`]'s lists, which
-/// its processor check reads too), named `$name`.
-macro_rules! run_compiled_for {
-    ($(#[$doc:meta])* $name:ident, [$($feature:tt),*]) => {
-        $(#[$doc])*
-        #[cfg(target_arch = "x86_64")]
-        $(#[target_feature(enable = $feature)])*
-        unsafe fn $name<A, Z>(
-            &mut self,
-            regs: &Registers,
-            clocks: u64,
-            analog: &mut A,
-            on_z: Z,
-        ) -> Outputs
-        where
-            A: AnalogSide,
-            Z: FnMut(u64, (i64, i64)),
-        {
-            self.run_blocks(regs, clocks, analog, on_z)
-        }
-    };
+    pub(super) carrier_nco: CarrierNco,
+    pub(super) modulation_nco: ModulationNco,
+    pub(super) am_mixer: AmMixer,
+    pub(super) reference_alignment: ReferenceAlignment,
+    pub(super) demod_mux: DemodMux,
+    pub(super) cic: CicDecimator,
+    pub(super) iir: IirLowpass,
 }
 
 impl GyroInterface {
@@ -145,6 +122,8 @@ impl GyroInterface {
     /// `on_z(i, z)` is called when clock `i` (from 0) publishes z, in the
     /// order of the clocks. Returns the outputs after the last edge.
     ///
+    /// The block loop is [`super::lanes`]'s, this datapath its only lane
+    /// (lanes run datapaths that differ only in their ADC words together).
     /// Compiled for the instruction set `Isa::selected` names (the widest
     /// this processor runs, [`super::isa`]): the same results on every one.
     #[inline(always)]
@@ -165,86 +144,15 @@ impl GyroInterface {
         regs: &Registers,
         clocks: u64,
         analog: &mut A,
-        on_z: Z,
-    ) -> Outputs
-    where
-        A: AnalogSide,
-        Z: FnMut(u64, (i64, i64)),
-    {
-        #[cfg(target_arch = "x86_64")]
-        if isa.supported() {
-            // SAFETY: the processor has every feature each function is
-            // compiled for (checked just above).
-            match isa {
-                Isa::X86_64V4 => return unsafe { self.run_x86_64_v4(regs, clocks, analog, on_z) },
-                Isa::X86_64V3 => return unsafe { self.run_x86_64_v3(regs, clocks, analog, on_z) },
-                Isa::Portable => {}
-            }
-        }
-        let _ = isa;
-        self.run_blocks(regs, clocks, analog, on_z)
-    }
-
-    x86_64_v4_features!(run_compiled_for!(
-        /// `run_blocks` compiled for x86-64-v4.
-        ///
-        /// # Safety
-        /// The processor must have its features (`Isa::X86_64V4.supported()`).
-        run_x86_64_v4,
-    ));
-
-    x86_64_v3_features!(run_compiled_for!(
-        /// `run_blocks` compiled for x86-64-v3.
-        ///
-        /// # Safety
-        /// The processor must have its features (`Isa::X86_64V3.supported()`).
-        run_x86_64_v3,
-    ));
-
-    /// `run`'s blocks, as its documentation says.
-    #[inline(always)]
-    fn run_blocks<A, Z>(
-        &mut self,
-        regs: &Registers,
-        clocks: u64,
-        analog: &mut A,
         mut on_z: Z,
     ) -> Outputs
     where
         A: AnalogSide,
         Z: FnMut(u64, (i64, i64)),
     {
-        let regs = &regs.at_ports();
-        let block = |done: u64| (clocks - done).min(BLOCK as u64) as usize;
-        let mut drives = [Drives::default(); BLOCK];
-        let mut stages = DriveStages::default();
-        let mut readout = ReadoutStages::default();
-        let mut n = block(0);
-        self.drive_block(&mut drives[..n], &mut stages, regs, false);
-        let mut done = 0u64;
-        while n > 0 {
-            // The next block's carrier lookups, beside the analog side's
-            // clocks of this one (the next block is never longer).
-            let ahead = block(done + n as u64);
-            let dac = drives[..n].iter().map(|d| (d.dac1, d.dac2));
-            let looked_up = self.carrier_nco.blocks();
-            if looked_up {
-                let entering = self.carrier_nco.entering(regs.carrier_step, regs.ref_phase);
-                let entered = &mut stages.entered;
-                analog.advance_block(dac, |t| {
-                    if t < ahead {
-                        entered[t] = entering(t);
-                    }
-                });
-            } else {
-                analog.advance_block(dac, |_| {});
-            }
-            analog.convert(&mut readout.adc[..n]);
-            self.readout_block(&drives[..n], &mut readout, regs, |i, z| on_z(done + i, z));
-            done += n as u64;
-            n = block(done);
-            self.drive_block(&mut drives[..n], &mut stages, regs, looked_up);
-        }
+        let lanes = std::slice::from_mut(self);
+        let on_z = |_: usize, i: u64, z: (i64, i64)| on_z(i, z);
+        super::lanes::run_on(isa, lanes, regs, clocks, &mut One(analog), on_z);
         self.outputs()
     }
 
@@ -255,7 +163,7 @@ impl GyroInterface {
     /// skips its idle clocks to the next sample (an idle step changes
     /// nothing but clearing z_valid, so one stands for them all).
     #[inline(always)]
-    fn readout_block(
+    pub(super) fn readout_block(
         &mut self,
         drives: &[Drives],
         stages: &mut ReadoutStages,
@@ -307,7 +215,7 @@ impl GyroInterface {
     /// clock by clock. `entered`: `stages.entered` holds the block's
     /// carrier words, looked up ahead.
     #[inline(always)]
-    fn drive_block(
+    pub(super) fn drive_block(
         &mut self,
         drives: &mut [Drives],
         stages: &mut DriveStages,
@@ -414,10 +322,10 @@ pub trait AnalogSide {
 
 /// The drive half's stages' outputs over a block, on the way to the
 /// drive words (`GyroInterface::drive_block`).
-struct DriveStages {
+pub(super) struct DriveStages {
     /// The carrier words entering the pipeline at the next block's edges,
     /// when looked up ahead.
-    entered: [Carriers; BLOCK],
+    pub(super) entered: [Carriers; BLOCK],
     carriers: [Carriers; BLOCK],
     am: [(i16, i16); BLOCK],
 }
@@ -434,8 +342,8 @@ impl Default for DriveStages {
 
 /// The readout half's stages over a block, on the way from the ADC words
 /// to the IIR (`GyroInterface::readout_block`).
-struct ReadoutStages {
-    adc: [Words; BLOCK],
+pub(super) struct ReadoutStages {
+    pub(super) adc: [Words; BLOCK],
     aligned: [Words; BLOCK],
     w: [(i32, i32); BLOCK],
     /// The CIC's samples over the block: cycle, words.
@@ -458,7 +366,7 @@ impl Default for ReadoutStages {
 pub const BLOCK: usize = 256;
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::gyro_interface::DRIVE_START_CLOCKS;
     use crate::test_util::Rng;
@@ -521,7 +429,7 @@ mod tests {
     /// any width), a filter designed for a decimation from the shortest
     /// to the longest, now and then with a decimation too short for the
     /// IIR (which then drops CIC samples), any reference delay.
-    fn run_registers(rng: &mut Rng) -> Registers {
+    pub(in crate::model) fn run_registers(rng: &mut Rng) -> Registers {
         let designed = [166u32, 200, 397, 1000, 4096][rng.range(0, 4) as usize];
         let fz = 1e6 / f64::from(designed);
         let design = gyrocal_regs::filter_design::design(1e6, designed, fz / 40.0, fz / 20.0)

@@ -15,6 +15,7 @@ pub mod demod_mux;
 pub mod gyro_interface;
 pub mod iir_lowpass;
 pub mod isa;
+pub mod lanes;
 pub mod modulation_nco;
 pub mod notch_coefficient;
 pub mod q15_multiplier;

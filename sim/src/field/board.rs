@@ -54,24 +54,9 @@ impl<E: Engine> SimBoard<E> {
         phase_reference_hz: f64,
         profile: CarrierProfile,
     ) -> Result<Self, RunError> {
-        let mut fe = front_end.clone();
-        for k in 0..2 {
-            fe.force_per_lsb[k] *= at.drive_gain[k];
-            fe.adc_per_meter[k] *= at.adc_gain[k];
-        }
-        let p = at.front_end_phase_deg;
-        let phase = if p == 0.0 {
-            None
-        } else {
-            Some(PickoffPhase::new(p, phase_reference_hz)?)
-        };
         Ok(Self {
             engine: E::power_up(profile)?,
-            analog: Analog::new(
-                Converters::new(&fe)?,
-                GyroModel::new(&at.gyro, clock_hz)?.with_thermal_noise(noise)?,
-                phase,
-            ),
+            analog: analog_at(at, front_end, noise, clock_hz, phase_reference_hz)?,
             host: HostRegisters::power_up(profile),
             outputs: Outputs::default(),
             samples: 0,
@@ -131,6 +116,34 @@ impl<E: Engine> SimBoard<E> {
     }
 }
 
+/// A board's analog side at `at` (`SimBoard::new`): `front_end` as built,
+/// scaled by `at`'s drive and ADC multipliers, the pick-off's phase lag
+/// exact at `phase_reference_hz`, the gyroscope with the Brownian `noise`.
+pub fn analog_at(
+    at: &DeviceAt,
+    front_end: &FrontEnd,
+    noise: &ThermalNoise,
+    clock_hz: f64,
+    phase_reference_hz: f64,
+) -> Result<Analog, RunError> {
+    let mut fe = front_end.clone();
+    for k in 0..2 {
+        fe.force_per_lsb[k] *= at.drive_gain[k];
+        fe.adc_per_meter[k] *= at.adc_gain[k];
+    }
+    let p = at.front_end_phase_deg;
+    let phase = if p == 0.0 {
+        None
+    } else {
+        Some(PickoffPhase::new(p, phase_reference_hz)?)
+    };
+    Ok(Analog::new(
+        Converters::new(&fe)?,
+        GyroModel::new(&at.gyro, clock_hz)?.with_thermal_noise(noise)?,
+        phase,
+    ))
+}
+
 impl<E: Engine> Board for SimBoard<E> {
     fn wait_clocks(&mut self, clocks: u64) -> Result<(), BusError> {
         self.run(clocks);
@@ -174,7 +187,7 @@ impl<E: Engine> RegisterAccess for SimBoard<E> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::config::Experiment;
     use crate::field::scenario;
@@ -183,12 +196,18 @@ mod tests {
     /// The paper's board in readout at 50 deg/s, ADC noise on, with a
     /// front-end phase lag (the path `run` takes through `PickoffPhase`)
     /// and ADC 1's gain 4 times too high, so that it clips.
-    fn readout_board() -> SimBoard {
-        readout_board_of(Experiment::paper())
-    }
-
-    fn readout_board_of(exp: Experiment) -> SimBoard {
-        let (fe, knowns) = scenario::build(&exp).unwrap();
+    /// `exp`'s board as built, its readout registers at the configured
+    /// carrier, and the device at 25 deg C behind a 3 deg pick-off lag
+    /// with ADC gains `adc_gain` times the board's.
+    pub(in crate::field) fn readout_setting(
+        exp: &Experiment,
+        adc_gain: [f64; 2],
+    ) -> (
+        FrontEnd,
+        gyrocal_hdl::model::gyro_interface::Registers,
+        DeviceAt,
+    ) {
+        let (fe, knowns) = scenario::build(exp).unwrap();
         let (regs, _) = knowns
             .registers(exp.drive.carrier_hz, None, knowns.amplitude, 0.0)
             .unwrap();
@@ -196,10 +215,19 @@ mod tests {
             temperature_c: 25.0,
             delta_k: 0.0,
             gyro: exp.gyro.clone(),
-            adc_gain: [4.0, 1.0],
+            adc_gain,
             drive_gain: [1.0; 2],
             front_end_phase_deg: 3.0,
         };
+        (fe, regs, at)
+    }
+
+    fn readout_board() -> SimBoard {
+        readout_board_of(Experiment::paper())
+    }
+
+    fn readout_board_of(exp: Experiment) -> SimBoard {
+        let (fe, regs, at) = readout_setting(&exp, [4.0, 1.0]);
         let mut board = scenario::board_at(&exp, &fe, &at).unwrap();
         board.program(&regs).unwrap();
         board.set_rate(50f64.to_radians());

@@ -18,6 +18,7 @@
 //! ratio, rate output) is `gyrocal_host`; it never imports this crate.
 
 pub mod board;
+pub mod lanes;
 pub mod probe;
 pub mod profile;
 pub mod scenario;

@@ -27,6 +27,7 @@
 //!   the factory's null and scale factor.
 
 use super::board::{Board, SimBoard};
+use super::lanes::LaneBoards;
 use super::probe::DriveProbe;
 use super::profile::{self, ClippedRecords, Profile, ProfileRun, RateTrace};
 use crate::config::{self, Experiment};
@@ -734,7 +735,7 @@ enum TableAt {
 /// windows'). A window during which an ADC clipped is an error, never a
 /// slope.
 fn table_windows(
-    board: &mut SimBoard,
+    board: &mut dyn Board,
     knowns: &Knowns,
     windows: usize,
     whose: TableAt,
@@ -764,21 +765,67 @@ fn table_windows(
     Ok(parts)
 }
 
-/// One point of the rate table: readout at `op` on a fresh board (from
-/// power-up, as `experiment` runs its points), settled, then
-/// `TABLE_WINDOWS` windows ([`table_windows`]); returns the board, to run
-/// on, and the parts.
-fn table_point(
+/// The points of a rate table: readout at `op` on a fresh board per rate
+/// (from power-up, as `experiment` runs its points; the boards in lanes,
+/// `super::lanes`), settled, then `TABLE_WINDOWS` windows
+/// ([`table_windows`]); returns the boards, to run on, and each rate's
+/// parts or why it has none.
+fn table_points(
     exp: &Experiment,
     fe: &FrontEnd,
     at: &DeviceAt,
     knowns: &Knowns,
     (op, whose): (&Operating, TableAt),
-    rate_dps: f64,
-) -> Result<(SimBoard, Vec<[f64; 2]>), FieldError> {
-    let mut board = settled_readout_board(exp, fe, at, knowns, op, rate_dps)?;
-    let parts = table_windows(&mut board, knowns, TABLE_WINDOWS, whose, rate_dps)?;
-    Ok((board, parts))
+    rates_dps: &[f64],
+) -> Result<(LaneBoards, Vec<TablePart>), FieldError> {
+    let mut boards = settled_lanes(exp, fe, at, knowns, op, rates_dps)?;
+    let parts = table_windows_in_lanes(&mut boards, knowns, TABLE_WINDOWS, whose, rates_dps);
+    Ok((boards, parts))
+}
+
+/// Boards in lanes at `rates_dps`, powered up, programmed in readout at
+/// `op` and settled, as `settled_readout_board` makes each alone.
+fn settled_lanes(
+    exp: &Experiment,
+    fe: &FrontEnd,
+    at: &DeviceAt,
+    knowns: &Knowns,
+    op: &Operating,
+    rates_dps: &[f64],
+) -> Result<LaneBoards, FieldError> {
+    let reference = 0.5 * (exp.gyro.f1_hz + exp.gyro.f2_hz);
+    let timing = (exp.drive.board_clock_hz(), reference);
+    let profile = exp.drive.carrier_profile;
+    let lanes = rates_dps.len();
+    let mut boards = LaneBoards::new(at, fe, &exp.noise, timing, profile, lanes)?;
+    boards.wait_clocks(gyrocal_regs::datapath::DRIVE_START_CLOCKS)?;
+    program_readout(&mut boards, knowns, op)?;
+    let rates: Vec<f64> = rates_dps.iter().map(|r| r.to_radians()).collect();
+    boards.set_rates(&rates);
+    boards.wait_clocks(settle_clocks_at(knowns, at))?;
+    Ok(boards)
+}
+
+/// One rate's parts of a table, or why it has none.
+type TablePart = Result<Vec<[f64; 2]>, FieldError>;
+
+/// [`table_windows`] on every lane of `boards` at `rates_dps`: run on the
+/// boards (lane 0's face), then replayed on each other lane's reads.
+fn table_windows_in_lanes(
+    boards: &mut LaneBoards,
+    knowns: &Knowns,
+    windows: usize,
+    whose: TableAt,
+    rates_dps: &[f64],
+) -> Vec<TablePart> {
+    boards.forget_reads();
+    let first = table_windows(boards, knowns, windows, whose, rates_dps[0]);
+    let mut parts = vec![first];
+    for (l, &rate) in rates_dps.iter().enumerate().skip(1) {
+        let replay = &mut boards.replay(l);
+        parts.push(table_windows(replay, knowns, windows, whose, rate));
+    }
+    parts
 }
 
 /// Least-squares slopes of the table's z against its rates (z LSB per deg/s).
@@ -834,8 +881,9 @@ impl RateTable {
     }
 }
 
-/// The rate table: readout at `op` on a fresh board per rate, the rates in
-/// parallel; returns the slopes with their uncertainty, and the clocks.
+/// The rate table: readout at `op` on a fresh board per rate, the boards
+/// in lanes (`table_points`); returns the slopes with their uncertainty,
+/// and the clocks (every board's).
 /// `compared_with` is the relative sigma of the figures the table will
 /// judge (the self-calibration's, per output), if any: where the table's
 /// own sigma after `TABLE_WINDOWS` exceeds `TABLE_EXTEND_SHARE` of it,
@@ -858,28 +906,18 @@ pub fn rate_table(
     compared_with: Option<[f64; 2]>,
 ) -> Result<(RateTable, u64), FieldError> {
     let rates = &knowns.rates_dps;
-    let mut points: Vec<(SimBoard, Vec<[f64; 2]>)> = rates
-        .par_iter()
-        .map(|&rate| table_point(exp, fe, at, knowns, (op, TableAt::Cycle), rate))
-        .collect::<Result<_, FieldError>>()?;
-    let parts = |points: &[(SimBoard, Vec<[f64; 2]>)]| -> Vec<Vec<[f64; 2]>> {
-        points.iter().map(|p| p.1.clone()).collect()
-    };
-    let mut table = RateTable::from_parts(rates, &parts(&points));
+    let (mut boards, parts) = table_points(exp, fe, at, knowns, (op, TableAt::Cycle), rates)?;
+    let mut parts: Vec<Vec<[f64; 2]>> = parts.into_iter().collect::<Result<_, _>>()?;
+    let mut table = RateTable::from_parts(rates, &parts);
     if needs_more_windows(&table, compared_with) {
-        points
-            .par_iter_mut()
-            .zip(rates)
-            .try_for_each(|((board, parts), &rate)| {
-                let more = TABLE_EXTENDED_WINDOWS - TABLE_WINDOWS;
-                let run = table_windows(board, knowns, more, TableAt::Cycle, rate)?;
-                parts.extend(run);
-                Ok::<(), FieldError>(())
-            })?;
-        table = RateTable::from_parts(rates, &parts(&points));
+        let more = TABLE_EXTENDED_WINDOWS - TABLE_WINDOWS;
+        let run = table_windows_in_lanes(&mut boards, knowns, more, TableAt::Cycle, rates);
+        for (parts, run) in parts.iter_mut().zip(run) {
+            parts.extend(run?);
+        }
+        table = RateTable::from_parts(rates, &parts);
     }
-    let clocks = points.iter().map(|p| p.0.cycle()).sum();
-    Ok((table, clocks))
+    Ok((table, boards.cycle() * rates.len() as u64))
 }
 
 /// Whether the table's sigma exceeds `TABLE_EXTEND_SHARE` of the compared
@@ -910,7 +948,7 @@ struct Cycle {
 
 /// Self-calibrate a fresh board at `t`; with a profile, then switch to
 /// readout, measure the null at rest and run the profile on that board.
-/// The rate table at the cycle's settings follows (its rates in parallel).
+/// The rate table at the cycle's settings follows (its rates in lanes, `super::lanes`).
 fn cycle_at(sc: &Scenario, fe: &FrontEnd, knowns: &Knowns, t: f64) -> Result<Cycle, CycleFailure> {
     let at = sc.drift.at(&sc.exp.gyro, t);
     let mut board = board_at(&sc.exp, fe, &at).map_err(|e| CycleFailure::before(e, 0))?;
@@ -1002,6 +1040,15 @@ impl Job {
             Job::Factory { step, .. } | Job::BaselineProfile { step } => step,
         }
     }
+
+    /// A table point's rate (its index in the table's rates); 0 for a
+    /// profile.
+    fn rate(&self) -> usize {
+        match *self {
+            Job::Factory { rate, .. } => rate,
+            Job::BaselineProfile { .. } => 0,
+        }
+    }
 }
 
 enum Done {
@@ -1075,8 +1122,12 @@ fn run_cycles(
         .collect()
 }
 
+/// A job's result and the clocks it ran, or its error.
+type JobResult = Result<(Done, u64), FieldError>;
+
 /// The rate-table points and baseline profiles at the factory's settings,
-/// in parallel; each job's result (and its clocks) or its error.
+/// in parallel (a step's points together, in lanes: [`table_points`]);
+/// each job's result (and its clocks) or its error.
 fn run_jobs(
     sc: &Scenario,
     fe: &FrontEnd,
@@ -1084,28 +1135,78 @@ fn run_jobs(
     factory: &Operating,
     cycles: &[Result<Cycle, CycleFailure>],
     jobs: &[Job],
-) -> Vec<Result<(Done, u64), FieldError>> {
-    let exp = &sc.exp;
-    let rates = &knowns.rates_dps;
-    jobs.par_iter()
-        .map(|job| -> Result<(Done, u64), FieldError> {
-            let at = &cycles[job.step()].as_ref().map_err(|f| f.error.clone())?.at;
-            match *job {
-                Job::Factory { rate, .. } => {
-                    let whose = (factory, TableAt::Factory);
-                    let (board, parts) = table_point(exp, fe, at, knowns, whose, rates[rate])?;
-                    Ok((Done::Point(mean_of_parts(&parts)), board.cycle()))
-                }
-                Job::BaselineProfile { .. } => {
-                    let p = sc.profile.as_ref().ok_or(FieldError::NoProfile)?;
-                    let mut board = settled_readout_board(exp, fe, at, knowns, factory, 0.0)?;
-                    let r = knowns.filter.decimation;
-                    let run = profile::run_profile(&mut board, p, r, knowns.clock_hz)?;
-                    Ok((Done::Profile(run), board.cycle()))
-                }
-            }
+) -> Vec<JobResult> {
+    // A step's table points as one unit, each profile as its own.
+    let mut units: Vec<Vec<usize>> = vec![];
+    for (i, job) in jobs.iter().enumerate() {
+        let same_table = |u: &&mut Vec<usize>| {
+            matches!(job, Job::Factory { .. })
+                && matches!(jobs[u[0]], Job::Factory { step, .. } if step == job.step())
+        };
+        match units.iter_mut().find(same_table) {
+            Some(unit) => unit.push(i),
+            None => units.push(vec![i]),
+        }
+    }
+    let done: Vec<Vec<(usize, JobResult)>> = units
+        .par_iter()
+        .map(|unit| match &cycles[jobs[unit[0]].step()] {
+            Ok(c) => run_unit(sc, fe, knowns, factory, &c.at, jobs, unit),
+            Err(f) => unit.iter().map(|&i| (i, Err(f.error.clone()))).collect(),
         })
+        .collect();
+    let mut ordered: Vec<Option<JobResult>> = jobs.iter().map(|_| None).collect();
+    for (i, d) in done.into_iter().flatten() {
+        ordered[i] = Some(d);
+    }
+    ordered
+        .into_iter()
+        .map(|d| d.expect("every job ran"))
         .collect()
+}
+
+/// One unit of `run_jobs` on the device `at` of its step: a table's
+/// points (the jobs `unit` names), or a profile; each job's result.
+fn run_unit(
+    sc: &Scenario,
+    fe: &FrontEnd,
+    knowns: &Knowns,
+    factory: &Operating,
+    at: &DeviceAt,
+    jobs: &[Job],
+    unit: &[usize],
+) -> Vec<(usize, JobResult)> {
+    if let Job::BaselineProfile { .. } = jobs[unit[0]] {
+        return vec![(unit[0], baseline_profile(sc, fe, knowns, factory, at))];
+    }
+    let rates: Vec<f64> = unit
+        .iter()
+        .map(|&i| knowns.rates_dps[jobs[i].rate()])
+        .collect();
+    let whose = (factory, TableAt::Factory);
+    match table_points(&sc.exp, fe, at, knowns, whose, &rates) {
+        Ok((boards, parts)) => {
+            let point = |p: Vec<[f64; 2]>| (Done::Point(mean_of_parts(&p)), boards.cycle());
+            let results = parts.into_iter().map(|p| p.map(point));
+            unit.iter().copied().zip(results).collect()
+        }
+        Err(e) => unit.iter().map(|&i| (i, Err(e.clone()))).collect(),
+    }
+}
+
+/// The profile of a step at the factory's settings, on its own board.
+fn baseline_profile(
+    sc: &Scenario,
+    fe: &FrontEnd,
+    knowns: &Knowns,
+    factory: &Operating,
+    at: &DeviceAt,
+) -> JobResult {
+    let p = sc.profile.as_ref().ok_or(FieldError::NoProfile)?;
+    let mut board = settled_readout_board(&sc.exp, fe, at, knowns, factory, 0.0)?;
+    let r = knowns.filter.decimation;
+    let run = profile::run_profile(&mut board, p, r, knowns.clock_hz)?;
+    Ok((Done::Profile(run), board.cycle()))
 }
 
 /// Run a scenario: every step's cycle and rate table in parallel (the
@@ -1199,7 +1300,7 @@ pub fn run(sc: &Scenario, progress: &(dyn Fn(&str) + Sync)) -> Result<FieldRepor
 struct AtFactory<'a> {
     factory: &'a Factory,
     jobs: &'a [Job],
-    done: &'a [Result<(Done, u64), FieldError>],
+    done: &'a [JobResult],
 }
 
 /// The steps of a run as its cycles and the factory's jobs left them.
