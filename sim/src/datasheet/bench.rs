@@ -12,11 +12,13 @@ use super::Error;
 use crate::config::Experiment;
 use crate::drift::{DeviceAt, Drift};
 use crate::field::board::{Board, SimBoard};
+use crate::field::lanes::LaneBoards;
 use crate::field::scenario;
 use crate::frontend::FrontEnd;
 use gyrocal_host::Knowns;
 use gyrocal_host::sampling::window_z;
 use gyrocal_regs::Registers;
+use rayon::prelude::*;
 
 /// Amplitude time constants of the slower mode (with the filter's
 /// settling) waited before a reading: the field scenario's rate-table
@@ -100,6 +102,40 @@ impl Bench {
         window_z(&mut board, r, f64::from(r), self.window_clocks()).map_err(run)
     }
 
+    /// `reading` at each of `rates_dps`, the boards in lanes
+    /// (`crate::field::lanes`): lane 0 reads, each other lane's reads are
+    /// replayed; the same readings, bit for bit.
+    pub fn readings(&self, at: &DeviceAt, rates_dps: &[f64]) -> Result<Vec<[f64; 2]>, Error> {
+        let settle = self.settle_clocks();
+        let mut boards =
+            LaneBoards::settled(&self.exp, &self.fe, at, &self.regs, rates_dps, settle)
+                .map_err(run)?;
+        let r = self.knowns.filter.decimation;
+        let window = self.window_clocks();
+        boards
+            .each_lane(|board, _| window_z(board, r, f64::from(r), window).map_err(run))
+            .into_iter()
+            .collect()
+    }
+
+    /// `readings` over as many lane groups as there are threads, in
+    /// parallel; the readings in the order of `rates_dps`.
+    pub fn readings_in_parallel(
+        &self,
+        at: &DeviceAt,
+        rates_dps: &[f64],
+    ) -> Result<Vec<[f64; 2]>, Error> {
+        let threads = rayon::current_num_threads().max(1);
+        let groups: Vec<&[f64]> = rates_dps
+            .chunks(rates_dps.len().div_ceil(threads).max(1))
+            .collect();
+        let z: Vec<Vec<[f64; 2]>> = groups
+            .par_iter()
+            .map(|rates| self.readings(at, rates))
+            .collect::<Result<_, _>>()?;
+        Ok(z.into_iter().flatten().collect())
+    }
+
     /// Clocks of one reading's window (the experiment's first window).
     pub fn window_clocks(&self) -> f64 {
         (self.knowns.filter.min_window_s * self.knowns.clock_hz).ceil()
@@ -109,4 +145,26 @@ impl Bench {
 /// A bus or host error during a run.
 pub(super) fn run(e: impl std::fmt::Display) -> Error {
     Error::Run(e.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Readings in lanes are the readings on a board each: the paper's
+    /// device (ADC noise on) at four rates, in one group and in groups of
+    /// two threads' worth, against `reading` at each rate.
+    #[test]
+    fn readings_in_lanes_are_the_readings_alone() {
+        let bench = Bench::new(&Experiment::paper(), None).unwrap();
+        let rates = [-20.0, 0.0, 7.5, 20.0];
+        let lanes = bench.readings(&bench.at0, &rates).unwrap();
+        let parallel = bench.readings_in_parallel(&bench.at0, &rates).unwrap();
+        for (i, &rate) in rates.iter().enumerate() {
+            let alone = bench.reading(&bench.at0, rate).unwrap();
+            assert_eq!(lanes[i], alone, "at {rate} deg/s");
+            assert_eq!(parallel[i], alone, "at {rate} deg/s, in parallel");
+        }
+        assert_ne!(lanes[0], lanes[3]);
+    }
 }

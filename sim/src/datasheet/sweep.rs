@@ -2,7 +2,7 @@
 //! scale (IEEE Std 952-1997 section 8.1.4 style).
 //!
 //! `SWEEP_POINTS` rates evenly spaced from `-FS` to `+FS`, each on a fresh
-//! board at the factory temperature (in parallel), settled and averaged
+//! board at the factory temperature (in lanes, `Bench::readings`), settled and averaged
 //! over one first window, with the file's Brownian and ADC noise (the rate
 //! noises are not applied: they are what the Allan deviation measures).
 //!
@@ -18,7 +18,6 @@
 use super::Error;
 use super::bench::Bench;
 use crate::fit::linear_fit;
-use rayon::prelude::*;
 use serde::Serialize;
 
 /// Rates in a sweep, zero included (`-FS, -0.9 FS, ..., FS`).
@@ -63,10 +62,7 @@ pub fn run(bench: &Bench, full_scale_dps: f64) -> Result<Sweep, Error> {
     let rates: Vec<f64> = (0..SWEEP_POINTS)
         .map(|i| full_scale_dps * (i as f64 - half) / half)
         .collect();
-    let z: Vec<[f64; 2]> = rates
-        .par_iter()
-        .map(|&r| bench.reading(&bench.at0, r))
-        .collect::<Result<_, _>>()?;
+    let z = bench.readings_in_parallel(&bench.at0, &rates)?;
     let fit = lines(&rates, &z);
     let sf = fit.map(|l| l.0);
     let residual_ppm: Vec<[f64; 2]> = rates

@@ -62,13 +62,13 @@ pub fn run(bench: &Bench, drift: &Drift) -> Result<Temperature, Error> {
             .filter(|r| **r != 0.0),
     );
     let temps = &drift.temperatures_c;
-    let jobs: Vec<(usize, usize)> = (0..temps.len())
-        .flat_map(|t| (0..rates.len()).map(move |r| (t, r)))
-        .collect();
-    let z: Vec<[f64; 2]> = jobs
+    // Each temperature's rates in lanes (`Bench::readings`), the
+    // temperatures in parallel.
+    let z: Vec<Vec<[f64; 2]>> = temps
         .par_iter()
-        .map(|&(t, r)| bench.reading(&drift.at(&bench.exp.gyro, temps[t]), rates[r]))
+        .map(|&t| bench.readings(&drift.at(&bench.exp.gyro, t), &rates))
         .collect::<Result<_, _>>()?;
+    let z: Vec<[f64; 2]> = z.into_iter().flatten().collect();
     let lines: Vec<[(f64, f64); 2]> = z
         .chunks(rates.len())
         .map(|zt| {

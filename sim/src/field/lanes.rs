@@ -18,15 +18,18 @@
 
 use super::board::{Board, analog_at};
 use crate::analog::{self, Analog};
+use crate::config::Experiment;
 use crate::cosim::HostRegisters;
 use crate::drift::DeviceAt;
-use crate::error::RunError;
+use crate::error::{FieldError, RunError};
 use crate::frontend::FrontEnd;
 use crate::noise::ThermalNoise;
 use gyrocal_hdl::host::clip_counter::{ClipCount, clip_word};
 use gyrocal_hdl::model::gyro_interface::{CarrierProfile, GyroInterface, Words};
 use gyrocal_hdl::model::isa::Isa;
 use gyrocal_hdl::model::lanes::Lanes;
+use gyrocal_regs::Registers;
+use gyrocal_regs::datapath::DRIVE_START_CLOCKS;
 use gyrocal_regs::map::{ADC_CLIP, BusError, RegisterAccess};
 use std::collections::VecDeque;
 
@@ -76,6 +79,43 @@ impl LaneBoards {
         })
     }
 
+    /// Boards at `rates_dps` of `exp`'s device at `at`, each as
+    /// `scenario::board_at` makes one (powered up, `DRIVE_START_CLOCKS`
+    /// waited), then programmed with `regs`, its rate set and `settle`
+    /// clocks waited: a table's settled boards.
+    pub fn settled(
+        exp: &Experiment,
+        fe: &FrontEnd,
+        at: &DeviceAt,
+        regs: &Registers,
+        rates_dps: &[f64],
+        settle: u64,
+    ) -> Result<Self, FieldError> {
+        let reference = 0.5 * (exp.gyro.f1_hz + exp.gyro.f2_hz);
+        let timing = (exp.drive.board_clock_hz(), reference);
+        let profile = exp.drive.carrier_profile;
+        let lanes = rates_dps.len();
+        let mut boards = LaneBoards::new(at, fe, &exp.noise, timing, profile, lanes)?;
+        boards.wait_clocks(DRIVE_START_CLOCKS)?;
+        boards.program(regs)?;
+        let rates: Vec<f64> = rates_dps.iter().map(|r| r.to_radians()).collect();
+        boards.set_rates(&rates);
+        boards.wait_clocks(settle)?;
+        Ok(boards)
+    }
+
+    /// `read(board, lane)` on every lane: on these boards for lane 0 (the
+    /// clocks and writes every lane's), then on each other lane's
+    /// [`LaneBoards::replay`] of the reads it made.
+    pub fn each_lane<T>(&mut self, mut read: impl FnMut(&mut dyn Board, usize) -> T) -> Vec<T> {
+        self.forget_reads();
+        let mut out = vec![read(self, 0)];
+        for l in 1..self.analogs.len() {
+            out.push(read(&mut self.replay(l), l));
+        }
+        out
+    }
+
     /// Lane l's rotation rate (rad/s) from the next clock on: the rate
     /// table of the harness, as `SimBoard::set_rate`.
     pub fn set_rates(&mut self, rates_rad_s: &[f64]) {
@@ -92,14 +132,14 @@ impl LaneBoards {
 
     /// Lane `lane`'s reads since its last replay, to run the host's code
     /// again as that lane's board answered it.
-    pub fn replay(&mut self, lane: usize) -> Replay {
+    fn replay(&mut self, lane: usize) -> Replay {
         Replay {
             reads: std::mem::take(&mut self.reads[lane]),
         }
     }
 
     /// Forgets the reads kept so far (those no replay will need).
-    pub fn forget_reads(&mut self) {
+    fn forget_reads(&mut self) {
         self.reads.iter_mut().for_each(VecDeque::clear);
     }
 
@@ -261,12 +301,7 @@ mod tests {
         lanes.wait_clocks(start).unwrap();
         lanes.program(&regs).unwrap();
         lanes.set_rates(&rates);
-        lanes.forget_reads();
-        let lead = read_table(&mut lanes, r);
-        let mut read = vec![lead];
-        for l in 1..3 {
-            read.push(read_table(&mut lanes.replay(l), r));
-        }
+        let read = lanes.each_lane(|board, _| read_table(board, r));
         for (l, &rate) in rates.iter().enumerate() {
             let mut board = scenario::board_at(&exp, &fe, &at).unwrap();
             board.program(&regs).unwrap();

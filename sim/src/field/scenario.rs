@@ -793,17 +793,8 @@ fn settled_lanes(
     op: &Operating,
     rates_dps: &[f64],
 ) -> Result<LaneBoards, FieldError> {
-    let reference = 0.5 * (exp.gyro.f1_hz + exp.gyro.f2_hz);
-    let timing = (exp.drive.board_clock_hz(), reference);
-    let profile = exp.drive.carrier_profile;
-    let lanes = rates_dps.len();
-    let mut boards = LaneBoards::new(at, fe, &exp.noise, timing, profile, lanes)?;
-    boards.wait_clocks(gyrocal_regs::datapath::DRIVE_START_CLOCKS)?;
-    program_readout(&mut boards, knowns, op)?;
-    let rates: Vec<f64> = rates_dps.iter().map(|r| r.to_radians()).collect();
-    boards.set_rates(&rates);
-    boards.wait_clocks(settle_clocks_at(knowns, at))?;
-    Ok(boards)
+    let (regs, _) = knowns.registers(op.carrier_hz, None, op.amplitude, op.ref_lag_deg)?;
+    LaneBoards::settled(exp, fe, at, &regs, rates_dps, settle_clocks_at(knowns, at))
 }
 
 /// One rate's parts of a table, or why it has none.
@@ -818,14 +809,7 @@ fn table_windows_in_lanes(
     whose: TableAt,
     rates_dps: &[f64],
 ) -> Vec<TablePart> {
-    boards.forget_reads();
-    let first = table_windows(boards, knowns, windows, whose, rates_dps[0]);
-    let mut parts = vec![first];
-    for (l, &rate) in rates_dps.iter().enumerate().skip(1) {
-        let replay = &mut boards.replay(l);
-        parts.push(table_windows(replay, knowns, windows, whose, rate));
-    }
-    parts
+    boards.each_lane(|board, l| table_windows(board, knowns, windows, whose, rates_dps[l]))
 }
 
 /// Least-squares slopes of the table's z against its rates (z LSB per deg/s).
