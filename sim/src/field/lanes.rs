@@ -47,7 +47,7 @@ pub struct LaneBoards {
     cycle: u64,
     clip: Vec<[ClipCount; 2]>,
     isa: Isa,
-    /// Each lane's reads (offset, word) since its last [`LaneBoards::replay`].
+    /// Each lane's reads (offset, word) since its last `LaneBoards::replay`.
     reads: Vec<VecDeque<(u32, u32)>>,
 }
 
@@ -106,7 +106,7 @@ impl LaneBoards {
 
     /// `read(board, lane)` on every lane: on these boards for lane 0 (the
     /// clocks and writes every lane's), then on each other lane's
-    /// [`LaneBoards::replay`] of the reads it made.
+    /// `LaneBoards::replay` of the reads it made.
     pub fn each_lane<T>(&mut self, mut read: impl FnMut(&mut dyn Board, usize) -> T) -> Vec<T> {
         self.forget_reads();
         let mut out = vec![read(self, 0)];
@@ -218,7 +218,7 @@ impl RegisterAccess for LaneBoards {
     }
 }
 
-/// One lane's reads, answered again in order ([`LaneBoards::replay`]):
+/// One lane's reads, answered again in order (`LaneBoards::replay`):
 /// the host's code run on it gets the words that lane's board gave. The
 /// clocks it waits were played already; its writes were made.
 pub struct Replay {
