@@ -136,10 +136,12 @@ impl Analog {
 /// same noise alone, so one block of draws serves them all; each lane then
 /// advances its own gyroscope and converts its own ADC words. Every lane's
 /// words are those its own `Analog` gives alone.
+///
+/// The block's forces and noise are kept in the first lane's own buffers
+/// (those its `AnalogSide` methods use alone), so making lanes for a run
+/// allocates nothing.
 pub struct Lanes<'a, W: FnMut(usize, &[Words]) = fn(usize, &[Words])> {
     analogs: &'a mut [Analog],
-    forces: Vec<(f64, f64)>,
-    noise: Vec<f64>,
     /// Sees each lane's ADC words once converted (lane, words).
     watch: W,
 }
@@ -186,12 +188,7 @@ impl<'a, W: FnMut(usize, &[Words])> Lanes<'a, W> {
         {
             return Err(LanesError::NotShared(l + 1));
         }
-        Ok(Self {
-            analogs,
-            forces: Vec::with_capacity(BLOCK),
-            noise: vec![],
-            watch,
-        })
+        Ok(Self { analogs, watch })
     }
 }
 
@@ -209,16 +206,18 @@ impl<W: FnMut(usize, &[Words])> AnalogLanes for Lanes<'_, W> {
             .analogs
             .split_first_mut()
             .expect("lanes are never empty");
-        lead.converters.forces_block(dac, &mut self.forces);
-        lead.advance_under(&self.forces, beside);
+        let mut forces = std::mem::take(&mut lead.forces);
+        lead.converters.forces_block(dac, &mut forces);
+        lead.advance_under(&forces, beside);
         for analog in rest {
-            analog.advance_under(&self.forces, |_| {});
+            analog.advance_under(&forces, |_| {});
         }
+        lead.forces = forces;
     }
 
     /// The block's noise drawn by the first lane's converters when it
-    /// converts, the same draws for the others, which then take on its
-    /// DAC words and generator (`Converters::follow`).
+    /// converts (into its buffer), the same draws for the others, which
+    /// then take on its DAC words and generator (`Converters::follow`).
     #[inline(always)]
     fn convert(&mut self, lane: usize, adc: &mut [Words]) {
         let (lead, rest) = self
@@ -226,12 +225,14 @@ impl<W: FnMut(usize, &[Words])> AnalogLanes for Lanes<'_, W> {
             .split_first_mut()
             .expect("lanes are never empty");
         if lane == 0 {
-            lead.converters.noise_block(adc.len(), &mut self.noise);
-            lead.convert_with(&self.noise, adc);
+            let mut noise = std::mem::take(&mut lead.noise);
+            lead.converters.noise_block(adc.len(), &mut noise);
+            lead.convert_with(&noise, adc);
+            lead.noise = noise;
         } else {
             let analog = &mut rest[lane - 1];
             analog.converters.follow(&lead.converters);
-            analog.convert_with(&self.noise, adc);
+            analog.convert_with(&lead.noise, adc);
         }
         (self.watch)(lane, adc);
     }

@@ -11,12 +11,9 @@
 //! whole `reproduce` experiment, timed wall to wall on all cores, with the
 //! process's peak resident memory.
 
-use crate::cosim::CoSimLanes;
 use crate::engine::{Engine, EngineKind, ModelEngine, RtlEngine};
 use crate::error::RunError;
 use crate::experiment::{self, Experiment, Plan};
-use crate::frontend::Converters;
-use crate::gyro::GyroModel;
 use gyrocal_hdl::model::gyro_interface::{AnalogSide, Words};
 use gyrocal_hdl::model::isa::Isa;
 use serde::Serialize;
@@ -183,17 +180,8 @@ fn measure_lanes(clocks: u64, repetitions: usize) -> Result<Measurement, RunErro
     let per_lane = (clocks / RATE_LANES as u64).max(1);
     let mut samples = vec![];
     for _ in 0..repetitions {
-        let gyros = (0..RATE_LANES)
-            .map(|l| {
-                let mut gyro = GyroModel::new(&exp.gyro, exp.drive.clock_hz)?;
-                gyro.set_rate((l as f64).to_radians());
-                Ok(gyro)
-            })
-            .collect::<Result<Vec<_>, RunError>>()?;
-        let converters = Converters::new(&plan.front_end)?;
-        let profile = exp.drive.carrier_profile;
-        let mut sim =
-            CoSimLanes::new(profile, converters, gyros, point.regs).expect("RATE_LANES is not 0");
+        let rates: Vec<f64> = (0..RATE_LANES).map(|l| (l as f64).to_radians()).collect();
+        let mut sim = experiment::lanes_loop(&exp, &plan, point.regs, &rates)?;
         let start = Instant::now();
         let mut check = 0i64;
         sim.run(per_lane, |l, n, z| {

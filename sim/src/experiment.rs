@@ -710,6 +710,29 @@ pub fn point_loop<E: Engine>(
     Ok(sim)
 }
 
+/// `point_loop`'s loops at each of `rates_rad_s` on the model engine, as
+/// lanes (`CoSimLanes`): each lane the loop `point_loop` makes for a point
+/// with `regs` at that rate.
+pub fn lanes_loop(
+    exp: &Experiment,
+    plan: &Plan,
+    regs: Registers,
+    rates_rad_s: &[f64],
+) -> Result<CoSimLanes, RunError> {
+    let gyros = rates_rad_s
+        .iter()
+        .map(|&rate| {
+            let gyro = GyroModel::new(&exp.gyro, exp.drive.clock_hz)?;
+            let mut gyro = gyro.with_thermal_noise(&exp.noise)?;
+            gyro.set_rate(rate);
+            Ok(gyro)
+        })
+        .collect::<Result<Vec<_>, RunError>>()?;
+    let converters = Converters::new(&plan.front_end)?;
+    let profile = exp.drive.carrier_profile;
+    Ok(CoSimLanes::new(profile, converters, gyros, regs)?)
+}
+
 /// The z samples of one point from just before its window, and a thinned
 /// trace of all of them.
 #[derive(Clone)]
@@ -769,6 +792,11 @@ impl Samples {
     }
 }
 
+/// Clocks a point's loop runs at a time, between progress ticks. A point
+/// alone (`advance`) and in lanes (`run_points_in_lanes`) take the same
+/// runs, so their blocks fall on the same clocks.
+const RUN_CHUNK: u64 = 1 << 20;
+
 /// Simulate up to clock `end`, keeping the z samples.
 fn advance<E: Engine>(
     sim: &mut CoSim<E>,
@@ -776,9 +804,8 @@ fn advance<E: Engine>(
     end: u64,
     progress: &(dyn Fn(Tick) + Sync),
 ) {
-    const CHUNK: u64 = 1 << 20;
     while sim.cycle() < end {
-        let clocks = (end - sim.cycle()).min(CHUNK);
+        let clocks = (end - sim.cycle()).min(RUN_CHUNK);
         sim.run(clocks, |n, z| samples.push(n, z));
         progress(Tick::Clocks(clocks));
     }
@@ -852,23 +879,12 @@ pub fn run_points_in_lanes(
         return Ok(vec![]);
     };
     debug_assert!(points.iter().all(|p| lane_key(p) == lane_key(first)));
-    let gyros = points
-        .iter()
-        .map(|p| {
-            let gyro = GyroModel::new(&exp.gyro, exp.drive.clock_hz)?;
-            let mut gyro = gyro.with_thermal_noise(&exp.noise)?;
-            gyro.set_rate(p.omz_rad_s);
-            Ok(gyro)
-        })
-        .collect::<Result<Vec<_>, RunError>>()?;
-    let converters = Converters::new(&plan.front_end)?;
-    let profile = exp.drive.carrier_profile;
-    let mut sim = CoSimLanes::new(profile, converters, gyros, first.regs)?;
+    let rates: Vec<f64> = points.iter().map(|p| p.omz_rad_s).collect();
+    let mut sim = lanes_loop(exp, plan, first.regs, &rates)?;
     let (samples, end) = Samples::for_point(plan, first, units);
     let mut samples = vec![samples; points.len()];
-    const CHUNK: u64 = 1 << 20;
     while sim.cycle() < end {
-        let clocks = (end - sim.cycle()).min(CHUNK);
+        let clocks = (end - sim.cycle()).min(RUN_CHUNK);
         sim.run(clocks, |l, n, z| samples[l].push(n, z));
         progress(Tick::Clocks(clocks * points.len() as u64));
     }
@@ -1173,16 +1189,27 @@ fn run_model_points(
             run_points_in_lanes(exp, plan, &points, jobs[lane[0]].1, progress)
         })
         .collect::<Result<_, _>>()?;
-    let mut ordered: Vec<Option<PointResult>> = vec![None; jobs.len()];
-    for (lane, results) in lanes.iter().zip(results) {
-        for (&i, r) in lane.iter().zip(results) {
+    Ok(in_item_order(jobs.len(), &lanes, results))
+}
+
+/// Work units' results back in the order of the items they hold:
+/// `results[u][j]` is item `units[u][j]`'s, and each of the `items` is in
+/// exactly one unit (a round's points in lanes, a scenario's jobs).
+pub(crate) fn in_item_order<T, U: AsRef<[usize]>>(
+    items: usize,
+    units: &[U],
+    results: Vec<Vec<T>>,
+) -> Vec<T> {
+    let mut ordered: Vec<Option<T>> = (0..items).map(|_| None).collect();
+    for (unit, results) in units.iter().zip(results) {
+        for (&i, r) in unit.as_ref().iter().zip(results) {
             ordered[i] = Some(r);
         }
     }
-    Ok(ordered
+    ordered
         .into_iter()
-        .map(|r| r.expect("every point ran"))
-        .collect())
+        .map(|r| r.expect("every item is in a unit"))
+        .collect()
 }
 
 #[cfg(feature = "verilator")]

@@ -1024,15 +1024,6 @@ impl Job {
             Job::Factory { step, .. } | Job::BaselineProfile { step } => step,
         }
     }
-
-    /// A table point's rate (its index in the table's rates); 0 for a
-    /// profile.
-    fn rate(&self) -> usize {
-        match *self {
-            Job::Factory { rate, .. } => rate,
-            Job::BaselineProfile { .. } => 0,
-        }
-    }
 }
 
 enum Done {
@@ -1132,25 +1123,18 @@ fn run_jobs(
             None => units.push(vec![i]),
         }
     }
-    let done: Vec<Vec<(usize, JobResult)>> = units
+    let done: Vec<Vec<JobResult>> = units
         .par_iter()
         .map(|unit| match &cycles[jobs[unit[0]].step()] {
             Ok(c) => run_unit(sc, fe, knowns, factory, &c.at, jobs, unit),
-            Err(f) => unit.iter().map(|&i| (i, Err(f.error.clone()))).collect(),
+            Err(f) => unit.iter().map(|_| Err(f.error.clone())).collect(),
         })
         .collect();
-    let mut ordered: Vec<Option<JobResult>> = jobs.iter().map(|_| None).collect();
-    for (i, d) in done.into_iter().flatten() {
-        ordered[i] = Some(d);
-    }
-    ordered
-        .into_iter()
-        .map(|d| d.expect("every job ran"))
-        .collect()
+    experiment::in_item_order(jobs.len(), &units, done)
 }
 
 /// One unit of `run_jobs` on the device `at` of its step: a table's
-/// points (the jobs `unit` names), or a profile; each job's result.
+/// points (the jobs `unit` names), or a profile; each job's result, in the unit's order.
 fn run_unit(
     sc: &Scenario,
     fe: &FrontEnd,
@@ -1159,22 +1143,25 @@ fn run_unit(
     at: &DeviceAt,
     jobs: &[Job],
     unit: &[usize],
-) -> Vec<(usize, JobResult)> {
+) -> Vec<JobResult> {
     if let Job::BaselineProfile { .. } = jobs[unit[0]] {
-        return vec![(unit[0], baseline_profile(sc, fe, knowns, factory, at))];
+        return vec![baseline_profile(sc, fe, knowns, factory, at)];
     }
     let rates: Vec<f64> = unit
         .iter()
-        .map(|&i| knowns.rates_dps[jobs[i].rate()])
+        .map(|&i| match jobs[i] {
+            Job::Factory { rate, .. } => knowns.rates_dps[rate],
+            Job::BaselineProfile { .. } => unreachable!("a table's unit holds its points"),
+        })
         .collect();
     let whose = (factory, TableAt::Factory);
     match table_points(&sc.exp, fe, at, knowns, whose, &rates) {
         Ok((boards, parts)) => {
             let point = |p: Vec<[f64; 2]>| (Done::Point(mean_of_parts(&p)), boards.cycle());
             let results = parts.into_iter().map(|p| p.map(point));
-            unit.iter().copied().zip(results).collect()
+            results.collect()
         }
-        Err(e) => unit.iter().map(|&i| (i, Err(e.clone()))).collect(),
+        Err(e) => unit.iter().map(|_| Err(e.clone())).collect(),
     }
 }
 
