@@ -318,13 +318,25 @@ mod tests {
     /// them cover it: the pick-off sits at the end of both (its gain slope
     /// at the bound, its images on the first-order form), so its pull is
     /// their sum, to the 6% (at Q 100) that the two add at second order.
+    /// So at 5 and 10 deg too (the lag `examples/sweep/phase_drift_20khz.toml`
+    /// reaches), where Q's remainder grows past 0.03 phi (0.15 phi at
+    /// 770 kHz and 10 deg) and the terms still cover it (at most 1.03 of
+    /// their sum).
     #[test]
     fn the_front_ends_delay_is_in_the_model_and_what_it_leaves_within_its_terms() {
-        let phi = 2f64.to_radians();
+        for lag_deg in [2.0, 5.0, 10.0] {
+            delay_in_the_model_leaves_within_its_terms(f64::to_radians(lag_deg));
+        }
+    }
+
+    fn delay_in_the_model_leaves_within_its_terms(phi: f64) {
         for (fk, q, fs) in PICKOFF_MODES {
             let alone = fit_through_pickoff(fk, q, fs, phi, FrontSlope::default());
             let bias = (alone.q.value - q) / phi;
-            assert!(bias > 0.7, "{fk} Hz: Q alone only {bias} phi high");
+            assert!(
+                bias > 0.7,
+                "{fk} Hz, {phi} rad: Q alone only {bias} phi high"
+            );
             let front = FrontEnd {
                 slope: FrontSlope {
                     delay_s: phi.sin() * phi.cos() / (TAU * fk),
@@ -339,14 +351,18 @@ mod tests {
                 let term = gain[i] + images[i];
                 assert!(
                     left.abs() <= 1.1 * term,
-                    "{fk} Hz: {left:e} left, terms {term:e}"
+                    "{fk} Hz, {phi} rad: {left:e} left, terms {term:e}"
                 );
             }
-            assert!(
-                (m.q.value - q).abs() < 0.03 * phi,
-                "{fk} Hz: Q {}",
-                m.q.value
-            );
+            // The delay in the model takes Q's bias to first order, so
+            // what it leaves is small at the field's usual 2 deg.
+            if phi < 2.5f64.to_radians() {
+                assert!(
+                    (m.q.value - q).abs() < 0.03 * phi,
+                    "{fk} Hz, {phi} rad: Q {}",
+                    m.q.value
+                );
+            }
         }
     }
 
