@@ -28,8 +28,11 @@ pub struct Analog {
     pub phase: Option<PickoffPhase>,
     /// The ADC noise of a block, in the order `step` draws it.
     noise: Vec<f64>,
-    /// What the ADCs see at each edge advanced and not yet converted.
+    /// What the ADCs see at each edge advanced and not yet converted: the
+    /// first `filled` words. The buffer keeps its length between blocks,
+    /// so a block's gyroscope writes it without clearing it first.
     pending: Vec<(f64, f64)>,
+    filled: usize,
     /// The DAC forces of a block (`advance_block`).
     forces: Vec<(f64, f64)>,
 }
@@ -43,6 +46,7 @@ impl Analog {
             phase,
             noise: vec![],
             pending: Vec::with_capacity(BLOCK),
+            filled: 0,
             forces: Vec::with_capacity(BLOCK),
         }
     }
@@ -80,7 +84,12 @@ impl AnalogSide for Analog {
     #[inline(always)]
     fn advance(&mut self, dac: Words) {
         let x = self.sensed();
-        self.pending.push(x);
+        if self.filled == self.pending.len() {
+            self.pending.push(x);
+        } else {
+            self.pending[self.filled] = x;
+        }
+        self.filled += 1;
         let force = self.converters.dac_step(dac);
         self.gyro.step(force.0, force.1);
     }
@@ -109,22 +118,27 @@ impl Analog {
     /// the ADCs see at each edge kept, `beside(t)` at clock t.
     #[inline(always)]
     fn advance_under(&mut self, forces: &[(f64, f64)], mut beside: impl FnMut(usize)) {
-        let start = self.pending.len();
-        self.pending.resize(start + forces.len(), (0.0, 0.0));
+        let (start, end) = (self.filled, self.filled + forces.len());
+        if self.pending.len() < end {
+            self.pending.resize(end, (0.0, 0.0));
+        }
         let phase = self.phase;
-        self.gyro.steps(forces, &mut self.pending[start..], |t, s| {
-            beside(t);
-            sense(phase, s)
-        });
+        self.gyro
+            .steps(forces, &mut self.pending[start..end], |t, s| {
+                beside(t);
+                sense(phase, s)
+            });
+        self.filled = end;
     }
 
     /// The ADC words of the edges advanced, with their standard normal
     /// draws `noise` (two a clock).
     #[inline(always)]
     fn convert_with(&mut self, noise: &[f64], adc: &mut [Words]) {
-        debug_assert_eq!(adc.len(), self.pending.len());
-        self.converters.adc_block(&self.pending, noise, adc);
-        self.pending.clear();
+        debug_assert_eq!(adc.len(), self.filled);
+        self.converters
+            .adc_block(&self.pending[..self.filled], noise, adc);
+        self.filled = 0;
     }
 }
 
