@@ -162,8 +162,11 @@ impl GyroInterface {
     /// its samples as events; the IIR steps through its schedules and
     /// skips its idle clocks to the next sample (an idle step changes
     /// nothing but clearing z_valid, so one stands for them all).
+    ///
+    /// `WEIGHTED`: the CIC's inputs integrated as weighted sums
+    /// (`CicDecimator::block`), for a build with vector multiplies.
     #[inline(always)]
-    pub(super) fn readout_block(
+    pub(super) fn readout_block<const WEIGHTED: bool>(
         &mut self,
         drives: &[Drives],
         stages: &mut ReadoutStages,
@@ -180,7 +183,8 @@ impl GyroInterface {
         let (r, shift) = (regs.cic_decimation as u32, regs.cic_shift as u32);
         let samples = &mut stages.samples;
         samples.clear();
-        self.cic.block(w, r, shift, |t, y| samples.push((t, y)));
+        self.cic
+            .block::<WEIGHTED>(w, r, shift, |t, y| samples.push((t, y)));
         let mut next = samples.iter().peekable();
         let mut t = 0;
         while t < n {

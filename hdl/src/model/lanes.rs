@@ -144,7 +144,9 @@ macro_rules! run_compiled_for {
             A: AnalogLanes,
             Z: FnMut(usize, u64, (i64, i64)),
         {
-            run_blocks(lanes, regs, clocks, analog, on_z)
+            // Both have vector multiplies: the CIC integrates by weighted
+            // sums (`CicDecimator::block`).
+            run_blocks::<true, _, _>(lanes, regs, clocks, analog, on_z)
         }
     };
 }
@@ -190,13 +192,15 @@ pub(super) fn run_on<A, Z>(
         }
     }
     let _ = isa;
-    run_blocks(lanes, regs, clocks, analog, on_z)
+    run_blocks::<false, _, _>(lanes, regs, clocks, analog, on_z)
 }
 
 /// The blocks of the module header, on `lanes` (whose drive halves are
-/// equal: the first plays for all).
+/// equal: the first plays for all). `WEIGHTED`: the CIC integrates by
+/// weighted sums (`CicDecimator::block`), for a build with vector
+/// multiplies; the same outputs either way.
 #[inline(always)]
-fn run_blocks<A, Z>(
+fn run_blocks<const WEIGHTED: bool, A, Z>(
     lanes: &mut [GyroInterface],
     regs: &Registers,
     clocks: u64,
@@ -235,7 +239,7 @@ fn run_blocks<A, Z>(
         for (l, lane) in lanes.iter_mut().enumerate() {
             analog.convert(l, &mut readout.adc[..n]);
             let on_z = |i, z| on_z(l, done + i, z);
-            lane.readout_block(&drives[..n], &mut readout, regs, on_z);
+            lane.readout_block::<WEIGHTED>(&drives[..n], &mut readout, regs, on_z);
         }
         done += n as u64;
         n = block(done);
