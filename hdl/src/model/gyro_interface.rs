@@ -5,7 +5,7 @@ use super::am_mixer::{AmMixer, Drives};
 use super::carrier_nco::{CarrierNco, Carriers};
 use super::cic_decimator::CicDecimator;
 use super::demod_mux::DemodMux;
-use super::iir_lowpass::IirLowpass;
+use super::iir_lowpass::{Factors, IirLowpass};
 use super::isa::Isa;
 use super::lanes::One;
 use super::modulation_nco::ModulationNco;
@@ -200,7 +200,7 @@ impl GyroInterface {
                 // Busy, no sample before `at`: the schedule runs on.
                 let from = t;
                 let on = |i: usize, z| on_z((from + i) as u64, z);
-                t += self.iir.run_without_input(at - t, &regs.iir, on);
+                t += self.iir.run_without_input(at - t, &stages.factors, on);
                 continue;
             }
             let sample = next.next_if(|&&(at, _)| at == t);
@@ -352,15 +352,19 @@ pub(super) struct ReadoutStages {
     w: [(i32, i32); BLOCK],
     /// The CIC's samples over the block: cycle, words.
     samples: Vec<(usize, (i64, i64))>,
+    /// The IIR's operands for the run's coefficients.
+    factors: Factors,
 }
 
-impl Default for ReadoutStages {
-    fn default() -> Self {
+impl ReadoutStages {
+    /// The stages of a run that holds `regs`.
+    pub(super) fn new(regs: &Registers) -> Self {
         Self {
             adc: [(0, 0); BLOCK],
             aligned: [(0, 0); BLOCK],
             w: [(0, 0); BLOCK],
             samples: Vec::with_capacity(BLOCK),
+            factors: Factors::new(&regs.iir),
         }
     }
 }

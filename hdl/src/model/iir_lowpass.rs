@@ -37,11 +37,14 @@ const RAM_WORDS: usize = 1 << crate::iir_program::RAM_ADDRESS_BITS;
 const FACTOR_SELECTS: usize = 1 << 5;
 
 /// `factor_value` of every factor select for one set of coefficients,
-/// looked up by a busy clock (`run_without_input`, `slots`).
-struct Factors([i64; FACTOR_SELECTS]);
+/// looked up by a busy clock (`IirLowpass::run_without_input`): made
+/// once for the coefficients a run holds.
+#[derive(Clone, Debug)]
+pub struct Factors([i64; FACTOR_SELECTS]);
 
 impl Factors {
-    fn new(k: &Coefficients) -> Self {
+    /// The operands of the coefficients `k`.
+    pub fn new(k: &Coefficients) -> Self {
         Self(std::array::from_fn(|select| factor_value(select as u8, k)))
     }
 }
@@ -170,17 +173,18 @@ impl IirLowpass {
     /// stopping at the first clock the filter is idle at (where a step
     /// without a sample would only clear z_valid): returns the clocks
     /// played, calling `on_z(i, z)` when clock i (from 0) publishes z.
-    /// The registers live in locals over the run, and each word's
-    /// addresses, operations and operands come from a table built once
-    /// (`slots`), where decoded at every clock a busy clock took 6.4 ns.
+    /// `factors` are the coefficients' (`Factors::new`). The registers
+    /// live in locals over the run, and each word's addresses and
+    /// operations come from a table built once (`slots`), where decoded
+    /// at every clock a busy clock took 6.4 ns.
     #[inline(always)]
     pub fn run_without_input(
         &mut self,
         clocks: usize,
-        k: &Coefficients,
+        factors: &Factors,
         on_z: impl FnMut(usize, (i64, i64)),
     ) -> usize {
-        self.run_slots(clocks, &Factors::new(k), on_z)
+        self.run_slots(clocks, factors, on_z)
     }
 
     /// One clock with inputs `x` and strobe `x_valid`; returns

@@ -214,7 +214,7 @@ fn run_blocks<const WEIGHTED: bool, A, Z>(
     let block = |done: u64| (clocks - done).min(BLOCK as u64) as usize;
     let mut drives = [Drives::default(); BLOCK];
     let mut stages = DriveStages::default();
-    let mut readout = ReadoutStages::default();
+    let mut readout = ReadoutStages::new(regs);
     let mut n = block(0);
     lanes[0].drive_block(&mut drives[..n], &mut stages, regs, false);
     let mut done = 0u64;

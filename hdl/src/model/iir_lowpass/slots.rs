@@ -180,7 +180,7 @@ impl IirLowpass {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{Coefficients, IirLowpass};
+    use super::super::{Coefficients, Factors, IirLowpass};
     use crate::iir_lowpass::SCHEDULE_CLOCKS;
     use crate::test_util::Rng;
 
@@ -225,7 +225,8 @@ mod tests {
                 }
                 let clocks = lengths[rng.range(0, lengths.len() as i64 - 1) as usize];
                 let mut z_run = vec![];
-                let played = run.run_without_input(clocks, &k, |i, z| z_run.push((i, z)));
+                let factors = Factors::new(&k);
+                let played = run.run_without_input(clocks, &factors, |i, z| z_run.push((i, z)));
                 let mut z_stepped = vec![];
                 let mut i = 0;
                 while i < clocks && !stepped.idle() {
