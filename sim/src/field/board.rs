@@ -104,10 +104,8 @@ impl<E: Engine> SimBoard<E> {
         let mut analog = Watched {
             analog,
             watch: |adc: &[Words]| {
-                for a in adc {
-                    clip[0].step(a.0, false);
-                    clip[1].step(a.1, false);
-                }
+                clip[0].steps(adc.iter().map(|a| a.0));
+                clip[1].steps(adc.iter().map(|a| a.1));
             },
         };
         let on_z = |_, _| *samples = samples.wrapping_add(1);

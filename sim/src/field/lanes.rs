@@ -150,10 +150,8 @@ impl LaneBoards {
         }
         let clip = &mut self.clip;
         let watch = |l: usize, adc: &[Words]| {
-            for a in adc {
-                clip[l][0].step(a.0, false);
-                clip[l][1].step(a.1, false);
-            }
+            clip[l][0].steps(adc.iter().map(|a| a.0));
+            clip[l][1].steps(adc.iter().map(|a| a.1));
         };
         let mut analogs = analog::Lanes::watched(&mut self.analogs, watch)
             .expect("the lanes share one set of converters");
