@@ -159,6 +159,32 @@ fn times(m: &Columns, v: [f64; 4], coupled: bool) -> [f64; 4] {
     }
 }
 
+/// The input term of a clock, `Gamma f` (`d`'s, its diagonal blocks
+/// alone when the modes are not `coupled`), plus the Brownian increment
+/// from `thermal` when on.
+#[inline(always)]
+fn input_term(
+    d: &Discrete,
+    coupled: bool,
+    thermal: Option<&mut (ThermalNoise, StateNoise)>,
+    f1: f64,
+    f2: f64,
+) -> [f64; 4] {
+    let mut u: [f64; 4] = if coupled {
+        let [g1, g2] = &d.gamma_by;
+        std::array::from_fn(|i| g1[i] * f1 + g2[i] * f2)
+    } else {
+        let f = [f1, f1, f2, f2];
+        std::array::from_fn(|i| d.gamma_diagonal[i] * f[i])
+    };
+    if let Some((_, source)) = thermal {
+        for (u, w) in u.iter_mut().zip(source.sample()) {
+            *u += w;
+        }
+    }
+    u
+}
+
 /// The gyroscope, stepped once per clock with zero-order-held forces.
 ///
 /// Internal state is scaled (`[x1, v1/wr, x2, v2/wr]`); [`GyroModel::state`]
@@ -412,42 +438,83 @@ impl GyroModel {
     /// x2, v2]` at each clock's edge, before its step, into `seen`. The
     /// state stays in registers over the run instead of going through
     /// memory at every clock, which would add a store and a load to the
-    /// recursion's latency.
+    /// recursion's latency; the loop is compiled for the step's case
+    /// (coupled or not, Brownian noise or not) and plays whole pairs, so
+    /// no clock tests what the run holds fixed or which half it is.
     #[inline(always)]
     pub fn steps<X>(
+        &mut self,
+        forces: &[(f64, f64)],
+        seen: &mut [X],
+        sense: impl FnMut(usize, [f64; 4]) -> X,
+    ) {
+        match (self.coupled, self.thermal.is_some()) {
+            (true, false) => self.steps_as::<true, false, X>(forces, seen, sense),
+            (false, false) => self.steps_as::<false, false, X>(forces, seen, sense),
+            (true, true) => self.steps_as::<true, true, X>(forces, seen, sense),
+            (false, true) => self.steps_as::<false, true, X>(forces, seen, sense),
+        }
+    }
+
+    /// `steps` with `COUPLED` = `self.coupled` and `THERMAL` =
+    /// `self.thermal.is_some()`: a pair begun before the run finished
+    /// first, then whole pairs (`pair_step`'s two halves in turn, its
+    /// operations in its order), then a pair begun at the run's end.
+    #[inline(always)]
+    fn steps_as<const COUPLED: bool, const THERMAL: bool, X>(
         &mut self,
         forces: &[(f64, f64)],
         seen: &mut [X],
         mut sense: impl FnMut(usize, [f64; 4]) -> X,
     ) {
         debug_assert_eq!(forces.len(), seen.len());
-        let (mut s, mut half) = (self.s, self.half);
-        for (t, (&(f1, f2), x)) in forces.iter().zip(seen).enumerate() {
-            *x = sense(t, [s[0], s[1] * self.wr, s[2], s[3] * self.wr]);
-            let u = self.input(f1, f2);
-            (s, half) = pair_step(&self.cur, self.coupled, s, half, u);
+        debug_assert_eq!((COUPLED, THERMAL), (self.coupled, self.thermal.is_some()));
+        let Self {
+            cur: d,
+            thermal,
+            wr,
+            s: state,
+            half: held,
+            ..
+        } = self;
+        let wr = *wr;
+        let mut input = |(f1, f2): (f64, f64)| {
+            let thermal = if THERMAL { thermal.as_mut() } else { None };
+            input_term(d, COUPLED, thermal, f1, f2)
+        };
+        let scaled = |s: [f64; 4]| [s[0], s[1] * wr, s[2], s[3] * wr];
+        let (mut s, mut half) = (*state, *held);
+        let n = forces.len();
+        let mut t = 0;
+        if half.is_some() && n > 0 {
+            seen[0] = sense(0, scaled(s));
+            (s, half) = pair_step(d, COUPLED, s, half, input(forces[0]));
+            t = 1;
         }
-        (self.s, self.half) = (s, half);
+        while t + 2 <= n {
+            seen[t] = sense(t, scaled(s));
+            let first = input(forces[t]);
+            let p = times(&d.phi_by, s, COUPLED);
+            let mid: [f64; 4] = std::array::from_fn(|i| first[i] + p[i]);
+            seen[t + 1] = sense(t + 1, scaled(mid));
+            let u = input(forces[t + 1]);
+            let carried = times(&d.phi_by, first, COUPLED);
+            let p = times(&d.phi2_by, s, COUPLED);
+            s = std::array::from_fn(|i| (carried[i] + u[i]) + p[i]);
+            t += 2;
+        }
+        if t < n {
+            seen[t] = sense(t, scaled(s));
+            (s, half) = pair_step(d, COUPLED, s, half, input(forces[t]));
+        }
+        (*state, *held) = (s, half);
     }
 
     /// The input term of a clock, `Gamma f` plus the Brownian increment
     /// when on.
     #[inline(always)]
     fn input(&mut self, f1: f64, f2: f64) -> [f64; 4] {
-        let d = &self.cur;
-        let mut u: [f64; 4] = if self.coupled {
-            let [g1, g2] = &d.gamma_by;
-            std::array::from_fn(|i| g1[i] * f1 + g2[i] * f2)
-        } else {
-            let f = [f1, f1, f2, f2];
-            std::array::from_fn(|i| d.gamma_diagonal[i] * f[i])
-        };
-        if let Some((_, source)) = &mut self.thermal {
-            for (u, w) in u.iter_mut().zip(source.sample()) {
-                *u += w;
-            }
-        }
-        u
+        input_term(&self.cur, self.coupled, self.thermal.as_mut(), f1, f2)
     }
 
     /// Position of mode 1 at the current clock edge (m).

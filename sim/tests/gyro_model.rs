@@ -532,8 +532,8 @@ fn state_round_trip_reset_and_rate_cache() {
 /// `steps` is `step` clock by clock, bit for bit: the state it senses at
 /// each edge and the state after the run, over runs of odd and even
 /// length (the pairs of `step` run across them), coupled and not, with
-/// thermal noise, the rate and the state changed between runs (which
-/// start a new pair in both).
+/// thermal noise and without (each its own loop in `steps`), the rate and
+/// the state changed between runs (which start a new pair in both).
 #[test]
 fn steps_are_the_steps_clock_by_clock() {
     use gyrocal_sim::noise::ThermalNoise;
@@ -543,11 +543,11 @@ fn steps_are_the_steps_clock_by_clock() {
         seed: 9,
     };
     let p = params(1.0e6, 1.0003e6, 3000.0, 2500.0, 0.8);
-    for omz in [0.0, 2.0] {
-        let mut a = GyroModel::new(&p, 10.0e6)
-            .expect("valid")
-            .with_thermal_noise(&noise)
-            .expect("valid noise");
+    for (omz, thermal) in [(0.0, false), (2.0, false), (0.0, true), (2.0, true)] {
+        let mut a = GyroModel::new(&p, 10.0e6).expect("valid");
+        if thermal {
+            a = a.with_thermal_noise(&noise).expect("valid noise");
+        }
         a.set_rate(omz);
         let mut b = a.clone();
         let mut k = 0.0f64;
@@ -561,10 +561,12 @@ fn steps_are_the_steps_clock_by_clock() {
             let mut seen = vec![[0.0; 4]; len];
             a.steps(&forces, &mut seen, |_, s| s);
             for (n, &(f1, f2)) in forces.iter().enumerate() {
-                assert_eq!(seen[n], b.state(), "rate {omz}, run {i}, clock {n}");
+                let at = format!("rate {omz}, thermal {thermal}, run {i}, clock {n}");
+                assert_eq!(seen[n], b.state(), "{at}");
                 b.step(f1, f2);
             }
-            assert_eq!(a.state(), b.state(), "rate {omz}, after run {i}");
+            let at = format!("rate {omz}, thermal {thermal}, after run {i}");
+            assert_eq!(a.state(), b.state(), "{at}");
             match i {
                 3 => {
                     a.set_rate(omz + 1.0);
