@@ -117,6 +117,22 @@ impl Analog {
         });
     }
 
+    /// `advance_under` on `a` and `b` without a `beside`, their
+    /// gyroscopes' clocks in one loop (`GyroModel::steps_abreast`).
+    #[inline(always)]
+    fn advance_abreast(a: &mut Analog, b: &mut Analog, forces: &[(f64, f64)]) {
+        let (pa, pb) = (a.phase, b.phase);
+        let seen = (a.pending.next(forces.len()), b.pending.next(forces.len()));
+        GyroModel::steps_abreast(
+            &mut a.gyro,
+            &mut b.gyro,
+            forces,
+            seen,
+            |_, s| sense(pa, s),
+            |_, s| sense(pb, s),
+        );
+    }
+
     /// The ADC words of the edges advanced, with their standard normal
     /// draws `noise` (two a clock).
     #[inline(always)]
@@ -229,7 +245,8 @@ impl<W: FnMut(usize, &[Words])> AnalogLanes for Lanes<'_, W> {
     }
 
     /// The forces once, from the first lane's converters; every lane's
-    /// gyroscope under them, `beside` beside the first's.
+    /// gyroscope under them, `beside` beside the first's, the others two
+    /// by two (`GyroModel::steps_abreast`).
     #[inline(always)]
     fn advance_block(&mut self, dac: impl Iterator<Item = Words>, beside: impl FnMut(usize)) {
         let (lead, rest) = self
@@ -239,8 +256,12 @@ impl<W: FnMut(usize, &[Words])> AnalogLanes for Lanes<'_, W> {
         let mut forces = std::mem::take(&mut lead.forces);
         lead.converters.forces_block(dac, &mut forces);
         lead.advance_under(&forces, beside);
-        for analog in rest {
-            analog.advance_under(&forces, |_| {});
+        for two in rest.chunks_mut(2) {
+            match two {
+                [a, b] => Analog::advance_abreast(a, b, &forces),
+                [a] => a.advance_under(&forces, |_| {}),
+                _ => unreachable!("chunks of one or two"),
+            }
         }
         lead.forces = forces;
     }

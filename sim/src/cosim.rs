@@ -421,9 +421,10 @@ mod tests {
         }
     }
 
-    /// Lanes play what each point's `CoSim` plays alone: three rates on a
+    /// Lanes play what each point's `CoSim` plays alone: six rates on a
     /// calibration and a readout point (ADC noise on, so the lanes' shared
-    /// draws must be each one's own), runs of lengths around a block's,
+    /// draws must be each one's own; the lanes after the first abreast two
+    /// by two, one pair coupled and uncoupled, the last alone), runs of lengths around a block's,
     /// compiled for every instruction set this processor runs; every z at
     /// the same cycle and the same gyroscope state after each run. The
     /// rates' z differ (else the lanes could be mixed up unseen).
@@ -432,7 +433,7 @@ mod tests {
         let exp = Experiment::paper();
         let plan = plan(&exp).unwrap();
         use crate::experiment::Mode;
-        let rates = [0.3, -0.1, 0.05];
+        let rates = [0.3, -0.1, 0.05, 0.0, 0.2, -0.4];
         for (mode, isa) in [Mode::Calibration, Mode::Readout]
             .into_iter()
             .flat_map(|m| Isa::supported_all().into_iter().map(move |i| (m, i)))

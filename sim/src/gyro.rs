@@ -510,6 +510,101 @@ impl GyroModel {
         (*state, *held) = (s, half);
     }
 
+    /// `a.steps(forces, seen_a, sense_a)` and `b.steps(forces, seen_b,
+    /// sense_b)` (two lanes of a rate table under the same forces), their
+    /// whole pairs in one loop where both take the same one (both coupled
+    /// or both not, neither with Brownian noise, at the same half of a
+    /// pair): one recursion's latency leaves the units idle that the
+    /// other's operations then fill. Each model's operations are its own,
+    /// in its own order, so each ends where its own `steps` leaves it, bit
+    /// for bit; in any other case the two run one after the other.
+    #[inline(always)]
+    pub fn steps_abreast<X, Y>(
+        a: &mut Self,
+        b: &mut Self,
+        forces: &[(f64, f64)],
+        (seen_a, seen_b): (&mut [X], &mut [Y]),
+        sense_a: impl FnMut(usize, [f64; 4]) -> X,
+        sense_b: impl FnMut(usize, [f64; 4]) -> Y,
+    ) {
+        let alike = a.coupled == b.coupled
+            && a.thermal.is_none()
+            && b.thermal.is_none()
+            && a.half.is_some() == b.half.is_some();
+        match (alike, a.coupled) {
+            (true, true) => {
+                Self::abreast_as::<true, X, Y>(a, b, forces, (seen_a, seen_b), sense_a, sense_b)
+            }
+            (true, false) => {
+                Self::abreast_as::<false, X, Y>(a, b, forces, (seen_a, seen_b), sense_a, sense_b)
+            }
+            (false, _) => {
+                a.steps(forces, seen_a, sense_a);
+                b.steps(forces, seen_b, sense_b);
+            }
+        }
+    }
+
+    /// `steps_abreast` where both take `steps_as::<COUPLED, false>`: the
+    /// pair begun before the run finished on each, then whole pairs of
+    /// both, then a pair begun at the run's end on each.
+    #[inline(always)]
+    fn abreast_as<const COUPLED: bool, X, Y>(
+        a: &mut Self,
+        b: &mut Self,
+        forces: &[(f64, f64)],
+        (seen_a, seen_b): (&mut [X], &mut [Y]),
+        mut sense_a: impl FnMut(usize, [f64; 4]) -> X,
+        mut sense_b: impl FnMut(usize, [f64; 4]) -> Y,
+    ) {
+        let n = forces.len();
+        debug_assert!(seen_a.len() == n && seen_b.len() == n);
+        let lead = usize::from(a.half.is_some()).min(n);
+        let whole = lead + (n - lead) / 2 * 2;
+        let (da, db) = (&a.cur, &b.cur);
+        let (wa, wb) = (a.wr, b.wr);
+        let scaled = |s: [f64; 4], wr: f64| [s[0], s[1] * wr, s[2], s[3] * wr];
+        let input = |d: &Discrete, (f1, f2): (f64, f64)| input_term(d, COUPLED, None, f1, f2);
+        let (mut sa, mut ha, mut sb, mut hb) = (a.s, a.half, b.s, b.half);
+        let mut t = 0;
+        while t < n {
+            if t >= lead && t < whole {
+                // Whole pairs.
+                seen_a[t] = sense_a(t, scaled(sa, wa));
+                seen_b[t] = sense_b(t, scaled(sb, wb));
+                let (fa, fb) = (input(da, forces[t]), input(db, forces[t]));
+                let (pa, pb) = (
+                    times(&da.phi_by, sa, COUPLED),
+                    times(&db.phi_by, sb, COUPLED),
+                );
+                let ma: [f64; 4] = std::array::from_fn(|i| fa[i] + pa[i]);
+                let mb: [f64; 4] = std::array::from_fn(|i| fb[i] + pb[i]);
+                seen_a[t + 1] = sense_a(t + 1, scaled(ma, wa));
+                seen_b[t + 1] = sense_b(t + 1, scaled(mb, wb));
+                let (ua, ub) = (input(da, forces[t + 1]), input(db, forces[t + 1]));
+                let (ca, cb) = (
+                    times(&da.phi_by, fa, COUPLED),
+                    times(&db.phi_by, fb, COUPLED),
+                );
+                let (qa, qb) = (
+                    times(&da.phi2_by, sa, COUPLED),
+                    times(&db.phi2_by, sb, COUPLED),
+                );
+                sa = std::array::from_fn(|i| (ca[i] + ua[i]) + qa[i]);
+                sb = std::array::from_fn(|i| (cb[i] + ub[i]) + qb[i]);
+                t += 2;
+                continue;
+            }
+            // A half pair on each: before the whole pairs or after them.
+            seen_a[t] = sense_a(t, scaled(sa, wa));
+            (sa, ha) = pair_step(da, COUPLED, sa, ha, input(da, forces[t]));
+            seen_b[t] = sense_b(t, scaled(sb, wb));
+            (sb, hb) = pair_step(db, COUPLED, sb, hb, input(db, forces[t]));
+            t += 1;
+        }
+        (a.s, a.half, b.s, b.half) = (sa, ha, sb, hb);
+    }
+
     /// The input term of a clock, `Gamma f` plus the Brownian increment
     /// when on.
     #[inline(always)]

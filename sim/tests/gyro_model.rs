@@ -529,6 +529,23 @@ fn state_round_trip_reset_and_rate_cache() {
     assert_eq!(g.rate(), 0.0);
 }
 
+/// The device the block tests step (`steps`, `steps_abreast`) at rate
+/// `omz`, with thermal noise of seed `noise_seed` when given.
+fn stepped_model(omz: f64, noise_seed: Option<u64>) -> GyroModel {
+    let p = params(1.0e6, 1.0003e6, 3000.0, 2500.0, 0.8);
+    let mut g = GyroModel::new(&p, 10.0e6).expect("valid");
+    if let Some(seed) = noise_seed {
+        let noise = gyrocal_sim::noise::ThermalNoise {
+            mass_kg: 1.0e-9,
+            temperature_k: 300.0,
+            seed,
+        };
+        g = g.with_thermal_noise(&noise).expect("valid noise");
+    }
+    g.set_rate(omz);
+    g
+}
+
 /// `steps` is `step` clock by clock, bit for bit: the state it senses at
 /// each edge and the state after the run, over runs of odd and even
 /// length (the pairs of `step` run across them), coupled and not, with
@@ -536,19 +553,8 @@ fn state_round_trip_reset_and_rate_cache() {
 /// the state changed between runs (which start a new pair in both).
 #[test]
 fn steps_are_the_steps_clock_by_clock() {
-    use gyrocal_sim::noise::ThermalNoise;
-    let noise = ThermalNoise {
-        mass_kg: 1.0e-9,
-        temperature_k: 300.0,
-        seed: 9,
-    };
-    let p = params(1.0e6, 1.0003e6, 3000.0, 2500.0, 0.8);
     for (omz, thermal) in [(0.0, false), (2.0, false), (0.0, true), (2.0, true)] {
-        let mut a = GyroModel::new(&p, 10.0e6).expect("valid");
-        if thermal {
-            a = a.with_thermal_noise(&noise).expect("valid noise");
-        }
-        a.set_rate(omz);
+        let mut a = stepped_model(omz, thermal.then_some(9));
         let mut b = a.clone();
         let mut k = 0.0f64;
         for (i, len) in [1usize, 2, 3, 256, 7, 1, 1, 100, 5].into_iter().enumerate() {
@@ -584,6 +590,61 @@ fn steps_are_the_steps_clock_by_clock() {
             a.state().iter().any(|&x| x != 0.0),
             "the runs moved the state"
         );
+    }
+}
+
+/// Two models stepped abreast (`GyroModel::steps_abreast`) are each one
+/// stepped alone, bit for bit: coupled, uncoupled and one of each (which
+/// run one after the other), with thermal noise on one (likewise), over
+/// runs of odd and even length so that both start pairs and halves, and
+/// with the rate changed between runs on one model only (its pair starts
+/// again where the other's runs on: halves not aligned, one after the
+/// other).
+#[test]
+fn steps_abreast_are_each_ones_own_steps() {
+    let cases = [
+        (0.5, -1.5, false),
+        (0.0, 0.0, false),
+        (0.0, 2.0, false),
+        (1.0, 0.7, true),
+    ];
+    for (rate_a, rate_b, thermal) in cases {
+        let (mut a, mut b) = (
+            stepped_model(rate_a, None),
+            stepped_model(rate_b, thermal.then_some(5)),
+        );
+        let (mut alone_a, mut alone_b) = (a.clone(), b.clone());
+        let mut k = 0.0f64;
+        for (i, len) in [1usize, 2, 3, 256, 7, 1, 100, 5, 4].into_iter().enumerate() {
+            let forces: Vec<(f64, f64)> = (0..len)
+                .map(|_| {
+                    k += 1.0;
+                    ((0.29 * k).sin() * 1e3, (0.13 * k).cos() * 1e3)
+                })
+                .collect();
+            let (mut seen_a, mut seen_b) = (vec![[0.0; 4]; len], vec![[0.0; 4]; len]);
+            GyroModel::steps_abreast(
+                &mut a,
+                &mut b,
+                &forces,
+                (&mut seen_a, &mut seen_b),
+                |_, s| s,
+                |_, s| s,
+            );
+            let (mut want_a, mut want_b) = (vec![[0.0; 4]; len], vec![[0.0; 4]; len]);
+            alone_a.steps(&forces, &mut want_a, |_, s| s);
+            alone_b.steps(&forces, &mut want_b, |_, s| s);
+            let at = format!("rates {rate_a}, {rate_b}, thermal {thermal}, run {i}");
+            assert_eq!(seen_a, want_a, "{at}: a's edges");
+            assert_eq!(seen_b, want_b, "{at}: b's edges");
+            assert_eq!(a.state(), alone_a.state(), "{at}: a after");
+            assert_eq!(b.state(), alone_b.state(), "{at}: b after");
+            if i == 4 {
+                a.set_rate(rate_a + 0.25);
+                alone_a.set_rate(rate_a + 0.25);
+            }
+        }
+        assert!(a.state().iter().chain(&b.state()).all(|&x| x != 0.0));
     }
 }
 
