@@ -129,16 +129,27 @@ fn pair_step(
     u: [f64; 4],
 ) -> ([f64; 4], Half) {
     match half {
-        None => {
-            let p = times(&d.phi_by, s, coupled);
-            (std::array::from_fn(|i| u[i] + p[i]), Some((s, u)))
-        }
-        Some((before, first)) => {
-            let carried = times(&d.phi_by, first, coupled);
-            let p = times(&d.phi2_by, before, coupled);
-            (std::array::from_fn(|i| (carried[i] + u[i]) + p[i]), None)
-        }
+        None => (pair_mid(d, coupled, s, u), Some((s, u))),
+        Some((before, first)) => (pair_end(d, coupled, before, first, u), None),
     }
+}
+
+/// The state after a pair's first clock from the state `s` with its
+/// input term `first`: `first + Phi s`.
+#[inline(always)]
+fn pair_mid(d: &Discrete, coupled: bool, s: [f64; 4], first: [f64; 4]) -> [f64; 4] {
+    let p = times(&d.phi_by, s, coupled);
+    std::array::from_fn(|i| first[i] + p[i])
+}
+
+/// The state after a whole pair from the state `s` before it, with its
+/// clocks' input terms `first` and `u`: `(Phi first + u) + Phi^2 s`, the
+/// recursion's latency one product from `s` for two clocks.
+#[inline(always)]
+fn pair_end(d: &Discrete, coupled: bool, s: [f64; 4], first: [f64; 4], u: [f64; 4]) -> [f64; 4] {
+    let carried = times(&d.phi_by, first, coupled);
+    let p = times(&d.phi2_by, s, coupled);
+    std::array::from_fn(|i| (carried[i] + u[i]) + p[i])
 }
 
 /// `m v`, with the products of exact zeros skipped when the modes are
@@ -494,13 +505,9 @@ impl GyroModel {
         while t + 2 <= n {
             seen[t] = sense(t, scaled(s));
             let first = input(forces[t]);
-            let p = times(&d.phi_by, s, COUPLED);
-            let mid: [f64; 4] = std::array::from_fn(|i| first[i] + p[i]);
-            seen[t + 1] = sense(t + 1, scaled(mid));
+            seen[t + 1] = sense(t + 1, scaled(pair_mid(d, COUPLED, s, first)));
             let u = input(forces[t + 1]);
-            let carried = times(&d.phi_by, first, COUPLED);
-            let p = times(&d.phi2_by, s, COUPLED);
-            s = std::array::from_fn(|i| (carried[i] + u[i]) + p[i]);
+            s = pair_end(d, COUPLED, s, first, u);
             t += 2;
         }
         if t < n {
@@ -573,25 +580,12 @@ impl GyroModel {
                 seen_a[t] = sense_a(t, scaled(sa, wa));
                 seen_b[t] = sense_b(t, scaled(sb, wb));
                 let (fa, fb) = (input(da, forces[t]), input(db, forces[t]));
-                let (pa, pb) = (
-                    times(&da.phi_by, sa, COUPLED),
-                    times(&db.phi_by, sb, COUPLED),
-                );
-                let ma: [f64; 4] = std::array::from_fn(|i| fa[i] + pa[i]);
-                let mb: [f64; 4] = std::array::from_fn(|i| fb[i] + pb[i]);
+                let (ma, mb) = (pair_mid(da, COUPLED, sa, fa), pair_mid(db, COUPLED, sb, fb));
                 seen_a[t + 1] = sense_a(t + 1, scaled(ma, wa));
                 seen_b[t + 1] = sense_b(t + 1, scaled(mb, wb));
                 let (ua, ub) = (input(da, forces[t + 1]), input(db, forces[t + 1]));
-                let (ca, cb) = (
-                    times(&da.phi_by, fa, COUPLED),
-                    times(&db.phi_by, fb, COUPLED),
-                );
-                let (qa, qb) = (
-                    times(&da.phi2_by, sa, COUPLED),
-                    times(&db.phi2_by, sb, COUPLED),
-                );
-                sa = std::array::from_fn(|i| (ca[i] + ua[i]) + qa[i]);
-                sb = std::array::from_fn(|i| (cb[i] + ub[i]) + qb[i]);
+                sa = pair_end(da, COUPLED, sa, fa, ua);
+                sb = pair_end(db, COUPLED, sb, fb, ub);
                 t += 2;
                 continue;
             }
