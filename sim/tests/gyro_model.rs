@@ -529,6 +529,18 @@ fn state_round_trip_reset_and_rate_cache() {
     assert_eq!(g.rate(), 0.0);
 }
 
+/// `len` forces for the block tests, each clock's from the count `k` of
+/// clocks so far (moved on by `len`): two incommensurate sinusoids, so
+/// that no two clocks' forces repeat.
+fn block_forces(k: &mut f64, len: usize) -> Vec<(f64, f64)> {
+    (0..len)
+        .map(|_| {
+            *k += 1.0;
+            ((0.37 * *k).sin() * 1e3, (0.11 * *k).cos() * 1e3)
+        })
+        .collect()
+}
+
 /// The device the block tests step (`steps`, `steps_abreast`) at rate
 /// `omz`, with thermal noise of seed `noise_seed` when given.
 fn stepped_model(omz: f64, noise_seed: Option<u64>) -> GyroModel {
@@ -558,12 +570,7 @@ fn steps_are_the_steps_clock_by_clock() {
         let mut b = a.clone();
         let mut k = 0.0f64;
         for (i, len) in [1usize, 2, 3, 256, 7, 1, 1, 100, 5].into_iter().enumerate() {
-            let forces: Vec<(f64, f64)> = (0..len)
-                .map(|_| {
-                    k += 1.0;
-                    ((0.37 * k).sin() * 1e3, (0.11 * k).cos() * 1e3)
-                })
-                .collect();
+            let forces = block_forces(&mut k, len);
             let mut seen = vec![[0.0; 4]; len];
             a.steps(&forces, &mut seen, |_, s| s);
             for (n, &(f1, f2)) in forces.iter().enumerate() {
@@ -616,12 +623,7 @@ fn steps_abreast_are_each_ones_own_steps() {
         let (mut alone_a, mut alone_b) = (a.clone(), b.clone());
         let mut k = 0.0f64;
         for (i, len) in [1usize, 2, 3, 256, 7, 1, 100, 5, 4].into_iter().enumerate() {
-            let forces: Vec<(f64, f64)> = (0..len)
-                .map(|_| {
-                    k += 1.0;
-                    ((0.29 * k).sin() * 1e3, (0.13 * k).cos() * 1e3)
-                })
-                .collect();
+            let forces = block_forces(&mut k, len);
             let (mut seen_a, mut seen_b) = (vec![[0.0; 4]; len], vec![[0.0; 4]; len]);
             GyroModel::steps_abreast(
                 &mut a,

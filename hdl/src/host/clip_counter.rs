@@ -195,9 +195,6 @@ mod tests {
         assert!(model.count() < u16::MAX, "cleared at the end");
     }
 
-    /// Both rail codes of every converter from `MIN_CONVERTER_BITS` to 16
-    /// bits are counted, and exactly the words within 1/128 of full
-    /// scale are.
     /// `steps` over a stretch of words is `step` without a clear at each:
     /// stretches of every length up to 70,000 words, rail-heavy and not,
     /// from counts anywhere (near the top too), so that some saturate.
@@ -237,6 +234,9 @@ mod tests {
         }
     }
 
+    /// Both rail codes of every converter from `MIN_CONVERTER_BITS` to 16
+    /// bits are counted, and exactly the words within 1/128 of full
+    /// scale are.
     #[test]
     fn every_converters_rails_are_counted() {
         for bits in MIN_CONVERTER_BITS..=16 {

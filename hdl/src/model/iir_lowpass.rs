@@ -191,7 +191,6 @@ impl IirLowpass {
     /// `(z1, z2, z_valid)` after the edge.
     #[inline(always)]
     pub fn step(&mut self, x: (i64, i64), x_valid: bool, k: &Coefficients) -> (i64, i64, bool) {
-        let address = physical_address;
         if self.idle() && !x_valid {
             // Idle: word 0 does nothing that a schedule reads back.
             self.z_valid = false;
@@ -200,7 +199,7 @@ impl IirLowpass {
         let w: MicroWord = self.words[self.word];
         let accept = self.pc == 0 && x_valid;
         // Values at the rising edge, all from the current registers.
-        let ram_q = self.ram[address(w.read, self.base)];
+        let ram_q = self.ram[physical_address(w.read, self.base)];
         let digit = self.acc & DIGIT_MASK;
         let top_digit = wrap(self.acc, DIGIT_BITS);
         match w.emit {
@@ -215,7 +214,7 @@ impl IirLowpass {
                     Emit::TopDigit => top_digit,
                     _ => self.input_digit(w.x_select),
                 };
-                self.ram[address(w.write, self.base)] = value as i16;
+                self.ram[physical_address(w.write, self.base)] = value as i16;
             }
         }
         let p = self.p;
